@@ -1,0 +1,100 @@
+//! Fixed-point quantities. G-code and job-file numbers are parsed into
+//! [`Milli`] (thousandths of a unit: µm or millidegrees) so no float is
+//! needed between the text and the step count.
+
+/// A length in µm or an angle in millidegrees: thousandths of the axis unit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Milli(pub i32);
+
+impl Milli {
+    pub const ZERO: Milli = Milli(0);
+    /// Scale of the fixed point: 1 unit = 1000 milli.
+    pub const SCALE: i32 = 1000;
+
+    pub const fn from_units(units: i32) -> Milli {
+        Milli(units * Self::SCALE)
+    }
+
+    pub fn to_f32(self) -> f32 {
+        self.0 as f32 / Self::SCALE as f32
+    }
+}
+
+/// Steps per axis unit as an exact ratio `num / den` (e.g. the drill's
+/// 1600 steps per 12 mm, which is not a whole number per mm).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StepsPerUnit {
+    pub num: u32,
+    pub den: u32,
+}
+
+impl StepsPerUnit {
+    pub const fn new(num: u32, den: u32) -> Self {
+        StepsPerUnit { num, den }
+    }
+
+    /// Absolute step position of an absolute target, rounded once, half
+    /// away from zero. Converting from the absolute target (never adding
+    /// rounded relative moves) is what keeps positions from drifting.
+    pub fn steps(self, target: Milli) -> i32 {
+        let n = target.0 as i64 * self.num as i64;
+        let d = self.den as i64 * Milli::SCALE as i64;
+        div_round(n, d) as i32
+    }
+
+    /// The position of a step count, rounded to the nearest milli-unit.
+    pub fn milli(self, steps: i32) -> Milli {
+        let n = steps as i64 * self.den as i64 * Milli::SCALE as i64;
+        Milli(div_round(n, self.num as i64) as i32)
+    }
+
+    pub fn as_f32(self) -> f32 {
+        self.num as f32 / self.den as f32
+    }
+}
+
+/// `n / d` rounded half away from zero; `d > 0`.
+pub fn div_round(n: i64, d: i64) -> i64 {
+    if n >= 0 {
+        (n + d / 2) / d
+    } else {
+        -((-n + d / 2) / d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn one_degree_steps_accumulate_exactly() {
+        let base = StepsPerUnit::new(9600, 360);
+        let mut target = Milli::ZERO;
+        for _ in 0..360 {
+            target.0 += 1000;
+        }
+        assert_eq!(base.steps(target), 9600);
+        assert_eq!(base.steps(Milli(1000)), 27); // 26.67 rounds to 27
+    }
+
+    #[test]
+    fn drill_non_integer_steps_per_mm() {
+        let drill = StepsPerUnit::new(1600, 12);
+        assert_eq!(drill.steps(Milli(12_000)), 1600);
+        assert_eq!(drill.steps(Milli(-10_000)), -1333);
+        assert_eq!(drill.steps(Milli(10_386)), 1385); // 1384.8
+    }
+
+    proptest! {
+        #[test]
+        fn round_trip_within_half_step(m in -2_000_000i32..2_000_000, num in 1u32..20000, den in 1u32..400) {
+            let s = StepsPerUnit::new(num, den);
+            let steps = s.steps(Milli(m));
+            let back = s.milli(steps);
+            // back is the position of the rounded step: within half a step of m.
+            let half_step_milli = (den as f64 * 1000.0) / (2.0 * num as f64) + 1.0;
+            prop_assert!(((back.0 - m) as f64).abs() <= half_step_milli);
+        }
+    }
+}
