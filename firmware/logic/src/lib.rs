@@ -1,5 +1,10 @@
 //! The pure logic of taut: everything that can be computed without touching
 //! hardware. `no_std`, no heap; unit- and property-tested on the host.
+//!
+//! The data's path, Grbl-style: text (`gcode`, `job`) → targets in steps
+//! (`kinematics`, `units`) → `planner` (look-ahead) → `segment` (timed step
+//! runs the step interrupt executes). `sched` is the task dispatcher's logic;
+//! `stringart` the string-art job.
 #![no_std]
 #![forbid(unsafe_code)]
 
@@ -8,4 +13,13 @@ extern crate std;
 
 pub mod axis;
 pub mod config;
+pub mod gcode;
+pub mod geometry;
+pub mod job;
+pub mod kinematics;
+pub mod planner;
+pub mod sched;
+pub mod segment;
+pub mod settings;
+pub mod stringart;
 pub mod units;
