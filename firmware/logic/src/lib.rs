@@ -17,6 +17,7 @@ pub mod gcode;
 pub mod geometry;
 pub mod job;
 pub mod kinematics;
+pub mod pinmap;
 pub mod planner;
 pub mod sched;
 pub mod segment;
