@@ -67,8 +67,8 @@ impl Port {
 /// Pins D0..D69 of the Mega (A0..A15 are D54..D69), as printed on the board.
 pub const PIN_COUNT: u8 = 70;
 
-#[rustfmt::skip]
 use Port::*;
+#[rustfmt::skip]
 const MEGA: [(Port, u8); PIN_COUNT as usize] = [
     (E, 0), (E, 1), (E, 4), (E, 5), (G, 5), (E, 3), (H, 3), (H, 4), // D0-D7
     (H, 5), (H, 6), (B, 4), (B, 5), (B, 6), (B, 7), (J, 1), (J, 0), // D8-D15
