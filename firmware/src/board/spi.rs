@@ -1,0 +1,84 @@
+//! Hardware SPI master on Mega pins 50 (MISO), 51 (MOSI), 52 (SCK), 53 (SS,
+//! the SD card's chip select). Starts slow (125 kHz, as SD cards require for
+//! initialisation) and switches to 8 MHz with [`Spi::full_speed`].
+
+use super::gpio::{Floating, Output, Pin};
+use avr_device::atmega2560::SPI;
+use core::convert::Infallible;
+
+pub struct Spi {
+    spi: SPI,
+}
+
+impl Spi {
+    /// SS (D53) must be an output for the SPI to stay in master mode.
+    pub fn start(
+        spi: SPI,
+        _sck: Pin<52, Output>,
+        _mosi: Pin<51, Output>,
+        _miso: Pin<50, Floating>,
+        _ss: &Pin<53, Output>,
+    ) -> Spi {
+        spi.spcr().write(|w| w.spe().set_bit().mstr().set_bit().spr().fosc_128_64());
+        spi.spsr().write(|w| w.spi2x().clear_bit());
+        Spi { spi }
+    }
+
+    pub fn slow_speed(&mut self) {
+        self.spi.spcr().modify(|_, w| w.spr().fosc_128_64());
+        self.spi.spsr().write(|w| w.spi2x().clear_bit());
+    }
+
+    /// f/2 = 8 MHz.
+    pub fn full_speed(&mut self) {
+        self.spi.spcr().modify(|_, w| w.spr().fosc_4_2());
+        self.spi.spsr().write(|w| w.spi2x().set_bit());
+    }
+
+    fn exchange(&mut self, out: u8) -> u8 {
+        self.spi.spdr().write(|w| unsafe { w.bits(out) });
+        while self.spi.spsr().read().spif().bit_is_clear() {}
+        self.spi.spdr().read().bits()
+    }
+}
+
+impl embedded_hal::spi::ErrorType for Spi {
+    type Error = Infallible;
+}
+
+impl embedded_hal::spi::SpiBus<u8> for Spi {
+    fn read(&mut self, words: &mut [u8]) -> Result<(), Infallible> {
+        for w in words {
+            *w = self.exchange(0xFF);
+        }
+        Ok(())
+    }
+
+    fn write(&mut self, words: &[u8]) -> Result<(), Infallible> {
+        for &w in words {
+            self.exchange(w);
+        }
+        Ok(())
+    }
+
+    fn transfer(&mut self, read: &mut [u8], write: &[u8]) -> Result<(), Infallible> {
+        for i in 0..read.len().max(write.len()) {
+            let b = self.exchange(write.get(i).copied().unwrap_or(0xFF));
+            if let Some(r) = read.get_mut(i) {
+                *r = b;
+            }
+        }
+        Ok(())
+    }
+
+    fn transfer_in_place(&mut self, words: &mut [u8]) -> Result<(), Infallible> {
+        for w in words {
+            *w = self.exchange(*w);
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> Result<(), Infallible> {
+        Ok(())
+    }
+}

@@ -1,0 +1,140 @@
+//! Logging over the serial console: `error!`, `warn!`, `info!`, `debug!`.
+//!
+//! `info!("nail ", i, " of ", n)`: string literals are stored in flash (they
+//! would otherwise cost SRAM for the firmware's whole life), other arguments
+//! are printed with `ufmt`. Each line reads `[I 1234 module] text`: level,
+//! milliseconds since boot, module. Brackets make Grbl-style senders treat it
+//! as a message, not a reply. A line is formatted on the stack and queued
+//! whole; when the TX ring has no room it is dropped and counted, and the
+//! count is reported on the next line that fits. Levels below `MAX_LEVEL`
+//! (cargo feature `log-debug` lowers it) compile to nothing.
+
+use crate::board::{clock, flash::FlashStr, usart};
+use core::cell::Cell;
+use avr_device::interrupt::Mutex;
+
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Level {
+    Error = 0,
+    Warn = 1,
+    Info = 2,
+    Debug = 3,
+}
+
+pub const MAX_LEVEL: Level = if cfg!(feature = "log-debug") { Level::Debug } else { Level::Info };
+
+/// Longest line; longer ones are cut and end in `~`.
+const LINE: usize = 96;
+
+static DROPPED: Mutex<Cell<u16>> = Mutex::new(Cell::new(0));
+
+/// Lines dropped because the TX ring was full, since boot.
+pub fn dropped() -> u16 {
+    avr_device::interrupt::free(|cs| DROPPED.borrow(cs).get())
+}
+
+pub struct Line {
+    buf: heapless::Vec<u8, LINE>,
+    cut: bool,
+}
+
+impl ufmt::uWrite for Line {
+    type Error = core::convert::Infallible;
+    fn write_str(&mut self, s: &str) -> Result<(), Self::Error> {
+        for &b in s.as_bytes() {
+            if self.buf.push(b).is_err() {
+                self.cut = true;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Line {
+    pub fn new(level: Level, module: FlashStr) -> Line {
+        let mut l = Line { buf: heapless::Vec::new(), cut: false };
+        let tag = [b'E', b'W', b'I', b'D'][level as usize];
+        let _ = ufmt::uwrite!(l, "[{} {} ", tag as char, clock::millis());
+        let _ = ufmt::uwrite!(l, "{}] ", module);
+        l
+    }
+
+    /// Queue the line, or count it as dropped.
+    pub fn emit(mut self) {
+        if self.cut {
+            self.buf.truncate(LINE - 2);
+            let _ = self.buf.push(b'~');
+        }
+        let _ = self.buf.push(b'\n');
+        let dropped = dropped();
+        if dropped > 0 {
+            let mut note = Line::new(Level::Warn, crate::flash_str!("log"));
+            let _ = ufmt::uwrite!(note, "{}{}\n", dropped, crate::flash_str!(" lines dropped"));
+            if note.buf.len() + self.buf.len() > usart::TX.free() {
+                return count_drop();
+            }
+            usart::send(&note.buf);
+            avr_device::interrupt::free(|cs| DROPPED.borrow(cs).set(0));
+        }
+        if !usart::send(&self.buf) {
+            count_drop();
+        }
+    }
+}
+
+fn count_drop() {
+    avr_device::interrupt::free(|cs| {
+        let d = DROPPED.borrow(cs);
+        d.set(d.get().saturating_add(1));
+    });
+}
+
+/// The module path without the crate name, at compile time, in flash.
+#[macro_export]
+#[doc(hidden)]
+macro_rules! __log_module {
+    () => {{
+        const FULL: &str = module_path!();
+        const SKIP: usize = if FULL.len() > 6 { 6 } else { 0 }; // "taut::"
+        const LEN: usize = FULL.len() - SKIP;
+        #[link_section = ".progmem.data"]
+        static S: [u8; LEN] = $crate::board::flash::bytes::<LEN>(FULL, SKIP);
+        // SAFETY: S is a progmem static of LEN bytes.
+        unsafe { $crate::board::flash::FlashStr::from_progmem(S.as_ptr(), LEN) }
+    }};
+}
+
+#[macro_export]
+#[doc(hidden)]
+macro_rules! __log_parts {
+    ($l:ident;) => {};
+    ($l:ident; $s:literal $(, $($rest:tt)*)?) => {
+        let _ = ufmt::uwrite!($l, "{}", $crate::flash_str!($s));
+        $crate::__log_parts!($l; $($($rest)*)?);
+    };
+    ($l:ident; $e:expr $(, $($rest:tt)*)?) => {
+        let _ = ufmt::uwrite!($l, "{}", $e);
+        $crate::__log_parts!($l; $($($rest)*)?);
+    };
+}
+
+#[macro_export]
+macro_rules! log {
+    ($level:expr, $($parts:tt)*) => {
+        if $level <= $crate::log::MAX_LEVEL {
+            #[allow(unused_mut)]
+            let mut line = $crate::log::Line::new($level, $crate::__log_module!());
+            $crate::__log_parts!(line; $($parts)*);
+            line.emit();
+        }
+    };
+}
+
+#[macro_export]
+macro_rules! error { ($($p:tt)*) => { $crate::log!($crate::log::Level::Error, $($p)*) }; }
+#[macro_export]
+macro_rules! warn { ($($p:tt)*) => { $crate::log!($crate::log::Level::Warn, $($p)*) }; }
+#[macro_export]
+macro_rules! info { ($($p:tt)*) => { $crate::log!($crate::log::Level::Info, $($p)*) }; }
+#[macro_export]
+macro_rules! debug { ($($p:tt)*) => { $crate::log!($crate::log::Level::Debug, $($p)*) }; }
