@@ -1,0 +1,220 @@
+//! The ready set: which spawned tasks wait to run, in dispatch order.
+
+use super::TaskId;
+
+/// The set of tasks waiting to run, for `N` tasks over `P` priority levels.
+///
+/// One intrusive FIFO list per level, linked through a per-task `next`
+/// slot: a task is pending at most once, so one link per task is all the
+/// storage needed (`N + 2P` task slots plus `N` flags, a few dozen bytes).
+/// `spawn` is O(1); `next` scans at most `P` level heads.
+pub struct Ready<T: TaskId, const N: usize, const P: usize> {
+    pending: [bool; N],
+    /// The task queued after this one at its level.
+    link: [Option<T>; N],
+    head: [Option<T>; P],
+    tail: [Option<T>; P],
+}
+
+impl<T: TaskId, const N: usize, const P: usize> Ready<T, N, P> {
+    pub const fn new() -> Self {
+        const {
+            assert!(N >= T::COUNT, "Ready: fewer task slots than tasks");
+            assert!(P > 0, "Ready: no priority level");
+        }
+        Ready {
+            pending: [false; N],
+            link: [None; N],
+            head: [None; P],
+            tail: [None; P],
+        }
+    }
+
+    /// Marks `task` ready behind the tasks already waiting at its priority.
+    /// Returns `false`, changing nothing, if it is already pending.
+    pub fn spawn(&mut self, task: T) -> bool {
+        let i = task.index();
+        if self.pending[i] {
+            return false;
+        }
+        self.pending[i] = true;
+        self.link[i] = None;
+        let level = task.priority() as usize;
+        match self.tail[level] {
+            None => self.head[level] = Some(task),
+            Some(last) => self.link[last.index()] = Some(task),
+        }
+        self.tail[level] = Some(task);
+        true
+    }
+
+    /// Takes the task to run now: the oldest spawn at the highest level.
+    pub fn next(&mut self) -> Option<T> {
+        for level in (0..P).rev() {
+            if let Some(task) = self.head[level] {
+                let i = task.index();
+                self.head[level] = self.link[i];
+                if self.head[level].is_none() {
+                    self.tail[level] = None;
+                }
+                self.pending[i] = false;
+                return Some(task);
+            }
+        }
+        None
+    }
+
+    pub fn is_pending(&self, task: T) -> bool {
+        self.pending[task.index()]
+    }
+
+    /// True when no task waits: the idle loop may sleep.
+    pub fn is_idle(&self) -> bool {
+        self.head.iter().all(Option::is_none)
+    }
+}
+
+impl<T: TaskId, const N: usize, const P: usize> Default for Ready<T, N, P> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_task::{tk, Tk};
+    use super::*;
+    use proptest::prelude::*;
+    use std::vec::Vec;
+
+    type R = Ready<Tk, 8, 4>;
+
+    fn drain(r: &mut R) -> Vec<u8> {
+        core::iter::from_fn(|| r.next()).map(|t| t.id).collect()
+    }
+
+    #[test]
+    fn higher_priority_runs_first() {
+        let mut r = R::new();
+        r.spawn(tk(0, 0));
+        r.spawn(tk(1, 2));
+        r.spawn(tk(2, 1));
+        r.spawn(tk(3, 3));
+        assert_eq!(drain(&mut r), [3, 1, 2, 0]);
+    }
+
+    #[test]
+    fn equal_priorities_run_in_spawn_order() {
+        let mut r = R::new();
+        for id in [4, 1, 6, 2] {
+            assert!(r.spawn(tk(id, 1)));
+        }
+        r.spawn(tk(0, 2));
+        assert_eq!(drain(&mut r), [0, 4, 1, 6, 2]);
+    }
+
+    #[test]
+    fn pending_task_is_not_queued_twice_nor_moved() {
+        let mut r = R::new();
+        assert!(r.spawn(tk(1, 1)));
+        assert!(r.spawn(tk(2, 1)));
+        assert!(!r.spawn(tk(1, 1)));
+        assert!(r.is_pending(tk(1, 1)));
+        assert_eq!(drain(&mut r), [1, 2]);
+        assert!(!r.is_pending(tk(1, 1)));
+    }
+
+    #[test]
+    fn isr_spawns_between_dispatches_keep_the_rules() {
+        let mut r = R::new();
+        r.spawn(tk(0, 0)); // main: logger
+        r.spawn(tk(1, 1)); // main: planner
+        assert_eq!(r.next().map(|t| t.id), Some(1));
+        // "ISR" while the planner runs: the UI (same level as planner) and
+        // the planner itself again, then a higher-priority job event.
+        r.spawn(tk(2, 1));
+        assert!(r.spawn(tk(1, 1)), "a running task can be spawned again");
+        r.spawn(tk(3, 3));
+        assert_eq!(r.next().map(|t| t.id), Some(3));
+        r.spawn(tk(4, 1));
+        assert_eq!(drain(&mut r), [2, 1, 4, 0]);
+    }
+
+    #[test]
+    fn idle_only_when_empty() {
+        let mut r = R::new();
+        assert!(r.is_idle());
+        assert_eq!(r.next(), None);
+        r.spawn(tk(5, 0));
+        assert!(!r.is_idle());
+        r.next();
+        assert!(r.is_idle());
+    }
+
+    #[test]
+    fn usable_from_a_static_initialiser() {
+        static R0: R = R::new();
+        assert!(R0.is_idle());
+    }
+
+    /// The obvious model: a list sorted by (priority desc, spawn order).
+    #[derive(Default)]
+    struct Model {
+        waiting: Vec<(Tk, u64)>,
+        seq: u64,
+    }
+
+    impl Model {
+        fn spawn(&mut self, t: Tk) -> bool {
+            if self.waiting.iter().any(|(w, _)| w.id == t.id) {
+                return false;
+            }
+            self.seq += 1;
+            self.waiting.push((t, self.seq));
+            true
+        }
+
+        fn next(&mut self) -> Option<Tk> {
+            let best = (0..self.waiting.len()).min_by_key(|&i| {
+                let (t, seq) = self.waiting[i];
+                (core::cmp::Reverse(t.prio), seq)
+            })?;
+            Some(self.waiting.remove(best).0)
+        }
+    }
+
+    #[derive(Clone, Debug)]
+    enum Op {
+        Spawn(u8),
+        Next,
+    }
+
+    fn op() -> impl Strategy<Value = Op> {
+        prop_oneof![(0u8..8).prop_map(Op::Spawn), Just(Op::Next)]
+    }
+
+    proptest! {
+        #[test]
+        fn matches_the_sorted_list_model(
+            prios in proptest::array::uniform8(0u8..4),
+            ops in proptest::collection::vec(op(), 0..200),
+        ) {
+            let mut r = R::new();
+            let mut m = Model::default();
+            for o in ops {
+                match o {
+                    Op::Spawn(id) => {
+                        let t = tk(id, prios[id as usize]);
+                        prop_assert_eq!(r.spawn(t), m.spawn(t));
+                    }
+                    Op::Next => prop_assert_eq!(r.next(), m.next()),
+                }
+                prop_assert_eq!(r.is_idle(), m.waiting.is_empty());
+            }
+            while let Some(t) = m.next() {
+                prop_assert_eq!(r.next(), Some(t));
+            }
+            prop_assert_eq!(r.next(), None);
+        }
+    }
+}
