@@ -7,16 +7,16 @@
 //! O(1) on the interrupt side, so a spawn costs a few dozen AVR instructions.
 //!
 //! # Ordering guarantees of [`Ready`]
-//! - **Priority first**: [`Ready::next`] returns a ready task of the highest
+//! - **Priority first**: [`Ready::pop`] returns a ready task of the highest
 //!   priority level; a lower level runs only when every higher one is empty.
 //! - **FIFO within a priority**: tasks of the same level come out in the
 //!   order they were spawned, whether the spawns came from the main loop or
-//!   from interrupts interleaved between `next()` calls.
+//!   from interrupts interleaved between `pop()` calls.
 //! - **At most once**: spawning a task that is already pending is a no-op
 //!   (`spawn` returns `false`) and does not move it in the queue. Its work is
 //!   carried by its own message [`Channel`], so nothing is lost: the task
 //!   drains its channel when it runs.
-//! - **Run to completion**: a task is taken off the ready set when `next()`
+//! - **Run to completion**: a task is taken off the ready set when `pop()`
 //!   returns it, so it may be spawned again (even by itself) while running
 //!   and will then run once more after the tasks already queued at its level.
 //!

@@ -159,9 +159,8 @@ mod tests {
     #[test]
     fn const_constructible_and_send_for_a_static_mutex() {
         // The firmware's `static Mutex<RefCell<Channel>>` needs both.
-        const C: Channel<u8, 4> = Channel::new();
         fn is_send<S: Send>(_: &S) {}
-        let c = C;
+        let c: Channel<u8, 4> = const { Channel::new() };
         is_send(&c);
         assert!(c.is_empty());
         assert_eq!(c.stats(), QueueStats::new());

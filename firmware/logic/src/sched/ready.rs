@@ -49,7 +49,7 @@ impl<T: TaskId, const N: usize, const P: usize> Ready<T, N, P> {
     }
 
     /// Takes the task to run now: the oldest spawn at the highest level.
-    pub fn next(&mut self) -> Option<T> {
+    pub fn pop(&mut self) -> Option<T> {
         for level in (0..P).rev() {
             if let Some(task) = self.head[level] {
                 let i = task.index();
@@ -90,7 +90,7 @@ mod tests {
     type R = Ready<Tk, 8, 4>;
 
     fn drain(r: &mut R) -> Vec<u8> {
-        core::iter::from_fn(|| r.next()).map(|t| t.id).collect()
+        core::iter::from_fn(|| r.pop()).map(|t| t.id).collect()
     }
 
     #[test]
@@ -129,13 +129,13 @@ mod tests {
         let mut r = R::new();
         r.spawn(tk(0, 0)); // main: logger
         r.spawn(tk(1, 1)); // main: planner
-        assert_eq!(r.next().map(|t| t.id), Some(1));
+        assert_eq!(r.pop().map(|t| t.id), Some(1));
         // "ISR" while the planner runs: the UI (same level as planner) and
         // the planner itself again, then a higher-priority job event.
         r.spawn(tk(2, 1));
         assert!(r.spawn(tk(1, 1)), "a running task can be spawned again");
         r.spawn(tk(3, 3));
-        assert_eq!(r.next().map(|t| t.id), Some(3));
+        assert_eq!(r.pop().map(|t| t.id), Some(3));
         r.spawn(tk(4, 1));
         assert_eq!(drain(&mut r), [2, 1, 4, 0]);
     }
@@ -144,10 +144,10 @@ mod tests {
     fn idle_only_when_empty() {
         let mut r = R::new();
         assert!(r.is_idle());
-        assert_eq!(r.next(), None);
+        assert_eq!(r.pop(), None);
         r.spawn(tk(5, 0));
         assert!(!r.is_idle());
-        r.next();
+        r.pop();
         assert!(r.is_idle());
     }
 
@@ -174,7 +174,7 @@ mod tests {
             true
         }
 
-        fn next(&mut self) -> Option<Tk> {
+        fn pop(&mut self) -> Option<Tk> {
             let best = (0..self.waiting.len()).min_by_key(|&i| {
                 let (t, seq) = self.waiting[i];
                 (core::cmp::Reverse(t.prio), seq)
@@ -186,11 +186,11 @@ mod tests {
     #[derive(Clone, Debug)]
     enum Op {
         Spawn(u8),
-        Next,
+        Pop,
     }
 
     fn op() -> impl Strategy<Value = Op> {
-        prop_oneof![(0u8..8).prop_map(Op::Spawn), Just(Op::Next)]
+        prop_oneof![(0u8..8).prop_map(Op::Spawn), Just(Op::Pop)]
     }
 
     proptest! {
@@ -207,14 +207,14 @@ mod tests {
                         let t = tk(id, prios[id as usize]);
                         prop_assert_eq!(r.spawn(t), m.spawn(t));
                     }
-                    Op::Next => prop_assert_eq!(r.next(), m.next()),
+                    Op::Pop => prop_assert_eq!(r.pop(), m.pop()),
                 }
                 prop_assert_eq!(r.is_idle(), m.waiting.is_empty());
             }
-            while let Some(t) = m.next() {
-                prop_assert_eq!(r.next(), Some(t));
+            while let Some(t) = m.pop() {
+                prop_assert_eq!(r.pop(), Some(t));
             }
-            prop_assert_eq!(r.next(), None);
+            prop_assert_eq!(r.pop(), None);
         }
     }
 }

@@ -208,9 +208,9 @@ mod tests {
         t.spawn_after(A, 0, 3).unwrap();
         t.spawn_after(C, 0, 50).unwrap();
         assert_eq!(t.fire_due(10, &mut r), 2, "second A coalesces");
-        assert_eq!(r.next(), Some(A));
-        assert_eq!(r.next(), Some(B));
-        assert_eq!(r.next(), None);
+        assert_eq!(r.pop(), Some(A));
+        assert_eq!(r.pop(), Some(B));
+        assert_eq!(r.pop(), None);
         assert_eq!(t.ms_to_next(10), Some(40));
     }
 
