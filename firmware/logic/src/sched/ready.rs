@@ -4,10 +4,10 @@ use super::TaskId;
 
 /// The set of tasks waiting to run, for `N` tasks over `P` priority levels.
 ///
-/// One intrusive FIFO list per level, linked through a per-task `next`
+/// One intrusive FIFO list per level, linked through a per-task `link`
 /// slot: a task is pending at most once, so one link per task is all the
 /// storage needed (`N + 2P` task slots plus `N` flags, a few dozen bytes).
-/// `spawn` is O(1); `next` scans at most `P` level heads.
+/// `spawn` is O(1); `pop` scans at most `P` level heads.
 pub struct Ready<T: TaskId, const N: usize, const P: usize> {
     pending: [bool; N],
     /// The task queued after this one at its level.
