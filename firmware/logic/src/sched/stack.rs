@@ -5,9 +5,9 @@
 /// `painted` runs from the lowest address (end of static RAM, the far end
 /// of the downward-growing AVR stack) up to where painting stopped. Bytes
 /// still holding the pattern at the low end were never reached; everything
-/// above the first overwritten byte counts as used. A used byte that happens
-/// to equal the pattern only ever makes the figure larger, never smaller,
-/// except at the very frontier.
+/// from the first overwritten byte up counts as used. Only the deepest used
+/// bytes, if they happen to equal the pattern, go uncounted: pick a pattern
+/// unlikely as data (not 0x00 or 0xFF).
 pub fn stack_high_water(painted: &[u8], pattern: u8) -> usize {
     let untouched = painted.iter().take_while(|&&b| b == pattern).count();
     painted.len() - untouched
