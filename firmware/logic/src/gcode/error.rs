@@ -1,0 +1,135 @@
+//! Command-line errors, numbered like Grbl's so senders that know Grbl's
+//! table (UGS, bCNC, CNCjs) show the right text. Code 70 (checksum) is
+//! taut's own: Grbl has no checksums, Marlin has no error numbers.
+
+use ufmt::{uDisplay, uWrite, uwrite, Formatter};
+
+/// What went wrong. The discriminant is the number printed after `error:`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum ErrorKind {
+    /// A word must start with a letter (`10`, `#`).
+    ExpectedCommandLetter = 1,
+    /// A letter without a number, a stray sign or point, or an overflow.
+    BadNumberFormat = 2,
+    /// A `$` line taut does not know.
+    InvalidStatement = 3,
+    /// `F` or `P` below zero.
+    NegativeValue = 4,
+    /// More than [`MAX_LINE`](super::MAX_LINE) characters.
+    LineOverflow = 11,
+    /// A G/M number or a letter taut does not implement.
+    UnsupportedCommand = 20,
+    /// Two commands of one group (`G0 G1`, `G90 G91`, two M words, …).
+    ModalGroupViolation = 21,
+    /// `G1` before any `F`: raised by the interpreter, which knows the
+    /// modal feed rate; the parser never does.
+    UndefinedFeedRate = 22,
+    /// Two commands that both take the axis words (`G1 G92 X0`).
+    AxisWordConflict = 24,
+    /// A letter given twice (`X1 X2`).
+    RepeatedWord = 25,
+    /// `G92` without an axis word.
+    NoAxisWords = 26,
+    /// `N` negative, fractional or above 9 999 999.
+    InvalidLineNumber = 27,
+    /// `G4` without `P`.
+    ValueWordMissing = 28,
+    /// Axis words on a command that takes none (`G4`, `M17`, …).
+    UnusedAxisWords = 31,
+    /// `P` on a command other than `G4`.
+    UnusedValueWords = 36,
+    /// `*` checksum wrong, malformed, or followed by more words.
+    BadChecksum = 70,
+}
+
+impl ErrorKind {
+    /// Short text; every string costs SRAM on the AVR.
+    pub const fn message(self) -> &'static str {
+        match self {
+            ErrorKind::ExpectedCommandLetter => "Expected command letter",
+            ErrorKind::BadNumberFormat => "Bad number format",
+            ErrorKind::InvalidStatement => "Invalid statement",
+            ErrorKind::NegativeValue => "Negative value",
+            ErrorKind::LineOverflow => "Line overflow",
+            ErrorKind::UnsupportedCommand => "Unsupported command",
+            ErrorKind::ModalGroupViolation => "Modal group violation",
+            ErrorKind::UndefinedFeedRate => "Undefined feed rate",
+            ErrorKind::AxisWordConflict => "Two commands use axis words",
+            ErrorKind::RepeatedWord => "Repeated word",
+            ErrorKind::NoAxisWords => "No axis words",
+            ErrorKind::InvalidLineNumber => "Invalid line number",
+            ErrorKind::ValueWordMissing => "Value word missing",
+            ErrorKind::UnusedAxisWords => "Unused axis words",
+            ErrorKind::UnusedValueWords => "Unused value words",
+            ErrorKind::BadChecksum => "Bad checksum",
+        }
+    }
+}
+
+/// An error with where it happened, printed as
+/// `error:<code> <message> (col <c>)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Error {
+    kind: ErrorKind,
+    /// 1-based column of the offending character; 0 when unknown.
+    column: u8,
+    /// The line's `N`, if it was read before the error, so a Marlin-style
+    /// host can be asked to resend it.
+    line_number: Option<u32>,
+}
+
+impl Error {
+    /// `column` is 1-based; 0 means "no column" (e.g. interpreter errors).
+    pub const fn new(kind: ErrorKind, column: u8) -> Error {
+        Error {
+            kind,
+            column,
+            line_number: None,
+        }
+    }
+
+    pub(super) fn with_line_number(self, line_number: Option<u32>) -> Error {
+        Error {
+            line_number,
+            ..self
+        }
+    }
+
+    pub const fn kind(&self) -> ErrorKind {
+        self.kind
+    }
+
+    /// Grbl's error number.
+    pub const fn code(&self) -> u8 {
+        self.kind as u8
+    }
+
+    pub const fn message(&self) -> &'static str {
+        self.kind.message()
+    }
+
+    /// 1-based column of the offending character, if known.
+    pub const fn column(&self) -> Option<u8> {
+        if self.column == 0 {
+            None
+        } else {
+            Some(self.column)
+        }
+    }
+
+    /// The `N` of the failed line, if it had been read.
+    pub const fn line_number(&self) -> Option<u32> {
+        self.line_number
+    }
+}
+
+impl uDisplay for Error {
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
+        uwrite!(f, "error:{} {}", self.code(), self.message())?;
+        match self.column() {
+            Some(c) => uwrite!(f, " (col {})", c),
+            None => Ok(()),
+        }
+    }
+}

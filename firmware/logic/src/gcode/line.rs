@@ -1,0 +1,184 @@
+//! What the parser hands to the interpreter: one parsed line, a `$` line
+//! or a realtime byte.
+
+use super::system::SystemLine;
+use crate::units::Milli;
+
+/// Axis letters the command line accepts. Which channel each drives is the
+/// kinematics' business (string art: C base °, X radial mm, Z drill mm).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum AxisWord {
+    C = 0,
+    X = 1,
+    Y = 2,
+    Z = 3,
+    A = 4,
+}
+
+/// Number of axis letters.
+pub const AXIS_WORDS: usize = 5;
+
+impl AxisWord {
+    pub const ALL: [AxisWord; AXIS_WORDS] = [
+        AxisWord::C,
+        AxisWord::X,
+        AxisWord::Y,
+        AxisWord::Z,
+        AxisWord::A,
+    ];
+
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Upper-case letter of the word.
+    pub const fn letter(self) -> u8 {
+        match self {
+            AxisWord::C => b'C',
+            AxisWord::X => b'X',
+            AxisWord::Y => b'Y',
+            AxisWord::Z => b'Z',
+            AxisWord::A => b'A',
+        }
+    }
+
+    pub(super) fn from_letter(upper: u8) -> Option<AxisWord> {
+        AxisWord::ALL.into_iter().find(|w| w.letter() == upper)
+    }
+}
+
+/// `G90`/`G91`: a modal setting that may share a line with a command
+/// (`G91 G1 C1`), so it is a field of [`Line`], not a [`Command`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Distance {
+    /// `G90`: axis words are positions.
+    Absolute,
+    /// `G91`: axis words are offsets from the current position.
+    Relative,
+}
+
+/// The one command of a line (taut runs at most one per line).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Command {
+    /// No G/M command. Axis words then move in the modal motion mode and
+    /// `F` alone sets the feed rate, as in Grbl.
+    Empty,
+    /// `G0`.
+    Rapid,
+    /// `G1`. The parser does not check that a feed rate was ever given
+    /// (Grbl's error 22): only the interpreter knows the modal `F`.
+    Linear,
+    /// `G4 P<seconds>`: `p` holds thousandths of a second, i.e. ms.
+    Dwell,
+    /// `G92`: the axis words name the current position.
+    SetPosition,
+    /// `M17`.
+    EnableDrivers,
+    /// `M18`, or its alias `M84`.
+    DisableDrivers,
+    /// `M114`.
+    ReportPosition,
+    /// `M400`: answer `ok` only once motion is done.
+    WaitIdle,
+}
+
+impl Command {
+    /// The command a G or M number names. G/M numbers are read as
+    /// fixed-point like every value and matched exactly, so `G1`, `G01`
+    /// and `G1.0` are one command while `G38.2` or `G1.5` are unsupported.
+    pub(super) fn from_word(letter: u8, number: Milli) -> Option<Command> {
+        Some(match (letter, number.0) {
+            (b'G', 0) => Command::Rapid,
+            (b'G', 1000) => Command::Linear,
+            (b'G', 4000) => Command::Dwell,
+            (b'G', 92_000) => Command::SetPosition,
+            (b'M', 17_000) => Command::EnableDrivers,
+            (b'M', 18_000) | (b'M', 84_000) => Command::DisableDrivers,
+            (b'M', 114_000) => Command::ReportPosition,
+            (b'M', 400_000) => Command::WaitIdle,
+            _ => return None,
+        })
+    }
+
+    /// Whether the command consumes the axis words (Grbl's error 24 when
+    /// two such commands share a line).
+    pub(super) const fn uses_axes(self) -> bool {
+        matches!(
+            self,
+            Command::Rapid | Command::Linear | Command::SetPosition
+        )
+    }
+}
+
+/// One G-code line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Line {
+    /// `N` line number, 0..=9 999 999. Checking that it follows the last
+    /// one is the console's job.
+    pub n: Option<u32>,
+    /// The `*` checksum; present only if it matched.
+    pub checksum: Option<u8>,
+    pub distance: Option<Distance>,
+    pub command: Command,
+    /// Axis words, indexed by [`AxisWord::index`].
+    pub axes: [Option<Milli>; AXIS_WORDS],
+    /// Feed rate, units per minute, never negative.
+    pub f: Option<Milli>,
+    /// `P`, only with `G4`: seconds in thousandths, i.e. milliseconds.
+    pub p: Option<Milli>,
+}
+
+impl Line {
+    /// A blank line (or one holding only comments): answered with `ok`.
+    pub const EMPTY: Line = Line {
+        n: None,
+        checksum: None,
+        distance: None,
+        command: Command::Empty,
+        axes: [None; AXIS_WORDS],
+        f: None,
+        p: None,
+    };
+
+    pub fn axis(&self, word: AxisWord) -> Option<Milli> {
+        self.axes[word.index()]
+    }
+}
+
+/// Grbl's single-byte realtime commands: acted on as soon as they arrive,
+/// wherever they fall in a line, and never part of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Realtime {
+    /// `?`: report status.
+    Status,
+    /// `!`: feed hold.
+    FeedHold,
+    /// `~`: cycle start / resume.
+    CycleStart,
+    /// Ctrl-X (0x18): soft reset; the parser also drops the partial line.
+    Reset,
+}
+
+impl Realtime {
+    pub const fn from_byte(byte: u8) -> Option<Realtime> {
+        match byte {
+            b'?' => Some(Realtime::Status),
+            b'!' => Some(Realtime::FeedHold),
+            b'~' => Some(Realtime::CycleStart),
+            0x18 => Some(Realtime::Reset),
+            _ => None,
+        }
+    }
+}
+
+/// What a byte pushed into the parser completed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Input {
+    /// A G-code line (answer `ok` once executed or queued).
+    Line(Line),
+    /// A `$` line.
+    System(SystemLine),
+    /// A realtime byte (no `ok`).
+    Realtime(Realtime),
+}

@@ -1,0 +1,208 @@
+//! The byte-level stage: realtime bytes, line ends, the length limit,
+//! comments and the `*` checksum. What remains of the line goes, one
+//! character at a time, to the statement (G-code words or a `$` line), so
+//! nothing is buffered.
+
+use super::error::{Error, ErrorKind};
+use super::line::{Input, Line, Realtime};
+use super::number::Number;
+use super::system::SystemBuilder;
+use super::words::Words;
+
+/// Longest line, characters (without `\r`, `\n` and realtime bytes).
+pub const MAX_LINE: u8 = 80;
+
+/// Where in the line the next byte falls.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Lexeme {
+    Code,
+    /// Inside `( … )`.
+    Comment,
+    /// After `;`, to the end of the line.
+    LineComment,
+    /// Reading the digits after `*`.
+    Checksum,
+    /// After the checksum: only spaces and a `;` comment may follow.
+    AfterChecksum,
+    /// Past [`MAX_LINE`]: everything is dropped until the newline.
+    Overflow,
+}
+
+/// The `*` of a line.
+#[derive(Clone, Copy, Debug)]
+struct Checksum {
+    column: u8,
+    number: Number,
+    /// Column of a character that spoils it; 0 = none.
+    bad: u8,
+}
+
+#[derive(Clone, Debug)]
+enum Statement {
+    /// Only spaces and comments so far.
+    Start,
+    GCode(Words),
+    System(SystemBuilder),
+}
+
+/// The streaming command-line parser: push every received byte, act on
+/// what comes out. Each `\n` yields exactly one line result (`ok` or
+/// `error:` for the host); realtime bytes yield at once.
+#[derive(Clone, Debug)]
+pub struct Parser {
+    /// Characters of this line so far = column of the last one.
+    column: u8,
+    /// XOR of the bytes before `*`.
+    xor: u8,
+    lexeme: Lexeme,
+    checksum: Option<Checksum>,
+    statement: Statement,
+}
+
+impl Default for Parser {
+    fn default() -> Self {
+        Parser::new()
+    }
+}
+
+impl Parser {
+    pub const fn new() -> Parser {
+        Parser {
+            column: 0,
+            xor: 0,
+            lexeme: Lexeme::Code,
+            checksum: None,
+            statement: Statement::Start,
+        }
+    }
+
+    /// Takes one received byte; returns what it completed, if anything.
+    pub fn push(&mut self, byte: u8) -> Option<Result<Input, Error>> {
+        if let Some(realtime) = Realtime::from_byte(byte) {
+            if realtime == Realtime::Reset {
+                *self = Parser::new();
+            }
+            return Some(Ok(Input::Realtime(realtime)));
+        }
+        match byte {
+            b'\r' => None,
+            b'\n' => {
+                let line = core::mem::take(self).finish();
+                Some(line)
+            }
+            _ => {
+                self.column = self.column.saturating_add(1);
+                if self.column > MAX_LINE {
+                    self.lexeme = Lexeme::Overflow;
+                } else {
+                    self.take(byte);
+                }
+                None
+            }
+        }
+    }
+
+    fn take(&mut self, c: u8) {
+        let column = self.column;
+        // Marlin's checksum covers every byte before the `*`.
+        let star = self.lexeme == Lexeme::Code && c == b'*';
+        if self.checksum.is_none() && !star {
+            self.xor ^= c;
+        }
+        match (self.lexeme, c) {
+            (Lexeme::Code, b'(') => {
+                self.lexeme = Lexeme::Comment;
+                self.feed(b' ', column);
+            }
+            (Lexeme::Code, b';') | (Lexeme::AfterChecksum, b';') => {
+                self.lexeme = Lexeme::LineComment;
+                self.feed(b' ', column);
+            }
+            (Lexeme::Code, b'*') => {
+                self.lexeme = Lexeme::Checksum;
+                self.checksum = Some(Checksum {
+                    column,
+                    number: Number::integer(u8::MAX as u32),
+                    bad: 0,
+                });
+            }
+            (Lexeme::Code, _) => self.feed(c, column),
+            (Lexeme::Comment, b')') => self.lexeme = Lexeme::Code,
+            (Lexeme::Checksum, b' ' | b'\t') | (Lexeme::AfterChecksum, b' ' | b'\t') => {
+                self.lexeme = Lexeme::AfterChecksum
+            }
+            (Lexeme::Checksum, _) | (Lexeme::AfterChecksum, _) => {
+                if let Some(ck) = &mut self.checksum {
+                    let spoilt = self.lexeme == Lexeme::AfterChecksum || ck.number.push(c).is_err();
+                    if spoilt && ck.bad == 0 {
+                        ck.bad = column;
+                    }
+                }
+            }
+            (Lexeme::Comment, _) | (Lexeme::LineComment, _) | (Lexeme::Overflow, _) => {}
+        }
+    }
+
+    /// Hands a character of the statement on; the first one decides
+    /// whether the line is G-code or a `$` line.
+    fn feed(&mut self, c: u8, column: u8) {
+        match &mut self.statement {
+            Statement::Start => match c {
+                b' ' | b'\t' => {}
+                b'$' => self.statement = Statement::System(SystemBuilder::new(column)),
+                _ => {
+                    let mut words = Words::new();
+                    words.feed(c, column);
+                    self.statement = Statement::GCode(words);
+                }
+            },
+            Statement::GCode(words) => words.feed(c, column),
+            Statement::System(system) => system.feed(c, column),
+        }
+    }
+
+    /// The result of a complete line. Errors rank: overflow (the line was
+    /// cut), then checksum (a corrupted byte explains any other error),
+    /// then the first error in the text.
+    fn finish(self) -> Result<Input, Error> {
+        let line_number = match &self.statement {
+            Statement::GCode(words) => words.line_number(),
+            _ => None,
+        };
+        self.result().map_err(|e| e.with_line_number(line_number))
+    }
+
+    fn result(self) -> Result<Input, Error> {
+        if self.lexeme == Lexeme::Overflow {
+            return Err(Error::new(ErrorKind::LineOverflow, MAX_LINE + 1));
+        }
+        let end = match self.checksum {
+            Some(ck) => ck.column,
+            None => self.column + 1,
+        };
+        let checksum = match self.checksum {
+            Some(ck) => {
+                let bad = |column| Err(Error::new(ErrorKind::BadChecksum, column));
+                if ck.bad != 0 {
+                    return bad(ck.bad);
+                }
+                match ck.number.value() {
+                    Some(v) if v == self.xor as u32 => Some(self.xor),
+                    _ => return bad(ck.column),
+                }
+            }
+            None => None,
+        };
+        match self.statement {
+            Statement::Start => Ok(Input::Line(Line {
+                checksum,
+                ..Line::EMPTY
+            })),
+            Statement::GCode(words) => {
+                let line = words.finish(end)?;
+                Ok(Input::Line(Line { checksum, ..line }))
+            }
+            Statement::System(system) => system.finish(end).map(Input::System),
+        }
+    }
+}

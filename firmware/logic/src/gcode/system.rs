@@ -1,0 +1,96 @@
+//! `$` lines (Grbl's system commands): spaces are ignored, every error is
+//! Grbl's 3 "Invalid statement".
+
+use super::error::{Error, ErrorKind};
+use heapless::String;
+
+/// Longest `$` key and value, characters.
+pub const SYSTEM_TEXT: usize = 16;
+
+/// A key or value of a `$` line.
+pub type SystemText = String<SYSTEM_TEXT, u8>;
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SystemLine {
+    /// `$$`: print the settings.
+    PrintSettings,
+    /// `$Q`: planner queue statistics.
+    QueueStats,
+    /// `$S`: stack high-water mark.
+    Stack,
+    /// `$<key>=<value>`, both as typed; the settings module interprets
+    /// them (e.g. with [`parse_milli`](super::parse_milli)).
+    Set { key: SystemText, value: SystemText },
+}
+
+/// A `$` line being read.
+#[derive(Clone, Debug)]
+pub(super) struct SystemBuilder {
+    /// Column of the `$`: where errors found at the end point.
+    dollar: u8,
+    key: SystemText,
+    value: SystemText,
+    equals: bool,
+    error: Option<Error>,
+}
+
+impl SystemBuilder {
+    pub(super) fn new(dollar: u8) -> SystemBuilder {
+        SystemBuilder {
+            dollar,
+            key: String::new(),
+            value: String::new(),
+            equals: false,
+            error: None,
+        }
+    }
+
+    pub(super) fn feed(&mut self, c: u8, column: u8) {
+        if self.error.is_none() && !matches!(c, b' ' | b'\t') && self.take(c).is_err() {
+            self.error = Some(Error::new(ErrorKind::InvalidStatement, column));
+        }
+    }
+
+    fn take(&mut self, c: u8) -> Result<(), ()> {
+        if self.equals {
+            return if c.is_ascii_graphic() {
+                self.value.push(c as char).map_err(drop)
+            } else {
+                Err(())
+            };
+        }
+        let key_char = c.is_ascii_alphanumeric() || c == b'_' || (c == b'$' && self.key.is_empty());
+        if self.key == "$" {
+            Err(()) // nothing may follow `$$`
+        } else if c == b'=' && !self.key.is_empty() {
+            self.equals = true;
+            Ok(())
+        } else if key_char {
+            self.key.push(c as char).map_err(drop)
+        } else {
+            Err(())
+        }
+    }
+
+    pub(super) fn finish(self, end: u8) -> Result<SystemLine, Error> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        if self.equals {
+            return if self.value.is_empty() {
+                Err(Error::new(ErrorKind::InvalidStatement, end))
+            } else {
+                Ok(SystemLine::Set {
+                    key: self.key,
+                    value: self.value,
+                })
+            };
+        }
+        match self.key.as_str() {
+            "$" => Ok(SystemLine::PrintSettings),
+            "Q" | "q" => Ok(SystemLine::QueueStats),
+            "S" | "s" => Ok(SystemLine::Stack),
+            _ => Err(Error::new(ErrorKind::InvalidStatement, self.dollar)),
+        }
+    }
+}

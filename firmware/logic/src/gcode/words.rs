@@ -1,0 +1,219 @@
+//! The words of a G-code line: letters with their numbers, collected into a
+//! [`Line`] with Grbl's checks (repeated words, modal groups, words the
+//! command cannot use). The first error is kept; the rest of the line is
+//! then only skipped.
+
+use super::error::{Error, ErrorKind};
+use super::line::{AxisWord, Command, Distance, Line};
+use super::number::Number;
+use crate::units::Milli;
+
+/// Largest line number, as in Grbl.
+const MAX_LINE_NUMBER: u32 = 9_999_999;
+
+/// A letter whose number is being read.
+#[derive(Clone, Copy, Debug)]
+struct Word {
+    letter: u8,
+    column: u8,
+    number: Number,
+}
+
+#[derive(Clone, Debug)]
+pub(super) struct Words {
+    line: Line,
+    word: Option<Word>,
+    error: Option<Error>,
+    // Columns of words checked once the line is complete; 0 = absent.
+    command_column: u8,
+    distance_column: u8,
+    axis_column: u8,
+    p_column: u8,
+}
+
+impl Words {
+    pub(super) const fn new() -> Words {
+        Words {
+            line: Line::EMPTY,
+            word: None,
+            error: None,
+            command_column: 0,
+            distance_column: 0,
+            axis_column: 0,
+            p_column: 0,
+        }
+    }
+
+    pub(super) fn line_number(&self) -> Option<u32> {
+        self.line.n
+    }
+
+    /// One character outside comments; a comment arrives as a space.
+    pub(super) fn feed(&mut self, c: u8, column: u8) {
+        if self.error.is_none() {
+            if let Err(e) = self.take(c, column) {
+                self.error = Some(e);
+            }
+        }
+    }
+
+    fn take(&mut self, c: u8, column: u8) -> Result<(), Error> {
+        match c {
+            // A space ends a number but may sit between letter and number.
+            b' ' | b'\t' => match self.word {
+                Some(w) if w.number.has_digits() => self.close(column),
+                _ => Ok(()),
+            },
+            b'a'..=b'z' | b'A'..=b'Z' => {
+                self.close(column)?;
+                let letter = c.to_ascii_uppercase();
+                let number = match letter {
+                    b'N' => Number::integer(MAX_LINE_NUMBER),
+                    _ => Number::fixed(),
+                };
+                self.word = Some(Word {
+                    letter,
+                    column,
+                    number,
+                });
+                Ok(())
+            }
+            _ => match &mut self.word {
+                Some(w) => w.number.push(c).map_err(|()| {
+                    let kind = match w.letter {
+                        b'N' => ErrorKind::InvalidLineNumber,
+                        _ => ErrorKind::BadNumberFormat,
+                    };
+                    Error::new(kind, column)
+                }),
+                None => Err(Error::new(ErrorKind::ExpectedCommandLetter, column)),
+            },
+        }
+    }
+
+    /// Ends the word being read at the character in `column`.
+    fn close(&mut self, column: u8) -> Result<(), Error> {
+        let Some(w) = self.word.take() else {
+            return Ok(());
+        };
+        let bad = Error::new(ErrorKind::BadNumberFormat, column);
+        if w.letter == b'N' {
+            let n = w.number.value().ok_or(bad)?;
+            self.set_line_number(n, w.column)
+        } else {
+            let value = w.number.milli().ok_or(bad)?;
+            self.apply(w.letter, w.column, value)
+        }
+    }
+
+    fn set_line_number(&mut self, n: u32, column: u8) -> Result<(), Error> {
+        if self.line.n.is_some() {
+            return Err(Error::new(ErrorKind::RepeatedWord, column));
+        }
+        self.line.n = Some(n);
+        Ok(())
+    }
+
+    fn apply(&mut self, letter: u8, column: u8, value: Milli) -> Result<(), Error> {
+        let error = |kind| Err(Error::new(kind, column));
+        if let Some(word) = AxisWord::from_letter(letter) {
+            let slot = &mut self.line.axes[word.index()];
+            if slot.is_some() {
+                return error(ErrorKind::RepeatedWord);
+            }
+            *slot = Some(value);
+            if self.axis_column == 0 {
+                self.axis_column = column;
+            }
+            return Ok(());
+        }
+        match letter {
+            b'G' if value.0 == 90_000 || value.0 == 91_000 => {
+                if self.distance_column != 0 {
+                    return error(ErrorKind::ModalGroupViolation);
+                }
+                self.distance_column = column;
+                self.line.distance = Some(if value.0 == 90_000 {
+                    Distance::Absolute
+                } else {
+                    Distance::Relative
+                });
+                Ok(())
+            }
+            b'G' | b'M' => {
+                let Some(command) = Command::from_word(letter, value) else {
+                    return error(ErrorKind::UnsupportedCommand);
+                };
+                if self.command_column != 0 {
+                    // G92 with G0/G1: different groups, but both want the
+                    // axis words. Anything else is one group here.
+                    let previous = self.line.command;
+                    let set_position = |c| c == Command::SetPosition;
+                    let axis_conflict = command.uses_axes()
+                        && previous.uses_axes()
+                        && set_position(command) != set_position(previous);
+                    return error(if axis_conflict {
+                        ErrorKind::AxisWordConflict
+                    } else {
+                        ErrorKind::ModalGroupViolation
+                    });
+                }
+                self.command_column = column;
+                self.line.command = command;
+                Ok(())
+            }
+            b'F' | b'P' => {
+                let slot = if letter == b'F' {
+                    &mut self.line.f
+                } else {
+                    self.p_column = column;
+                    &mut self.line.p
+                };
+                if slot.is_some() {
+                    return error(ErrorKind::RepeatedWord);
+                }
+                if value.0 < 0 {
+                    return error(ErrorKind::NegativeValue);
+                }
+                *slot = Some(value);
+                Ok(())
+            }
+            _ => error(ErrorKind::UnsupportedCommand),
+        }
+    }
+
+    /// The line, once its last character (before `column`) has been read.
+    pub(super) fn finish(mut self, column: u8) -> Result<Line, Error> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        self.close(column)?;
+        let line = self.line;
+        let fail = |kind, column| Err(Error::new(kind, column));
+        let has_axes = self.axis_column != 0;
+        match line.command {
+            Command::Dwell if has_axes => {
+                return fail(ErrorKind::UnusedAxisWords, self.axis_column)
+            }
+            Command::Dwell if line.p.is_none() => {
+                return fail(ErrorKind::ValueWordMissing, self.command_column)
+            }
+            Command::SetPosition if !has_axes => {
+                return fail(ErrorKind::NoAxisWords, self.command_column)
+            }
+            Command::EnableDrivers
+            | Command::DisableDrivers
+            | Command::ReportPosition
+            | Command::WaitIdle
+                if has_axes =>
+            {
+                return fail(ErrorKind::UnusedAxisWords, self.axis_column)
+            }
+            _ => {}
+        }
+        if line.p.is_some() && line.command != Command::Dwell {
+            return fail(ErrorKind::UnusedValueWords, self.p_column);
+        }
+        Ok(line)
+    }
+}
