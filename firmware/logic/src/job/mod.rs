@@ -8,6 +8,7 @@
 
 pub mod cursor;
 pub mod error;
+pub mod kv;
 pub mod num;
 
 pub use error::{ErrorKind, FileError, FileName};
