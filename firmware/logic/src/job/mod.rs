@@ -10,5 +10,6 @@ pub mod cursor;
 pub mod error;
 pub mod kv;
 pub mod num;
+pub mod param;
 
 pub use error::{ErrorKind, FileError, FileName};

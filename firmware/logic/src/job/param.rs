@@ -1,0 +1,355 @@
+//! `param.txt`: the board's shape, its number of nails and its radius.
+//!
+//! ```text
+//! tvar = 0               # shape: 0 circle, n >= 3 regular n-gon
+//! pocet_hrebiku = 250    # number of nails
+//! polomer_matrice = 40.2 # board radius in cm
+//! ```
+//! Keys are the original firmware's or their English aliases (`shape`,
+//! `nails`, `radius_cm`), in any case. Each must appear exactly once.
+
+use crate::job::error::{ErrorKind, FileError, FileName};
+use crate::job::kv::{Item, KvReader};
+use crate::job::num::{parse_fixed, parse_u32, NumError};
+
+/// Most corners of a polygonal board.
+pub const MAX_SHAPE: u16 = 1000;
+/// Most nails on a board.
+pub const MAX_NAILS: u16 = 10_000;
+/// Largest board radius, µm (10 m).
+pub const MAX_RADIUS_UM: u32 = 10_000_000;
+/// Nails stand this far inside the board radius, µm.
+pub const NAIL_MARGIN_UM: u32 = 15_000;
+/// While winding, the needle goes this far inside the nail nearest the
+/// centre, µm; that radius must stay positive.
+pub const INNER_CLEARANCE_UM: u32 = 20_000;
+
+const FILE: FileName = FileName::Param;
+
+/// The job's board.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Params {
+    /// 0 for a circle, n ≥ 3 for a regular n-gon.
+    pub shape: u16,
+    pub nails: u16,
+    /// Board radius (circumradius of a polygon), µm.
+    pub radius_um: u32,
+}
+
+/// The board radius must be more than this, µm, for the winding needle's
+/// inner radius `(R − margin)·cos(π/n) − clearance` to be positive.
+/// One `cosf` per file: not on any hot path.
+pub fn radius_limit_um(shape: u16) -> u32 {
+    let apothem_ratio = match shape {
+        0 => 1.0,
+        n => libm::cosf(core::f32::consts::PI / n as f32),
+    };
+    NAIL_MARGIN_UM + (INNER_CLEARANCE_UM as f32 / apothem_ratio) as u32
+}
+
+/// Names a key may have: the original's first, as `missing key` prints them.
+const KEYS: [(&str, &str, &str); 3] = [
+    ("tvar", "shape", "tvar (shape)"),
+    ("pocet_hrebiku", "nails", "pocet_hrebiku (nails)"),
+    (
+        "polomer_matrice",
+        "radius_cm",
+        "polomer_matrice (radius_cm)",
+    ),
+];
+
+/// Values seen so far, by the index of their key in [`KEYS`].
+#[derive(Default)]
+struct Seen {
+    shape: Option<u16>,
+    nails: Option<u16>,
+    /// The radius is checked at the end (its limit depends on the shape),
+    /// so its position is kept.
+    radius: Option<(u32, u32, u32)>,
+    lines: bool,
+}
+
+/// Streaming parser of `param.txt`: `push` chunks, then `finish`.
+pub struct ParamFile {
+    kv: KvReader,
+    seen: Seen,
+}
+
+impl Default for ParamFile {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ParamFile {
+    pub fn new() -> Self {
+        ParamFile {
+            kv: KvReader::new(FILE),
+            seen: Seen::default(),
+        }
+    }
+
+    pub fn push(&mut self, chunk: &[u8]) -> Result<(), FileError> {
+        for &b in chunk {
+            if let Some(item) = self.kv.push(b)? {
+                self.seen.take(item)?;
+            }
+        }
+        Ok(())
+    }
+
+    pub fn finish(mut self) -> Result<Params, FileError> {
+        if let Some(item) = self.kv.finish()? {
+            self.seen.take(item)?;
+        }
+        let seen = self.seen;
+        if !seen.lines {
+            return Err(FileError::whole(FILE, ErrorKind::Empty));
+        }
+        let missing = |key: usize| FileError::whole(FILE, ErrorKind::MissingKey(KEYS[key].2));
+        let shape = seen.shape.ok_or(missing(0))?;
+        let nails = seen.nails.ok_or(missing(1))?;
+        let (radius_um, line, col) = seen.radius.ok_or(missing(2))?;
+        let above_um = radius_limit_um(shape);
+        if radius_um <= above_um {
+            let kind = ErrorKind::RadiusTooSmall { above_um };
+            return Err(FileError::at(FILE, line, col, kind));
+        }
+        Ok(Params {
+            shape,
+            nails,
+            radius_um,
+        })
+    }
+}
+
+impl Seen {
+    fn take(&mut self, item: Item<'_>) -> Result<(), FileError> {
+        self.lines = true;
+        let at = |col, kind| FileError::at(FILE, item.line, col, kind);
+        let key = KEYS
+            .iter()
+            .position(|k| {
+                item.key.eq_ignore_ascii_case(k.0.as_bytes())
+                    || item.key.eq_ignore_ascii_case(k.1.as_bytes())
+            })
+            .ok_or(at(item.key_col, ErrorKind::UnknownKey))?;
+        let already = match key {
+            0 => self.shape.is_some(),
+            1 => self.nails.is_some(),
+            _ => self.radius.is_some(),
+        };
+        if already {
+            return Err(at(item.key_col, ErrorKind::DuplicateKey));
+        }
+        let number_error = |e: NumError| at(item.value_col + e.at as u32, e.kind);
+        let out_of_range = |kind| at(item.value_col, kind);
+        match key {
+            0 => {
+                let n = parse_u32(item.value).map_err(number_error)?;
+                if n == 1 || n == 2 || n > MAX_SHAPE as u32 {
+                    return Err(out_of_range(ErrorKind::Shape {
+                        max: MAX_SHAPE as u32,
+                    }));
+                }
+                self.shape = Some(n as u16);
+            }
+            1 => {
+                let n = parse_u32(item.value).map_err(number_error)?;
+                if !(3..=MAX_NAILS as u32).contains(&n) {
+                    return Err(out_of_range(ErrorKind::Range {
+                        min: 3,
+                        max: MAX_NAILS as u32,
+                    }));
+                }
+                self.nails = Some(n as u16);
+            }
+            _ => {
+                let um = parse_fixed(item.value, 4).map_err(number_error)?;
+                if um > MAX_RADIUS_UM {
+                    return Err(out_of_range(ErrorKind::TooBig));
+                }
+                self.radius = Some((um, item.line, item.value_col));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::job::error::tests::show;
+    use proptest::prelude::*;
+    use std::string::String;
+
+    fn parse_in_chunks(text: &[u8], chunk: usize) -> Result<Params, FileError> {
+        let mut p = ParamFile::new();
+        for part in text.chunks(chunk) {
+            p.push(part)?;
+        }
+        p.finish()
+    }
+
+    /// Parses whole and in chunks of every size; all must agree.
+    fn parse(text: &str) -> Result<Params, String> {
+        let whole = parse_in_chunks(text.as_bytes(), text.len().max(1));
+        for chunk in 1..text.len() {
+            assert_eq!(
+                parse_in_chunks(text.as_bytes(), chunk),
+                whole,
+                "chunk {chunk}"
+            );
+        }
+        whole.map_err(|e| show(&e))
+    }
+
+    const fn params(shape: u16, nails: u16, radius_um: u32) -> Params {
+        Params {
+            shape,
+            nails,
+            radius_um,
+        }
+    }
+
+    #[test]
+    fn good_files() {
+        let good: &[(&str, Params)] = &[
+            (
+                "tvar = 0               # shape: 0 circle, n >= 3 regular n-gon\n\
+                 pocet_hrebiku = 250    # number of nails\n\
+                 polomer_matrice = 40.2 # board radius in cm\n",
+                params(0, 250, 402_000),
+            ),
+            (
+                "\u{FEFF}# English\r\nSHAPE=4\r\n\r\nnails =\t300\r\nRadius_CM = 25",
+                params(4, 300, 250_000),
+            ),
+            ("radius_cm=3.5001\nnails=3\nshape=0", params(0, 3, 35_001)),
+            (
+                "tvar=3\npocet_hrebiku=10000\npolomer_matrice=5.5001",
+                params(3, 10_000, 55_001),
+            ),
+            (
+                "tvar=1000\nnails=3\nradius_cm=1000",
+                params(1000, 3, 10_000_000),
+            ),
+        ];
+        for (text, expected) in good {
+            assert_eq!(parse(text), Ok(*expected), "{text:?}");
+        }
+    }
+
+    #[test]
+    fn bad_files_say_where_and_what() {
+        let ok = "tvar = 0\npocet_hrebiku = 250\n";
+        let bad: &[(&str, &str)] = &[
+            ("", "param.txt: empty file"),
+            ("\u{FEFF}# nothing\r\n\r\n", "param.txt: empty file"),
+            (
+                "tvar = 0\npocet_hrebiku = 250\n",
+                "param.txt: missing key polomer_matrice (radius_cm)",
+            ),
+            (
+                "nails = 250\nradius_cm = 30",
+                "param.txt: missing key tvar (shape)",
+            ),
+            (
+                "tvar = 0\nradius_cm = 30",
+                "param.txt: missing key pocet_hrebiku (nails)",
+            ),
+            ("tvar = 0\n  pocet = 250\n", "param.txt:2:3: unknown key"),
+            ("tvar = 0\nshape = 4\n", "param.txt:2:1: duplicate key"),
+            ("tvar = 1\n", "param.txt:1:8: expected 0 or 3 to 1000"),
+            ("tvar = 2\n", "param.txt:1:8: expected 0 or 3 to 1000"),
+            ("tvar = 1001\n", "param.txt:1:8: expected 0 or 3 to 1000"),
+            ("tvar = -3\n", "param.txt:1:8: expected a number"),
+            ("tvar = kruznice\n", "param.txt:1:8: expected a number"),
+            ("tvar =\n", "param.txt:1:7: expected a number"),
+            ("pocet_hrebiku = 2\n", "param.txt:1:17: expected 3 to 10000"),
+            (
+                "pocet_hrebiku = 10001\n",
+                "param.txt:1:17: expected 3 to 10000",
+            ),
+            (
+                "pocet_hrebiku = 99999999999\n",
+                "param.txt:1:17: number too big",
+            ),
+            (
+                "pocet_hrebiku = 250.0\n",
+                "param.txt:1:20: expected a number",
+            ),
+            (
+                "polomer_matrice = 40,2\n",
+                "param.txt:1:21: expected a number",
+            ),
+            (
+                "polomer_matrice = 1000.0001\n",
+                "param.txt:1:19: number too big",
+            ),
+            ("tvar 0\n", "param.txt:1:1: expected key = value"),
+            (
+                "tvar = 0 # a comment that is far too long for a line of param.txt\n",
+                "param.txt:1:65: line too long (max 64)",
+            ),
+            // The radius check waits for the shape, wherever it is.
+            (
+                "polomer_matrice = 3.5\npocet_hrebiku = 250\ntvar = 0\n",
+                "param.txt:1:19: expected more than 3.5 cm",
+            ),
+            (
+                "polomer_matrice = 0\npocet_hrebiku = 250\ntvar = 0\n",
+                "param.txt:1:19: expected more than 3.5 cm",
+            ),
+            (
+                "tvar = 3\nnails = 250\nradius_cm = 5.5",
+                "param.txt:3:13: expected more than 5.5 cm",
+            ),
+            (
+                "tvar = 4\nnails = 250\nradius_cm = 4.3284",
+                "param.txt:3:13: expected more than 4.3284 cm",
+            ),
+        ];
+        for (text, message) in bad {
+            assert_eq!(parse(text), Err(String::from(*message)), "{text:?}");
+        }
+        assert!(parse(&(String::from(ok) + "radius_cm = 4")).is_ok());
+    }
+
+    #[test]
+    fn square_board_limit_is_just_above_the_exact_value() {
+        // 1.5 + 2.0 / cos(45°) = 4.32842… cm.
+        assert_eq!(radius_limit_um(4), 43_284);
+        assert!(parse("tvar=4\nnails=4\nradius_cm=4.3285").is_ok());
+    }
+
+    proptest! {
+        #[test]
+        fn written_params_read_back(
+            shape in prop_oneof![Just(0u16), 3u16..=MAX_SHAPE],
+            nails in 3u16..=MAX_NAILS,
+            radius_um in 0u32..=MAX_RADIUS_UM,
+            order in Just([0usize, 1, 2]).prop_shuffle(),
+            english in proptest::bool::ANY,
+            crlf in proptest::bool::ANY,
+            chunk in 1usize..80,
+        ) {
+            let values = [
+                std::format!("{shape}"),
+                std::format!("{nails}"),
+                std::format!("{}.{:04}", radius_um / 10_000, radius_um % 10_000),
+            ];
+            let mut text = String::new();
+            for k in order {
+                let key = if english { KEYS[k].1 } else { KEYS[k].0 };
+                text += &std::format!("{key} = {}{}", values[k], if crlf { "\r\n" } else { "\n" });
+            }
+            let result = parse_in_chunks(text.as_bytes(), chunk);
+            if radius_um > radius_limit_um(shape) {
+                prop_assert_eq!(result, Ok(params(shape, nails, radius_um)));
+            } else {
+                prop_assert_eq!(result.unwrap_err().kind, ErrorKind::RadiusTooSmall { above_um: radius_limit_um(shape) });
+            }
+        }
+    }
+}
