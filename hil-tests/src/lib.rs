@@ -1,1 +1,48 @@
+//! Shared helpers of the HIL tests: where the firmware images are, built on
+//! demand so `cargo test -p hil-tests` works on its own (xtask builds them
+//! first anyway).
 
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Once;
+
+pub use taut_simavr as sim;
+
+fn firmware_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware")
+}
+
+fn release_dir() -> PathBuf {
+    firmware_dir().join("target/avr-none/release")
+}
+
+static BUILD: Once = Once::new();
+
+/// Build the release image and the examples once per test process.
+fn build() {
+    BUILD.call_once(|| {
+        let st = Command::new("cargo")
+            .args(["build", "--release", "--bins", "--examples"])
+            .current_dir(firmware_dir())
+            .env_remove("RUSTUP_TOOLCHAIN")
+            .env_remove("CARGO_TARGET_DIR")
+            .status()
+            .expect("cannot run cargo for the firmware");
+        assert!(st.success(), "firmware build failed");
+    });
+}
+
+/// The shipped firmware: the release ELF.
+pub fn firmware_elf() -> PathBuf {
+    build();
+    release_dir().join("taut.elf")
+}
+
+/// A special-purpose image from `firmware/examples/NAME.rs`.
+pub fn example_elf(name: &str) -> PathBuf {
+    build();
+    release_dir().join("examples").join(format!("{name}.elf"))
+}
+
+/// The firmware version the banner must show.
+pub const VERSION: &str = "0.1.0";

@@ -1,0 +1,81 @@
+//! Building and flashing the AVR firmware (its own cargo workspace).
+
+use crate::run::{cargo, cargo_cmd, root, status, Result};
+use std::path::PathBuf;
+use std::process::Command;
+
+pub struct Image {
+    pub elf: PathBuf,
+    pub hex: PathBuf,
+    pub flash_bytes: u64,
+    pub ram_static_bytes: u64,
+    pub data_bytes: u64,
+}
+
+pub fn dir() -> PathBuf {
+    root().join("firmware")
+}
+
+pub fn release_dir() -> PathBuf {
+    dir().join("target/avr-none/release")
+}
+
+pub fn build_release() -> Result<Image> {
+    println!("== building the firmware (avr-none, release)");
+    cargo(&["build", "--release"], &dir())?;
+    let elf = release_dir().join("taut.elf");
+    let hex = release_dir().join("taut.hex");
+    status(Command::new("avr-objcopy").args(["-O", "ihex", "-R", ".eeprom"]).arg(&elf).arg(&hex))?;
+    let sizes = section_sizes(&elf)?;
+    let get = |n: &str| sizes.iter().find(|(s, _)| s == n).map_or(0, |(_, v)| *v);
+    Ok(Image {
+        flash_bytes: get(".text") + get(".data"),
+        ram_static_bytes: get(".data") + get(".bss") + get(".noinit"),
+        data_bytes: get(".data"),
+        elf,
+        hex,
+    })
+}
+
+/// The special-purpose images in firmware/examples (crash, hang, …).
+pub fn build_examples() -> Result<()> {
+    println!("== building the example images");
+    cargo(&["build", "--release", "--examples"], &dir())
+}
+
+pub fn flash() -> Result<()> {
+    let img = build_release()?;
+    img.print_size();
+    println!("== flashing through ravedude (Mega 2560 on the first serial port it finds)");
+    let mut c = cargo_cmd(&["run", "--release"], &dir());
+    status(&mut c)
+}
+
+impl Image {
+    pub fn print_size(&self) {
+        println!(
+            "size: flash {} B of 262144 ({:.1} %), static RAM {} B of 8192 (.data {} B)\n      {}\n      {}",
+            self.flash_bytes,
+            self.flash_bytes as f64 / 2621.44,
+            self.ram_static_bytes,
+            self.data_bytes,
+            self.elf.display(),
+            self.hex.display()
+        );
+    }
+}
+
+/// Allocated section sizes, from `avr-size -A`.
+fn section_sizes(elf: &PathBuf) -> Result<Vec<(String, u64)>> {
+    let out = Command::new("avr-size").arg("-A").arg(elf).output()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    Ok(text
+        .lines()
+        .filter_map(|l| {
+            let mut f = l.split_whitespace();
+            let name = f.next()?;
+            let size = f.next()?.parse().ok()?;
+            name.starts_with('.').then(|| (name.to_string(), size))
+        })
+        .collect())
+}
