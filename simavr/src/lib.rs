@@ -1,1 +1,27 @@
-pub fn x() { let _ = unsafe { simavr_ffi::avr_make_mcu_by_name(c"atmega2560".as_ptr()) }; }
+//! Safe harness over simavr for the Arduino Mega 2560 (ATmega2560, 16 MHz):
+//! load a firmware ELF, run it for a simulated time or until a condition
+//! holds, watch its pins and its serial port, drive its inputs, and learn
+//! whether it crashed, hung, was reset by its watchdog or overflowed its
+//! stack. Every `unsafe` call into simavr stays inside this crate.
+
+pub mod clock;
+pub mod elf;
+mod error;
+mod gpio;
+mod hooks;
+mod input;
+mod outcome;
+pub mod pins;
+pub mod probe;
+pub mod report;
+mod run;
+mod sim;
+pub mod uart;
+pub mod vcd;
+
+pub use elf::ElfInfo;
+pub use error::{Error, Result};
+pub use outcome::Outcome;
+pub use probe::{Edge, Probe};
+pub use report::{PinReport, Report};
+pub use sim::Sim;

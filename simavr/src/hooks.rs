@@ -1,0 +1,92 @@
+//! The state simavr's callbacks write into, and the callbacks themselves.
+//!
+//! Invariants (upheld by `Sim`):
+//! - `Shared` lives in one heap allocation that does not move and outlives the
+//!   `avr_t` (it is freed after `avr_terminate`), so the `param` pointers
+//!   handed to simavr stay valid for every callback.
+//! - Callbacks run only inside simavr calls made by `Sim`'s `&mut self`
+//!   methods (`avr_run`, `avr_raise_irq`, `avr_ioctl`), on the thread that
+//!   owns the `Sim`, and no Rust reference into `Shared` is alive across
+//!   such a call, so each callback's `&mut Shared` is the only one.
+
+use crate::probe::Probe;
+use crate::uart::Uart;
+use simavr_ffi::{avr_irq_t, avr_t};
+use std::os::raw::c_void;
+
+pub(crate) struct Shared {
+    pub avr: *mut avr_t,
+    /// Cycles run before the last reset (simavr zeroes its counter on reset).
+    pub cycle_base: u64,
+    /// Bumped by every callback: tells the run loop something happened.
+    pub events: u64,
+    pub probes: Vec<Probe>,
+    pub uart: Uart,
+    /// Address of the first invalid opcode executed.
+    pub bad_opcode_pc: Option<u32>,
+}
+
+impl Shared {
+    /// Cycles since power-on, across resets.
+    pub fn now(&self) -> u64 {
+        // SAFETY: `avr` is valid while `Shared` is reachable (see module doc).
+        self.cycle_base + unsafe { (*self.avr).cycle }
+    }
+}
+
+/// Parameter of a pin callback: which probe of which `Shared`.
+pub(crate) struct PinHook {
+    pub shared: *mut Shared,
+    pub probe: usize,
+}
+
+/// # Safety
+/// `param` is a live `PinHook` whose `shared` obeys the module invariants.
+pub(crate) unsafe extern "C" fn on_pin(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
+    let hook = &*(param as *const PinHook);
+    let shared = &mut *hook.shared;
+    let now = shared.now();
+    shared.probes[hook.probe].record(now, value & 0xff != 0);
+    shared.events += 1;
+}
+
+/// # Safety
+/// `param` is the `Shared` of the simulation (module invariants).
+pub(crate) unsafe extern "C" fn on_uart_tx(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
+    let shared = &mut *(param as *mut Shared);
+    shared.uart.tx.push(value as u8);
+    shared.events += 1;
+}
+
+/// # Safety
+/// As `on_uart_tx`.
+pub(crate) unsafe extern "C" fn on_uart_xon(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
+    let shared = &mut *(param as *mut Shared);
+    if value != 0 && !shared.uart.rx_ready {
+        shared.uart.rx_ready = true;
+        shared.events += 1;
+    }
+}
+
+/// # Safety
+/// As `on_uart_tx`.
+pub(crate) unsafe extern "C" fn on_uart_xoff(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
+    let shared = &mut *(param as *mut Shared);
+    if value != 0 {
+        shared.uart.rx_ready = false;
+    }
+}
+
+/// # Safety
+/// As `on_uart_tx`.
+pub(crate) unsafe extern "C" fn on_bad_opcode(_irq: *mut avr_irq_t, _op: u32, param: *mut c_void) {
+    let shared = &mut *(param as *mut Shared);
+    if shared.bad_opcode_pc.is_none() {
+        shared.bad_opcode_pc = Some((*shared.avr).pc);
+    }
+    shared.events += 1;
+}
+
+/// simavr's default sleeps in real time; the harness wants simulated time
+/// to pass as fast as the host can go.
+pub(crate) unsafe extern "C" fn no_sleep(_avr: *mut avr_t, _how_long: u64) {}

@@ -1,0 +1,145 @@
+//! Running the MCU: one instruction at a time, watching after each for a
+//! crash, a hang, a watchdog reset and the stack crossing into the statics,
+//! and applying the outside world's inputs when they fall due.
+
+use crate::clock::cycles_in;
+use crate::outcome::Outcome;
+use crate::sim::Sim;
+use crate::uart::CYCLES_PER_BYTE;
+use simavr_ffi as ffi;
+use std::time::{Duration, Instant};
+
+/// A predicate is checked after anything a callback reported, and at least
+/// this often (100 µs of simulated time) in between.
+const POLL_CYCLES: u64 = 1_600;
+
+impl Sim {
+    /// Runs for a simulated duration. `Running` when it went the distance.
+    pub fn run_for(&mut self, duration: Duration) -> Outcome {
+        self.run_until(|_| false, duration)
+    }
+
+    /// Runs until `done` holds (`Done`), the firmware fails, or `timeout` of
+    /// simulated time passes (`Running`). `done` sees the simulator after
+    /// every pin edge or UART byte and at least every 100 µs.
+    pub fn run_until(&mut self, mut done: impl FnMut(&Sim) -> bool, timeout: Duration) -> Outcome {
+        if let Some(end) = self.ended {
+            return end;
+        }
+        let start = self.cycles();
+        let deadline = start + cycles_in(timeout);
+        let wall = Instant::now();
+        let mut next_poll = start;
+        let mut seen_events = None;
+        let mut next_input = 0;
+        let outcome = loop {
+            let now = self.cycles();
+            let events = self.shared().events;
+            if now >= next_poll || seen_events != Some(events) {
+                if done(self) {
+                    break Outcome::Done;
+                }
+                next_poll = now + POLL_CYCLES;
+            }
+            if now >= next_input || seen_events != Some(events) {
+                next_input = self.apply_inputs(now);
+            }
+            seen_events = Some(self.shared().events);
+            if now >= deadline {
+                break Outcome::Running;
+            }
+            if let Some(end) = self.step() {
+                break end;
+            }
+        };
+        self.last_speed = Some((self.cycles() - start, wall.elapsed()));
+        if outcome.is_fatal() {
+            self.ended = Some(outcome);
+        }
+        outcome
+    }
+
+    /// Runs until the UART output holds `text`.
+    pub fn run_until_uart_contains(&mut self, text: &str, timeout: Duration) -> Outcome {
+        let needle = text.as_bytes().to_vec();
+        let mut searched = 0;
+        self.run_until(
+            |sim| {
+                let tx = &sim.shared().uart.tx;
+                let from = crate::uart::resume_from(searched.min(tx.len()), needle.len());
+                searched = tx.len();
+                crate::uart::contains(&tx[from..], &needle)
+            },
+            timeout,
+        )
+    }
+
+    /// Applies input changes due by `now`; returns the cycle of the next one.
+    fn apply_inputs(&mut self, now: u64) -> u64 {
+        while let Some((pin, high)) = self.schedule.pop_due(now) {
+            self.drive(pin, high);
+        }
+        let mut next = self.schedule.next_due().unwrap_or(u64::MAX);
+        let uart = &self.shared().uart;
+        if uart.rx_ready && !uart.rx.is_empty() {
+            if now >= uart.next_rx_cycle {
+                let uart = &mut self.shared_mut().uart;
+                let byte = uart.rx.pop_front().unwrap_or_default();
+                uart.next_rx_cycle = now + CYCLES_PER_BYTE;
+                // SAFETY: `uart_input` is UART0's input IRQ of our live avr_t;
+                // no reference into `Shared` is held across the call.
+                unsafe { ffi::avr_raise_irq(self.uart_input, byte as u32) };
+            }
+            next = next.min(self.shared().uart.next_rx_cycle);
+        }
+        next
+    }
+
+    /// Executes one instruction (or one sleep stretch) and says whether it
+    /// ended the run.
+    fn step(&mut self) -> Option<Outcome> {
+        let avr = self.avr.as_ptr();
+        // SAFETY: `avr` is live (Sim invariants); callbacks it triggers only
+        // touch `Shared`, and no reference into it is held here.
+        let (pc_before, state, pc, cycle) = unsafe {
+            let pc_before = (*avr).pc;
+            let state = ffi::avr_run(avr) as u32;
+            (pc_before, state, (*avr).pc, (*avr).cycle)
+        };
+        if cycle < self.last_avr_cycle {
+            // Only a reset sets simavr's counter back, and in a run only the
+            // watchdog resets.
+            let before = self.last_avr_cycle;
+            let shared = self.shared_mut();
+            shared.cycle_base += before;
+            shared.uart.rx_ready = false;
+            self.last_avr_cycle = cycle;
+            self.resets += 1;
+            return Some(Outcome::WatchdogReset { count: self.resets });
+        }
+        self.last_avr_cycle = cycle;
+        match state {
+            ffi::cpu_Crashed => return Some(Outcome::Crashed { pc: pc_before }),
+            ffi::cpu_Done => return Some(Outcome::Hung { pc: pc_before }),
+            _ => {}
+        }
+        if let Some(pc) = self.shared().bad_opcode_pc {
+            return Some(Outcome::Crashed { pc });
+        }
+        if pc == 0 {
+            return Some(Outcome::Crashed { pc: pc_before });
+        }
+        let sp = self.sp();
+        if sp < self.min_sp {
+            self.min_sp = sp;
+            // The last push wrote at sp + 1.
+            if u32::from(sp) + 1 < u32::from(self.ram_limit) {
+                return Some(Outcome::StackOverflow {
+                    sp,
+                    limit: self.ram_limit,
+                });
+            }
+        }
+        None
+    }
+}

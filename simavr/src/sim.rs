@@ -1,0 +1,283 @@
+//! A simulated ATmega2560 at 16 MHz: setting it up from an ELF or from raw
+//! machine code, tearing it down, and its clock and stack figures.
+//!
+//! Safety invariants of `Sim` (every `unsafe` block below relies on them):
+//! - `avr` points to the `avr_t` simavr allocated for this `Sim` alone; it is
+//!   initialised before `Sim` exists and freed only in `Drop`.
+//! - `shared` is a `Box<Shared>` turned into a raw pointer; simavr callbacks
+//!   hold it as their `param` (see `hooks`). It is freed after the `avr_t` is
+//!   terminated, so no callback can outlive it. All access goes through the
+//!   raw pointer, in short scopes that never span a simavr call.
+//! - `Sim` is neither `Send` nor `Sync` (raw pointers): callbacks always run
+//!   on the owning thread.
+
+use crate::clock::{self, FREQ_HZ};
+use crate::elf::{self, ElfInfo, RAM_END, RAM_START};
+use crate::hooks::{self, PinHook, Shared};
+use crate::input::PinSchedule;
+use crate::outcome::Outcome;
+use crate::uart::Uart;
+use crate::{Error, Result};
+use simavr_ffi as ffi;
+use std::ffi::CString;
+use std::os::raw::c_void;
+use std::path::Path;
+use std::ptr::NonNull;
+use std::time::Duration;
+
+extern "C" {
+    /// simavr allocates the `avr_t` with `malloc`; `avr_terminate` does not
+    /// free it.
+    fn free(ptr: *mut c_void);
+}
+
+/// Stack pointer registers in data space.
+const SPL: usize = 0x5D;
+const SPH: usize = 0x5E;
+
+/// The number simavr builds an ioctl code from four characters with.
+pub(crate) const fn ioctl(a: u8, b: u8, c: u8, d: u8) -> u32 {
+    (a as u32) << 24 | (b as u32) << 16 | (c as u32) << 8 | d as u32
+}
+
+/// A STEP/DIR pair whose net steps go into reports.
+pub(crate) struct StepDir {
+    pub step: u8,
+    pub dir: u8,
+    pub dir_high_is_positive: bool,
+}
+
+pub struct Sim {
+    pub(crate) avr: NonNull<ffi::avr_t>,
+    pub(crate) shared: NonNull<Shared>,
+    pub(crate) pin_hooks: Vec<Box<PinHook>>,
+    pub(crate) uart_input: *mut ffi::avr_irq_t,
+    pub(crate) elf: Option<ElfInfo>,
+    pub(crate) ram_limit: u16,
+    pub(crate) min_sp: u16,
+    pub(crate) resets: u32,
+    /// simavr's own cycle counter after the last step: it drops on reset.
+    pub(crate) last_avr_cycle: u64,
+    /// A fatal ending, repeated by every later run.
+    pub(crate) ended: Option<Outcome>,
+    pub(crate) schedule: PinSchedule,
+    /// Externally driven pins per port A..L: (mask, levels).
+    pub(crate) external: [(u8, u8); 12],
+    pub(crate) step_dir: Vec<StepDir>,
+    /// Simulated cycles and host time of the last run.
+    pub(crate) last_speed: Option<(u64, Duration)>,
+}
+
+impl Sim {
+    /// Loads a firmware ELF built for the ATmega2560.
+    pub fn load(elf_path: &Path) -> Result<Sim> {
+        let info = elf::read(elf_path)?;
+        let c_path = CString::new(elf_path.to_string_lossy().as_bytes())
+            .map_err(|_| Error::Elf(format!("{}: NUL in path", elf_path.display())))?;
+        // SAFETY: elf_firmware_t is plain C data that simavr requires zeroed
+        // before reading; all-zero is valid for its integers and pointers.
+        let mut firmware: ffi::elf_firmware_t = unsafe { std::mem::zeroed() };
+        // SAFETY: valid NUL-terminated path and a zeroed firmware struct.
+        if unsafe { ffi::elf_read_firmware(c_path.as_ptr(), &mut firmware) } != 0 {
+            return Err(Error::Elf(format!(
+                "simavr could not read {}",
+                elf_path.display()
+            )));
+        }
+        let avr = new_mcu()?;
+        // SAFETY: `avr` is initialised; `firmware` was filled by simavr.
+        unsafe { ffi::avr_load_firmware(avr.as_ptr(), &mut firmware) };
+        Ok(Sim::attach(avr, Some(info), info.static_ram_end))
+    }
+
+    /// Loads raw machine code (little-endian 16-bit words) at address 0, for
+    /// tests with hand-assembled programs. No statics: the stack may grow
+    /// down to the start of SRAM unless `set_ram_limit` says otherwise.
+    pub fn from_program(words: &[u16]) -> Result<Sim> {
+        let mut bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        let avr = new_mcu()?;
+        // SAFETY: `avr` is initialised, so `flashend` is set.
+        let flash = unsafe { (*avr.as_ptr()).flashend } as usize + 1;
+        if bytes.len() > flash {
+            // SAFETY: `avr` came from simavr and is not used afterwards.
+            unsafe { release_mcu(avr) };
+            return Err(Error::Simavr(format!("{} bytes exceed flash", bytes.len())));
+        }
+        // SAFETY: simavr copies `bytes.len()` bytes, which fit in flash.
+        unsafe { ffi::avr_loadcode(avr.as_ptr(), bytes.as_mut_ptr(), bytes.len() as u32, 0) };
+        Ok(Sim::attach(avr, None, RAM_START))
+    }
+
+    /// Wires the harness into an initialised MCU with its code loaded.
+    fn attach(avr: NonNull<ffi::avr_t>, elf: Option<ElfInfo>, ram_limit: u16) -> Sim {
+        let a = avr.as_ptr();
+        let shared = Box::into_raw(Box::new(Shared {
+            avr: a,
+            cycle_base: 0,
+            events: 0,
+            probes: Vec::new(),
+            uart: Uart::default(),
+            bad_opcode_pc: None,
+        }));
+        let param = shared as *mut c_void;
+        // SAFETY: `a` is a live, initialised avr_t; `param` outlives it (see
+        // module invariants); the callbacks match simavr's signatures.
+        let uart_input = unsafe {
+            (*a).sleep = Some(hooks::no_sleep);
+            (*a).frequency = FREQ_HZ as u32;
+            // No echo of UART output to our stdout, and no host usleep while
+            // the firmware polls an empty receiver.
+            let mut flags: u32 = 0;
+            ffi::avr_ioctl(
+                a,
+                ioctl(b'u', b'a', b'g', b'0'),
+                &mut flags as *mut u32 as *mut c_void,
+            );
+            flags &= !(ffi::AVR_UART_FLAG_STDIO | ffi::AVR_UART_FLAG_POLL_SLEEP);
+            ffi::avr_ioctl(
+                a,
+                ioctl(b'u', b'a', b's', b'0'),
+                &mut flags as *mut u32 as *mut c_void,
+            );
+            let uart = |n: u32| ffi::avr_io_getirq(a, ioctl(b'u', b'a', b'r', b'0'), n as i32);
+            ffi::avr_irq_register_notify(
+                uart(ffi::UART_IRQ_OUTPUT),
+                Some(hooks::on_uart_tx),
+                param,
+            );
+            ffi::avr_irq_register_notify(
+                uart(ffi::UART_IRQ_OUT_XON),
+                Some(hooks::on_uart_xon),
+                param,
+            );
+            ffi::avr_irq_register_notify(
+                uart(ffi::UART_IRQ_OUT_XOFF),
+                Some(hooks::on_uart_xoff),
+                param,
+            );
+            let bad = ffi::avr_get_core_irq(a, ffi::AVR_CORE_BAD_OPCODE as i32);
+            ffi::avr_irq_register_notify(bad, Some(hooks::on_bad_opcode), param);
+            uart(ffi::UART_IRQ_INPUT)
+        };
+        Sim {
+            avr,
+            // SAFETY: from Box::into_raw, never null.
+            shared: unsafe { NonNull::new_unchecked(shared) },
+            pin_hooks: Vec::new(),
+            uart_input,
+            elf,
+            ram_limit,
+            min_sp: RAM_END,
+            resets: 0,
+            last_avr_cycle: 0,
+            ended: None,
+            schedule: PinSchedule::default(),
+            external: [(0, 0); 12],
+            step_dir: Vec::new(),
+            last_speed: None,
+        }
+    }
+
+    pub(crate) fn shared(&self) -> &Shared {
+        // SAFETY: module invariants: valid, and no callback runs during `&self`.
+        unsafe { self.shared.as_ref() }
+    }
+
+    pub(crate) fn shared_mut(&mut self) -> &mut Shared {
+        // SAFETY: as `shared`; `&mut self` makes this the only reference.
+        unsafe { self.shared.as_mut() }
+    }
+
+    /// Section sizes and end of statics, when loaded from an ELF.
+    pub fn elf(&self) -> Option<&ElfInfo> {
+        self.elf.as_ref()
+    }
+
+    /// Cycles since power-on (resets do not restart the count).
+    pub fn cycles(&self) -> u64 {
+        self.shared().now()
+    }
+
+    pub fn time_s(&self) -> f64 {
+        self.cycles() as f64 / FREQ_HZ as f64
+    }
+
+    pub fn time_us(&self) -> f64 {
+        clock::cycles_to_us(self.cycles())
+    }
+
+    /// Simulated MHz per host second during the last run.
+    pub fn sim_mhz(&self) -> Option<f64> {
+        let (cycles, wall) = self.last_speed?;
+        let secs = wall.as_secs_f64();
+        (secs > 0.0).then(|| cycles as f64 / secs / 1e6)
+    }
+
+    /// Watchdog resets so far.
+    pub fn watchdog_resets(&self) -> u32 {
+        self.resets
+    }
+
+    /// Current stack pointer.
+    pub fn sp(&self) -> u16 {
+        // SAFETY: `data` holds `ramend + 1` bytes, far above 0x5E.
+        unsafe {
+            let data = (*self.avr.as_ptr()).data;
+            u16::from_le_bytes([*data.add(SPL), *data.add(SPH)])
+        }
+    }
+
+    /// Lowest stack pointer seen (checked after every instruction).
+    pub fn stack_high_water(&self) -> u16 {
+        self.min_sp
+    }
+
+    /// Most stack ever in use, in bytes.
+    pub fn peak_stack_bytes(&self) -> u16 {
+        RAM_END - self.min_sp
+    }
+
+    /// First address past the statics: the stack must stay above it.
+    pub fn ram_limit(&self) -> u16 {
+        self.ram_limit
+    }
+
+    /// Overrides the end of statics (raw programs have no symbols).
+    pub fn set_ram_limit(&mut self, limit: u16) {
+        self.ram_limit = limit;
+    }
+}
+
+impl Drop for Sim {
+    fn drop(&mut self) {
+        // SAFETY: `avr` is live and used no more; callbacks can no longer run
+        // once it is terminated, so `shared` may be freed after it.
+        unsafe {
+            release_mcu(self.avr);
+            drop(Box::from_raw(self.shared.as_ptr()));
+        }
+    }
+}
+
+/// A fresh, initialised ATmega2560 at 16 MHz.
+fn new_mcu() -> Result<NonNull<ffi::avr_t>> {
+    // SAFETY: a NUL-terminated name; simavr returns a new avr_t or null.
+    let avr = NonNull::new(unsafe { ffi::avr_make_mcu_by_name(c"atmega2560".as_ptr()) })
+        .ok_or_else(|| Error::Simavr("no atmega2560 core".into()))?;
+    // SAFETY: `avr` was just allocated by simavr.
+    unsafe {
+        (*avr.as_ptr()).frequency = FREQ_HZ as u32;
+        if ffi::avr_init(avr.as_ptr()) != 0 {
+            free(avr.as_ptr() as *mut c_void);
+            return Err(Error::Simavr("avr_init failed".into()));
+        }
+    }
+    Ok(avr)
+}
+
+/// # Safety
+/// `avr` is an initialised avr_t from `new_mcu`, not used afterwards.
+unsafe fn release_mcu(avr: NonNull<ffi::avr_t>) {
+    ffi::avr_terminate(avr.as_ptr());
+    free(avr.as_ptr() as *mut c_void);
+}

@@ -1,0 +1,175 @@
+//! The harness checked against tiny hand-assembled AVR programs, whose exact
+//! cycle counts are known from the instruction set manual.
+
+use std::time::Duration;
+use taut_simavr::{vcd, Outcome, Sim};
+
+const LED: u8 = 13; // PB7
+const BUTTON: u8 = 22; // PA0
+
+const CLI: u16 = 0x94F8;
+const SLEEP: u16 = 0x9588;
+const NOP: u16 = 0x0000;
+
+/// Toggles PB7 ten times (out PINB; dec; brne: 4 cycles a toggle), then
+/// `cli; sleep`.
+const TOGGLE_10: [u16; 8] = [
+    0xE800, // ldi r16, 0x80
+    0xB904, // out DDRB, r16
+    0xE01A, // ldi r17, 10
+    0xB903, // loop: out PINB, r16   (writing 1 to PINx toggles PORTx)
+    0x951A, // dec r17
+    0xF7E9, // brne loop
+    CLI, SLEEP,
+];
+
+fn ms(n: u64) -> Duration {
+    Duration::from_millis(n)
+}
+
+#[test]
+fn probe_counts_exact_edges_and_timing() {
+    let mut sim = Sim::from_program(&TOGGLE_10).unwrap();
+    sim.probe(LED, "led");
+    let end = sim.run_for(ms(1));
+    assert!(matches!(end, Outcome::Hung { pc: 14 }), "{end:?}");
+    let led = sim.probed("led");
+    assert_eq!(led.edge_count(), 10);
+    assert_eq!(led.rising_count(), 5);
+    assert_eq!(led.min_high_cycles(), Some(4));
+    assert_eq!(led.min_period_cycles(), Some(8));
+    assert!(!led.level(), "ten toggles end low");
+    let first = led.edges()[0].cycle;
+    let last = led.edges()[9].cycle;
+    assert_eq!(last - first, 9 * 4);
+}
+
+#[test]
+fn vcd_holds_the_named_signals_and_their_edges() {
+    let mut sim = Sim::from_program(&TOGGLE_10).unwrap();
+    sim.probe(LED, "status_led");
+    sim.probe(BUTTON, "confirm");
+    sim.run_for(ms(1));
+    let path = std::env::temp_dir().join(format!("taut-selftest-{}.vcd", std::process::id()));
+    sim.write_vcd(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let signals = vcd::parse(&text).unwrap();
+    let names: Vec<&str> = signals.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(names, ["status_led", "confirm"]);
+    let led = sim.probed("status_led");
+    let back: Vec<(u64, bool)> = signals[0]
+        .changes
+        .iter()
+        .map(|&(ns, high)| (taut_simavr::clock::ns_to_cycles(ns), high))
+        .collect();
+    let want: Vec<(u64, bool)> = led.edges().iter().map(|e| (e.cycle, e.high)).collect();
+    assert_eq!(back, want);
+    assert!(signals[1].changes.is_empty());
+}
+
+#[test]
+fn sleep_with_interrupts_off_is_a_hang() {
+    let mut sim = Sim::from_program(&[NOP, CLI, SLEEP]).unwrap();
+    assert_eq!(sim.run_for(ms(1)), Outcome::Hung { pc: 4 });
+    // The ending sticks.
+    assert_eq!(sim.run_for(ms(1)), Outcome::Hung { pc: 4 });
+}
+
+#[test]
+fn running_into_erased_flash_is_a_crash() {
+    // rjmp .+510: to word 257, erased (0xFFFF) like the rest of flash.
+    let mut sim = Sim::from_program(&[NOP, 0xC0FF]).unwrap();
+    let end = sim.run_for(ms(100));
+    assert!(
+        matches!(end, Outcome::Crashed { pc } if pc >= 512),
+        "{end:?}"
+    );
+}
+
+#[test]
+fn jump_to_reset_vector_is_a_crash() {
+    // nop; nop; rjmp 0 (what a null function pointer does).
+    let mut sim = Sim::from_program(&[NOP, NOP, 0xCFFD]).unwrap();
+    assert_eq!(sim.run_for(ms(1)), Outcome::Crashed { pc: 4 });
+}
+
+#[test]
+fn pushing_forever_overflows_the_stack() {
+    // nop; loop: push r16; rjmp loop
+    let mut sim = Sim::from_program(&[NOP, 0x930F, 0xCFFE]).unwrap();
+    sim.set_ram_limit(0x1000);
+    let end = sim.run_for(ms(10));
+    assert_eq!(
+        end,
+        Outcome::StackOverflow {
+            sp: 0x0FFE,
+            limit: 0x1000
+        }
+    );
+    assert_eq!(sim.stack_high_water(), 0x0FFE);
+    assert_eq!(sim.peak_stack_bytes(), 0x21FF - 0x0FFE);
+}
+
+#[test]
+fn watchdog_without_wdr_resets() {
+    let program = [
+        0xE108, // ldi r16, WDCE|WDE
+        0x9300, 0x0060, // sts WDTCSR, r16
+        0xE008, // ldi r16, WDE (16 ms)
+        0x9300, 0x0060, // sts WDTCSR, r16
+        0xCFFF, // rjmp .-2
+    ];
+    let mut sim = Sim::from_program(&program).unwrap();
+    let end = sim.run_for(ms(100));
+    assert_eq!(end, Outcome::WatchdogReset { count: 1 });
+    assert_eq!(sim.watchdog_resets(), 1);
+    // 2048 cycles of the 128 kHz watchdog oscillator: 16 ms.
+    let t = sim.time_s();
+    assert!((0.0159..0.0162).contains(&t), "reset at {t} s");
+    // The firmware restarts, arms the watchdog again and is reset again.
+    assert_eq!(sim.run_for(ms(100)), Outcome::WatchdogReset { count: 2 });
+    assert!(sim.time_s() > 0.031, "time runs on across resets");
+}
+
+#[test]
+fn run_until_stops_when_the_predicate_holds() {
+    let mut sim = Sim::from_program(&TOGGLE_10).unwrap();
+    sim.probe(LED, "led");
+    let end = sim.run_until(|s| s.probed("led").rising_count() == 3, ms(1));
+    assert_eq!(end, Outcome::Done);
+    assert_eq!(sim.probed("led").edge_count(), 5);
+}
+
+#[test]
+fn pressed_button_reads_low_despite_pull_up() {
+    // Pull-up on PA0, then copy PINA bit 0 to PB7 forever, rewriting PORTA
+    // each time round (which must not undo a press).
+    let program = [
+        0xE011, // ldi r17, 0x01
+        0xB912, // out PORTA, r17
+        0xE800, // ldi r16, 0x80
+        0xB904, // out DDRB, r16
+        0x9900, // loop: sbic PINA, 0
+        0xC002, // rjmp high
+        0x982F, // cbi PORTB, 7
+        0xCFFC, // rjmp loop
+        0x9A2F, // high: sbi PORTB, 7
+        0xB912, // out PORTA, r17
+        0xCFF9, // rjmp loop
+    ];
+    let mut sim = Sim::from_program(&program).unwrap();
+    sim.probe(LED, "led");
+    sim.probe(BUTTON, "button");
+    sim.run_for(ms(1));
+    assert!(sim.pin_level(LED), "pull-up reads high");
+    sim.press(BUTTON);
+    sim.run_for(ms(1));
+    assert!(!sim.pin_level(LED), "pressed reads low");
+    sim.release_with_bounce(BUTTON, 3, Duration::from_micros(100));
+    sim.run_for(ms(2));
+    assert!(sim.pin_level(LED));
+    // Pull-up, press, then release with three bounces: 1 + 1 + 7 edges.
+    assert_eq!(sim.probed("button").edge_count(), 9);
+    assert_eq!(sim.probed("led").rising_count(), 1 + 4);
+}
