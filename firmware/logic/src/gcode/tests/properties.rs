@@ -1,0 +1,137 @@
+use super::render::{render, Choices};
+use super::*;
+use proptest::prelude::*;
+use std::{format, string::String, vec::Vec};
+
+fn milli() -> impl Strategy<Value = Milli> {
+    prop_oneof![-i32::MAX..=i32::MAX, -100_000i32..100_000].prop_map(Milli)
+}
+
+fn command() -> impl Strategy<Value = Command> {
+    use Command::*;
+    prop::sample::select(
+        &[
+            Empty,
+            Rapid,
+            Linear,
+            Dwell,
+            SetPosition,
+            EnableDrivers,
+            DisableDrivers,
+            ReportPosition,
+            WaitIdle,
+        ][..],
+    )
+}
+
+/// Any line the parser can produce, its words consistent with its command.
+fn any_line() -> impl Strategy<Value = Line> {
+    let distance = prop::option::of(prop_oneof![
+        Just(Distance::Absolute),
+        Just(Distance::Relative)
+    ]);
+    let axes = prop::array::uniform5(prop::option::weighted(0.4, milli()));
+    let positive = (0..=i32::MAX).prop_map(Milli);
+    (
+        command(),
+        distance,
+        axes,
+        prop::option::of(positive.clone()),
+        positive,
+        prop::option::of(0u32..=9_999_999),
+    )
+        .prop_map(|(command, distance, mut axes, f, p, n)| {
+            let takes_axes = matches!(
+                command,
+                Command::Empty | Command::Rapid | Command::Linear | Command::SetPosition
+            );
+            if !takes_axes {
+                axes = [None; AXIS_WORDS];
+            } else if command == Command::SetPosition && axes.iter().all(Option::is_none) {
+                axes[AxisWord::Z.index()] = Some(Milli(0));
+            }
+            let p = (command == Command::Dwell).then_some(p);
+            Line {
+                n,
+                checksum: None,
+                distance,
+                command,
+                axes,
+                f,
+                p,
+            }
+        })
+}
+
+/// The reference: `int.frac` (frac as typed) rounded to thousandths, half
+/// away from zero, or `None` beyond i32.
+fn reference(negative: bool, int: u64, frac: &str) -> Option<i32> {
+    let digits = format!("{frac:0<4}");
+    let thousandths: u64 = digits[..3].parse().unwrap();
+    let round = (digits.as_bytes()[3] >= b'5') as u64;
+    let magnitude = int * 1000 + thousandths + round;
+    let m = i32::try_from(magnitude).ok()?;
+    Some(if negative { -m } else { m })
+}
+
+proptest! {
+    #[test]
+    fn printed_lines_parse_back(line in any_line(), choices in prop::collection::vec(any::<u8>(), 0..64)) {
+        let (text, checksum) = render(&mut Choices::new(&choices), &line);
+        let result = parse(&text);
+        if text.trim_end_matches('\r').len() > MAX_LINE as usize {
+            prop_assert_eq!(result.map_err(|e| (e.code(), e.column())), Err((11, Some(81))));
+        } else {
+            prop_assert_eq!(result, Ok(Input::Line(Line { checksum, ..line })), "{:?}", text);
+        }
+    }
+
+    #[test]
+    fn numbers_round_half_away_from_zero(
+        negative: bool,
+        int in prop_oneof![0u64..3_000_000, 0u64..10],
+        frac in "[0-9]{0,7}",
+    ) {
+        let text = format!("G1 X{}{int}.{frac}", if negative { "-" } else { "" });
+        let expected = reference(negative, int, &frac);
+        match parse(&text) {
+            Ok(Input::Line(l)) => prop_assert_eq!(l.axis(AxisWord::X).map(|m| m.0), expected),
+            other => {
+                prop_assert_eq!(expected, None);
+                prop_assert_eq!(other.map_err(|e| e.code()), Err(2));
+            }
+        }
+    }
+
+    #[test]
+    fn random_bytes_never_panic_and_each_newline_answers_once(
+        bytes in prop::collection::vec(prop_oneof![any::<u8>(), prop::sample::select(&b"GXN*;() 1.-\n$="[..])], 0..300),
+    ) {
+        let mut parser = Parser::new();
+        let mut lines = 0;
+        for &b in &bytes {
+            match parser.push(b) {
+                Some(Ok(Input::Realtime(r))) => prop_assert_eq!(Realtime::from_byte(b), Some(r)),
+                Some(_) => {
+                    prop_assert_eq!(b, b'\n');
+                    lines += 1;
+                }
+                None => prop_assert!(b != b'\n' && Realtime::from_byte(b).is_none()),
+            }
+        }
+        prop_assert_eq!(lines, bytes.iter().filter(|&&b| b == b'\n').count());
+        // Whatever came before, the parser is clean after the next newline.
+        let out: Vec<_> = b"\nG91 G1 C1\n".iter().filter_map(|&b| parser.push(b)).collect();
+        let expected = line(Command::Linear).distance(Distance::Relative).at(AxisWord::C, 1_000);
+        prop_assert_eq!(out.len(), 2);
+        prop_assert_eq!(&out[1], &Ok(Input::Line(expected)));
+    }
+
+    #[test]
+    fn columns_point_into_the_line(text in "[ -~]{0,90}") {
+        if let Err(e) = parse(&String::from_iter(text.chars().filter(|c| !"?!~".contains(*c)))) {
+            let column = e.column().expect("parser errors have a column");
+            prop_assert!((1..=MAX_LINE + 1).contains(&column));
+        }
+    }
+}
