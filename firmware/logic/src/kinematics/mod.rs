@@ -1,1 +1,175 @@
-//! (being written)
+//! Kinematics: the machine's coordinates (what the G-code words name) ↔
+//! absolute motor positions in steps.
+//!
+//! A [`Position`] holds one coordinate per channel in [`Milli`] (µm or
+//! millidegrees); coordinate `i` is named by the G-code word
+//! [`Kinematics::words`]`[i]`. Steps are always computed from the absolute
+//! target and rounded once, so positions never drift.
+//!
+//! Linear kinematics (cylindrical, cartesian) map each coordinate to its own
+//! channel with exact integer arithmetic. Polargraph and SCARA are not
+//! linear: a straight line in space is curved in joint space, so a move is
+//! cut by [`Segmenter`] into short pieces, each converted with f32/libm.
+//! Cost on the AVR per piece: sqrtf ≈ 7 300 cycles, atan2f ≈ 20 000,
+//! sinf/cosf ≈ 36 000, acosf ≈ 25 000 — a SCARA inverse is ≈ 60 000 cycles
+//! (≈ 4 ms at 16 MHz), a polargraph inverse ≈ 20 000 (≈ 1.3 ms). That bounds
+//! the piece rate, never the step rate: nothing here runs per step.
+
+mod cartesian;
+mod cylindrical;
+mod polargraph;
+mod scara;
+mod segmenter;
+
+pub use cartesian::Cartesian;
+pub use cylindrical::Cylindrical;
+pub use polargraph::Polargraph;
+pub use scara::Scara;
+pub use segmenter::Segmenter;
+
+use crate::axis::{PerAxis, AXES};
+use crate::config::MachineConfig;
+use crate::units::{div_round, Milli, StepsPerUnit};
+
+/// Machine coordinates, one per channel, in thousandths of the unit.
+pub type Position = PerAxis<Milli>;
+/// Absolute motor positions, one per channel.
+pub type Steps = PerAxis<i32>;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KinError {
+    /// The position is outside the machine's reach.
+    Unreachable,
+    /// The step count does not fit an `i32`.
+    Overflow,
+}
+
+impl KinError {
+    pub const fn message(self) -> &'static str {
+        match self {
+            KinError::Unreachable => "unreachable",
+            KinError::Overflow => "too far",
+        }
+    }
+}
+
+pub trait Kinematics {
+    /// Absolute step targets of an absolute position.
+    fn inverse(&self, pos: &Position) -> Result<Steps, KinError>;
+    /// The position the motors are at.
+    fn forward(&self, steps: &Steps) -> Position;
+    /// True when a straight line in space is a straight line in joint
+    /// space, so moves need no segmentation.
+    fn is_linear(&self) -> bool;
+    /// The G-code word (ASCII letter) naming each coordinate.
+    fn words(&self) -> [u8; AXES];
+}
+
+/// Each coordinate scaled onto its own channel: the whole of a linear
+/// kinematics, and the pen/aux channels of the others.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ChannelScale(pub PerAxis<StepsPerUnit>);
+
+impl ChannelScale {
+    pub fn from_config(config: &MachineConfig) -> Self {
+        ChannelScale(config.axes.map(|a| a.steps_per_unit))
+    }
+
+    /// Steps of one coordinate, rounded once from the absolute target.
+    pub fn steps(&self, axis: usize, target: Milli) -> Result<i32, KinError> {
+        let spu = self.0[axis];
+        let n = target.0 as i64 * spu.num as i64;
+        let steps = div_round(n, spu.den as i64 * Milli::SCALE as i64);
+        i32::try_from(steps).map_err(|_| KinError::Overflow)
+    }
+
+    pub fn milli(&self, axis: usize, steps: i32) -> Milli {
+        self.0[axis].milli(steps)
+    }
+
+    /// Steps of a joint value computed in floating point (mm or degrees).
+    fn steps_f32(&self, axis: usize, value: f32) -> Result<i32, KinError> {
+        let s = libm::roundf(value * self.0[axis].as_f32());
+        // 2^31 is exact in f32; NaN fails both comparisons.
+        if (-2_147_483_648.0..2_147_483_648.0).contains(&s) {
+            Ok(s as i32)
+        } else {
+            Err(KinError::Overflow)
+        }
+    }
+
+    /// The joint value (mm or degrees) of a step count.
+    fn value_f32(&self, axis: usize, steps: i32) -> f32 {
+        let spu = self.0[axis];
+        steps as f32 * spu.den as f32 / spu.num as f32
+    }
+
+    fn all_steps(&self, pos: &Position) -> Result<Steps, KinError> {
+        let mut out = [0; AXES];
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.steps(i, pos[i])?;
+        }
+        Ok(out)
+    }
+
+    fn all_milli(&self, steps: &Steps) -> Position {
+        core::array::from_fn(|i| self.milli(i, steps[i]))
+    }
+}
+
+/// µm → mm for the float kinematics.
+fn mm(m: Milli) -> f32 {
+    m.0 as f32 / Milli::SCALE as f32
+}
+
+/// mm → µm, rounded.
+fn milli(mm: f32) -> Milli {
+    Milli(libm::roundf(mm * Milli::SCALE as f32) as i32)
+}
+
+/// One of the kinematics, chosen at run time from the machine's config.
+#[derive(Clone, Copy, Debug)]
+pub enum AnyKinematics {
+    Cylindrical(Cylindrical),
+    Cartesian(Cartesian),
+    Polargraph(Polargraph),
+    Scara(Scara),
+}
+
+impl Kinematics for AnyKinematics {
+    fn inverse(&self, pos: &Position) -> Result<Steps, KinError> {
+        match self {
+            AnyKinematics::Cylindrical(k) => k.inverse(pos),
+            AnyKinematics::Cartesian(k) => k.inverse(pos),
+            AnyKinematics::Polargraph(k) => k.inverse(pos),
+            AnyKinematics::Scara(k) => k.inverse(pos),
+        }
+    }
+
+    fn forward(&self, steps: &Steps) -> Position {
+        match self {
+            AnyKinematics::Cylindrical(k) => k.forward(steps),
+            AnyKinematics::Cartesian(k) => k.forward(steps),
+            AnyKinematics::Polargraph(k) => k.forward(steps),
+            AnyKinematics::Scara(k) => k.forward(steps),
+        }
+    }
+
+    fn is_linear(&self) -> bool {
+        match self {
+            AnyKinematics::Cylindrical(k) => k.is_linear(),
+            AnyKinematics::Cartesian(k) => k.is_linear(),
+            AnyKinematics::Polargraph(k) => k.is_linear(),
+            AnyKinematics::Scara(k) => k.is_linear(),
+        }
+    }
+
+    fn words(&self) -> [u8; AXES] {
+        match self {
+            AnyKinematics::Cylindrical(k) => k.words(),
+            AnyKinematics::Cartesian(k) => k.words(),
+            AnyKinematics::Polargraph(k) => k.words(),
+            AnyKinematics::Scara(k) => k.words(),
+        }
+    }
+}

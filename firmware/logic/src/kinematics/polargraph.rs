@@ -1,0 +1,153 @@
+//! Two-string hanging plotter (seed 003's whiteboard machine). The left
+//! motor's string leaves its pulley at (0, 0), the right one's at (D, 0),
+//! y up; the pen hangs below (y < 0) where the strings meet. Channel 0 winds
+//! the left string, channel 1 the right one (both in mm of string), channel 2
+//! lifts the pen. The user's (0, 0) is `origin` in that frame, and the step
+//! counts are zero there (the pen is parked at the origin when zeroed).
+
+use super::{milli, mm, ChannelScale, KinError, Kinematics, Position, Steps};
+use crate::axis::AXES;
+use crate::units::Milli;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Polargraph {
+    scale: ChannelScale,
+    /// Distance between the string exits, mm.
+    distance: f32,
+    /// The user's origin in the motors' frame, mm.
+    origin: [f32; 2],
+    /// String lengths at the origin, mm.
+    home: [f32; 2],
+}
+
+impl Polargraph {
+    /// `origin` must hang below the motors, between them or not.
+    pub fn new(scale: ChannelScale, distance: Milli, origin: [Milli; 2]) -> Result<Self, KinError> {
+        let mut k = Polargraph {
+            scale,
+            distance: mm(distance),
+            origin: [mm(origin[0]), mm(origin[1])],
+            home: [0.0; 2],
+        };
+        if k.distance <= 0.0 {
+            return Err(KinError::Unreachable);
+        }
+        k.home = k.lengths(k.origin)?;
+        Ok(k)
+    }
+
+    /// String lengths to a point of the motors' frame.
+    fn lengths(&self, [x, y]: [f32; 2]) -> Result<[f32; 2], KinError> {
+        if y >= 0.0 {
+            return Err(KinError::Unreachable);
+        }
+        let dx = self.distance - x;
+        Ok([libm::sqrtf(x * x + y * y), libm::sqrtf(dx * dx + y * y)])
+    }
+}
+
+impl Kinematics for Polargraph {
+    fn inverse(&self, pos: &Position) -> Result<Steps, KinError> {
+        let p = [self.origin[0] + mm(pos[0]), self.origin[1] + mm(pos[1])];
+        let len = self.lengths(p)?;
+        let mut steps = self.scale.all_steps(pos)?;
+        for i in 0..2 {
+            steps[i] = self.scale.steps_f32(i, len[i] - self.home[i])?;
+        }
+        Ok(steps)
+    }
+
+    fn forward(&self, steps: &Steps) -> Position {
+        let l = self.home[0] + self.scale.value_f32(0, steps[0]);
+        let r = self.home[1] + self.scale.value_f32(1, steps[1]);
+        let d = self.distance;
+        // Intersection of the two circles, the lower one.
+        let x = (l * l - r * r + d * d) / (2.0 * d);
+        let y = -libm::sqrtf((l * l - x * x).max(0.0));
+        let mut pos = self.scale.all_milli(steps);
+        pos[0] = milli(x - self.origin[0]);
+        pos[1] = milli(y - self.origin[1]);
+        pos
+    }
+
+    fn is_linear(&self) -> bool {
+        false
+    }
+
+    fn words(&self) -> [u8; AXES] {
+        *b"XYZA"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::units::StepsPerUnit;
+    use proptest::prelude::*;
+
+    /// Motors 1.2 m apart, origin 0.6 m below their middle; 2000 steps per
+    /// turn of a 40 mm sprocket: 50 steps/mm (20 µm per step).
+    fn kin() -> Polargraph {
+        let s = StepsPerUnit::new(50, 1);
+        let scale = ChannelScale([s, s, s, s]);
+        Polargraph::new(scale, Milli(1_200_000), [Milli(600_000), Milli(-600_000)]).unwrap()
+    }
+
+    #[test]
+    fn origin_is_zero_steps() {
+        let k = kin();
+        assert_eq!(k.inverse(&[Milli(0); AXES]), Ok([0; AXES]));
+        assert_eq!(k.forward(&[0; AXES]), [Milli(0); AXES]);
+    }
+
+    #[test]
+    fn hand_computed_lengths() {
+        let k = kin();
+        // The user's (−300, −200) is (300, −800) in the motors' frame; strings
+        // √(300²+800²) = 854.400 mm and √(900²+800²) = 1204.159 mm; at the
+        // origin both are √(600²+600²) = 848.528 mm.
+        let s = k
+            .inverse(&[Milli(-300_000), Milli(-200_000), Milli(0), Milli(0)])
+            .unwrap();
+        assert!((s[0] - 294).abs() <= 1, "{}", s[0]); // 5.872 mm × 50
+        assert!((s[1] - 17782).abs() <= 1, "{}", s[1]); // 355.631 mm × 50
+    }
+
+    #[test]
+    fn above_the_motors_is_unreachable() {
+        let k = kin();
+        assert_eq!(
+            k.inverse(&[Milli(0), Milli(600_000), Milli(0), Milli(0)]),
+            Err(KinError::Unreachable)
+        );
+        let s = StepsPerUnit::new(50, 1);
+        assert!(Polargraph::new(
+            ChannelScale([s; 4]),
+            Milli(1_000_000),
+            [Milli(0), Milli(10)]
+        )
+        .is_err());
+    }
+
+    proptest! {
+        /// Over the board (1.1 m × 0.8 m, kept 300 mm below the motor line
+        /// where flat strings make the pen's height ill-conditioned): back
+        /// within one step (20 µm) plus f32 slack.
+        #[test]
+        fn forward_of_inverse_within_a_step(x in -550_000i32..550_000, y in -500_000i32..300_000) {
+            let k = kin();
+            let pos = [Milli(x), Milli(y), Milli(0), Milli(0)];
+            let back = k.forward(&k.inverse(&pos).unwrap());
+            let err = libm::hypotf((back[0].0 - x) as f32, (back[1].0 - y) as f32);
+            prop_assert!(err <= 25.0, "{:?} -> {:?}", pos, back);
+        }
+
+        #[test]
+        fn inverse_of_forward_within_a_step(x in -550_000i32..550_000, y in -500_000i32..300_000) {
+            let k = kin();
+            let s = k.inverse(&[Milli(x), Milli(y), Milli(0), Milli(0)]).unwrap();
+            let again = k.inverse(&k.forward(&s)).unwrap();
+            prop_assert!((again[0] - s[0]).abs() <= 1 && (again[1] - s[1]).abs() <= 1, "{:?} {:?}", s, again);
+        }
+    }
+}

@@ -1,0 +1,200 @@
+//! SCARA arm (seed 004, Klipper's formulas). Channel 0 turns the shoulder,
+//! channel 1 the elbow's motor, both in degrees; the elbow's belt passes
+//! through the shoulder joint, so turning the shoulder also turns the elbow
+//! by 1/ECR (the elbow crosstalk ratio ECR = n_S / n_E). At zero steps both
+//! arms point along +y. Angles are counted counter-clockwise from +y, so
+//! x = −sin: the seed's sign convention.
+//!
+//! The inverse takes the elbow bent to positive angles (one of the two
+//! solutions) and the shoulder in (−360°, 180°]; the workspace should not
+//! straddle the −y direction behind the base, where that angle jumps.
+
+use super::{milli, mm, ChannelScale, KinError, Kinematics, Position, Steps};
+use crate::axis::AXES;
+use crate::units::Milli;
+use core::f32::consts::PI;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scara {
+    scale: ChannelScale,
+    /// Arm lengths, mm.
+    l1: f32,
+    l2: f32,
+    /// Position of the shoulder joint, mm.
+    offset: [f32; 2],
+    /// 1/ECR; 0 when the elbow motor sits on the elbow (no crosstalk).
+    crosstalk: f32,
+}
+
+const DEG: f32 = 180.0 / PI;
+
+impl Scara {
+    pub fn new(
+        scale: ChannelScale,
+        l1: Milli,
+        l2: Milli,
+        offset: [Milli; 2],
+        ecr: Option<f32>,
+    ) -> Result<Self, KinError> {
+        if l1.0 <= 0 || l2.0 <= 0 || ecr == Some(0.0) {
+            return Err(KinError::Unreachable);
+        }
+        Ok(Scara {
+            scale,
+            l1: mm(l1),
+            l2: mm(l2),
+            offset: [mm(offset[0]), mm(offset[1])],
+            crosstalk: ecr.map_or(0.0, |e| 1.0 / e),
+        })
+    }
+}
+
+/// acos of a cosine that float rounding may push just past ±1.
+fn acos_clamped(c: f32) -> f32 {
+    libm::acosf(c.clamp(-1.0, 1.0))
+}
+
+impl Kinematics for Scara {
+    fn inverse(&self, pos: &Position) -> Result<Steps, KinError> {
+        let (l1, l2) = (self.l1, self.l2);
+        let x = -(mm(pos[0]) - self.offset[0]);
+        let y = mm(pos[1]) - self.offset[1];
+        let h2 = x * x + y * y;
+        let h = libm::sqrtf(h2);
+        // Reach, with 1 µm of slack for the decimal input.
+        if h == 0.0 || h > l1 + l2 + 0.001 || h < (l1 - l2).abs() - 0.001 {
+            return Err(KinError::Unreachable);
+        }
+        let shoulder = libm::atan2f(x, y) - acos_clamped((h2 + l1 * l1 - l2 * l2) / (2.0 * l1 * h));
+        // The seed prints "+ L1² + L2²" here; the law of cosines has minus.
+        let elbow =
+            shoulder * self.crosstalk + acos_clamped((h2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2));
+        let mut steps = self.scale.all_steps(pos)?;
+        steps[0] = self.scale.steps_f32(0, shoulder * DEG)?;
+        steps[1] = self.scale.steps_f32(1, elbow * DEG)?;
+        Ok(steps)
+    }
+
+    fn forward(&self, steps: &Steps) -> Position {
+        let a = self.scale.value_f32(0, steps[0]) / DEG;
+        let b = self.scale.value_f32(1, steps[1]) / DEG;
+        let s = a;
+        let e = b - a * self.crosstalk;
+        let x = -libm::sinf(s) * self.l1 - libm::sinf(s + e) * self.l2 + self.offset[0];
+        let y = libm::cosf(s) * self.l1 + libm::cosf(s + e) * self.l2 + self.offset[1];
+        let mut pos = self.scale.all_milli(steps);
+        pos[0] = milli(x);
+        pos[1] = milli(y);
+        pos
+    }
+
+    fn is_linear(&self) -> bool {
+        false
+    }
+
+    fn words(&self) -> [u8; AXES] {
+        *b"XYZA"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::units::StepsPerUnit;
+    use proptest::prelude::*;
+
+    /// 150 mm + 120 mm arms, 200 × 16 microsteps × 4:1 belt per turn
+    /// (12 800 steps per 360°: 0.028° a step), ECR 3, shoulder at (10, 20).
+    fn kin() -> Scara {
+        let s = StepsPerUnit::new(12_800, 360);
+        let scale = ChannelScale([s, s, StepsPerUnit::new(100, 1), s]);
+        Scara::new(
+            scale,
+            Milli(150_000),
+            Milli(120_000),
+            [Milli(10_000), Milli(20_000)],
+            Some(3.0),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn zero_steps_is_the_arm_straight_along_y() {
+        let p = kin().forward(&[0; AXES]);
+        assert_eq!((p[0], p[1]), (Milli(10_000), Milli(290_000)));
+    }
+
+    #[test]
+    fn right_angle_elbow_by_hand() {
+        // Shoulder 0°, elbow bent 90°: with ECR 3 the elbow motor reads
+        // 90° too (no shoulder turn to compensate). The tip is L1 up and
+        // L2 to −x: (10 − 120, 20 + 150).
+        let k = kin();
+        let steps = k
+            .inverse(&[Milli(-110_000), Milli(170_000), Milli(0), Milli(0)])
+            .unwrap();
+        assert!(
+            steps[0].abs() <= 1 && (steps[1] - 3200).abs() <= 1,
+            "{:?}",
+            steps
+        );
+        // Shoulder at 30°: the elbow motor must be 30°/3 further.
+        let s = 30.0 / DEG;
+        let tip = [
+            -libm::sinf(s) * 150.0 - libm::sinf(s + PI / 2.0) * 120.0 + 10.0,
+            libm::cosf(s) * 150.0 + libm::cosf(s + PI / 2.0) * 120.0 + 20.0,
+        ];
+        let steps = k
+            .inverse(&[milli(tip[0]), milli(tip[1]), Milli(0), Milli(0)])
+            .unwrap();
+        assert!(
+            (steps[0] - 1067).abs() <= 1 && (steps[1] - 3556).abs() <= 1,
+            "{:?}",
+            steps
+        );
+    }
+
+    #[test]
+    fn out_of_reach() {
+        let k = kin();
+        let far = [Milli(10_000), Milli(300_000), Milli(0), Milli(0)];
+        let near = [Milli(20_000), Milli(20_000), Milli(0), Milli(0)];
+        assert_eq!(k.inverse(&far), Err(KinError::Unreachable));
+        assert_eq!(k.inverse(&near), Err(KinError::Unreachable));
+    }
+
+    /// A point of the annulus the arm reaches, in front of the base.
+    fn reachable() -> impl Strategy<Value = (i32, i32)> {
+        (35_000i32..265_000, -2.5f32..2.5).prop_map(|(r, t)| {
+            let r = r as f32;
+            (
+                libm::roundf(10_000.0 - r * libm::sinf(t)) as i32,
+                libm::roundf(20_000.0 + r * libm::cosf(t)) as i32,
+            )
+        })
+    }
+
+    proptest! {
+        /// One step moves the tip at most (L1 + L2)·0.028° ≈ 132 µm; the
+        /// two joints round by half a step each.
+        #[test]
+        fn forward_of_inverse_within_a_step((x, y) in reachable()) {
+            let k = kin();
+            let pos = [Milli(x), Milli(y), Milli(0), Milli(0)];
+            let back = k.forward(&k.inverse(&pos).unwrap());
+            let err = libm::hypotf((back[0].0 - x) as f32, (back[1].0 - y) as f32);
+            prop_assert!(err <= 132.0, "{:?} -> {:?}", pos, back);
+        }
+
+        /// Away from the straight and folded arm (where the elbow angle is
+        /// ill-conditioned) the steps come back within one.
+        #[test]
+        fn inverse_of_forward_within_a_step(a in -3000i32..3000, bend in 400i32..6000) {
+            let k = kin();
+            // Elbow motor = bend + shoulder/ECR, as the arm is built.
+            let s = [a, bend + a / 3, 0, 0];
+            let again = k.inverse(&k.forward(&s)).unwrap();
+            prop_assert!((again[0] - s[0]).abs() <= 1 && (again[1] - s[1]).abs() <= 1, "{:?} {:?}", s, again);
+        }
+    }
+}
