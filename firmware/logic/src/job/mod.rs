@@ -9,7 +9,9 @@
 pub mod cursor;
 pub mod error;
 pub mod kv;
+pub mod list;
 pub mod num;
 pub mod param;
+pub mod poradi;
 
 pub use error::{ErrorKind, FileError, FileName};
