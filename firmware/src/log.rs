@@ -95,7 +95,7 @@ fn count_drop() {
 macro_rules! __log_module {
     () => {{
         const FULL: &str = module_path!();
-        const SKIP: usize = if FULL.len() > 6 { 6 } else { 0 }; // "taut::"
+        const SKIP: usize = $crate::board::flash::after_crate_name(FULL);
         const LEN: usize = FULL.len() - SKIP;
         #[link_section = ".progmem.data"]
         static S: [u8; LEN] = $crate::board::flash::bytes::<LEN>(FULL, SKIP);

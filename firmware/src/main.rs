@@ -5,12 +5,10 @@
 //! (peripherals) and `taut_logic` (host-tested logic).
 #![no_std]
 #![no_main]
-#![feature(abi_avr_interrupt, asm_experimental_arch)]
+#![feature(abi_avr_interrupt)]
 
-mod board;
-mod log;
-
-use board::{clock, usart, ResetCause, F_CPU};
+use taut_firmware::board::{self, clock, usart, ResetCause, F_CPU};
+use taut_firmware::{flash_str, info};
 use embedded_hal::digital::OutputPin;
 use panic_halt as _;
 

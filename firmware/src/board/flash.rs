@@ -72,6 +72,19 @@ pub const fn bytes<const N: usize>(s: &str, skip: usize) -> [u8; N] {
     out
 }
 
+/// Where a module path continues after its crate name (`taut_firmware::`).
+pub const fn after_crate_name(path: &str) -> usize {
+    let b = path.as_bytes();
+    let mut i = 0;
+    while i + 1 < b.len() {
+        if b[i] == b':' && b[i + 1] == b':' {
+            return i + 2;
+        }
+        i += 1;
+    }
+    0
+}
+
 /// Place a string literal (or `concat!`/`env!` of them) in flash.
 #[macro_export]
 macro_rules! flash_str {

@@ -8,6 +8,7 @@ pub mod gpio;
 pub mod spi;
 pub mod step_timer;
 pub mod usart;
+pub mod watchdog;
 
 /// CPU clock of the Mega 2560.
 pub const F_CPU: u32 = 16_000_000;

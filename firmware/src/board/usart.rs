@@ -1,77 +1,15 @@
 //! USART0, the serial console: 115200 8N1. Transmit goes through a 256-byte
 //! ring drained by the data-register-empty interrupt, so writing never waits
 //! for the wire; received bytes go into a 64-byte ring filled by the receive
-//! interrupt. Each ring has one producer and one consumer and byte-sized
-//! indices, which the AVR loads and stores atomically: no locking needed.
+//! interrupt.
 
+use crate::rt::Ring;
 use avr_device::atmega2560::USART0;
-use core::cell::UnsafeCell;
-use core::sync::atomic::{AtomicU16, AtomicU8, Ordering::Relaxed};
 
-/// A single-producer single-consumer byte ring of 2^k ≤ 256 bytes.
-pub struct ByteRing<const N: usize> {
-    buf: UnsafeCell<[u8; N]>,
-    head: AtomicU8,
-    tail: AtomicU8,
-}
-
-// SAFETY: the producer only writes `buf[head]` then publishes `head`; the
-// consumer only reads `buf[tail]` then publishes `tail`; the slots they touch
-// never overlap, and index stores are single-byte (atomic on AVR).
-unsafe impl<const N: usize> Sync for ByteRing<N> {}
-
-impl<const N: usize> ByteRing<N> {
-    const MASK: u8 = (N - 1) as u8;
-
-    pub const fn new() -> Self {
-        assert!(N.is_power_of_two() && N <= 256);
-        ByteRing { buf: UnsafeCell::new([0; N]), head: AtomicU8::new(0), tail: AtomicU8::new(0) }
-    }
-
-    pub fn len(&self) -> usize {
-        let used = self.head.load(Relaxed).wrapping_sub(self.tail.load(Relaxed)) & Self::MASK;
-        used as usize
-    }
-
-    /// Free slots (one slot stays empty to tell full from empty).
-    pub fn free(&self) -> usize {
-        N - 1 - self.len()
-    }
-
-    /// Producer side: append all of `bytes` or nothing.
-    pub fn push_all(&self, bytes: &[u8]) -> bool {
-        if bytes.len() > self.free() {
-            return false;
-        }
-        let mut h = self.head.load(Relaxed);
-        for &b in bytes {
-            // SAFETY: slot `h` is free (checked above), owned by the producer.
-            unsafe { (*self.buf.get())[(h & Self::MASK) as usize] = b };
-            h = h.wrapping_add(1) & Self::MASK;
-        }
-        core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::Release);
-        self.head.store(h, Relaxed);
-        true
-    }
-
-    /// Consumer side.
-    pub fn pop(&self) -> Option<u8> {
-        let t = self.tail.load(Relaxed);
-        if t == self.head.load(Relaxed) {
-            return None;
-        }
-        core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::Acquire);
-        // SAFETY: slot `t` was published by the producer and is ours to read.
-        let b = unsafe { (*self.buf.get())[t as usize] };
-        self.tail.store(t.wrapping_add(1) & Self::MASK, Relaxed);
-        Some(b)
-    }
-}
-
-pub static TX: ByteRing<256> = ByteRing::new();
-pub static RX: ByteRing<64> = ByteRing::new();
-/// Received bytes lost because RX was full (reported by `$Q`).
-pub static RX_OVERRUNS: AtomicU16 = AtomicU16::new(0);
+/// Bytes waiting for the wire; refusals are log lines dropped whole.
+pub static TX: Ring<u8, 256> = Ring::new();
+/// Bytes received and not yet parsed; refusals are bytes lost to overrun.
+pub static RX: Ring<u8, 64> = Ring::new();
 
 pub struct Usart0;
 
@@ -124,7 +62,6 @@ pub fn on_data_register_empty() {
 /// Called by `USART0_RX`.
 pub fn on_receive() {
     let b = regs().udr0().read().bits();
-    if !RX.push_all(&[b]) {
-        RX_OVERRUNS.store(RX_OVERRUNS.load(Relaxed).saturating_add(1), Relaxed);
-    }
+    // A full ring counts the lost byte (the sender ignored flow control).
+    let _ = RX.push(b);
 }

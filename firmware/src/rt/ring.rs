@@ -1,0 +1,117 @@
+//! A lock-free single-producer single-consumer ring for queues that cross
+//! an interrupt boundary (UART bytes, step segments). Indices are single
+//! bytes, which the AVR loads and stores atomically, so neither side ever
+//! masks interrupts. Each ring counts what it accepted and refused and how
+//! full it got: a full ring is back-pressure to the producer, never a
+//! silent loss.
+
+use core::cell::UnsafeCell;
+use core::mem::MaybeUninit;
+use core::sync::atomic::{compiler_fence, AtomicU8, Ordering::*};
+use taut_logic::sched::QueueStats;
+
+pub struct Ring<T: Copy, const N: usize> {
+    buf: UnsafeCell<[MaybeUninit<T>; N]>,
+    head: AtomicU8,
+    tail: AtomicU8,
+    /// Written by the producer only.
+    stats: UnsafeCell<QueueStats>,
+}
+
+// SAFETY: the producer writes only `buf[head]` before publishing `head`, the
+// consumer reads only `buf[tail]` before publishing `tail`: their slots never
+// overlap. `stats` is written by the producer only; readers take a copy
+// inside a critical section (see `stats`).
+unsafe impl<T: Copy + Send, const N: usize> Sync for Ring<T, N> {}
+
+impl<T: Copy, const N: usize> Ring<T, N> {
+    const MASK: u8 = (N - 1) as u8;
+
+    pub const fn new() -> Self {
+        assert!(N.is_power_of_two() && N <= 256);
+        Ring {
+            buf: UnsafeCell::new([MaybeUninit::uninit(); N]),
+            head: AtomicU8::new(0),
+            tail: AtomicU8::new(0),
+            stats: UnsafeCell::new(QueueStats::new()),
+        }
+    }
+
+    /// Messages waiting.
+    pub fn len(&self) -> usize {
+        (self.head.load(Relaxed).wrapping_sub(self.tail.load(Relaxed)) & Self::MASK) as usize
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Free slots (one stays empty to tell full from empty).
+    pub fn free(&self) -> usize {
+        N - 1 - self.len()
+    }
+
+    /// Producer: append all of `items` or none (refusal is counted once).
+    pub fn push_all(&self, items: &[T]) -> bool {
+        // SAFETY: only the producer touches `stats` mutably.
+        let stats = unsafe { &mut *self.stats.get() };
+        if items.len() > self.free() {
+            stats.on_refused();
+            return false;
+        }
+        let mut h = self.head.load(Relaxed);
+        for &item in items {
+            // SAFETY: slot `h` is free (checked above) and the producer's.
+            unsafe { (*self.buf.get())[h as usize] = MaybeUninit::new(item) };
+            h = h.wrapping_add(1) & Self::MASK;
+        }
+        compiler_fence(Release);
+        self.head.store(h, Relaxed);
+        stats.on_send(self.len());
+        true
+    }
+
+    pub fn push(&self, item: T) -> Result<(), T> {
+        if self.push_all(&[item]) {
+            Ok(())
+        } else {
+            Err(item)
+        }
+    }
+
+    /// Consumer: the oldest message, if any.
+    pub fn pop(&self) -> Option<T> {
+        let t = self.tail.load(Relaxed);
+        if t == self.head.load(Relaxed) {
+            return None;
+        }
+        compiler_fence(Acquire);
+        // SAFETY: slot `t` was published by the producer and not yet consumed.
+        let item = unsafe { (*self.buf.get())[t as usize].assume_init() };
+        compiler_fence(Release);
+        self.tail.store(t.wrapping_add(1) & Self::MASK, Relaxed);
+        Some(item)
+    }
+
+    /// Consumer: the oldest message without taking it.
+    pub fn peek(&self) -> Option<T> {
+        let t = self.tail.load(Relaxed);
+        if t == self.head.load(Relaxed) {
+            return None;
+        }
+        compiler_fence(Acquire);
+        // SAFETY: as in `pop`.
+        Some(unsafe { (*self.buf.get())[t as usize].assume_init() })
+    }
+
+    /// Usable capacity.
+    pub const fn capacity(&self) -> usize {
+        N - 1
+    }
+
+    /// A consistent copy of the counters (the producer may be an interrupt).
+    pub fn stats(&self) -> QueueStats {
+        // SAFETY: interrupts are off, so the producer cannot be mid-update.
+        avr_device::interrupt::free(|_| unsafe { *self.stats.get() })
+    }
+}
