@@ -1,0 +1,219 @@
+use super::trapezoid::{icbrt, isqrt};
+use super::*;
+use proptest::prelude::*;
+use std::vec::Vec;
+
+/// Inputs of one block's profile, feasible (entry and exit reachable).
+#[derive(Clone, Copy, Debug)]
+struct Ramp {
+    events: u32,
+    accel: u32,
+    v0_sqr: u64,
+    cruise_sqr: u64,
+    v1_sqr: u64,
+}
+
+impl Ramp {
+    fn trapezoid(&self) -> Trapezoid {
+        Trapezoid::new(
+            self.events,
+            self.accel,
+            self.v0_sqr,
+            self.cruise_sqr,
+            self.v1_sqr,
+        )
+    }
+
+    /// Exact time of event `k` on the continuous trapezoid, seconds.
+    fn ideal(&self, k: u32) -> f64 {
+        let (e, a) = (self.events as f64, self.accel as f64);
+        let two_ae = 2 * self.accel as u64 * self.events as u64;
+        let peak = self
+            .cruise_sqr
+            .min((self.v0_sqr + self.v1_sqr + two_ae) / 2)
+            .max(self.v0_sqr)
+            .max(self.v1_sqr) as f64;
+        let (v0, v1) = (self.v0_sqr as f64, self.v1_sqr as f64);
+        let (sa, sd, vp) = (
+            (peak - v0) / (2.0 * a),
+            (peak - v1) / (2.0 * a),
+            peak.sqrt(),
+        );
+        let t_acc = (vp - v0.sqrt()) / a;
+        let t_end = t_acc + (e - sa - sd) / vp + (vp - v1.sqrt()) / a;
+        let k = k as f64;
+        if k <= sa {
+            ((v0 + 2.0 * a * k).sqrt() - v0.sqrt()) / a
+        } else if k >= e - sd {
+            t_end - ((v1 + 2.0 * a * (e - k)).sqrt() - v1.sqrt()) / a
+        } else {
+            t_acc + (k - sa) / vp
+        }
+    }
+}
+
+fn ramp() -> impl Strategy<Value = Ramp> {
+    (
+        1u32..20_000,
+        50u32..20_000,
+        0u64..1600,
+        10u64..60_000,
+        0u64..1600,
+    )
+        .prop_map(|(events, accel, v0, vc, v1)| {
+            let two_ae = 2 * accel as u64 * events as u64;
+            let v0_sqr = (v0 * v0).min(vc * vc);
+            let v1_sqr = (v1 * v1).min(vc * vc).min(v0_sqr + two_ae);
+            let v0_sqr = v0_sqr.min(v1_sqr + two_ae);
+            Ramp {
+                events,
+                accel,
+                v0_sqr,
+                cruise_sqr: vc * vc,
+                v1_sqr,
+            }
+        })
+}
+
+/// Segments and blocks of a chain of profiles, one single-axis block each.
+fn prepare(ramps: &[Ramp]) -> (Vec<Segment>, Vec<StepBlock>) {
+    let mut prep = Preparer::new();
+    let (mut segs, mut blocks) = (Vec::new(), Vec::new());
+    for r in ramps {
+        prep.start(r.trapezoid());
+        blocks.push(StepBlock {
+            steps: [r.events, 0, 0, 0],
+            events: r.events,
+            dir: 1,
+        });
+        while let Some(s) = prep.next() {
+            segs.push(s);
+        }
+        assert!(prep.is_idle());
+    }
+    (segs, blocks)
+}
+
+/// Largest distance of an event from its ideal time, ticks.
+fn worst_error(ramps: &[Ramp]) -> f64 {
+    let (segs, blocks) = prepare(ramps);
+    let mut ideal = Vec::new();
+    let mut origin = 0.0;
+    for r in ramps {
+        ideal.extend((1..=r.events).map(|k| origin + r.ideal(k)));
+        origin += r.ideal(r.events);
+    }
+    let events: Vec<Event> = expand(segs, blocks).collect();
+    assert_eq!(events.len(), ideal.len());
+    events
+        .iter()
+        .zip(&ideal)
+        .map(|(e, t)| (e.tick as f64 - t * TICK_HZ as f64).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn roots_are_exact() {
+    for x in [0u64, 1, 2, 3, 4, 8, 26, 27, 1 << 40, u64::MAX] {
+        let r = isqrt(x);
+        assert!(r * r <= x && (r + 1).checked_mul(r + 1).map_or(true, |s| s > x));
+        let c = icbrt(x);
+        assert!(c * c * c <= x && (c + 1).checked_pow(3).map_or(true, |s| s > x));
+    }
+}
+
+#[test]
+fn segment_is_small() {
+    assert!(core::mem::size_of::<Segment>() <= 12);
+    assert!(core::mem::size_of::<StepBlock>() <= 24);
+}
+
+#[test]
+fn string_art_ramp_is_accurate_and_compact() {
+    // Full turn of the base at the defaults: 0 → 2000 → 0 steps/s at 500/s².
+    let r = Ramp {
+        events: 9600,
+        accel: 500,
+        v0_sqr: 0,
+        cruise_sqr: 2000 * 2000,
+        v1_sqr: 0,
+    };
+    assert!(worst_error(&[r]) <= TOLERANCE_TICKS as f64);
+    let (segs, _) = prepare(&[r]);
+    std::println!("segments for a 9600-step move: {}", segs.len());
+    assert!(segs.len() < 400, "{} segments", segs.len());
+}
+
+#[test]
+fn fast_cruise_is_few_segments() {
+    // 40 kHz for one second after a steep ramp.
+    let r = Ramp {
+        events: 40_000,
+        accel: 200_000,
+        v0_sqr: 40_000 * 40_000,
+        cruise_sqr: 40_000 * 40_000,
+        v1_sqr: 40_000 * 40_000,
+    };
+    assert!(worst_error(&[r]) <= TOLERANCE_TICKS as f64);
+    let (segs, _) = prepare(&[r]);
+    assert!(segs.len() <= 40_000 / 4096 + 1, "{}", segs.len());
+}
+
+#[test]
+fn first_step_from_standstill_waits_long() {
+    // sqrt(2 / 500) s = 63.2 ms = 1.01 M ticks before the first step.
+    let r = Ramp {
+        events: 10,
+        accel: 500,
+        v0_sqr: 0,
+        cruise_sqr: 1_000_000,
+        v1_sqr: 0,
+    };
+    let (segs, blocks) = prepare(&[r]);
+    let first = expand(segs, blocks).next().unwrap();
+    assert!((first.tick as f64 - 0.063_245_6 * 16e6).abs() < 16.0);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn every_event_within_tolerance(r in ramp()) {
+        let err = worst_error(&[r]);
+        prop_assert!(err <= TOLERANCE_TICKS as f64, "error {} ticks", err);
+    }
+
+    #[test]
+    fn chained_blocks_do_not_drift(a in ramp(), b in ramp()) {
+        // Join b to a's exit speed so the chain is continuous.
+        let two_ae = 2 * b.accel as u64 * b.events as u64;
+        let b = Ramp { v0_sqr: a.v1_sqr.min(b.v1_sqr + two_ae).min(b.cruise_sqr), ..b };
+        let b = Ramp { v1_sqr: b.v1_sqr.min(b.v0_sqr + two_ae), ..b };
+        let err = worst_error(&[a, b, a]);
+        prop_assert!(err <= TOLERANCE_TICKS as f64, "error {} ticks", err);
+    }
+
+    #[test]
+    fn trapezoid_time_matches_exact(r in ramp(), f in 0.0f64..1.0) {
+        let t = r.trapezoid();
+        let k = (f * r.events as f64) as u32;
+        let exact = r.ideal(k) * SUBTICKS_PER_S as f64;
+        prop_assert!((t.time(k) as f64 - exact).abs() < 64.0 + exact * 1e-9);
+    }
+
+    #[test]
+    fn dda_steps_exact_totals(steps in proptest::array::uniform4(0u32..3000)) {
+        let events = *steps.iter().max().unwrap();
+        prop_assume!(events > 0);
+        let block = StepBlock { steps, events, dir: 0 };
+        let seg = Segment { interval: 1000, count: events as u16, add: 0, flags: NEW_BLOCK };
+        let mut totals = [0u32; 4];
+        for e in expand([seg], [block]) {
+            for (i, t) in totals.iter_mut().enumerate() {
+                *t += (e.axes >> i & 1) as u32;
+            }
+            prop_assert!(e.axes & 1 << steps.iter().position(|&s| s == events).unwrap() != 0);
+        }
+        prop_assert_eq!(totals, steps);
+    }
+}

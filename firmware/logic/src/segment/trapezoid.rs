@@ -1,0 +1,206 @@
+//! The ideal velocity profile of one block, in events, and the exact time
+//! of every event on it. Integer only: speeds are handled as fixed-point
+//! square roots so a ramp's event times are `(v(k) - v0) / a`, with no
+//! cancellation and no u128.
+
+use super::SUBTICKS_PER_S as Q;
+
+/// Part of a block's profile.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    Accel,
+    Cruise,
+    Decel,
+}
+
+/// Entry, peak and exit speed of a block with constant acceleration
+/// between them. Speeds are squared, events²/s²; acceleration events/s².
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Trapezoid {
+    events: u32,
+    accel: u64,
+    two_a: u64,
+    v0_sqr: u64,
+    v1_sqr: u64,
+    /// Fixed-point shift: speeds are `isqrt(v² << 2·shift)`, i.e. `v·2^shift`.
+    shift: u32,
+    s0: u64,
+    s1: u64,
+    /// Length of the ramps in units of `1 / (2a)` events.
+    acc2: u64,
+    dec2: u64,
+    /// Cruise interval in sub-ticks `<< (31 - shift)`.
+    cruise_iv: u64,
+    t_acc: u64,
+    t_dec: u64,
+    t_end: u64,
+    /// Last event fully inside the acceleration; first fully in deceleration.
+    k_acc: u32,
+    k_dec: u32,
+}
+
+impl Trapezoid {
+    /// No events: the preparer's idle state.
+    pub const ZERO: Trapezoid = Trapezoid {
+        events: 0,
+        accel: 1,
+        two_a: 2,
+        v0_sqr: 0,
+        v1_sqr: 0,
+        shift: 0,
+        s0: 0,
+        s1: 0,
+        acc2: 0,
+        dec2: 0,
+        cruise_iv: 0,
+        t_acc: 0,
+        t_dec: 0,
+        t_end: 0,
+        k_acc: 0,
+        k_dec: 0,
+    };
+}
+
+/// Largest acceleration in events/s² the fixed-point arithmetic allows.
+pub const MAX_ACCEL: u32 = 1 << 24;
+
+impl Trapezoid {
+    /// The fastest profile over `events` events that starts at `entry_sqr`,
+    /// never exceeds `cruise_sqr` and ends at `exit_sqr`. Entry and exit are
+    /// clamped to what `accel` allows over the block (the planner already
+    /// guarantees this up to rounding).
+    pub fn new(events: u32, accel: u32, entry_sqr: u64, cruise_sqr: u64, exit_sqr: u64) -> Self {
+        let a = accel.clamp(1, MAX_ACCEL) as u64;
+        let two_a = 2 * a;
+        let two_ae = two_a * events as u64;
+        let v1_sqr = exit_sqr.min(entry_sqr.saturating_add(two_ae));
+        let v0_sqr = entry_sqr.min(v1_sqr + two_ae);
+        let peak = cruise_sqr
+            .max(1)
+            .min((v0_sqr + v1_sqr + two_ae) / 2)
+            .max(v0_sqr)
+            .max(v1_sqr);
+        let shift = (64 - (64 - peak.leading_zeros())) / 2;
+        let mut t = Trapezoid {
+            events,
+            accel: a,
+            two_a,
+            v0_sqr,
+            v1_sqr,
+            shift,
+            acc2: peak - v0_sqr,
+            dec2: peak - v1_sqr,
+            ..Self::ZERO
+        };
+        let sp = t.scaled_speed(peak);
+        t.s0 = t.scaled_speed(v0_sqr);
+        t.s1 = t.scaled_speed(v1_sqr);
+        t.cruise_iv = (Q << 31) / sp;
+        t.t_acc = t.ramp_time(sp, t.s0);
+        t.t_dec = t.t_acc + t.cruise_time(two_ae - t.acc2 - t.dec2);
+        t.t_end = t.t_dec + t.ramp_time(sp, t.s1);
+        t.k_acc = (t.acc2 / two_a) as u32;
+        t.k_dec = events - t.dec2.div_ceil(two_a) as u32;
+        t
+    }
+
+    pub fn events(&self) -> u32 {
+        self.events
+    }
+
+    /// Ideal time of event `k` (0..=events), sub-ticks after event 0.
+    pub fn time(&self, k: u32) -> u64 {
+        let x = self.two_a * k as u64;
+        let y = self.two_a * (self.events - k) as u64;
+        if x <= self.acc2 {
+            self.ramp_time(self.scaled_speed(self.v0_sqr + x), self.s0)
+        } else if y <= self.dec2 {
+            let back = self.ramp_time(self.scaled_speed(self.v1_sqr + y), self.s1);
+            self.t_end.saturating_sub(back)
+        } else {
+            self.t_acc + self.cruise_time(x - self.acc2)
+        }
+    }
+
+    /// The phase that holds the whole step from event `k0` to `k0 + 1`, and
+    /// the last event of that phase; `None` if a phase boundary falls
+    /// strictly inside the step.
+    pub fn phase_after(&self, k0: u32) -> Option<(Phase, u32)> {
+        if k0 < self.k_acc {
+            return Some((Phase::Accel, self.k_acc));
+        }
+        let past_accel = k0 > self.k_acc || self.acc2 % self.two_a == 0;
+        if past_accel && k0 < self.k_dec {
+            return Some((Phase::Cruise, self.k_dec));
+        }
+        if self.two_a * (self.events - k0) as u64 <= self.dec2 {
+            return Some((Phase::Decel, self.events));
+        }
+        None
+    }
+
+    /// Speed at event `k` of a ramp as (time to stop from it at `accel`,
+    /// sub-ticks; speed, events/s, rounded down).
+    pub fn ramp_speed(&self, k: u32) -> (u64, u64) {
+        let x = self.two_a * k as u64;
+        let v_sqr = if x <= self.acc2 {
+            self.v0_sqr + x
+        } else {
+            self.v1_sqr + self.two_a * (self.events - k) as u64
+        };
+        let s = self.scaled_speed(v_sqr);
+        (self.ramp_time(s, 0), s >> self.shift)
+    }
+
+    fn scaled_speed(&self, v_sqr: u64) -> u64 {
+        isqrt(v_sqr << (2 * self.shift))
+    }
+
+    /// Time to change speed between two scaled speeds at `accel`.
+    fn ramp_time(&self, s_hi: u64, s_lo: u64) -> u64 {
+        (s_hi - s_lo) * Q / (self.accel << self.shift)
+    }
+
+    /// Time to cruise `w / (2a)` events.
+    fn cruise_time(&self, w: u64) -> u64 {
+        let (q, r) = (w / self.two_a, w % self.two_a);
+        (q * self.cruise_iv + r * self.cruise_iv / self.two_a) >> (31 - self.shift)
+    }
+}
+
+/// Integer square root, rounded down.
+pub fn isqrt(x: u64) -> u64 {
+    let mut rem = x;
+    let mut root = 0u64;
+    let mut bit = 1u64 << 62;
+    while bit > x {
+        bit >>= 2;
+    }
+    while bit != 0 {
+        if rem >= root + bit {
+            rem -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    root
+}
+
+/// Integer cube root, rounded down (Hacker's Delight, bit by bit).
+pub fn icbrt(x: u64) -> u64 {
+    let mut rem = x;
+    let mut y = 0u64;
+    let mut s = 63i32;
+    while s >= 0 {
+        y *= 2;
+        let b = 3 * y * (y + 1) + 1;
+        if (rem >> s) >= b {
+            rem -= b << s;
+            y += 1;
+        }
+        s -= 3;
+    }
+    y
+}
