@@ -1,1 +1,376 @@
-//! (being written)
+//! The machine's settings by name, as `$$` lists them, `$name=value` sets
+//! them and `machine.txt` overrides them: `base_max_rate = 2000`,
+//! `drill_steps_per_unit = 1600/12`, `step_pulse_us = 5`.
+//!
+//! Names are composed (axis name + `_` + field) rather than stored whole:
+//! every string costs SRAM on the AVR. Printing uses ufmt only.
+
+use crate::axis::{Axis, AXES};
+use crate::config::MachineConfig;
+use crate::job::error::ErrorKind;
+use crate::job::num::{parse_ratio, parse_u32, trim, NumError};
+use crate::units::StepsPerUnit;
+use ufmt::{uDisplay, uWrite, uwrite, Formatter};
+
+/// A setting value that did not fit: what, and at which byte of the value.
+pub type SettingError = NumError;
+
+/// The figures every axis has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AxisField {
+    /// Exact `num/den` steps per degree (base) or mm.
+    StepsPerUnit,
+    /// Steps/s.
+    MaxRate,
+    /// Steps/s².
+    Accel,
+    /// 1: DIR low is the positive direction.
+    DirInvert,
+    /// 1: the driver is on while ENABLE is high.
+    EnableActiveHigh,
+}
+
+/// The machine-wide figures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GlobalField {
+    StepPulseUs,
+    DirSetupUs,
+    EnableSetupUs,
+    JunctionDeviationUm,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Setting {
+    Axis(Axis, AxisField),
+    Global(GlobalField),
+}
+
+/// A setting's value, printable for `$$`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Value {
+    Number(u32),
+    Ratio(StepsPerUnit),
+}
+
+const AXIS_FIELDS: [AxisField; 5] = [
+    AxisField::StepsPerUnit,
+    AxisField::MaxRate,
+    AxisField::Accel,
+    AxisField::DirInvert,
+    AxisField::EnableActiveHigh,
+];
+
+const GLOBAL_FIELDS: [GlobalField; 4] = [
+    GlobalField::StepPulseUs,
+    GlobalField::DirSetupUs,
+    GlobalField::EnableSetupUs,
+    GlobalField::JunctionDeviationUm,
+];
+
+/// Number of settings; [`Setting::index`] is below it.
+pub const COUNT: usize = AXES * AXIS_FIELDS.len() + GLOBAL_FIELDS.len();
+
+impl AxisField {
+    pub const fn name(self) -> &'static str {
+        match self {
+            AxisField::StepsPerUnit => "steps_per_unit",
+            AxisField::MaxRate => "max_rate",
+            AxisField::Accel => "accel",
+            AxisField::DirInvert => "dir_invert",
+            AxisField::EnableActiveHigh => "enable_active_high",
+        }
+    }
+}
+
+impl GlobalField {
+    pub const fn name(self) -> &'static str {
+        match self {
+            GlobalField::StepPulseUs => "step_pulse_us",
+            GlobalField::DirSetupUs => "dir_setup_us",
+            GlobalField::EnableSetupUs => "enable_setup_us",
+            GlobalField::JunctionDeviationUm => "junction_deviation_um",
+        }
+    }
+}
+
+/// Every setting in `$$` order: per axis, then the machine-wide ones.
+pub fn all() -> impl Iterator<Item = Setting> {
+    let per_axis = Axis::ALL
+        .into_iter()
+        .flat_map(|a| AXIS_FIELDS.into_iter().map(move |f| Setting::Axis(a, f)));
+    per_axis.chain(GLOBAL_FIELDS.into_iter().map(Setting::Global))
+}
+
+/// Calls `f` with every setting and its value, in `$$` order.
+pub fn for_each(cfg: &MachineConfig, mut f: impl FnMut(Setting, Value)) {
+    for s in all() {
+        f(s, s.get(cfg));
+    }
+}
+
+/// Sets the named setting (name in any case) from its text.
+pub fn set(cfg: &mut MachineConfig, key: &str, value: &str) -> Result<(), SettingError> {
+    let setting = Setting::parse(key.as_bytes()).ok_or(NumError {
+        at: 0,
+        kind: ErrorKind::UnknownKey,
+    })?;
+    setting.set(cfg, value.as_bytes())
+}
+
+impl Setting {
+    /// The setting named `key`, in any case.
+    pub fn parse(key: &[u8]) -> Option<Setting> {
+        for axis in Axis::ALL {
+            let prefix = axis.name().as_bytes();
+            let named = key.len() > prefix.len()
+                && key[..prefix.len()].eq_ignore_ascii_case(prefix)
+                && key[prefix.len()] == b'_';
+            if named {
+                let rest = &key[prefix.len() + 1..];
+                let field = AXIS_FIELDS
+                    .into_iter()
+                    .find(|f| rest.eq_ignore_ascii_case(f.name().as_bytes()))?;
+                return Some(Setting::Axis(axis, field));
+            }
+        }
+        GLOBAL_FIELDS
+            .into_iter()
+            .find(|f| key.eq_ignore_ascii_case(f.name().as_bytes()))
+            .map(Setting::Global)
+    }
+
+    /// Position in [`all`], below [`COUNT`].
+    pub fn index(self) -> usize {
+        match self {
+            Setting::Axis(a, f) => a.index() * AXIS_FIELDS.len() + f as usize,
+            Setting::Global(g) => AXES * AXIS_FIELDS.len() + g as usize,
+        }
+    }
+
+    pub fn get(self, cfg: &MachineConfig) -> Value {
+        let p = &cfg.pulse;
+        Value::Number(match self {
+            Setting::Axis(a, field) => {
+                let axis = &cfg.axes[a.index()];
+                match field {
+                    AxisField::StepsPerUnit => return Value::Ratio(axis.steps_per_unit),
+                    AxisField::MaxRate => axis.max_rate,
+                    AxisField::Accel => axis.accel,
+                    AxisField::DirInvert => !axis.dir_high_is_positive as u32,
+                    AxisField::EnableActiveHigh => axis.enable_active_high as u32,
+                }
+            }
+            Setting::Global(GlobalField::StepPulseUs) => p.step_pulse_us as u32,
+            Setting::Global(GlobalField::DirSetupUs) => p.dir_setup_us as u32,
+            Setting::Global(GlobalField::EnableSetupUs) => p.enable_setup_us as u32,
+            Setting::Global(GlobalField::JunctionDeviationUm) => cfg.junction_deviation_um,
+        })
+    }
+
+    /// Whole numbers this setting accepts.
+    const fn range(self) -> (u32, u32) {
+        match self {
+            Setting::Axis(_, AxisField::MaxRate) => (1, 200_000),
+            Setting::Axis(_, AxisField::Accel) => (1, 10_000_000),
+            Setting::Axis(_, _) => (0, 1),
+            Setting::Global(GlobalField::StepPulseUs) => (1, 255),
+            Setting::Global(GlobalField::JunctionDeviationUm) => (0, 100_000),
+            Setting::Global(_) => (0, 255),
+        }
+    }
+
+    /// Sets this setting from its text; nothing changes on an error.
+    pub fn set(self, cfg: &mut MachineConfig, text: &[u8]) -> Result<(), SettingError> {
+        let (lead, text) = trim(text);
+        let fail = |at, kind| NumError {
+            at: lead + at,
+            kind,
+        };
+        let located = |e: NumError| fail(e.at, e.kind);
+        let number = || {
+            let n = parse_u32(text).map_err(located)?;
+            let (min, max) = self.range();
+            match (min..=max).contains(&n) {
+                true => Ok(n),
+                false => Err(fail(0, ErrorKind::Range { min, max })),
+            }
+        };
+        let ratio = || {
+            let r = parse_ratio(text).map_err(located)?;
+            match r.num != 0 && r.den != 0 {
+                true => Ok(r),
+                false => Err(fail(0, ErrorKind::Invalid(AxisField::StepsPerUnit.name()))),
+            }
+        };
+        let p = &mut cfg.pulse;
+        match self {
+            Setting::Axis(a, field) => {
+                let axis = &mut cfg.axes[a.index()];
+                match field {
+                    AxisField::StepsPerUnit => axis.steps_per_unit = ratio()?,
+                    AxisField::MaxRate => axis.max_rate = number()?,
+                    AxisField::Accel => axis.accel = number()?,
+                    AxisField::DirInvert => axis.dir_high_is_positive = number()? == 0,
+                    AxisField::EnableActiveHigh => axis.enable_active_high = number()? == 1,
+                }
+            }
+            // The ranges keep these within u8.
+            Setting::Global(GlobalField::StepPulseUs) => p.step_pulse_us = number()? as u8,
+            Setting::Global(GlobalField::DirSetupUs) => p.dir_setup_us = number()? as u8,
+            Setting::Global(GlobalField::EnableSetupUs) => p.enable_setup_us = number()? as u8,
+            Setting::Global(GlobalField::JunctionDeviationUm) => {
+                cfg.junction_deviation_um = number()?
+            }
+        }
+        Ok(())
+    }
+}
+
+impl uDisplay for Setting {
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
+        match *self {
+            Setting::Axis(a, field) => uwrite!(f, "{}_{}", a.name(), field.name()),
+            Setting::Global(g) => f.write_str(g.name()),
+        }
+    }
+}
+
+impl uDisplay for Value {
+    /// Re-readable by [`set`]: `32`, `1600/12`.
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
+        match *self {
+            Value::Number(n) => uwrite!(f, "{}", n),
+            Value::Ratio(r) if r.den == 1 => uwrite!(f, "{}", r.num),
+            Value::Ratio(r) => uwrite!(f, "{}/{}", r.num, r.den),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::job::error::tests::show;
+    use proptest::prelude::*;
+    use std::string::String;
+    use std::vec::Vec;
+
+    fn listing(cfg: &MachineConfig) -> Vec<String> {
+        let mut lines = Vec::new();
+        for_each(cfg, |s, v| lines.push(show(&s) + " = " + &show(&v)));
+        lines
+    }
+
+    #[test]
+    fn listing_shows_every_setting_once_with_defaults() {
+        let lines = listing(&MachineConfig::STRING_ART);
+        assert_eq!(lines.len(), COUNT);
+        assert_eq!(lines[0], "base_steps_per_unit = 9600/360");
+        assert_eq!(lines[1], "base_max_rate = 2000");
+        assert_eq!(lines[5], "radial_steps_per_unit = 32");
+        assert_eq!(lines[10], "drill_steps_per_unit = 1600/12");
+        assert_eq!(lines[18], "aux_dir_invert = 0");
+        assert_eq!(lines[19], "aux_enable_active_high = 1");
+        assert_eq!(lines[20], "step_pulse_us = 5");
+        assert_eq!(lines[23], "junction_deviation_um = 10");
+        for (i, s) in all().enumerate() {
+            assert_eq!(s.index(), i);
+        }
+    }
+
+    #[test]
+    fn every_listed_value_reads_back() {
+        let cfg = MachineConfig::STRING_ART;
+        let mut copy = cfg;
+        copy.axes[0].max_rate = 1;
+        copy.pulse.dir_setup_us = 0;
+        for line in listing(&cfg) {
+            let (key, value) = line.split_once(" = ").unwrap();
+            set(&mut copy, key, value).unwrap();
+        }
+        assert_eq!(copy, cfg);
+    }
+
+    #[test]
+    fn values_land_in_their_fields() {
+        let mut cfg = MachineConfig::STRING_ART;
+        set(&mut cfg, "DRILL_STEPS_PER_UNIT", "1600 / 12").unwrap();
+        set(&mut cfg, "radial_steps_per_unit", "26.5").unwrap();
+        set(&mut cfg, "radial_dir_invert", "1").unwrap();
+        set(&mut cfg, "aux_enable_active_high", "0").unwrap();
+        set(&mut cfg, "base_accel", " 750 ").unwrap();
+        set(&mut cfg, "enable_setup_us", "0").unwrap();
+        set(&mut cfg, "junction_deviation_um", "20").unwrap();
+        assert_eq!(cfg.axes[2].steps_per_unit, StepsPerUnit::new(1600, 12));
+        assert_eq!(cfg.axes[1].steps_per_unit, StepsPerUnit::new(53, 2));
+        assert!(!cfg.axes[1].dir_high_is_positive);
+        assert!(!cfg.axes[3].enable_active_high);
+        assert_eq!(cfg.axes[0].accel, 750);
+        assert_eq!(cfg.pulse.enable_setup_us, 0);
+        assert_eq!(cfg.junction_deviation_um, 20);
+    }
+
+    #[test]
+    fn bad_settings_change_nothing() {
+        let mut cfg = MachineConfig::STRING_ART;
+        let error = |cfg: &mut MachineConfig, k, v| {
+            let e = set(cfg, k, v).unwrap_err();
+            (e.at, show(&e.kind))
+        };
+        assert_eq!(
+            error(&mut cfg, "base_speed", "1"),
+            (0, "unknown key".into())
+        );
+        assert_eq!(error(&mut cfg, "base_", "1"), (0, "unknown key".into()));
+        assert_eq!(error(&mut cfg, "drill", "1"), (0, "unknown key".into()));
+        assert_eq!(
+            error(&mut cfg, "base_max_rate", "0"),
+            (0, "expected 1 to 200000".into())
+        );
+        assert_eq!(
+            error(&mut cfg, "base_max_rate", " 2k"),
+            (2, "expected a number".into())
+        );
+        assert_eq!(
+            error(&mut cfg, "base_dir_invert", "2"),
+            (0, "expected 0 to 1".into())
+        );
+        assert_eq!(
+            error(&mut cfg, "step_pulse_us", "0"),
+            (0, "expected 1 to 255".into())
+        );
+        assert_eq!(
+            error(&mut cfg, "dir_setup_us", "256"),
+            (0, "expected 0 to 255".into())
+        );
+        assert_eq!(
+            error(&mut cfg, "drill_steps_per_unit", "1600/0"),
+            (0, "invalid steps_per_unit".into())
+        );
+        assert_eq!(
+            error(&mut cfg, "drill_steps_per_unit", "1600/x"),
+            (5, "expected a number".into())
+        );
+        assert_eq!(cfg, MachineConfig::STRING_ART);
+    }
+
+    proptest! {
+        #[test]
+        fn any_accepted_value_is_listed_as_set(index in 0..COUNT, n in 0u32..300_000, den in 1u32..1000) {
+            let mut cfg = MachineConfig::STRING_ART;
+            let s = all().nth(index).unwrap();
+            let text = match s {
+                Setting::Axis(_, AxisField::StepsPerUnit) => std::format!("{}/{}", n.max(1), den),
+                _ => std::format!("{n}"),
+            };
+            if set(&mut cfg, &show(&s), &text).is_ok() {
+                // A ratio over 1 is listed as a whole number.
+                let listed = text.strip_suffix("/1").unwrap_or(&text);
+                prop_assert_eq!(show(&s.get(&cfg)), listed);
+                prop_assert!(cfg.validate().is_ok());
+            } else {
+                let (min, max) = s.range();
+                prop_assert!(!(min..=max).contains(&n));
+            }
+        }
+    }
+}
