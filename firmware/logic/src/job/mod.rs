@@ -10,6 +10,7 @@ pub mod cursor;
 pub mod error;
 pub mod kv;
 pub mod list;
+pub mod machine;
 pub mod num;
 pub mod param;
 pub mod poradi;
