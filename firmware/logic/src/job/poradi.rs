@@ -147,19 +147,27 @@ mod tests {
     use std::string::String;
     use std::vec::Vec;
 
-    fn check_in_chunks(text: &[u8], nails: u16, chunk: usize) -> Result<u32, FileError> {
+    /// `text` cut at the given positions (taken modulo its length).
+    fn pieces<'a>(text: &'a [u8], cuts: &[usize]) -> Vec<&'a [u8]> {
+        let mut at: Vec<usize> = cuts.iter().map(|c| c % (text.len() + 1)).collect();
+        at.extend([0, text.len()]);
+        at.sort();
+        at.windows(2).map(|w| &text[w[0]..w[1]]).collect()
+    }
+
+    fn check_pieces(pieces: &[&[u8]], nails: u16) -> Result<u32, FileError> {
         let mut c = PoradiCheck::new(nails);
-        for part in text.chunks(chunk) {
+        for part in pieces {
             c.push(part)?;
         }
         c.finish()
     }
 
-    /// Reads all indices with the reader, fed in chunks of `chunk` bytes.
-    fn read_in_chunks(text: &[u8], nails: u16, chunk: usize) -> Result<Vec<u16>, FileError> {
+    /// Reads all indices with the reader, fed piece by piece.
+    fn read_pieces(pieces: &[&[u8]], nails: u16) -> Result<Vec<u16>, FileError> {
         let mut r = PoradiReader::new(nails);
         let mut out = Vec::new();
-        for mut part in text.chunks(chunk) {
+        for &(mut part) in pieces {
             while !part.is_empty() {
                 let (used, nail) = r.next(part)?;
                 out.extend(nail);
@@ -168,6 +176,14 @@ mod tests {
         }
         out.extend(r.finish()?);
         Ok(out)
+    }
+
+    fn check_in_chunks(text: &[u8], nails: u16, chunk: usize) -> Result<u32, FileError> {
+        check_pieces(&text.chunks(chunk).collect::<Vec<_>>(), nails)
+    }
+
+    fn read_in_chunks(text: &[u8], nails: u16, chunk: usize) -> Result<Vec<u16>, FileError> {
+        read_pieces(&text.chunks(chunk).collect::<Vec<_>>(), nails)
     }
 
     /// Checks whole and in chunks of every size; all must agree.
@@ -277,25 +293,27 @@ mod tests {
             gaps in proptest::collection::vec((any::<u8>(), any::<u8>()), 1..20),
             bom in proptest::bool::ANY,
             trailing in proptest::bool::ANY,
-            chunk in 1usize..70,
+            cuts in proptest::collection::vec(any::<usize>(), 0..40),
         ) {
             let indices: Vec<u16> = raw.iter().map(|i| i % nails).collect();
             let text = written(&indices, &gaps, bom, trailing);
-            prop_assert_eq!(check_in_chunks(text.as_bytes(), nails, chunk), Ok(indices.len() as u32));
-            prop_assert_eq!(read_in_chunks(text.as_bytes(), nails, chunk), Ok(indices));
+            let pieces = pieces(text.as_bytes(), &cuts);
+            prop_assert_eq!(check_pieces(&pieces, nails), Ok(indices.len() as u32));
+            prop_assert_eq!(read_pieces(&pieces, nails), Ok(indices));
         }
 
         #[test]
         fn chunk_boundaries_never_change_the_verdict(
             text in "[0-9, \r\n.x]{0,40}",
             nails in 3u16..300,
-            chunk in 1usize..40,
+            cuts in proptest::collection::vec(any::<usize>(), 0..10),
         ) {
             let whole = check_in_chunks(text.as_bytes(), nails, text.len().max(1));
-            prop_assert_eq!(check_in_chunks(text.as_bytes(), nails, chunk), whole);
+            let pieces = pieces(text.as_bytes(), &cuts);
+            prop_assert_eq!(check_pieces(&pieces, nails), whole);
             // Both passes agree on every file the check accepts.
             if let Ok(count) = whole {
-                let read = read_in_chunks(text.as_bytes(), nails, chunk).unwrap();
+                let read = read_pieces(&pieces, nails).unwrap();
                 prop_assert_eq!(read.len() as u32, count);
             }
         }
