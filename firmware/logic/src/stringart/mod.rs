@@ -1,1 +1,59 @@
-//! (being written)
+//! Move planning of the string-art job: pure iterators that turn the board's
+//! geometry into the machine's sequence of absolute step targets and events.
+//! `drilling` drills every nail's hole, `winding` wraps the pattern's nails,
+//! `timing` estimates machine time on the host (for the closing report).
+
+mod drilling;
+mod timing;
+mod winding;
+
+pub use drilling::Drilling;
+pub use timing::{machine_time, Overlap};
+pub use winding::{WindError, Winder, Winding, Wrap};
+
+use crate::axis::{Axis, PerAxis, AXES};
+
+/// Drill axis vs board surface: a depth d needs d / sin(74.333°) of travel.
+pub const DRILL_ANGLE_DEG: f32 = 74.333;
+/// Holes are drilled this deep, from this high above the surface, mm.
+pub const HOLE_DEPTH_MM: f32 = 10.0;
+pub const DRILL_CLEARANCE_MM: f32 = 10.0;
+/// The drill rests at the bottom of each hole this long.
+pub const DWELL_MS: u16 = 250;
+/// While winding, the needle turns this far inside the smallest nail
+/// radius, and this far outside the radius of the nail being wrapped, mm.
+pub const INNER_MARGIN_MM: f32 = 20.0;
+pub const OUTER_MARGIN_MM: f32 = 29.0;
+
+/// One thing the machine does, in order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// Move the axes that have a target to it (absolute steps). They start
+    /// together, each within its own speed and acceleration, and the next
+    /// step waits until all have arrived.
+    Move(PerAxis<Option<i32>>),
+    /// Wait, ms.
+    Dwell(u16),
+    /// Switch the drivers of the axes in `mask` (bit = axis index) on or off.
+    Drivers { mask: u8, on: bool },
+}
+
+impl Step {
+    /// A move of one axis.
+    pub fn to(axis: Axis, target: i32) -> Step {
+        let mut t = [None; AXES];
+        t[axis.index()] = Some(target);
+        Step::Move(t)
+    }
+}
+
+/// The driver bit of an axis, for [`Step::Drivers`].
+pub const fn bit(axis: Axis) -> u8 {
+    1 << axis as u8
+}
+
+/// Base, radial and drill.
+pub const MACHINE_DRIVERS: u8 = bit(Axis::Base) | bit(Axis::Radial) | bit(Axis::Drill);
+
+#[cfg(test)]
+mod tests;

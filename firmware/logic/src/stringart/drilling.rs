@@ -1,0 +1,163 @@
+//! Drilling every nail's hole, in order: the tool is raised 1 cm above the
+//! surface, the base and the carriage move together to the nail, the drill
+//! plunges 1 cm deep along its tilted axis, dwells and retracts. The base
+//! and the carriage only move while the drill is raised. After the last
+//! hole the tool goes back over nail 0 and the drivers are switched off.
+
+use super::{Step, DRILL_ANGLE_DEG, DRILL_CLEARANCE_MM, DWELL_MS, HOLE_DEPTH_MM, MACHINE_DRIVERS};
+use crate::axis::{Axis, AXES};
+use crate::config::MachineConfig;
+use crate::geometry::{Board, StepScale};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stage {
+    Raise,
+    Approach,
+    Plunge,
+    Dwell,
+    Retract,
+    Home,
+    Off,
+    Done,
+}
+
+/// The drilling sequence, from the zero pose (base 0 = nail 0's angle,
+/// tool at the board's edge, tip on the surface).
+pub struct Drilling {
+    board: Board,
+    scale: StepScale,
+    /// Drill positions 1 cm above the surface and 1 cm deep, steps.
+    raised: i32,
+    plunged: i32,
+    nail: u16,
+    base: i32,
+    stage: Stage,
+}
+
+/// Drill steps for a vertical distance, along the tilted axis: rounded once.
+fn tool_axis_steps(config: &MachineConfig, vertical_mm: f32) -> i32 {
+    let along = vertical_mm / libm::sinf(DRILL_ANGLE_DEG.to_radians());
+    libm::roundf(along * config.axes[Axis::Drill.index()].steps_per_unit.as_f32()) as i32
+}
+
+impl Drilling {
+    pub fn new(board: Board, config: &MachineConfig) -> Self {
+        Drilling {
+            board,
+            scale: StepScale::from_config(config),
+            raised: -tool_axis_steps(config, DRILL_CLEARANCE_MM),
+            plunged: tool_axis_steps(config, HOLE_DEPTH_MM),
+            nail: 0,
+            base: 0,
+            stage: Stage::Raise,
+        }
+    }
+
+    /// Base and carriage together over nail `i`, the shorter way round.
+    fn over_nail(&mut self, i: u16) -> Step {
+        let nail = self.board.nail(i);
+        self.base = self.scale.shorter_rotation(self.base, nail.angle);
+        let mut t = [None; AXES];
+        t[Axis::Base.index()] = Some(self.base);
+        t[Axis::Radial.index()] = Some(self.scale.radial_steps(&self.board, nail.radius));
+        Step::Move(t)
+    }
+}
+
+impl Iterator for Drilling {
+    type Item = Step;
+
+    fn next(&mut self) -> Option<Step> {
+        let (step, next) = match self.stage {
+            Stage::Raise => (Step::to(Axis::Drill, self.raised), Stage::Approach),
+            Stage::Approach => (self.over_nail(self.nail), Stage::Plunge),
+            Stage::Plunge => (Step::to(Axis::Drill, self.plunged), Stage::Dwell),
+            Stage::Dwell => (Step::Dwell(DWELL_MS), Stage::Retract),
+            Stage::Retract => {
+                self.nail += 1;
+                let next = if self.nail < self.board.nails() {
+                    Stage::Approach
+                } else {
+                    Stage::Home
+                };
+                (Step::to(Axis::Drill, self.raised), next)
+            }
+            Stage::Home => (self.over_nail(0), Stage::Off),
+            Stage::Off => (
+                Step::Drivers {
+                    mask: MACHINE_DRIVERS,
+                    on: false,
+                },
+                Stage::Done,
+            ),
+            Stage::Done => return None,
+        };
+        self.stage = next;
+        Some(step)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::units::Milli;
+    use std::vec::Vec;
+
+    fn mv(base: i32, radial: i32) -> Step {
+        Step::Move([Some(base), Some(radial), None, None])
+    }
+
+    #[test]
+    fn hexagon_of_24_nails_exactly() {
+        let board = Board::new(6, 24, Milli(402_000)).unwrap();
+        let steps: Vec<Step> = Drilling::new(board, &MachineConfig::STRING_ART).collect();
+        // 10 mm / sin(74.333°) = 10.386 mm = 1384.8 drill steps.
+        let (up, down) = (Step::to(Axis::Drill, -1385), Step::to(Axis::Drill, 1385));
+        assert_eq!(steps.len(), 1 + 24 * 4 + 2);
+        assert_eq!(steps[0], up);
+        // Nail 0: vertex at 0°, 387 mm = 15 mm inside the edge = −480 steps.
+        assert_eq!(steps[1..5], [mv(0, -480), down, Step::Dwell(250), up]);
+        // Nail 1: 13.898°, 348.837 mm → 371 base, −1701 radial steps.
+        assert_eq!(steps[5], mv(371, -1701));
+        // Nail 2: the edge's midpoint, 30°, 335.152 mm.
+        assert_eq!(steps[9], mv(800, -2139));
+        // Nail 23 (346.1°): the base keeps turning forwards, past 9229.
+        assert_eq!(steps[1 + 23 * 4], mv(9229, -1701));
+        // Back over nail 0 the short way (a full turn on), then off.
+        assert_eq!(
+            steps[97..],
+            [
+                mv(9600, -480),
+                Step::Drivers {
+                    mask: 0b111,
+                    on: false
+                }
+            ]
+        );
+    }
+
+    #[test]
+    fn base_and_carriage_move_only_with_the_drill_raised() {
+        let board = Board::new(0, 250, Milli(402_000)).unwrap();
+        let mut drill = 0;
+        let mut holes = Vec::new();
+        let mut base = 0;
+        for step in Drilling::new(board, &MachineConfig::STRING_ART) {
+            if let Step::Move(t) = step {
+                if t[0].is_some() || t[1].is_some() {
+                    assert!(drill < 0, "{step:?} with the drill at {drill}");
+                }
+                base = t[0].unwrap_or(base);
+                if let Some(d) = t[2] {
+                    if d > 0 {
+                        holes.push(base);
+                    }
+                    drill = d;
+                }
+            }
+        }
+        // One hole per nail, at 38.4 steps per nail rounded once.
+        let expect: Vec<i32> = (0..250).map(|i| (i * 9600 * 2 + 250) / 500).collect();
+        assert_eq!(holes, expect);
+    }
+}

@@ -1,0 +1,174 @@
+//! Winding the pattern: every nail of `poradi.txt`, the last one included.
+//!
+//! The needle starts outside nail 0 (zero pose). Entry: half a nail round
+//! to the gap after nail 0, needle in, back to nail 0's angle. Each wrap of
+//! nail j: with the needle inside the ring, turn the shorter way to the
+//! nearer gap beside j; needle out beyond j; turn across j to the gap on its
+//! other side; needle back in. The needle crosses the ring of nails only
+//! inside a gap, and turns only well inside the ring or beyond the nail it
+//! wraps. Every target is absolute, from the nail index: no drift.
+
+use super::{bit, Step, INNER_MARGIN_MM, OUTER_MARGIN_MM};
+use crate::axis::Axis;
+use crate::config::MachineConfig;
+use crate::geometry::{Board, StepScale};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WindError {
+    /// A nail index past the board's last nail.
+    BadNail(u16),
+    /// The inner winding radius would reach the board's centre.
+    BoardTooSmall,
+}
+
+/// Plans the wraps one nail at a time, so the pattern can be streamed from
+/// the card.
+pub struct Winder {
+    board: Board,
+    scale: StepScale,
+    /// Needle inside the ring, radial steps.
+    inner: i32,
+    base: i32,
+}
+
+/// The four moves that wrap one nail: base, radial, base, radial.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Wrap {
+    targets: [i32; 4],
+    next: u8,
+}
+
+impl Iterator for Wrap {
+    type Item = Step;
+
+    fn next(&mut self) -> Option<Step> {
+        let i = self.next as usize;
+        let target = *self.targets.get(i)?;
+        self.next += 1;
+        const AXES: [Axis; 4] = [Axis::Base, Axis::Radial, Axis::Base, Axis::Radial];
+        Some(Step::to(AXES[i], target))
+    }
+}
+
+impl Winder {
+    /// From the winding zero pose: nail 0 under the needle, needle at the
+    /// board's edge.
+    pub fn new(board: Board, config: &MachineConfig) -> Result<Self, WindError> {
+        let inner_mm = board.min_nail_radius() - INNER_MARGIN_MM;
+        if inner_mm <= 0.0 {
+            return Err(WindError::BoardTooSmall);
+        }
+        let scale = StepScale::from_config(config);
+        Ok(Winder {
+            inner: scale.radial_steps(&board, inner_mm),
+            board,
+            scale,
+            base: 0,
+        })
+    }
+
+    /// The drill's driver off (the needle holds its height unpowered),
+    /// then the entry move.
+    pub fn entry(&mut self) -> [Step; 4] {
+        let gap = self
+            .scale
+            .shorter_rotation(self.base, self.board.gap_after(0));
+        self.base = self.scale.shorter_rotation(gap, self.board.nail(0).angle);
+        [
+            Step::Drivers {
+                mask: bit(Axis::Drill),
+                on: false,
+            },
+            Step::to(Axis::Base, gap),
+            Step::to(Axis::Radial, self.inner),
+            Step::to(Axis::Base, self.base),
+        ]
+    }
+
+    /// The moves that wrap nail `j`.
+    pub fn wrap(&mut self, j: u16) -> Result<Wrap, WindError> {
+        let nails = self.board.nails();
+        if j >= nails {
+            return Err(WindError::BadNail(j));
+        }
+        let s = &self.scale;
+        let before = s.shorter_rotation(self.base, self.board.gap_before(j));
+        let after = s.shorter_rotation(self.base, self.board.gap_after(j));
+        // Steps across nail j, from its gap before to its gap after.
+        let span = (after - before).rem_euclid(s.steps_per_turn);
+        let (first, second) = if (before - self.base).abs() <= (after - self.base).abs() {
+            (before, before + span)
+        } else {
+            (after, after - span)
+        };
+        let outer = s.radial_steps(&self.board, self.board.nail(j).radius + OUTER_MARGIN_MM);
+        self.base = second;
+        Ok(Wrap {
+            targets: [first, outer, second, self.inner],
+            next: 0,
+        })
+    }
+
+    /// All drivers off at the end of the job.
+    pub fn finish(&self) -> Step {
+        Step::Drivers {
+            mask: super::MACHINE_DRIVERS,
+            on: false,
+        }
+    }
+}
+
+/// The whole winding as one sequence: entry, a wrap per nail, drivers off.
+pub struct Winding<I> {
+    winder: Winder,
+    pattern: I,
+    entry: Option<core::array::IntoIter<Step, 4>>,
+    wrap: Option<Wrap>,
+    finished: bool,
+}
+
+impl<I: Iterator<Item = u16>> Winding<I> {
+    pub fn new(winder: Winder, pattern: I) -> Self {
+        Winding {
+            winder,
+            pattern,
+            entry: None,
+            wrap: None,
+            finished: false,
+        }
+    }
+}
+
+impl<I: Iterator<Item = u16>> Iterator for Winding<I> {
+    type Item = Result<Step, WindError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.finished {
+            return None;
+        }
+        let entry = self
+            .entry
+            .get_or_insert_with(|| self.winder.entry().into_iter());
+        if let Some(step) = entry.next() {
+            return Some(Ok(step));
+        }
+        loop {
+            if let Some(step) = self.wrap.as_mut().and_then(Iterator::next) {
+                return Some(Ok(step));
+            }
+            match self.pattern.next() {
+                Some(j) => match self.winder.wrap(j) {
+                    Ok(w) => self.wrap = Some(w),
+                    Err(e) => {
+                        self.finished = true;
+                        return Some(Err(e));
+                    }
+                },
+                None => {
+                    self.finished = true;
+                    return Some(Ok(self.winder.finish()));
+                }
+            }
+        }
+    }
+}
