@@ -1,1 +1,212 @@
-//! (being written)
+//! Look-ahead planner: a ring of moves in steps with Grbl's junction
+//! deviation and trapezoidal speed profiles.
+//!
+//! Speeds are compared across blocks along the *path*: each axis's steps
+//! are divided by its steps per unit, so the path is measured in thousandths
+//! of the axes' units (µm, millidegrees) — the same scale as
+//! `junction_deviation_um`. A base turn of 1° and a radial move of 1 mm are
+//! thus equally long; that is the only way to compare degrees with mm.
+//! Floats are used once per block when it is added (its length, the
+//! junction cosine); the look-ahead passes are additions and comparisons of
+//! squared speeds, `u64` (µm/s)². The block handed to the segment preparer
+//! is converted to events (steps of its dominant axis).
+
+mod junction;
+
+#[cfg(test)]
+mod tests;
+
+use crate::axis::{PerAxis, AXES};
+use crate::config::MachineConfig;
+use crate::segment::{StepBlock, Trapezoid};
+use crate::units::Milli;
+use junction::{Corner, Geometry};
+
+/// Number of moves the planner holds.
+pub const PLANNER_BLOCKS: usize = 16;
+
+/// Requested speed of a move.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Feed {
+    /// As fast as every axis allows (`G0`).
+    Rapid,
+    /// Thousandths of a unit per minute along the path (`G1 F`).
+    PerMinute(Milli),
+}
+
+/// The planner is full; push again after the preparer took a block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Full;
+
+/// A block taken by the segment preparer: what the step interrupt needs and
+/// the profile to cut into segments. The planner no longer changes it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Planned {
+    pub block: StepBlock,
+    pub profile: Trapezoid,
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct Block {
+    step: StepBlock,
+    /// Events/s², the tightest of the axes' limits.
+    accel: u32,
+    /// Cruise speed², events²/s².
+    nominal_ev_sqr: u64,
+    /// (events per path milli-unit)²: converts path speeds² to events²/s².
+    ev_per_milli_sqr: f32,
+    /// Path speeds², (milli-units/s)².
+    max_entry_sqr: u64,
+    entry_sqr: u64,
+    /// Largest change of speed² over the block: 2·accel·length.
+    delta_sqr: u64,
+}
+
+pub struct Planner {
+    blocks: [Block; PLANNER_BLOCKS],
+    /// Oldest block.
+    head: usize,
+    len: usize,
+    /// Entry speed² of the oldest block, fixed: the exit speed of the block
+    /// the preparer took before it.
+    carry_sqr: u64,
+    /// Target of the last move, steps.
+    position: PerAxis<i32>,
+    geometry: Geometry,
+    /// Direction and cruise speed² of the last move, for the next junction.
+    last: Option<([f32; AXES], u64)>,
+}
+
+impl Planner {
+    pub fn new(config: &MachineConfig) -> Self {
+        Planner {
+            blocks: [Block::default(); PLANNER_BLOCKS],
+            head: 0,
+            len: 0,
+            carry_sqr: 0,
+            position: [0; AXES],
+            geometry: Geometry::new(config),
+            last: None,
+        }
+    }
+
+    /// Adds a move to the absolute step position `target`. A move of no
+    /// step is dropped.
+    pub fn push(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
+        if self.len == PLANNER_BLOCKS {
+            return Err(Full);
+        }
+        let mut step = StepBlock::default();
+        let mut delta = [0i64; AXES];
+        for i in 0..AXES {
+            delta[i] = target[i] as i64 - self.position[i] as i64;
+            step.steps[i] = delta[i].unsigned_abs() as u32;
+            if delta[i] > 0 {
+                step.dir |= 1 << i;
+            }
+        }
+        step.events = step.steps.iter().copied().max().unwrap_or(0);
+        if step.events == 0 {
+            return Ok(());
+        }
+        let (accel, rate) = self.geometry.limits(&step);
+        let path = self.geometry.path(&delta);
+        let feed_ev = match feed {
+            Feed::Rapid => rate,
+            Feed::PerMinute(f) => (f.0.max(0) as f32 / 60.0 * path.ev_per_milli) as u32,
+        };
+        let nominal_ev = feed_ev.clamp(1, rate) as u64;
+        let k2 = path.ev_per_milli * path.ev_per_milli;
+        let nominal_ev_sqr = nominal_ev * nominal_ev;
+        let nominal_sqr = (nominal_ev_sqr as f32 / k2) as u64;
+        let mut max_entry_sqr = 0;
+        if let Some((prev_unit, prev_nominal_sqr)) = self.last {
+            let corner = Corner::new(&prev_unit, &path.unit);
+            max_entry_sqr = self
+                .geometry
+                .junction_sqr(&corner)
+                .min(nominal_sqr)
+                .min(prev_nominal_sqr);
+        }
+        let slot = (self.head + self.len) % PLANNER_BLOCKS;
+        self.blocks[slot] = Block {
+            step,
+            accel,
+            nominal_ev_sqr,
+            ev_per_milli_sqr: k2,
+            max_entry_sqr,
+            entry_sqr: 0,
+            delta_sqr: ((2 * accel as u64 * step.events as u64) as f32 / k2) as u64,
+        };
+        self.len += 1;
+        self.position = target;
+        self.last = Some((path.unit, nominal_sqr));
+        self.recalculate();
+        Ok(())
+    }
+
+    /// No move is waiting for the preparer.
+    pub fn is_idle(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Target of the last move pushed, steps.
+    pub fn position(&self) -> PerAxis<i32> {
+        self.position
+    }
+
+    /// Redefines the position (`G92`, homing). Only when idle and stopped:
+    /// the next move starts from standstill.
+    pub fn set_position(&mut self, position: PerAxis<i32>) {
+        self.position = position;
+        self.last = None;
+    }
+
+    /// Hands the oldest block to the segment preparer. Its exit speed is
+    /// what the look-ahead allows now; the next block's entry is fixed to it.
+    pub fn take(&mut self) -> Option<Planned> {
+        if self.len == 0 {
+            return None;
+        }
+        let b = self.blocks[self.head];
+        self.head = (self.head + 1) % PLANNER_BLOCKS;
+        self.len -= 1;
+        let exit_sqr = if self.len > 0 {
+            self.blocks[self.head].entry_sqr
+        } else {
+            0
+        };
+        self.carry_sqr = exit_sqr;
+        let to_events = |v: u64| (v as f32 * b.ev_per_milli_sqr) as u64;
+        Some(Planned {
+            block: b.step,
+            profile: Trapezoid::new(
+                b.step.events,
+                b.accel,
+                to_events(b.entry_sqr),
+                b.nominal_ev_sqr,
+                to_events(exit_sqr),
+            ),
+        })
+    }
+
+    /// Grbl's passes: backwards, each entry is at most what still stops at
+    /// the end of the queue; forwards, at most what the previous block can
+    /// reach from its entry. Additions and comparisons only.
+    fn recalculate(&mut self) {
+        let at = |i: usize| (self.head + i) % PLANNER_BLOCKS;
+        let mut next_entry = 0u64;
+        for i in (1..self.len).rev() {
+            let b = &mut self.blocks[at(i)];
+            b.entry_sqr = b.max_entry_sqr.min(next_entry.saturating_add(b.delta_sqr));
+            next_entry = b.entry_sqr;
+        }
+        self.blocks[self.head].entry_sqr = self.carry_sqr;
+        for i in 1..self.len {
+            let prev = self.blocks[at(i - 1)];
+            let reach = prev.entry_sqr.saturating_add(prev.delta_sqr);
+            let b = &mut self.blocks[at(i)];
+            b.entry_sqr = b.entry_sqr.min(reach);
+        }
+    }
+}

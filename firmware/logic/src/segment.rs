@@ -30,7 +30,7 @@ mod tests;
 
 pub use expand::{expand, Event, Expand};
 pub use prepare::Preparer;
-pub use trapezoid::Trapezoid;
+pub use trapezoid::{Trapezoid, MAX_ACCEL};
 
 use crate::axis::PerAxis;
 

@@ -1,0 +1,202 @@
+use super::*;
+use crate::config::AxisConfig;
+use crate::segment::{expand, Event, Preparer, Segment, TICK_HZ};
+use crate::units::StepsPerUnit;
+use proptest::prelude::*;
+use std::vec::Vec;
+
+/// Two identical axes, 100 steps per unit, so corners are plain geometry.
+fn square() -> MachineConfig {
+    let axis = AxisConfig {
+        steps_per_unit: StepsPerUnit::new(100, 1),
+        max_rate: 4000,
+        accel: 1000,
+        dir_high_is_positive: true,
+        enable_active_high: true,
+    };
+    MachineConfig {
+        axes: [axis; AXES],
+        junction_deviation_um: 50,
+        ..MachineConfig::STRING_ART
+    }
+}
+
+fn entries(p: &Planner) -> Vec<u64> {
+    (0..p.len)
+        .map(|i| p.blocks[(p.head + i) % PLANNER_BLOCKS].entry_sqr)
+        .collect()
+}
+
+/// Nominal path speed² of a 4000 steps/s move on one axis of `square()`:
+/// 40 units/s = 40 000 milli/s.
+const FULL_SQR: u64 = 40_000 * 40_000;
+
+#[test]
+fn straight_on_keeps_full_speed() {
+    let mut p = Planner::new(&square());
+    for k in 1..=3 {
+        p.push([k * 20_000, 0, 0, 0], Feed::Rapid).unwrap();
+    }
+    let e = entries(&p);
+    assert_eq!(e[0], 0);
+    // 20 000 steps at 1000/s² reach 4000 steps/s; the junctions run at it.
+    assert!(e[1].abs_diff(FULL_SQR) <= FULL_SQR / 100_000, "{e:?}");
+    assert!(e[2].abs_diff(FULL_SQR) <= FULL_SQR / 100_000, "{e:?}");
+}
+
+#[test]
+fn right_angle_uses_grbl_formula() {
+    let mut p = Planner::new(&square());
+    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
+    p.push([20_000, 20_000, 0, 0], Feed::Rapid).unwrap();
+    // Grbl: a = 1000 steps/s² = 10 000 milli/s² per axis, limited along the
+    // velocity change (-1, 1)/√2 → a·√2; sin(θ/2) = √½.
+    let a = 10_000.0 * 2f64.sqrt();
+    let s = 0.5f64.sqrt();
+    let expected = a * 50.0 * s / (1.0 - s);
+    let got = entries(&p)[1] as f64;
+    assert!(
+        (got - expected).abs() < expected * 1e-4,
+        "{got} vs {expected}"
+    );
+    assert!(got > 0.0 && (got as u64) < FULL_SQR);
+}
+
+#[test]
+fn reversal_stops() {
+    let mut p = Planner::new(&square());
+    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
+    p.push([0, 0, 0, 0], Feed::Rapid).unwrap();
+    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
+    assert_eq!(entries(&p), [0, 0, 0]);
+}
+
+#[test]
+fn gentle_corner_does_not_stop() {
+    let mut p = Planner::new(&MachineConfig::STRING_ART);
+    p.push([9600, 320, 0, 0], Feed::Rapid).unwrap();
+    p.push([19_200, 680, 0, 0], Feed::Rapid).unwrap();
+    let e = entries(&p)[1];
+    assert!(e > 0, "{e}");
+}
+
+#[test]
+fn full_queue_pushes_back() {
+    let mut p = Planner::new(&square());
+    for k in 1..=PLANNER_BLOCKS as i32 {
+        p.push([k * 100, 0, 0, 0], Feed::Rapid).unwrap();
+    }
+    assert_eq!(p.push([0, 0, 0, 0], Feed::Rapid), Err(Full));
+    assert!(p.take().is_some());
+    assert_eq!(p.push([0, 0, 0, 0], Feed::Rapid), Ok(()));
+    assert_eq!(p.position(), [0; AXES]);
+}
+
+/// Plans `moves`, taking blocks when the queue is full, and replays what
+/// the step interrupt would do.
+fn run(
+    config: &MachineConfig,
+    moves: &[(PerAxis<i32>, Feed)],
+) -> (Vec<Event>, Vec<StepBlock>, usize) {
+    let mut p = Planner::new(config);
+    let mut prep = Preparer::new();
+    let (mut segs, mut blocks) = (Vec::<Segment>::new(), Vec::new());
+    let mut drain = |p: &mut Planner, segs: &mut Vec<Segment>, blocks: &mut Vec<StepBlock>| {
+        let planned = p.take().unwrap();
+        blocks.push(planned.block);
+        prep.start(planned.profile);
+        while let Some(s) = prep.next() {
+            segs.push(s);
+        }
+    };
+    for &(target, feed) in moves {
+        while p.push(target, feed) == Err(Full) {
+            drain(&mut p, &mut segs, &mut blocks);
+        }
+    }
+    while !p.is_idle() {
+        drain(&mut p, &mut segs, &mut blocks);
+    }
+    let n = segs.len();
+    (expand(segs, blocks.clone()).collect(), blocks, n)
+}
+
+/// Net steps per axis of a replay.
+fn travel(events: &[Event]) -> PerAxis<i32> {
+    let mut pos = [0; AXES];
+    for e in events {
+        for (i, p) in pos.iter_mut().enumerate() {
+            if e.axes >> i & 1 != 0 {
+                *p += if e.dir >> i & 1 != 0 { 1 } else { -1 };
+            }
+        }
+    }
+    pos
+}
+
+/// Highest speed and acceleration of an axis rebuilt from its step times
+/// over windows of `w` steps, steps/s and steps/s².
+fn speed_and_accel(times: &[u64], w: usize) -> (f64, f64) {
+    let t: Vec<f64> = times.iter().map(|&t| t as f64 / TICK_HZ as f64).collect();
+    let v: Vec<(f64, f64)> = (0..t.len().saturating_sub(w))
+        .map(|j| ((t[j] + t[j + w]) / 2.0, w as f64 / (t[j + w] - t[j])))
+        .collect();
+    let vmax = v.iter().map(|x| x.1).fold(0.0, f64::max);
+    let amax = (0..v.len().saturating_sub(w))
+        .map(|j| ((v[j + w].1 - v[j].1) / (v[j + w].0 - v[j].0)).abs())
+        .fold(0.0, f64::max);
+    (vmax, amax)
+}
+
+#[test]
+fn string_art_turn_profile() {
+    let c = MachineConfig::STRING_ART;
+    let (events, _, segs) = run(&c, &[([9600, 0, 0, 0], Feed::Rapid)]);
+    assert_eq!(travel(&events), [9600, 0, 0, 0]);
+    let times: Vec<u64> = events.iter().map(|e| e.tick).collect();
+    let (v, a) = speed_and_accel(&times, 128);
+    assert!(v <= 2000.0 * 1.001 && v > 1990.0, "{v}");
+    assert!(a <= 500.0 * 1.02 && a > 450.0, "{a}");
+    std::println!("one turn: {segs} segments");
+}
+
+fn moves() -> impl Strategy<Value = Vec<(PerAxis<i32>, Feed)>> {
+    let feed = prop_oneof![
+        Just(Feed::Rapid),
+        (1_000i32..200_000).prop_map(|f| Feed::PerMinute(Milli(f * 100)))
+    ];
+    proptest::collection::vec((proptest::array::uniform4(-3000i32..3000), feed), 1..40)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn exact_totals_and_final_position(moves in moves()) {
+        let (events, blocks, segs) = run(&MachineConfig::STRING_ART, &moves);
+        prop_assert_eq!(travel(&events), moves.last().unwrap().0);
+        // Every block's DDA makes exactly its steps.
+        let total: u64 = blocks.iter().map(|b| b.events as u64).sum();
+        prop_assert_eq!(events.len() as u64, total);
+        prop_assert!(segs <= events.len());
+    }
+
+    #[test]
+    fn collinear_moves_never_exceed_limits(
+        lengths in proptest::collection::vec(1i32..4000, 1..20),
+        feeds in proptest::collection::vec(60_000i32..200_000, 20),
+    ) {
+        // Base axis forward in pieces at varying feeds (millidegrees/min).
+        let mut pos = 0;
+        let moves: Vec<_> = lengths.iter().zip(&feeds).map(|(&l, &f)| {
+            pos += l;
+            ([pos, 0, 0, 0], Feed::PerMinute(Milli(f * 100)))
+        }).collect();
+        let (events, _, _) = run(&MachineConfig::STRING_ART, &moves);
+        prop_assert_eq!(travel(&events)[0], pos);
+        let times: Vec<u64> = events.iter().map(|e| e.tick).collect();
+        let (v, a) = speed_and_accel(&times, 128);
+        prop_assert!(v <= 2000.0 * 1.001, "speed {}", v);
+        prop_assert!(a <= 500.0 * 1.02, "accel {}", a);
+    }
+}
