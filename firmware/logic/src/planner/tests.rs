@@ -179,6 +179,12 @@ proptest! {
         let total: u64 = blocks.iter().map(|b| b.events as u64).sum();
         prop_assert_eq!(events.len() as u64, total);
         prop_assert!(segs <= events.len());
+        // No axis ever runs faster than its 2000 steps/s.
+        for i in 0..AXES {
+            let times: Vec<u64> = events.iter().filter(|e| e.axes >> i & 1 != 0).map(|e| e.tick).collect();
+            let (v, _) = speed_and_accel(&times, 64);
+            prop_assert!(v <= 2000.0 * 1.01, "axis {} at {}", i, v);
+        }
     }
 
     #[test]
