@@ -351,5 +351,14 @@ mod tests {
                 prop_assert_eq!(result.unwrap_err().kind, ErrorKind::RadiusTooSmall { above_um: radius_limit_um(shape) });
             }
         }
+
+        #[test]
+        fn chunk_boundaries_never_change_the_verdict(
+            text in "(tvar|nails|radius_cm|x|[ =.0-9#\r\n\t\u{FEFF}]){0,40}",
+            chunk in 1usize..40,
+        ) {
+            let whole = parse_in_chunks(text.as_bytes(), text.len().max(1));
+            prop_assert_eq!(parse_in_chunks(text.as_bytes(), chunk), whole);
+        }
     }
 }
