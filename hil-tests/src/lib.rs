@@ -44,5 +44,13 @@ pub fn example_elf(name: &str) -> PathBuf {
     release_dir().join("examples").join(format!("{name}.elf"))
 }
 
-/// The firmware version the banner must show.
-pub const VERSION: &str = "0.1.0";
+/// The version in firmware/Cargo.toml, which the banner must show.
+pub fn firmware_version() -> String {
+    let manifest = std::fs::read_to_string(firmware_dir().join("Cargo.toml")).unwrap();
+    manifest
+        .lines()
+        .find_map(|l| l.strip_prefix("version = \""))
+        .and_then(|v| v.strip_suffix('"'))
+        .expect("version in firmware/Cargo.toml")
+        .to_string()
+}

@@ -1,0 +1,120 @@
+//! `taut-sim ELF [options]`: run a firmware image on the simulated machine
+//! with every RAMPS pin probed under its fixed VCD name, then write the
+//! trace and a JSON report. `cargo xtask sim` calls it with the release ELF.
+
+use serde_json::json;
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+use taut_logic::axis::Axis;
+use taut_logic::pinmap::{self, Button};
+use taut_simavr::{Outcome, Sim};
+
+const USAGE: &str = "\
+usage: taut-sim ELF [--for SECONDS] [--vcd PATH] [--report PATH] [--echo]
+  --for SECONDS   simulated time to run (default 5)
+  --vcd PATH      write a VCD trace of every probed pin
+  --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
+  --echo          print the firmware's serial output as it runs";
+
+struct Args {
+    elf: PathBuf,
+    seconds: f64,
+    vcd: Option<PathBuf>,
+    report: Option<PathBuf>,
+    echo: bool,
+}
+
+fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
+    let elf = it.next().ok_or("missing ELF")?.into();
+    let mut args = Args { elf, seconds: 5.0, vcd: None, report: None, echo: false };
+    while let Some(a) = it.next() {
+        let mut value = || it.next().ok_or(format!("{a} needs a value"));
+        match a.as_str() {
+            "--for" => args.seconds = value()?.parse().map_err(|e| format!("--for: {e}"))?,
+            "--vcd" => args.vcd = Some(value()?.into()),
+            "--report" => args.report = Some(value()?.into()),
+            "--echo" => args.echo = true,
+            _ => return Err(format!("unknown option {a}")),
+        }
+    }
+    Ok(args)
+}
+
+/// Probes with the documented signal names: `<axis>_step|dir|en`,
+/// `btn_<button>`, `led`.
+fn probe_machine(sim: &mut Sim) {
+    for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
+        let d = pinmap::driver(axis);
+        sim.probe_step_dir(axis.name(), d.step, d.dir, true);
+        sim.probe(d.enable, &format!("{}_en", axis.name()));
+    }
+    for b in Button::ALL {
+        sim.probe(b.pin(), &format!("btn_{}", b.name()));
+    }
+    sim.probe(pinmap::STATUS_LED, "led");
+}
+
+fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
+    let mut sim = Sim::load(&args.elf)?;
+    probe_machine(&mut sim);
+    let wall = Instant::now();
+    let total = Duration::from_secs_f64(args.seconds);
+    let slice = Duration::from_millis(10);
+    let mut printed = 0;
+    let mut outcome = Outcome::Running;
+    let mut elapsed = Duration::ZERO;
+    while elapsed < total {
+        let step = slice.min(total - elapsed);
+        outcome = sim.run_for(step);
+        elapsed += step;
+        if args.echo {
+            let text = sim.uart_bytes();
+            std::io::stdout().write_all(&text[printed..])?;
+            printed = text.len();
+        }
+        if outcome != Outcome::Running {
+            break;
+        }
+    }
+    let wall_s = wall.elapsed().as_secs_f64();
+    if let Some(path) = &args.vcd {
+        sim.write_vcd(path)?;
+    }
+    if let Some(path) = &args.report {
+        let mut report = serde_json::to_value(sim.report(outcome))?;
+        let extra = json!({
+            "wall_seconds": wall_s,
+            "sim_mhz": sim.cycles() as f64 / wall_s / 1e6,
+        });
+        report.as_object_mut().unwrap().extend(extra.as_object().unwrap().clone());
+        std::fs::write(path, serde_json::to_string_pretty(&report)?)?;
+    }
+    eprintln!(
+        "taut-sim: {:.3} s of machine time in {:.2} s ({:.0} simulated MHz), ended: {:?}",
+        sim.time_s(),
+        wall_s,
+        sim.cycles() as f64 / wall_s / 1e6,
+        outcome
+    );
+    Ok(outcome)
+}
+
+fn main() -> ExitCode {
+    let args = match parse(std::env::args().skip(1)) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("taut-sim: {e}\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    match run(args) {
+        Ok(o) if !o.is_fatal() => ExitCode::SUCCESS,
+        Ok(_) => ExitCode::FAILURE,
+        Err(e) => {
+            eprintln!("taut-sim: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
