@@ -90,3 +90,23 @@ pub(crate) unsafe extern "C" fn on_bad_opcode(_irq: *mut avr_irq_t, _op: u32, pa
 /// simavr's default sleeps in real time; the harness wants simulated time
 /// to pass as fast as the host can go.
 pub(crate) unsafe extern "C" fn no_sleep(_avr: *mut avr_t, _how_long: u64) {}
+
+/// simavr's messages: warnings and errors go to stderr; its chatter (such as
+/// "Loaded N bytes", printed whatever the log level) is dropped.
+///
+/// # Safety
+/// Called by simavr with a printf format and its matching argument list.
+pub(crate) unsafe extern "C" fn log(
+    _avr: *mut avr_t,
+    level: std::os::raw::c_int,
+    format: *const std::os::raw::c_char,
+    args: *mut simavr_ffi::__va_list_tag,
+) {
+    if level > simavr_ffi::LOG_WARNING as std::os::raw::c_int {
+        return;
+    }
+    let mut buf = [0u8; 256];
+    simavr_ffi::vsnprintf(buf.as_mut_ptr() as *mut _, buf.len() as _, format, args);
+    let text = std::ffi::CStr::from_bytes_until_nul(&buf).unwrap_or_default();
+    eprintln!("simavr: {}", text.to_string_lossy().trim_end());
+}

@@ -261,6 +261,9 @@ impl Drop for Sim {
 
 /// A fresh, initialised ATmega2560 at 16 MHz.
 fn new_mcu() -> Result<NonNull<ffi::avr_t>> {
+    static QUIET: std::sync::Once = std::sync::Once::new();
+    // SAFETY: `hooks::log` has the logger signature simavr expects.
+    QUIET.call_once(|| unsafe { ffi::avr_global_logger_set(Some(hooks::log)) });
     // SAFETY: a NUL-terminated name; simavr returns a new avr_t or null.
     let avr = NonNull::new(unsafe { ffi::avr_make_mcu_by_name(c"atmega2560".as_ptr()) })
         .ok_or_else(|| Error::Simavr("no atmega2560 core".into()))?;

@@ -173,3 +173,29 @@ fn pressed_button_reads_low_despite_pull_up() {
     assert_eq!(sim.probed("button").edge_count(), 9);
     assert_eq!(sim.probed("led").rising_count(), 1 + 4);
 }
+
+#[test]
+fn uart_echoes_bytes_sent_before_the_receiver_is_on() {
+    // USART0 at 115200 (UBRR0 = 8), RX+TX on, then echo every byte plus one.
+    let program = [
+        0xE008, // ldi r16, 8
+        0x9300, 0x00C4, // sts UBRR0L, r16
+        0xE108, // ldi r16, RXEN0|TXEN0
+        0x9300, 0x00C1, // sts UCSR0B, r16
+        0x9110, 0x00C0, // loop: lds r17, UCSR0A
+        0xFF17, // sbrs r17, RXC0
+        0xCFFC, // rjmp loop
+        0x9120, 0x00C6, // lds r18, UDR0
+        0x9523, // inc r18
+        0x9320, 0x00C6, // sts UDR0, r18
+        0xCFF6, // rjmp loop
+    ];
+    let mut sim = Sim::from_program(&program).unwrap();
+    sim.uart_send(b"HAL");
+    assert_eq!(sim.run_until_uart_contains("IBM", ms(10)), Outcome::Done);
+    assert_eq!(sim.uart_pending(), 0);
+    // Three bytes on a ~115200 baud line take over 3 x 1388 cycles.
+    assert!(sim.cycles() > 3 * taut_simavr::uart::CYCLES_PER_BYTE);
+    assert_eq!(sim.take_uart(), "IBM");
+    assert_eq!(sim.uart_text(), "");
+}
