@@ -114,10 +114,11 @@ impl Parser {
                 self.lexeme = Lexeme::Comment;
                 self.feed(b' ', column);
             }
-            (Lexeme::Code, b';') | (Lexeme::AfterChecksum, b';') => {
+            (Lexeme::Code, b';') => {
                 self.lexeme = Lexeme::LineComment;
                 self.feed(b' ', column);
             }
+            (Lexeme::Checksum | Lexeme::AfterChecksum, b';') => self.lexeme = Lexeme::LineComment,
             (Lexeme::Code, b'*') => {
                 self.lexeme = Lexeme::Checksum;
                 self.checksum = Some(Checksum {

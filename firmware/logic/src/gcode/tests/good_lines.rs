@@ -73,6 +73,7 @@ fn checksummed_lines_report_number_and_checksum() {
     };
     assert_eq!(with(""), Ok(Input::Line(checked)));
     assert_eq!(with("  ; trailing comment"), Ok(Input::Line(checked)));
+    assert_eq!(with(";no space"), Ok(Input::Line(checked)));
     // The checksum covers comments and spaces before the `*` too.
     let body = "N3 (c) M400 ";
     let checked = Line {
