@@ -50,6 +50,8 @@ pub(crate) struct StepDir {
 pub struct Sim {
     pub(crate) avr: NonNull<ffi::avr_t>,
     pub(crate) shared: NonNull<Shared>,
+    /// Boxed: simavr holds their addresses, which must survive the Vec growing.
+    #[allow(clippy::vec_box)]
     pub(crate) pin_hooks: Vec<Box<PinHook>>,
     pub(crate) uart_input: *mut ffi::avr_irq_t,
     pub(crate) elf: Option<ElfInfo>,
