@@ -108,5 +108,27 @@ pub(crate) unsafe extern "C" fn log(
     let mut buf = [0u8; 256];
     simavr_ffi::vsnprintf(buf.as_mut_ptr() as *mut _, buf.len() as _, format, args);
     let text = std::ffi::CStr::from_bytes_until_nul(&buf).unwrap_or_default();
-    eprintln!("simavr: {}", text.to_string_lossy().trim_end());
+    eprintln!("simavr: {}", plain(&text.to_string_lossy()).trim_end());
+}
+
+/// Text without ANSI colour sequences (`ESC [ ... m`).
+fn plain(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars();
+    while let Some(c) = chars.next() {
+        if c == '\x1b' {
+            chars.by_ref().find(|&c| c == 'm');
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn colour_codes_are_dropped() {
+        assert_eq!(super::plain("\x1b[31mCORE: bad\x1b[0m!"), "CORE: bad!");
+    }
 }

@@ -22,12 +22,26 @@ impl Sim {
     /// Runs until `done` holds (`Done`), the firmware fails, or `timeout` of
     /// simulated time passes (`Running`). `done` sees the simulator after
     /// every pin edge or UART byte and at least every 100 µs.
-    pub fn run_until(&mut self, mut done: impl FnMut(&Sim) -> bool, timeout: Duration) -> Outcome {
+    pub fn run_until(&mut self, done: impl FnMut(&Sim) -> bool, timeout: Duration) -> Outcome {
+        self.run_until_cycles(done, cycles_in(timeout))
+    }
+
+    /// Runs at least `cycles` cycles (ends on an instruction boundary).
+    pub fn run_cycles(&mut self, cycles: u64) -> Outcome {
+        self.run_until_cycles(|_| false, cycles)
+    }
+
+    /// `run_until` with the timeout in cycles.
+    pub fn run_until_cycles(
+        &mut self,
+        mut done: impl FnMut(&Sim) -> bool,
+        timeout: u64,
+    ) -> Outcome {
         if let Some(end) = self.ended {
             return end;
         }
         let start = self.cycles();
-        let deadline = start + cycles_in(timeout);
+        let deadline = start + timeout;
         let wall = Instant::now();
         let mut next_poll = start;
         let mut seen_events = None;

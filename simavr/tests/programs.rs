@@ -45,6 +45,19 @@ fn probe_counts_exact_edges_and_timing() {
 }
 
 #[test]
+fn run_cycles_stops_on_the_cycle() {
+    let mut sim = Sim::from_program(&TOGGLE_10).unwrap();
+    sim.probe(LED, "led");
+    // ldi, out, ldi: three one-cycle instructions before the first toggle.
+    assert_eq!(sim.run_cycles(3), Outcome::Running);
+    assert_eq!(sim.cycles(), 3);
+    assert_eq!(sim.probed("led").edge_count(), 0);
+    sim.run_cycles(1);
+    assert_eq!(sim.probed("led").edge_count(), 1);
+    assert!(sim.pin_level(LED));
+}
+
+#[test]
 fn vcd_holds_the_named_signals_and_their_edges() {
     let mut sim = Sim::from_program(&TOGGLE_10).unwrap();
     sim.probe(LED, "status_led");
@@ -85,6 +98,13 @@ fn running_into_erased_flash_is_a_crash() {
         matches!(end, Outcome::Crashed { pc } if pc >= 512),
         "{end:?}"
     );
+}
+
+#[test]
+fn invalid_opcode_is_a_crash() {
+    // 0x0001 is no AVR instruction (only 0x0000, nop, starts with 0x00).
+    let mut sim = Sim::from_program(&[NOP, NOP, 0x0001, NOP]).unwrap();
+    assert_eq!(sim.run_for(ms(1)), Outcome::Crashed { pc: 4 });
 }
 
 #[test]
