@@ -1,8 +1,14 @@
-//! The AVR side of taut: the board layer, logging and the runtime the `app`
-//! (src/main.rs) and the special-purpose images in examples/ are built on.
+//! The AVR side of taut: the board layer, logging, the runtime, and the
+//! tasks' state, which the `app` (src/main.rs) wires together. The special
+//! images in examples/ are built on the same pieces.
 #![no_std]
 #![feature(asm_experimental_arch)]
 
 pub mod board;
+pub mod console;
+pub mod drivers;
 pub mod log;
+pub mod motion;
+pub mod report;
 pub mod rt;
+pub mod stepper;

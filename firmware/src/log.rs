@@ -10,8 +10,8 @@
 //! (cargo feature `log-debug` lowers it) compile to nothing.
 
 use crate::board::{clock, flash::FlashStr, usart};
-use core::cell::Cell;
 use avr_device::interrupt::Mutex;
+use core::cell::Cell;
 
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Level {
@@ -21,7 +21,11 @@ pub enum Level {
     Debug = 3,
 }
 
-pub const MAX_LEVEL: Level = if cfg!(feature = "log-debug") { Level::Debug } else { Level::Info };
+pub const MAX_LEVEL: Level = if cfg!(feature = "log-debug") {
+    Level::Debug
+} else {
+    Level::Info
+};
 
 /// Longest line; longer ones are cut and end in `~`.
 const LINE: usize = 96;
@@ -52,7 +56,10 @@ impl ufmt::uWrite for Line {
 
 impl Line {
     pub fn new(level: Level, module: FlashStr) -> Line {
-        let mut l = Line { buf: heapless::Vec::new(), cut: false };
+        let mut l = Line {
+            buf: heapless::Vec::new(),
+            cut: false,
+        };
         let tag = [b'E', b'W', b'I', b'D'][level as usize];
         let _ = ufmt::uwrite!(l, "[{} {} ", tag as char, clock::millis());
         let _ = ufmt::uwrite!(l, "{}] ", module);

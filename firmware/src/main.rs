@@ -1,54 +1,247 @@
-//! taut firmware for the Arduino Mega 2560.
+//! taut firmware for the Arduino Mega 2560: the `app`.
 //!
-//! The `app` below is the machine at a glance: its interrupts, what each one
-//! does, and the idle loop. Everything else is plain functions in `board`
-//! (peripherals) and `taut_logic` (host-tested logic).
+//! The machine at a glance, RTIC style. Hardware tasks (interrupts) do the
+//! least work possible and spawn software tasks; software tasks run to
+//! completion from the dispatcher, highest priority first, FIFO within a
+//! priority, and never preempt each other.
+//!
+//! | task | kind | priority | input | shared with |
+//! | --- | --- | --- | --- | --- |
+//! | `TIMER1_COMPA` step events | interrupt | above all | `SEGMENTS`, `BLOCKS` rings | motion |
+//! | `TIMER0_COMPA` 1 ms tick | interrupt | | clock, timer alarm | |
+//! | `USART0_RX` / `USART0_UDRE` | interrupts | | `RX` / `TX` rings | console, logger |
+//! | `Timers` fires due timers | software | 3 | `TIMERS` | |
+//! | `Motion` planner → segments | software | 2 | `MOTION` | console |
+//! | `Console` G-code line in, reply out | software | 1 | `RX`, `MOTION` | |
+//! | `Logger` deferred reports | software | 0 | every 1 s | |
+//! | `Led` status LED pattern | software | 0 | its timer | |
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt)]
 
-use taut_firmware::board::{self, clock, usart, ResetCause, F_CPU};
-use taut_firmware::{flash_str, info};
 use embedded_hal::digital::OutputPin;
 use panic_halt as _;
+use taut_firmware::board::gpio::{Output, Pin};
+use taut_firmware::board::{
+    self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
+};
+use taut_firmware::console::{Console, Poll};
+use taut_firmware::drivers::{Drivers, EnablePins};
+use taut_firmware::motion::Motion;
+use taut_firmware::rt::{dispatch, stack, Shared, TaskCell};
+use taut_firmware::stepper::{self, Stepper};
+use taut_firmware::{flash_str, info, warn};
+use taut_logic::config::MachineConfig;
+use taut_logic::kinematics::Cylindrical;
+use taut_logic::sched::{Ready, TaskId, Timers};
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Task {
+    Timers,
+    Motion,
+    Console,
+    Logger,
+    Led,
+}
+
+impl TaskId for Task {
+    const COUNT: usize = 5;
+    fn index(self) -> usize {
+        self as usize
+    }
+    fn priority(self) -> u8 {
+        match self {
+            Task::Timers => 3,
+            Task::Motion => 2,
+            Task::Console => 1,
+            Task::Logger | Task::Led => 0,
+        }
+    }
+}
+
+// Shared with interrupts: reached through critical sections.
+static READY: Shared<Ready<Task, 5, 4>> = Shared::new(Ready::new());
+// Software tasks only: no masking needed.
+static TIMERS: TaskCell<Timers<Task, 6>> = TaskCell::new(Timers::new());
+static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
+static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
+static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
+/// The console waits for the motion task (planner room or idle).
+static CONSOLE_WAITS_MOTION: TaskCell<bool> = TaskCell::new(false);
 
 /// Boot blink of the status LED: this many flashes, 100 ms on, 100 ms off.
 const BOOT_BLINKS: u32 = 3;
+const LOGGER_PERIOD_MS: u32 = 1000;
+
+fn spawn(task: Task) {
+    READY.lock(|r| r.spawn(task));
+}
+
+fn spawn_after(task: Task, ms: u32) {
+    arm(|t, now| t.spawn_after(task, now, ms).is_ok());
+}
+
+fn spawn_every(task: Task, ms: u32) {
+    arm(|t, now| t.every(task, now, ms).is_ok());
+}
+
+/// Add a timer and point the tick's alarm at the earliest deadline.
+fn arm(add: impl FnOnce(&mut Timers<Task, 6>, u32) -> bool) {
+    let now = clock::millis();
+    let (ok, next) = TIMERS.with(|t| (add(t, now), t.ms_to_next(now)));
+    if !ok {
+        warn!("timers full");
+    }
+    if let Some(ms) = next {
+        clock::set_alarm(now.wrapping_add(ms));
+    }
+}
 
 #[avr_device::entry]
 fn main() -> ! {
+    stack::paint();
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
     let reset = ResetCause::take(&dp.CPU);
+    let watchdog = Watchdog::start(dp.WDT);
     let pins = board::gpio::Pins::new(
         dp.PORTA, dp.PORTB, dp.PORTC, dp.PORTD, dp.PORTE, dp.PORTF, dp.PORTG, dp.PORTH, dp.PORTJ,
         dp.PORTK, dp.PORTL,
     );
-    let mut led = pins.d13.into_output_at(false);
+    let status_led = pins.d13.into_output_at(false);
     clock::Clock::start(dp.TC0);
     usart::Usart0::start(dp.USART0);
-    // SAFETY: all interrupt handlers and the state they share are set up.
+    let config = MachineConfig::STRING_ART;
+    let enable = EnablePins {
+        base: pins.d38.into_output(),
+        radial: pins.a2.into_output(),
+        drill: pins.a8.into_output(),
+        aux: pins.d24.into_output(),
+    };
+    let drivers = Drivers::new(enable, &config);
+    let stepper = Stepper::new(StepTimer::start(dp.TC1), &config);
+    MOTION.with(|m| *m = Some(Motion::new(&config, stepper, drivers)));
+    // SAFETY: every interrupt handler and the state it touches is ready.
     unsafe { avr_device::interrupt::enable() };
 
-    info!(flash_str!(concat!(
-        "taut ",
-        env!("CARGO_PKG_VERSION"),
-        " git ",
-        env!("TAUT_GIT_HASH"),
-        " atmega2560 "
-    )), F_CPU / 1_000_000, "MHz reset:", reset.name());
+    info!(
+        flash_str!(concat!(
+            "taut ",
+            env!("CARGO_PKG_VERSION"),
+            " git ",
+            env!("TAUT_GIT_HASH"),
+            " atmega2560 "
+        )),
+        F_CPU / 1_000_000,
+        "MHz reset:",
+        reset.name()
+    );
+    if reset == ResetCause::Watchdog {
+        warn!("watchdog reset: a task did not return");
+    }
+    LED.with(|l| *l = Some(status_led));
+    spawn(Task::Led);
+    spawn_every(Task::Logger, LOGGER_PERIOD_MS);
 
-    loop {
-        // The LED level is a function of time: exactly BOOT_BLINKS flashes.
-        let ms = clock::millis();
-        let on = ms < BOOT_BLINKS * 200 && (ms / 100) % 2 == 0;
-        let _ = if on { led.set_high() } else { led.set_low() };
-        avr_device::asm::sleep();
+    dispatch::run(&READY, &watchdog, |task| match task {
+        Task::Timers => timers(),
+        Task::Motion => motion(),
+        Task::Console => console(),
+        Task::Logger => logger(),
+        Task::Led => led(),
+    })
+}
+
+/// Move due timers into the ready set and re-arm the tick's alarm.
+fn timers() {
+    let now = clock::millis();
+    let next = TIMERS.with(|t| {
+        while let Some(task) = t.due(now) {
+            spawn(task);
+        }
+        t.ms_to_next(now)
+    });
+    if let Some(ms) = next {
+        clock::set_alarm(now.wrapping_add(ms));
+    }
+}
+
+fn motion() {
+    let freed = MOTION.with(|m| {
+        let m = m.as_mut().unwrap();
+        let freed = m.refill();
+        freed || m.is_idle()
+    });
+    if freed && CONSOLE_WAITS_MOTION.with(|w| core::mem::take(w)) {
+        spawn(Task::Console);
+    }
+}
+
+fn console() {
+    let poll = MOTION.with(|m| {
+        CONFIG.with(|cfg| {
+            let kin = Cylindrical::from_config(cfg);
+            CONSOLE.with(|c| c.poll(m.as_mut().unwrap(), &kin, cfg))
+        })
+    });
+    // New moves may be queued: the motion task feeds them to the stepper.
+    spawn(Task::Motion);
+    match poll {
+        Poll::Drained => {}
+        Poll::Motion => CONSOLE_WAITS_MOTION.with(|w| *w = true),
+        Poll::After(ms) => spawn_after(Task::Console, ms as u32),
+    }
+}
+
+/// Deferred reports: dropped log lines, step-timing faults.
+fn logger() {
+    static LAST_FAULTS: TaskCell<(u16, u16)> = TaskCell::new((0, 0));
+    let faults = MOTION.with(|m| m.as_ref().unwrap().stepper.faults());
+    LAST_FAULTS.with(|last| {
+        if faults != *last {
+            warn!("step late:", faults.0, " underruns:", faults.1);
+            *last = faults;
+        }
+    });
+    if taut_firmware::log::dropped() > 0 {
+        // An empty-bodied line carries the pending "N lines dropped" note.
+        info!("log check");
+    }
+}
+
+static LED: TaskCell<Option<Pin<13, Output>>> = TaskCell::new(None);
+
+/// The status LED: `BOOT_BLINKS` flashes of 100 ms at boot, then off.
+fn led() {
+    let now = clock::millis();
+    LED.with(|l| {
+        let Some(led) = l.as_mut() else { return };
+        let phase = now / 100;
+        if phase >= BOOT_BLINKS * 2 {
+            let _ = led.set_low();
+            *l = None;
+            return;
+        }
+        let _ = if phase % 2 == 0 {
+            led.set_high()
+        } else {
+            led.set_low()
+        };
+        spawn_after(Task::Led, 100 - now % 100);
+    });
+}
+
+#[avr_device::interrupt(atmega2560)]
+fn TIMER1_COMPA() {
+    if stepper::on_compare() {
+        spawn(Task::Motion);
     }
 }
 
 #[avr_device::interrupt(atmega2560)]
 fn TIMER0_COMPA() {
-    clock::tick();
+    if clock::tick() {
+        spawn(Task::Timers);
+    }
 }
 
 #[avr_device::interrupt(atmega2560)]
@@ -59,4 +252,5 @@ fn USART0_UDRE() {
 #[avr_device::interrupt(atmega2560)]
 fn USART0_RX() {
     usart::on_receive();
+    spawn(Task::Console);
 }

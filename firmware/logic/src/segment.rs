@@ -30,7 +30,7 @@ mod tests;
 
 pub use expand::{expand, Event, Expand};
 pub use prepare::Preparer;
-pub use trapezoid::{Trapezoid, MAX_ACCEL};
+pub use trapezoid::{cbrt_floor_approx, isqrt, Trapezoid, MAX_ACCEL};
 
 use crate::axis::PerAxis;
 
@@ -62,10 +62,10 @@ pub struct StepBlock {
 pub struct Segment {
     /// Sub-ticks (1/256 tick) from the previous event to the first one.
     pub interval: u32,
+    /// Sub-ticks added to the interval after each event.
+    pub add: i32,
     /// Events in this segment, ≥ 1.
     pub count: u16,
-    /// Sub-ticks added to the interval after each event.
-    pub add: i16,
     /// [`NEW_BLOCK`]: load the next [`StepBlock`] before the first event.
     pub flags: u8,
 }

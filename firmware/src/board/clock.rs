@@ -6,6 +6,8 @@ use avr_device::interrupt::{self, Mutex};
 use core::cell::Cell;
 
 static MILLIS: Mutex<Cell<u32>> = Mutex::new(Cell::new(0));
+/// The millisecond at which `tick` reports the alarm (None: not armed).
+static ALARM: Mutex<Cell<Option<u32>>> = Mutex::new(Cell::new(None));
 
 pub struct Clock;
 
@@ -39,10 +41,25 @@ pub fn micros() -> u32 {
     })
 }
 
-/// Called by the `TIMER0_COMPA` interrupt.
-pub fn tick() {
+/// Arm the alarm for millisecond `at` (replacing any earlier one).
+pub fn set_alarm(at: u32) {
+    interrupt::free(|cs| ALARM.borrow(cs).set(Some(at)));
+}
+
+/// Called by the `TIMER0_COMPA` interrupt. True when the alarm fell due
+/// (it is then disarmed): the app runs its timers.
+pub fn tick() -> bool {
     interrupt::free(|cs| {
         let m = MILLIS.borrow(cs);
-        m.set(m.get().wrapping_add(1));
-    });
+        let now = m.get().wrapping_add(1);
+        m.set(now);
+        let alarm = ALARM.borrow(cs);
+        match alarm.get() {
+            Some(at) if now.wrapping_sub(at) as i32 >= 0 => {
+                alarm.set(None);
+                true
+            }
+            _ => false,
+        }
+    })
 }

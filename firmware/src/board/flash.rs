@@ -16,7 +16,10 @@ impl FlashStr {
     /// Only for statics placed in `.progmem.data` by [`flash_str!`].
     #[doc(hidden)]
     pub const unsafe fn from_progmem(ptr: *const u8, len: usize) -> FlashStr {
-        FlashStr { ptr, len: len as u16 }
+        FlashStr {
+            ptr,
+            len: len as u16,
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -38,7 +41,10 @@ impl FlashStr {
 }
 
 impl ufmt::uDisplay for FlashStr {
-    fn fmt<W: ufmt::uWrite + ?Sized>(&self, f: &mut ufmt::Formatter<'_, W>) -> Result<(), W::Error> {
+    fn fmt<W: ufmt::uWrite + ?Sized>(
+        &self,
+        f: &mut ufmt::Formatter<'_, W>,
+    ) -> Result<(), W::Error> {
         let mut chunk = [0u8; 16];
         let mut i = 0;
         while i < self.len() {

@@ -19,7 +19,8 @@ impl Spi {
         _miso: Pin<50, Floating>,
         _ss: &Pin<53, Output>,
     ) -> Spi {
-        spi.spcr().write(|w| w.spe().set_bit().mstr().set_bit().spr().fosc_128_64());
+        spi.spcr()
+            .write(|w| w.spe().set_bit().mstr().set_bit().spr().fosc_128_64());
         spi.spsr().write(|w| w.spi2x().clear_bit());
         Spi { spi }
     }

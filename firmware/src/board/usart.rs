@@ -20,7 +20,9 @@ impl Usart0 {
         usart.ubrr0().write(|w| w.set(16));
         usart.ucsr0a().write(|w| w.u2x0().set_bit());
         usart.ucsr0c().write(|w| w.ucsz0().chr8());
-        usart.ucsr0b().write(|w| w.txen0().set_bit().rxen0().set_bit().rxcie0().set_bit());
+        usart
+            .ucsr0b()
+            .write(|w| w.txen0().set_bit().rxen0().set_bit().rxcie0().set_bit());
         Usart0
     }
 }

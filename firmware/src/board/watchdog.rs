@@ -14,7 +14,8 @@ impl Watchdog {
         avr_device::interrupt::free(|_| {
             // Timed sequence: WDCE|WDE, then the new setting within 4 cycles.
             wdt.wdtcsr().write(|w| w.wdce().set_bit().wde().set_bit());
-            wdt.wdtcsr().write(|w| w.wde().set_bit().wdpl().cycles_64k());
+            wdt.wdtcsr()
+                .write(|w| w.wde().set_bit().wdpl().cycles_64k());
         });
         Watchdog { wdt }
     }
@@ -27,7 +28,9 @@ impl Watchdog {
     pub fn stop(self) -> WDT {
         avr_device::interrupt::free(|_| {
             avr_device::asm::wdr();
-            self.wdt.wdtcsr().write(|w| w.wdce().set_bit().wde().set_bit());
+            self.wdt
+                .wdtcsr()
+                .write(|w| w.wdce().set_bit().wde().set_bit());
             self.wdt.wdtcsr().write(|w| unsafe { w.bits(0) });
         });
         self.wdt

@@ -39,7 +39,11 @@ impl<T: Copy, const N: usize> Ring<T, N> {
 
     /// Messages waiting.
     pub fn len(&self) -> usize {
-        (self.head.load(Relaxed).wrapping_sub(self.tail.load(Relaxed)) & Self::MASK) as usize
+        (self
+            .head
+            .load(Relaxed)
+            .wrapping_sub(self.tail.load(Relaxed))
+            & Self::MASK) as usize
     }
 
     pub fn is_empty(&self) -> bool {

@@ -39,6 +39,11 @@ pub enum ErrorKind {
     UnusedAxisWords = 31,
     /// `P` on a command other than `G4`.
     UnusedValueWords = 36,
+    /// A setting or a `G92` while motion is under way (interpreter).
+    NotIdle = 8,
+    /// A target the kinematics cannot reach or the step counter cannot
+    /// hold (interpreter).
+    InvalidTarget = 33,
     /// `*` checksum wrong, malformed, or followed by more words.
     BadChecksum = 70,
 }
@@ -62,6 +67,8 @@ impl ErrorKind {
             ErrorKind::ValueWordMissing => "Value word missing",
             ErrorKind::UnusedAxisWords => "Unused axis words",
             ErrorKind::UnusedValueWords => "Unused value words",
+            ErrorKind::NotIdle => "Not idle",
+            ErrorKind::InvalidTarget => "Invalid target",
             ErrorKind::BadChecksum => "Bad checksum",
         }
     }

@@ -24,7 +24,7 @@ pub struct Expand<S, B> {
     /// 24.8 fixed-point time of the last event, sub-ticks.
     time: u64,
     interval: u32,
-    add: i16,
+    add: i32,
     left: u16,
 }
 
@@ -69,7 +69,7 @@ where
             self.left = seg.count;
         }
         self.time += self.interval as u64;
-        self.interval = self.interval.wrapping_add(self.add as i32 as u32);
+        self.interval = self.interval.wrapping_add(self.add as u32);
         self.left -= 1;
         let mut axes = 0;
         for (i, c) in self.counter.iter_mut().enumerate() {

@@ -1,4 +1,4 @@
-use super::trapezoid::{icbrt, isqrt};
+use super::trapezoid::{cbrt_floor_approx, isqrt};
 use super::*;
 use proptest::prelude::*;
 use std::vec::Vec;
@@ -117,8 +117,39 @@ fn roots_are_exact() {
     for x in [0u64, 1, 2, 3, 4, 8, 26, 27, 1 << 40, u64::MAX] {
         let r = isqrt(x);
         assert!(r * r <= x && (r + 1).checked_mul(r + 1).map_or(true, |s| s > x));
-        let c = icbrt(x);
-        assert!(c * c * c <= x && (c + 1).checked_pow(3).map_or(true, |s| s > x));
+    }
+}
+
+#[test]
+fn cube_root_is_a_close_lower_bound() {
+    for x in [
+        1u64,
+        2,
+        7,
+        8,
+        9,
+        26,
+        27,
+        1000,
+        1 << 33,
+        3 << 40,
+        u64::MAX / 3,
+    ] {
+        let c = cbrt_floor_approx(x) as f64;
+        let exact = (x as f64).cbrt();
+        assert!(
+            c <= exact + 1e-9 && c >= exact / 1.26 - 1.0,
+            "cbrt({x}) = {c}, exact {exact}"
+        );
+    }
+}
+
+proptest::proptest! {
+    #[test]
+    fn isqrt_is_the_floor_root(x in proptest::prelude::any::<u64>()) {
+        let r = isqrt(x);
+        proptest::prop_assert!(r * r <= x);
+        proptest::prop_assert!((r + 1).checked_mul(r + 1).map_or(true, |s| s > x));
     }
 }
 

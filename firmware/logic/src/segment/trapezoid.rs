@@ -168,11 +168,34 @@ impl Trapezoid {
     }
 }
 
-/// Integer square root, rounded down.
+/// Integer square root, rounded down. Written for the AVR, where `u64`
+/// arithmetic is a library call: a 32-bit digit-by-digit root of the top
+/// half gives 16 good bits, one Newton step (one `u64 / u32` division)
+/// doubles them, and a final check fixes the last unit.
 pub fn isqrt(x: u64) -> u64 {
+    if x <= u32::MAX as u64 {
+        return isqrt32(x as u32) as u64;
+    }
+    // x ≥ 2^32: shift right by the even amount that leaves 31–32 bits.
+    let shift = (33 - x.leading_zeros()) & !1;
+    let r0 = (isqrt32((x >> shift) as u32) as u64) << (shift / 2);
+    // r0 ≤ √x < r0 + 2^(shift/2): Newton from above converges downwards.
+    let r0 = r0 + (1u64 << (shift / 2));
+    let mut r = (r0 + x / r0) / 2;
+    while r.checked_mul(r).is_none_or(|sq| sq > x) {
+        r -= 1;
+    }
+    while (r + 1).checked_mul(r + 1).is_some_and(|sq| sq <= x) {
+        r += 1;
+    }
+    r
+}
+
+/// 32-bit integer square root, rounded down (digit by digit).
+fn isqrt32(x: u32) -> u32 {
     let mut rem = x;
-    let mut root = 0u64;
-    let mut bit = 1u64 << 62;
+    let mut root = 0u32;
+    let mut bit = 1u32 << 30;
     while bit > x {
         bit >>= 2;
     }
@@ -188,19 +211,17 @@ pub fn isqrt(x: u64) -> u64 {
     root
 }
 
-/// Integer cube root, rounded down (Hacker's Delight, bit by bit).
-pub fn icbrt(x: u64) -> u64 {
-    let mut rem = x;
-    let mut y = 0u64;
-    let mut s = 63i32;
-    while s >= 0 {
-        y *= 2;
-        let b = 3 * y * (y + 1) + 1;
-        if (rem >> s) >= b {
-            rem -= b << s;
-            y += 1;
-        }
-        s -= 3;
+/// A cube root that is never above the true one and at most 26 % below
+/// it (a power of two times 1, ∛2 or ∛4): enough to size a segment.
+pub fn cbrt_floor_approx(x: u64) -> u64 {
+    if x == 0 {
+        return 0;
     }
-    y
+    let bits = 63 - x.leading_zeros(); // 2^bits ≤ x
+    let base = 1u64 << (bits / 3);
+    match bits % 3 {
+        0 => base,
+        1 => base * 1260 / 1000, // ∛2 = 1.2599…
+        _ => base * 1587 / 1000, // ∛4 = 1.5874…
+    }
 }
