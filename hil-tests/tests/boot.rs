@@ -9,13 +9,24 @@ use taut_logic::pinmap::STATUS_LED;
 fn banner_within_50_ms_with_version_and_reset_cause() {
     let mut sim = Sim::load(&firmware_elf()).unwrap();
     let out = sim.run_until_uart_contains("reset:", Duration::from_millis(50));
-    assert_eq!(out, Outcome::Done, "no banner within 50 ms; UART: {:?}", sim.uart_text());
+    assert_eq!(
+        out,
+        Outcome::Done,
+        "no banner within 50 ms; UART: {:?}",
+        sim.uart_text()
+    );
     // The line is complete once its newline is out.
     sim.run_until_uart_contains("\n", Duration::from_millis(50));
     let text = sim.uart_text();
-    let banner = text.lines().find(|l| l.contains("taut ")).expect("banner line");
+    let banner = text
+        .lines()
+        .find(|l| l.contains("taut "))
+        .expect("banner line");
     assert!(banner.starts_with("[I "), "log line format: {banner}");
-    assert!(banner.contains(&format!("taut {} git ", firmware_version())), "{banner}");
+    assert!(
+        banner.contains(&format!("taut {} git ", firmware_version())),
+        "{banner}"
+    );
     assert!(banner.contains("atmega2560 16MHz"), "{banner}");
     assert!(banner.ends_with("reset:power-on"), "{banner}");
     assert!(sim.time_s() < 0.050);
@@ -31,7 +42,10 @@ fn status_led_blinks_three_times_at_boot_then_stays_off() {
     assert_eq!(led.edge_count(), 6);
     assert_eq!(led.rising_count(), 3);
     let high_us = led.min_high_us().unwrap();
-    assert!((99_000.0..=101_000.0).contains(&high_us), "flash length {high_us} µs");
+    assert!(
+        (99_000.0..=101_000.0).contains(&high_us),
+        "flash length {high_us} µs"
+    );
     assert!(!led.level());
 }
 

@@ -25,7 +25,12 @@ pub fn build_release() -> Result<Image> {
     cargo(&["build", "--release"], &dir())?;
     let elf = release_dir().join("taut.elf");
     let hex = release_dir().join("taut.hex");
-    status(Command::new("avr-objcopy").args(["-O", "ihex", "-R", ".eeprom"]).arg(&elf).arg(&hex))?;
+    status(
+        Command::new("avr-objcopy")
+            .args(["-O", "ihex", "-R", ".eeprom"])
+            .arg(&elf)
+            .arg(&hex),
+    )?;
     let sizes = section_sizes(&elf)?;
     let get = |n: &str| sizes.iter().find(|(s, _)| s == n).map_or(0, |(_, v)| *v);
     Ok(Image {

@@ -99,6 +99,10 @@ fn demo() -> Result<()> {
     println!("\nThe string-art job (issue 6) is not wired yet: the machine boots, prints its");
     println!("banner and blinks its status LED. Next it will read param.txt/poradi.txt from a");
     println!("virtual SD card, drill the nail holes and wind the thread.");
-    println!("\nwritten: {}\n         {}", report.display(), vcd.display());
+    println!(
+        "\nwritten: {}\n         {}",
+        report.display(),
+        vcd.display()
+    );
     Ok(())
 }

@@ -7,11 +7,16 @@ pub type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
 /// The repository root (xtask lives in `<root>/xtask`).
 pub fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
 }
 
 pub fn status(cmd: &mut Command) -> Result<()> {
-    let st = cmd.status().map_err(|e| format!("cannot run {cmd:?}: {e}"))?;
+    let st = cmd
+        .status()
+        .map_err(|e| format!("cannot run {cmd:?}: {e}"))?;
     if st.success() {
         Ok(())
     } else {
@@ -23,7 +28,10 @@ pub fn status(cmd: &mut Command) -> Result<()> {
 /// rust-toolchain.toml, not from the xtask's own environment.
 pub fn cargo_cmd(args: &[&str], dir: &Path) -> Command {
     let mut c = Command::new("cargo");
-    c.args(args).current_dir(dir).env_remove("RUSTUP_TOOLCHAIN").env_remove("CARGO_TARGET_DIR");
+    c.args(args)
+        .current_dir(dir)
+        .env_remove("RUSTUP_TOOLCHAIN")
+        .env_remove("CARGO_TARGET_DIR");
     c
 }
 
@@ -37,7 +45,19 @@ pub fn setup() -> Result<()> {
 
 /// `taut-sim ELF ARGS…`, built optimised (it runs millions of instructions).
 pub fn taut_sim(elf: &Path, args: &[String]) -> Result<()> {
-    let mut c = cargo_cmd(&["run", "--quiet", "--release", "-p", "taut-simavr", "--bin", "taut-sim", "--"], &root());
+    let mut c = cargo_cmd(
+        &[
+            "run",
+            "--quiet",
+            "--release",
+            "-p",
+            "taut-simavr",
+            "--bin",
+            "taut-sim",
+            "--",
+        ],
+        &root(),
+    );
     c.arg(elf).args(args);
     status(&mut c)
 }

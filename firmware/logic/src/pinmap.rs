@@ -58,9 +58,7 @@ impl Port {
 
     /// The letter simavr uses to name the port.
     pub const fn letter(self) -> char {
-        [
-            'A', 'B', 'C', 'D', 'E', 'F', 'G', 'H', 'J', 'K', 'L',
-        ][self as usize]
+        ['A', 'B', 'C', 'D', 'E', 'F', 'G', 'H', 'J', 'K', 'L'][self as usize]
     }
 }
 
@@ -102,10 +100,26 @@ pub struct DriverPins {
 
 /// RAMPS 1.4 X, Y, Z and E0 drivers, in [`Axis`] order.
 pub const DRIVERS: PerAxis<DriverPins> = [
-    DriverPins { step: 54, dir: 55, enable: 38 },
-    DriverPins { step: 60, dir: 61, enable: 56 },
-    DriverPins { step: 46, dir: 48, enable: 62 },
-    DriverPins { step: 26, dir: 28, enable: 24 },
+    DriverPins {
+        step: 54,
+        dir: 55,
+        enable: 38,
+    },
+    DriverPins {
+        step: 60,
+        dir: 61,
+        enable: 56,
+    },
+    DriverPins {
+        step: 46,
+        dir: 48,
+        enable: 62,
+    },
+    DriverPins {
+        step: 26,
+        dir: 28,
+        enable: 24,
+    },
 ];
 
 pub const fn driver(axis: Axis) -> DriverPins {

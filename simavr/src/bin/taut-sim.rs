@@ -28,7 +28,13 @@ struct Args {
 
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     let elf = it.next().ok_or("missing ELF")?.into();
-    let mut args = Args { elf, seconds: 5.0, vcd: None, report: None, echo: false };
+    let mut args = Args {
+        elf,
+        seconds: 5.0,
+        vcd: None,
+        report: None,
+        echo: false,
+    };
     while let Some(a) = it.next() {
         let mut value = || it.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
@@ -88,7 +94,10 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
             "wall_seconds": wall_s,
             "sim_mhz": sim.cycles() as f64 / wall_s / 1e6,
         });
-        report.as_object_mut().unwrap().extend(extra.as_object().unwrap().clone());
+        report
+            .as_object_mut()
+            .unwrap()
+            .extend(extra.as_object().unwrap().clone());
         std::fs::write(path, serde_json::to_string_pretty(&report)?)?;
     }
     eprintln!(
