@@ -12,6 +12,7 @@
 extern crate std;
 
 pub mod axis;
+pub mod buttons;
 pub mod config;
 pub mod gcode;
 pub mod geometry;
