@@ -15,6 +15,8 @@ pub mod pins;
 pub mod probe;
 pub mod report;
 mod run;
+pub mod sdcard;
+pub mod sdimage;
 mod sim;
 pub mod uart;
 pub mod vcd;

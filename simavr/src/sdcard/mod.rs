@@ -1,0 +1,27 @@
+//! A virtual microSD card on the simulated SPI bus (Mega pins 50–53, chip
+//! select D53 = PB0, active low), in SPI mode as the SD Physical Layer
+//! Simplified Specification describes it.
+//!
+//! `SdCard` is the card alone, a pure byte-exchange state machine usable
+//! without a simulator; `bus` wires it to simavr's SPI and to `Sim`.
+
+mod bus;
+mod card;
+pub mod crc;
+mod fault;
+mod image;
+mod registers;
+mod stats;
+#[cfg(test)]
+mod tests;
+
+pub use card::{
+    CardKind, SdCard, SdConfig, DATA_ACCEPTED, DATA_CRC_ERROR, DATA_WRITE_ERROR, R1_ADDRESS,
+    R1_CRC, R1_IDLE, R1_ILLEGAL, R1_PARAMETER, TOKEN_MULTI_WRITE, TOKEN_START, TOKEN_STOP_TRAN,
+};
+pub use fault::ReadFault;
+pub use image::{SdImage, BLOCK};
+pub use stats::SdStats;
+
+/// Board pin of the card's chip select.
+pub const CS_PIN: u8 = 53;
