@@ -4,6 +4,7 @@
 //! `timing` estimates machine time on the host (for the closing report).
 
 mod drilling;
+pub mod job;
 mod timing;
 mod winding;
 

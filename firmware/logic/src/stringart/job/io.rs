@@ -1,0 +1,205 @@
+//! What the job hears ([`Event`]) and what it asks the firmware to do
+//! ([`Action`]), with the texts the firmware logs.
+
+use super::progress::Progress;
+use crate::axis::Axis;
+use crate::buttons::ButtonEvent;
+use crate::config::MachineConfig;
+use crate::job::param::Params;
+
+/// The two phases that move the machine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    Drilling,
+    Winding,
+}
+
+impl Phase {
+    /// Progress lines start with this: `drill 12/24`, `wind 1234/3000`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Phase::Drilling => "drill",
+            Phase::Winding => "wind",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum State {
+    WaitingForCard,
+    /// The firmware is reading and checking the card's files.
+    Reading,
+    /// The files are bad: nothing moves until the card is replaced.
+    BadFiles,
+    /// Preparation before drilling: zeroing, starting the drill.
+    PrepDrill,
+    Drilling,
+    /// Nails in, thread tied to nail 0, zeroing again.
+    WaitingForNails,
+    Winding,
+    /// Drilling or winding, stopped after the current move; drivers hold.
+    Paused(Phase),
+    End,
+}
+
+impl State {
+    /// Logged as `state: <name>` on every transition.
+    pub const fn name(self) -> &'static str {
+        match self {
+            State::WaitingForCard => "waiting for card",
+            State::Reading => "reading",
+            State::BadFiles => "bad files",
+            State::PrepDrill => "prep drill",
+            State::Drilling => "drilling",
+            State::WaitingForNails => "waiting for nails",
+            State::Winding => "winding",
+            State::Paused(_) => "paused",
+            State::End => "end",
+        }
+    }
+
+    /// Drilling or winding, not paused: the only states that move.
+    pub const fn is_running(self) -> bool {
+        matches!(self, State::Drilling | State::Winding)
+    }
+}
+
+/// Everything the job reacts to. `'c`: the machine configuration lent
+/// with the checked files.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Event<'c> {
+    /// Once at start-up.
+    PowerOn,
+    CardInserted,
+    CardRemoved,
+    /// The answer to [`Action::ReadFiles`]: `param.txt` and `machine.txt`
+    /// read, `poradi.txt` checked completely ([`crate::job::poradi::PoradiCheck`]).
+    FilesValid {
+        params: Params,
+        count: u32,
+        config: &'c MachineConfig,
+    },
+    /// The answer to [`Action::ReadFiles`] when a file is missing or bad
+    /// (the firmware logs the [`crate::job::FileError`] itself).
+    FilesInvalid,
+    Button(ButtonEvent),
+    /// Every step taken from [`super::Job::next_step`] has been carried
+    /// out, and `next_step` returned `None`.
+    MotionDone,
+    /// Serial `!`.
+    Pause,
+    /// Serial `~`.
+    Resume,
+    /// The next nail index of `poradi.txt`, while [`super::Job::wants_nail`].
+    Nail(u16),
+    /// The card could not deliver the next index while winding.
+    PatternLost,
+}
+
+/// Something the firmware logs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Msg {
+    /// The board in `param.txt` cannot be drilled or wound.
+    BadBoard,
+    /// A zeroing button's first press: that driver is off.
+    Loose(Axis),
+    /// Its second press: the current position is that axis's zero.
+    Zeroed(Axis),
+    /// Green refused: an axis is loose, press its button again first.
+    ZeroPending,
+    CardRemoved,
+    /// The card is back, with the job's files.
+    CardOk,
+    /// A card came back with other or bad files: it does not count.
+    OtherCard,
+    /// Green refused: the job needs its card.
+    NoCard,
+    /// Winding lost its pattern stream; it waits for the card.
+    PatternLost,
+    Resumed,
+}
+
+impl Msg {
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Msg::BadBoard => "board cannot be made",
+            Msg::Loose(Axis::Base) => "base free, zero: press again",
+            Msg::Loose(Axis::Radial) => "radial free, zero: press again",
+            Msg::Loose(_) => "drill free, zero: press again",
+            Msg::Zeroed(Axis::Base) => "base zeroed",
+            Msg::Zeroed(Axis::Radial) => "radial zeroed",
+            Msg::Zeroed(_) => "drill zeroed",
+            Msg::ZeroPending => "finish zeroing first",
+            Msg::CardRemoved => "card removed",
+            Msg::CardOk => "card ok",
+            Msg::OtherCard => "not this job's card",
+            Msg::NoCard => "insert the job's card",
+            Msg::PatternLost => "pattern lost",
+            Msg::Resumed => "resumed",
+        }
+    }
+}
+
+/// What a waiting state waits for. Prompts that green answers contain
+/// `press green`, so a test bench can answer them; the card prompts do
+/// not (green cannot help there).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Prompt {
+    InsertCard,
+    ReplaceCard,
+    StartDrilling,
+    StartWinding,
+    Resume,
+    Finished,
+}
+
+/// Every prompt starts with this.
+pub const PROMPT_MARK: &str = ">>> ";
+
+impl Prompt {
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Prompt::InsertCard => ">>> insert the card",
+            Prompt::ReplaceCard => ">>> bad files: replace the card",
+            Prompt::StartDrilling => ">>> zero, start the drill, press green to start drilling",
+            Prompt::StartWinding => ">>> nails in, thread on 0, zero, press green to start winding",
+            Prompt::Resume => ">>> paused: press green to resume",
+            Prompt::Finished => ">>> done: press green for the next card",
+        }
+    }
+
+    pub const fn wants_green(self) -> bool {
+        !matches!(self, Prompt::InsertCard | Prompt::ReplaceCard)
+    }
+}
+
+/// What the firmware must do, in order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    /// Log `state: <name>`.
+    Enter(State),
+    Log(Msg),
+    /// Log the prompt's text.
+    Prompt(Prompt),
+    /// Read and check the card's files; answer with `FilesValid` or
+    /// `FilesInvalid`.
+    ReadFiles,
+    /// Open `poradi.txt` for streaming ([`crate::job::poradi::PoradiReader`])
+    /// and pass over its first `skip` nail indices (already fed).
+    OpenPattern {
+        skip: u32,
+    },
+    /// Switch the drivers in the mask (bit = axis index) on / off.
+    DriversOn(u8),
+    DriversOff(u8),
+    /// Take the axis's current position as its zero.
+    SetZero(Axis),
+    /// Take steps from [`super::Job::next_step`] until it returns `None`,
+    /// carry them out, then send [`Event::MotionDone`].
+    NextMoves,
+    /// Log the progress line.
+    Progress(Progress),
+}
+
+/// The actions of one event; never more than this many.
+pub type Actions = heapless::Vec<Action, 6>;

@@ -1,0 +1,494 @@
+//! The string-art job as a state machine (`shared/spec/string-art-machine.md`):
+//! waiting for card → reading → prep drill → drilling → waiting for nails →
+//! winding → end → waiting for card, with `paused` inside drilling and
+//! winding and `bad files` when the card's files are unusable.
+//!
+//! Event-driven: the firmware turns buttons, the card and the console into
+//! [`Event`]s, calls [`Job::on`] and carries out the returned [`Action`]s in
+//! order. While the job is drilling or winding, the firmware pulls the
+//! machine's [`Step`]s from [`Job::next_step`] after each
+//! [`Action::NextMoves`] until it returns `None`, runs them, and then sends
+//! [`Event::MotionDone`]. While winding it feeds the pattern read from the
+//! card through [`Event::Nail`] whenever [`Job::wants_nail`].
+//!
+//! Buttons: green confirms on a short press (released before 2 s) and
+//! pauses drilling or winding on a long press; the white zeroing buttons
+//! act on their press, in prep drill and waiting for nails only.
+
+mod io;
+mod motion;
+mod progress;
+
+pub use io::{Action, Actions, Event, Msg, Phase, Prompt, State, PROMPT_MARK};
+pub use motion::FEED;
+pub use progress::{left_s, Progress};
+
+use super::{bit, Drilling, Step, Winder, MACHINE_DRIVERS};
+use crate::axis::Axis;
+use crate::buttons::{ButtonEvent, LONG_PRESS_MS};
+use crate::config::MachineConfig;
+use crate::geometry::Board;
+use crate::job::param::Params;
+use crate::pinmap::Button;
+use crate::units::Milli;
+use motion::Motion;
+
+/// Where the card stands, as far as the job knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Card {
+    Absent,
+    /// Being read to see whether it is this job's card.
+    Checking,
+    /// In, and (once a job is on) holding the job's files.
+    Present,
+    /// Inserted at the end of a job: read when the next job starts.
+    Fresh,
+}
+
+/// The job's files, and the planners made from them at reading time (so
+/// a board that cannot be made is refused before anything moves).
+struct Plan {
+    params: Params,
+    count: u32,
+    board: Board,
+    drilling: Option<Drilling>,
+    winder: Option<Winder>,
+}
+
+pub struct Job {
+    state: State,
+    card: Card,
+    plan: Option<Plan>,
+    motion: Option<Motion>,
+    /// Axes whose zeroing button was pressed once: driver off, zero pending.
+    loose: u8,
+    /// `NextMoves` sent, `MotionDone` not yet received.
+    moving: bool,
+    /// Winding lost its pattern stream (card removed or unreadable).
+    lost: bool,
+}
+
+impl Default for Job {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Collects one event's actions.
+struct Out(Actions);
+
+impl Out {
+    fn push(&mut self, a: Action) {
+        // The capacity covers the longest sequence (starting to wind).
+        let pushed = self.0.push(a);
+        debug_assert!(pushed.is_ok(), "too many actions");
+    }
+}
+
+impl Job {
+    pub const fn new() -> Self {
+        Job {
+            state: State::WaitingForCard,
+            card: Card::Absent,
+            plan: None,
+            motion: None,
+            loose: 0,
+            moving: false,
+            lost: false,
+        }
+    }
+
+    pub fn state(&self) -> State {
+        self.state
+    }
+
+    /// The next step of the running phase; `None` at the end of a batch,
+    /// when paused, or outside drilling and winding.
+    pub fn next_step(&mut self) -> Option<Step> {
+        if !self.state.is_running() {
+            return None;
+        }
+        self.motion.as_mut()?.next()
+    }
+
+    /// Winding wants the next index of the pattern ([`Event::Nail`]).
+    pub fn wants_nail(&self) -> bool {
+        !self.lost && self.motion.as_ref().is_some_and(Motion::wants_nail)
+    }
+
+    /// Handles one event; `now_ms` is the firmware's millisecond clock
+    /// (for the time-left estimate; it may wrap).
+    pub fn on(&mut self, event: Event<'_>, now_ms: u32) -> Actions {
+        let mut out = Out(Actions::new());
+        let o = &mut out;
+        match event {
+            Event::PowerOn => {
+                *self = Job::new();
+                o.push(Action::DriversOff(MACHINE_DRIVERS));
+                self.enter(State::WaitingForCard, o);
+            }
+            Event::CardInserted => self.card_inserted(o),
+            Event::CardRemoved => self.card_removed(o, now_ms),
+            Event::FilesValid {
+                params,
+                count,
+                config,
+            } => self.files_valid(params, count, config, o),
+            Event::FilesInvalid => self.files_invalid(o),
+            Event::Button(b) => self.button(b, o, now_ms),
+            Event::MotionDone => {
+                self.moving = false;
+                if let Some(m) = &mut self.motion {
+                    m.release();
+                }
+                if self.state.is_running() {
+                    self.advance(o, now_ms);
+                }
+            }
+            Event::Pause => self.pause(o, now_ms),
+            Event::Resume => self.resume(o, now_ms),
+            Event::Nail(j) => self.nail(j, o, now_ms),
+            Event::PatternLost => {
+                if self.phase() == Some(Phase::Winding) {
+                    self.card = Card::Absent;
+                    self.lose_pattern(o, now_ms);
+                }
+            }
+        }
+        out.0
+    }
+
+    /// The phase of drilling, winding or their pause.
+    fn phase(&self) -> Option<Phase> {
+        match self.state {
+            State::Drilling => Some(Phase::Drilling),
+            State::Winding => Some(Phase::Winding),
+            State::Paused(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    fn enter(&mut self, state: State, o: &mut Out) {
+        self.state = state;
+        o.push(Action::Enter(state));
+        let prompt = match state {
+            State::WaitingForCard => Prompt::InsertCard,
+            State::BadFiles => Prompt::ReplaceCard,
+            State::PrepDrill => Prompt::StartDrilling,
+            State::WaitingForNails => Prompt::StartWinding,
+            State::Paused(_) if self.lost => Prompt::InsertCard,
+            State::Paused(_) => Prompt::Resume,
+            State::End => Prompt::Finished,
+            State::Reading | State::Drilling | State::Winding => return,
+        };
+        o.push(Action::Prompt(prompt));
+    }
+
+    /// Back to the start: the job and its files are dropped.
+    fn restart(&mut self, o: &mut Out) {
+        self.plan = None;
+        self.motion = None;
+        self.loose = 0;
+        self.enter(State::WaitingForCard, o);
+        if self.card == Card::Fresh {
+            self.read(o);
+        }
+    }
+
+    fn read(&mut self, o: &mut Out) {
+        self.card = Card::Checking;
+        self.enter(State::Reading, o);
+        o.push(Action::ReadFiles);
+    }
+
+    fn card_inserted(&mut self, o: &mut Out) {
+        match self.state {
+            State::WaitingForCard | State::BadFiles => self.read(o),
+            // The job is done with its card: the next one is read on green.
+            State::End => self.card = Card::Fresh,
+            _ if self.card == Card::Absent && self.plan.is_some() => {
+                // Is it the job's card again? Checked before it counts.
+                self.card = Card::Checking;
+                o.push(Action::ReadFiles);
+            }
+            _ => {}
+        }
+    }
+
+    fn card_removed(&mut self, o: &mut Out, now_ms: u32) {
+        self.card = Card::Absent;
+        match self.state {
+            State::WaitingForCard => {}
+            State::Reading | State::BadFiles => {
+                o.push(Action::Log(Msg::CardRemoved));
+                self.restart(o);
+            }
+            State::PrepDrill => {
+                // Nothing done yet: start over, the loose axes held again
+                // by nothing (the drivers go off as when waiting for a card).
+                o.push(Action::Log(Msg::CardRemoved));
+                o.push(Action::DriversOff(MACHINE_DRIVERS));
+                self.restart(o);
+            }
+            _ if self.phase() == Some(Phase::Winding) => self.lose_pattern(o, now_ms),
+            // Drilling needs no card; winding will ask for it.
+            _ => o.push(Action::Log(Msg::CardRemoved)),
+        }
+    }
+
+    /// Winding without its pattern: paused until the card is back.
+    fn lose_pattern(&mut self, o: &mut Out, now_ms: u32) {
+        self.lost = true;
+        o.push(Action::Log(Msg::PatternLost));
+        if self.state == State::Winding {
+            self.pause(o, now_ms);
+        } else {
+            o.push(Action::Prompt(Prompt::InsertCard));
+        }
+    }
+
+    fn files_valid(&mut self, params: Params, count: u32, config: &MachineConfig, o: &mut Out) {
+        if self.state == State::Reading {
+            match Self::plan(params, count, config) {
+                Some(plan) => {
+                    self.plan = Some(plan);
+                    self.card = Card::Present;
+                    o.push(Action::DriversOn(MACHINE_DRIVERS));
+                    self.enter(State::PrepDrill, o);
+                }
+                None => {
+                    o.push(Action::Log(Msg::BadBoard));
+                    self.card = Card::Present;
+                    self.enter(State::BadFiles, o);
+                }
+            }
+            return;
+        }
+        if self.card != Card::Checking {
+            return;
+        }
+        let same = self
+            .plan
+            .as_ref()
+            .is_some_and(|p| p.params == params && p.count == count);
+        if !same {
+            self.card = Card::Absent;
+            o.push(Action::Log(Msg::OtherCard));
+            return;
+        }
+        self.card = Card::Present;
+        o.push(Action::Log(Msg::CardOk));
+        if self.lost {
+            self.lost = false;
+            let skip = self.motion.as_ref().map_or(0, Motion::fed);
+            o.push(Action::OpenPattern { skip });
+        }
+        match self.state {
+            State::WaitingForNails => o.push(Action::Prompt(Prompt::StartWinding)),
+            State::Paused(_) => o.push(Action::Prompt(Prompt::Resume)),
+            _ => {}
+        }
+    }
+
+    fn plan(params: Params, count: u32, config: &MachineConfig) -> Option<Plan> {
+        let radius = Milli(i32::try_from(params.radius_um).ok()?);
+        let board = Board::new(params.shape, params.nails, radius).ok()?;
+        Some(Plan {
+            params,
+            count,
+            board,
+            drilling: Some(Drilling::new(board, config)),
+            winder: Some(Winder::new(board, config).ok()?),
+        })
+    }
+
+    fn files_invalid(&mut self, o: &mut Out) {
+        if self.state == State::Reading {
+            self.card = Card::Present;
+            self.enter(State::BadFiles, o);
+        } else if self.card == Card::Checking {
+            self.card = Card::Absent;
+            o.push(Action::Log(Msg::OtherCard));
+        }
+    }
+
+    fn button(&mut self, event: ButtonEvent, o: &mut Out, now_ms: u32) {
+        let axis = |b| match b {
+            Button::ZeroBase => Some(Axis::Base),
+            Button::ZeroRadial => Some(Axis::Radial),
+            Button::ZeroDrill => Some(Axis::Drill),
+            Button::Confirm => None,
+        };
+        match event {
+            ButtonEvent::Pressed(b) => {
+                if let Some(axis) = axis(b) {
+                    if matches!(self.state, State::PrepDrill | State::WaitingForNails) {
+                        self.zero(axis, o);
+                    }
+                }
+            }
+            ButtonEvent::LongPress(Button::Confirm) => self.pause(o, now_ms),
+            ButtonEvent::Released {
+                button: Button::Confirm,
+                held_ms,
+            } if held_ms < LONG_PRESS_MS => self.confirm(o, now_ms),
+            _ => {}
+        }
+    }
+
+    /// First press: the driver off, to move the axis by hand. Second: the
+    /// position is the zero, the driver holds again.
+    fn zero(&mut self, axis: Axis, o: &mut Out) {
+        let b = bit(axis);
+        if self.loose & b == 0 {
+            self.loose |= b;
+            o.push(Action::DriversOff(b));
+            o.push(Action::Log(Msg::Loose(axis)));
+        } else {
+            self.loose &= !b;
+            o.push(Action::SetZero(axis));
+            o.push(Action::DriversOn(b));
+            o.push(Action::Log(Msg::Zeroed(axis)));
+        }
+    }
+
+    /// Green, a short press.
+    fn confirm(&mut self, o: &mut Out, now_ms: u32) {
+        match self.state {
+            State::PrepDrill | State::WaitingForNails if self.loose != 0 => {
+                o.push(Action::Log(Msg::ZeroPending));
+            }
+            State::PrepDrill => self.start_drilling(o, now_ms),
+            State::WaitingForNails if self.card != Card::Present => {
+                o.push(Action::Log(Msg::NoCard));
+                o.push(Action::Prompt(Prompt::InsertCard));
+            }
+            State::WaitingForNails => self.start_winding(o, now_ms),
+            State::Paused(_) => self.resume(o, now_ms),
+            State::End => self.restart(o),
+            _ => {}
+        }
+    }
+
+    fn start_drilling(&mut self, o: &mut Out, now_ms: u32) {
+        let Some(plan) = &mut self.plan else { return };
+        let Some(drilling) = plan.drilling.take() else {
+            return;
+        };
+        let mut motion = Motion::drill(drilling, plan.board.nails(), now_ms);
+        let first = motion.reporter.first(now_ms);
+        self.motion = Some(motion);
+        self.enter(State::Drilling, o);
+        o.push(Action::DriversOn(MACHINE_DRIVERS));
+        o.push(Action::Progress(first));
+        self.next_moves(o);
+    }
+
+    fn start_winding(&mut self, o: &mut Out, now_ms: u32) {
+        let Some(plan) = &mut self.plan else { return };
+        let Some(winder) = plan.winder.take() else {
+            return;
+        };
+        let mut motion = Motion::wind(winder, plan.count, now_ms);
+        let first = motion.reporter.first(now_ms);
+        self.motion = Some(motion);
+        self.enter(State::Winding, o);
+        // Drilling came home a whole number of turns from the base's zero,
+        // and the winder counts from zero: without this, an unzeroed base
+        // would unwind those turns.
+        o.push(Action::SetZero(Axis::Base));
+        // The winder's entry switches the drill's driver off itself.
+        o.push(Action::DriversOn(bit(Axis::Base) | bit(Axis::Radial)));
+        o.push(Action::OpenPattern { skip: 0 });
+        o.push(Action::Progress(first));
+        self.next_moves(o);
+    }
+
+    fn next_moves(&mut self, o: &mut Out) {
+        self.moving = true;
+        o.push(Action::NextMoves);
+    }
+
+    /// The machine has carried out every step handed out: report, then
+    /// the next batch, or the end of the phase.
+    fn advance(&mut self, o: &mut Out, now_ms: u32) {
+        let Some(m) = &mut self.motion else { return };
+        if let Some(p) = m.reporter.update(m.done, now_ms) {
+            o.push(Action::Progress(p));
+        }
+        if m.exhausted {
+            if let Some(p) = m.reporter.finish(now_ms) {
+                o.push(Action::Progress(p));
+            }
+            self.motion = None;
+            // The phase's last step switched the drivers off.
+            let next = match self.state {
+                State::Drilling => State::WaitingForNails,
+                _ => State::End,
+            };
+            self.enter(next, o);
+        } else if !m.starved() {
+            self.next_moves(o);
+        }
+    }
+
+    fn pause(&mut self, o: &mut Out, now_ms: u32) {
+        let Some(phase) = self.phase().filter(|_| self.state.is_running()) else {
+            return;
+        };
+        if let Some(m) = &mut self.motion {
+            m.reporter.pause(now_ms);
+        }
+        self.enter(State::Paused(phase), o);
+    }
+
+    fn resume(&mut self, o: &mut Out, now_ms: u32) {
+        let State::Paused(phase) = self.state else {
+            return;
+        };
+        if self.lost {
+            o.push(Action::Log(Msg::NoCard));
+            o.push(Action::Prompt(Prompt::InsertCard));
+            return;
+        }
+        if let Some(m) = &mut self.motion {
+            m.reporter.resume(now_ms);
+        }
+        o.push(Action::Log(Msg::Resumed));
+        self.enter(
+            match phase {
+                Phase::Drilling => State::Drilling,
+                Phase::Winding => State::Winding,
+            },
+            o,
+        );
+        if self.moving {
+            // Still finishing the last batch: keep pulling.
+            o.push(Action::NextMoves);
+        } else {
+            self.advance(o, now_ms);
+        }
+    }
+
+    fn nail(&mut self, j: u16, o: &mut Out, now_ms: u32) {
+        if !self.wants_nail() {
+            return;
+        }
+        let in_range = self.plan.as_ref().is_some_and(|p| j < p.board.nails());
+        if !in_range {
+            // The check pass accepted this file: the card has changed.
+            self.card = Card::Absent;
+            self.lose_pattern(o, now_ms);
+            return;
+        }
+        let Some(m) = &mut self.motion else { return };
+        m.feed(j);
+        if self.state == State::Winding && !self.moving {
+            // It was waiting for this index.
+            self.advance(o, now_ms);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,176 @@
+//! Progress of a phase: a line at its start and end and whenever another
+//! 5 % is done, with the time left estimated proportionally from the time
+//! spent so far (pauses excluded). Integer maths, a division or two per
+//! line, never per step.
+
+use super::io::Phase;
+use ufmt::{uDisplay, uWrite, uwrite, Formatter};
+
+/// One progress line: `wind 1234/3000 left 3720s`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    pub phase: Phase,
+    pub done: u32,
+    pub total: u32,
+    /// Estimated seconds left; unknown before the first unit is done.
+    pub left_s: Option<u32>,
+}
+
+impl uDisplay for Progress {
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
+        uwrite!(f, "{} {}/{}", self.phase.name(), self.done, self.total)?;
+        match self.left_s {
+            Some(s) => uwrite!(f, " left {}s", s),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Seconds left if `done` of `total` took `elapsed_ms`.
+pub fn left_s(done: u32, total: u32, elapsed_ms: u32) -> Option<u32> {
+    if done == 0 {
+        return None;
+    }
+    let left_ms = elapsed_ms as u64 * total.saturating_sub(done) as u64 / done as u64;
+    Some((left_ms / 1000).min(u32::MAX as u64) as u32)
+}
+
+/// Keeps a phase's clock and decides when a line is due.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Reporter {
+    phase: Phase,
+    total: u32,
+    started_ms: u32,
+    /// Time spent paused so far, and the start of the current pause.
+    paused_ms: u32,
+    pause_from: Option<u32>,
+    /// A line is due when `done` reaches `next`; lines are `every` apart
+    /// (at most 5 % of the total, at least one unit).
+    every: u32,
+    next: u32,
+    last: Option<u32>,
+}
+
+impl Reporter {
+    pub fn start(phase: Phase, total: u32, now_ms: u32) -> Self {
+        let every = (total / 20).max(1);
+        Reporter {
+            phase,
+            total,
+            started_ms: now_ms,
+            paused_ms: 0,
+            pause_from: None,
+            every,
+            next: every,
+            last: None,
+        }
+    }
+
+    pub fn pause(&mut self, now_ms: u32) {
+        self.pause_from.get_or_insert(now_ms);
+    }
+
+    pub fn resume(&mut self, now_ms: u32) {
+        if let Some(from) = self.pause_from.take() {
+            self.paused_ms = self.paused_ms.wrapping_add(now_ms.wrapping_sub(from));
+        }
+    }
+
+    fn line(&mut self, done: u32, now_ms: u32) -> Progress {
+        self.last = Some(done);
+        let elapsed = now_ms
+            .wrapping_sub(self.started_ms)
+            .wrapping_sub(self.paused_ms);
+        Progress {
+            phase: self.phase,
+            done,
+            total: self.total,
+            left_s: left_s(done, self.total, elapsed),
+        }
+    }
+
+    /// The line for the phase's start.
+    pub fn first(&mut self, now_ms: u32) -> Progress {
+        self.line(0, now_ms)
+    }
+
+    /// A line if another 5 % is done.
+    pub fn update(&mut self, done: u32, now_ms: u32) -> Option<Progress> {
+        if done < self.next {
+            return None;
+        }
+        while self.next <= done {
+            self.next += self.every;
+        }
+        Some(self.line(done, now_ms))
+    }
+
+    /// The phase's last line, unless the last update already said it.
+    pub fn finish(&mut self, now_ms: u32) -> Option<Progress> {
+        (self.last != Some(self.total)).then(|| self.line(self.total, now_ms))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::job::error::tests::show;
+
+    #[test]
+    fn lines_read_as_the_issue_shows() {
+        let p = Progress {
+            phase: Phase::Winding,
+            done: 1234,
+            total: 3000,
+            left_s: Some(3720),
+        };
+        assert_eq!(show(&p), "wind 1234/3000 left 3720s");
+        let start = Progress {
+            done: 0,
+            left_s: None,
+            ..p
+        };
+        assert_eq!(show(&start), "wind 0/3000");
+    }
+
+    #[test]
+    fn proportional_estimate() {
+        assert_eq!(left_s(0, 100, 5000), None);
+        // A quarter done in 60 s: three quarters left take 180 s.
+        assert_eq!(left_s(25, 100, 60_000), Some(180));
+        assert_eq!(left_s(100, 100, 60_000), Some(0));
+        // Hours of a million-wrap job do not overflow.
+        assert_eq!(left_s(1000, 1_000_000, 4_000_000_000), Some(3_996_000_000));
+        assert_eq!(left_s(1, 1_000_000, 4_000_000_000), Some(u32::MAX));
+    }
+
+    #[test]
+    fn pauses_do_not_count_as_work() {
+        let mut r = Reporter::start(Phase::Drilling, 100, 1000);
+        r.pause(11_000);
+        r.pause(12_000); // a second `!` changes nothing
+        r.resume(51_000);
+        // 10 s of work, 40 s paused, 10 s of work: 20 s for 50 units.
+        let p = r.update(50, 61_000).unwrap();
+        assert_eq!(p.left_s, Some(20));
+    }
+
+    #[test]
+    fn a_line_every_5_percent_and_one_at_the_end() {
+        let mut r = Reporter::start(Phase::Winding, 3000, 0);
+        let lines: std::vec::Vec<u32> = (1..=3000)
+            .filter_map(|d| r.update(d, d))
+            .map(|p| p.done)
+            .collect();
+        assert_eq!(lines.len(), 20);
+        assert_eq!(lines[0], 150);
+        assert!(lines.windows(2).all(|w| w[1] - w[0] == 150));
+        assert_eq!(r.finish(3000), None, "3000/3000 was the last line");
+        // Small totals: a line per unit; jumps of several units report once.
+        let mut r = Reporter::start(Phase::Drilling, 7, 0);
+        assert!(r.update(1, 0).is_some());
+        assert_eq!(r.update(5, 0).map(|p| p.done), Some(5));
+        assert!(r.update(5, 0).is_none());
+        assert_eq!(r.finish(0).map(|p| p.done), Some(7));
+    }
+}
