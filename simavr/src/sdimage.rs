@@ -74,6 +74,9 @@ pub fn build_image_with_layout(dir: &Path, fat: FatChoice) -> io::Result<(Vec<u8
             file.write_all(&std::fs::read(dir.join(&entry.rel))?)?;
         }
     }
+    // Counting the free clusters records them in FAT32's FSInfo sector,
+    // which would otherwise say "unknown".
+    fs.stats()?;
     fs.unmount()?;
     let mut image = mbr(layout.fat32, part_bytes / SECTOR).to_vec();
     image.resize((PARTITION_START * SECTOR) as usize, 0);

@@ -437,7 +437,7 @@ impl SdCard {
     fn block_at(&self, arg: u32) -> Result<u32, u8> {
         let block = if self.sdhc {
             arg
-        } else if arg % BLOCK as u32 != 0 {
+        } else if !arg.is_multiple_of(BLOCK as u32) {
             return Err(R1_ADDRESS);
         } else {
             arg / BLOCK as u32
