@@ -189,3 +189,16 @@ fn a_removed_card_keeps_its_counts() {
     assert!(sim.uart_bytes()[seen..].iter().all(|&b| b == 0xFF));
     assert!(sim.sd_stats().is_none());
 }
+
+#[test]
+fn faults_reach_the_card_in_the_slot() {
+    let mut sim = Sim::from_program(&cmd0_loop()).unwrap();
+    sim.insert_sd(SdImage::blank(64));
+    sim.run_until(|s| s.uart_bytes().len() >= 3, Duration::from_millis(5));
+    sim.sd_card_mut().unwrap().timeout_next(2);
+    sim.run_until(|s| s.uart_bytes().len() >= 4 * 3, Duration::from_millis(5));
+    let all = answers(&sim);
+    let idle = [0xFF, R1_IDLE, 0xFF];
+    assert_eq!(all[..4], [idle, [0xFF; 3], [0xFF; 3], idle], "{all:?}");
+    assert_eq!(sim.sd_stats().unwrap().cmd(0), 4);
+}
