@@ -281,8 +281,8 @@ mod tests {
                     }
                 }
             }
-            for k in 0..4 {
-                prop_assert_eq!(down[k], b.pressed() & (1 << k) != 0);
+            for (k, &down) in down.iter().enumerate() {
+                prop_assert_eq!(down, b.pressed() & (1 << k) != 0);
             }
         }
     }

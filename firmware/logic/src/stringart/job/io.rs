@@ -122,25 +122,26 @@ pub enum Msg {
 impl Msg {
     pub const fn as_str(self) -> &'static str {
         match self {
-            Msg::BadBoard => "board cannot be made",
-            Msg::Loose(Axis::Base) => "base free, zero: press again",
-            Msg::Loose(Axis::Radial) => "radial free, zero: press again",
-            Msg::Loose(_) => "drill free, zero: press again",
+            Msg::BadBoard => "bad board",
+            Msg::Loose(Axis::Base) => "base free",
+            Msg::Loose(Axis::Radial) => "radial free",
+            Msg::Loose(_) => "drill free",
             Msg::Zeroed(Axis::Base) => "base zeroed",
             Msg::Zeroed(Axis::Radial) => "radial zeroed",
             Msg::Zeroed(_) => "drill zeroed",
-            Msg::ZeroPending => "finish zeroing first",
-            Msg::CardRemoved => "card removed",
+            Msg::ZeroPending => "zeroing unfinished",
+            Msg::CardRemoved => "card out",
             Msg::CardOk => "card ok",
-            Msg::OtherCard => "not this job's card",
-            Msg::NoCard => "insert the job's card",
+            Msg::OtherCard => "wrong card",
+            Msg::NoCard => "no card",
             Msg::PatternLost => "pattern lost",
             Msg::Resumed => "resumed",
         }
     }
 }
 
-/// What a waiting state waits for. Prompts that green answers contain
+/// What a waiting state waits for. Texts are short: on the AVR they live
+/// in SRAM. Prompts that green answers contain
 /// `press green`, so a test bench can answer them; the card prompts do
 /// not (green cannot help there).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -159,12 +160,12 @@ pub const PROMPT_MARK: &str = ">>> ";
 impl Prompt {
     pub const fn as_str(self) -> &'static str {
         match self {
-            Prompt::InsertCard => ">>> insert the card",
-            Prompt::ReplaceCard => ">>> bad files: replace the card",
-            Prompt::StartDrilling => ">>> zero, start the drill, press green to start drilling",
-            Prompt::StartWinding => ">>> nails in, thread on 0, zero, press green to start winding",
+            Prompt::InsertCard => ">>> insert card",
+            Prompt::ReplaceCard => ">>> bad files: replace card",
+            Prompt::StartDrilling => ">>> zero, drill on, press green to drill",
+            Prompt::StartWinding => ">>> nails, thread on 0, zero, press green to wind",
             Prompt::Resume => ">>> paused: press green to resume",
-            Prompt::Finished => ">>> done: press green for the next card",
+            Prompt::Finished => ">>> done: press green",
         }
     }
 

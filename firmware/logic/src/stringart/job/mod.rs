@@ -11,9 +11,26 @@
 //! [`Event::MotionDone`]. While winding it feeds the pattern read from the
 //! card through [`Event::Nail`] whenever [`Job::wants_nail`].
 //!
+//! Steps come in batches of one hole or one wrap: a pause (a long press of
+//! green, or `!`) stops the machine when the current batch is done — drill
+//! raised, needle inside the ring — with the drivers holding.
+//!
 //! Buttons: green confirms on a short press (released before 2 s) and
 //! pauses drilling or winding on a long press; the white zeroing buttons
 //! act on their press, in prep drill and waiting for nails only.
+//!
+//! The firmware's loop, in outline:
+//! ```text
+//! on each event e:    for a in job.on(e, now_ms) { carry out a }
+//!                     (NextMoves sets `pulling`)
+//! while job.wants_nail() and the pattern reader has an index j:
+//!                     for a in job.on(Event::Nail(j), now_ms) { … }
+//! while pulling and the motion queue has room:
+//!                     match job.next_step() { Some(s) => queue s,
+//!                                             None => pulling = false }
+//! when !pulling, the queue is empty and the machine stands, once per
+//! NextMoves:          for a in job.on(Event::MotionDone, now_ms) { … }
+//! ```
 
 mod io;
 mod motion;

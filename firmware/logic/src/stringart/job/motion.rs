@@ -11,6 +11,9 @@ use crate::stringart::{Drilling, Step, Winder, Wrap};
 /// machine moves.
 pub const FEED: usize = 8;
 
+// One phase at a time and no heap: the winding variant's size is the
+// price of not boxing.
+#[allow(clippy::large_enum_variant)]
 enum Work {
     Drill {
         drilling: Drilling,
