@@ -241,8 +241,8 @@ impl Job {
                 self.restart(o);
             }
             State::PrepDrill => {
-                // Nothing done yet: start over, the loose axes held again
-                // by nothing (the drivers go off as when waiting for a card).
+                // Nothing done yet: start over, with the drivers off as
+                // whenever the job waits for a card.
                 o.push(Action::Log(Msg::CardRemoved));
                 o.push(Action::DriversOff(MACHINE_DRIVERS));
                 self.restart(o);

@@ -284,6 +284,29 @@ fn a_whole_hexagon_job() {
 }
 
 #[test]
+fn a_card_changed_at_the_end_is_read_on_green() {
+    let mut b = Bench::new(HEX, &PATTERN);
+    b.ready();
+    b.green();
+    b.run();
+    b.green();
+    b.run();
+    assert_eq!(b.job.state(), State::End);
+    assert_eq!(b.sends(&[Event::CardRemoved, Event::CardInserted]), []);
+    assert_eq!(
+        b.green(),
+        [
+            Action::Enter(State::WaitingForCard),
+            Action::Prompt(Prompt::InsertCard),
+            Action::Enter(State::Reading),
+            Action::ReadFiles
+        ]
+    );
+    b.send(valid(HEX, 5));
+    assert_eq!(b.job.state(), State::PrepDrill);
+}
+
+#[test]
 fn time_left_is_estimated_from_the_time_spent() {
     let mut b = Bench::new(HEX, &PATTERN);
     b.ready();
