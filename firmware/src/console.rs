@@ -267,8 +267,7 @@ impl Console {
                         0,
                     ));
                 }
-                m.drivers.configure(cfg);
-                m.stepper.set_pulse_us(cfg.pulse.step_pulse_us);
+                m.configure(cfg);
             }
         }
         ok();

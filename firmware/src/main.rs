@@ -73,6 +73,7 @@ static CONSOLE_WAITS_MOTION: TaskCell<bool> = TaskCell::new(false);
 const BOOT_BLINKS: u32 = 3;
 const LOGGER_PERIOD_MS: u32 = 1000;
 
+#[inline(always)]
 fn spawn(task: Task) {
     READY.lock(|r| r.spawn(task));
 }
@@ -138,7 +139,7 @@ fn main() -> ! {
     if reset == ResetCause::Watchdog {
         warn!("watchdog reset: a task did not return");
     }
-    LED.with(|l| *l = Some(status_led));
+    LED.with(|l| *l = Some((status_led, clock::millis())));
     spawn(Task::Led);
     spawn_every(Task::Logger, LOGGER_PERIOD_MS);
 
@@ -152,6 +153,7 @@ fn main() -> ! {
 }
 
 /// Move due timers into the ready set and re-arm the tick's alarm.
+#[inline(never)]
 fn timers() {
     let now = clock::millis();
     let next = TIMERS.with(|t| {
@@ -165,6 +167,7 @@ fn timers() {
     }
 }
 
+#[inline(never)]
 fn motion() {
     let freed = MOTION.with(|m| {
         let m = m.as_mut().unwrap();
@@ -176,6 +179,7 @@ fn motion() {
     }
 }
 
+#[inline(never)]
 fn console() {
     let poll = MOTION.with(|m| {
         CONFIG.with(|cfg| {
@@ -193,6 +197,7 @@ fn console() {
 }
 
 /// Deferred reports: dropped log lines, step-timing faults.
+#[inline(never)]
 fn logger() {
     static LAST_FAULTS: TaskCell<(u16, u16)> = TaskCell::new((0, 0));
     let faults = MOTION.with(|m| m.as_ref().unwrap().stepper.faults());
@@ -208,14 +213,19 @@ fn logger() {
     }
 }
 
-static LED: TaskCell<Option<Pin<13, Output>>> = TaskCell::new(None);
+/// The status LED and when its boot pattern started.
+static LED: TaskCell<Option<(Pin<13, Output>, u32)>> = TaskCell::new(None);
 
 /// The status LED: `BOOT_BLINKS` flashes of 100 ms at boot, then off.
+#[inline(never)]
 fn led() {
     let now = clock::millis();
     LED.with(|l| {
-        let Some(led) = l.as_mut() else { return };
-        let phase = now / 100;
+        let Some((led, start)) = l.as_mut() else {
+            return;
+        };
+        let t = now.wrapping_sub(*start);
+        let phase = t / 100;
         if phase >= BOOT_BLINKS * 2 {
             let _ = led.set_low();
             *l = None;
@@ -226,7 +236,7 @@ fn led() {
         } else {
             led.set_low()
         };
-        spawn_after(Task::Led, 100 - now % 100);
+        spawn_after(Task::Led, 100 - t % 100);
     });
 }
 

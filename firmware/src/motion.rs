@@ -2,14 +2,17 @@
 //! interrupt's queues. Grbl's `planner` and `st_prep_buffer` in one place.
 
 use crate::drivers::Drivers;
+use crate::rt::TaskCell;
 use crate::stepper::{Stepper, BLOCKS, SEGMENTS};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Planner};
 use taut_logic::segment::Preparer;
 
+/// The look-ahead ring (1 KiB): its own static, built in place.
+static PLANNER: TaskCell<Planner> = TaskCell::new(Planner::EMPTY);
+
 pub struct Motion {
-    pub planner: Planner,
     prep: Preparer,
     pub stepper: Stepper,
     pub drivers: Drivers,
@@ -17,8 +20,8 @@ pub struct Motion {
 
 impl Motion {
     pub fn new(config: &MachineConfig, stepper: Stepper, drivers: Drivers) -> Motion {
+        PLANNER.with(|p| p.configure(config));
         Motion {
-            planner: Planner::new(config),
             prep: Preparer::new(),
             stepper,
             drivers,
@@ -27,7 +30,7 @@ impl Motion {
 
     /// Queue a move to the absolute step `target`; `Full` is back-pressure.
     pub fn push(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
-        self.planner.push(target, feed)
+        PLANNER.with(|p| p.push(target, feed))
     }
 
     /// Move planned blocks into the interrupt's queues while they have room
@@ -39,7 +42,9 @@ impl Motion {
                 if BLOCKS.free() == 0 {
                     break;
                 }
-                let Some(p) = self.planner.take() else { break };
+                let Some(p) = PLANNER.with(|p| p.take()) else {
+                    break;
+                };
                 // The block goes first: its first segment refers to it.
                 let _ = BLOCKS.push(p.block);
                 self.prep.start(p.profile);
@@ -58,15 +63,22 @@ impl Motion {
 
     /// Every queued move has been executed.
     pub fn is_idle(&self) -> bool {
-        self.planner.is_idle()
+        PLANNER.with(|p| p.is_idle())
             && self.prep.is_idle()
             && SEGMENTS.is_empty()
             && !self.stepper.is_running()
     }
 
+    /// Take new machine figures (a `$` setting); only when idle.
+    pub fn configure(&mut self, config: &MachineConfig) {
+        PLANNER.with(|p| p.configure(config));
+        self.drivers.configure(config);
+        self.stepper.set_pulse_us(config.pulse.step_pulse_us);
+    }
+
     /// Redefine where the machine is (`G92`, zeroing). Only when idle.
     pub fn set_position(&mut self, steps: PerAxis<i32>) {
-        self.planner.set_position(steps);
+        PLANNER.with(|p| p.set_position(steps));
         self.stepper.set_position(steps);
     }
 }

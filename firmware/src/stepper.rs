@@ -2,20 +2,26 @@
 //! `taut_logic::segment::expand` replays them on the host.
 //!
 //! Per event, in `TIMER1_COMPA`: raise the STEP pins chosen at the previous
-//! event (first, so pulse timing does not depend on the work below), count
-//! positions, advance the Klipper-style timing (`time += interval; interval
-//! += add`, 24.8 fixed point), run the DDA for the next event, program the
-//! compare register, then drop the STEP pins once the pulse width has passed
-//! and only then change DIR pins for a new block. Times are absolute (the
-//! compare register advances by the interval), so a late interrupt never
-//! shifts the events after it. Waits longer than the 16-bit timer are split.
+//! event (first, so pulse timing does not depend on the work below: one
+//! store per port, through the PINx toggle registers), advance the
+//! Klipper-style timing (`time += interval; interval += add`, 24.8 fixed
+//! point), run the DDA for the next event, program the compare register,
+//! drop the STEP pins once the pulse width has passed, and only then change
+//! DIR for a new block. Times are absolute (the compare register advances by
+//! the interval), so a late interrupt never shifts the events after it.
+//! Waits longer than the 16-bit timer are split.
+//!
+//! Positions are not counted per step: the DDA's closed form gives the steps
+//! done by each axis from the events fired, so the interrupt only counts
+//! events. Everything here is inlined into the handler: a call would make the
+//! compiler save every call-clobbered register on each entry.
 
 use crate::rt::Ring;
 use core::cell::UnsafeCell;
 use core::ptr::{read_volatile, write_volatile};
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::config::MachineConfig;
-use taut_logic::pinmap::{port_bit, DRIVERS};
+use taut_logic::pinmap::{port_bit, Port, DRIVERS};
 use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK};
 
 /// Segments waiting for the interrupt (11 bytes each).
@@ -40,6 +46,52 @@ const MIN_LEAD: u16 = 48;
 /// stays below 0x8000 so "how far ahead" reads correctly as an `i16`.
 const LONG_WAIT: u32 = 0x6000;
 const WAIT_PART: u32 = 0x4000;
+
+/// The ports that carry STEP pins ("slots"), and each axis's slot and bit,
+/// worked out from the pin map at compile time.
+const SLOTS: usize = 4;
+struct StepMap {
+    ports: [Option<Port>; SLOTS],
+    slot: [usize; AXES],
+    bit: [u8; AXES],
+}
+
+const fn step_map() -> StepMap {
+    let mut m = StepMap {
+        ports: [None; SLOTS],
+        slot: [0; AXES],
+        bit: [0; AXES],
+    };
+    let mut i = 0;
+    while i < AXES {
+        let (port, bit) = port_bit(DRIVERS[i].step);
+        let mut s = 0;
+        loop {
+            match m.ports[s] {
+                Some(p) if p as u8 == port as u8 => break,
+                Some(_) => s += 1,
+                None => {
+                    m.ports[s] = Some(port);
+                    break;
+                }
+            }
+        }
+        m.slot[i] = s;
+        m.bit[i] = 1 << bit;
+        i += 1;
+    }
+    m
+}
+
+const MAP: StepMap = step_map();
+
+/// PINx register of a slot (null for an unused slot).
+const fn slot_pin(s: usize) -> *mut u8 {
+    match MAP.ports[s] {
+        Some(p) => p.pin_register() as *mut u8,
+        None => core::ptr::null_mut(),
+    }
+}
 
 struct PinReg {
     pin: *mut u8,
@@ -72,7 +124,8 @@ const DIR: [PinReg; AXES] = [
 
 /// State owned by the interrupt once motion runs.
 struct Exec {
-    running: bool,
+    /// STEP bits to toggle at the pending event, per slot.
+    masks: [u8; SLOTS],
     /// Events left in the current segment, including the pending one.
     left: u16,
     interval: u32,
@@ -83,13 +136,18 @@ struct Exec {
     wait: u32,
     block: StepBlock,
     counter: PerAxis<u32>,
-    /// Axes that step at the pending event.
-    pending: u8,
+    /// STEP bits of the axes that step at every event of the block (as
+    /// many steps as events): no DDA needed for them.
+    always: [u8; SLOTS],
+    /// Axes that step at some events only: the DDA runs for these.
+    partial: u8,
     /// Events of the current block not yet fired.
     block_left: u32,
+    /// Position when the current block began.
+    block_start: PerAxis<i32>,
+    running: bool,
     /// Direction bits to apply once the current pulse is over.
     new_dir: Option<u8>,
-    position: PerAxis<i32>,
     /// DIR pin level that means positive, per axis (bit set: high).
     dir_high_positive: u8,
     pulse_ticks: u16,
@@ -98,12 +156,12 @@ struct Exec {
 }
 
 struct ExecCell(UnsafeCell<Exec>);
-// SAFETY: `Exec` is touched by TIMER1_COMPA, or by task code with that
-// interrupt disabled (`start`, `snapshot` run with interrupts off).
+// SAFETY: `Exec` is touched by TIMER1_COMPA, or by task code while that
+// interrupt is off (`kick`) or inside a critical section (the readers).
 unsafe impl Sync for ExecCell {}
 
 static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {
-    running: false,
+    masks: [0; SLOTS],
     left: 0,
     interval: 0,
     add: 0,
@@ -115,16 +173,19 @@ static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {
         dir: 0,
     },
     counter: [0; AXES],
-    pending: 0,
+    always: [0; SLOTS],
+    partial: 0,
     block_left: 0,
+    block_start: [0; AXES],
+    running: false,
     new_dir: None,
-    position: [0; AXES],
     dir_high_positive: 0xFF,
     pulse_ticks: 80,
     late: 0,
     underruns: 0,
 }));
 
+#[inline(always)]
 fn exec() -> &'static mut Exec {
     // SAFETY: see `ExecCell`; callers never hold two of these at once.
     unsafe { &mut *EXEC.0.get() }
@@ -162,39 +223,53 @@ impl Stepper {
     }
 
     /// Start executing queued segments if the interrupt is idle; the first
-    /// event comes one interval after now.
+    /// event comes one interval after now. Needs no critical section: while
+    /// motion is stopped the compare interrupt is off, and only this code
+    /// turns it on.
     pub fn kick(&mut self) {
-        avr_device::interrupt::free(|_| {
-            let e = exec();
-            if e.running || SEGMENTS.is_empty() {
-                return;
-            }
-            if !load_segment(e) {
-                return;
-            }
-            if let Some(dir) = e.new_dir.take() {
-                write_dir(dir, e.dir_high_positive);
-            }
+        let e = exec();
+        if avr_device::interrupt::free(|_| e.running) || SEGMENTS.is_empty() || !load_segment(e) {
+            return;
+        }
+        if let Some(dir) = e.new_dir.take() {
+            write_dir(dir, e.dir_high_positive);
+        }
+        e.frac = 0;
+        // SAFETY: Timer1 registers, owned by the stepper; its interrupt is off.
+        unsafe {
+            write_volatile(OCR1A, read_volatile(TCNT1).wrapping_add(MIN_LEAD));
+            schedule_next(e);
             e.running = true;
-            e.frac = 0;
-            // SAFETY: Timer1 registers; the compare interrupt is off here.
-            unsafe {
-                write_volatile(OCR1A, read_volatile(TCNT1).wrapping_add(MIN_LEAD));
-                schedule_next(e);
-                write_volatile(TIFR1, OCF1A);
-                write_volatile(TIMSK1, read_volatile(TIMSK1) | OCIE1A);
-            }
-        });
+            write_volatile(TIFR1, OCF1A);
+            avr_device::interrupt::free(|_| write_volatile(TIMSK1, read_volatile(TIMSK1) | OCIE1A));
+        }
     }
 
     /// Position in steps, as executed so far.
     pub fn position(&self) -> PerAxis<i32> {
-        avr_device::interrupt::free(|_| exec().position)
+        let (start, block, left) = avr_device::interrupt::free(|_| {
+            let e = exec();
+            (e.block_start, e.block, e.block_left)
+        });
+        let mut p = start;
+        for i in 0..AXES {
+            p[i] += signed(done(&block, block.events - left, i), block.dir, i);
+        }
+        p
     }
 
     /// Redefine the position (`G92`, zeroing); only while idle.
     pub fn set_position(&mut self, p: PerAxis<i32>) {
-        avr_device::interrupt::free(|_| exec().position = p);
+        avr_device::interrupt::free(|_| {
+            let e = exec();
+            e.block_start = p;
+            e.block_left = 0;
+            e.block = StepBlock {
+                steps: [0; AXES],
+                events: 0,
+                dir: e.block.dir,
+            };
+        });
     }
 
     pub fn is_running(&self) -> bool {
@@ -208,11 +283,29 @@ impl Stepper {
     }
 }
 
+/// Steps axis `i` made in the first `n` events of `block`: the DDA's closed
+/// form (its counter starts at `events / 2`).
+fn done(block: &StepBlock, n: u32, i: usize) -> u32 {
+    if block.events == 0 {
+        return 0;
+    }
+    ((block.events as u64 / 2 + n as u64 * block.steps[i] as u64) / block.events as u64) as u32
+}
+
+fn signed(steps: u32, dir: u8, i: usize) -> i32 {
+    if dir >> i & 1 != 0 {
+        steps as i32
+    } else {
+        -(steps as i32)
+    }
+}
+
 /// Apply `dir` bits (set = positive) through the PIN toggle registers.
+#[inline(always)]
 fn write_dir(dir: u8, high_positive: u8) {
     let level = !(dir ^ high_positive); // bit set: pin high
     for (i, r) in DIR.iter().enumerate() {
-        // SAFETY: DIR pins are written only here (interrupt or interrupts off).
+        // SAFETY: DIR pins are written only here (interrupt or interrupt off).
         unsafe {
             let is_high = read_volatile(r.port) & r.mask != 0;
             if is_high != (level >> i & 1 != 0) {
@@ -223,6 +316,7 @@ fn write_dir(dir: u8, high_positive: u8) {
 }
 
 /// Take the next segment (and its block); false when the queue is empty.
+#[inline(always)]
 fn load_segment(e: &mut Exec) -> bool {
     let Some(seg) = SEGMENTS.peek() else {
         return false;
@@ -231,12 +325,36 @@ fn load_segment(e: &mut Exec) -> bool {
         let Some(block) = BLOCKS.pop() else {
             return false;
         };
-        e.counter = [block.events / 2; AXES];
+        // The previous block is complete: fold it into the start position.
+        for i in 0..AXES {
+            e.block_start[i] += signed(e.block.steps[i], e.block.dir, i);
+        }
         e.block_left = block.events;
         if block.dir != e.block.dir || !e.running {
             e.new_dir = Some(block.dir);
         }
-        e.block = block;
+        // Field by field, volatile: an aggregate copy becomes a `memcpy`
+        // call, and any call makes the handler save every register.
+        for i in 0..AXES {
+            // SAFETY: plain writes to fields of `e`.
+            unsafe {
+                write_volatile(&mut e.block.steps[i], block.steps[i]);
+                write_volatile(&mut e.counter[i], block.events / 2);
+            }
+        }
+        e.block.events = block.events;
+        e.block.dir = block.dir;
+        let mut always = [0u8; SLOTS];
+        let mut partial = 0;
+        for i in 0..AXES {
+            if block.steps[i] == block.events {
+                always[MAP.slot[i]] |= MAP.bit[i];
+            } else if block.steps[i] != 0 {
+                partial |= 1 << i;
+            }
+        }
+        e.always = always;
+        e.partial = partial;
     }
     let _ = SEGMENTS.pop();
     e.interval = seg.interval;
@@ -245,31 +363,49 @@ fn load_segment(e: &mut Exec) -> bool {
     true
 }
 
+/// One axis of the DDA, with its slot and bit as constants.
+macro_rules! dda_axis {
+    ($e:ident, $m:ident, $i:literal) => {
+        if $e.partial & (1 << $i) != 0 {
+            dda_count!($e, $m, $i);
+        }
+    };
+}
+
+macro_rules! dda_count {
+    ($e:ident, $m:ident, $i:literal) => {
+        let c = $e.counter[$i].wrapping_add($e.block.steps[$i]);
+        if c >= $e.block.events {
+            $e.counter[$i] = c - $e.block.events;
+            $m[MAP.slot[$i]] |= MAP.bit[$i];
+        } else {
+            $e.counter[$i] = c;
+        }
+    };
+}
+
 /// Time, DDA and compare register of the next event.
 ///
 /// # Safety
 /// Timer1 registers; called from the interrupt or with it masked.
+#[inline(always)]
 unsafe fn schedule_next(e: &mut Exec) {
     let t = e.frac as u32 + e.interval;
     e.interval = e.interval.wrapping_add(e.add as u32);
     e.frac = t as u8;
-    let ticks = t >> FRAC_BITS;
-    let mut axes = 0;
-    for i in 0..AXES {
-        let c = &mut e.counter[i];
-        *c += e.block.steps[i];
-        if *c >= e.block.events {
-            *c -= e.block.events;
-            axes |= 1 << i;
-        }
-    }
-    e.pending = axes;
-    e.wait = ticks;
+    let mut m = e.always;
+    dda_axis!(e, m, 0);
+    dda_axis!(e, m, 1);
+    dda_axis!(e, m, 2);
+    dda_axis!(e, m, 3);
+    e.masks = m;
+    e.wait = t >> FRAC_BITS;
     advance_compare(e);
 }
 
 /// Move the compare register towards the pending event by at most
 /// `WAIT_PART` ticks at a time, flagging an event that can no longer be on time.
+#[inline(always)]
 unsafe fn advance_compare(e: &mut Exec) {
     let part = if e.wait > LONG_WAIT {
         WAIT_PART
@@ -287,31 +423,39 @@ unsafe fn advance_compare(e: &mut Exec) {
     }
 }
 
+/// Toggle the STEP pins of `m`: one store per port.
+#[inline(always)]
+unsafe fn toggle_steps(m: &[u8; SLOTS]) {
+    if !slot_pin(0).is_null() {
+        write_volatile(slot_pin(0), m[0]);
+    }
+    if !slot_pin(1).is_null() {
+        write_volatile(slot_pin(1), m[1]);
+    }
+    if !slot_pin(2).is_null() {
+        write_volatile(slot_pin(2), m[2]);
+    }
+    if !slot_pin(3).is_null() {
+        write_volatile(slot_pin(3), m[3]);
+    }
+}
+
 /// The `TIMER1_COMPA` interrupt. Returns true when the segment queue wants
 /// refilling (the app then spawns the motion task).
 #[inline(always)]
 pub fn on_compare() -> bool {
     let e = exec();
-    // SAFETY: Timer1 and STEP pin registers, owned by this interrupt.
+    // SAFETY: Timer1 and STEP/DIR pin registers, owned by this interrupt.
     unsafe {
         if e.wait > 0 {
             advance_compare(e);
             return false;
         }
-        let axes = e.pending;
+        let masks = e.masks;
+        toggle_steps(&masks);
         let raised = read_volatile(TCNT1);
-        for (i, r) in STEP.iter().enumerate() {
-            if axes >> i & 1 != 0 {
-                write_volatile(r.pin, r.mask);
-            }
-        }
-        for i in 0..AXES {
-            if axes >> i & 1 != 0 {
-                e.position[i] += if e.block.dir >> i & 1 != 0 { 1 } else { -1 };
-            }
-        }
-        e.left -= 1;
         e.block_left -= 1;
+        e.left -= 1;
         let loaded = e.left == 0 && load_segment(e);
         if e.left > 0 {
             schedule_next(e);
@@ -324,11 +468,7 @@ pub fn on_compare() -> bool {
             write_volatile(TIMSK1, read_volatile(TIMSK1) & !OCIE1A);
         }
         while read_volatile(TCNT1).wrapping_sub(raised) < e.pulse_ticks {}
-        for (i, r) in STEP.iter().enumerate() {
-            if axes >> i & 1 != 0 {
-                write_volatile(r.pin, r.mask);
-            }
-        }
+        toggle_steps(&masks);
         if let Some(dir) = e.new_dir.take() {
             write_dir(dir, e.dir_high_positive);
         }

@@ -5,6 +5,7 @@
 //! stack. Every `unsafe` call into simavr stays inside this crate.
 
 pub mod clock;
+pub mod console;
 pub mod elf;
 mod error;
 mod gpio;
@@ -21,6 +22,7 @@ mod sim;
 pub mod uart;
 pub mod vcd;
 
+pub use console::{Reply, SendError};
 pub use elf::ElfInfo;
 pub use error::{Error, Result};
 pub use outcome::Outcome;

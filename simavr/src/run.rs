@@ -132,6 +132,10 @@ impl Sim {
             return Some(Outcome::WatchdogReset { count: self.resets });
         }
         self.last_avr_cycle = cycle;
+        // SAFETY: as above; `sreg` is simavr's unpacked status register.
+        let enabled = unsafe { (*avr).sreg[7] } != 0;
+        let now = self.shared().cycle_base + cycle;
+        self.masked.observe(now, pc, enabled);
         match state {
             ffi::cpu_Crashed => return Some(Outcome::Crashed { pc: pc_before }),
             ffi::cpu_Done => return Some(Outcome::Hung { pc: pc_before }),

@@ -68,6 +68,8 @@ pub struct Sim {
     pub(crate) step_dir: Vec<StepDir>,
     /// Simulated cycles and host time of the last run.
     pub(crate) last_speed: Option<(u64, Duration)>,
+    /// Interrupts-masked spans: the open one, and the longest so far.
+    pub(crate) masked: MaskedSpans,
 }
 
 impl Sim {
@@ -177,6 +179,7 @@ impl Sim {
             external: [(0, 0); 12],
             step_dir: Vec::new(),
             last_speed: None,
+            masked: MaskedSpans::default(),
         }
     }
 
@@ -244,9 +247,83 @@ impl Sim {
         self.ram_limit
     }
 
+    /// The longest stretch, in cycles, during which interrupts were masked,
+    /// not counting spans that began at the interrupt vector `exempt` (a
+    /// byte address, e.g. the step timer's own vector, whose handler cannot
+    /// delay itself). It bounds how late that interrupt can start. Returns
+    /// (cycles, byte address where the span began).
+    pub fn max_masked_cycles(&self, exempt: u32) -> (u64, u32) {
+        self.masked
+            .longest
+            .iter()
+            .filter(|(_, pc)| *pc != exempt)
+            .fold(
+                (0, 0),
+                |best, &(c, pc)| if c > best.0 { (c, pc) } else { best },
+            )
+    }
+
+    /// Spans that began at `pc` (an interrupt vector: its handler's runs):
+    /// (count, mean cycles, longest cycles).
+    pub fn masked_stats(&self, pc: u32) -> Option<(u64, f64, u64)> {
+        let &(_, n, total) = self.masked.totals.iter().find(|t| t.0 == pc)?;
+        let &(max, _) = self.masked.longest.iter().find(|l| l.1 == pc)?;
+        Some((n, total as f64 / n as f64, max))
+    }
+
+    /// Every masked span's longest duration by start address, longest first.
+    pub fn masked_spans(&self) -> Vec<(u64, u32)> {
+        let mut v = self.masked.longest.clone();
+        v.sort_unstable_by(|a, b| b.cmp(a));
+        v
+    }
+
     /// Overrides the end of statics (raw programs have no symbols).
     pub fn set_ram_limit(&mut self, limit: u16) {
         self.ram_limit = limit;
+    }
+}
+
+/// Interrupt-masked spans by the address they began at (the vector for an
+/// interrupt entry, the instruction after `cli` otherwise).
+#[derive(Default)]
+pub(crate) struct MaskedSpans {
+    /// Start cycle and address of the span under way.
+    pub(crate) open: Option<(u64, u32)>,
+    /// Longest span per start address.
+    pub(crate) longest: Vec<(u64, u32)>,
+    /// Per start address: number of spans and their total cycles.
+    pub(crate) totals: Vec<(u32, u64, u64)>,
+    /// Interrupts were enabled once: start-up (masked from reset) is over.
+    pub(crate) started: bool,
+}
+
+impl MaskedSpans {
+    /// Called after every instruction with the I flag.
+    pub(crate) fn observe(&mut self, cycle: u64, pc: u32, enabled: bool) {
+        if !self.started {
+            self.started = enabled;
+            return;
+        }
+        match (self.open, enabled) {
+            (None, false) => self.open = Some((cycle, pc)),
+            (Some((start, at)), true) => {
+                self.open = None;
+                let len = cycle - start;
+                match self.longest.iter_mut().find(|(_, p)| *p == at) {
+                    Some(e) => e.0 = e.0.max(len),
+                    None => self.longest.push((len, at)),
+                }
+                match self.totals.iter_mut().find(|(p, _, _)| *p == at) {
+                    Some(t) => {
+                        t.1 += 1;
+                        t.2 += len;
+                    }
+                    None => self.totals.push((at, 1, len)),
+                }
+            }
+            _ => {}
+        }
     }
 }
 

@@ -62,6 +62,22 @@ struct Block {
     delta_sqr: u64,
 }
 
+impl Block {
+    const EMPTY: Block = Block {
+        step: StepBlock {
+            steps: [0; AXES],
+            events: 0,
+            dir: 0,
+        },
+        accel: 0,
+        nominal_ev_sqr: 0,
+        ev_per_milli_sqr: 0.0,
+        max_entry_sqr: 0,
+        entry_sqr: 0,
+        delta_sqr: 0,
+    };
+}
+
 pub struct Planner {
     blocks: [Block; PLANNER_BLOCKS],
     /// Oldest block.
@@ -78,6 +94,28 @@ pub struct Planner {
 }
 
 impl Planner {
+    /// A planner that moves nothing until [`Planner::configure`]: `const`, so
+    /// the firmware's static holds it without building 1 KiB on the stack.
+    pub const EMPTY: Planner = Planner {
+        blocks: [Block::EMPTY; PLANNER_BLOCKS],
+        head: 0,
+        len: 0,
+        carry_sqr: 0,
+        position: [0; AXES],
+        geometry: Geometry::EMPTY,
+        last: None,
+    };
+
+    /// Take the machine's figures, in place; drops queued moves and keeps
+    /// the position. Only while idle.
+    pub fn configure(&mut self, config: &MachineConfig) {
+        self.head = 0;
+        self.len = 0;
+        self.carry_sqr = 0;
+        self.geometry = Geometry::new(config);
+        self.last = None;
+    }
+
     pub fn new(config: &MachineConfig) -> Self {
         Planner {
             blocks: [Block::default(); PLANNER_BLOCKS],

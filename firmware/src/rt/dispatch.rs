@@ -15,13 +15,13 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
     // SAFETY: SMCR (0x53): sleep enable, idle mode (timers and UART run).
     unsafe { core::ptr::write_volatile(0x53 as *mut u8, 0x01) };
     loop {
-        while let Some(task) = ready.lock(|r| r.pop()) {
+        while let Some(task) = pop(ready) {
             dispatch(task);
         }
         // A task that never returns never gets here: the watchdog resets.
         watchdog.feed();
         avr_device::interrupt::disable();
-        if ready.lock(|r| r.is_idle()) {
+        if is_idle(ready) {
             // `sei` takes effect after the next instruction, so an interrupt
             // arriving now still wakes this `sleep`: no lost wake-up.
             // SAFETY: re-enables interrupts, as they were before `disable`.
@@ -31,4 +31,16 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
             unsafe { avr_device::interrupt::enable() };
         }
     }
+}
+
+// Out of line, so the compiler cannot pull unrelated work into the short
+// critical sections (each one delays the step interrupt by its length).
+#[inline(never)]
+fn pop<T: TaskId, const N: usize, const P: usize>(ready: &Shared<Ready<T, N, P>>) -> Option<T> {
+    ready.lock(|r| r.pop())
+}
+
+#[inline(never)]
+fn is_idle<T: TaskId, const N: usize, const P: usize>(ready: &Shared<Ready<T, N, P>>) -> bool {
+    ready.lock(|r| r.is_idle())
 }

@@ -35,6 +35,15 @@ pub struct Corner {
 }
 
 impl Geometry {
+    /// No axis can move until [`Geometry::new`] replaces it.
+    pub const EMPTY: Geometry = Geometry {
+        milli_per_step: [0.0; AXES],
+        accel_milli: [0.0; AXES],
+        accel: [0; AXES],
+        max_rate: [0; AXES],
+        deviation_milli: 0.0,
+    };
+
     pub fn new(config: &MachineConfig) -> Self {
         let mut g = Geometry {
             milli_per_step: [0.0; AXES],

@@ -1,0 +1,224 @@
+//! `taut-bench FIRMWARE_ELF BUSY_ELF OUT_JSON`: the figures of `cargo xtask
+//! bench`, from simavr's cycle counter (exact and repeatable), written as
+//! JSON and printed as a table.
+//!
+//! Step rates: the highest cruise rate at which every STEP pulse of a
+//! one-second cruise lands within 2 µs of its ideal time (a uniform grid at
+//! the cruise rate, best-aligned). Multi-axis moves step every axis at every
+//! event (equal step counts), so the aggregate rate is 3× the event rate.
+
+use serde_json::{json, Map, Value};
+use std::path::Path;
+use std::time::{Duration, Instant};
+use taut_logic::axis::Axis;
+use taut_logic::pinmap::driver;
+use taut_simavr::{Outcome, Reply, Sim};
+
+/// Timer1 COMPA vector (byte address): the step interrupt.
+const STEP_VECTOR: u32 = 0x44;
+const TOLERANCE_US: f64 = 2.0;
+const AXES3: [Axis; 3] = [Axis::Base, Axis::Radial, Axis::Drill];
+
+fn boot(elf: &Path) -> Sim {
+    let mut sim = Sim::load(elf).expect("firmware loads");
+    for axis in AXES3 {
+        let d = driver(axis);
+        sim.probe_step_dir(axis.name(), d.step, d.dir, true);
+    }
+    assert_eq!(
+        sim.run_until_uart_contains("reset:", Duration::from_millis(50)),
+        Outcome::Done
+    );
+    sim
+}
+
+fn send(sim: &mut Sim, line: &str, timeout: Duration) {
+    match sim.send_line(line, timeout) {
+        Ok(Reply::Ok) => {}
+        other => panic!("{line}: {other:?}\n{}", sim.uart_text()),
+    }
+}
+
+fn rises(sim: &Sim, axis: Axis) -> Vec<u64> {
+    let name = format!("{}_step", axis.name());
+    sim.probed(&name)
+        .edges()
+        .iter()
+        .filter(|e| e.high)
+        .map(|e| e.cycle)
+        .collect()
+}
+
+/// Largest deviation (µs) of the cruise pulses from a uniform grid at
+/// `rate`, aligned to minimise it; the cruise is where the spacing is within
+/// 0.5 % of the cruise interval.
+fn cruise_error_us(r: &[u64], rate: f64) -> Option<(f64, usize)> {
+    let period = 16e6 / rate;
+    let cruising: Vec<usize> = (1..r.len())
+        .filter(|&i| ((r[i] - r[i - 1]) as f64 - period).abs() < period * 0.005)
+        .collect();
+    let (first, last) = (*cruising.first()?, *cruising.last()?);
+    let n = last - first;
+    if (n as f64) < rate * 0.9 {
+        return None;
+    }
+    let res: Vec<f64> = (first..=last)
+        .map(|i| r[i] as f64 - (r[first] as f64 + (i - first) as f64 * period))
+        .collect();
+    let (lo, hi) = res
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+    Some(((hi - lo) / 2.0 / 16.0, n))
+}
+
+/// One cruise at `rate` events/s on `axes`; the worst pulse error (µs) and
+/// the step interrupt's mean cycles, or None if it could not hold the rate.
+fn cruise(elf: &Path, axes: &[Axis], rate: u32) -> Option<(f64, f64, u16)> {
+    let mut sim = boot(elf);
+    for a in axes {
+        send(
+            &mut sim,
+            &format!("${}_max_rate={rate}", a.name()),
+            Duration::from_millis(200),
+        );
+        send(
+            &mut sim,
+            &format!("${}_accel=2000000", a.name()),
+            Duration::from_millis(200),
+        );
+    }
+    send(&mut sim, "M17", Duration::from_millis(200));
+    // 1.3 s worth of events on every axis, equal counts.
+    let events = (rate as f64 * 1.3) as i64;
+    let words: Vec<String> = axes
+        .iter()
+        .map(|a| {
+            let (letter, per_unit) = match a {
+                Axis::Base => ("C", 9600.0 / 360.0),
+                Axis::Radial => ("X", 32.0),
+                Axis::Drill => ("Z", 1600.0 / 12.0),
+                Axis::Aux => ("A", 80.0),
+            };
+            format!("{letter}{:.3}", events as f64 / per_unit)
+        })
+        .collect();
+    send(
+        &mut sim,
+        &format!("G0 {}", words.join(" ")),
+        Duration::from_millis(200),
+    );
+    sim.send_line("M400", Duration::from_secs(5)).ok()?;
+    let mut worst: f64 = 0.0;
+    for a in axes {
+        let r = rises(&sim, *a);
+        if (r.len() as i64 - events).abs() > 1 {
+            return None;
+        }
+        let (err, _) = cruise_error_us(&r, rate as f64)?;
+        worst = worst.max(err);
+    }
+    let (_, mean, _) = sim.masked_stats(STEP_VECTOR)?;
+    Some((worst, mean, sim.peak_stack_bytes()))
+}
+
+/// Highest rate (events/s, to 1 kHz) whose cruise stays within tolerance.
+fn max_rate(elf: &Path, axes: &[Axis]) -> (u32, f64, f64) {
+    let ok = |rate| cruise(elf, axes, rate).filter(|c| c.0 <= TOLERANCE_US);
+    let (mut lo, mut hi) = (5_000u32, 200_000u32);
+    let mut best = ok(lo)
+        .map(|c| (lo, c.0, c.1))
+        .unwrap_or((0, f64::NAN, f64::NAN));
+    while hi - lo > 1_000 {
+        let mid = (lo + hi) / 2 / 1000 * 1000;
+        match ok(mid) {
+            Some(c) => {
+                lo = mid;
+                best = (mid, c.0, c.1);
+            }
+            None => hi = mid,
+        }
+    }
+    best
+}
+
+/// Worst deviation (µs) of a default-speed `G0 C360` from the exact
+/// trapezoid (a = 500 steps/s², v = 2000 steps/s, from standstill).
+fn default_speed_error_us(elf: &Path) -> (f64, f64, u16) {
+    let mut sim = boot(elf);
+    send(&mut sim, "M17", Duration::from_millis(200));
+    send(&mut sim, "G0 C360", Duration::from_millis(200));
+    send(&mut sim, "M400", Duration::from_secs(20));
+    let r = rises(&sim, Axis::Base);
+    let (a, v, n) = (500.0f64, 2000.0f64, r.len());
+    let ramp = v * v / (2.0 * a);
+    let t_ramp = v / a;
+    let cruise_steps = n as f64 - 2.0 * ramp;
+    let ideal = |k: f64| -> f64 {
+        if k <= ramp {
+            (2.0 * k / a).sqrt()
+        } else if k <= ramp + cruise_steps {
+            t_ramp + (k - ramp) / v
+        } else {
+            let total = 2.0 * t_ramp + cruise_steps / v;
+            total - (2.0 * (n as f64 - k) / a).sqrt()
+        }
+    };
+    let t0 = r[0] as f64 / 16e6 - ideal(1.0);
+    let worst = (0..n)
+        .map(|i| (r[i] as f64 / 16e6 - t0 - ideal((i + 1) as f64)).abs())
+        .fold(0.0, f64::max);
+    let masked = sim.max_masked_cycles(STEP_VECTOR).0 as f64;
+    (worst * 1e6, masked, sim.peak_stack_bytes())
+}
+
+fn sim_mhz(elf: &Path, seconds: u64) -> f64 {
+    let mut sim = Sim::load(elf).expect("image loads");
+    let wall = Instant::now();
+    sim.run_for(Duration::from_secs(seconds));
+    sim.cycles() as f64 / wall.elapsed().as_secs_f64() / 1e6
+}
+
+fn round(x: f64, digits: i32) -> f64 {
+    let k = 10f64.powi(digits);
+    (x * k).round() / k
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [fw, busy, out] = &args[..] else {
+        eprintln!("usage: taut-bench FIRMWARE_ELF BUSY_ELF OUT_JSON");
+        std::process::exit(2);
+    };
+    let (fw, busy) = (Path::new(fw), Path::new(busy));
+    let mut f = Map::new();
+    let info = *Sim::load(fw)
+        .expect("firmware loads")
+        .elf()
+        .expect("ELF symbols");
+    f.insert("flash_bytes".into(), json!(info.flash_bytes()));
+    f.insert("ram_static_bytes".into(), json!(info.ram_static_bytes()));
+    f.insert("ram_data_bytes".into(), json!(info.data_bytes));
+
+    let (rate1, err1, isr1) = max_rate(fw, &[Axis::Base]);
+    f.insert("step_rate_1axis_hz".into(), json!(rate1));
+    f.insert("step_rate_1axis_error_us".into(), json!(round(err1, 3)));
+    f.insert("isr_cycles_per_step".into(), json!(round(isr1, 1)));
+    let (rate3, err3, isr3) = max_rate(fw, &AXES3);
+    f.insert("step_rate_3axis_hz".into(), json!(rate3 * 3));
+    f.insert("step_rate_3axis_error_us".into(), json!(round(err3, 3)));
+    f.insert("isr_cycles_per_event_3axis".into(), json!(round(isr3, 1)));
+    let (err, masked, stack) = default_speed_error_us(fw);
+    f.insert("timing_error_max_us".into(), json!(round(err, 3)));
+    f.insert("step_isr_max_masked_cycles".into(), json!(masked));
+    f.insert("peak_stack_bytes".into(), json!(stack));
+    f.insert("sim_mhz_idle".into(), json!(round(sim_mhz(fw, 20), 1)));
+    f.insert("sim_mhz_busy".into(), json!(round(sim_mhz(busy, 2), 1)));
+
+    let v = Value::Object(f.clone());
+    std::fs::write(out, serde_json::to_string_pretty(&v).unwrap()).expect("write bench JSON");
+    println!("\n{:<28} {:>12}", "figure", "value");
+    for (k, v) in &f {
+        println!("{k:<28} {v:>12}");
+    }
+    println!("\nwritten: {out}");
+}
