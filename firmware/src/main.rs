@@ -17,7 +17,7 @@
 //! | `Led` status LED pattern | software | 0 | its timer | |
 #![no_std]
 #![no_main]
-#![feature(abi_avr_interrupt)]
+#![feature(abi_avr_interrupt, asm_experimental_arch)]
 
 use embedded_hal::digital::OutputPin;
 use panic_halt as _;
@@ -28,8 +28,13 @@ use taut_firmware::board::{
 use taut_firmware::console::{Console, Poll};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::motion::Motion;
-use taut_firmware::rt::{dispatch, stack, Shared, TaskCell};
+use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
+use taut_firmware::rt::{stack, TaskCell};
 use taut_firmware::stepper::{self, Stepper};
+use taut_firmware::{
+    board::usart::{RXCIE0, UDRIE0},
+    nested_vector, step_vector,
+};
 use taut_firmware::{flash_str, info, warn};
 use taut_logic::config::MachineConfig;
 use taut_logic::kinematics::Cylindrical;
@@ -59,9 +64,10 @@ impl TaskId for Task {
     }
 }
 
-// Shared with interrupts: reached through critical sections.
-static READY: Shared<Ready<Task, 5, 4>> = Shared::new(Ready::new());
+/// Task ids spawned by interrupts, moved into `READY` by the dispatcher.
+static SPAWNED: Spawned = Spawned::new();
 // Software tasks only: no masking needed.
+static READY: TaskCell<Ready<Task, 5, 4>> = TaskCell::new(Ready::new());
 static TIMERS: TaskCell<Timers<Task, 6>> = TaskCell::new(Timers::new());
 static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
 static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
@@ -73,9 +79,18 @@ static CONSOLE_WAITS_MOTION: TaskCell<bool> = TaskCell::new(false);
 const BOOT_BLINKS: u32 = 3;
 const LOGGER_PERIOD_MS: u32 = 1000;
 
-#[inline(always)]
 fn spawn(task: Task) {
-    READY.lock(|r| r.spawn(task));
+    READY.with(|r| r.spawn(task));
+}
+
+fn task_of(id: u8) -> Task {
+    [
+        Task::Timers,
+        Task::Motion,
+        Task::Console,
+        Task::Logger,
+        Task::Led,
+    ][id as usize]
 }
 
 fn spawn_after(task: Task, ms: u32) {
@@ -143,7 +158,7 @@ fn main() -> ! {
     spawn(Task::Led);
     spawn_every(Task::Logger, LOGGER_PERIOD_MS);
 
-    dispatch::run(&READY, &watchdog, |task| match task {
+    dispatch::run(&SPAWNED, &READY, task_of, &watchdog, |task| match task {
         Task::Timers => timers(),
         Task::Motion => motion(),
         Task::Console => console(),
@@ -240,27 +255,37 @@ fn led() {
     });
 }
 
-#[avr_device::interrupt(atmega2560)]
-fn TIMER1_COMPA() {
+// The step timer: the one handler that is never interrupted. Plain events
+// take the assembly fast path (`stepper::fast`), all others this handler.
+step_vector!(timer1_compa);
+
+extern "avr-interrupt" fn timer1_compa() {
     if stepper::on_compare() {
-        spawn(Task::Motion);
+        spawn_from_isr(&SPAWNED, Task::Motion as u8);
     }
 }
 
-#[avr_device::interrupt(atmega2560)]
-fn TIMER0_COMPA() {
+// The others are nestable (see `rt::nested`): the step timer preempts them.
+nested_vector!(__vector_21, timer0_compa); // TIMER0_COMPA
+nested_vector!(__vector_25, usart0_rx, reg = "0xC1", keep = "0x7F"); // USART0_RX: RXCIE0
+nested_vector!(__vector_26, usart0_udre, reg = "0xC1", keep = "0xDF"); // USART0_UDRE: UDRIE0
+const _: () = assert!(usart::UCSR0B == 0xC1 && !0x7Fu8 == 1 << RXCIE0 && !0xDFu8 == 1 << UDRIE0);
+
+extern "avr-interrupt" fn timer0_compa() {
     if clock::tick() {
-        spawn(Task::Timers);
+        spawn_from_isr(&SPAWNED, Task::Timers as u8);
+    }
+    // The step interrupt's assembly path cannot spawn; it leaves a flag.
+    if stepper::take_refill() {
+        spawn_from_isr(&SPAWNED, Task::Motion as u8);
     }
 }
 
-#[avr_device::interrupt(atmega2560)]
-fn USART0_UDRE() {
-    usart::on_data_register_empty();
+extern "avr-interrupt" fn usart0_rx() {
+    usart::on_receive();
+    spawn_from_isr(&SPAWNED, Task::Console as u8);
 }
 
-#[avr_device::interrupt(atmega2560)]
-fn USART0_RX() {
-    usart::on_receive();
-    spawn(Task::Console);
+extern "avr-interrupt" fn usart0_udre() {
+    usart::on_data_register_empty();
 }

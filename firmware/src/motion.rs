@@ -3,17 +3,19 @@
 
 use crate::drivers::Drivers;
 use crate::rt::TaskCell;
-use crate::stepper::{Stepper, BLOCKS, SEGMENTS};
+use crate::stepper::{fast_segment, Stepper, BLOCKS, FAST, SEGMENTS};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Planner};
-use taut_logic::segment::Preparer;
+use taut_logic::segment::{Preparer, StepBlock};
 
 /// The look-ahead ring (1 KiB): its own static, built in place.
 static PLANNER: TaskCell<Planner> = TaskCell::new(Planner::EMPTY);
 
 pub struct Motion {
     prep: Preparer,
+    /// The block the preparer is cutting (for the fast-path flag).
+    block: StepBlock,
     pub stepper: Stepper,
     pub drivers: Drivers,
 }
@@ -23,6 +25,7 @@ impl Motion {
         PLANNER.with(|p| p.configure(config));
         Motion {
             prep: Preparer::new(),
+            block: StepBlock::default(),
             stepper,
             drivers,
         }
@@ -47,11 +50,15 @@ impl Motion {
                 };
                 // The block goes first: its first segment refers to it.
                 let _ = BLOCKS.push(p.block);
+                self.block = p.block;
                 self.prep.start(p.profile);
                 freed = true;
             }
             match self.prep.next() {
-                Some(seg) => {
+                Some(mut seg) => {
+                    if fast_segment(&seg, &self.block) {
+                        seg.flags |= FAST;
+                    }
                     let _ = SEGMENTS.push(seg);
                 }
                 None => break,

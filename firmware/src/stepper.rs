@@ -16,6 +16,8 @@
 //! events. Everything here is inlined into the handler: a call would make the
 //! compiler save every call-clobbered register on each entry.
 
+pub mod fast;
+
 use crate::rt::Ring;
 use core::cell::UnsafeCell;
 use core::ptr::{read_volatile, write_volatile};
@@ -29,7 +31,7 @@ pub static SEGMENTS: Ring<Segment, 32> = Ring::new();
 /// Blocks waiting for their first segment (21 bytes each).
 pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
 /// Refill the queues when this few segments are left.
-const LOW_WATER: usize = 16;
+pub(crate) const LOW_WATER: usize = 16;
 
 /// Timer1 registers (data-space addresses).
 const TCNT1: *mut u16 = 0x84 as *mut u16;
@@ -41,7 +43,7 @@ const OCF1A: u8 = 1 << 1;
 
 /// Compare times closer than this to "now" would be missed by the 16-bit
 /// timer: the event is late and fired this many ticks from now instead.
-const MIN_LEAD: u16 = 48;
+pub(crate) const MIN_LEAD: u16 = 48;
 /// Waits longer than this are split into `WAIT_PART`-tick parts; every part
 /// stays below 0x8000 so "how far ahead" reads correctly as an `i16`.
 const LONG_WAIT: u32 = 0x6000;
@@ -50,8 +52,9 @@ const WAIT_PART: u32 = 0x4000;
 /// The ports that carry STEP pins ("slots"), and each axis's slot and bit,
 /// worked out from the pin map at compile time.
 const SLOTS: usize = 4;
-struct StepMap {
-    ports: [Option<Port>; SLOTS],
+pub(crate) struct StepMap {
+    #[doc(hidden)]
+    pub(crate) ports: [Option<Port>; SLOTS],
     slot: [usize; AXES],
     bit: [u8; AXES],
 }
@@ -83,7 +86,7 @@ const fn step_map() -> StepMap {
     m
 }
 
-const MAP: StepMap = step_map();
+pub(crate) const MAP: StepMap = step_map();
 
 /// PINx register of a slot (null for an unused slot).
 const fn slot_pin(s: usize) -> *mut u8 {
@@ -122,8 +125,23 @@ const DIR: [PinReg; AXES] = [
     reg(DRIVERS[3].dir),
 ];
 
-/// State owned by the interrupt once motion runs.
-struct Exec {
+/// State owned by the interrupt once motion runs. `repr(C)`: the assembly
+/// fast path (`fast.rs`) reads fields at their `offset_of!`.
+#[repr(C)]
+#[doc(hidden)]
+pub struct Exec {
+    /// The pending event and the rest of its segment may take the fast
+    /// path: every moving axis steps at every event, no wait beyond the
+    /// 16-bit timer, no DIR change.
+    fast_ok: u8,
+    /// `wait` is not zero: the next compare match is a split wait, not an
+    /// event (a byte, for the assembly entry).
+    waiting: u8,
+    /// TCNT1 when the assembly entry raised the pending event's pins.
+    raised: u16,
+    /// Set by the assembly path when it took a segment and the queue is
+    /// low; the tick handler passes it on as a refill request.
+    refill: u8,
     /// STEP bits to toggle at the pending event, per slot.
     masks: [u8; SLOTS],
     /// Events left in the current segment, including the pending one.
@@ -141,7 +159,8 @@ struct Exec {
     always: [u8; SLOTS],
     /// Axes that step at some events only: the DDA runs for these.
     partial: u8,
-    /// Events of the current block not yet fired.
+    /// Events of the current block not yet loaded from segments (the
+    /// current segment's are counted in `left`).
     block_left: u32,
     /// Position when the current block began.
     block_start: PerAxis<i32>,
@@ -155,12 +174,18 @@ struct Exec {
     underruns: u16,
 }
 
-struct ExecCell(UnsafeCell<Exec>);
+#[doc(hidden)]
+pub struct ExecCell(UnsafeCell<Exec>);
 // SAFETY: `Exec` is touched by TIMER1_COMPA, or by task code while that
 // interrupt is off (`kick`) or inside a critical section (the readers).
 unsafe impl Sync for ExecCell {}
 
-static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {
+#[doc(hidden)]
+pub static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {
+    fast_ok: 0,
+    waiting: 0,
+    raised: 0,
+    refill: 0,
     masks: [0; SLOTS],
     left: 0,
     interval: 0,
@@ -189,6 +214,12 @@ static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {
 fn exec() -> &'static mut Exec {
     // SAFETY: see `ExecCell`; callers never hold two of these at once.
     unsafe { &mut *EXEC.0.get() }
+}
+
+/// From the tick handler: did the assembly path ask for a refill since?
+#[inline(always)]
+pub fn take_refill() -> bool {
+    avr_device::interrupt::free(|_| core::mem::take(&mut exec().refill) != 0)
 }
 
 /// Owner of the STEP and DIR pins: constructing it proves they are outputs.
@@ -249,7 +280,7 @@ impl Stepper {
     pub fn position(&self) -> PerAxis<i32> {
         let (start, block, left) = avr_device::interrupt::free(|_| {
             let e = exec();
-            (e.block_start, e.block, e.block_left)
+            (e.block_start, e.block, e.block_left + e.left as u32)
         });
         let mut p = start;
         for i in 0..AXES {
@@ -264,6 +295,7 @@ impl Stepper {
             let e = exec();
             e.block_start = p;
             e.block_left = 0;
+            e.left = 0;
             e.block = StepBlock {
                 steps: [0; AXES],
                 events: 0,
@@ -360,7 +392,30 @@ fn load_segment(e: &mut Exec) -> bool {
     e.interval = seg.interval;
     e.add = seg.add;
     e.left = seg.count;
+    e.block_left -= seg.count as u32;
+    e.fast_ok = seg.flags & FAST;
     true
+}
+
+/// [`Segment::flags`] bit, set by the motion task: every event of the
+/// segment may take the assembly fast path.
+pub const FAST: u8 = 0x80;
+
+/// Whether `seg` of a block with `steps` per axis and `events` events can
+/// take the fast path: no interval needs a split wait (the 24.8 fraction
+/// adds under one tick) and every moving axis steps at every event, so the
+/// DDA has nothing to do. Run by the motion task, not the interrupt.
+pub fn fast_segment(seg: &Segment, block: &StepBlock) -> bool {
+    let every_event = block.steps.iter().all(|&s| s == 0 || s == block.events);
+    let last = seg.interval as i64 + seg.add as i64 * (seg.count as i64 - 1);
+    let longest = last.max(seg.interval as i64) + 255;
+    every_event && longest < (LONG_WAIT << FRAC_BITS) as i64
+}
+
+#[inline(never)]
+#[cold]
+fn load_segment_cold(e: &mut Exec) -> bool {
+    load_segment(e)
 }
 
 /// One axis of the DDA, with its slot and bit as constants.
@@ -384,6 +439,16 @@ macro_rules! dda_count {
     };
 }
 
+/// The DDA for axes that do not step at every event, out of line: single-
+/// axis and equal-count moves never need it.
+#[inline(never)]
+fn dda_partial(e: &mut Exec, m: &mut [u8; SLOTS]) {
+    dda_axis!(e, m, 0);
+    dda_axis!(e, m, 1);
+    dda_axis!(e, m, 2);
+    dda_axis!(e, m, 3);
+}
+
 /// Time, DDA and compare register of the next event.
 ///
 /// # Safety
@@ -394,10 +459,9 @@ unsafe fn schedule_next(e: &mut Exec) {
     e.interval = e.interval.wrapping_add(e.add as u32);
     e.frac = t as u8;
     let mut m = e.always;
-    dda_axis!(e, m, 0);
-    dda_axis!(e, m, 1);
-    dda_axis!(e, m, 2);
-    dda_axis!(e, m, 3);
+    if e.partial != 0 {
+        dda_partial(e, &mut m);
+    }
     e.masks = m;
     e.wait = t >> FRAC_BITS;
     advance_compare(e);
@@ -413,10 +477,11 @@ unsafe fn advance_compare(e: &mut Exec) {
         e.wait
     };
     e.wait -= part;
+    e.waiting = (e.wait != 0) as u8;
     let at = read_volatile(OCR1A).wrapping_add(part as u16);
     let now = read_volatile(TCNT1);
     if (at.wrapping_sub(now) as i16) < MIN_LEAD as i16 {
-        e.late = e.late.saturating_add(1);
+        e.late = e.late.wrapping_add(1);
         write_volatile(OCR1A, now.wrapping_add(MIN_LEAD));
     } else {
         write_volatile(OCR1A, at);
@@ -440,8 +505,10 @@ unsafe fn toggle_steps(m: &[u8; SLOTS]) {
     }
 }
 
-/// The `TIMER1_COMPA` interrupt. Returns true when the segment queue wants
-/// refilling (the app then spawns the motion task).
+/// The `TIMER1_COMPA` interrupt's general path, entered from the assembly
+/// entry in `fast.rs`, which has raised the STEP pins unless this compare
+/// match is part of a split wait (it handles plain events itself). Returns true when the segment queue
+/// wants refilling (the app then spawns the motion task).
 #[inline(always)]
 pub fn on_compare() -> bool {
     let e = exec();
@@ -451,17 +518,17 @@ pub fn on_compare() -> bool {
             advance_compare(e);
             return false;
         }
+        // The assembly entry (`fast.rs`) raised the pins already.
         let masks = e.masks;
-        toggle_steps(&masks);
-        let raised = read_volatile(TCNT1);
-        e.block_left -= 1;
+        let raised = e.raised;
         e.left -= 1;
-        let loaded = e.left == 0 && load_segment(e);
+        let loaded = e.left == 0 && load_segment_cold(e);
         if e.left > 0 {
             schedule_next(e);
         } else {
             e.running = false;
             // Dry in the middle of a block: the preparer fell behind.
+            e.fast_ok = 0;
             if e.block_left > 0 {
                 e.underruns = e.underruns.saturating_add(1);
             }

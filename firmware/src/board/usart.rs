@@ -49,21 +49,27 @@ pub fn tx_pending() -> usize {
     TX.len()
 }
 
-/// Called by `USART0_UDRE`.
+/// USART0 control register B and its interrupt-enable bits, for the
+/// nestable entry (`rt::nested`), which clears the enable before `sei`.
+pub const UCSR0B: u16 = 0xC1;
+pub const RXCIE0: u8 = 7;
+pub const UDRIE0: u8 = 5;
+
+/// The `USART0_UDRE` handler, entered with its interrupt switched off:
+/// send one byte, and switch it back on while more are waiting.
 pub fn on_data_register_empty() {
-    match TX.pop() {
-        Some(b) => {
-            regs().udr0().write(|w| unsafe { w.bits(b) });
-        }
-        None => {
-            regs().ucsr0b().modify(|_, w| w.udrie0().clear_bit());
+    if let Some(b) = TX.pop() {
+        regs().udr0().write(|w| unsafe { w.bits(b) });
+        if !TX.is_empty() {
+            avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.udrie0().set_bit()));
         }
     }
 }
 
-/// Called by `USART0_RX`.
+/// The `USART0_RX` handler, entered with its interrupt switched off.
 pub fn on_receive() {
     let b = regs().udr0().read().bits();
     // A full ring counts the lost byte (the sender ignored flow control).
     let _ = RX.push(b);
+    avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.rxcie0().set_bit()));
 }

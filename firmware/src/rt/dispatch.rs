@@ -1,27 +1,52 @@
 //! The dispatcher: runs ready software tasks, highest priority first, each
 //! to completion; feeds the watchdog only when every ready task has run;
 //! sleeps when nothing is ready.
+//!
+//! Interrupts never touch the ready set: they push task ids into `spawned`
+//! (a short masked push), and the dispatcher moves them into `Ready` in
+//! arrival order. So the ready set needs no lock, and nothing in the main
+//! loop masks the step interrupt for longer than a ring push.
 
-use super::Shared;
+use super::{Ring, TaskCell};
 use crate::board::watchdog::Watchdog;
 use core::arch::asm;
 use taut_logic::sched::{Ready, TaskId};
 
+/// Task ids spawned from interrupts, in arrival order.
+pub type Spawned = Ring<u8, 16>;
+
+/// From an interrupt handler: make task `id` ready. A full ring is counted
+/// in its stats (it holds more slots than there are tasks, so it cannot
+/// fill unless the dispatcher is stuck, which the watchdog handles).
+#[inline(always)]
+pub fn spawn_from_isr(spawned: &Spawned, id: u8) {
+    // Masked: a nested handler may also be pushing.
+    avr_device::interrupt::free(|_| {
+        let _ = spawned.push(id);
+    });
+}
+
 pub fn run<T: TaskId, const N: usize, const P: usize>(
-    ready: &Shared<Ready<T, N, P>>,
+    spawned: &Spawned,
+    ready: &TaskCell<Ready<T, N, P>>,
+    task: fn(u8) -> T,
     watchdog: &Watchdog,
     mut dispatch: impl FnMut(T),
 ) -> ! {
     // SAFETY: SMCR (0x53): sleep enable, idle mode (timers and UART run).
     unsafe { core::ptr::write_volatile(0x53 as *mut u8, 0x01) };
     loop {
-        while let Some(task) = pop(ready) {
-            dispatch(task);
+        while let Some(id) = spawned.pop() {
+            ready.with(|r| r.spawn(task(id)));
+        }
+        if let Some(t) = ready.with(|r| r.pop()) {
+            dispatch(t);
+            continue;
         }
         // A task that never returns never gets here: the watchdog resets.
         watchdog.feed();
         avr_device::interrupt::disable();
-        if is_idle(ready) {
+        if spawned.is_empty() {
             // `sei` takes effect after the next instruction, so an interrupt
             // arriving now still wakes this `sleep`: no lost wake-up.
             // SAFETY: re-enables interrupts, as they were before `disable`.
@@ -31,16 +56,4 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
             unsafe { avr_device::interrupt::enable() };
         }
     }
-}
-
-// Out of line, so the compiler cannot pull unrelated work into the short
-// critical sections (each one delays the step interrupt by its length).
-#[inline(never)]
-fn pop<T: TaskId, const N: usize, const P: usize>(ready: &Shared<Ready<T, N, P>>) -> Option<T> {
-    ready.lock(|r| r.pop())
-}
-
-#[inline(never)]
-fn is_idle<T: TaskId, const N: usize, const P: usize>(ready: &Shared<Ready<T, N, P>>) -> bool {
-    ready.lock(|r| r.is_idle())
 }

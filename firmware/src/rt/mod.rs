@@ -3,6 +3,7 @@
 //! `taut_logic::sched` (host-tested); the app holds it in `Shared` statics.
 
 pub mod dispatch;
+pub mod nested;
 pub mod ring;
 pub mod shared;
 pub mod stack;

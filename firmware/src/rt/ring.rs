@@ -10,6 +10,7 @@ use core::mem::MaybeUninit;
 use core::sync::atomic::{compiler_fence, AtomicU8, Ordering::*};
 use taut_logic::sched::QueueStats;
 
+#[repr(C)]
 pub struct Ring<T: Copy, const N: usize> {
     buf: UnsafeCell<[MaybeUninit<T>; N]>,
     head: AtomicU8,
@@ -107,6 +108,13 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         // SAFETY: as in `pop`.
         Some(unsafe { (*self.buf.get())[t as usize].assume_init() })
     }
+
+    /// Byte offsets of the indices, for the step interrupt's assembly
+    /// consumer (`stepper::fast`); the slots start at offset 0.
+    #[doc(hidden)]
+    pub const HEAD: usize = core::mem::offset_of!(Self, head);
+    #[doc(hidden)]
+    pub const TAIL: usize = core::mem::offset_of!(Self, tail);
 
     /// Usable capacity.
     pub const fn capacity(&self) -> usize {
