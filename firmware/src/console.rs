@@ -29,6 +29,10 @@ pub enum Poll {
     Motion,
     /// Try again after this many ms (dwell, serial output full).
     After(u16),
+    /// One line was carried out and more input may wait: run again after
+    /// the tasks already ready (a task's run stays short, so the motion
+    /// task is never held up by a burst of lines).
+    Yield,
 }
 
 pub struct Console {
@@ -124,7 +128,7 @@ impl Console {
             }
             if let Some(next) = self.listing {
                 self.list_setting(next, cfg);
-                continue;
+                return Poll::Yield;
             }
             if let Some(line) = self.held.take() {
                 if let Some(wait) = self.execute(&line, m, kin) {

@@ -11,8 +11,9 @@
 //! | `TIMER0_COMPA` 1 ms tick | interrupt | | clock, timer alarm | |
 //! | `USART0_RX` / `USART0_UDRE` | interrupts | | `RX` / `TX` rings | console, logger |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
-//! | `Motion` planner → segments | software | 2 | `MOTION` | console |
-//! | `Console` G-code line in, reply out | software | 1 | `RX`, `MOTION` | |
+//! | `Refill` planner → segments while the queue is short | software | 3 | `MOTION` | console |
+//! | `Console` G-code line in, reply out | software | 2 | `RX`, `MOTION` | |
+//! | `Motion` planner → segments, background | software | 1 | `MOTION` | console |
 //! | `Logger` deferred reports | software | 0 | every 1 s | |
 //! | `Led` status LED pattern | software | 0 | its timer | |
 #![no_std]
@@ -27,7 +28,7 @@ use taut_firmware::board::{
 };
 use taut_firmware::console::{Console, Poll};
 use taut_firmware::drivers::{Drivers, EnablePins};
-use taut_firmware::motion::Motion;
+use taut_firmware::motion::{self, Motion};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{stack, TaskCell};
 use taut_firmware::stepper::{self, Stepper};
@@ -43,22 +44,42 @@ use taut_logic::sched::{Ready, TaskId, Timers};
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Task {
     Timers,
+    Refill,
     Motion,
     Console,
     Logger,
     Led,
 }
 
+impl Task {
+    /// Every task, in discriminant order (`Task::X as u8` indexes it).
+    const ALL: [Task; 6] = [
+        Task::Timers,
+        Task::Refill,
+        Task::Motion,
+        Task::Console,
+        Task::Logger,
+        Task::Led,
+    ];
+}
+const _: () = {
+    let mut i = 0;
+    while i < Task::ALL.len() {
+        assert!(Task::ALL[i] as usize == i);
+        i += 1;
+    }
+};
+
 impl TaskId for Task {
-    const COUNT: usize = 5;
+    const COUNT: usize = Task::ALL.len();
     fn index(self) -> usize {
         self as usize
     }
     fn priority(self) -> u8 {
         match self {
-            Task::Timers => 3,
-            Task::Motion => 2,
-            Task::Console => 1,
+            Task::Timers | Task::Refill => 3,
+            Task::Console => 2,
+            Task::Motion => 1,
             Task::Logger | Task::Led => 0,
         }
     }
@@ -67,7 +88,7 @@ impl TaskId for Task {
 /// Task ids spawned by interrupts, moved into `READY` by the dispatcher.
 static SPAWNED: Spawned = Spawned::new();
 // Software tasks only: no masking needed.
-static READY: TaskCell<Ready<Task, 5, 4>> = TaskCell::new(Ready::new());
+static READY: TaskCell<Ready<Task, 6, 4>> = TaskCell::new(Ready::new());
 static TIMERS: TaskCell<Timers<Task, 6>> = TaskCell::new(Timers::new());
 static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
 static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
@@ -84,13 +105,7 @@ fn spawn(task: Task) {
 }
 
 fn task_of(id: u8) -> Task {
-    [
-        Task::Timers,
-        Task::Motion,
-        Task::Console,
-        Task::Logger,
-        Task::Led,
-    ][id as usize]
+    Task::ALL[id as usize]
 }
 
 fn spawn_after(task: Task, ms: u32) {
@@ -160,7 +175,7 @@ fn main() -> ! {
 
     dispatch::run(&SPAWNED, &READY, task_of, &watchdog, |task| match task {
         Task::Timers => timers(),
-        Task::Motion => motion(),
+        Task::Refill | Task::Motion => motion(),
         Task::Console => console(),
         Task::Logger => logger(),
         Task::Led => led(),
@@ -184,13 +199,28 @@ fn timers() {
 
 #[inline(never)]
 fn motion() {
-    let freed = MOTION.with(|m| {
+    /// Segments per run: bounds the run to ~30 ms at worst.
+    const BATCH: usize = 8;
+    let (freed, more, idle) = MOTION.with(|m| {
         let m = m.as_mut().unwrap();
-        let freed = m.refill();
-        freed || m.is_idle()
+        let (freed, more) = m.refill(BATCH);
+        (freed, more, m.is_idle())
     });
-    if freed && CONSOLE_WAITS_MOTION.with(|w| core::mem::take(w)) {
+    if more {
+        spawn(refill_task());
+    }
+    if (freed || idle) && CONSOLE_WAITS_MOTION.with(|w| core::mem::take(w)) {
         spawn(Task::Console);
+    }
+}
+
+/// Urgent refill while the step queue is short, background otherwise.
+#[inline(always)]
+fn refill_task() -> Task {
+    if stepper::SEGMENTS.len() <= motion::URGENT {
+        Task::Refill
+    } else {
+        Task::Motion
     }
 }
 
@@ -208,6 +238,7 @@ fn console() {
         Poll::Drained => {}
         Poll::Motion => CONSOLE_WAITS_MOTION.with(|w| *w = true),
         Poll::After(ms) => spawn_after(Task::Console, ms as u32),
+        Poll::Yield => spawn(Task::Console),
     }
 }
 
@@ -261,7 +292,7 @@ step_vector!(timer1_compa);
 
 extern "avr-interrupt" fn timer1_compa() {
     if stepper::on_compare() {
-        spawn_from_isr(&SPAWNED, Task::Motion as u8);
+        spawn_from_isr(&SPAWNED, refill_task() as u8);
     }
 }
 
@@ -277,7 +308,7 @@ extern "avr-interrupt" fn timer0_compa() {
     }
     // The step interrupt's assembly path cannot spawn; it leaves a flag.
     if stepper::take_refill() {
-        spawn_from_isr(&SPAWNED, Task::Motion as u8);
+        spawn_from_isr(&SPAWNED, refill_task() as u8);
     }
 }
 

@@ -9,6 +9,10 @@ use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Planner};
 use taut_logic::segment::{Preparer, StepBlock};
 
+/// Below this many queued segments, preparing more is urgent (the app runs
+/// it at the highest software priority); above, it is background work.
+pub const URGENT: usize = 16;
+
 /// The look-ahead ring (1 KiB): its own static, built in place.
 static PLANNER: TaskCell<Planner> = TaskCell::new(Planner::EMPTY);
 
@@ -36,11 +40,14 @@ impl Motion {
         PLANNER.with(|p| p.push(target, feed))
     }
 
-    /// Move planned blocks into the interrupt's queues while they have room
-    /// and start the interrupt. Returns true if a planner slot was freed.
-    pub fn refill(&mut self) -> bool {
+    /// Move planned blocks into the interrupt's queues, at most `max`
+    /// segments (a ramp segment costs up to ~4 ms here: runs stay short so
+    /// other tasks interleave), and start the interrupt. Returns (a planner
+    /// slot was freed, more can be prepared).
+    pub fn refill(&mut self, max: usize) -> (bool, bool) {
         let mut freed = false;
-        while SEGMENTS.free() > 0 {
+        let mut made = 0;
+        while SEGMENTS.free() > 0 && made < max {
             if self.prep.is_idle() {
                 if BLOCKS.free() == 0 {
                     break;
@@ -60,12 +67,14 @@ impl Motion {
                         seg.flags |= FAST;
                     }
                     let _ = SEGMENTS.push(seg);
+                    made += 1;
                 }
                 None => break,
             }
         }
         self.stepper.kick();
-        freed
+        let work = !self.prep.is_idle() || !PLANNER.with(|p| p.is_idle());
+        (freed, made == max && work && SEGMENTS.free() > 0)
     }
 
     /// Every queued move has been executed.

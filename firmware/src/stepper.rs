@@ -26,12 +26,14 @@ use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::{port_bit, Port, DRIVERS};
 use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK};
 
-/// Segments waiting for the interrupt (11 bytes each).
-pub static SEGMENTS: Ring<Segment, 32> = Ring::new();
+/// Segments waiting for the interrupt (11 bytes each). Deep, because
+/// preparing a ramp segment costs up to ~4 ms on the AVR while the
+/// interrupt may run one in 1 ms at high rates.
+pub static SEGMENTS: Ring<Segment, 64> = Ring::new();
 /// Blocks waiting for their first segment (21 bytes each).
 pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
 /// Refill the queues when this few segments are left.
-pub(crate) const LOW_WATER: usize = 16;
+pub(crate) const LOW_WATER: usize = 48;
 
 /// Timer1 registers (data-space addresses).
 const TCNT1: *mut u16 = 0x84 as *mut u16;
@@ -164,6 +166,9 @@ pub struct Exec {
     block_left: u32,
     /// Position when the current block began.
     block_start: PerAxis<i32>,
+    /// Bumped whenever `block`/`block_start` change: readers copy them
+    /// without masking interrupts and retry if it moved (a seqlock).
+    block_gen: u8,
     running: bool,
     /// Direction bits to apply once the current pulse is over.
     new_dir: Option<u8>,
@@ -202,6 +207,7 @@ pub static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {
     partial: 0,
     block_left: 0,
     block_start: [0; AXES],
+    block_gen: 0,
     running: false,
     new_dir: None,
     dir_high_positive: 0xFF,
@@ -276,12 +282,28 @@ impl Stepper {
         }
     }
 
-    /// Position in steps, as executed so far.
+    /// Position in steps, as executed so far. Interrupts are masked only
+    /// for the six bytes of event counters; the block is read as a seqlock.
     pub fn position(&self) -> PerAxis<i32> {
-        let (start, block, left) = avr_device::interrupt::free(|_| {
-            let e = exec();
-            (e.block_start, e.block, e.block_left + e.left as u32)
-        });
+        let e = EXEC.0.get();
+        let (start, block, left) = loop {
+            // SAFETY: volatile reads of fields the interrupt may be changing;
+            // the generation check below discards a torn copy.
+            let (gen, start, block) = unsafe {
+                (
+                    read_volatile(&(*e).block_gen),
+                    read_volatile(&(*e).block_start),
+                    read_volatile(&(*e).block),
+                )
+            };
+            let (now_gen, left) = avr_device::interrupt::free(|_| {
+                // SAFETY: interrupts are off: no concurrent writer.
+                unsafe { ((*e).block_gen, (*e).block_left + (*e).left as u32) }
+            });
+            if gen == now_gen {
+                break (start, block, left);
+            }
+        };
         let mut p = start;
         for i in 0..AXES {
             p[i] += signed(done(&block, block.events - left, i), block.dir, i);
@@ -294,6 +316,7 @@ impl Stepper {
         avr_device::interrupt::free(|_| {
             let e = exec();
             e.block_start = p;
+            e.block_gen = e.block_gen.wrapping_add(1);
             e.block_left = 0;
             e.left = 0;
             e.block = StepBlock {
@@ -357,6 +380,7 @@ fn load_segment(e: &mut Exec) -> bool {
         let Some(block) = BLOCKS.pop() else {
             return false;
         };
+        e.block_gen = e.block_gen.wrapping_add(1);
         // The previous block is complete: fold it into the start position.
         for i in 0..AXES {
             e.block_start[i] += signed(e.block.steps[i], e.block.dir, i);

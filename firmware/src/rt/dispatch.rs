@@ -1,6 +1,9 @@
 //! The dispatcher: runs ready software tasks, highest priority first, each
-//! to completion; feeds the watchdog only when every ready task has run;
-//! sleeps when nothing is ready.
+//! to completion; feeds the watchdog only when every task that was ready at
+//! the start of a round has run (when nothing is ready, on the idle path);
+//! sleeps when nothing is ready. A task that never returns ends every
+//! round, so the watchdog resets the board; a busy but healthy machine,
+//! whose tasks keep spawning each other, still completes rounds.
 //!
 //! Interrupts never touch the ready set: they push task ids into `spawned`
 //! (a short masked push), and the dispatcher moves them into `Ready` in
@@ -35,16 +38,26 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
 ) -> ! {
     // SAFETY: SMCR (0x53): sleep enable, idle mode (timers and UART run).
     unsafe { core::ptr::write_volatile(0x53 as *mut u8, 0x01) };
+    // Tasks (bit = index) still owed a run in this round.
+    let mut round: u32 = 0;
     loop {
         while let Some(id) = spawned.pop() {
             ready.with(|r| r.spawn(task(id)));
         }
+        if round == 0 {
+            // Every task of the last round ran: feed, and start a new one.
+            watchdog.feed();
+            round = ready.with(|r| {
+                (0..T::COUNT as u8)
+                    .filter(|&i| r.is_pending(task(i)))
+                    .fold(0, |m, i| m | 1 << i)
+            });
+        }
         if let Some(t) = ready.with(|r| r.pop()) {
+            round &= !(1 << t.index());
             dispatch(t);
             continue;
         }
-        // A task that never returns never gets here: the watchdog resets.
-        watchdog.feed();
         avr_device::interrupt::disable();
         if spawned.is_empty() {
             // `sei` takes effect after the next instruction, so an interrupt
