@@ -17,6 +17,7 @@ usage: cargo xtask <command> [args]
   simtest           build the firmware images and run the HIL tests in simavr
   build             release ELF + Intel HEX + size report
   sim [args]        run the firmware in simavr (see `cargo xtask sim --help`)
+  sdimage DIR -o IMG  build a FAT card image from a folder (dd it to a real card)
   bench             measure, write target/bench.json, print a table
   flash             flash a Mega 2560 through ravedude
   setup             install what is missing (apt packages, rust-src)
@@ -37,6 +38,7 @@ fn main() -> ExitCode {
         "test" => test(),
         "simtest" => run::setup().and_then(|_| simtest()),
         "sim" => run::setup().and_then(|_| sim(rest)),
+        "sdimage" => run::setup().and_then(|_| run::bin("taut-sdimage", rest)),
         "demo" => run::setup().and_then(|_| demo()),
         "bench" => run::setup().and_then(|_| bench::run()),
         "flash" => run::setup().and_then(|_| firmware::flash()),

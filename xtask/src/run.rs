@@ -45,6 +45,13 @@ pub fn setup() -> Result<()> {
 
 /// `taut-sim ELF ARGS…`, built optimised (it runs millions of instructions).
 pub fn taut_sim(elf: &Path, args: &[String]) -> Result<()> {
+    let mut all = vec![elf.display().to_string()];
+    all.extend_from_slice(args);
+    bin("taut-sim", &all)
+}
+
+/// One of the harness crate's binaries (simavr/src/bin), built optimised.
+pub fn bin(name: &str, args: &[String]) -> Result<()> {
     let mut c = cargo_cmd(
         &[
             "run",
@@ -53,11 +60,11 @@ pub fn taut_sim(elf: &Path, args: &[String]) -> Result<()> {
             "-p",
             "taut-simavr",
             "--bin",
-            "taut-sim",
+            name,
             "--",
         ],
         &root(),
     );
-    c.arg(elf).args(args);
+    c.args(args);
     status(&mut c)
 }

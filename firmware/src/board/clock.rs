@@ -14,8 +14,9 @@ pub struct Clock;
 impl Clock {
     pub fn start(tc0: TC0) -> Clock {
         tc0.tccr0a().write(|w| w.wgm0().ctc());
-        tc0.ocr0a().write(|w| unsafe { w.bits(249) });
         tc0.tccr0b().write(|w| w.cs0().prescale_64());
+        // After the mode is complete (simavr checks it on OCR writes).
+        tc0.ocr0a().write(|w| unsafe { w.bits(249) });
         tc0.timsk0().write(|w| w.ocie0a().set_bit());
         Clock
     }

@@ -9,18 +9,22 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
 use taut_logic::pinmap::{self, Button};
-use taut_simavr::{Outcome, Sim};
+use taut_simavr::{Outcome, Reply, Sim};
 
 const USAGE: &str = "\
-usage: taut-sim ELF [--for SECONDS] [--vcd PATH] [--report PATH] [--echo]
-  --for SECONDS   simulated time to run (default 5)
+usage: taut-sim ELF [--send FILE] [--for SECONDS] [--vcd PATH] [--report PATH] [--echo]
+  --send FILE     stream FILE's lines to the serial console, each after the
+                  previous one's ok/error, then run until motion is idle
+  --for SECONDS   simulated time to run (default 5; with --send: extra time
+                  after motion is idle, default 0)
   --vcd PATH      write a VCD trace of every probed pin
   --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
   --echo          print the firmware's serial output as it runs";
 
 struct Args {
     elf: PathBuf,
-    seconds: f64,
+    send: Option<PathBuf>,
+    seconds: Option<f64>,
     vcd: Option<PathBuf>,
     report: Option<PathBuf>,
     echo: bool,
@@ -30,7 +34,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     let elf = it.next().ok_or("missing ELF")?.into();
     let mut args = Args {
         elf,
-        seconds: 5.0,
+        send: None,
+        seconds: None,
         vcd: None,
         report: None,
         echo: false,
@@ -38,7 +43,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     while let Some(a) = it.next() {
         let mut value = || it.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
-            "--for" => args.seconds = value()?.parse().map_err(|e| format!("--for: {e}"))?,
+            "--for" => args.seconds = Some(value()?.parse().map_err(|e| format!("--for: {e}"))?),
+            "--send" => args.send = Some(value()?.into()),
             "--vcd" => args.vcd = Some(value()?.into()),
             "--report" => args.report = Some(value()?.into()),
             "--echo" => args.echo = true,
@@ -62,13 +68,46 @@ fn probe_machine(sim: &mut Sim) {
     sim.probe(pinmap::STATUS_LED, "led");
 }
 
+/// Send every line of `file` as a G-code sender would (next line after the
+/// reply), then wait until motion is idle (`M400`).
+fn stream(
+    sim: &mut Sim,
+    file: &std::path::Path,
+    echo: bool,
+    printed: &mut usize,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let text = std::fs::read_to_string(file).map_err(|e| format!("{}: {e}", file.display()))?;
+    if sim.run_until_uart_contains("reset:", Duration::from_millis(100)) != Outcome::Done {
+        return Err("the firmware did not boot".into());
+    }
+    let lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+    for (n, line) in lines.chain(std::iter::once("M400")).enumerate() {
+        // Motion may have to finish first (M400, a full planner): be patient.
+        match sim.send_line(line, Duration::from_secs(3600)) {
+            Ok(Reply::Ok) => {}
+            Ok(Reply::Error(e)) => eprintln!("taut-sim: line {}: {line}: {e}", n + 1),
+            Err(e) => return Err(format!("line {}: {line}: no reply ({e:?})", n + 1).into()),
+        }
+        if echo {
+            let out = sim.uart_bytes();
+            std::io::stdout().write_all(&out[*printed..])?;
+            *printed = out.len();
+        }
+    }
+    Ok(())
+}
+
 fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     let mut sim = Sim::load(&args.elf)?;
     probe_machine(&mut sim);
     let wall = Instant::now();
-    let total = Duration::from_secs_f64(args.seconds);
-    let slice = Duration::from_millis(10);
     let mut printed = 0;
+    if let Some(file) = &args.send {
+        stream(&mut sim, file, args.echo, &mut printed)?;
+    }
+    let default = if args.send.is_some() { 0.0 } else { 5.0 };
+    let total = Duration::from_secs_f64(args.seconds.unwrap_or(default));
+    let slice = Duration::from_millis(10);
     let mut outcome = Outcome::Running;
     let mut elapsed = Duration::ZERO;
     while elapsed < total {
