@@ -51,6 +51,8 @@ enum Task {
     Led,
 }
 
+const _: () = assert!(Task::ALL.len() <= 8, "interrupt spawns are a bit per task");
+
 impl Task {
     /// Every task, in discriminant order (`Task::X as u8` indexes it).
     const ALL: [Task; 6] = [

@@ -7,8 +7,9 @@ use taut_logic::pinmap::driver;
 
 /// Timer1 COMPA vector (byte address): the step interrupt.
 const STEP_VECTOR: u32 = 0x44;
-/// Documented bound (README): no code masks the step interrupt longer.
-const MASKED_BOUND_CYCLES: u64 = 128;
+/// Documented bound (README): no code masks the step interrupt longer
+/// (measured: 47 cycles in the benchmark cruise, 71 with console traffic).
+const MASKED_BOUND_CYCLES: u64 = 80;
 const RAM_BUDGET: u32 = 6 * 1024;
 
 fn send(sim: &mut Sim, line: &str) {

@@ -5,28 +5,49 @@
 //! round, so the watchdog resets the board; a busy but healthy machine,
 //! whose tasks keep spawning each other, still completes rounds.
 //!
-//! Interrupts never touch the ready set: they push task ids into `spawned`
-//! (a short masked push), and the dispatcher moves them into `Ready` in
-//! arrival order. So the ready set needs no lock, and nothing in the main
-//! loop masks the step interrupt for longer than a ring push.
+//! Interrupts never touch the ready set: they set the task's bit in
+//! `Spawned` (one masked `|=`), and the dispatcher moves flagged tasks into
+//! `Ready`, in task order, before each dispatch. So the ready set needs no
+//! lock, and a spawn from an interrupt masks the step interrupt for a few
+//! cycles. (A task pending already is not queued twice, so a bit per task
+//! loses nothing; tasks flagged between two dispatches enter their
+//! priority's FIFO in task order.)
 
-use super::{Ring, TaskCell};
+use super::TaskCell;
 use crate::board::watchdog::Watchdog;
 use core::arch::asm;
+use core::cell::UnsafeCell;
 use taut_logic::sched::{Ready, TaskId};
 
-/// Task ids spawned from interrupts, in arrival order.
-pub type Spawned = Ring<u8, 16>;
+/// Tasks spawned from interrupts and not yet in the ready set: bit = id.
+pub struct Spawned(UnsafeCell<u8>);
 
-/// From an interrupt handler: make task `id` ready. A full ring is counted
-/// in its stats (it holds more slots than there are tasks, so it cannot
-/// fill unless the dispatcher is stuck, which the watchdog handles).
+// SAFETY: every access is a read-modify-write with interrupts masked.
+unsafe impl Sync for Spawned {}
+
+impl Spawned {
+    pub const fn new() -> Self {
+        Spawned(UnsafeCell::new(0))
+    }
+
+    /// Take every flag (dispatcher side).
+    fn take(&self) -> u8 {
+        // SAFETY: masked read-modify-write (see `Sync`).
+        avr_device::interrupt::free(|_| unsafe { core::mem::take(&mut *self.0.get()) })
+    }
+
+    fn is_empty(&self) -> bool {
+        // SAFETY: a single-byte read.
+        unsafe { core::ptr::read_volatile(self.0.get()) == 0 }
+    }
+}
+
+/// From an interrupt handler: make task `id` (below 8) ready.
 #[inline(always)]
 pub fn spawn_from_isr(spawned: &Spawned, id: u8) {
-    // Masked: a nested handler may also be pushing.
-    avr_device::interrupt::free(|_| {
-        let _ = spawned.push(id);
-    });
+    // Masked: a nested handler may be setting another bit.
+    // SAFETY: masked read-modify-write (see `Sync`).
+    avr_device::interrupt::free(|_| unsafe { *spawned.0.get() |= 1 << id });
 }
 
 pub fn run<T: TaskId, const N: usize, const P: usize>(
@@ -41,8 +62,13 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
     // Tasks (bit = index) still owed a run in this round.
     let mut round: u32 = 0;
     loop {
-        while let Some(id) = spawned.pop() {
-            ready.with(|r| r.spawn(task(id)));
+        let flags = spawned.take();
+        if flags != 0 {
+            ready.with(|r| {
+                for id in (0..T::COUNT as u8).filter(|i| flags >> i & 1 != 0) {
+                    r.spawn(task(id));
+                }
+            });
         }
         if round == 0 {
             // Every task of the last round ran: feed, and start a new one.
