@@ -6,6 +6,7 @@
 
 use super::{KinError, Kinematics, Position, Steps};
 use crate::axis::AXES;
+use crate::segment::isqrt;
 use crate::units::{div_round, Milli};
 
 pub struct Segmenter<'a, K: Kinematics> {
@@ -66,26 +67,6 @@ impl<K: Kinematics> Iterator for Segmenter<'_, K> {
     }
 }
 
-/// Floor of the square root, bit by bit (no float, once per move).
-fn isqrt(n: u64) -> u64 {
-    let mut root = 0u64;
-    let mut bit = 1u64 << 62;
-    let mut rem = n;
-    while bit > n {
-        bit >>= 2;
-    }
-    while bit != 0 {
-        if rem >= root + bit {
-            rem -= root + bit;
-            root = (root >> 1) + bit;
-        } else {
-            root >>= 1;
-        }
-        bit >>= 2;
-    }
-    root
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::{ChannelScale, Cylindrical, Polargraph};
@@ -106,17 +87,6 @@ mod tests {
 
     fn pos(x: i32, y: i32) -> Position {
         [Milli(x), Milli(y), Milli(0), Milli(0)]
-    }
-
-    #[test]
-    fn isqrt_is_the_floor() {
-        for n in [0u64, 1, 2, 3, 4, 15, 16, 17, 1 << 40, u64::MAX] {
-            let r = isqrt(n);
-            assert!(
-                r * r <= n && (r + 1).checked_mul(r + 1).is_none_or(|s| s > n),
-                "{n}"
-            );
-        }
     }
 
     #[test]
