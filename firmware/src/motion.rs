@@ -89,7 +89,7 @@ impl Motion {
     pub fn configure(&mut self, config: &MachineConfig) {
         PLANNER.with(|p| p.configure(config));
         self.drivers.configure(config);
-        self.stepper.set_pulse_us(config.pulse.step_pulse_us);
+        self.stepper.set_timing(&config.pulse);
     }
 
     /// Redefine where the machine is (`G92`, zeroing). Only when idle.

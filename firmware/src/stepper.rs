@@ -175,6 +175,8 @@ pub struct Exec {
     /// DIR pin level that means positive, per axis (bit set: high).
     dir_high_positive: u8,
     pulse_ticks: u16,
+    /// DIR must be stable this long before the next STEP edge.
+    dir_setup_ticks: u16,
     late: u16,
     underruns: u16,
 }
@@ -212,6 +214,7 @@ pub static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {
     new_dir: None,
     dir_high_positive: 0xFF,
     pulse_ticks: 80,
+    dir_setup_ticks: 80,
     late: 0,
     underruns: 0,
 }));
@@ -237,6 +240,7 @@ impl Stepper {
     pub fn new(_timer: crate::board::step_timer::StepTimer, config: &MachineConfig) -> Stepper {
         let e = exec();
         e.pulse_ticks = config.pulse.step_pulse_us as u16 * 16;
+        e.dir_setup_ticks = config.pulse.dir_setup_us as u16 * 16;
         e.dir_high_positive = 0;
         for i in 0..AXES {
             if config.axes[i].dir_high_is_positive {
@@ -255,8 +259,11 @@ impl Stepper {
         Stepper(())
     }
 
-    pub fn set_pulse_us(&mut self, us: u8) {
-        avr_device::interrupt::free(|_| exec().pulse_ticks = us as u16 * 16);
+    pub fn set_timing(&mut self, pulse: &taut_logic::config::PulseTiming) {
+        avr_device::interrupt::free(|_| {
+            exec().pulse_ticks = pulse.step_pulse_us as u16 * 16;
+            exec().dir_setup_ticks = pulse.dir_setup_us as u16 * 16;
+        });
     }
 
     /// Start executing queued segments if the interrupt is idle; the first
@@ -562,6 +569,14 @@ pub fn on_compare() -> bool {
         toggle_steps(&masks);
         if let Some(dir) = e.new_dir.take() {
             write_dir(dir, e.dir_high_positive);
+            // Keep the DIR set-up time before the next STEP edge (only
+            // binding above ~200 000 steps/s with the 5 µs default).
+            let earliest = read_volatile(TCNT1).wrapping_add(e.dir_setup_ticks);
+            if e.running && e.wait == 0 && (read_volatile(OCR1A).wrapping_sub(earliest) as i16) < 0
+            {
+                write_volatile(OCR1A, earliest);
+                e.late = e.late.wrapping_add(1);
+            }
         }
         // Ask for a refill when a segment was taken (or motion stopped) and
         // the queue is low: once per segment, not once per event.
