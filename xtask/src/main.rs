@@ -85,12 +85,17 @@ fn demo() -> Result<()> {
     std::fs::create_dir_all(&out)?;
     let report = out.join("report.json");
     let vcd = out.join("trace.vcd");
-    println!("== booting the firmware in simavr for 1 s of machine time");
+    let job = root().join("examples/demo.gcode");
+    println!(
+        "== the simulated machine runs {} (drilling a hexagon's 6 holes)",
+        job.display()
+    );
+    let wall = std::time::Instant::now();
     run::taut_sim(
         &img.elf,
         &[
-            "--for".into(),
-            "1".into(),
+            "--send".into(),
+            job.display().to_string(),
             "--vcd".into(),
             vcd.display().to_string(),
             "--report".into(),
@@ -98,13 +103,25 @@ fn demo() -> Result<()> {
             "--echo".into(),
         ],
     )?;
-    println!("\nThe string-art job (issue 6) is not wired yet: the machine boots, prints its");
-    println!("banner and blinks its status LED. Next it will read param.txt/poradi.txt from a");
-    println!("virtual SD card, drill the nail holes and wind the thread.");
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report)?)?;
     println!(
-        "\nwritten: {}\n         {}",
-        report.display(),
-        vcd.display()
+        "\nmachine time {:.1} s, wall time {:.1} s",
+        r["sim_seconds"].as_f64().unwrap_or(0.0),
+        wall.elapsed().as_secs_f64()
     );
+    for pin in r["pins"].as_array().into_iter().flatten() {
+        if let Some(steps) = pin["net_steps"].as_i64() {
+            println!(
+                "  {:<12} {:>6} pulses, net {:>6} steps",
+                pin["name"].as_str().unwrap_or(""),
+                pin["rising"],
+                steps
+            );
+        }
+    }
+    println!(
+        "\nThe full string-art job (card, buttons, winding, picture) arrives with issues 5 and 6."
+    );
+    println!("written: {}\n         {}", report.display(), vcd.display());
     Ok(())
 }
