@@ -26,14 +26,12 @@ use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::{port_bit, Port, DRIVERS};
 use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK};
 
-/// Segments waiting for the interrupt (11 bytes each). Deep, because
-/// preparing a ramp segment costs up to ~4 ms on the AVR while the
-/// interrupt may run one in 1 ms at high rates.
-pub static SEGMENTS: Ring<Segment, 64> = Ring::new();
+/// Segments waiting for the interrupt (11 bytes each).
+pub static SEGMENTS: Ring<Segment, 32> = Ring::new();
 /// Blocks waiting for their first segment (21 bytes each).
 pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
 /// Refill the queues when this few segments are left.
-pub(crate) const LOW_WATER: usize = 48;
+pub(crate) const LOW_WATER: usize = 24;
 
 /// Timer1 registers (data-space addresses).
 const TCNT1: *mut u16 = 0x84 as *mut u16;

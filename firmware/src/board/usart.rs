@@ -1,4 +1,4 @@
-//! USART0, the serial console: 115200 8N1. Transmit goes through a 256-byte
+//! USART0, the serial console: 115200 8N1. Transmit goes through a 128-byte
 //! ring drained by the data-register-empty interrupt, so writing never waits
 //! for the wire; received bytes go into a 64-byte ring filled by the receive
 //! interrupt.
@@ -7,7 +7,7 @@ use crate::rt::Ring;
 use avr_device::atmega2560::USART0;
 
 /// Bytes waiting for the wire; refusals are log lines dropped whole.
-pub static TX: Ring<u8, 256> = Ring::new();
+pub static TX: Ring<u8, 128> = Ring::new();
 /// Bytes received and not yet parsed; refusals are bytes lost to overrun.
 pub static RX: Ring<u8, 64> = Ring::new();
 

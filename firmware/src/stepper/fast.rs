@@ -26,11 +26,11 @@ pub const REFILL: usize = offset_of!(Exec, refill);
 #[doc(hidden)]
 pub const BLOCK_LEFT: usize = offset_of!(Exec, block_left);
 #[doc(hidden)]
-pub const RING_HEAD: usize = Ring::<Segment, 64>::HEAD;
+pub const RING_HEAD: usize = Ring::<Segment, 32>::HEAD;
 #[doc(hidden)]
-pub const RING_TAIL: usize = Ring::<Segment, 64>::TAIL;
+pub const RING_TAIL: usize = Ring::<Segment, 32>::TAIL;
 #[doc(hidden)]
-pub const RING_MASK: u8 = 63;
+pub const RING_MASK: u8 = 31;
 #[doc(hidden)]
 pub const SEG_ADD: usize = offset_of!(Segment, add);
 #[doc(hidden)]

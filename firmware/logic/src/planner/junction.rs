@@ -5,7 +5,19 @@
 use crate::axis::AXES;
 use crate::config::MachineConfig;
 use crate::segment::{StepBlock, MAX_ACCEL};
-use libm::sqrtf;
+/// Square root without libm's 256-byte table (which the AVR would copy
+/// into SRAM): a bit-level first guess and three Newton steps, good to
+/// f32 precision for the positive, finite values used here.
+fn sqrtf(x: f32) -> f32 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    let mut y = f32::from_bits((x.to_bits() >> 1) + 0x1FC0_0000);
+    for _ in 0..3 {
+        y = 0.5 * (y + x / y);
+    }
+    y
+}
 
 /// Below this a corner counts as a straight line or a full reversal
 /// (Grbl's 0.999999).
@@ -131,5 +143,17 @@ impl Corner {
             change.iter_mut().for_each(|c| *c /= len);
         }
         Corner { cos, change }
+    }
+}
+
+#[cfg(test)]
+mod sqrt_tests {
+    #[test]
+    fn sqrt_matches_std() {
+        for x in [1e-6f32, 0.25, 0.5, 1.0, 2.0, 3.0, 1e3, 12345.678, 1e12] {
+            let (got, want) = (super::sqrtf(x), x.sqrt());
+            assert!((got - want).abs() <= want * 2e-7, "{x}: {got} vs {want}");
+        }
+        assert_eq!(super::sqrtf(0.0), 0.0);
     }
 }
