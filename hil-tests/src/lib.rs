@@ -54,3 +54,12 @@ pub fn firmware_version() -> String {
         .expect("version in firmware/Cargo.toml")
         .to_string()
 }
+
+/// Send one console line and panic (with the serial log) unless it is
+/// answered `ok` within `timeout`.
+pub fn send_ok(sim: &mut sim::Sim, line: &str, timeout: std::time::Duration) {
+    match sim.send_line(line, timeout) {
+        Ok(sim::Reply::Ok) => {}
+        other => panic!("{line:?}: {other:?}\nUART: {}", sim.uart_text()),
+    }
+}

@@ -2,7 +2,7 @@
 //! pulses, with the configured pulse width and DIR set-up, and a velocity
 //! profile within the configured acceleration.
 
-use hil_tests::{firmware_elf, sim::Outcome, sim::Reply, sim::Sim};
+use hil_tests::{firmware_elf, sim::Outcome, sim::Sim};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
@@ -25,10 +25,7 @@ fn boot() -> Sim {
 
 /// Send one line and wait for its `ok`.
 fn send(sim: &mut Sim, line: &str, timeout: Duration) {
-    match sim.send_line(line, timeout) {
-        Ok(Reply::Ok) => {}
-        other => panic!("{line:?}: {other:?}\nUART: {}", sim.uart_text()),
-    }
+    hil_tests::send_ok(sim, line, timeout);
 }
 
 fn steps(sim: &Sim, axis: Axis) -> i64 {

@@ -1,6 +1,6 @@
 //! Issue 3: the scheduler under load, the watchdog, and the RAM budget.
 
-use hil_tests::{example_elf, firmware_elf, sim::Outcome, sim::Reply, sim::Sim};
+use hil_tests::{example_elf, firmware_elf, sim::Outcome, sim::Sim};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 use taut_logic::pinmap::driver;
@@ -13,10 +13,7 @@ const MASKED_BOUND_CYCLES: u64 = 80;
 const RAM_BUDGET: u32 = 6 * 1024;
 
 fn send(sim: &mut Sim, line: &str) {
-    match sim.send_line(line, Duration::from_secs(2)) {
-        Ok(Reply::Ok) => {}
-        other => panic!("{line}: {other:?}\n{}", sim.uart_text()),
-    }
+    hil_tests::send_ok(sim, line, Duration::from_secs(2));
 }
 
 fn assert_ram_budget(sim: &Sim) {

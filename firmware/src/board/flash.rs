@@ -34,10 +34,6 @@ impl FlashStr {
         unsafe { asm!("lpm {0}, Z", out(reg) b, in("Z") addr, options(pure, readonly, nostack)) };
         b
     }
-
-    pub fn bytes(self) -> impl Iterator<Item = u8> {
-        (0..self.len()).map(move |i| self.byte(i))
-    }
 }
 
 impl ufmt::uDisplay for FlashStr {

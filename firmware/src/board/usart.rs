@@ -44,11 +44,6 @@ pub fn send(bytes: &[u8]) -> bool {
     ok
 }
 
-/// Bytes queued for sending and not yet on the wire.
-pub fn tx_pending() -> usize {
-    TX.len()
-}
-
 /// USART0 control register B and its interrupt-enable bits, for the
 /// nestable entry (`rt::nested`), which clears the enable before `sei`.
 pub const UCSR0B: u16 = 0xC1;
