@@ -38,7 +38,7 @@ use taut_firmware::{
 };
 use taut_firmware::{flash_str, info, warn};
 use taut_logic::config::MachineConfig;
-use taut_logic::kinematics::Cylindrical;
+use taut_logic::kinematics::Linear;
 use taut_logic::sched::{Ready, TaskId, Timers};
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -230,7 +230,7 @@ fn refill_task() -> Task {
 fn console() {
     let poll = MOTION.with(|m| {
         CONFIG.with(|cfg| {
-            let kin = Cylindrical::from_config(cfg);
+            let kin = Linear::cylindrical(cfg);
             CONSOLE.with(|c| c.poll(m.as_mut().unwrap(), &kin, cfg))
         })
     });

@@ -356,3 +356,27 @@ fn image_written_to_a_file_is_the_same_card() {
         files["PORADI.TXT"]
     );
 }
+
+/// The firmware's way of reading the card (raw handles; one volume, one
+/// directory and one file open at a time) on the sample card in
+/// `examples/card`.
+#[test]
+fn the_sample_card_reads_with_raw_handles_and_one_of_each() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/card");
+    let card = Rc::new(RefCell::new(SdCard::new(
+        SdImage::from_dir(&dir, FatChoice::Fat16).unwrap(),
+    )));
+    let sd = embedded_sdmmc::SdCard::new(Bus(card), NoDelay);
+    assert!(sd.num_bytes().unwrap() > 0);
+    let vm: VolumeManager<_, _, 1, 1, 1> = VolumeManager::new_with_limits(sd, Clock, 1);
+    let vol = vm.open_raw_volume(VolumeIdx(0)).unwrap();
+    let root = vm.open_root_dir(vol).unwrap();
+    let file = vm
+        .open_file_in_dir(root, "param.txt", Mode::ReadOnly)
+        .unwrap();
+    let mut buf = [0u8; 64];
+    let n = vm.read(file, &mut buf).unwrap();
+    assert!(std::str::from_utf8(&buf[..n])
+        .unwrap()
+        .starts_with("tvar = 6"));
+}

@@ -15,14 +15,12 @@
 //! (≈ 4 ms at 16 MHz), a polargraph inverse ≈ 20 000 (≈ 1.3 ms). That bounds
 //! the piece rate, never the step rate: nothing here runs per step.
 
-mod cartesian;
-mod cylindrical;
+mod linear;
 mod polargraph;
 mod scara;
 mod segmenter;
 
-pub use cartesian::Cartesian;
-pub use cylindrical::Cylindrical;
+pub use linear::{Linear, CARTESIAN, CYLINDRICAL};
 pub use polargraph::Polargraph;
 pub use scara::Scara;
 pub use segmenter::Segmenter;
@@ -130,8 +128,8 @@ fn milli(mm: f32) -> Milli {
 /// One of the kinematics, chosen at run time from the machine's config.
 #[derive(Clone, Copy, Debug)]
 pub enum AnyKinematics {
-    Cylindrical(Cylindrical),
-    Cartesian(Cartesian),
+    /// The string-art machine or a cartesian plotter.
+    Linear(Linear),
     Polargraph(Polargraph),
     Scara(Scara),
 }
@@ -139,8 +137,7 @@ pub enum AnyKinematics {
 impl Kinematics for AnyKinematics {
     fn inverse(&self, pos: &Position) -> Result<Steps, KinError> {
         match self {
-            AnyKinematics::Cylindrical(k) => k.inverse(pos),
-            AnyKinematics::Cartesian(k) => k.inverse(pos),
+            AnyKinematics::Linear(k) => k.inverse(pos),
             AnyKinematics::Polargraph(k) => k.inverse(pos),
             AnyKinematics::Scara(k) => k.inverse(pos),
         }
@@ -148,8 +145,7 @@ impl Kinematics for AnyKinematics {
 
     fn forward(&self, steps: &Steps) -> Position {
         match self {
-            AnyKinematics::Cylindrical(k) => k.forward(steps),
-            AnyKinematics::Cartesian(k) => k.forward(steps),
+            AnyKinematics::Linear(k) => k.forward(steps),
             AnyKinematics::Polargraph(k) => k.forward(steps),
             AnyKinematics::Scara(k) => k.forward(steps),
         }
@@ -157,8 +153,7 @@ impl Kinematics for AnyKinematics {
 
     fn is_linear(&self) -> bool {
         match self {
-            AnyKinematics::Cylindrical(k) => k.is_linear(),
-            AnyKinematics::Cartesian(k) => k.is_linear(),
+            AnyKinematics::Linear(k) => k.is_linear(),
             AnyKinematics::Polargraph(k) => k.is_linear(),
             AnyKinematics::Scara(k) => k.is_linear(),
         }
@@ -166,8 +161,7 @@ impl Kinematics for AnyKinematics {
 
     fn words(&self) -> [u8; AXES] {
         match self {
-            AnyKinematics::Cylindrical(k) => k.words(),
-            AnyKinematics::Cartesian(k) => k.words(),
+            AnyKinematics::Linear(k) => k.words(),
             AnyKinematics::Polargraph(k) => k.words(),
             AnyKinematics::Scara(k) => k.words(),
         }

@@ -69,7 +69,7 @@ impl<K: Kinematics> Iterator for Segmenter<'_, K> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{ChannelScale, Cylindrical, Polargraph};
+    use super::super::{ChannelScale, Linear, Polargraph};
     use super::*;
     use crate::config::MachineConfig;
     use crate::units::StepsPerUnit;
@@ -91,7 +91,7 @@ mod tests {
 
     #[test]
     fn linear_kinematics_take_one_piece() {
-        let k = Cylindrical::from_config(&MachineConfig::STRING_ART);
+        let k = Linear::cylindrical(&MachineConfig::STRING_ART);
         let mut s = Segmenter::new(
             &k,
             pos(0, 0),
