@@ -2,7 +2,7 @@
 //! in simavr/), written to target/bench.json and printed as a table.
 
 use crate::firmware;
-use crate::run::{cargo_cmd, root, status, Result};
+use crate::run::{self, root, Result};
 
 pub fn run() -> Result<()> {
     let img = firmware::build_release()?;
@@ -10,19 +10,10 @@ pub fn run() -> Result<()> {
     let busy = firmware::release_dir().join("examples/busy.elf");
     let out = root().join("target/bench.json");
     println!("== benchmarks (simulated ATmega2560, cycle-exact)");
-    let mut c = cargo_cmd(
-        &[
-            "run",
-            "--quiet",
-            "--release",
-            "-p",
-            "taut-simavr",
-            "--bin",
-            "taut-bench",
-            "--",
-        ],
-        &root(),
-    );
-    c.arg(&img.elf).arg(&busy).arg(&out);
-    status(&mut c)
+    let args = [
+        img.elf.display().to_string(),
+        busy.display().to_string(),
+        out.display().to_string(),
+    ];
+    run::bin("taut-bench", &args)
 }

@@ -84,6 +84,19 @@ pub enum Command {
 }
 
 impl Command {
+    /// Every command.
+    pub const ALL: [Command; 9] = [
+        Command::Empty,
+        Command::Rapid,
+        Command::Linear,
+        Command::Dwell,
+        Command::SetPosition,
+        Command::EnableDrivers,
+        Command::DisableDrivers,
+        Command::ReportPosition,
+        Command::WaitIdle,
+    ];
+
     /// The command a G or M number names. G/M numbers are read as
     /// fixed-point like every value and matched exactly, so `G1`, `G01`
     /// and `G1.0` are one command while `G38.2` or `G1.5` are unsupported.

@@ -8,20 +8,7 @@ fn milli() -> impl Strategy<Value = Milli> {
 }
 
 fn command() -> impl Strategy<Value = Command> {
-    use Command::*;
-    prop::sample::select(
-        &[
-            Empty,
-            Rapid,
-            Linear,
-            Dwell,
-            SetPosition,
-            EnableDrivers,
-            DisableDrivers,
-            ReportPosition,
-            WaitIdle,
-        ][..],
-    )
+    prop::sample::select(&Command::ALL[..])
 }
 
 /// Any line the parser can produce, its words consistent with its command.
