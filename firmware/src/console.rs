@@ -4,9 +4,10 @@
 //! them out against the motion task's state.
 
 use crate::board::{clock, usart};
-use crate::flash_str;
+use crate::job::{Hold, HOLDS};
 use crate::motion::Motion;
 use crate::rt::stack;
+use crate::{flash_str, warn};
 use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Command, Distance, Error, Input, Line, Parser, Realtime, SystemLine};
@@ -40,13 +41,19 @@ pub struct Console {
     /// A line read but not yet carried out (back-pressure).
     held: Option<Line>,
     dwell_until: Option<u32>,
-    /// `$$` listing in progress: next setting index.
-    listing: Option<usize>,
+    /// `$$` or `$Q` in progress: its next line.
+    listing: Option<Listing>,
     distance: Distance,
     rapid: bool,
     feed: Option<Milli>,
     /// Commanded position in milli-units (G-code coordinates).
     target: Position,
+}
+
+#[derive(Clone, Copy)]
+enum Listing {
+    Settings(usize),
+    Queues(u8),
 }
 
 /// A reply line assembled on the stack and queued whole.
@@ -126,8 +133,8 @@ impl Console {
             if usart::TX.free() < REPLY_ROOM {
                 return Poll::After(2);
             }
-            if let Some(next) = self.listing {
-                self.list_setting(next, cfg);
+            if let Some(listing) = self.listing {
+                self.list(listing, cfg);
                 return Poll::Yield;
             }
             if let Some(line) = self.held.take() {
@@ -247,10 +254,13 @@ impl Console {
     fn system(&mut self, s: SystemLine, m: &mut Motion, cfg: &mut MachineConfig) {
         match s {
             SystemLine::PrintSettings => {
-                self.listing = Some(0);
+                self.listing = Some(Listing::Settings(0));
                 return;
             }
-            SystemLine::QueueStats => crate::report::queues(),
+            SystemLine::QueueStats => {
+                self.listing = Some(Listing::Queues(0));
+                return;
+            }
             SystemLine::Stack => {
                 let mut r = Reply::new();
                 let _ = uwrite!(
@@ -277,18 +287,21 @@ impl Console {
         ok();
     }
 
-    fn list_setting(&mut self, next: usize, cfg: &MachineConfig) {
-        match settings::all().nth(next) {
-            Some(s) => {
+    /// One line of a listing per call: the TX ring never overflows.
+    fn list(&mut self, listing: Listing, cfg: &MachineConfig) {
+        self.listing = match listing {
+            Listing::Settings(next) => settings::all().nth(next).map(|s| {
                 let mut r = Reply::new();
                 let _ = uwrite!(r, "${}={}", s, s.get(cfg));
                 r.send();
-                self.listing = Some(next + 1);
+                Listing::Settings(next + 1)
+            }),
+            Listing::Queues(line) => {
+                crate::report::queue_line(line).then_some(Listing::Queues(line + 1))
             }
-            None => {
-                self.listing = None;
-                ok();
-            }
+        };
+        if self.listing.is_none() {
+            ok();
         }
     }
 
@@ -309,8 +322,10 @@ impl Console {
                 let _ = rep.write_str(">");
                 rep.send();
             }
-            // Feed hold, resume and reset arrive with the job (issue 6).
-            Realtime::FeedHold | Realtime::CycleStart | Realtime::Reset => {}
+            // The job pauses after its current move and resumes (`job`).
+            Realtime::FeedHold => push_hold(Hold::Pause),
+            Realtime::CycleStart => push_hold(Hold::Resume),
+            Realtime::Reset => {}
         }
     }
 }
@@ -341,4 +356,10 @@ fn report_position(m: &Motion, kin: &impl Kinematics) {
         let _ = uwrite!(r, " {}:{}", words[i] as char, steps[i]);
     }
     r.send();
+}
+
+fn push_hold(h: Hold) {
+    if HOLDS.push(h).is_err() {
+        warn!("hold queue full");
+    }
 }

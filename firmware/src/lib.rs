@@ -5,10 +5,14 @@
 #![feature(asm_experimental_arch)]
 
 pub mod board;
+pub mod buttons;
+pub mod card;
 pub mod console;
 pub mod drivers;
+pub mod job;
 pub mod log;
 pub mod motion;
 pub mod report;
 pub mod rt;
 pub mod stepper;
+pub mod texts;

@@ -8,14 +8,16 @@
 //! | task | kind | priority | input | shared with |
 //! | --- | --- | --- | --- | --- |
 //! | `TIMER1_COMPA` step events | interrupt | above all | `SEGMENTS`, `BLOCKS` rings | motion |
-//! | `TIMER0_COMPA` 1 ms tick | interrupt | | clock, timer alarm | |
+//! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `BUTTONS` → job |
 //! | `USART0_RX` / `USART0_UDRE` | interrupts | | `RX` / `TX` rings | console, logger |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
 //! | `Refill` planner → segments while the queue is short | software | 3 | `MOTION` | console |
-//! | `Console` G-code line in, reply out | software | 2 | `RX`, `MOTION` | |
-//! | `Motion` planner → segments, background | software | 1 | `MOTION` | console |
+//! | `Console` G-code line in, reply out | software | 2 | `RX` | `MOTION`, `HOLDS` → job |
+//! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `HOLDS` | `MOTION`, `CARD_IN` → card |
+//! | `Card` SD reader: one block per run | software | 1 | `CARD_IN`, every 1 s | `CARD_OUT` → job |
+//! | `Motion` planner → segments, background | software | 1 | `MOTION` | console, job |
 //! | `Logger` deferred reports | software | 0 | every 1 s | |
-//! | `Led` status LED pattern | software | 0 | its timer | |
+//! | `Led` status LED pattern (timed edges: runs before the long tasks) | software | 2 | its timer | |
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt, asm_experimental_arch)]
@@ -23,11 +25,15 @@
 use embedded_hal::digital::OutputPin;
 use panic_halt as _;
 use taut_firmware::board::gpio::{Output, Pin};
+use taut_firmware::board::spi::{CardSpi, Spi};
 use taut_firmware::board::{
     self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
 };
+use taut_firmware::buttons::{self, ButtonPins};
+use taut_firmware::card::{self, CardReader, Poll as CardPoll, CARD_IN, CARD_OUT};
 use taut_firmware::console::{Console, Poll};
 use taut_firmware::drivers::{Drivers, EnablePins};
+use taut_firmware::job::{JobTask, Poll as JobPoll, HOLDS};
 use taut_firmware::motion::{self, Motion};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{stack, TaskCell};
@@ -47,6 +53,8 @@ enum Task {
     Refill,
     Motion,
     Console,
+    Job,
+    Card,
     Logger,
     Led,
 }
@@ -55,11 +63,13 @@ const _: () = assert!(Task::ALL.len() <= 8, "interrupt spawns are a bit per task
 
 impl Task {
     /// Every task, in discriminant order (`Task::X as u8` indexes it).
-    const ALL: [Task; 6] = [
+    const ALL: [Task; 8] = [
         Task::Timers,
         Task::Refill,
         Task::Motion,
         Task::Console,
+        Task::Job,
+        Task::Card,
         Task::Logger,
         Task::Led,
     ];
@@ -80,9 +90,9 @@ impl TaskId for Task {
     fn priority(self) -> u8 {
         match self {
             Task::Timers | Task::Refill => 3,
-            Task::Console => 2,
-            Task::Motion => 1,
-            Task::Logger | Task::Led => 0,
+            Task::Console | Task::Job | Task::Led => 2,
+            Task::Card | Task::Motion => 1,
+            Task::Logger => 0,
         }
     }
 }
@@ -90,13 +100,18 @@ impl TaskId for Task {
 /// Task ids spawned by interrupts, moved into `READY` by the dispatcher.
 static SPAWNED: Spawned = Spawned::new();
 // Software tasks only: no masking needed.
-static READY: TaskCell<Ready<Task, 6, 4>> = TaskCell::new(Ready::new());
-static TIMERS: TaskCell<Timers<Task, 6>> = TaskCell::new(Timers::new());
+static READY: TaskCell<Ready<Task, 8, 4>> = TaskCell::new(Ready::new());
+static TIMERS: TaskCell<Timers<Task, 8>> = TaskCell::new(Timers::new());
 static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
 static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
 static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
-/// The console waits for the motion task (planner room or idle).
+static JOB: TaskCell<JobTask> = TaskCell::new(JobTask::new());
+static CARD: TaskCell<Option<CardReader>> = TaskCell::new(None);
+/// The console and the job wait for the motion task (planner room or idle).
 static CONSOLE_WAITS_MOTION: TaskCell<bool> = TaskCell::new(false);
+static JOB_WAITS_MOTION: TaskCell<bool> = TaskCell::new(false);
+/// The card reader waits for room in `CARD_OUT`.
+static CARD_WAITS_JOB: TaskCell<bool> = TaskCell::new(false);
 
 /// Boot blink of the status LED: this many flashes, 100 ms on, 100 ms off.
 const BOOT_BLINKS: u32 = 3;
@@ -114,12 +129,20 @@ fn spawn_after(task: Task, ms: u32) {
     arm(|t, now| t.spawn_after(task, now, ms).is_ok());
 }
 
+/// Like `spawn_after`, replacing the task's earlier timers.
+fn spawn_after_once(task: Task, ms: u32) {
+    arm(|t, now| {
+        t.cancel(task);
+        t.spawn_after(task, now, ms).is_ok()
+    });
+}
+
 fn spawn_every(task: Task, ms: u32) {
     arm(|t, now| t.every(task, now, ms).is_ok());
 }
 
 /// Add a timer and point the tick's alarm at the earliest deadline.
-fn arm(add: impl FnOnce(&mut Timers<Task, 6>, u32) -> bool) {
+fn arm(add: impl FnOnce(&mut Timers<Task, 8>, u32) -> bool) {
     let now = clock::millis();
     let (ok, next) = TIMERS.with(|t| (add(t, now), t.ms_to_next(now)));
     if !ok {
@@ -133,6 +156,22 @@ fn arm(add: impl FnOnce(&mut Timers<Task, 6>, u32) -> bool) {
 #[avr_device::entry]
 fn main() -> ! {
     stack::paint();
+    let watchdog = init();
+    dispatch::run(&SPAWNED, &READY, task_of, &watchdog, |task| match task {
+        Task::Timers => timers(),
+        Task::Refill | Task::Motion => motion(),
+        Task::Console => console(),
+        Task::Job => job(),
+        Task::Card => card(),
+        Task::Logger => logger(),
+        Task::Led => led(),
+    })
+}
+
+/// The board, the tasks' state, the first tasks. Its own frame: the
+/// set-up's locals are gone from the stack before the dispatcher starts.
+#[inline(never)]
+fn init() -> Watchdog {
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
     let reset = ResetCause::take(&dp.CPU);
     let watchdog = Watchdog::start(dp.WDT);
@@ -153,6 +192,21 @@ fn main() -> ! {
     let drivers = Drivers::new(enable, &config);
     let stepper = Stepper::new(StepTimer::start(dp.TC1), &config);
     MOTION.with(|m| *m = Some(Motion::new(&config, stepper, drivers)));
+    let cs = pins.d53.into_output_at(true);
+    let bus = Spi::start(
+        dp.SPI,
+        pins.d52.into_output(),
+        pins.d51.into_output(),
+        pins.d50.into_floating_input(),
+        &cs,
+    );
+    CARD.with(|c| *c = Some(CardReader::new(CardSpi { bus, cs })));
+    buttons::start(ButtonPins {
+        confirm: pins.d2.into_pull_up_input(),
+        zero_base: pins.d3.into_pull_up_input(),
+        zero_radial: pins.d14.into_pull_up_input(),
+        zero_drill: pins.d18.into_pull_up_input(),
+    });
     // SAFETY: every interrupt handler and the state it touches is ready.
     unsafe { avr_device::interrupt::enable() };
 
@@ -174,14 +228,11 @@ fn main() -> ! {
     LED.with(|l| *l = Some((status_led, clock::millis())));
     spawn(Task::Led);
     spawn_every(Task::Logger, LOGGER_PERIOD_MS);
+    JOB.with(|j| j.power_on(clock::millis()));
+    spawn(Task::Job);
+    spawn(Task::Card);
 
-    dispatch::run(&SPAWNED, &READY, task_of, &watchdog, |task| match task {
-        Task::Timers => timers(),
-        Task::Refill | Task::Motion => motion(),
-        Task::Console => console(),
-        Task::Logger => logger(),
-        Task::Led => led(),
-    })
+    watchdog
 }
 
 /// Move due timers into the ready set and re-arm the tick's alarm.
@@ -211,8 +262,13 @@ fn motion() {
     if more {
         spawn(refill_task());
     }
-    if (freed || idle) && CONSOLE_WAITS_MOTION.with(|w| core::mem::take(w)) {
-        spawn(Task::Console);
+    if freed || idle {
+        if CONSOLE_WAITS_MOTION.with(|w| core::mem::take(w)) {
+            spawn(Task::Console);
+        }
+        if JOB_WAITS_MOTION.with(|w| core::mem::take(w)) {
+            spawn(Task::Job);
+        }
     }
 }
 
@@ -241,6 +297,41 @@ fn console() {
         Poll::Motion => CONSOLE_WAITS_MOTION.with(|w| *w = true),
         Poll::After(ms) => spawn_after(Task::Console, ms as u32),
         Poll::Yield => spawn(Task::Console),
+    }
+    if !HOLDS.is_empty() {
+        spawn(Task::Job);
+    }
+}
+
+#[inline(never)]
+fn job() {
+    let now = clock::millis();
+    let poll =
+        MOTION.with(|m| CONFIG.with(|cfg| JOB.with(|j| j.poll(m.as_mut().unwrap(), cfg, now))));
+    spawn(Task::Motion);
+    match poll {
+        JobPoll::Idle => {}
+        JobPoll::Again => spawn(Task::Job),
+        JobPoll::Motion => JOB_WAITS_MOTION.with(|w| *w = true),
+        JobPoll::After(ms) => spawn_after_once(Task::Job, ms as u32),
+    }
+    if !CARD_IN.is_empty()
+        || (CARD_OUT.free() >= card::ROOM && CARD_WAITS_JOB.with(|w| core::mem::take(w)))
+    {
+        spawn(Task::Card);
+    }
+}
+
+#[inline(never)]
+fn card() {
+    let now = clock::millis();
+    match CARD.with(|c| c.as_mut().unwrap().poll(now)) {
+        CardPoll::Idle(ms) => spawn_after_once(Task::Card, ms as u32),
+        CardPoll::More => spawn(Task::Card),
+        CardPoll::Blocked => CARD_WAITS_JOB.with(|w| *w = true),
+    }
+    if !CARD_OUT.is_empty() {
+        spawn(Task::Job);
     }
 }
 
@@ -307,6 +398,9 @@ const _: () = assert!(usart::UCSR0B == 0xC1 && !0x7Fu8 == 1 << RXCIE0 && !0xDFu8
 extern "avr-interrupt" fn timer0_compa() {
     if clock::tick() {
         spawn_from_isr(&SPAWNED, Task::Timers as u8);
+    }
+    if buttons::sample() {
+        spawn_from_isr(&SPAWNED, Task::Job as u8);
     }
     // The step interrupt's assembly path cannot spawn; it leaves a flag.
     if stepper::take_refill() {

@@ -77,6 +77,11 @@ impl Motion {
         (freed, made == max && work && SEGMENTS.free() > 0)
     }
 
+    /// Where the last queued move ends, steps.
+    pub fn target(&self) -> PerAxis<i32> {
+        PLANNER.with(|p| p.position())
+    }
+
     /// Every queued move has been executed.
     pub fn is_idle(&self) -> bool {
         PLANNER.with(|p| p.is_idle())

@@ -3,6 +3,9 @@
 //! missed.
 
 use crate::board::usart;
+use crate::buttons::BUTTONS;
+use crate::card::{CARD_IN, CARD_OUT};
+use crate::job::HOLDS;
 use crate::stepper::{BLOCKS, SEGMENTS};
 use crate::{flash_str, info};
 use taut_logic::sched::QueueStats;
@@ -14,15 +17,24 @@ fn queue(name: crate::board::flash::FlashStr, s: QueueStats, capacity: usize) {
     );
 }
 
-/// `$Q`: every queue that crosses an interrupt, plus dropped log lines.
-pub fn queues() {
-    queue(flash_str!("rx"), usart::RX.stats(), usart::RX.capacity());
-    queue(flash_str!("tx"), usart::TX.stats(), usart::TX.capacity());
-    queue(
-        flash_str!("segments"),
-        SEGMENTS.stats(),
-        SEGMENTS.capacity(),
-    );
-    queue(flash_str!("blocks"), BLOCKS.stats(), BLOCKS.capacity());
-    info!("log dropped:", crate::log::dropped());
+/// `$Q` and the end of a job: every queue that crosses a task or an
+/// interrupt, then dropped log lines; line `i` of them. False past the end.
+pub fn queue_line(i: u8) -> bool {
+    match i {
+        0 => queue(flash_str!("rx"), usart::RX.stats(), usart::RX.capacity()),
+        1 => queue(flash_str!("tx"), usart::TX.stats(), usart::TX.capacity()),
+        2 => queue(
+            flash_str!("segments"),
+            SEGMENTS.stats(),
+            SEGMENTS.capacity(),
+        ),
+        3 => queue(flash_str!("blocks"), BLOCKS.stats(), BLOCKS.capacity()),
+        4 => queue(flash_str!("card"), CARD_OUT.stats(), CARD_OUT.capacity()),
+        5 => queue(flash_str!("card req"), CARD_IN.stats(), CARD_IN.capacity()),
+        6 => queue(flash_str!("buttons"), BUTTONS.stats(), BUTTONS.capacity()),
+        7 => queue(flash_str!("holds"), HOLDS.stats(), HOLDS.capacity()),
+        8 => info!("log dropped:", crate::log::dropped()),
+        _ => return false,
+    }
+    true
 }

@@ -63,3 +63,65 @@ pub fn send_ok(sim: &mut sim::Sim, line: &str, timeout: std::time::Duration) {
         other => panic!("{line:?}: {other:?}\nUART: {}", sim.uart_text()),
     }
 }
+
+/// Static RAM plus the deepest stack seen must stay under 6 KiB of the 8.
+pub const RAM_BUDGET: u32 = 6 * 1024;
+
+/// Checked at the end of every HIL test that runs the release image.
+pub fn assert_ram_budget(sim: &sim::Sim) {
+    let statics = sim.elf().unwrap().ram_static_bytes();
+    let stack = sim.peak_stack_bytes() as u32;
+    assert!(
+        statics + stack < RAM_BUDGET,
+        "static {statics} B + stack {stack} B"
+    );
+}
+
+/// A FAT card image holding `files` (name, contents).
+pub fn card(files: &[(&str, &[u8])]) -> sim::sdcard::SdImage {
+    static N: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let n = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("taut-hil-card-{}-{n}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, bytes) in files {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    let image = sim::sdcard::SdImage::from_dir(&dir, sim::sdimage::FatChoice::Auto).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    image
+}
+
+/// The sample job of `examples/card/` (hexagon, 24 nails, 30 connections).
+pub fn sample_card_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/card")
+}
+
+/// The release image with every machine pin probed under its VCD name
+/// (`<axis>_step|dir|en`, `btn_<button>`), booted.
+pub fn boot_machine() -> sim::Sim {
+    use taut_logic::axis::Axis;
+    use taut_logic::pinmap::{self, Button};
+    let mut sim = sim::Sim::load(&firmware_elf()).unwrap();
+    for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
+        let d = pinmap::driver(axis);
+        sim.probe_step_dir(axis.name(), d.step, d.dir, true);
+        sim.probe(d.enable, &format!("{}_en", axis.name()));
+    }
+    for b in Button::ALL {
+        sim.release(b.pin());
+        sim.probe(b.pin(), &format!("btn_{}", b.name()));
+    }
+    let booted = sim.run_until_uart_contains("reset:", std::time::Duration::from_millis(50));
+    assert_eq!(booted, sim::Outcome::Done);
+    sim
+}
+
+/// STEP pulses on `axis` so far, counted on its probe.
+pub fn pulses(sim: &sim::Sim, axis: taut_logic::axis::Axis) -> usize {
+    sim.probed(&format!("{}_step", axis.name()))
+        .edges()
+        .iter()
+        .filter(|e| e.high)
+        .count()
+}

@@ -11,6 +11,7 @@ mod error;
 mod gpio;
 mod hooks;
 mod input;
+pub mod operator;
 mod outcome;
 pub mod pins;
 pub mod probe;

@@ -57,6 +57,8 @@ pub struct Sim {
     pub(crate) elf: Option<ElfInfo>,
     pub(crate) ram_limit: u16,
     pub(crate) min_sp: u16,
+    /// The instruction that pushed the stack to `min_sp`.
+    pub(crate) min_sp_pc: u32,
     pub(crate) resets: u32,
     /// simavr's own cycle counter after the last step: it drops on reset.
     pub(crate) last_avr_cycle: u64,
@@ -172,6 +174,7 @@ impl Sim {
             elf,
             ram_limit,
             min_sp: RAM_END,
+            min_sp_pc: 0,
             resets: 0,
             last_avr_cycle: 0,
             ended: None,
@@ -223,6 +226,12 @@ impl Sim {
         self.resets
     }
 
+    /// Program counter, a byte address (as in the ELF's symbols).
+    pub fn pc(&self) -> u32 {
+        // SAFETY: `avr` is valid for the life of `self`.
+        unsafe { (*self.avr.as_ptr()).pc }
+    }
+
     /// Current stack pointer.
     pub fn sp(&self) -> u16 {
         // SAFETY: `data` holds `ramend + 1` bytes, far above 0x5E.
@@ -233,6 +242,11 @@ impl Sim {
     }
 
     /// Lowest stack pointer seen (checked after every instruction).
+    /// Where the stack was deepest: the instruction's byte address.
+    pub fn stack_peak_pc(&self) -> u32 {
+        self.min_sp_pc
+    }
+
     pub fn stack_high_water(&self) -> u16 {
         self.min_sp
     }

@@ -7,11 +7,14 @@
 //! rounded once from an angle or radius computed from the nail index, so
 //! thousands of wraps accumulate no error (38.4 steps per nail on 250 nails).
 //!
-//! f32/libm, once per nail: on the AVR a polygon nail costs two sinf/cosf
-//! pairs (≈ 140 000 cycles), an atan2f (≈ 20 000) and a sqrtf (≈ 7 300):
-//! ≈ 10 ms, small next to the second a move takes.
+//! f32 and the table-free `fmath` (no constant tables in the AVR's SRAM),
+//! once per nail: on the AVR (simavr) a polygon nail costs two `sin_cos`
+//! (≈ 41 000 cycles; libm's sinf/cosf pairs took 138 000), an `atan2`
+//! (≈ 16 000) and a `sqrt` (≈ 3 200): ≈ 4 ms, small next to the second a
+//! move takes.
 
 use crate::config::MachineConfig;
+use crate::fmath;
 use crate::units::{div_round, Milli, StepsPerUnit};
 use core::f32::consts::{PI, TAU};
 
@@ -106,14 +109,15 @@ impl Board {
         let frac = (n * i % n_nails) as f32 / n_nails as f32;
         let vertex = |k: u32| {
             let a = TAU * (k % n) as f32 / n as f32;
-            (libm::cosf(a), libm::sinf(a))
+            let (sin, cos) = fmath::sin_cos(a);
+            (cos, sin)
         };
         let (p, q) = (vertex(k), vertex(k + 1));
         let x = p.0 + frac * (q.0 - p.0);
         let y = p.1 + frac * (q.1 - p.1);
         Nail {
-            angle: in_turn(libm::atan2f(y, x)),
-            radius: libm::sqrtf(x * x + y * y) * self.scale(),
+            angle: in_turn(fmath::atan2(y, x)),
+            radius: fmath::sqrt(x * x + y * y) * self.scale(),
         }
     }
 
@@ -124,7 +128,7 @@ impl Board {
         if self.shape == 0 {
             self.scale()
         } else {
-            self.scale() * libm::cosf(PI / self.shape as f32)
+            self.scale() * fmath::sin_cos(PI / self.shape as f32).1
         }
     }
 

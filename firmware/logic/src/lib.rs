@@ -4,7 +4,7 @@
 //! The data's path, Grbl-style: text (`gcode`, `job`) → targets in steps
 //! (`kinematics`, `units`) → `planner` (look-ahead) → `segment` (timed step
 //! runs the step interrupt executes). `sched` is the task dispatcher's logic;
-//! `stringart` the string-art job.
+//! `stringart` the string-art job; `fat` reads its files from the SD card.
 #![no_std]
 #![forbid(unsafe_code)]
 
@@ -14,6 +14,9 @@ extern crate std;
 pub mod axis;
 pub mod buttons;
 pub mod config;
+pub mod fat;
+/// Table-free `sin_cos`, `atan2` and `sqrt`: no constant tables in the AVR's SRAM.
+pub mod fmath;
 pub mod gcode;
 pub mod geometry;
 pub mod job;

@@ -5,6 +5,8 @@
 use super::gpio::{Floating, Output, Pin};
 use avr_device::atmega2560::SPI;
 use core::convert::Infallible;
+use embedded_hal::digital::OutputPin;
+use embedded_hal::spi::{Operation, SpiBus};
 
 pub struct Spi {
     spi: SPI,
@@ -80,6 +82,43 @@ impl embedded_hal::spi::SpiBus<u8> for Spi {
     }
 
     fn flush(&mut self) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// The SD card's SPI device: the bus with chip select on D53, low for the
+/// length of each transaction (embedded-hal's `SpiDevice`).
+pub struct CardSpi {
+    pub bus: Spi,
+    pub cs: Pin<53, Output>,
+}
+
+impl CardSpi {
+    /// Clocks with the card deselected: 80 of them wake a card up.
+    pub fn idle_clocks(&mut self, bytes: u8) {
+        for _ in 0..bytes {
+            self.bus.exchange(0xFF);
+        }
+    }
+}
+
+impl embedded_hal::spi::ErrorType for CardSpi {
+    type Error = Infallible;
+}
+
+impl embedded_hal::spi::SpiDevice<u8> for CardSpi {
+    fn transaction(&mut self, ops: &mut [Operation<'_, u8>]) -> Result<(), Infallible> {
+        let _ = self.cs.set_low();
+        for op in ops {
+            match op {
+                Operation::Read(b) => self.bus.read(b)?,
+                Operation::Write(b) => self.bus.write(b)?,
+                Operation::Transfer(r, w) => self.bus.transfer(r, w)?,
+                Operation::TransferInPlace(b) => self.bus.transfer_in_place(b)?,
+                Operation::DelayNs(_) => {}
+            }
+        }
+        let _ = self.cs.set_high();
         Ok(())
     }
 }

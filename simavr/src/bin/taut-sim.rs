@@ -9,47 +9,74 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
 use taut_logic::pinmap::{self, Button};
+use taut_simavr::operator::Operator;
+use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
 const USAGE: &str = "\
-usage: taut-sim ELF [--send FILE] [--for SECONDS] [--vcd PATH] [--report PATH] [--echo]
+usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]] [--send FILE]
+                   [--for SECONDS] [--vcd PATH] [--report PATH] [--echo]
+  --sd PATH       put a virtual SD card in the slot: an image file, or a
+                  folder, imaged on the fly (FAT16 or FAT32 by size)
+  --sd-insert-at SECONDS
+                  insert that card later instead of at power-on
   --send FILE     stream FILE's lines to the serial console, each after the
                   previous one's ok/error, then run until motion is idle
   --for SECONDS   simulated time to run (default 5; with --send: extra time
                   after motion is idle, default 0)
   --vcd PATH      write a VCD trace of every probed pin
   --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
+  --auto-confirm  press the green button whenever the job asks for it, and
+                  run until the job is done (or --for SECONDS, default 7200)
   --echo          print the firmware's serial output as it runs";
 
 struct Args {
     elf: PathBuf,
+    sd: Option<PathBuf>,
+    sd_insert_at: Option<f64>,
     send: Option<PathBuf>,
     seconds: Option<f64>,
     vcd: Option<PathBuf>,
     report: Option<PathBuf>,
     echo: bool,
+    auto_confirm: bool,
 }
 
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     let elf = it.next().ok_or("missing ELF")?.into();
     let mut args = Args {
         elf,
+        sd: None,
+        sd_insert_at: None,
         send: None,
         seconds: None,
         vcd: None,
         report: None,
         echo: false,
+        auto_confirm: false,
     };
     while let Some(a) = it.next() {
         let mut value = || it.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
             "--for" => args.seconds = Some(value()?.parse().map_err(|e| format!("--for: {e}"))?),
+            "--sd" => args.sd = Some(value()?.into()),
+            "--sd-insert-at" => {
+                args.sd_insert_at = Some(
+                    value()?
+                        .parse()
+                        .map_err(|e| format!("--sd-insert-at: {e}"))?,
+                )
+            }
             "--send" => args.send = Some(value()?.into()),
             "--vcd" => args.vcd = Some(value()?.into()),
             "--report" => args.report = Some(value()?.into()),
             "--echo" => args.echo = true,
+            "--auto-confirm" => args.auto_confirm = true,
             _ => return Err(format!("unknown option {a}")),
         }
+    }
+    if args.sd_insert_at.is_some() && args.sd.is_none() {
+        return Err("--sd-insert-at needs --sd".into());
     }
     Ok(args)
 }
@@ -100,12 +127,24 @@ fn stream(
 fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     let mut sim = Sim::load(&args.elf)?;
     probe_machine(&mut sim);
+    if let Some(path) = &args.sd {
+        let card = SdImage::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        match args.sd_insert_at {
+            Some(s) => sim.sd_insert_at(Duration::from_secs_f64(s), card),
+            None => sim.insert_sd(card),
+        }
+    }
     let wall = Instant::now();
     let mut printed = 0;
     if let Some(file) = &args.send {
         stream(&mut sim, file, args.echo, &mut printed)?;
     }
-    let default = if args.send.is_some() { 0.0 } else { 5.0 };
+    let default = match (args.auto_confirm, args.send.is_some()) {
+        (true, _) => 7200.0,
+        (false, true) => 0.0,
+        (false, false) => 5.0,
+    };
+    let mut operator = Operator::confirming();
     let total = Duration::from_secs_f64(args.seconds.unwrap_or(default));
     let slice = Duration::from_millis(10);
     let mut outcome = Outcome::Running;
@@ -121,6 +160,12 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         }
         if outcome != Outcome::Running {
             break;
+        }
+        if args.auto_confirm {
+            operator.step(&mut sim);
+            if operator.finished {
+                break;
+            }
         }
     }
     let wall_s = wall.elapsed().as_secs_f64();

@@ -46,7 +46,7 @@ impl MachineFile {
     }
 
     /// The configuration with the file's overrides, checked as a whole.
-    pub fn finish(mut self) -> Result<MachineConfig, FileError> {
+    pub fn finish(&mut self) -> Result<MachineConfig, FileError> {
         if let Some(item) = self.kv.finish()? {
             apply(&mut self.cfg, &mut self.seen, item)?;
         }

@@ -8,6 +8,7 @@
 
 pub mod cursor;
 pub mod error;
+pub mod files;
 pub mod kv;
 pub mod list;
 pub mod machine;

@@ -38,11 +38,11 @@ pub struct Params {
 
 /// The board radius must be more than this, µm, for the winding needle's
 /// inner radius `(R − margin)·cos(π/n) − clearance` to be positive.
-/// One `cosf` per file: not on any hot path.
+/// One cosine per file: not on any hot path.
 pub fn radius_limit_um(shape: u16) -> u32 {
     let apothem_ratio = match shape {
         0 => 1.0,
-        n => libm::cosf(core::f32::consts::PI / n as f32),
+        n => crate::fmath::sin_cos(core::f32::consts::PI / n as f32).1,
     };
     NAIL_MARGIN_UM + (INNER_CLEARANCE_UM as f32 / apothem_ratio) as u32
 }
@@ -98,11 +98,12 @@ impl ParamFile {
         Ok(())
     }
 
-    pub fn finish(mut self) -> Result<Params, FileError> {
+    /// The file ended: its values, checked as a whole.
+    pub fn finish(&mut self) -> Result<Params, FileError> {
         if let Some(item) = self.kv.finish()? {
             self.seen.take(item)?;
         }
-        let seen = self.seen;
+        let seen = core::mem::take(&mut self.seen);
         if !seen.lines {
             return Err(FileError::whole(FILE, ErrorKind::Empty));
         }

@@ -102,7 +102,7 @@ impl PoradiCheck {
     }
 
     /// The whole file was good: returns the number of connections.
-    pub fn finish(mut self) -> Result<u32, FileError> {
+    pub fn finish(&mut self) -> Result<u32, FileError> {
         self.seq.finish()?;
         Ok(self.seq.found)
     }

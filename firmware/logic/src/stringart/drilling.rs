@@ -7,6 +7,7 @@
 use super::{Step, DRILL_ANGLE_DEG, DRILL_CLEARANCE_MM, DWELL_MS, HOLE_DEPTH_MM, MACHINE_DRIVERS};
 use crate::axis::{Axis, AXES};
 use crate::config::MachineConfig;
+use crate::fmath;
 use crate::geometry::{Board, StepScale};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,7 +37,7 @@ pub struct Drilling {
 
 /// Drill steps for a vertical distance, along the tilted axis: rounded once.
 fn tool_axis_steps(config: &MachineConfig, vertical_mm: f32) -> i32 {
-    let along = vertical_mm / libm::sinf(DRILL_ANGLE_DEG.to_radians());
+    let along = vertical_mm / fmath::sin_cos(DRILL_ANGLE_DEG.to_radians()).0;
     libm::roundf(along * config.axes[Axis::Drill.index()].steps_per_unit.as_f32()) as i32
 }
 

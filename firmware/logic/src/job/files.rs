@@ -1,0 +1,196 @@
+//! Checking a card's job files in one pass each, in the order the card
+//! reader opens them: `param.txt`, then the optional `machine.txt`, then
+//! `poradi.txt` (its count and every index checked against the nails).
+//! Nothing is kept of `poradi.txt`: winding streams it again.
+//!
+//! The firmware opens [`Files::file`], feeds its bytes to [`Files::push`]
+//! and answers its end with [`Files::end`] (or [`Files::missing`] when the
+//! card has no such file), until one of them returns [`Next::Done`] or an
+//! error.
+
+use crate::config::MachineConfig;
+use crate::job::error::{ErrorKind, FileError, FileName};
+use crate::job::machine::MachineFile;
+use crate::job::param::{ParamFile, Params};
+use crate::job::poradi::PoradiCheck;
+
+/// What the card holds, once every file checked out.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Checked {
+    pub params: Params,
+    /// The machine configuration with `machine.txt`'s overrides.
+    pub config: MachineConfig,
+    /// Connections in `poradi.txt`.
+    pub count: u32,
+}
+
+/// After a file: open the next one, or all are read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Next {
+    Open(FileName),
+    Done(Checked),
+}
+
+enum Stage {
+    Param(ParamFile),
+    Machine(Params, MachineFile),
+    Poradi(Params, MachineConfig, PoradiCheck),
+}
+
+pub struct Files {
+    stage: Stage,
+}
+
+impl Default for Files {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Files {
+    pub fn new() -> Self {
+        Files {
+            stage: Stage::Param(ParamFile::new()),
+        }
+    }
+
+    /// The file being read.
+    pub fn file(&self) -> FileName {
+        match self.stage {
+            Stage::Param(_) => FileName::Param,
+            Stage::Machine(..) => FileName::Machine,
+            Stage::Poradi(..) => FileName::Poradi,
+        }
+    }
+
+    pub fn push(&mut self, chunk: &[u8]) -> Result<(), FileError> {
+        match &mut self.stage {
+            Stage::Param(p) => p.push(chunk),
+            Stage::Machine(_, m) => m.push(chunk),
+            Stage::Poradi(_, _, c) => c.push(chunk),
+        }
+    }
+
+    /// The current file ended. `base`: the configuration in force, which
+    /// `machine.txt` amends.
+    pub fn end(&mut self, base: &MachineConfig) -> Result<Next, FileError> {
+        // Finished in place: the parsers are too big to move around on the
+        // AVR's stack.
+        match &mut self.stage {
+            Stage::Param(p) => {
+                let params = p.finish()?;
+                self.stage = Stage::Machine(params, MachineFile::new(*base));
+            }
+            Stage::Machine(params, m) => {
+                let params = *params;
+                let config = m.finish()?;
+                self.stage = Stage::Poradi(params, config, PoradiCheck::new(params.nails));
+            }
+            Stage::Poradi(params, config, c) => {
+                return Ok(Next::Done(Checked {
+                    params: *params,
+                    config: *config,
+                    count: c.finish()?,
+                }));
+            }
+        }
+        Ok(Next::Open(self.file()))
+    }
+
+    /// The card has no such file: only `machine.txt` may be left out.
+    pub fn missing(&mut self, base: &MachineConfig) -> Result<Next, FileError> {
+        match self.stage {
+            Stage::Machine(params, _) => {
+                self.stage = Stage::Poradi(params, *base, PoradiCheck::new(params.nails));
+                Ok(Next::Open(FileName::Poradi))
+            }
+            _ => Err(FileError::whole(self.file(), ErrorKind::NotFound)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::job::error::tests::show;
+
+    const PARAM: &[u8] = b"tvar = 6\npocet_hrebiku = 24\npolomer_matrice = 20\n";
+
+    /// Reads a card given as (file, contents or None when missing).
+    fn read(card: &[(FileName, Option<&[u8]>)]) -> Result<Checked, FileError> {
+        let base = MachineConfig::STRING_ART;
+        let mut files = Files::new();
+        loop {
+            let name = files.file();
+            let contents = card.iter().find(|(f, _)| *f == name).and_then(|(_, c)| *c);
+            let next = match contents {
+                None => files.missing(&base)?,
+                Some(bytes) => {
+                    // Odd chunks, as the card reader's queue delivers them.
+                    for chunk in bytes.chunks(7) {
+                        files.push(chunk)?;
+                    }
+                    files.end(&base)?
+                }
+            };
+            if let Next::Done(c) = next {
+                return Ok(c);
+            }
+        }
+    }
+
+    #[test]
+    fn a_good_card_without_machine_txt_keeps_the_configuration() {
+        let c = read(&[
+            (FileName::Param, Some(PARAM)),
+            (FileName::Poradi, Some(b"3, 0,12, 23")),
+        ])
+        .unwrap();
+        assert_eq!(
+            (c.params.shape, c.params.nails, c.params.radius_um),
+            (6, 24, 200_000)
+        );
+        assert_eq!(c.count, 3);
+        assert_eq!(c.config, MachineConfig::STRING_ART);
+    }
+
+    #[test]
+    fn machine_txt_amends_the_configuration() {
+        let c = read(&[
+            (FileName::Param, Some(PARAM)),
+            (FileName::Machine, Some(b"base_max_rate = 1500\n")),
+            (FileName::Poradi, Some(b"1,5")),
+        ])
+        .unwrap();
+        assert_ne!(c.config, MachineConfig::STRING_ART);
+    }
+
+    #[test]
+    fn each_file_reports_its_own_errors() {
+        let cases: [(&[(FileName, Option<&[u8]>)], &str); 4] = [
+            (&[(FileName::Param, None)], "param.txt: file not found"),
+            (
+                &[(FileName::Param, Some(PARAM)), (FileName::Poradi, None)],
+                "poradi.txt: file not found",
+            ),
+            (
+                &[
+                    (FileName::Param, Some(PARAM)),
+                    (FileName::Poradi, Some(b"2,1,24")),
+                ],
+                "poradi.txt:1:5: nail 24 out of range (nails: 24)",
+            ),
+            (
+                &[
+                    (FileName::Param, Some(PARAM)),
+                    (FileName::Machine, Some(b"speed = 3\n")),
+                    (FileName::Poradi, Some(b"1,1")),
+                ],
+                "machine.txt:1:1: unknown key",
+            ),
+        ];
+        for (card, message) in cases {
+            assert_eq!(show(&read(card).unwrap_err()), message);
+        }
+    }
+}

@@ -1,0 +1,434 @@
+//! The job task's state: the string-art job (`taut_logic::stringart::job`)
+//! fed by the buttons, the card reader and the console's `!`/`~`, its
+//! actions carried out here — log lines, card requests, drivers, zeroing,
+//! and the machine's steps handed to the planner.
+//!
+//! Log lines wait for room in the TX ring rather than being dropped: the
+//! prompts and the bad-file messages must reach the user.
+
+use crate::board::usart;
+use crate::card::{CardMsg, Request, What, CARD_IN, CARD_OUT, CHUNK};
+use crate::motion::Motion;
+use crate::rt::Ring;
+use crate::{error, info, report, texts};
+use heapless::Deque;
+use taut_logic::axis::AXES;
+use taut_logic::config::MachineConfig;
+use taut_logic::job::files::{Files, Next};
+use taut_logic::job::poradi::PoradiReader;
+use taut_logic::job::{FileError, FileName};
+use taut_logic::planner::Feed;
+use taut_logic::stringart::job::{Action, Event, Job, State};
+use taut_logic::stringart::Step;
+
+/// The console's `!` and `~`, for the job.
+#[derive(Clone, Copy)]
+pub enum Hold {
+    Pause,
+    Resume,
+}
+
+/// Console → job.
+pub static HOLDS: Ring<Hold, 4> = Ring::new();
+
+/// What the job task wants next.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Poll {
+    /// Wait for input (a button, the card, the console).
+    Idle,
+    /// Run again.
+    Again,
+    /// Run when the motion task has freed planner room or gone idle.
+    Motion,
+    /// Run in this many ms (a dwell, or the TX ring draining).
+    After(u16),
+}
+
+/// Steps handed to the planner per run, to keep runs short.
+const STEPS_PER_RUN: u8 = 8;
+/// Room a log line needs in the TX ring (the longest line is 96 bytes).
+const LINE_ROOM: usize = 96;
+
+/// `poradi.txt` streamed for winding.
+struct Pattern {
+    reader: PoradiReader,
+    /// Indices to pass over (already wound before the card was lost).
+    skip: u32,
+    chunk: [u8; CHUNK],
+    at: u8,
+    len: u8,
+    ended: bool,
+}
+
+/// What the card is streaming to the job.
+enum Stream {
+    None,
+    /// The files being checked.
+    Files(Files),
+    /// `poradi.txt` while winding.
+    Pattern(Pattern),
+}
+
+pub struct JobTask {
+    job: Job,
+    /// Actions not yet carried out, in order: one event's at most, as
+    /// inputs are taken only when the last event's are done.
+    todo: Deque<Action, 6>,
+    stream: Stream,
+    /// Numbers the card requests; messages of older ones are dropped.
+    ticket: u8,
+    nails: u16,
+    /// Between `NextMoves` and `MotionDone`: taking steps, then waiting
+    /// for the machine to stand.
+    pulling: bool,
+    settling: bool,
+    pending: Option<Step>,
+    dwell_until: Option<u32>,
+    /// Queue figures are logged line by line after a job ends.
+    report_line: Option<u8>,
+}
+
+impl Default for JobTask {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl JobTask {
+    pub const fn new() -> Self {
+        JobTask {
+            job: Job::new(),
+            todo: Deque::new(),
+            stream: Stream::None,
+            ticket: 0,
+            nails: 0,
+            pulling: false,
+            settling: false,
+            pending: None,
+            dwell_until: None,
+            report_line: None,
+        }
+    }
+
+    pub fn state(&self) -> State {
+        self.job.state()
+    }
+
+    /// Once at boot: drivers off, waiting for a card.
+    pub fn power_on(&mut self, now: u32) {
+        self.event(Event::PowerOn, now);
+    }
+
+    /// One run: carry out pending actions, then take one input, then move.
+    pub fn poll(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> Poll {
+        loop {
+            if let Some(p) = self.carry_out(m) {
+                return p;
+            }
+            if let Some(line) = self.report_line {
+                if usart::TX.free() < LINE_ROOM {
+                    return Poll::After(5);
+                }
+                self.report_line = report::queue_line(line).then_some(line + 1);
+                continue;
+            }
+            if !self.input(m, config, now) {
+                break;
+            }
+        }
+        self.feed_nails(now);
+        if !self.todo.is_empty() {
+            return Poll::Again;
+        }
+        self.run_steps(m, now)
+    }
+
+    fn event(&mut self, e: Event<'_>, now: u32) {
+        for a in self.job.on(e, now) {
+            let pushed = self.todo.push_back(a);
+            debug_assert!(pushed.is_ok(), "an event's actions fit");
+        }
+    }
+
+    /// The next input: a button, a card message, the console. False: none.
+    fn input(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> bool {
+        if let Some(b) = crate::buttons::BUTTONS.pop() {
+            self.event(Event::Button(b), now);
+            return true;
+        }
+        if let Some(h) = HOLDS.pop() {
+            let e = match h {
+                Hold::Pause => Event::Pause,
+                Hold::Resume => Event::Resume,
+            };
+            self.event(e, now);
+            return true;
+        }
+        let Some(msg) = CARD_OUT.peek() else {
+            return false;
+        };
+        // Pattern bytes wait in the queue until winding wants them.
+        let winding = matches!(self.stream, Stream::Pattern(_));
+        if matches!(msg.what, What::Data { .. }) && winding && msg.ticket == self.ticket {
+            return false;
+        }
+        let _ = CARD_OUT.pop();
+        self.card(msg, m, config, now);
+        true
+    }
+
+    fn card(&mut self, msg: CardMsg, m: &mut Motion, config: &mut MachineConfig, now: u32) {
+        match msg.what {
+            What::Inserted => return self.event(Event::CardInserted, now),
+            What::Removed => {
+                if matches!(self.stream, Stream::Files(_)) {
+                    self.stream = Stream::None;
+                }
+                return self.event(Event::CardRemoved, now);
+            }
+            _ if msg.ticket != self.ticket => return,
+            _ => {}
+        }
+        let files = match &mut self.stream {
+            Stream::None => return,
+            Stream::Pattern(_) => return self.pattern_ended(msg, now),
+            Stream::Files(files) => files,
+        };
+        let next = match msg.what {
+            What::Data { len, bytes } => match files.push(&bytes[..len as usize]) {
+                Ok(()) => return,
+                Err(e) => Err(e),
+            },
+            What::End => files.end(config),
+            What::Missing => files.missing(config),
+            _ => {
+                error!("card: ", files.file().name(), ": read failed");
+                self.stream = Stream::None;
+                return self.event(Event::FilesInvalid, now);
+            }
+        };
+        match next {
+            Ok(Next::Open(name)) => self.open(name),
+            Ok(Next::Done(c)) => {
+                self.stream = Stream::None;
+                info!(
+                    "files ok: shape ",
+                    c.params.shape,
+                    " nails ",
+                    c.params.nails,
+                    " radius ",
+                    c.params.radius_um,
+                    "um connections ",
+                    c.count
+                );
+                self.nails = c.params.nails;
+                // A new job takes the card's machine figures; a card coming
+                // back mid-job is only compared with the job's.
+                if self.job.state() == State::Reading && m.is_idle() {
+                    *config = c.config;
+                    m.configure(config);
+                }
+                let event = Event::FilesValid {
+                    params: c.params,
+                    count: c.count,
+                    config,
+                };
+                self.event(event, now);
+            }
+            Err(e) => {
+                self.stream = Stream::None;
+                error!(e);
+                self.event(Event::FilesInvalid, now);
+            }
+        }
+    }
+
+    /// Ask the card reader for a file; its messages carry the new ticket.
+    fn open(&mut self, name: FileName) {
+        self.ticket = self.ticket.wrapping_add(1).max(1);
+        // The reader takes requests before anything else: one slot will do,
+        // and a full one means the last request is being replaced anyway.
+        while CARD_IN.push(Request::Open(name, self.ticket)).is_err() {
+            let _ = CARD_IN.pop();
+        }
+    }
+
+    /// End, loss or failure of `poradi.txt` while winding.
+    fn pattern_ended(&mut self, msg: CardMsg, now: u32) {
+        match (&mut self.stream, msg.what) {
+            (Stream::Pattern(p), What::End) => p.ended = true,
+            _ => {
+                self.stream = Stream::None;
+                self.event(Event::PatternLost, now);
+            }
+        }
+    }
+
+    /// While winding wants nails and the card has delivered them.
+    fn feed_nails(&mut self, now: u32) {
+        // One nail's actions at a time: `todo` holds one event's.
+        while self.todo.is_empty() && self.job.wants_nail() {
+            let Stream::Pattern(p) = &mut self.stream else {
+                return;
+            };
+            let nail = match p.next() {
+                Ok(Some(nail)) => nail,
+                Ok(None) => return,
+                Err(e) => {
+                    // The file changed since it was checked.
+                    error!(e);
+                    self.stream = Stream::None;
+                    self.event(Event::PatternLost, now);
+                    return;
+                }
+            };
+            if p.skip > 0 {
+                p.skip -= 1;
+                continue;
+            }
+            self.event(Event::Nail(nail), now);
+        }
+    }
+
+    /// Carry out actions while their log lines fit; `Some` to stop the run.
+    fn carry_out(&mut self, m: &mut Motion) -> Option<Poll> {
+        while let Some(&a) = self.todo.front() {
+            if usart::TX.free() < LINE_ROOM {
+                return Some(Poll::After(5));
+            }
+            let _ = self.todo.pop_front();
+            match a {
+                Action::Enter(s) => {
+                    info!("state: ", texts::state(s));
+                    if s == State::End {
+                        self.stream = Stream::None;
+                        self.report_line = Some(0);
+                    }
+                }
+                Action::Log(msg) => info!(texts::msg(msg)),
+                Action::Prompt(p) => info!(texts::prompt(p)),
+                Action::ReadFiles => {
+                    self.stream = Stream::Files(Files::new());
+                    self.open(FileName::Param);
+                }
+                Action::OpenPattern { skip } => {
+                    self.stream = Stream::Pattern(Pattern::new(self.nails, skip));
+                    self.open(FileName::Poradi);
+                }
+                Action::DriversOn(mask) => m.drivers.set(mask, true),
+                Action::DriversOff(mask) => m.drivers.set(mask, false),
+                Action::SetZero(axis) => {
+                    let mut at = m.target();
+                    at[axis.index()] = 0;
+                    m.set_position(at);
+                }
+                Action::NextMoves => self.pulling = true,
+                Action::Progress(p) => info!(p),
+            }
+        }
+        None
+    }
+
+    /// Hand the job's steps to the planner; report `MotionDone` when the
+    /// machine stands after the last one.
+    fn run_steps(&mut self, m: &mut Motion, now: u32) -> Poll {
+        if let Some(until) = self.dwell_until {
+            let left = until.wrapping_sub(now) as i32;
+            if left > 0 {
+                return Poll::After(left as u16);
+            }
+            self.dwell_until = None;
+        }
+        let mut budget = STEPS_PER_RUN;
+        while self.pulling {
+            if budget == 0 {
+                return Poll::Again;
+            }
+            budget -= 1;
+            let Some(step) = self.pending.take().or_else(|| self.job.next_step()) else {
+                self.pulling = false;
+                self.settling = true;
+                break;
+            };
+            match step {
+                Step::Move(targets) => {
+                    let mut at = m.target();
+                    for i in 0..AXES {
+                        if let Some(t) = targets[i] {
+                            at[i] = t;
+                        }
+                    }
+                    if m.push(at, Feed::Rapid).is_err() {
+                        self.pending = Some(step);
+                        return Poll::Motion;
+                    }
+                }
+                // Dwells and driver switches wait for the machine to stand.
+                _ if !m.is_idle() => {
+                    self.pending = Some(step);
+                    return Poll::Motion;
+                }
+                Step::Dwell(ms) => {
+                    self.dwell_until = Some(now.wrapping_add(ms as u32));
+                    return Poll::After(ms);
+                }
+                Step::Drivers { mask, on } => m.drivers.set(mask, on),
+            }
+        }
+        if self.settling {
+            if !m.is_idle() {
+                return Poll::Motion;
+            }
+            self.settling = false;
+            self.event(Event::MotionDone, now);
+            return Poll::Again;
+        }
+        Poll::Idle
+    }
+}
+
+impl Pattern {
+    fn new(nails: u16, skip: u32) -> Self {
+        Pattern {
+            reader: PoradiReader::new(nails),
+            skip,
+            chunk: [0; CHUNK],
+            at: 0,
+            len: 0,
+            ended: false,
+        }
+    }
+
+    /// The next nail index, from the chunk in hand or the card's queue;
+    /// `None` until more bytes arrive.
+    fn next(&mut self) -> Result<Option<u16>, FileError> {
+        loop {
+            if self.at < self.len {
+                let (used, nail) = self
+                    .reader
+                    .next(&self.chunk[self.at as usize..self.len as usize])?;
+                self.at += used as u8;
+                if nail.is_some() {
+                    return Ok(nail);
+                }
+                continue;
+            }
+            if self.ended {
+                self.ended = false;
+                return self.reader.finish();
+            }
+            match CARD_OUT.peek() {
+                Some(CardMsg {
+                    what: What::Data { len, bytes },
+                    ..
+                }) => {
+                    let _ = CARD_OUT.pop();
+                    self.chunk = bytes;
+                    self.at = 0;
+                    self.len = len;
+                }
+                _ => return Ok(None),
+            }
+        }
+    }
+}

@@ -1,0 +1,224 @@
+//! Issue 5: the release firmware reads its job from a virtual SD card: a
+//! good card is read and checked, a late card is found, every bad file ends
+//! in its one message with nothing moved, and a card pulled while being
+//! read is reported and read again when it is back.
+
+use hil_tests::sim::operator::message;
+use hil_tests::sim::{Outcome, Sim};
+use hil_tests::{assert_ram_budget, boot_machine, card, pulses, sample_card_dir};
+use std::time::Duration;
+use taut_logic::axis::Axis;
+
+const PARAM: &[u8] = b"tvar = 6\npocet_hrebiku = 24\npolomer_matrice = 20.0\n";
+const PORADI: &[u8] = b"3,0,7,13";
+
+/// Log messages (without level, time and module) so far.
+fn messages(sim: &Sim) -> Vec<String> {
+    sim.uart_text()
+        .lines()
+        .filter_map(|l| message(l).map(str::to_string))
+        .collect()
+}
+
+fn wait_for(sim: &mut Sim, text: &str, timeout: Duration) {
+    let end = sim.run_until_uart_contains(text, timeout);
+    assert_eq!(
+        end,
+        Outcome::Done,
+        "waiting for {text:?}:\n{}",
+        sim.uart_text()
+    );
+}
+
+fn no_motion(sim: &Sim) {
+    for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
+        assert_eq!(pulses(sim, axis), 0, "{axis:?} moved:\n{}", sim.uart_text());
+    }
+}
+
+#[test]
+fn the_sample_card_is_read_and_checked_before_anything_can_start() {
+    let mut sim = boot_machine();
+    sim.insert_sd(hil_tests::sim::sdcard::SdImage::from_path(&sample_card_dir()).unwrap());
+    wait_for(&mut sim, "press green to drill", Duration::from_secs(2));
+    let log = messages(&sim);
+    let at = |m: &str| {
+        log.iter()
+            .position(|l| l == m)
+            .unwrap_or_else(|| panic!("{m:?} in {log:#?}"))
+    };
+    assert!(
+        log.iter()
+            .any(|l| l.starts_with("card: ") && l.ends_with("MiB FAT16")),
+        "{log:#?}"
+    );
+    assert!(
+        at("state: waiting for card") < at("state: reading")
+            && at("state: reading")
+                < at("files ok: shape 6 nails 24 radius 200000um connections 30")
+            && at("files ok: shape 6 nails 24 radius 200000um connections 30")
+                < at("state: prep drill")
+    );
+    // Waiting for green: nothing moves by itself.
+    sim.run_for(Duration::from_secs(2));
+    no_motion(&sim);
+    assert_ram_budget(&sim);
+}
+
+#[test]
+fn a_card_inserted_three_seconds_after_boot_is_found() {
+    let mut sim = boot_machine();
+    sim.sd_insert_at(
+        Duration::from_secs(3),
+        card(&[("param.txt", PARAM), ("poradi.txt", PORADI)]),
+    );
+    wait_for(&mut sim, ">>> insert card", Duration::from_millis(200));
+    sim.run_for(Duration::from_millis(2900));
+    assert!(!sim.uart_text().contains("card: "), "no card yet");
+    // Looked for once a second: found within a second of going in.
+    wait_for(&mut sim, "files ok:", Duration::from_millis(1200));
+    assert!(sim.time_s() < 4.1, "found at {:.2} s", sim.time_s());
+    no_motion(&sim);
+    assert_ram_budget(&sim);
+}
+
+/// Every way the job files can be wrong, and the one line each gets.
+#[test]
+fn every_bad_file_gets_its_message_and_nothing_moves() {
+    let big_param = b"tvar = 0\npocet_hrebiku = 24\npolomer_matrice = 20\n";
+    let cases: &[(&[(&str, &[u8])], &str)] = &[
+        (&[("poradi.txt", PORADI)], "param.txt: file not found"),
+        (&[("param.txt", PARAM)], "poradi.txt: file not found"),
+        (
+            &[("param.txt", b""), ("poradi.txt", PORADI)],
+            "param.txt: empty file",
+        ),
+        (
+            &[
+                ("param.txt", b"tvar = 6\nnails = 24\nbarva = 3\n"),
+                ("poradi.txt", PORADI),
+            ],
+            "param.txt:3:1: unknown key",
+        ),
+        (
+            &[
+                ("param.txt", b"tvar = 6\npolomer_matrice = 20\n"),
+                ("poradi.txt", PORADI),
+            ],
+            "param.txt: missing key pocet_hrebiku (nails)",
+        ),
+        (
+            &[
+                ("param.txt", b"tvar = 2\nnails = 24\nradius_cm = 20\n"),
+                ("poradi.txt", PORADI),
+            ],
+            "param.txt:1:8: expected 0 or 3 to 1000",
+        ),
+        (
+            &[
+                ("param.txt", b"tvar = 6\nnails = 2\nradius_cm = 20\n"),
+                ("poradi.txt", PORADI),
+            ],
+            "param.txt:2:9: expected 3 to 10000",
+        ),
+        (
+            &[
+                ("param.txt", b"tvar = 6\nnails = 24\nradius_cm = 2\n"),
+                ("poradi.txt", PORADI),
+            ],
+            "param.txt:3:13: expected more than 3.8094 cm",
+        ),
+        (
+            &[
+                ("param.txt", b"tvar = 6\nnails = x24\nradius_cm = 20\n"),
+                ("poradi.txt", PORADI),
+            ],
+            "param.txt:2:9: expected a number",
+        ),
+        (
+            &[("param.txt", big_param), ("poradi.txt", b"3,0,7,24")],
+            "poradi.txt:1:7: nail 24 out of range (nails: 24)",
+        ),
+        (
+            &[("param.txt", big_param), ("poradi.txt", b"4,0,7,13")],
+            "poradi.txt:1:1: declared 4 nails, found 3",
+        ),
+        (
+            &[("param.txt", big_param), ("poradi.txt", b"3,0;7,13")],
+            "poradi.txt:1:4: expected ','",
+        ),
+        (
+            &[("param.txt", big_param), ("poradi.txt", b"")],
+            "poradi.txt: empty file",
+        ),
+        (
+            &[
+                ("param.txt", big_param),
+                ("machine.txt", b"base_max_rate = -5\n"),
+                ("poradi.txt", PORADI),
+            ],
+            "machine.txt:1:17: expected a number",
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (files, expected) in cases {
+        let mut sim = boot_machine();
+        sim.insert_sd(card(files));
+        if sim.run_until_uart_contains("bad files: replace card", Duration::from_secs(2))
+            != Outcome::Done
+        {
+            failures.push(format!("{expected:?}: never refused\n{}", sim.uart_text()));
+            continue;
+        }
+        let errors: Vec<String> = sim
+            .uart_text()
+            .lines()
+            .filter(|l| l.starts_with("[E"))
+            .filter_map(|l| message(l).map(str::to_string))
+            .collect();
+        if errors != [expected.to_string()] {
+            failures.push(format!("{expected:?}: got {errors:?}"));
+        }
+        // Nothing moves, whatever is pressed, until the card is replaced.
+        sim.press(taut_logic::pinmap::Button::Confirm.pin());
+        sim.run_for(Duration::from_millis(300));
+        sim.release(taut_logic::pinmap::Button::Confirm.pin());
+        sim.run_for(Duration::from_millis(500));
+        no_motion(&sim);
+        assert!(
+            sim.uart_text().ends_with(">>> bad files: replace card\n")
+                || !sim.uart_text().contains("state: prep drill")
+        );
+        assert_ram_budget(&sim);
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn a_card_pulled_while_being_read_is_reported_and_read_again_when_back() {
+    // A long pattern, so the card is still being read when it goes.
+    let poradi: String = std::iter::once("3000".to_string())
+        .chain((0..3000).map(|i| (i * 7 % 24).to_string()))
+        .collect::<Vec<_>>()
+        .join(",");
+    let image = card(&[("param.txt", PARAM), ("poradi.txt", poradi.as_bytes())]);
+    let mut sim = boot_machine();
+    sim.insert_sd(image.clone());
+    // Probed for once a second.
+    wait_for(&mut sim, "state: reading", Duration::from_millis(1500));
+    sim.run_for(Duration::from_millis(20));
+    assert!(!sim.uart_text().contains("files ok"), "still reading");
+    let _ = sim.remove_sd();
+    wait_for(&mut sim, "card out", Duration::from_millis(500));
+    wait_for(&mut sim, ">>> insert card", Duration::from_millis(500));
+    let before = sim.uart_text().len();
+    sim.insert_sd(image);
+    wait_for(&mut sim, "press green to drill", Duration::from_secs(3));
+    let after = &sim.uart_text()[before..];
+    assert!(
+        after.contains("files ok: shape 6 nails 24 radius 200000um connections 3000"),
+        "{after}"
+    );
+    no_motion(&sim);
+    assert_ram_budget(&sim);
+}
