@@ -130,13 +130,14 @@ impl CardReader {
         }
     }
 
-    /// One step of work at millisecond `now`; see [`Poll`].
-    pub fn poll(&mut self, now: u32) -> Poll {
+    /// One step of work at millisecond `now`; see [`Poll`]. While the
+    /// machine is `moving`, an empty slot is not probed (next second).
+    pub fn poll(&mut self, now: u32, moving: bool) -> Poll {
         let due = now.wrapping_sub(self.check_at) as i32 >= 0;
         if due {
             self.check_at = now.wrapping_add(CHECK_MS);
         }
-        let poll = self.work(due);
+        let poll = self.work(due && !(moving && matches!(self.slot, Slot::Empty)));
         match poll {
             Poll::Idle(_) => Poll::Idle(self.check_at.wrapping_sub(now).min(CHECK_MS) as u16),
             _ => poll,

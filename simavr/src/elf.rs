@@ -63,3 +63,17 @@ pub fn read(path: &Path) -> Result<ElfInfo, Error> {
         static_ram_end,
     })
 }
+
+/// The address of the function whose (mangled) name contains `part`: the
+/// app's tasks are found by name, e.g. `4taut7console` for `console`.
+pub fn function_address(path: &Path, part: &str) -> Result<Option<u32>, Error> {
+    use object::ObjectSymbol;
+    let bytes = std::fs::read(path).map_err(|e| Error::Io(path.to_owned(), e))?;
+    let file =
+        object::File::parse(&*bytes).map_err(|e| Error::Elf(format!("{}: {e}", path.display())))?;
+    Ok(file
+        .symbols()
+        .filter(|s| s.kind() == object::SymbolKind::Text)
+        .find(|s| s.name().is_ok_and(|n| n.contains(part)))
+        .map(|s| s.address() as u32))
+}

@@ -136,6 +136,11 @@ impl Sim {
         let enabled = unsafe { (*avr).sreg[7] } != 0;
         let now = self.shared().cycle_base + cycle;
         self.masked.observe(now, pc, enabled);
+        for (at, hits) in &mut self.pc_watches {
+            if *at == pc {
+                hits.push(now);
+            }
+        }
         match state {
             ffi::cpu_Crashed => return Some(Outcome::Crashed { pc: pc_before }),
             ffi::cpu_Done => return Some(Outcome::Hung { pc: pc_before }),

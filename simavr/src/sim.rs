@@ -59,6 +59,8 @@ pub struct Sim {
     pub(crate) min_sp: u16,
     /// The instruction that pushed the stack to `min_sp`.
     pub(crate) min_sp_pc: u32,
+    /// Watched program addresses and the cycles execution reached them.
+    pub(crate) pc_watches: Vec<(u32, Vec<u64>)>,
     pub(crate) resets: u32,
     /// simavr's own cycle counter after the last step: it drops on reset.
     pub(crate) last_avr_cycle: u64,
@@ -175,6 +177,7 @@ impl Sim {
             ram_limit,
             min_sp: RAM_END,
             min_sp_pc: 0,
+            pc_watches: Vec::new(),
             resets: 0,
             last_avr_cycle: 0,
             ended: None,
@@ -242,6 +245,20 @@ impl Sim {
     }
 
     /// Lowest stack pointer seen (checked after every instruction).
+    /// Record every cycle at which execution reaches byte address `pc` (an
+    /// interrupt vector, a task's entry): latencies measured exactly.
+    pub fn watch_pc(&mut self, pc: u32) {
+        self.pc_watches.push((pc, Vec::new()));
+    }
+
+    /// The cycles at which a watched address was reached.
+    pub fn pc_hits(&self, pc: u32) -> &[u64] {
+        self.pc_watches
+            .iter()
+            .find(|w| w.0 == pc)
+            .map_or(&[], |w| &w.1)
+    }
+
     /// Where the stack was deepest: the instruction's byte address.
     pub fn stack_peak_pc(&self) -> u32 {
         self.min_sp_pc

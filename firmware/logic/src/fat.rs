@@ -53,6 +53,9 @@ pub struct File {
     cluster: u32,
     size: u32,
     pos: u32,
+    /// Clusters `cluster..=run_end` follow each other on the disk (seen in
+    /// the last FAT block read): no FAT read until `run_end`.
+    run_end: u32,
 }
 
 const ATTR_VOLUME: u8 = 0x08;
@@ -182,7 +185,7 @@ impl Volume {
                     return Err(FatError::NotFound);
                 }
                 cluster = match self.next_cluster(dev, buf, cluster)? {
-                    Some(next) => next,
+                    Some((next, _)) => next,
                     None => return Err(FatError::NotFound),
                 };
                 lba = self.cluster_lba(cluster);
@@ -212,6 +215,7 @@ impl Volume {
                     cluster: first,
                     size,
                     pos: 0,
+                    run_end: first,
                 });
             }
             lba += 1;
@@ -226,34 +230,47 @@ impl Volume {
 
     /// The cluster after `cluster` from the FAT (read into `buf`), or None
     /// at the end of the chain.
+    /// The cluster after `cluster`, and the last cluster of the
+    /// contiguous run it starts, as far as this FAT block tells: files are
+    /// mostly written in one piece, so most cluster steps need no FAT read.
     fn next_cluster<D: BlockRead>(
         &self,
         dev: &mut D,
         buf: &mut [u8; BLOCK],
         cluster: u32,
-    ) -> Result<Option<u32>, FatError<D::Error>> {
+    ) -> Result<Option<(u32, u32)>, FatError<D::Error>> {
         // 256 two-byte or 128 four-byte entries per block.
-        let (block, at) = if self.fat32 {
-            (cluster >> 7, (cluster as usize & 0x7F) * 4)
-        } else {
-            (cluster >> 8, (cluster as usize & 0xFF) * 2)
-        };
+        let per_block_shift = if self.fat32 { 7 } else { 8 };
+        let block = cluster >> per_block_shift;
         dev.read_block(self.fat_start + block, buf)
             .map_err(FatError::Device)?;
-        let (next, end) = if self.fat32 {
-            (le32(buf, at) & 0x0FFF_FFFF, 0x0FFF_FFF8)
-        } else {
-            (u32::from(le16(buf, at)), 0xFFF8)
+        let entry = |c: u32| {
+            let i = (c & ((1 << per_block_shift) - 1)) as usize;
+            if self.fat32 {
+                le32(buf, i * 4) & 0x0FFF_FFFF
+            } else {
+                u32::from(le16(buf, i * 2))
+            }
         };
+        let next = entry(cluster);
+        let end = if self.fat32 { 0x0FFF_FFF8 } else { 0xFFF8 };
         if next >= end {
             return Ok(None);
         }
         // Below 2 (free, reserved) wraps round to a huge value too; bad
         // cluster marks (…F7) lie beyond every volume's last cluster.
-        if next.wrapping_sub(2) >= self.clusters {
+        let valid = |c: u32| c.wrapping_sub(2) < self.clusters;
+        if !valid(next) {
             return Err(FatError::BadChain);
         }
-        Ok(Some(next))
+        let mut run_end = next;
+        while run_end >> per_block_shift == block
+            && valid(run_end + 1)
+            && entry(run_end) == run_end + 1
+        {
+            run_end += 1;
+        }
+        Ok(Some((next, run_end)))
     }
 }
 
@@ -299,17 +316,22 @@ impl File {
         }
         // `pos` is a whole number of blocks here: only the last read is short.
         let in_cluster = (self.pos >> 9) & ((1 << vol.cluster_shift) - 1);
-        let mut cluster = self.cluster;
+        let (mut cluster, mut run_end) = (self.cluster, self.run_end);
         if in_cluster == 0 && self.pos != 0 {
-            cluster = vol
-                .next_cluster(dev, buf, cluster)?
-                .ok_or(FatError::BadChain)?;
+            if cluster < run_end {
+                cluster += 1;
+            } else {
+                (cluster, run_end) = vol
+                    .next_cluster(dev, buf, cluster)?
+                    .ok_or(FatError::BadChain)?;
+            }
         }
         dev.read_block(vol.cluster_lba(cluster) + in_cluster, buf)
             .map_err(FatError::Device)?;
         // Committed only now, so that a failed read can be retried.
         let n = (self.size - self.pos).min(BLOCK as u32);
         self.cluster = cluster;
+        self.run_end = run_end;
         self.pos += n;
         Ok(n as usize)
     }
@@ -317,6 +339,7 @@ impl File {
     /// Back to the start of the file (no device access).
     pub fn rewind(&mut self) {
         self.cluster = self.first;
+        self.run_end = self.first;
         self.pos = 0;
     }
 }
@@ -566,6 +589,33 @@ mod tests {
         assert_eq!(disk.reads, 7);
         file.rewind();
         assert_eq!(read_all(&vol, &mut disk, &mut file), Ok(want));
+    }
+
+    #[test]
+    fn a_fragmented_chain_reads_the_fat_only_where_the_run_breaks() {
+        let mut disk = fat16_disk();
+        entry(&mut disk, FAT16_ROOT + 1, 1, b"F       TXT", 0x20, 2, 8000);
+        // 2 → 3 → 6 → 7: two runs; clusters of 4 blocks from block 43.
+        set_fat16(&mut disk, 3, 6);
+        set_fat16(&mut disk, 6, 7);
+        set_fat16(&mut disk, 7, 0xFFFF);
+        let mut want = std::vec::Vec::new();
+        for (i, cluster) in [2u32, 3, 6, 7].into_iter().enumerate() {
+            for b in 0..4 {
+                let fill = (i * 4 + b) as u8 + 1;
+                disk.block(43 + (cluster - 2) * 4 + b as u32).fill(fill);
+                want.extend_from_slice(&[fill; BLOCK]);
+            }
+        }
+        want.truncate(8000);
+        let mut buf = [0; BLOCK];
+        let vol = Volume::mount(&mut disk, &mut buf).unwrap();
+        let mut file = vol.open(&mut disk, &mut buf, b"f.txt").unwrap();
+        disk.reads = 0;
+        let back = read_all(&vol, &mut disk, &mut file).unwrap();
+        assert!(back == want, "the fragmented file reads back");
+        // Sixteen data blocks; the FAT at 2 → 3 and at 3 → 6, not at 6 → 7.
+        assert_eq!(disk.reads, 18);
     }
 
     #[test]

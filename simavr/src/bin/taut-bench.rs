@@ -13,6 +13,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
 use taut_logic::pinmap::driver;
+use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
 /// Timer1 COMPA vector (byte address): the step interrupt.
@@ -198,6 +199,109 @@ fn default_speed_error_us(elf: &Path) -> (f64, f64, u16) {
     (worst * 1e6, masked, sim.peak_stack_bytes())
 }
 
+/// USART0_RX vector (byte address).
+const RX_VECTOR: u32 = 0x64;
+
+/// Interrupt-spawn → task-start latency, cycles (worst, 90th percentile):
+/// single status queries (`?`) every 5 ms, each spawning the console from
+/// the receive interrupt, while a rapid move runs at the maximum rate and
+/// the job reads the sample card. From the receive vector to the console
+/// task's entry. The worst cases fall at the start of the move, while the
+/// urgent refill (a higher priority) fills the step queue.
+fn dispatch_latency_cycles(elf: &Path, card: &Path) -> (u64, u64) {
+    let console = taut_simavr::elf::function_address(elf, "4taut7console")
+        .expect("ELF symbols")
+        .expect("the console task");
+    let mut sim = boot(elf);
+    sim.insert_sd(SdImage::from_path(card).expect("sample card"));
+    send(&mut sim, "M17", Duration::from_millis(100));
+    send(&mut sim, "G0 C3600", Duration::from_millis(100));
+    sim.watch_pc(RX_VECTOR);
+    sim.watch_pc(console);
+    for _ in 0..400 {
+        sim.uart_send(b"?");
+        sim.run_for(Duration::from_millis(5));
+    }
+    let (rx, starts) = (sim.pc_hits(RX_VECTOR), sim.pc_hits(console));
+    assert!(rx.len() >= 400, "every query received");
+    let mut latency: Vec<u64> = rx
+        .iter()
+        .map(|&r| {
+            let i = starts.partition_point(|&c| c < r);
+            starts.get(i).expect("the console ran after each byte") - r
+        })
+        .collect();
+    latency.sort_unstable();
+    (latency[latency.len() - 1], latency[latency.len() * 9 / 10])
+}
+
+/// The firmware's own millisecond stamp of the first log line containing `text`.
+fn log_ms(sim: &Sim, text: &str) -> u64 {
+    let line = sim
+        .uart_text()
+        .lines()
+        .find(|l| l.contains(text))
+        .unwrap_or_else(|| panic!("{text:?} in the log:\n{}", sim.uart_text()))
+        .to_string();
+    line.split(' ')
+        .nth(1)
+        .and_then(|ms| ms.parse().ok())
+        .expect("[L ms module] line")
+}
+
+/// A card folder with `param.txt` (the sample's) and `poradi.txt`.
+fn card_dir(name: &str, poradi: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("taut-bench-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("param.txt"),
+        "tvar = 6\npocet_hrebiku = 24\npolomer_matrice = 20\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("poradi.txt"), poradi).unwrap();
+    dir
+}
+
+/// A pattern of `count` connections on 24 nails.
+fn pattern(count: u32) -> String {
+    let mut s = count.to_string();
+    for i in 0..count {
+        s.push_str(&format!(",{}", i * 7 % 24));
+    }
+    s
+}
+
+/// `sd_poradi_parse_ms`: the release image reading and checking a card
+/// with a 3000-connection `poradi.txt`, from `state: reading` to
+/// `files ok` (param.txt included), by the firmware's own clock.
+fn sd_poradi_parse_ms(elf: &Path) -> u64 {
+    let dir = card_dir("poradi", &pattern(3000));
+    let mut sim = boot(elf);
+    sim.insert_sd(SdImage::from_path(&dir).unwrap());
+    std::fs::remove_dir_all(&dir).unwrap();
+    let end = sim.run_until_uart_contains("files ok", Duration::from_secs(5));
+    assert_eq!(end, Outcome::Done, "{}", sim.uart_text());
+    log_ms(&sim, "files ok") - log_ms(&sim, "state: reading")
+}
+
+/// `sd_read_kib_per_s`: `examples/sd_read.rs` streams a 256 KiB file
+/// through the card reader into its queue (drained at once).
+fn sd_read_kib_per_s(elf: &Path) -> f64 {
+    let dir = card_dir("read", &"0123456789,".repeat(256 * 1024 / 11));
+    let mut sim = Sim::load(elf).expect("sd_read image");
+    sim.insert_sd(SdImage::from_path(&dir).unwrap());
+    std::fs::remove_dir_all(&dir).unwrap();
+    let end = sim.run_until_uart_contains(" us\n", Duration::from_secs(30));
+    assert_eq!(end, Outcome::Done, "{}", sim.uart_text());
+    let text = sim.uart_text();
+    let words: Vec<&str> = text.lines().last().unwrap().split(' ').collect();
+    // `[I ms sd_read] read <bytes> B in <us> us`
+    let bytes: f64 = words[4].parse().unwrap();
+    let us: f64 = words[7].parse().unwrap();
+    bytes / 1024.0 / (us / 1e6)
+}
+
 fn sim_mhz(elf: &Path, seconds: u64) -> f64 {
     let mut sim = Sim::load(elf).expect("image loads");
     let wall = Instant::now();
@@ -246,6 +350,16 @@ fn main() {
     f.insert("timing_error_max_us".into(), json!(round(err, 3)));
     f.insert("step_isr_max_masked_cycles".into(), json!(masked));
     f.insert("peak_stack_bytes".into(), json!(stack));
+    let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/card");
+    let (worst, p90) = dispatch_latency_cycles(fw, &card);
+    f.insert("dispatch_latency_cycles".into(), json!(worst));
+    f.insert("dispatch_latency_p90_cycles".into(), json!(p90));
+    f.insert("sd_poradi_parse_ms".into(), json!(sd_poradi_parse_ms(fw)));
+    let sd_read = busy.with_file_name("sd_read.elf");
+    f.insert(
+        "sd_read_kib_per_s".into(),
+        json!(round(sd_read_kib_per_s(&sd_read), 1)),
+    );
     f.insert("sim_mhz_idle".into(), json!(round(sim_mhz(fw, 20), 1)));
     f.insert("sim_mhz_busy".into(), json!(round(sim_mhz(busy, 2), 1)));
 

@@ -2,6 +2,7 @@
 //! with every RAMPS pin probed under its fixed VCD name, then write the
 //! trace and a JSON report. `cargo xtask sim` calls it with the release ELF.
 
+use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::io::Write;
 use std::path::PathBuf;
@@ -9,7 +10,7 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
 use taut_logic::pinmap::{self, Button};
-use taut_simavr::operator::Operator;
+use taut_simavr::operator::{Operator, Seen};
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
@@ -144,7 +145,12 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         (false, true) => 0.0,
         (false, false) => 5.0,
     };
-    let mut operator = Operator::confirming();
+    let mut operator = if args.auto_confirm {
+        Operator::confirming()
+    } else {
+        Operator::default()
+    };
+    let mut bar = Bar::default();
     let total = Duration::from_secs_f64(args.seconds.unwrap_or(default));
     let slice = Duration::from_millis(10);
     let mut outcome = Outcome::Running;
@@ -154,20 +160,19 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         outcome = sim.run_for(step);
         elapsed += step;
         if args.echo {
-            let text = sim.uart_bytes();
-            std::io::stdout().write_all(&text[printed..])?;
-            printed = text.len();
+            let text = &sim.uart_bytes()[printed..];
+            bar.suspend(|| std::io::stdout().write_all(text))?;
+            printed += text.len();
         }
         if outcome != Outcome::Running {
             break;
         }
-        if args.auto_confirm {
-            operator.step(&mut sim);
-            if operator.finished {
-                break;
-            }
+        bar.show(&operator.step(&mut sim));
+        if args.auto_confirm && operator.finished {
+            break;
         }
     }
+    bar.finish();
     let wall_s = wall.elapsed().as_secs_f64();
     if let Some(path) = &args.vcd {
         sim.write_vcd(path)?;
@@ -177,6 +182,11 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         let extra = json!({
             "wall_seconds": wall_s,
             "sim_mhz": sim.cycles() as f64 / wall_s / 1e6,
+            "job": {
+                "state": operator.state,
+                "finished": operator.finished,
+                "green_presses": operator.presses,
+            },
         });
         report
             .as_object_mut()
@@ -192,6 +202,58 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         outcome
     );
     Ok(outcome)
+}
+
+/// The job's progress lines (`drill 3/24`, `wind 10/30`) as a bar per
+/// phase, with the job's state as its message. Drawn only on a terminal.
+#[derive(Default)]
+struct Bar {
+    phase: Option<(String, ProgressBar)>,
+}
+
+impl Bar {
+    fn show(&mut self, seen: &[Seen]) {
+        for s in seen {
+            match s {
+                Seen::Progress(phase, done, total) => {
+                    if self.phase.as_ref().is_none_or(|(p, _)| p != phase) {
+                        self.finish();
+                        let style = ProgressStyle::with_template(
+                            "{prefix:>5} [{bar:40}] {pos}/{len} {msg} ({elapsed} wall, eta {eta})",
+                        )
+                        .expect("template")
+                        .progress_chars("=> ");
+                        let bar = ProgressBar::new(u64::from(*total))
+                            .with_style(style)
+                            .with_prefix(phase.clone());
+                        self.phase = Some((phase.clone(), bar));
+                    }
+                    if let Some((_, bar)) = &self.phase {
+                        bar.set_position(u64::from(*done));
+                    }
+                }
+                Seen::State(state) => {
+                    if let Some((_, bar)) = &self.phase {
+                        bar.set_message(state.clone());
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
+        match &self.phase {
+            Some((_, bar)) => bar.suspend(f),
+            None => f(),
+        }
+    }
+
+    fn finish(&mut self) {
+        if let Some((_, bar)) = self.phase.take() {
+            bar.finish();
+        }
+    }
 }
 
 fn main() -> ExitCode {

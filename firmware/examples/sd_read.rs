@@ -1,0 +1,80 @@
+//! The card reader alone, for `cargo xtask bench` (`sd_read_kib_per_s`):
+//! streams `poradi.txt` through the firmware's `CardReader` into its queue,
+//! drains the queue at once, and logs `read <bytes> B in <µs> us`. The
+//! release image's job parses what it reads; this measures the reader.
+#![no_std]
+#![no_main]
+#![feature(abi_avr_interrupt)]
+
+use panic_halt as _;
+use taut_firmware::board::spi::{CardSpi, Spi};
+use taut_firmware::board::{clock, gpio::Pins, usart};
+use taut_firmware::card::{CardReader, Poll, Request, What, CARD_IN, CARD_OUT};
+use taut_firmware::info;
+use taut_logic::job::FileName;
+
+#[avr_device::entry]
+fn main() -> ! {
+    let dp = avr_device::atmega2560::Peripherals::take().unwrap();
+    let pins = Pins::new(
+        dp.PORTA, dp.PORTB, dp.PORTC, dp.PORTD, dp.PORTE, dp.PORTF, dp.PORTG, dp.PORTH, dp.PORTJ,
+        dp.PORTK, dp.PORTL,
+    );
+    clock::Clock::start(dp.TC0);
+    usart::Usart0::start(dp.USART0);
+    let cs = pins.d53.into_output_at(true);
+    let bus = Spi::start(
+        dp.SPI,
+        pins.d52.into_output(),
+        pins.d51.into_output(),
+        pins.d50.into_floating_input(),
+        &cs,
+    );
+    let mut reader = CardReader::new(CardSpi { bus, cs });
+    // SAFETY: the two handlers below touch only the clock and the TX ring.
+    unsafe { avr_device::interrupt::enable() };
+    loop {
+        let _ = reader.poll(clock::millis(), false);
+        if let Some(m) = CARD_OUT.pop() {
+            if matches!(m.what, What::Inserted) {
+                break;
+            }
+        }
+    }
+    let _ = CARD_IN.push(Request::Open(FileName::Poradi, 1));
+    let start = clock::micros();
+    let mut bytes: u32 = 0;
+    loop {
+        if reader.poll(clock::millis(), false) == Poll::Blocked && CARD_OUT.is_empty() {
+            break;
+        }
+        match CARD_OUT.pop().map(|m| m.what) {
+            Some(What::Data { len, .. }) => bytes += len as u32,
+            Some(What::End) => break,
+            Some(_) => break,
+            None => {}
+        }
+    }
+    let us = clock::micros().wrapping_sub(start);
+    info!("read ", bytes, " B in ", us, " us");
+    loop {
+        avr_device::asm::sleep();
+    }
+}
+
+#[avr_device::interrupt(atmega2560)]
+fn TIMER0_COMPA() {
+    clock::tick();
+}
+
+#[avr_device::interrupt(atmega2560)]
+fn USART0_UDRE() {
+    // Entered with the interrupt enabled: switch it off, the handler
+    // switches it back on while bytes are waiting.
+    // SAFETY: UCSR0B; the main loop never writes it while interrupts run.
+    unsafe {
+        let ucsr0b = usart::UCSR0B as *mut u8;
+        ucsr0b.write_volatile(ucsr0b.read_volatile() & !(1 << usart::UDRIE0));
+    }
+    usart::on_data_register_empty();
+}
