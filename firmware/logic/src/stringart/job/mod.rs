@@ -119,10 +119,14 @@ impl Job {
         self.state
     }
 
-    /// The next step of the running phase; `None` at the end of a batch,
-    /// when paused, or outside drilling and winding.
+    /// The next step of the running phase; `None` at the end of a batch
+    /// or outside drilling and winding. A pause takes effect at the end of
+    /// the batch: its remaining steps still come (drill raised, needle
+    /// inside the ring before the machine stands).
     pub fn next_step(&mut self) -> Option<Step> {
-        if !self.state.is_running() {
+        let finishing = matches!(self.state, State::Paused(_))
+            && self.motion.as_ref().is_some_and(Motion::mid_batch);
+        if !self.state.is_running() && !finishing {
             return None;
         }
         self.motion.as_mut()?.next()

@@ -39,6 +39,8 @@ pub(super) struct Motion {
     pub total: u32,
     /// The batch is complete: no more steps until the next `MotionDone`.
     hold: bool,
+    /// A step of the current batch has been handed out.
+    started: bool,
     /// Every step has been handed out.
     pub exhausted: bool,
     pub reporter: Reporter,
@@ -75,6 +77,7 @@ impl Motion {
             done: 0,
             total,
             hold: false,
+            started: false,
             exhausted: false,
             reporter: Reporter::start(phase, total, now_ms),
         }
@@ -83,9 +86,21 @@ impl Motion {
     /// The motion of the last batch has finished.
     pub fn release(&mut self) {
         self.hold = false;
+        self.started = false;
+    }
+
+    /// Some of the current batch's steps have been handed out, not all.
+    pub fn mid_batch(&self) -> bool {
+        self.started && !self.hold && !self.exhausted
     }
 
     pub fn next(&mut self) -> Option<Step> {
+        let step = self.step();
+        self.started |= step.is_some();
+        step
+    }
+
+    fn step(&mut self) -> Option<Step> {
         if self.hold || self.exhausted {
             return None;
         }

@@ -1,0 +1,161 @@
+//! Issue 6: the buttons on the release image — a zeroing button's two
+//! presses take the current position as that axis's zero (driver off in
+//! between); a long press of green pauses drilling after the current hole
+//! and a short one resumes; the serial `!` and `~` do the same.
+
+use hil_tests::sim::operator::message;
+use hil_tests::sim::sdcard::SdImage;
+use hil_tests::sim::{Outcome, Sim};
+use hil_tests::{assert_ram_budget, boot_machine, pulses, sample_card_dir, send_ok};
+use std::time::Duration;
+use taut_logic::axis::Axis;
+use taut_logic::config::MachineConfig;
+use taut_logic::pinmap::{driver, Button};
+
+fn wait_for(sim: &mut Sim, text: &str, timeout: Duration) {
+    let end = sim.run_until_uart_contains(text, timeout);
+    assert_eq!(
+        end,
+        Outcome::Done,
+        "waiting for {text:?}:\n{}",
+        sim.uart_text()
+    );
+}
+
+/// Held for `ms`, then released, then 100 ms to settle.
+fn press(sim: &mut Sim, button: Button, ms: u64) {
+    sim.press(button.pin());
+    sim.run_for(Duration::from_millis(ms));
+    sim.release(button.pin());
+    sim.run_for(Duration::from_millis(100));
+}
+
+/// Booted with the sample card, in the preparation state before drilling.
+fn prepared() -> Sim {
+    let mut sim = boot_machine();
+    sim.insert_sd(SdImage::from_path(&sample_card_dir()).unwrap());
+    wait_for(&mut sim, "press green to drill", Duration::from_secs(3));
+    sim
+}
+
+fn driver_on(sim: &Sim, axis: Axis) -> bool {
+    let active_high = MachineConfig::STRING_ART.axes[axis.index()].enable_active_high;
+    sim.pin_level(driver(axis).enable) == active_high
+}
+
+fn base_steps(sim: &Sim) -> i64 {
+    let d = driver(Axis::Base);
+    sim.net_steps(d.step, d.dir, true)
+}
+
+fn all_pulses(sim: &Sim) -> [usize; 3] {
+    [Axis::Base, Axis::Radial, Axis::Drill].map(|a| pulses(sim, a))
+}
+
+/// Runs until no axis has stepped for a second (at most 30 s): the pulse
+/// counts then.
+fn settle(sim: &mut Sim) -> [usize; 3] {
+    let mut last = all_pulses(sim);
+    for _ in 0..30 {
+        sim.run_for(Duration::from_secs(1));
+        let now = all_pulses(sim);
+        if now == last {
+            return now;
+        }
+        last = now;
+    }
+    panic!("still moving after 30 s:\n{}", sim.uart_text());
+}
+
+fn log_has(sim: &Sim, text: &str) -> bool {
+    sim.uart_text().lines().any(|l| message(l) == Some(text))
+}
+
+#[test]
+fn two_presses_of_a_zeroing_button_move_that_axis_zero() {
+    let mut sim = prepared();
+    assert!(driver_on(&sim, Axis::Base));
+    // The operator turns the board 15° (here over the console) to line
+    // nail 0 up, then zeroes the base there.
+    send_ok(&mut sim, "G0 C15", Duration::from_millis(200));
+    send_ok(&mut sim, "M400", Duration::from_secs(10));
+    let jog = base_steps(&sim);
+    assert_eq!(jog, 400, "15° of 9600 steps a turn");
+
+    press(&mut sim, Button::ZeroBase, 100);
+    assert!(log_has(&sim, "base free"), "{}", sim.uart_text());
+    assert!(!driver_on(&sim, Axis::Base), "first press: driver off");
+    assert!(driver_on(&sim, Axis::Radial) && driver_on(&sim, Axis::Drill));
+    // A long press counts once.
+    press(&mut sim, Button::ZeroBase, 2500);
+    assert!(log_has(&sim, "base zeroed"), "{}", sim.uart_text());
+    assert!(driver_on(&sim, Axis::Base), "second press: driver on again");
+    send_ok(&mut sim, "M114", Duration::from_millis(200));
+    assert!(
+        sim.uart_text().contains("Count C:0 "),
+        "{}",
+        sim.uart_text()
+    );
+
+    // Drilling starts from the new zero: nail 0 is where the board stands.
+    press(&mut sim, Button::Confirm, 150);
+    wait_for(&mut sim, "drill 1/24", Duration::from_secs(30));
+    assert_eq!(base_steps(&sim), jog, "hole 0 drilled at the new zero");
+    assert_ram_budget(&sim);
+}
+
+#[test]
+fn a_long_press_pauses_after_the_hole_and_a_short_press_resumes() {
+    let mut sim = prepared();
+    press(&mut sim, Button::Confirm, 150);
+    wait_for(&mut sim, "drill 1/24", Duration::from_secs(30));
+    press(&mut sim, Button::Confirm, 2200);
+    wait_for(
+        &mut sim,
+        ">>> paused: press green to resume",
+        Duration::from_secs(30),
+    );
+    assert!(log_has(&sim, "state: paused"));
+    // The hole being drilled is finished, then the machine stands: drill
+    // raised, drivers holding.
+    let stopped = settle(&mut sim);
+    sim.run_for(Duration::from_secs(3));
+    let still = all_pulses(&sim);
+    assert_eq!(stopped, still, "nothing moves while paused");
+    assert!([Axis::Base, Axis::Radial, Axis::Drill]
+        .iter()
+        .all(|&a| driver_on(&sim, a)));
+    let d = driver(Axis::Drill);
+    assert!(
+        sim.net_steps(d.step, d.dir, true) <= 0,
+        "drill out of the board: {} {}",
+        sim.net_steps(d.step, d.dir, true),
+        sim.uart_text()
+    );
+
+    press(&mut sim, Button::Confirm, 150);
+    wait_for(&mut sim, "resumed", Duration::from_secs(1));
+    sim.run_for(Duration::from_secs(2));
+    assert!(pulses(&sim, Axis::Base) + pulses(&sim, Axis::Drill) > still[0] + still[2]);
+    assert_ram_budget(&sim);
+}
+
+#[test]
+fn serial_feed_hold_and_resume_pause_the_job_the_same_way() {
+    let mut sim = prepared();
+    press(&mut sim, Button::Confirm, 150);
+    wait_for(&mut sim, "drill 1/24", Duration::from_secs(30));
+    sim.uart_send(b"!");
+    wait_for(
+        &mut sim,
+        ">>> paused: press green to resume",
+        Duration::from_secs(30),
+    );
+    let stopped = settle(&mut sim);
+    sim.run_for(Duration::from_secs(2));
+    assert_eq!(all_pulses(&sim), stopped, "nothing moves while paused");
+    sim.uart_send(b"~");
+    wait_for(&mut sim, "resumed", Duration::from_secs(1));
+    wait_for(&mut sim, "drill 2/24", Duration::from_secs(30));
+    assert_ram_budget(&sim);
+}
