@@ -13,7 +13,8 @@ use taut_logic::pinmap::Button;
 /// behind a human's presses).
 pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
 
-/// Pins named as on the RAMPS board: X-MIN, X-MAX, Y-MIN, Z-MIN.
+/// The end-stop inputs of the RAMPS board: X-MAX (green), X-MIN, Y-MIN,
+/// Z-MIN (white).
 pub struct ButtonPins {
     pub confirm: Pin<2, PullUp>,
     pub zero_base: Pin<3, PullUp>,

@@ -222,3 +222,60 @@ fn a_card_pulled_while_being_read_is_reported_and_read_again_when_back() {
     no_motion(&sim);
     assert_ram_budget(&sim);
 }
+
+#[test]
+fn a_card_pulled_while_winding_pauses_the_job_until_it_is_back() {
+    use hil_tests::sim::operator::Operator;
+    use taut_logic::pinmap::Button;
+    // A small job: 6 nails on a circle, 12 wraps.
+    let image = card(&[
+        ("param.txt", b"shape = 0\nnails = 6\nradius_cm = 20\n"),
+        ("poradi.txt", b"12,0,3,1,4,2,5,0,2,4,1,3,5"),
+    ]);
+    let mut sim = boot_machine();
+    sim.insert_sd(image.clone());
+    let mut operator = Operator::confirming();
+    let mut run_until = |sim: &mut Sim, text: &str, limit_s: f64| {
+        while !sim.uart_text().contains(text) {
+            assert!(
+                sim.time_s() < limit_s,
+                "no {text:?} by {limit_s} s:\n{}",
+                sim.uart_text()
+            );
+            sim.run_for(Duration::from_millis(10));
+            operator.step(sim);
+        }
+    };
+    run_until(&mut sim, "wind 3/12", 300.0);
+    let _ = sim.remove_sd();
+    wait_for(&mut sim, "pattern lost", Duration::from_secs(60));
+    wait_for(&mut sim, ">>> insert card", Duration::from_secs(30));
+    // The wrap in progress is finished, then the machine stands, drivers on.
+    sim.run_for(Duration::from_secs(20));
+    let stopped: Vec<usize> = [Axis::Base, Axis::Radial].map(|a| pulses(&sim, a)).into();
+    sim.run_for(Duration::from_secs(3));
+    let still: Vec<usize> = [Axis::Base, Axis::Radial].map(|a| pulses(&sim, a)).into();
+    assert_eq!(stopped, still, "nothing moves without the pattern");
+    assert!(!sim.uart_text().contains("wind 12/12"));
+
+    sim.insert_sd(image);
+    wait_for(&mut sim, "card ok", Duration::from_millis(1500));
+    wait_for(
+        &mut sim,
+        ">>> paused: press green to resume",
+        Duration::from_secs(1),
+    );
+    sim.press(Button::Confirm.pin());
+    sim.run_for(Duration::from_millis(150));
+    sim.release(Button::Confirm.pin());
+    run_until(&mut sim, "state: end", 600.0);
+    let log = messages(&sim);
+    let wound: Vec<&String> = log.iter().filter(|l| l.starts_with("wind ")).collect();
+    assert!(wound.last().unwrap().starts_with("wind 12/12"), "{wound:?}");
+    no_errors(&sim);
+    assert_ram_budget(&sim);
+}
+
+fn no_errors(sim: &Sim) {
+    assert!(!sim.uart_text().contains("[E "), "{}", sim.uart_text());
+}

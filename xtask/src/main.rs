@@ -3,6 +3,7 @@
 //! the idempotent bootstrap (`scripts/setup.sh`).
 
 mod bench;
+mod demo;
 mod firmware;
 mod run;
 
@@ -39,7 +40,7 @@ fn main() -> ExitCode {
         "simtest" => run::setup().and_then(|_| simtest()),
         "sim" => run::setup().and_then(|_| sim(rest)),
         "sdimage" => run::setup().and_then(|_| run::bin("taut-sdimage", rest)),
-        "demo" => run::setup().and_then(|_| demo()),
+        "demo" => run::setup().and_then(|_| demo::run()),
         "bench" => run::setup().and_then(|_| bench::run()),
         "flash" => run::setup().and_then(|_| firmware::flash()),
         "help" | "--help" | "-h" => {
@@ -76,52 +77,4 @@ fn simtest() -> Result<()> {
 fn sim(args: &[String]) -> Result<()> {
     let img = firmware::build_release()?;
     run::taut_sim(&img.elf, args)
-}
-
-fn demo() -> Result<()> {
-    let img = firmware::build_release()?;
-    img.print_size();
-    let out = root().join("target/demo");
-    std::fs::create_dir_all(&out)?;
-    let report = out.join("report.json");
-    let vcd = out.join("trace.vcd");
-    let job = root().join("examples/demo.gcode");
-    println!(
-        "== the simulated machine runs {} (drilling a hexagon's 6 holes)",
-        job.display()
-    );
-    let wall = std::time::Instant::now();
-    run::taut_sim(
-        &img.elf,
-        &[
-            "--send".into(),
-            job.display().to_string(),
-            "--vcd".into(),
-            vcd.display().to_string(),
-            "--report".into(),
-            report.display().to_string(),
-            "--echo".into(),
-        ],
-    )?;
-    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report)?)?;
-    println!(
-        "\nmachine time {:.1} s, wall time {:.1} s",
-        r["sim_seconds"].as_f64().unwrap_or(0.0),
-        wall.elapsed().as_secs_f64()
-    );
-    for pin in r["pins"].as_array().into_iter().flatten() {
-        if let Some(steps) = pin["net_steps"].as_i64() {
-            println!(
-                "  {:<12} {:>6} pulses, net {:>6} steps",
-                pin["name"].as_str().unwrap_or(""),
-                pin["rising"],
-                steps
-            );
-        }
-    }
-    println!(
-        "\nThe full string-art job (card, buttons, winding, picture) arrives with issues 5 and 6."
-    );
-    println!("written: {}\n         {}", report.display(), vcd.display());
-    Ok(())
 }

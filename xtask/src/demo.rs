@@ -1,0 +1,110 @@
+//! `cargo xtask demo`: the string-art machine's whole job on the simulated
+//! Mega. A card image is made from `examples/card/` (a hexagon of 24 nails,
+//! 30 connections), the release firmware reads it, drills every hole,
+//! waits for nails, winds the pattern — the simulated operator pressing
+//! green at each prompt — and `target/demo/` gets the pulse trace, the
+//! report and a picture of the result rebuilt from the step pulses.
+
+use crate::firmware;
+use crate::run::{self, root, Result};
+
+pub fn run() -> Result<()> {
+    let img = firmware::build_release()?;
+    img.print_size();
+    let out = root().join("target/demo");
+    std::fs::create_dir_all(&out)?;
+    let card = out.join("card.img");
+    let (report, vcd, png) = (
+        out.join("report.json"),
+        out.join("trace.vcd"),
+        out.join("result.png"),
+    );
+    let folder = root().join("examples/card");
+    println!("== card image {} from {}", card.display(), folder.display());
+    run::bin(
+        "taut-sdimage",
+        &[
+            folder.display().to_string(),
+            "-o".into(),
+            card.display().to_string(),
+        ],
+    )?;
+    println!("== the simulated machine runs the job (green pressed at each prompt)");
+    let wall = std::time::Instant::now();
+    let path = |p: &std::path::Path| p.display().to_string();
+    run::taut_sim(
+        &img.elf,
+        &[
+            "--sd".into(),
+            path(&card),
+            "--auto-confirm".into(),
+            "--vcd".into(),
+            path(&vcd),
+            "--report".into(),
+            path(&report),
+            "--png".into(),
+            path(&png),
+        ],
+    )?;
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report)?)?;
+    let job = &r["job"];
+    println!(
+        "\njob: {} ({} green presses), machine time {:.1} s, wall time {:.1} s",
+        job["state"].as_str().unwrap_or("?"),
+        job["green_presses"],
+        r["sim_seconds"].as_f64().unwrap_or(0.0),
+        wall.elapsed().as_secs_f64()
+    );
+    if job["finished"] != true {
+        return Err("the job did not finish".into());
+    }
+    let (together, sequential) = estimate(&folder)?;
+    println!(
+        "host estimate from the same files: {together:.1} s with the axes of a move together \
+         (this firmware), {sequential:.1} s one axis after another (the original's blocking moves)"
+    );
+    println!(
+        "written: {}\n         {}\n         {}",
+        png.display(),
+        vcd.display(),
+        report.display()
+    );
+    Ok(())
+}
+
+/// Machine time of the card's job on the host (`stringart::machine_time`):
+/// drilling and winding, each axis on its own trapezoid, with the axes of a
+/// move together and one after another.
+fn estimate(folder: &std::path::Path) -> Result<(f64, f64)> {
+    use taut_logic::config::MachineConfig;
+    use taut_logic::geometry::Board;
+    use taut_logic::job::param::ParamFile;
+    use taut_logic::job::poradi::PoradiReader;
+    use taut_logic::stringart::{machine_time, Drilling, Overlap, Step, Winder, Winding};
+    use taut_logic::units::Milli;
+    let bad = |e: taut_logic::job::FileError| format!("{e:?}");
+    let mut param = ParamFile::new();
+    param
+        .push(&std::fs::read(folder.join("param.txt"))?)
+        .map_err(bad)?;
+    let p = param.finish().map_err(bad)?;
+    let mut reader = PoradiReader::new(p.nails);
+    let text = std::fs::read(folder.join("poradi.txt"))?;
+    let (mut at, mut nails) = (0, Vec::new());
+    while at < text.len() {
+        let (used, nail) = reader.next(&text[at..]).map_err(bad)?;
+        at += used;
+        nails.extend(nail);
+    }
+    nails.extend(reader.finish().map_err(bad)?);
+    let c = MachineConfig::STRING_ART;
+    let board = Board::new(p.shape, p.nails, Milli(p.radius_um as i32)).map_err(|e| e.message())?;
+    let winder = Winder::new(board, &c).map_err(|e| format!("{e:?}"))?;
+    let steps: Vec<Step> = Drilling::new(board, &c)
+        .chain(Winding::new(winder, nails.into_iter()).map_while(|s| s.ok()))
+        .collect();
+    Ok((
+        machine_time(steps.iter().copied(), &c, Overlap::Together),
+        machine_time(steps.iter().copied(), &c, Overlap::Sequential),
+    ))
+}
