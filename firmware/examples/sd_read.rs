@@ -7,7 +7,7 @@
 #![feature(abi_avr_interrupt)]
 
 use panic_halt as _;
-use taut_firmware::board::spi::{CardSpi, Spi};
+use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{clock, gpio::Pins, usart};
 use taut_firmware::card::{CardReader, Poll, Request, What, CARD_IN, CARD_OUT};
 use taut_firmware::info;
@@ -22,15 +22,14 @@ fn main() -> ! {
     );
     clock::Clock::start(dp.TC0);
     usart::Usart0::start(dp.USART0);
-    let cs = pins.d53.into_output_at(true);
-    let bus = Spi::start(
+    let spi = CardSpi::start(
         dp.SPI,
         pins.d52.into_output(),
         pins.d51.into_output(),
-        pins.d50.into_floating_input(),
-        &cs,
+        pins.d50,
+        pins.d53,
     );
-    let mut reader = CardReader::new(CardSpi { bus, cs });
+    let mut reader = CardReader::new(spi);
     // SAFETY: the two handlers below touch only the clock and the TX ring.
     unsafe { avr_device::interrupt::enable() };
     loop {

@@ -25,7 +25,7 @@
 use embedded_hal::digital::OutputPin;
 use panic_halt as _;
 use taut_firmware::board::gpio::{Output, Pin};
-use taut_firmware::board::spi::{CardSpi, Spi};
+use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{
     self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
 };
@@ -192,15 +192,14 @@ fn init() -> Watchdog {
     let drivers = Drivers::new(enable, &config);
     let stepper = Stepper::new(StepTimer::start(dp.TC1), &config);
     MOTION.with(|m| *m = Some(Motion::new(&config, stepper, drivers)));
-    let cs = pins.d53.into_output_at(true);
-    let bus = Spi::start(
+    let spi = CardSpi::start(
         dp.SPI,
         pins.d52.into_output(),
         pins.d51.into_output(),
-        pins.d50.into_floating_input(),
-        &cs,
+        pins.d50,
+        pins.d53,
     );
-    CARD.with(|c| *c = Some(CardReader::new(CardSpi { bus, cs })));
+    CARD.with(|c| *c = Some(CardReader::new(spi)));
     buttons::start(ButtonPins {
         confirm: pins.d2.into_pull_up_input(),
         zero_base: pins.d3.into_pull_up_input(),

@@ -125,3 +125,14 @@ pub fn pulses(sim: &sim::Sim, axis: taut_logic::axis::Axis) -> usize {
         .filter(|e| e.high)
         .count()
 }
+
+/// Run until the serial log contains `text`; panic with the log otherwise.
+pub fn wait_for(sim: &mut sim::Sim, text: &str, timeout: std::time::Duration) {
+    let end = sim.run_until_uart_contains(text, timeout);
+    assert_eq!(
+        end,
+        sim::Outcome::Done,
+        "waiting for {text:?}:\n{}",
+        sim.uart_text()
+    );
+}

@@ -5,22 +5,12 @@
 
 use hil_tests::sim::operator::message;
 use hil_tests::sim::sdcard::SdImage;
-use hil_tests::sim::{Outcome, Sim};
-use hil_tests::{assert_ram_budget, boot_machine, pulses, sample_card_dir, send_ok};
+use hil_tests::sim::Sim;
+use hil_tests::{assert_ram_budget, boot_machine, pulses, sample_card_dir, send_ok, wait_for};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::{driver, Button};
-
-fn wait_for(sim: &mut Sim, text: &str, timeout: Duration) {
-    let end = sim.run_until_uart_contains(text, timeout);
-    assert_eq!(
-        end,
-        Outcome::Done,
-        "waiting for {text:?}:\n{}",
-        sim.uart_text()
-    );
-}
 
 /// Held for `ms`, then released, then 100 ms to settle.
 fn press(sim: &mut Sim, button: Button, ms: u64) {

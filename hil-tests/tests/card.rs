@@ -5,7 +5,7 @@
 
 use hil_tests::sim::operator::message;
 use hil_tests::sim::{Outcome, Sim};
-use hil_tests::{assert_ram_budget, boot_machine, card, pulses, sample_card_dir};
+use hil_tests::{assert_ram_budget, boot_machine, card, pulses, sample_card_dir, wait_for};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 
@@ -18,16 +18,6 @@ fn messages(sim: &Sim) -> Vec<String> {
         .lines()
         .filter_map(|l| message(l).map(str::to_string))
         .collect()
-}
-
-fn wait_for(sim: &mut Sim, text: &str, timeout: Duration) {
-    let end = sim.run_until_uart_contains(text, timeout);
-    assert_eq!(
-        end,
-        Outcome::Done,
-        "waiting for {text:?}:\n{}",
-        sim.uart_text()
-    );
 }
 
 fn no_motion(sim: &Sim) {

@@ -4,8 +4,8 @@
 //! back byte for byte, in FAT16 and FAT32 and with clusters of one and of
 //! several blocks, with at most two device reads per block.
 
-use std::collections::BTreeMap;
-use std::path::PathBuf;
+mod common;
+
 use taut_logic::fat::{BlockRead, FatError, File, Volume, BLOCK};
 use taut_simavr::sdimage::{build_image_with_layout, FatChoice, Layout};
 
@@ -26,38 +26,6 @@ impl BlockRead for Image {
         buf.copy_from_slice(block);
         Ok(())
     }
-}
-
-/// A folder of job files as in sdcard_host.rs: 8.3 names in mixed case, a
-/// multi-cluster file of `big_bytes`, an empty file and a subfolder.
-fn job_folder(tag: &str, big_bytes: usize) -> (PathBuf, BTreeMap<String, Vec<u8>>) {
-    let dir = std::env::temp_dir().join(format!("taut-fat-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(dir.join("Gcode")).unwrap();
-    let mut seed = 0x2545_F491u32;
-    let big: Vec<u8> = (0..big_bytes)
-        .map(|_| {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed as u8
-        })
-        .collect();
-    let poradi: String = (0..3000).map(|i| format!("{},", i * 7 % 200)).collect();
-    let files: [(&str, Vec<u8>); 6] = [
-        ("param.txt", b"tvar = 1\r\npocet_hrebiku = 200\r\n".to_vec()),
-        ("PORADI.TXT", format!("3000,\n{poradi}").into_bytes()),
-        ("Machine.Txt", b"# overrides\nbase.accel = 4000\n".to_vec()),
-        ("BIG.BIN", big),
-        ("EMPTY", Vec::new()),
-        ("Gcode/Part1.gco", b"G28\nG1 X10 Y10 F3000\n".to_vec()),
-    ];
-    let mut expected = BTreeMap::new();
-    for (name, bytes) in files {
-        std::fs::write(dir.join(name), &bytes).unwrap();
-        expected.insert(name.to_owned(), bytes);
-    }
-    (dir, expected)
 }
 
 /// The whole file through `read_next`, checking that each call reads at
@@ -82,7 +50,7 @@ fn read_all(vol: &Volume, image: &mut Image, file: &mut File) -> Vec<u8> {
 
 fn check(fat: FatChoice, big_bytes: usize) -> Layout {
     let tag = format!("{fat:?}-{big_bytes}");
-    let (dir, files) = job_folder(&tag, big_bytes);
+    let (dir, files) = common::job_folder(&tag, big_bytes);
     let (bytes, layout) = build_image_with_layout(&dir, fat).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     let mut image = Image { bytes, reads: 0 };

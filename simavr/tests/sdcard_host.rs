@@ -3,12 +3,13 @@
 //! listed and read back byte for byte, in FAT16 and FAT32, on SDSC and SDHC
 //! cards, with CRC on and off; writes land in the image; faults surface.
 
+mod common;
+
 use embedded_hal::spi::{Operation, SpiDevice};
 use embedded_sdmmc::embedded_sdmmc_types::sdcard::CardType;
 use embedded_sdmmc::sdcard::spi::AcquireOpts;
 use embedded_sdmmc::{Mode, TimeSource, Timestamp, VolumeIdx, VolumeManager};
 use std::cell::RefCell;
-use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -82,38 +83,6 @@ fn mount(card: SdCard, use_crc: bool) -> (Rc<RefCell<SdCard>>, Volumes) {
     (card, VolumeManager::new(sd, Clock))
 }
 
-/// A folder of job files: 8.3 names in mixed case, a multi-cluster file of
-/// several hundred KiB, an empty file and a subfolder.
-fn job_folder(tag: &str) -> (PathBuf, BTreeMap<String, Vec<u8>>) {
-    let dir = std::env::temp_dir().join(format!("taut-sd-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(dir.join("Gcode")).unwrap();
-    let mut seed = 0x2545_F491u32;
-    let big: Vec<u8> = (0..700 * 1024 + 123)
-        .map(|_| {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed as u8
-        })
-        .collect();
-    let poradi: String = (0..3000).map(|i| format!("{},", i * 7 % 200)).collect();
-    let files: [(&str, Vec<u8>); 6] = [
-        ("param.txt", b"tvar = 1\r\npocet_hrebiku = 200\r\n".to_vec()),
-        ("PORADI.TXT", format!("3000,\n{poradi}").into_bytes()),
-        ("Machine.Txt", b"# overrides\nbase.accel = 4000\n".to_vec()),
-        ("BIG.BIN", big),
-        ("EMPTY", Vec::new()),
-        ("Gcode/Part1.gco", b"G28\nG1 X10 Y10 F3000\n".to_vec()),
-    ];
-    let mut expected = BTreeMap::new();
-    for (name, bytes) in files {
-        std::fs::write(dir.join(name), &bytes).unwrap();
-        expected.insert(name.to_owned(), bytes);
-    }
-    (dir, expected)
-}
-
 /// Everything in a directory: (short name, size, is a directory).
 fn list<D: embedded_sdmmc::BlockDevice>(
     dir: &embedded_sdmmc::Directory<'_, D, Clock, 4, 4, 1>,
@@ -129,7 +98,7 @@ fn list<D: embedded_sdmmc::BlockDevice>(
 
 fn check_card(fat: FatChoice, kind: CardKind, use_crc: bool, ncr: u8) {
     let tag = format!("{fat:?}-{kind:?}-{use_crc}-{ncr}");
-    let (dir, files) = job_folder(&tag);
+    let (dir, files) = common::job_folder(&tag, 700 * 1024 + 123);
     let (image, layout) = sdimage::build_image_with_layout(&dir, fat).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(layout.fat32, fat == FatChoice::Fat32, "{tag}");
@@ -233,7 +202,7 @@ fn card_type_and_size_as_the_driver_sees_them() {
 /// What `embedded-sdmmc` writes, `fatfs` reads back from the image.
 #[test]
 fn files_written_by_the_driver_are_in_the_image() {
-    let (dir, _) = job_folder("write");
+    let (dir, _) = common::job_folder("write", 700 * 1024 + 123);
     let image = sdimage::build_image(&dir, FatChoice::Fat16).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     let log: Vec<u8> = (0..5000u32).flat_map(|i| i.to_le_bytes()).collect();
@@ -271,7 +240,7 @@ fn read_with_fatfs(image: &[u8], name: &str) -> Vec<u8> {
 
 /// A card with job files whose first data block of BIG.BIN is known.
 fn faulty_setup(tag: &str) -> (Rc<RefCell<SdCard>>, Volumes, u32) {
-    let (dir, files) = job_folder(tag);
+    let (dir, files) = common::job_folder(tag, 700 * 1024 + 123);
     let image = sdimage::build_image(&dir, FatChoice::Fat16).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     let big = &files["BIG.BIN"];
@@ -343,7 +312,7 @@ fn a_card_pulled_mid_read_fails_until_reinserted() {
 
 #[test]
 fn image_written_to_a_file_is_the_same_card() {
-    let (dir, files) = job_folder("file");
+    let (dir, files) = common::job_folder("file", 700 * 1024 + 123);
     let image = SdImage::from_dir(&dir, FatChoice::Auto).unwrap();
     let path = dir.with_extension("img");
     image.save(&path).unwrap();

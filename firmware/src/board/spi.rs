@@ -94,6 +94,19 @@ pub struct CardSpi {
 }
 
 impl CardSpi {
+    /// The card on the hardware SPI, deselected, at the slow init clock.
+    pub fn start(
+        spi: SPI,
+        sck: Pin<52, Output>,
+        mosi: Pin<51, Output>,
+        miso: Pin<50, Floating>,
+        cs: Pin<53, Floating>,
+    ) -> CardSpi {
+        let cs = cs.into_output_at(true);
+        let bus = Spi::start(spi, sck, mosi, miso, &cs);
+        CardSpi { bus, cs }
+    }
+
     /// Clocks with the card deselected: 80 of them wake a card up.
     pub fn idle_clocks(&mut self, bytes: u8) {
         for _ in 0..bytes {

@@ -11,7 +11,9 @@ use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
 use taut_logic::pinmap::{self, Button};
 use taut_simavr::operator::{Operator, Seen};
+use taut_logic::config::MachineConfig;
 use taut_simavr::sdcard::SdImage;
+use taut_simavr::{picture, replay};
 use taut_simavr::{Outcome, Reply, Sim};
 
 const USAGE: &str = "\
@@ -26,6 +28,8 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]] [--send FILE]
   --for SECONDS   simulated time to run (default 5; with --send: extra time
                   after motion is idle, default 0)
   --vcd PATH      write a VCD trace of every probed pin
+  --png PATH      draw the string-art job from the step pulses alone (the
+                  board from the card's param.txt; needs --sd)
   --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
   --auto-confirm  press the green button whenever the job asks for it, and
                   run until the job is done (or --for SECONDS, default 7200)
@@ -38,6 +42,7 @@ struct Args {
     send: Option<PathBuf>,
     seconds: Option<f64>,
     vcd: Option<PathBuf>,
+    png: Option<PathBuf>,
     report: Option<PathBuf>,
     echo: bool,
     auto_confirm: bool,
@@ -52,6 +57,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         send: None,
         seconds: None,
         vcd: None,
+        png: None,
         report: None,
         echo: false,
         auto_confirm: false,
@@ -70,14 +76,15 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             }
             "--send" => args.send = Some(value()?.into()),
             "--vcd" => args.vcd = Some(value()?.into()),
+            "--png" => args.png = Some(value()?.into()),
             "--report" => args.report = Some(value()?.into()),
             "--echo" => args.echo = true,
             "--auto-confirm" => args.auto_confirm = true,
             _ => return Err(format!("unknown option {a}")),
         }
     }
-    if args.sd_insert_at.is_some() && args.sd.is_none() {
-        return Err("--sd-insert-at needs --sd".into());
+    if (args.sd_insert_at.is_some() || args.png.is_some()) && args.sd.is_none() {
+        return Err("--sd-insert-at and --png need --sd".into());
     }
     Ok(args)
 }
@@ -128,8 +135,10 @@ fn stream(
 fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     let mut sim = Sim::load(&args.elf)?;
     probe_machine(&mut sim);
+    let mut param = None;
     if let Some(path) = &args.sd {
         let card = SdImage::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        param = card.read_file("param.txt");
         match args.sd_insert_at {
             Some(s) => sim.sd_insert_at(Duration::from_secs_f64(s), card),
             None => sim.insert_sd(card),
@@ -177,6 +186,21 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     if let Some(path) = &args.vcd {
         sim.write_vcd(path)?;
     }
+    let mut picture = None;
+    if let Some(path) = &args.png {
+        let param = param.ok_or("--png: the card has no param.txt")?;
+        let board = replay::board_from_param(&param).map_err(|e| format!("param.txt: {e}"))?;
+        let s = picture::render_job(&sim.vcd_signals(), board, &MachineConfig::STRING_ART, path)?;
+        eprintln!(
+            "taut-sim: {}: {} holes, {} wraps, {} ring crossings outside a gap, {} moves with the drill down",
+            path.display(),
+            s.holes,
+            s.wraps,
+            s.crossings_outside_gaps,
+            s.moves_while_plunged
+        );
+        picture = Some(serde_json::to_value(&s)?);
+    }
     if let Some(path) = &args.report {
         let mut report = serde_json::to_value(sim.report(outcome))?;
         let extra = json!({
@@ -186,6 +210,7 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
                 "state": operator.state,
                 "finished": operator.finished,
                 "green_presses": operator.presses,
+                "picture": picture,
             },
         });
         report

@@ -82,6 +82,30 @@ impl SdImage {
         out
     }
 
+    /// A file of the root directory (8.3 name, any case), read with the
+    /// firmware's own FAT reader (`taut_logic::fat`); `None` if missing.
+    pub fn read_file(&self, name: &str) -> Option<Vec<u8>> {
+        use taut_logic::fat::{BlockRead, Volume};
+        struct Blocks<'a>(&'a SdImage);
+        impl BlockRead for Blocks<'_> {
+            type Error = std::convert::Infallible;
+            fn read_block(&mut self, lba: u32, buf: &mut [u8; BLOCK]) -> Result<(), Self::Error> {
+                *buf = self.0.block(lba);
+                Ok(())
+            }
+        }
+        let (mut dev, mut buf) = (Blocks(self), [0; BLOCK]);
+        let volume = Volume::mount(&mut dev, &mut buf).ok()?;
+        let mut file = volume.open(&mut dev, &mut buf, name.as_bytes()).ok()?;
+        let mut out = Vec::new();
+        loop {
+            match file.read_next(&volume, &mut dev, &mut buf).ok()? {
+                0 => return Some(out),
+                n => out.extend_from_slice(&buf[..n]),
+            }
+        }
+    }
+
     /// Writes block `n`, growing the image when it lies past the end.
     pub fn write_block(&mut self, n: u32, data: &[u8; BLOCK]) {
         let start = n as usize * BLOCK;

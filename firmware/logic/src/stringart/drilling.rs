@@ -2,7 +2,8 @@
 //! surface, the base and the carriage move together to the nail, the drill
 //! plunges 1 cm deep along its tilted axis, dwells and retracts. The base
 //! and the carriage only move while the drill is raised. After the last
-//! hole the tool goes back over nail 0 and the drivers are switched off.
+//! hole the tool goes back to nail 0's angle at the board's edge (the zero
+//! pose) and the drivers are switched off.
 
 use super::{Step, DRILL_ANGLE_DEG, DRILL_CLEARANCE_MM, DWELL_MS, HOLE_DEPTH_MM, MACHINE_DRIVERS};
 use crate::axis::{Axis, AXES};
@@ -65,6 +66,18 @@ impl Drilling {
     }
 }
 
+impl Drilling {
+    /// After the last hole: back to nail 0's angle with the tool at the
+    /// board's edge (the zero pose), clear of the nails about to go in.
+    fn home(&mut self) -> Step {
+        self.base = self.scale.shorter_rotation(self.base, self.board.nail(0).angle);
+        let mut t = [None; AXES];
+        t[Axis::Base.index()] = Some(self.base);
+        t[Axis::Radial.index()] = Some(0);
+        Step::Move(t)
+    }
+}
+
 impl Iterator for Drilling {
     type Item = Step;
 
@@ -83,7 +96,7 @@ impl Iterator for Drilling {
                 };
                 (Step::to(Axis::Drill, self.raised), next)
             }
-            Stage::Home => (self.over_nail(0), Stage::Off),
+            Stage::Home => (self.home(), Stage::Off),
             Stage::Off => (
                 Step::Drivers {
                     mask: MACHINE_DRIVERS,
@@ -124,11 +137,12 @@ mod tests {
         assert_eq!(steps[9], mv(800, -2139));
         // Nail 23 (346.1°): the base keeps turning forwards, past 9229.
         assert_eq!(steps[1 + 23 * 4], mv(9229, -1701));
-        // Back over nail 0 the short way (a full turn on), then off.
+        // Back to nail 0's angle the short way (a full turn on), tool at the
+        // board's edge, then off.
         assert_eq!(
             steps[97..],
             [
-                mv(9600, -480),
+                mv(9600, 0),
                 Step::Drivers {
                     mask: 0b111,
                     on: false

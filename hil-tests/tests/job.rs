@@ -1,0 +1,127 @@
+//! The whole string-art job of the sample card (`examples/card`: hexagon,
+//! 24 nails, 30 connections) on the release image, with an operator who
+//! presses green at each prompt, judged from its VCD trace alone: the
+//! machine's motion is rebuilt from the STEP/DIR/ENABLE pulses
+//! (`taut_simavr::replay`), not taken from the firmware's word.
+//!
+//! About 700 s of machine time: the job runs once, and every check reads
+//! that one trace. It also draws `target/hil-job.png` to be looked at.
+
+use hil_tests::sim::operator::Operator;
+use hil_tests::sim::replay::{board_from_param, JobReplay};
+use hil_tests::sim::sdcard::SdImage;
+use hil_tests::sim::{picture, vcd, Outcome};
+use hil_tests::{assert_ram_budget, boot_machine, sample_card_dir};
+use std::f64::consts::TAU;
+use std::path::Path;
+use std::time::{Duration, Instant};
+use taut_logic::config::MachineConfig;
+use taut_logic::geometry::StepScale;
+
+/// The job must be over by then (it takes about 700 s).
+const TIMEOUT_S: f64 = 1500.0;
+
+/// `poradi.txt`: the count C, then C nail indices.
+fn pattern(text: &str) -> Vec<u16> {
+    let numbers: Vec<u16> = text
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().expect("a number"))
+        .collect();
+    let (count, nails) = numbers.split_first().expect("a count");
+    assert_eq!(usize::from(*count), nails.len(), "poradi.txt's count");
+    nails.to_vec()
+}
+
+#[test]
+fn the_sample_job_drills_and_winds_as_its_pulses_show() {
+    let wall = Instant::now();
+    let config = MachineConfig::STRING_ART;
+    let card = sample_card_dir();
+    let mut sim = boot_machine();
+    sim.insert_sd(SdImage::from_path(&card).unwrap());
+    let mut op = Operator::confirming();
+    while !op.finished {
+        let end = sim.run_for(Duration::from_millis(10));
+        assert_eq!(end, Outcome::Running, "{}", sim.uart_text());
+        op.step(&mut sim);
+        assert!(
+            sim.time_s() < TIMEOUT_S,
+            "not finished after {TIMEOUT_S} s:\n{}",
+            sim.uart_text()
+        );
+    }
+    let finished_ns = (sim.time_s() * 1e9) as u64;
+    // A moment at the end, to see the machine stay still.
+    sim.run_for(Duration::from_millis(500));
+    assert_eq!(op.presses, 2, "green: drill, wind\n{}", sim.uart_text());
+    let simulated = wall.elapsed();
+
+    // Back from the VCD text, as any viewer would read it.
+    let path = std::env::temp_dir().join(format!("taut-hil-job-{}.vcd", std::process::id()));
+    sim.write_vcd(&path).unwrap();
+    let signals = vcd::parse(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let board = board_from_param(&std::fs::read(card.join("param.txt")).unwrap()).unwrap();
+    let job = JobReplay::from_signals(&signals, board, &config).unwrap();
+    let scale = StepScale::from_config(&config);
+    let turn = i64::from(scale.steps_per_turn);
+    let radial_per_mm = f64::from(scale.radial.as_f32());
+
+    // A hole at every nail, in order, where the geometry puts it.
+    let plunges = job.plunges();
+    assert_eq!(plunges.len(), usize::from(board.nails()), "{plunges:#?}");
+    for (i, p) in plunges.iter().enumerate() {
+        let nail = board.nail(i as u16);
+        let want = f64::from(nail.angle) / TAU * turn as f64;
+        let off = (p.base.rem_euclid(turn) as f64 - want).rem_euclid(turn as f64);
+        assert!(
+            off.min(turn as f64 - off) <= 1.0,
+            "hole {i}: base at {} steps, nail at {want:.2} ({p:?})",
+            p.base
+        );
+        let want = f64::from(nail.radius - board.radius()) * radial_per_mm;
+        assert!(
+            (p.radial as f64 - want).abs() <= 1.0,
+            "hole {i}: radial at {} steps, nail at {want:.2} ({p:?})",
+            p.radial
+        );
+    }
+    let stray = job.moves_while_plunged();
+    assert!(
+        stray.is_empty(),
+        "moved with the drill below: {:?}",
+        &stray[..stray.len().min(10)]
+    );
+
+    // Winding: every nail of the pattern, the last one included.
+    let pattern = pattern(&std::fs::read_to_string(card.join("poradi.txt")).unwrap());
+    let wraps = job.wraps();
+    assert!(wraps.iter().all(|w| w.nails.len() == 1), "{wraps:#?}");
+    assert_eq!(job.wrapped_nails(), pattern);
+    let crossings = job.crossings();
+    // The entry, then out and in for each wrap.
+    assert_eq!(crossings.len(), 1 + 2 * pattern.len(), "{crossings:#?}");
+    let bad = job.crossings_outside_gaps();
+    assert!(bad.is_empty(), "crossed the ring at a nail: {bad:#?}");
+
+    // Drivers off while waiting for nails (green pressed to wind) and at
+    // the end.
+    let wind = job.trace.presses("confirm")[1];
+    assert_eq!(job.winding().0, wind);
+    assert_eq!(job.trace.drivers_on(wind), [false; 3], "at {wind} ns");
+    assert_eq!(job.trace.drivers_on(finished_ns), [false; 3]);
+    assert_eq!(job.trace.drivers_on(u64::MAX), [false; 3]);
+
+    let png = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/hil-job.png");
+    let summary = picture::render(&job, &png).unwrap();
+    assert_eq!((summary.holes, summary.wraps), (24, 30));
+    eprintln!(
+        "job: {:.1} s machine time, simulated in {:.1} s, checked in {:.1} s; {}",
+        sim.time_s(),
+        simulated.as_secs_f64(),
+        (wall.elapsed() - simulated).as_secs_f64(),
+        png.display()
+    );
+    assert_ram_budget(&sim);
+}
