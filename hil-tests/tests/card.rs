@@ -55,6 +55,44 @@ fn the_sample_card_is_read_and_checked_before_anything_can_start() {
     assert_ram_budget(&sim);
 }
 
+/// FAT16 and FAT32, SDSC and SDHC cards, names in any case: the same files
+/// read the same.
+#[test]
+fn fat16_fat32_sdsc_and_sdhc_cards_all_read() {
+    use hil_tests::sim::sdcard::{CardKind, SdCard, SdConfig, SdImage};
+    use hil_tests::sim::sdimage::FatChoice;
+    let dir = std::env::temp_dir().join(format!("taut-hil-kinds-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("PARAM.TXT"), PARAM).unwrap();
+    std::fs::write(dir.join("Poradi.Txt"), PORADI).unwrap();
+    for fat in [FatChoice::Fat16, FatChoice::Fat32] {
+        for kind in [CardKind::Sdsc, CardKind::Sdhc] {
+            let image = SdImage::from_dir(&dir, fat).unwrap();
+            let config = SdConfig {
+                kind,
+                ..SdConfig::default()
+            };
+            let mut sim = boot_machine();
+            sim.insert_sd(SdCard::with_config(image, config));
+            let fat_name = if fat == FatChoice::Fat32 {
+                "FAT32"
+            } else {
+                "FAT16"
+            };
+            wait_for(&mut sim, fat_name, Duration::from_millis(1500));
+            wait_for(
+                &mut sim,
+                "files ok: shape 6 nails 24 radius 200000um connections 3",
+                Duration::from_secs(1),
+            );
+            no_motion(&sim);
+            assert_ram_budget(&sim);
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_card_inserted_three_seconds_after_boot_is_found() {
     let mut sim = boot_machine();

@@ -1,6 +1,6 @@
 //! Issue 3: the scheduler under load, the watchdog, and the RAM budget.
 
-use hil_tests::{example_elf, firmware_elf, sim::Outcome, sim::Sim};
+use hil_tests::{assert_ram_budget, example_elf, firmware_elf, sim::Outcome, sim::Sim};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 use taut_logic::pinmap::driver;
@@ -10,19 +10,9 @@ const STEP_VECTOR: u32 = 0x44;
 /// Documented bound (README): no code masks the step interrupt longer
 /// (measured: 47 cycles in the benchmark cruise, 71 with console traffic).
 const MASKED_BOUND_CYCLES: u64 = 80;
-const RAM_BUDGET: u32 = 6 * 1024;
 
 fn send(sim: &mut Sim, line: &str) {
     hil_tests::send_ok(sim, line, Duration::from_secs(2));
-}
-
-fn assert_ram_budget(sim: &Sim) {
-    let statics = sim.elf().unwrap().ram_static_bytes();
-    let stack = sim.peak_stack_bytes() as u32;
-    assert!(
-        statics + stack < RAM_BUDGET,
-        "static {statics} B + stack {stack} B"
-    );
 }
 
 /// Motion at the configured maximum step rate while a sender streams commands as Grbl
