@@ -114,7 +114,8 @@ fn a_card_inserted_three_seconds_after_boot_is_found() {
 #[test]
 fn every_bad_file_gets_its_message_and_nothing_moves() {
     let big_param = b"tvar = 0\npocet_hrebiku = 24\npolomer_matrice = 20\n";
-    let cases: &[(&[(&str, &[u8])], &str)] = &[
+    type Files<'a> = &'a [(&'a str, &'a [u8])];
+    let cases: &[(Files, &str)] = &[
         (&[("poradi.txt", PORADI)], "param.txt: file not found"),
         (&[("param.txt", PARAM)], "poradi.txt: file not found"),
         (

@@ -167,7 +167,8 @@ mod tests {
 
     #[test]
     fn each_file_reports_its_own_errors() {
-        let cases: [(&[(FileName, Option<&[u8]>)], &str); 4] = [
+        type Card<'a> = &'a [(FileName, Option<&'a [u8]>)];
+        let cases: [(Card, &str); 4] = [
             (&[(FileName::Param, None)], "param.txt: file not found"),
             (
                 &[(FileName::Param, Some(PARAM)), (FileName::Poradi, None)],

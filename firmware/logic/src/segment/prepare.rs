@@ -35,6 +35,12 @@ pub struct Preparer {
     fresh: bool,
 }
 
+impl Default for Preparer {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Preparer {
     pub const fn new() -> Self {
         Preparer {

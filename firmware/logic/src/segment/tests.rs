@@ -116,7 +116,7 @@ fn worst_error(ramps: &[Ramp]) -> f64 {
 fn roots_are_exact() {
     for x in [0u64, 1, 2, 3, 4, 8, 26, 27, 1 << 40, u64::MAX] {
         let r = isqrt(x);
-        assert!(r * r <= x && (r + 1).checked_mul(r + 1).map_or(true, |s| s > x));
+        assert!(r * r <= x && (r + 1).checked_mul(r + 1).is_none_or(|s| s > x));
     }
 }
 
@@ -149,7 +149,7 @@ proptest::proptest! {
     fn isqrt_is_the_floor_root(x in proptest::prelude::any::<u64>()) {
         let r = isqrt(x);
         proptest::prop_assert!(r * r <= x);
-        proptest::prop_assert!((r + 1).checked_mul(r + 1).map_or(true, |s| s > x));
+        proptest::prop_assert!((r + 1).checked_mul(r + 1).is_none_or(|s| s > x));
     }
 }
 

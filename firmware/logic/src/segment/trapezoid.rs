@@ -129,7 +129,7 @@ impl Trapezoid {
         if k0 < self.k_acc {
             return Some((Phase::Accel, self.k_acc));
         }
-        let past_accel = k0 > self.k_acc || self.acc2 % self.two_a == 0;
+        let past_accel = k0 > self.k_acc || self.acc2.is_multiple_of(self.two_a);
         if past_accel && k0 < self.k_dec {
             return Some((Phase::Cruise, self.k_dec));
         }
