@@ -144,9 +144,11 @@ impl CardReader {
         }
     }
 
-    fn work(&mut self, second: bool) -> Poll {
+    /// The step of work; `check`: look for the card or at it. Its `Idle`
+    /// carries no delay: `poll` puts in the time to the next check.
+    fn work(&mut self, check: bool) -> Poll {
         match self.slot {
-            Slot::Empty if second => self.look_for_card(),
+            Slot::Empty if check => self.look_for_card(),
             Slot::Empty => Poll::Idle(0),
             Slot::Mounted(volume) => {
                 if let Some(Request::Open(name, ticket)) = CARD_IN.peek() {
@@ -159,7 +161,7 @@ impl CardReader {
                 }
                 match volume {
                     Some(v) if self.file.is_some() => self.stream(v),
-                    _ if second => self.check_still_there(),
+                    _ if check => self.check_still_there(),
                     _ => Poll::Idle(0),
                 }
             }
@@ -192,8 +194,7 @@ impl CardReader {
             }
         };
         self.sd.spi(|spi| spi.bus.full_speed());
-        let mut buf = Device(&self.sd);
-        let volume = match Volume::mount(&mut buf, &mut self.block.contents) {
+        let volume = match Volume::mount(&mut Device(&self.sd), &mut self.block.contents) {
             Ok(v) => {
                 info!(
                     "card: ",

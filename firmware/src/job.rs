@@ -110,16 +110,13 @@ impl JobTask {
         }
     }
 
-    pub fn state(&self) -> State {
-        self.job.state()
-    }
-
     /// Once at boot: drivers off, waiting for a card.
     pub fn power_on(&mut self, now: u32) {
         self.event(Event::PowerOn, now);
     }
 
-    /// One run: carry out pending actions, then take one input, then move.
+    /// One run: carry out the pending actions and then each input in turn
+    /// (while their log lines fit), feed winding its nails, then move.
     pub fn poll(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> Poll {
         loop {
             if let Some(p) = self.carry_out(m) {
