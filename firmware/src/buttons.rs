@@ -1,16 +1,22 @@
-//! The machine's four buttons (RAMPS end-stop inputs, see `pinmap`),
-//! sampled by the millisecond tick and debounced by
-//! `taut_logic::buttons`. Events go to the job through [`BUTTONS`].
+//! The machine's four buttons (RAMPS end-stop inputs, see `pinmap`). The
+//! millisecond tick samples the pins — only while a button is down or has
+//! just changed — into [`SAMPLES`]; the buttons task debounces them
+//! (`taut_logic::buttons`) and sends the presses to the job through
+//! [`BUTTONS`].
 
 use crate::board::gpio::{Pin, PullUp};
 use crate::rt::Ring;
 use core::cell::UnsafeCell;
 use embedded_hal::digital::InputPin;
-use taut_logic::buttons::{ButtonEvent, Buttons};
+use taut_logic::buttons::{ButtonEvent, Buttons, DEBOUNCE_MS};
 use taut_logic::pinmap::Button;
 
-/// Tick → job. Full: the event is refused and counted (the job is far
-/// behind a human's presses).
+/// Tick → buttons task: one raw sample (bit `Button as u8` = pressed) per
+/// millisecond while active. Full: the sample is refused and counted (the
+/// task fell 15 ms behind; a press then counts a little late).
+pub static SAMPLES: Ring<u8, 16> = Ring::new();
+/// Buttons task → job. Full: refused and counted (the job is far behind a
+/// human's presses).
 pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
 
 /// The end-stop inputs of the RAMPS board: X-MAX (green), X-MIN, Y-MIN,
@@ -39,7 +45,9 @@ impl ButtonPins {
     }
 }
 
-struct Sampler(UnsafeCell<Option<(ButtonPins, Buttons)>>);
+/// The tick's side: the pins, the last sample, and how many quiet
+/// milliseconds (all released, unchanged) have passed since.
+struct Sampler(UnsafeCell<Option<(ButtonPins, u8, u8)>>);
 
 // SAFETY: written once by `start` before interrupts are enabled, then used
 // only by `sample`, which only the tick interrupt calls (and a tick never
@@ -50,18 +58,49 @@ static SAMPLER: Sampler = Sampler(UnsafeCell::new(None));
 
 /// Hand the pins to the tick; call before interrupts are enabled.
 pub fn start(pins: ButtonPins) {
-    avr_device::interrupt::free(|_| unsafe { *SAMPLER.0.get() = Some((pins, Buttons::new())) });
+    avr_device::interrupt::free(|_| unsafe { *SAMPLER.0.get() = Some((pins, 0, u8::MAX)) });
 }
 
-/// The tick's millisecond sample. True when events were queued.
+/// The tick's millisecond sample: queued while a button is down and until
+/// the levels have been quiet long enough to debounce a release. True when
+/// a sample was queued (spawn the buttons task).
 pub fn sample() -> bool {
     // SAFETY: see `Sampler`.
-    let Some((pins, debouncer)) = (unsafe { &mut *SAMPLER.0.get() }) else {
+    let Some((pins, last, quiet)) = (unsafe { &mut *SAMPLER.0.get() }) else {
         return false;
     };
-    let events = debouncer.tick(pins.raw());
-    for &e in &events {
-        let _ = BUTTONS.push(e);
+    let raw = pins.raw();
+    *quiet = if raw == 0 && raw == *last {
+        quiet.saturating_add(1)
+    } else {
+        0
+    };
+    *last = raw;
+    *quiet <= DEBOUNCE_MS && SAMPLES.push(raw).is_ok()
+}
+
+/// The buttons task's state: the debouncer.
+pub struct Debounce(Buttons);
+
+impl Default for Debounce {
+    fn default() -> Self {
+        Self::new()
     }
-    !events.is_empty()
+}
+
+impl Debounce {
+    pub const fn new() -> Self {
+        Debounce(Buttons::new())
+    }
+
+    /// Debounce every queued sample; true when events went to the job.
+    pub fn poll(&mut self) -> bool {
+        let mut sent = false;
+        while let Some(raw) = SAMPLES.pop() {
+            for e in self.0.tick(raw) {
+                sent |= BUTTONS.push(e).is_ok();
+            }
+        }
+        sent
+    }
 }

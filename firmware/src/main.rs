@@ -8,11 +8,12 @@
 //! | task | kind | priority | input | shared with |
 //! | --- | --- | --- | --- | --- |
 //! | `TIMER1_COMPA` step events | interrupt | above all | `SEGMENTS`, `BLOCKS` rings | motion |
-//! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `BUTTONS` → job |
+//! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `SAMPLES` → buttons |
 //! | `USART0_RX` / `USART0_UDRE` | interrupts | | `RX` / `TX` rings | console, logger |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
 //! | `Refill` planner → segments while the queue is short | software | 3 | `MOTION` | console |
 //! | `Console` G-code line in, reply out | software | 2 | `RX` | `MOTION`, `HOLDS` → job |
+//! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` → job |
 //! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `HOLDS` | `MOTION`, `CARD_IN` → card |
 //! | `Card` SD reader: one block per run | software | 1 | `CARD_IN`, every 1 s | `CARD_OUT` → job |
 //! | `Motion` planner → segments, background | software | 1 | `MOTION` | console, job |
@@ -29,7 +30,7 @@ use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{
     self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
 };
-use taut_firmware::buttons::{self, ButtonPins};
+use taut_firmware::buttons::{self, ButtonPins, Debounce};
 use taut_firmware::card::{self, CardReader, Poll as CardPoll, CARD_IN, CARD_OUT};
 use taut_firmware::console::{Console, Poll};
 use taut_firmware::drivers::{Drivers, EnablePins};
@@ -53,21 +54,23 @@ enum Task {
     Refill,
     Motion,
     Console,
+    Buttons,
     Job,
     Card,
     Logger,
     Led,
 }
 
-const _: () = assert!(Task::ALL.len() <= 8, "interrupt spawns are a bit per task");
+const _: () = assert!(Task::ALL.len() <= 16, "interrupt spawns are a bit per task");
 
 impl Task {
     /// Every task, in discriminant order (`Task::X as u8` indexes it).
-    const ALL: [Task; 8] = [
+    const ALL: [Task; 9] = [
         Task::Timers,
         Task::Refill,
         Task::Motion,
         Task::Console,
+        Task::Buttons,
         Task::Job,
         Task::Card,
         Task::Logger,
@@ -90,7 +93,7 @@ impl TaskId for Task {
     fn priority(self) -> u8 {
         match self {
             Task::Timers | Task::Refill => 3,
-            Task::Console | Task::Job | Task::Led => 2,
+            Task::Console | Task::Buttons | Task::Job | Task::Led => 2,
             Task::Card | Task::Motion => 1,
             Task::Logger => 0,
         }
@@ -100,11 +103,12 @@ impl TaskId for Task {
 /// Task ids spawned by interrupts, moved into `READY` by the dispatcher.
 static SPAWNED: Spawned = Spawned::new();
 // Software tasks only: no masking needed.
-static READY: TaskCell<Ready<Task, 8, 4>> = TaskCell::new(Ready::new());
+static READY: TaskCell<Ready<Task, 9, 4>> = TaskCell::new(Ready::new());
 static TIMERS: TaskCell<Timers<Task, 8>> = TaskCell::new(Timers::new());
 static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
 static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
 static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
+static DEBOUNCE: TaskCell<Debounce> = TaskCell::new(Debounce::new());
 static JOB: TaskCell<JobTask> = TaskCell::new(JobTask::new());
 static CARD: TaskCell<Option<CardReader>> = TaskCell::new(None);
 /// The console and the job wait for the motion task (planner room or idle).
@@ -161,6 +165,7 @@ fn main() -> ! {
         Task::Timers => timers(),
         Task::Refill | Task::Motion => motion(),
         Task::Console => console(),
+        Task::Buttons => buttons(),
         Task::Job => job(),
         Task::Card => card(),
         Task::Logger => logger(),
@@ -303,6 +308,14 @@ fn console() {
     }
 }
 
+/// Debounce the tick's samples; presses go to the job.
+#[inline(never)]
+fn buttons() {
+    if DEBOUNCE.with(|d| d.poll()) {
+        spawn(Task::Job);
+    }
+}
+
 #[inline(never)]
 fn job() {
     let now = clock::millis();
@@ -403,7 +416,7 @@ extern "avr-interrupt" fn timer0_compa() {
         spawn_from_isr(&SPAWNED, Task::Timers as u8);
     }
     if buttons::sample() {
-        spawn_from_isr(&SPAWNED, Task::Job as u8);
+        spawn_from_isr(&SPAWNED, Task::Buttons as u8);
     }
     // The step interrupt's assembly path cannot spawn; it leaves a flag.
     if stepper::take_refill() {

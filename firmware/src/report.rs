@@ -3,7 +3,7 @@
 //! missed.
 
 use crate::board::usart;
-use crate::buttons::BUTTONS;
+use crate::buttons::{BUTTONS, SAMPLES};
 use crate::card::{CARD_IN, CARD_OUT};
 use crate::job::HOLDS;
 use crate::stepper::{BLOCKS, SEGMENTS};
@@ -31,9 +31,14 @@ pub fn queue_line(i: u8) -> bool {
         3 => queue(flash_str!("blocks"), BLOCKS.stats(), BLOCKS.capacity()),
         4 => queue(flash_str!("card"), CARD_OUT.stats(), CARD_OUT.capacity()),
         5 => queue(flash_str!("card req"), CARD_IN.stats(), CARD_IN.capacity()),
-        6 => queue(flash_str!("buttons"), BUTTONS.stats(), BUTTONS.capacity()),
-        7 => queue(flash_str!("holds"), HOLDS.stats(), HOLDS.capacity()),
-        8 => info!("log dropped:", crate::log::dropped()),
+        6 => queue(
+            flash_str!("button samples"),
+            SAMPLES.stats(),
+            SAMPLES.capacity(),
+        ),
+        7 => queue(flash_str!("buttons"), BUTTONS.stats(), BUTTONS.capacity()),
+        8 => queue(flash_str!("holds"), HOLDS.stats(), HOLDS.capacity()),
+        9 => info!("log dropped:", crate::log::dropped()),
         _ => return false,
     }
     true

@@ -72,8 +72,18 @@ fn two_presses_of_a_zeroing_button_move_that_axis_zero() {
     let jog = base_steps(&sim);
     assert_eq!(jog, 400, "15° of 9600 steps a turn");
 
-    press(&mut sim, Button::ZeroBase, 100);
-    assert!(log_has(&sim, "base free"), "{}", sim.uart_text());
+    // A bouncing contact: one press.
+    let pin = Button::ZeroBase.pin();
+    sim.press_with_bounce(pin, 6, Duration::from_millis(2));
+    sim.run_for(Duration::from_millis(150));
+    sim.release_with_bounce(pin, 6, Duration::from_millis(2));
+    sim.run_for(Duration::from_millis(150));
+    let frees = sim
+        .uart_text()
+        .lines()
+        .filter(|l| message(l) == Some("base free"))
+        .count();
+    assert_eq!(frees, 1, "{}", sim.uart_text());
     assert!(!driver_on(&sim, Axis::Base), "first press: driver off");
     assert!(driver_on(&sim, Axis::Radial) && driver_on(&sim, Axis::Drill));
     // A long press counts once.

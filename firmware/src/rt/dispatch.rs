@@ -20,7 +20,7 @@ use core::cell::UnsafeCell;
 use taut_logic::sched::{Ready, TaskId};
 
 /// Tasks spawned from interrupts and not yet in the ready set: bit = id.
-pub struct Spawned(UnsafeCell<u8>);
+pub struct Spawned(UnsafeCell<u16>);
 
 // SAFETY: every access is a read-modify-write with interrupts masked.
 unsafe impl Sync for Spawned {}
@@ -31,18 +31,19 @@ impl Spawned {
     }
 
     /// Take every flag (dispatcher side).
-    fn take(&self) -> u8 {
+    fn take(&self) -> u16 {
         // SAFETY: masked read-modify-write (see `Sync`).
         avr_device::interrupt::free(|_| unsafe { core::mem::take(&mut *self.0.get()) })
     }
 
+    /// With interrupts masked (the idle path): the two bytes agree.
     fn is_empty(&self) -> bool {
-        // SAFETY: a single-byte read.
+        // SAFETY: called with interrupts masked, so no handler writes it.
         unsafe { core::ptr::read_volatile(self.0.get()) == 0 }
     }
 }
 
-/// From an interrupt handler: make task `id` (below 8) ready.
+/// From an interrupt handler: make task `id` (below 16) ready.
 #[inline(always)]
 pub fn spawn_from_isr(spawned: &Spawned, id: u8) {
     // Masked: a nested handler may be setting another bit.
