@@ -314,6 +314,11 @@ impl JobTask {
                 }
                 Action::DriversOn(mask) => m.drivers.set(mask, true),
                 Action::DriversOff(mask) => m.drivers.set(mask, false),
+                Action::SetZero(_) if !m.is_idle() => {
+                    // A console jog still running: zero where it ends.
+                    let _ = self.todo.push_front(a);
+                    return Some(Poll::Motion);
+                }
                 Action::SetZero(axis) => {
                     let mut at = m.target();
                     at[axis.index()] = 0;

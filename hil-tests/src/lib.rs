@@ -136,3 +136,18 @@ pub fn wait_for(sim: &mut sim::Sim, text: &str, timeout: std::time::Duration) {
         sim.uart_text()
     );
 }
+
+/// Timer1 COMPA vector (byte address): the step interrupt.
+pub const STEP_VECTOR: u32 = 0x44;
+/// Documented bound (README): no code masks the step interrupt longer.
+pub const MASKED_BOUND_CYCLES: u64 = 80;
+
+/// Nothing (the card driver, the job, the console…) kept the step
+/// interrupt masked longer than the documented bound.
+pub fn assert_step_interrupt_never_masked_long(sim: &sim::Sim) {
+    let (masked, at) = sim.max_masked_cycles(STEP_VECTOR);
+    assert!(
+        masked <= MASKED_BOUND_CYCLES,
+        "interrupts masked {masked} cycles at {at:#x}"
+    );
+}

@@ -6,7 +6,10 @@
 use hil_tests::sim::operator::message;
 use hil_tests::sim::sdcard::SdImage;
 use hil_tests::sim::Sim;
-use hil_tests::{assert_ram_budget, boot_machine, pulses, sample_card_dir, send_ok, wait_for};
+use hil_tests::{
+    assert_ram_budget, assert_step_interrupt_never_masked_long, boot_machine, pulses,
+    sample_card_dir, send_ok, wait_for,
+};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
@@ -101,6 +104,7 @@ fn two_presses_of_a_zeroing_button_move_that_axis_zero() {
     press(&mut sim, Button::Confirm, 150);
     wait_for(&mut sim, "drill 1/24", Duration::from_secs(30));
     assert_eq!(base_steps(&sim), jog, "hole 0 drilled at the new zero");
+    assert_step_interrupt_never_masked_long(&sim);
     assert_ram_budget(&sim);
 }
 

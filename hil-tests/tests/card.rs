@@ -5,7 +5,10 @@
 
 use hil_tests::sim::operator::message;
 use hil_tests::sim::{Outcome, Sim};
-use hil_tests::{assert_ram_budget, boot_machine, card, pulses, sample_card_dir, wait_for};
+use hil_tests::{
+    assert_ram_budget, assert_step_interrupt_never_masked_long, boot_machine, card, pulses,
+    sample_card_dir, wait_for,
+};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 
@@ -52,6 +55,8 @@ fn the_sample_card_is_read_and_checked_before_anything_can_start() {
     // Waiting for green: nothing moves by itself.
     sim.run_for(Duration::from_secs(2));
     no_motion(&sim);
+    // Card I/O never holds the step interrupt off.
+    assert_step_interrupt_never_masked_long(&sim);
     assert_ram_budget(&sim);
 }
 
@@ -302,6 +307,7 @@ fn a_card_pulled_while_winding_pauses_the_job_until_it_is_back() {
     let wound: Vec<&String> = log.iter().filter(|l| l.starts_with("wind ")).collect();
     assert!(wound.last().unwrap().starts_with("wind 12/12"), "{wound:?}");
     no_errors(&sim);
+    assert_step_interrupt_never_masked_long(&sim);
     assert_ram_budget(&sim);
 }
 

@@ -11,7 +11,9 @@ use hil_tests::sim::operator::Operator;
 use hil_tests::sim::replay::{board_from_param, JobReplay};
 use hil_tests::sim::sdcard::SdImage;
 use hil_tests::sim::{picture, vcd, Outcome};
-use hil_tests::{assert_ram_budget, boot_machine, sample_card_dir};
+use hil_tests::{
+    assert_ram_budget, assert_step_interrupt_never_masked_long, boot_machine, sample_card_dir,
+};
 use std::f64::consts::TAU;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -123,5 +125,8 @@ fn the_sample_job_drills_and_winds_as_its_pulses_show() {
         (wall.elapsed() - simulated).as_secs_f64(),
         png.display()
     );
+    // Reading the card while the machine moves never held the step
+    // interrupt off.
+    assert_step_interrupt_never_masked_long(&sim);
     assert_ram_budget(&sim);
 }
