@@ -22,13 +22,7 @@ fn main() -> ! {
     );
     clock::Clock::start(dp.TC0);
     usart::Usart0::start(dp.USART0);
-    let spi = CardSpi::start(
-        dp.SPI,
-        pins.d52.into_output(),
-        pins.d51.into_output(),
-        pins.d50,
-        pins.d53,
-    );
+    let spi = CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53);
     let mut reader = CardReader::new(spi);
     // SAFETY: the two handlers below touch only the clock and the TX ring.
     unsafe { avr_device::interrupt::enable() };

@@ -197,13 +197,7 @@ fn init() -> Watchdog {
     let drivers = Drivers::new(enable, &config);
     let stepper = Stepper::new(StepTimer::start(dp.TC1), &config);
     MOTION.with(|m| *m = Some(Motion::new(&config, stepper, drivers)));
-    let spi = CardSpi::start(
-        dp.SPI,
-        pins.d52.into_output(),
-        pins.d51.into_output(),
-        pins.d50,
-        pins.d53,
-    );
+    let spi = CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53);
     CARD.with(|c| *c = Some(CardReader::new(spi)));
     buttons::start(ButtonPins {
         confirm: pins.d2.into_pull_up_input(),

@@ -44,6 +44,7 @@ pub fn run() -> Result<()> {
             path(&report),
             "--png".into(),
             path(&png),
+            "--echo".into(),
         ],
     )?;
     let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report)?)?;

@@ -97,13 +97,13 @@ impl CardSpi {
     /// The card on the hardware SPI, deselected, at the slow init clock.
     pub fn start(
         spi: SPI,
-        sck: Pin<52, Output>,
-        mosi: Pin<51, Output>,
+        sck: Pin<52, Floating>,
+        mosi: Pin<51, Floating>,
         miso: Pin<50, Floating>,
         cs: Pin<53, Floating>,
     ) -> CardSpi {
         let cs = cs.into_output_at(true);
-        let bus = Spi::start(spi, sck, mosi, miso, &cs);
+        let bus = Spi::start(spi, sck.into_output(), mosi.into_output(), miso, &cs);
         CardSpi { bus, cs }
     }
 
