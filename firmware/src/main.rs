@@ -274,7 +274,7 @@ fn motion() {
 /// Urgent refill while the step queue is short, background otherwise.
 #[inline(always)]
 fn refill_task() -> Task {
-    if stepper::SEGMENTS.len() <= motion::URGENT {
+    if motion::urgent() {
         Task::Refill
     } else {
         Task::Motion

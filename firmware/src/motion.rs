@@ -3,21 +3,39 @@
 
 use crate::drivers::Drivers;
 use crate::rt::TaskCell;
-use crate::stepper::{fast_segment, Stepper, BLOCKS, FAST, SEGMENTS};
+use crate::stepper::{fast_segment, Stepper, BLOCKS, FAST, SEGMENTS, SEGMENTS_CAPACITY};
+use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Planner};
-use taut_logic::segment::{Preparer, StepBlock};
+use taut_logic::segment::{Buffered, Preparer, StepBlock};
 
-/// Below this many queued segments, preparing more is urgent (the app runs
-/// it at the highest software priority); above, it is background work.
-pub const URGENT: usize = 16;
+/// Preparing segments is urgent (the app runs it at the highest software
+/// priority) while the queue holds less motion than this; otherwise it is
+/// background work. Longer than any other task's run (a card block, a
+/// wrap's planning: under 10 ms), so they never starve the queue.
+const URGENT_BUDGET_US: u32 = 30_000;
+/// Fewer segments than this are always urgent.
+const URGENT_MIN: u8 = 2;
+
+/// At or below this many queued segments the refill is urgent: as many of
+/// the newest as last less than the budget. Set by the refill, read by the
+/// interrupts that spawn it (one byte: atomic on the AVR).
+static SHORT_AT: AtomicU8 = AtomicU8::new(SEGMENTS_CAPACITY as u8);
+
+/// The step queue holds less than the urgent budget of motion.
+#[inline(always)]
+pub fn urgent() -> bool {
+    SEGMENTS.len() <= SHORT_AT.load(Relaxed) as usize
+}
 
 /// The look-ahead ring (1 KiB): its own static, built in place.
 static PLANNER: TaskCell<Planner> = TaskCell::new(Planner::EMPTY);
 
 pub struct Motion {
     prep: Preparer,
+    /// How long the queued segments last.
+    buffered: Buffered<SEGMENTS_CAPACITY>,
     /// The block the preparer is cutting (for the fast-path flag).
     block: StepBlock,
     pub stepper: Stepper,
@@ -29,6 +47,7 @@ impl Motion {
         PLANNER.with(|p| p.configure(config));
         Motion {
             prep: Preparer::new(),
+            buffered: Buffered::new(),
             block: StepBlock::default(),
             stepper,
             drivers,
@@ -67,10 +86,18 @@ impl Motion {
                         seg.flags |= FAST;
                     }
                     let _ = SEGMENTS.push(seg);
+                    self.buffered.push(&seg);
                     made += 1;
                 }
                 None => break,
             }
+        }
+        if made > 0 {
+            let short = self
+                .buffered
+                .short_at(URGENT_BUDGET_US)
+                .max(URGENT_MIN as usize);
+            SHORT_AT.store(short as u8, Relaxed);
         }
         self.stepper.kick();
         let work = !self.prep.is_idle() || !PLANNER.with(|p| p.is_idle());

@@ -27,7 +27,9 @@ use taut_logic::pinmap::{port_bit, Port, DRIVERS};
 use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK};
 
 /// Segments waiting for the interrupt (11 bytes each).
-pub static SEGMENTS: Ring<Segment, 32> = Ring::new();
+pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
+/// Slots of the segment ring (one fewer can be queued).
+pub const SEGMENTS_CAPACITY: usize = 32;
 /// Blocks waiting for their first segment (21 bytes each).
 pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
 /// Refill the queues when this few segments are left.

@@ -21,6 +21,7 @@
 //! keeps rounding from accumulating: with whole ticks a 5333.3-tick cruise
 //! interval drifts a tick every three steps.
 
+mod buffered;
 mod expand;
 mod prepare;
 mod trapezoid;
@@ -28,6 +29,7 @@ mod trapezoid;
 #[cfg(test)]
 mod tests;
 
+pub use buffered::Buffered;
 pub use expand::{expand, Event, Expand};
 pub use prepare::Preparer;
 pub use trapezoid::{cbrt_floor_approx, isqrt, Trapezoid, MAX_ACCEL};
