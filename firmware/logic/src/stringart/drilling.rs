@@ -70,7 +70,9 @@ impl Drilling {
     /// After the last hole: back to nail 0's angle with the tool at the
     /// board's edge (the zero pose), clear of the nails about to go in.
     fn home(&mut self) -> Step {
-        self.base = self.scale.shorter_rotation(self.base, self.board.nail(0).angle);
+        self.base = self
+            .scale
+            .shorter_rotation(self.base, self.board.nail(0).angle);
         let mut t = [None; AXES];
         t[Axis::Base.index()] = Some(self.base);
         t[Axis::Radial.index()] = Some(0);

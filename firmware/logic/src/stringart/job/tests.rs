@@ -407,7 +407,10 @@ fn long_press_pauses_after_the_batch_and_a_short_press_resumes() {
     // The hole is finished first: its dwell and retract still come (the
     // machine stands with the drill raised), then nothing.
     let rest: std::vec::Vec<Step> = core::iter::from_fn(|| b.job.next_step()).collect();
-    assert!(matches!(rest[..], [Step::Dwell(_), Step::Move(_)]), "{rest:?}");
+    assert!(
+        matches!(rest[..], [Step::Dwell(_), Step::Move(_)]),
+        "{rest:?}"
+    );
     b.steps.extend(rest);
     assert_eq!(b.job.next_step(), None, "paused after the hole");
     assert_eq!(b.send(Event::MotionDone), []);
