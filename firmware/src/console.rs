@@ -4,10 +4,11 @@
 //! them out against the motion task's state.
 
 use crate::board::{clock, usart};
-use crate::job::{Hold, HOLDS};
+use crate::job::{Hold, CLAIMS_TX, HOLDS};
 use crate::motion::Motion;
 use crate::rt::stack;
 use crate::{flash_str, warn};
+use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Command, Distance, Error, Input, Line, Parser, Realtime, SystemLine};
@@ -130,7 +131,7 @@ impl Console {
     /// Read and carry out input until it runs out or must wait.
     pub fn poll(&mut self, m: &mut Motion, kin: &impl Kinematics, cfg: &mut MachineConfig) -> Poll {
         loop {
-            if usart::TX.free() < REPLY_ROOM {
+            if usart::TX.free() < REPLY_ROOM || CLAIMS_TX.load(Relaxed) {
                 return Poll::After(2);
             }
             if let Some(listing) = self.listing {

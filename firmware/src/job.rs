@@ -11,6 +11,7 @@ use crate::card::{CardMsg, Request, What, CARD_IN, CARD_OUT, CHUNK};
 use crate::motion::Motion;
 use crate::rt::Ring;
 use crate::{error, info, report, texts};
+use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
 use heapless::Deque;
 use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
@@ -30,6 +31,18 @@ pub enum Hold {
 
 /// Console → job.
 pub static HOLDS: Ring<Hold, 4> = Ring::new();
+
+/// The job waits for room in the TX ring for a line it must not drop (a
+/// prompt, a bad file's message): the console holds its replies meanwhile,
+/// or a stream of replies would keep the ring full for as long as it lasts.
+pub static CLAIMS_TX: AtomicBool = AtomicBool::new(false);
+
+/// Room for a whole log line, claimed from the console while there is none.
+fn room_for_a_line() -> bool {
+    let room = usart::TX.free() >= LINE_ROOM;
+    CLAIMS_TX.store(!room, Relaxed);
+    room
+}
 
 /// What the job task wants next.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -118,12 +131,14 @@ impl JobTask {
     /// One run: carry out the pending actions and then each input in turn
     /// (while their log lines fit), feed winding its nails, then move.
     pub fn poll(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> Poll {
+        // Claimed again below if still needed.
+        CLAIMS_TX.store(false, Relaxed);
         loop {
             if let Some(p) = self.carry_out(m) {
                 return p;
             }
             if let Some(line) = self.report_line {
-                if usart::TX.free() < LINE_ROOM {
+                if !room_for_a_line() {
                     return Poll::After(5);
                 }
                 self.report_line = report::queue_line(line).then_some(line + 1);
@@ -132,6 +147,10 @@ impl JobTask {
             if !self.input(m, config, now) {
                 break;
             }
+        }
+        if CLAIMS_TX.load(Relaxed) {
+            // Card messages wait for room for the line they may end in.
+            return Poll::After(5);
         }
         self.feed_nails(now);
         if !self.todo.is_empty() {
@@ -164,6 +183,10 @@ impl JobTask {
         let Some(msg) = CARD_OUT.peek() else {
             return false;
         };
+        // Checking the files ends in a log line (`files ok` or the error).
+        if matches!(self.stream, Stream::Files(_)) && !room_for_a_line() {
+            return false;
+        }
         // Pattern bytes wait in the queue until winding wants them.
         let winding = matches!(self.stream, Stream::Pattern(_));
         if matches!(msg.what, What::Data { .. }) && winding && msg.ticket == self.ticket {
@@ -290,7 +313,11 @@ impl JobTask {
     /// Carry out actions while their log lines fit; `Some` to stop the run.
     fn carry_out(&mut self, m: &mut Motion) -> Option<Poll> {
         while let Some(&a) = self.todo.front() {
-            if usart::TX.free() < LINE_ROOM {
+            let logs = matches!(
+                a,
+                Action::Enter(_) | Action::Log(_) | Action::Prompt(_) | Action::Progress(_)
+            );
+            if logs && !room_for_a_line() {
                 return Some(Poll::After(5));
             }
             let _ = self.todo.pop_front();

@@ -129,12 +129,10 @@ fn task_of(id: u8) -> Task {
     Task::ALL[id as usize]
 }
 
+/// Spawn `task` in `ms`, replacing its earlier timers: a task spawned
+/// often (by every received byte) must not fill the timer slots with
+/// wake-ups it no longer needs.
 fn spawn_after(task: Task, ms: u32) {
-    arm(|t, now| t.spawn_after(task, now, ms).is_ok());
-}
-
-/// Like `spawn_after`, replacing the task's earlier timers.
-fn spawn_after_once(task: Task, ms: u32) {
     arm(|t, now| {
         t.cancel(task);
         t.spawn_after(task, now, ms).is_ok()
@@ -320,7 +318,7 @@ fn job() {
         JobPoll::Idle => {}
         JobPoll::Again => spawn(Task::Job),
         JobPoll::Motion => JOB_WAITS_MOTION.with(|w| *w = true),
-        JobPoll::After(ms) => spawn_after_once(Task::Job, ms as u32),
+        JobPoll::After(ms) => spawn_after(Task::Job, ms as u32),
     }
     if !CARD_IN.is_empty()
         || (CARD_OUT.free() >= card::ROOM && CARD_WAITS_JOB.with(|w| core::mem::take(w)))
@@ -336,7 +334,7 @@ fn card() {
     // not while the machine moves (the refill would wait).
     let moving = MOTION.with(|m| !m.as_ref().unwrap().is_idle());
     match CARD.with(|c| c.as_mut().unwrap().poll(now, moving)) {
-        CardPoll::Idle(ms) => spawn_after_once(Task::Card, ms as u32),
+        CardPoll::Idle(ms) => spawn_after(Task::Card, ms as u32),
         CardPoll::More => spawn(Task::Card),
         CardPoll::Blocked => CARD_WAITS_JOB.with(|w| *w = true),
     }

@@ -12,10 +12,12 @@ fn send(sim: &mut Sim, line: &str) {
     hil_tests::send_ok(sim, line, Duration::from_secs(2));
 }
 
-/// Motion at the configured maximum step rate while a sender streams commands as Grbl
-/// senders do (character counting: never more bytes in flight than the
-/// receive ring holds). Every line is answered, nothing is refused, the
-/// pulse train keeps its timing, the masked-span bound holds.
+/// Every task busy: motion at the configured maximum step rate while a
+/// sender streams commands as Grbl senders do (character counting: never
+/// more bytes in flight than the receive ring holds), a card goes in and
+/// the job reads and checks a 3000-connection pattern, and a button is
+/// pressed. Every line is answered, no queue refuses anything, the pulse
+/// train keeps its timing, the masked-span bound holds.
 #[test]
 fn no_message_lost_and_pulses_on_time_under_load() {
     let mut sim = Sim::load(&firmware_elf()).unwrap();
@@ -25,6 +27,17 @@ fn no_message_lost_and_pulses_on_time_under_load() {
         sim.run_until_uart_contains("reset:", Duration::from_millis(50)),
         Outcome::Done
     );
+    let poradi: Vec<String> = std::iter::once("3000".to_string())
+        .chain((0..3000).map(|i| (i * 7 % 24).to_string()))
+        .collect();
+    let param: &[u8] = b"tvar = 6\nnails = 24\nradius_cm = 20\n";
+    sim.insert_sd(hil_tests::card(&[
+        ("param.txt", param),
+        ("poradi.txt", poradi.join(",").as_bytes()),
+    ]));
+    // Found before the motion starts (an empty slot is not probed while
+    // the machine moves); read and checked while it runs.
+    hil_tests::wait_for(&mut sim, "state: reading", Duration::from_millis(1500));
     send(&mut sim, "M17");
     // 2 s at the machine's 2000 steps/s after a 4 s ramp up and down.
     let cfg = taut_logic::config::MachineConfig::STRING_ART.axes[Axis::Base.index()];
@@ -38,12 +51,19 @@ fn no_message_lost_and_pulses_on_time_under_load() {
     let line = "M114\n";
     let window = 48; // bytes in flight, below the 63-byte receive ring
     let (mut sent, mut in_flight): (usize, Vec<usize>) = (0, Vec::new());
+    let mut pressed = false;
     let oks = |s: &Sim| s.uart_text().matches("\nok\n").count();
     let base_oks = oks(&sim);
     while sent < lines || !in_flight.is_empty() {
         let answered = oks(&sim) - base_oks;
         while in_flight.len() > lines.min(sent) - answered.min(sent) {
             in_flight.remove(0);
+        }
+        if sent == lines / 2 && !pressed {
+            pressed = true;
+            // The buttons task and the job: a zeroing button (the drill's,
+            // which does not move here) pressed mid-stream.
+            sim.press(taut_logic::pinmap::Button::ZeroDrill.pin());
         }
         if sent < lines && in_flight.iter().sum::<usize>() + line.len() <= window {
             sim.uart_send(line.as_bytes());
@@ -64,9 +84,22 @@ fn no_message_lost_and_pulses_on_time_under_load() {
         );
     }
     assert_eq!(oks(&sim) - base_oks, lines, "every line answered once");
+    sim.release(taut_logic::pinmap::Button::ZeroDrill.pin());
     send(&mut sim, "M400");
+    let text = sim.uart_text();
+    assert!(
+        text.contains("files ok: shape 6 nails 24 radius 200000um connections 3000")
+            && text.contains("drill free"),
+        "the job read the card and took the press under load:\n{text}"
+    );
     send(&mut sim, "$Q");
     let text = sim.uart_text();
+    let queues: Vec<&str> = text.lines().filter(|l| l.contains(" sent:")).collect();
+    assert_eq!(queues.len(), 9, "every queue reported: {queues:#?}");
+    assert!(
+        queues.iter().all(|l| l.contains("refused:0 ")),
+        "nothing refused: {queues:#?}"
+    );
     assert!(
         text.contains("rx sent:") && !text.contains("rx sent:0"),
         "{text}"
