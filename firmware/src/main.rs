@@ -11,14 +11,14 @@
 //! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `SAMPLES` → buttons |
 //! | `USART0_RX` / `USART0_UDRE` | interrupts | | `RX` / `TX` rings | console, logger |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
-//! | `Refill` planner → segments while the queue is short | software | 3 | `MOTION` | console |
+//! | `Refill` planner → segments while the queue holds < 30 ms of motion | software | 3 | `MOTION` | console, job |
 //! | `Console` G-code line in, reply out | software | 2 | `RX` | `MOTION`, `HOLDS` → job |
 //! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` → job |
 //! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `HOLDS` | `MOTION`, `CARD_IN` → card |
 //! | `Card` SD reader: one block per run | software | 1 | `CARD_IN`, every 1 s | `CARD_OUT` → job |
 //! | `Motion` planner → segments, background | software | 1 | `MOTION` | console, job |
-//! | `Logger` deferred reports | software | 0 | every 1 s | |
 //! | `Led` status LED pattern (timed edges: runs before the long tasks) | software | 2 | its timer | |
+//! | `Logger` deferred reports | software | 0 | every 1 s | |
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt, asm_experimental_arch)]
