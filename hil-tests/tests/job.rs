@@ -106,6 +106,15 @@ fn the_sample_job_drills_and_winds_as_its_pulses_show() {
     assert_eq!(crossings.len(), 1 + 2 * pattern.len(), "{crossings:#?}");
     let bad = job.crossings_outside_gaps();
     assert!(bad.is_empty(), "crossed the ring at a nail: {bad:#?}");
+    // The drill's driver is off while winding, the others hold: checked
+    // at every crossing of the ring.
+    for c in &crossings {
+        assert_eq!(
+            job.trace.drivers_on(c.at_ns),
+            [true, true, false],
+            "drivers at {c:?}"
+        );
+    }
 
     // Drivers off while waiting for nails (green pressed to wind) and at
     // the end.
