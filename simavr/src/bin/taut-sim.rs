@@ -17,8 +17,9 @@ use taut_simavr::{picture, replay};
 use taut_simavr::{Outcome, Reply, Sim};
 
 const USAGE: &str = "\
-usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]] [--send FILE]
-                   [--for SECONDS] [--vcd PATH] [--report PATH] [--echo]
+usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]] [--auto-confirm]
+                   [--send FILE] [--for SECONDS] [--vcd PATH] [--png PATH]
+                   [--report PATH] [--echo]
   --sd PATH       put a virtual SD card in the slot: an image file, or a
                   folder, imaged on the fly (FAT16 or FAT32 by size)
   --sd-insert-at SECONDS
