@@ -90,7 +90,7 @@ impl embedded_hal::spi::SpiBus<u8> for Spi {
 /// length of each transaction (embedded-hal's `SpiDevice`).
 pub struct CardSpi {
     pub bus: Spi,
-    pub cs: Pin<53, Output>,
+    cs: Pin<53, Output>,
 }
 
 impl CardSpi {
