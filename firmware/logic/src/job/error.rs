@@ -176,6 +176,23 @@ pub(crate) mod tests {
         t.0
     }
 
+    /// Parses `text` whole and in chunks of every size with
+    /// `parse_in_chunks(bytes, chunk)`; all must agree. Errors as printed.
+    pub fn in_every_chunking<T: PartialEq + core::fmt::Debug>(
+        text: &str,
+        parse_in_chunks: impl Fn(&[u8], usize) -> Result<T, FileError>,
+    ) -> Result<T, String> {
+        let whole = parse_in_chunks(text.as_bytes(), text.len().max(1));
+        for chunk in 1..text.len() {
+            assert_eq!(
+                parse_in_chunks(text.as_bytes(), chunk),
+                whole,
+                "chunk {chunk}"
+            );
+        }
+        whole.map_err(|e| show(&e))
+    }
+
     #[test]
     fn one_line_per_error() {
         let e = FileError::at(

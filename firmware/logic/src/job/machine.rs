@@ -74,7 +74,7 @@ fn apply(cfg: &mut MachineConfig, seen: &mut u32, item: Item<'_>) -> Result<(), 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::show;
+    use crate::job::error::tests::{in_every_chunking, show};
     use crate::units::StepsPerUnit;
     use proptest::prelude::*;
     use std::string::String;
@@ -88,15 +88,7 @@ mod tests {
     }
 
     fn parse(text: &str) -> Result<MachineConfig, String> {
-        let whole = parse_in_chunks(text.as_bytes(), text.len().max(1));
-        for chunk in 1..text.len() {
-            assert_eq!(
-                parse_in_chunks(text.as_bytes(), chunk),
-                whole,
-                "chunk {chunk}"
-            );
-        }
-        whole.map_err(|e| show(&e))
+        in_every_chunking(text, parse_in_chunks)
     }
 
     #[test]

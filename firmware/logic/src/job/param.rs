@@ -180,7 +180,7 @@ impl Seen {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::show;
+    use crate::job::error::tests::in_every_chunking;
     use proptest::prelude::*;
     use std::string::String;
 
@@ -194,15 +194,7 @@ mod tests {
 
     /// Parses whole and in chunks of every size; all must agree.
     fn parse(text: &str) -> Result<Params, String> {
-        let whole = parse_in_chunks(text.as_bytes(), text.len().max(1));
-        for chunk in 1..text.len() {
-            assert_eq!(
-                parse_in_chunks(text.as_bytes(), chunk),
-                whole,
-                "chunk {chunk}"
-            );
-        }
-        whole.map_err(|e| show(&e))
+        in_every_chunking(text, parse_in_chunks)
     }
 
     const fn params(shape: u16, nails: u16, radius_um: u32) -> Params {
