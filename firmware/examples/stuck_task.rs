@@ -1,5 +1,5 @@
 //! A firmware whose software task never returns, on the release runtime:
-//! the watchdog (fed only from the dispatcher's idle path) must reset the
+//! the watchdog (fed only when a dispatch round ends) must reset the
 //! board, and the next boot must log the reset cause.
 #![no_std]
 #![no_main]
@@ -43,6 +43,7 @@ fn main() -> ! {
         &SPAWNED,
         &READY,
         |_| Stuck,
+        clock::millis,
         &watchdog,
         |_| {
             warn!("task entering an endless loop");

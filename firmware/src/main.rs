@@ -159,16 +159,23 @@ fn arm(add: impl FnOnce(&mut Timers<Task, 8>, u32) -> bool) {
 fn main() -> ! {
     stack::paint();
     let watchdog = init();
-    dispatch::run(&SPAWNED, &READY, task_of, &watchdog, |task| match task {
-        Task::Timers => timers(),
-        Task::Refill | Task::Motion => motion(),
-        Task::Console => console(),
-        Task::Buttons => buttons(),
-        Task::Job => job(),
-        Task::Card => card(),
-        Task::Logger => logger(),
-        Task::Led => led(),
-    })
+    dispatch::run(
+        &SPAWNED,
+        &READY,
+        task_of,
+        clock::millis,
+        &watchdog,
+        |task| match task {
+            Task::Timers => timers(),
+            Task::Refill | Task::Motion => motion(),
+            Task::Console => console(),
+            Task::Buttons => buttons(),
+            Task::Job => job(),
+            Task::Card => card(),
+            Task::Logger => logger(),
+            Task::Led => led(),
+        },
+    )
 }
 
 /// The board, the tasks' state, the first tasks. Its own frame: the

@@ -1,10 +1,10 @@
 //! The task dispatcher's logic: which software task runs next, when timed
 //! tasks fall due, and how full the message queues got.
 //!
-//! The firmware keeps each of these in a `static` behind a critical section
-//! (`Mutex<RefCell<…>>`); interrupts spawn tasks and send messages, the main
-//! loop dispatches. Everything here is `const`-constructible, heap-free and
-//! O(1) on the interrupt side, so a spawn costs a few dozen AVR instructions.
+//! The firmware keeps each of these in a `static` that only software tasks
+//! touch (interrupts only set a task's bit, which the dispatcher moves into
+//! [`Ready`]); the main loop dispatches, and [`Round`] decides when the
+//! watchdog is fed. Everything here is `const`-constructible and heap-free.
 //!
 //! # Ordering guarantees of [`Ready`]
 //! - **Priority first**: [`Ready::pop`] returns a ready task of the highest
@@ -28,11 +28,13 @@
 
 mod channel;
 mod ready;
+mod round;
 mod stack;
 mod timers;
 
 pub use channel::{Channel, QueueStats};
 pub use ready::Ready;
+pub use round::Round;
 pub use stack::stack_high_water;
 pub use timers::{Full, Timers};
 

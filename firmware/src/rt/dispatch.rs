@@ -1,9 +1,9 @@
 //! The dispatcher: runs ready software tasks, highest priority first, each
-//! to completion; feeds the watchdog only when every task that was ready at
-//! the start of a round has run (when nothing is ready, on the idle path);
-//! sleeps when nothing is ready. A task that never returns ends every
-//! round, so the watchdog resets the board; a busy but healthy machine,
-//! whose tasks keep spawning each other, still completes rounds.
+//! to completion, and sleeps when nothing is ready. The watchdog is fed by
+//! `taut_logic::sched::Round` (host-tested): when every task that was
+//! ready at the start of a round has run, with tasks still owed going
+//! first once a round is 50 ms old. So rounds end under any load, and only
+//! a task that never returns lets the watchdog reset the board.
 //!
 //! Interrupts never touch the ready set: they set the task's bit in
 //! `Spawned` (one masked `|=`), and the dispatcher moves flagged tasks into
@@ -17,7 +17,7 @@ use super::TaskCell;
 use crate::board::watchdog::Watchdog;
 use core::arch::asm;
 use core::cell::UnsafeCell;
-use taut_logic::sched::{Ready, TaskId};
+use taut_logic::sched::{Ready, Round, TaskId};
 
 /// Tasks spawned from interrupts and not yet in the ready set: bit = id.
 pub struct Spawned(UnsafeCell<u16>);
@@ -55,13 +55,13 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
     spawned: &Spawned,
     ready: &TaskCell<Ready<T, N, P>>,
     task: fn(u8) -> T,
+    millis: fn() -> u32,
     watchdog: &Watchdog,
     mut dispatch: impl FnMut(T),
 ) -> ! {
     // SAFETY: SMCR (0x53): sleep enable, idle mode (timers and UART run).
     unsafe { core::ptr::write_volatile(0x53 as *mut u8, 0x01) };
-    // Tasks (bit = index) still owed a run in this round.
-    let mut round: u32 = 0;
+    let mut round = Round::new();
     loop {
         let flags = spawned.take();
         if flags != 0 {
@@ -71,17 +71,7 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
                 }
             });
         }
-        if round == 0 {
-            // Every task of the last round ran: feed, and start a new one.
-            watchdog.feed();
-            round = ready.with(|r| {
-                (0..T::COUNT as u8)
-                    .filter(|&i| r.is_pending(task(i)))
-                    .fold(0, |m, i| m | 1 << i)
-            });
-        }
-        if let Some(t) = ready.with(|r| r.pop()) {
-            round &= !(1 << t.index());
+        if let Some(t) = ready.with(|r| round.next(r, millis(), || watchdog.feed())) {
             dispatch(t);
             continue;
         }

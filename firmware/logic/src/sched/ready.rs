@@ -64,6 +64,39 @@ impl<T: TaskId, const N: usize, const P: usize> Ready<T, N, P> {
         None
     }
 
+    /// Like [`Ready::pop`], among the tasks whose bit (`1 << index`) is
+    /// set in `among` only: the oldest spawn at the highest level of those.
+    pub fn pop_among(&mut self, among: u32) -> Option<T> {
+        for level in (0..P).rev() {
+            let mut prev: Option<T> = None;
+            let mut at = self.head[level];
+            while let Some(task) = at {
+                let i = task.index();
+                if among >> i & 1 != 0 {
+                    match prev {
+                        None => self.head[level] = self.link[i],
+                        Some(p) => self.link[p.index()] = self.link[i],
+                    }
+                    if self.tail[level].is_some_and(|t| t.index() == i) {
+                        self.tail[level] = prev;
+                    }
+                    self.pending[i] = false;
+                    return Some(task);
+                }
+                prev = at;
+                at = self.link[i];
+            }
+        }
+        None
+    }
+
+    /// The pending tasks as a bit set (`1 << index`).
+    pub fn pending_mask(&self) -> u32 {
+        (0..T::COUNT)
+            .filter(|&i| self.pending[i])
+            .fold(0, |m, i| m | 1 << i)
+    }
+
     pub fn is_pending(&self, task: T) -> bool {
         self.pending[task.index()]
     }
@@ -175,10 +208,16 @@ mod tests {
         }
 
         fn pop(&mut self) -> Option<Tk> {
-            let best = (0..self.waiting.len()).min_by_key(|&i| {
-                let (t, seq) = self.waiting[i];
-                (core::cmp::Reverse(t.prio), seq)
-            })?;
+            self.pop_among(u32::MAX)
+        }
+
+        fn pop_among(&mut self, among: u32) -> Option<Tk> {
+            let best = (0..self.waiting.len())
+                .filter(|&i| among >> self.waiting[i].0.id & 1 != 0)
+                .min_by_key(|&i| {
+                    let (t, seq) = self.waiting[i];
+                    (core::cmp::Reverse(t.prio), seq)
+                })?;
             Some(self.waiting.remove(best).0)
         }
     }
@@ -187,10 +226,15 @@ mod tests {
     enum Op {
         Spawn(u8),
         Pop,
+        PopAmong(u8),
     }
 
     fn op() -> impl Strategy<Value = Op> {
-        prop_oneof![(0u8..8).prop_map(Op::Spawn), Just(Op::Pop)]
+        prop_oneof![
+            (0u8..8).prop_map(Op::Spawn),
+            Just(Op::Pop),
+            any::<u8>().prop_map(Op::PopAmong)
+        ]
     }
 
     proptest! {
@@ -208,7 +252,12 @@ mod tests {
                         prop_assert_eq!(r.spawn(t), m.spawn(t));
                     }
                     Op::Pop => prop_assert_eq!(r.pop(), m.pop()),
+                    Op::PopAmong(mask) => {
+                        prop_assert_eq!(r.pop_among(mask as u32), m.pop_among(mask as u32))
+                    }
                 }
+                let model_mask = m.waiting.iter().fold(0, |a, (t, _)| a | 1 << t.id);
+                prop_assert_eq!(r.pending_mask(), model_mask);
                 prop_assert_eq!(r.is_idle(), m.waiting.is_empty());
             }
             while let Some(t) = m.pop() {
