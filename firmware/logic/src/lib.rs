@@ -23,6 +23,7 @@ pub mod job;
 pub mod kinematics;
 pub mod pinmap;
 pub mod planner;
+pub mod prep;
 pub mod sched;
 pub mod segment;
 pub mod settings;

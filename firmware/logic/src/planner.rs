@@ -40,10 +40,13 @@ pub struct Full;
 
 /// A block taken by the segment preparer: what the step interrupt needs and
 /// the profile to cut into segments. The planner no longer changes it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Planned {
     pub block: StepBlock,
     pub profile: Trapezoid,
+    /// (events per path milli-unit)²: converts a speed² in events to the
+    /// path's, to carry a speed from one block into the next.
+    pub ev_per_milli_sqr: f32,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -217,6 +220,7 @@ impl Planner {
         self.carry_sqr = exit_sqr;
         let to_events = |v: u64| (v as f32 * b.ev_per_milli_sqr) as u64;
         Some(Planned {
+            ev_per_milli_sqr: b.ev_per_milli_sqr,
             block: b.step,
             profile: Trapezoid::new(
                 b.step.events,
@@ -226,6 +230,24 @@ impl Planner {
                 to_events(exit_sqr),
             ),
         })
+    }
+
+    /// The oldest block may enter at `path_sqr` at most, (milli-units/s)²:
+    /// the block before it was held and can no longer leave faster.
+    pub fn limit_entry(&mut self, path_sqr: u64) {
+        self.carry_sqr = self.carry_sqr.min(path_sqr);
+        if self.len > 0 {
+            self.recalculate();
+        }
+    }
+
+    /// Drops every queued move (a stop that abandons them): the planner
+    /// stands at `position`, the next move starts from rest.
+    pub fn clear(&mut self, position: PerAxis<i32>) {
+        self.head = 0;
+        self.len = 0;
+        self.carry_sqr = 0;
+        self.set_position(position);
     }
 
     /// Grbl's passes: backwards, each entry is at most what still stops at

@@ -23,16 +23,32 @@ const MAX_CRUISE_EVENTS: u32 = 4096;
 const FIT_GAIN: u64 = 43;
 
 /// Turns one block's [`Trapezoid`] after another into segments.
+///
+/// A feed hold replaces the rest of the block's profile by the quickest
+/// stop from the current speed ([`Preparer::stop`]), and a resume by a new
+/// start from rest to the block's end ([`Preparer::restart`]): the block is
+/// then cut in *legs*, each its own profile, joined at equal speed, so the
+/// events (and the DDA's step totals) stay those of the block.
 #[derive(Clone, Debug)]
 pub struct Preparer {
+    /// The leg being cut.
     profile: Trapezoid,
-    /// Events already cut into segments.
+    /// Events of the leg already cut into segments.
     done: u32,
     /// Time of event `done` as the segments place it, sub-ticks after the
-    /// block's ideal start (negative when the previous block ended early).
+    /// leg's ideal start (negative when the previous leg ended early).
     now: i64,
     /// The next segment is the block's first.
     fresh: bool,
+    /// Events of the block in the legs before this one.
+    before: u32,
+    /// The block's events.
+    events: u32,
+    /// The block's figures, for the legs after a hold: events/s², and
+    /// cruise and planned exit speeds², events²/s².
+    accel: u32,
+    cruise_sqr: u64,
+    exit_sqr: u64,
 }
 
 impl Default for Preparer {
@@ -48,30 +64,104 @@ impl Preparer {
             done: 0,
             now: 0,
             fresh: false,
+            before: 0,
+            events: 0,
+            accel: 1,
+            cruise_sqr: 0,
+            exit_sqr: 0,
         }
     }
 
     /// Every event of the current block has been cut into segments.
     pub fn is_idle(&self) -> bool {
-        self.done >= self.profile.events()
+        self.before + self.done >= self.events
+    }
+
+    /// A hold stopped the block short of its end: [`Preparer::next`] has
+    /// nothing until [`Preparer::restart`].
+    pub fn is_stopped(&self) -> bool {
+        self.done >= self.profile.events() && !self.is_idle()
     }
 
     /// Starts the next block. Its ideal start is the previous block's ideal
     /// end, so timing errors never accumulate across blocks.
     pub fn start(&mut self, profile: Trapezoid) {
-        self.now = if self.done > 0 {
-            self.now - self.profile.time(self.done) as i64
-        } else {
-            0
-        };
-        self.profile = profile;
-        self.done = 0;
+        self.switch(profile);
+        self.before = 0;
+        self.events = profile.events();
+        self.accel = profile.accel();
+        self.cruise_sqr = profile.cruise_sqr();
+        self.exit_sqr = profile.exit_sqr();
         self.fresh = true;
     }
 
-    /// The next segment of the current block, `None` when it is done.
-    pub fn next(&mut self) -> Option<Segment> {
+    /// Speed² at the last event cut, events²/s² (at the end of the block
+    /// when it is all cut).
+    pub fn speed_sqr(&self) -> u64 {
+        self.profile.speed_sqr(self.done)
+    }
+
+    /// Feed hold: the rest of the block becomes the quickest stop from the
+    /// current speed at the block's acceleration. Returns the speed² left
+    /// at the end of the block when it is too short to stop in (the next
+    /// block must go on braking: [`Preparer::start_stopping`]), else 0.
+    pub fn stop(&mut self) -> u64 {
         if self.is_idle() {
+            return self.speed_sqr();
+        }
+        self.brake(self.speed_sqr())
+    }
+
+    /// Starts the next block braking from `entry_sqr` (a hold that did not
+    /// stop inside the previous block); returns the speed² left at its end.
+    pub fn start_stopping(&mut self, profile: Trapezoid, entry_sqr: u64) -> u64 {
+        self.start(profile);
+        self.brake(entry_sqr)
+    }
+
+    /// After a hold stopped the block: the rest of it from rest, to the
+    /// block's exit speed if it can still be reached. Returns the exit
+    /// speed² it will have (the next block must enter no faster).
+    pub fn restart(&mut self) -> u64 {
+        let left = self.events - self.before - self.done;
+        let leg = Trapezoid::new(left, self.accel, 0, self.cruise_sqr, self.exit_sqr);
+        self.switch(leg);
+        leg.exit_sqr()
+    }
+
+    /// The rest of the block: braking from `v_sqr` to a stop, or to its end.
+    fn brake(&mut self, v_sqr: u64) -> u64 {
+        let two_a = 2 * self.accel as u64;
+        let left = (self.events - self.before - self.done) as u64;
+        let (n, end_sqr) = match v_sqr.div_ceil(two_a) {
+            stop if stop <= left => (stop, 0),
+            _ => (left, v_sqr - two_a * left),
+        };
+        // Standing already: an empty leg (a profile needs an event).
+        let leg = match n {
+            0 => Trapezoid::ZERO,
+            n => Trapezoid::new(n as u32, self.accel, v_sqr, v_sqr, end_sqr),
+        };
+        self.switch(leg);
+        end_sqr
+    }
+
+    /// Make `leg` the profile from the last event cut on. Its ideal start
+    /// is that event's ideal time on the leg before.
+    fn switch(&mut self, leg: Trapezoid) {
+        self.now = if self.done > 0 {
+            self.now - self.profile.time(self.done) as i64
+        } else {
+            self.now
+        };
+        self.before += self.done;
+        self.profile = leg;
+        self.done = 0;
+    }
+
+    /// The next segment of the current leg, `None` when it is done.
+    pub fn next(&mut self) -> Option<Segment> {
+        if self.done >= self.profile.events() {
             return None;
         }
         let k0 = self.done;

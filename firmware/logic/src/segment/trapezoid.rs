@@ -22,6 +22,8 @@ pub struct Trapezoid {
     two_a: u64,
     v0_sqr: u64,
     v1_sqr: u64,
+    /// The cruise speed² asked for (the peak may stay below it).
+    cruise_sqr: u64,
     /// Fixed-point shift: speeds are `isqrt(v² << 2·shift)`, i.e. `v·2^shift`.
     shift: u32,
     s0: u64,
@@ -47,6 +49,7 @@ impl Trapezoid {
         two_a: 2,
         v0_sqr: 0,
         v1_sqr: 0,
+        cruise_sqr: 0,
         shift: 0,
         s0: 0,
         s1: 0,
@@ -87,6 +90,7 @@ impl Trapezoid {
             two_a,
             v0_sqr,
             v1_sqr,
+            cruise_sqr,
             shift,
             acc2: peak - v0_sqr,
             dec2: peak - v1_sqr,
@@ -106,6 +110,34 @@ impl Trapezoid {
 
     pub fn events(&self) -> u32 {
         self.events
+    }
+
+    /// Acceleration, events/s².
+    pub fn accel(&self) -> u32 {
+        self.accel as u32
+    }
+
+    /// The cruise speed² asked for, events²/s².
+    pub fn cruise_sqr(&self) -> u64 {
+        self.cruise_sqr
+    }
+
+    /// Speed² at the last event, events²/s².
+    pub fn exit_sqr(&self) -> u64 {
+        self.v1_sqr
+    }
+
+    /// Speed² at event `k` (0..=events), events²/s².
+    pub fn speed_sqr(&self, k: u32) -> u64 {
+        let x = self.two_a * k as u64;
+        let y = self.two_a * (self.events - k) as u64;
+        if x <= self.acc2 {
+            self.v0_sqr + x
+        } else if y <= self.dec2 {
+            self.v1_sqr + y
+        } else {
+            self.v0_sqr + self.acc2
+        }
     }
 
     /// Ideal time of event `k` (0..=events), sub-ticks after event 0.

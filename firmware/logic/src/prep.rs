@@ -1,0 +1,173 @@
+//! From the planner's blocks to the step interrupt's segments, with feed
+//! hold: Grbl's `st_prep_buffer`. The firmware's motion task calls
+//! [`Prep::next`] while the step queue has room and queues what it returns.
+//!
+//! A hold ([`Prep::hold`]) brakes at the block's acceleration from the speed
+//! of the last segment cut — the motion already queued runs first, so the
+//! firmware keeps that short — along the planned path: inside the block
+//! when it is long enough, else on through the next blocks, each entered
+//! at the speed the last left with (never above its planned entry, which
+//! the planned profile reaches no slower than the quickest stop). Every
+//! event of every block is still executed after [`Prep::resume`], so the
+//! position is kept exactly.
+
+use crate::planner::{Planned, Planner};
+use crate::segment::{Preparer, Segment, StepBlock};
+
+/// Where a feed hold stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hold {
+    /// Running (or standing with nothing to do).
+    Off,
+    /// Braking: the segments to a stop are not all cut yet.
+    Braking,
+    /// Every segment up to the stop is cut: the machine stands once the
+    /// step queue has run out.
+    Stopped,
+}
+
+/// A segment for the step interrupt, with its block if it starts one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Cut {
+    pub block: Option<StepBlock>,
+    pub segment: Segment,
+}
+
+pub struct Prep {
+    cut: Preparer,
+    hold: Hold,
+    /// A resume asked for while braking: it takes effect at the stop.
+    resume_at_stop: bool,
+    /// The block being cut, until its first segment goes out with it.
+    block: Option<StepBlock>,
+    /// (events per path milli-unit)² of the block being cut.
+    ev_per_milli_sqr: f32,
+}
+
+impl Default for Prep {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Prep {
+    pub const fn new() -> Self {
+        Prep {
+            cut: Preparer::new(),
+            hold: Hold::Off,
+            resume_at_stop: false,
+            block: None,
+            ev_per_milli_sqr: 1.0,
+        }
+    }
+
+    pub fn hold_state(&self) -> Hold {
+        self.hold
+    }
+
+    /// Every block taken has been cut whole (no hold stopped one short).
+    pub fn is_idle(&self) -> bool {
+        self.cut.is_idle()
+    }
+
+    /// The next segment, taking the next block from `planner` when the last
+    /// is cut; `None` when there is nothing to cut or a hold has stopped.
+    pub fn next(&mut self, planner: &mut Planner) -> Option<Cut> {
+        loop {
+            if self.cut.is_idle() {
+                self.block = Some(self.take(planner)?);
+            }
+            if let Some(segment) = self.cut.next() {
+                let block = self.block.take();
+                return Some(Cut { block, segment });
+            }
+            if !self.cut.is_idle() {
+                // A leg ended short of the block's end: a hold's stop.
+                self.hold = Hold::Stopped;
+                if !core::mem::take(&mut self.resume_at_stop) || !self.resume(planner) {
+                    return None;
+                }
+            }
+        }
+    }
+
+    /// The next block from the planner, braking into it during a hold.
+    fn take(&mut self, planner: &mut Planner) -> Option<StepBlock> {
+        let carried = self.cut.speed_sqr();
+        match self.hold {
+            Hold::Stopped => return None,
+            Hold::Braking if carried == 0 => return self.stopped_at_block_end(planner),
+            _ => {}
+        }
+        let Some(p) = planner.take() else {
+            // The queue ends at rest: a hold's stop is there.
+            return match self.hold {
+                Hold::Braking => self.stopped_at_block_end(planner),
+                _ => None,
+            };
+        };
+        let Planned {
+            block,
+            profile,
+            ev_per_milli_sqr,
+        } = p;
+        if self.hold == Hold::Braking {
+            // The same path speed in the new block's events.
+            let entry = (carried as f32 * (ev_per_milli_sqr / self.ev_per_milli_sqr)) as u64;
+            self.cut
+                .start_stopping(profile, entry.min(profile.speed_sqr(0)));
+        } else {
+            self.cut.start(profile);
+        }
+        self.ev_per_milli_sqr = ev_per_milli_sqr;
+        Some(block)
+    }
+
+    /// A hold's stop fell on a block's end: nothing more until resumed.
+    fn stopped_at_block_end(&mut self, planner: &mut Planner) -> Option<StepBlock> {
+        self.hold = Hold::Stopped;
+        if core::mem::take(&mut self.resume_at_stop) && self.resume(planner) {
+            return self.take(planner);
+        }
+        None
+    }
+
+    /// Feed hold: brake to a stop from the speed of the last segment cut.
+    pub fn hold(&mut self) {
+        if self.hold == Hold::Off {
+            self.hold = Hold::Braking;
+            self.cut.stop();
+        }
+    }
+
+    /// Go on after a hold: the rest of the held block from rest, and the
+    /// planner's next block no faster than it can now enter. While still
+    /// braking, it takes effect at the stop. False when not held.
+    pub fn resume(&mut self, planner: &mut Planner) -> bool {
+        match self.hold {
+            Hold::Off => return false,
+            Hold::Braking => {
+                self.resume_at_stop = true;
+                return true;
+            }
+            Hold::Stopped => {}
+        }
+        self.hold = Hold::Off;
+        let exit_sqr = if self.cut.is_stopped() {
+            self.cut.restart()
+        } else {
+            0
+        };
+        planner.limit_entry((exit_sqr as f32 / self.ev_per_milli_sqr) as u64);
+        true
+    }
+
+    /// Drop the block being cut and any hold: a stop that abandons the
+    /// queued motion (the planner is cleared by the caller).
+    pub fn clear(&mut self) {
+        *self = Prep::new();
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,223 @@
+use super::*;
+use crate::axis::{PerAxis, AXES};
+use crate::config::{AxisConfig, MachineConfig};
+use crate::planner::{Feed, Full};
+use crate::segment::{expand, Event, TICK_HZ};
+use crate::units::StepsPerUnit;
+use proptest::prelude::*;
+use std::vec::Vec;
+
+/// Two identical axes, 100 steps per unit, 4000 steps/s, 1000 steps/s².
+fn square() -> MachineConfig {
+    let axis = AxisConfig {
+        steps_per_unit: StepsPerUnit::new(100, 1),
+        max_rate: 4000,
+        accel: 1000,
+        dir_high_is_positive: true,
+        enable_active_high: true,
+    };
+    MachineConfig {
+        axes: [axis; AXES],
+        junction_deviation_um: 50,
+        ..MachineConfig::STRING_ART
+    }
+}
+
+const ACCEL: f64 = 1000.0;
+
+/// What a run produced: the replayed events, how many were cut when the
+/// hold was asked and when it stood.
+struct Run {
+    events: Vec<Event>,
+    /// Events before each block's first.
+    block_starts: Vec<usize>,
+    held_at: Option<usize>,
+    stood_at: Option<usize>,
+}
+
+/// Plans `moves` and cuts them; after `hold_after` events are cut, holds,
+/// cuts until the stop, then resumes (or `resume_early`: right after the
+/// hold, while still braking) and cuts the rest.
+fn run(moves: &[PerAxis<i32>], hold_after: usize, resume_early: bool) -> Run {
+    let mut planner = Planner::new(&square());
+    let mut prep = Prep::new();
+    let (mut segs, mut blocks) = (Vec::new(), Vec::new());
+    let mut cut_events = 0usize;
+    let (mut held_at, mut stood_at) = (None, None);
+    let mut pending = moves.iter();
+    let mut next_move = pending.next();
+    loop {
+        // Keep the planner full, as a sender does.
+        while let Some(&m) = next_move {
+            match planner.push(m, Feed::Rapid) {
+                Ok(()) => next_move = pending.next(),
+                Err(Full) => break,
+            }
+        }
+        if held_at.is_none() && cut_events >= hold_after {
+            held_at = Some(cut_events);
+            prep.hold();
+            if resume_early {
+                assert!(prep.resume(&mut planner));
+            }
+        }
+        match prep.next(&mut planner) {
+            Some(c) => {
+                blocks.extend(c.block);
+                cut_events += c.segment.count as usize;
+                segs.push(c.segment);
+            }
+            None if prep.hold_state() == Hold::Stopped => {
+                assert!(stood_at.is_none(), "one stop");
+                stood_at = Some(cut_events);
+                assert!(prep.resume(&mut planner));
+            }
+            None => {
+                assert!(next_move.is_none() && planner.is_idle() && prep.is_idle());
+                break;
+            }
+        }
+    }
+    let block_starts = blocks
+        .iter()
+        .scan(0, |at, b: &StepBlock| {
+            let start = *at;
+            *at += b.events as usize;
+            Some(start)
+        })
+        .collect();
+    Run {
+        events: expand(segs, blocks).collect(),
+        block_starts,
+        held_at,
+        stood_at,
+    }
+}
+
+fn travel(events: &[Event]) -> PerAxis<i32> {
+    let mut pos = [0; AXES];
+    for e in events {
+        for (i, p) in pos.iter_mut().enumerate() {
+            if e.axes >> i & 1 != 0 {
+                *p += if e.dir >> i & 1 != 0 { 1 } else { -1 };
+            }
+        }
+    }
+    pos
+}
+
+/// Speed after each event from the interval to the next, events/s.
+fn speeds(events: &[Event]) -> Vec<f64> {
+    events
+        .windows(2)
+        .map(|w| TICK_HZ as f64 / (w[1].tick - w[0].tick) as f64)
+        .collect()
+}
+
+#[test]
+fn a_hold_mid_cruise_brakes_to_a_stop_and_resume_ends_on_target() {
+    let target = [40_000, 0, 0, 0];
+    let r = run(&[target], 20_000, false);
+    assert_eq!(travel(&r.events), target);
+    let (held, stood) = (r.held_at.unwrap(), r.stood_at.unwrap());
+    // Cruising at 4000 steps/s: the stop takes v²/2a = 8000 events.
+    let braking = stood - held;
+    assert!((7990..=8010).contains(&braking), "{braking} events to stop");
+    let v = speeds(&r.events);
+    // Braking: the speed falls at every event until the stop.
+    assert!(v[held..stood - 1].windows(2).all(|w| w[1] <= w[0] + 1.0));
+    assert!(v[stood - 2] < 100.0, "stands: {}", v[stood - 2]);
+}
+
+#[test]
+fn a_hold_near_the_end_of_a_short_block_brakes_on_into_the_next() {
+    // Blocks of 2000 steps straight on: the stop (8000 events) spans four.
+    let moves: Vec<PerAxis<i32>> = (1..=8).map(|k| [k * 2000, k * 2000, 0, 0]).collect();
+    let r = run(&moves, 9_000, false);
+    assert_eq!(travel(&r.events), [16_000, 16_000, 0, 0]);
+    let (held, stood) = (r.held_at.unwrap(), r.stood_at.unwrap());
+    assert!(stood > held + 2000, "braked across blocks: {held}..{stood}");
+}
+
+#[test]
+fn resume_while_braking_goes_on_from_the_stop() {
+    let target = [0, 30_000, 0, 0];
+    let r = run(&[target], 15_000, true);
+    assert_eq!(travel(&r.events), target);
+    assert!(r.stood_at.is_none(), "resumed at once: no stop reported");
+}
+
+#[test]
+fn a_hold_with_nothing_moving_is_a_stop_at_once() {
+    let mut planner = Planner::new(&square());
+    let mut prep = Prep::new();
+    prep.hold();
+    assert_eq!(prep.next(&mut planner), None);
+    assert_eq!(prep.hold_state(), Hold::Stopped);
+    planner.push([100, 0, 0, 0], Feed::Rapid).unwrap();
+    assert_eq!(prep.next(&mut planner), None, "held: nothing starts");
+    assert!(prep.resume(&mut planner));
+    assert!(prep.next(&mut planner).is_some_and(|c| c.block.is_some()));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Any moves, a hold at any moment, resumed at the stop: every step
+    /// of every move is made, and the braking never exceeds the
+    /// acceleration (speeds from the replayed event times).
+    #[test]
+    fn holds_keep_every_step_and_brake_within_the_acceleration(
+        moves in proptest::collection::vec((-3000i32..3000, -3000i32..3000), 1..6),
+        hold_frac in 0.0f64..1.0,
+        early in any::<bool>(),
+    ) {
+        let mut at = [0i32; AXES];
+        let targets: Vec<PerAxis<i32>> = moves
+            .iter()
+            .map(|&(x, y)| {
+                at[0] += x;
+                at[1] += y;
+                at
+            })
+            .collect();
+        let total: usize = {
+            let mut prev = [0i32; AXES];
+            targets
+                .iter()
+                .map(|t| {
+                    let n = (t[0] - prev[0]).unsigned_abs().max((t[1] - prev[1]).unsigned_abs());
+                    prev = *t;
+                    n as usize
+                })
+                .sum()
+        };
+        let r = run(&targets, (hold_frac * total as f64) as usize, early);
+        prop_assert_eq!(travel(&r.events), at);
+        prop_assert_eq!(r.events.len(), total);
+        if let (Some(held), Some(stood)) = (r.held_at, r.stood_at) {
+            // Braking: v² falls by 2a per event at most, measured over
+            // windows of 16 events (single intervals carry the 1 µs
+            // timing tolerance) away from the stop (where a window's mean
+            // speed is no longer the speed at its middle), and inside a
+            // block (the event rate jumps at a corner where the path
+            // speed does not).
+            let w = 16;
+            let t: Vec<f64> = r.events.iter().map(|e| e.tick as f64 / TICK_HZ as f64).collect();
+            let v = |j: usize| w as f64 / (t[j + w] - t[j]);
+            let mut j = held;
+            while j + 2 * w < stood {
+                let (a, b) = (v(j), v(j + w));
+                if b * b < 2.0 * ACCEL * (4 * w) as f64 {
+                    break;
+                }
+                let corner = r.block_starts.iter().any(|&s| s > j && s <= j + 2 * w);
+                prop_assert!(
+                    corner || (a * a - b * b) / (2.0 * w as f64) <= ACCEL * 1.05,
+                    "events {}..{}: {} -> {} steps/s", j, j + 2 * w, a, b
+                );
+                j += w;
+            }
+        }
+    }
+}
