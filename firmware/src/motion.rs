@@ -1,5 +1,7 @@
 //! The motion task's state: planner → segment preparer → the step
-//! interrupt's queues. Grbl's `planner` and `st_prep_buffer` in one place.
+//! interrupt's queues. Grbl's `planner` and `st_prep_buffer` in one place,
+//! with its feed hold (`!`/`~`), its stop at once (Ctrl-X) and a stop that
+//! abandons the rest of the queued motion (a pulled card).
 
 use crate::drivers::Drivers;
 use crate::rt::TaskCell;
@@ -8,7 +10,8 @@ use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Planner};
-use taut_logic::segment::{Buffered, Preparer, StepBlock};
+use taut_logic::prep::{Hold, Prep};
+use taut_logic::segment::{Buffered, StepBlock};
 
 /// Preparing segments is urgent (the app runs it at the highest software
 /// priority) while the queue holds less motion than this; otherwise it is
@@ -17,6 +20,9 @@ use taut_logic::segment::{Buffered, Preparer, StepBlock};
 const URGENT_BUDGET_US: u32 = 30_000;
 /// Fewer segments than this are always urgent.
 const URGENT_MIN: u8 = 2;
+/// The queue holds no more motion than this: a feed hold brakes from the
+/// last segment queued, so this bounds how long a hold waits to begin.
+const QUEUED_MAX_US: u32 = 60_000;
 
 /// At or below this many queued segments the refill is urgent: as many of
 /// the newest as last less than the budget. Set by the refill, read by the
@@ -32,12 +38,23 @@ pub fn urgent() -> bool {
 /// The look-ahead ring (1 KiB): its own static, built in place.
 static PLANNER: TaskCell<Planner> = TaskCell::new(Planner::EMPTY);
 
+/// What the machine is doing, for status reports.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum State {
+    Idle,
+    Run,
+    /// A feed hold braking (`Hold:1` in Grbl's words) or standing (`Hold:0`).
+    Hold { standing: bool },
+}
+
 pub struct Motion {
-    prep: Preparer,
+    prep: Prep,
     /// How long the queued segments last.
     buffered: Buffered<SEGMENTS_CAPACITY>,
     /// The block the preparer is cutting (for the fast-path flag).
     block: StepBlock,
+    /// Drop the queued motion once a hold has brought the machine to rest.
+    cancel: bool,
     pub stepper: Stepper,
     pub drivers: Drivers,
 }
@@ -46,9 +63,10 @@ impl Motion {
     pub fn new(config: &MachineConfig, stepper: Stepper, drivers: Drivers) -> Motion {
         PLANNER.with(|p| p.configure(config));
         Motion {
-            prep: Preparer::new(),
+            prep: Prep::new(),
             buffered: Buffered::new(),
             block: StepBlock::default(),
+            cancel: false,
             stepper,
             drivers,
         }
@@ -66,31 +84,25 @@ impl Motion {
     pub fn refill(&mut self, max: usize) -> (bool, bool) {
         let mut freed = false;
         let mut made = 0;
-        while SEGMENTS.free() > 0 && made < max {
-            if self.prep.is_idle() {
-                if BLOCKS.free() == 0 {
-                    break;
-                }
-                let Some(p) = PLANNER.with(|p| p.take()) else {
-                    break;
-                };
+        let mut room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
+        while room && made < max && self.buffered.queued_us(SEGMENTS.len()) < QUEUED_MAX_US {
+            let Some(cut) = PLANNER.with(|p| self.prep.next(p)) else {
+                break;
+            };
+            let mut seg = cut.segment;
+            if let Some(block) = cut.block {
                 // The block goes first: its first segment refers to it.
-                let _ = BLOCKS.push(p.block);
-                self.block = p.block;
-                self.prep.start(p.profile);
+                let _ = BLOCKS.push(block);
+                self.block = block;
                 freed = true;
             }
-            match self.prep.next() {
-                Some(mut seg) => {
-                    if fast_segment(&seg, &self.block) {
-                        seg.flags |= FAST;
-                    }
-                    let _ = SEGMENTS.push(seg);
-                    self.buffered.push(&seg);
-                    made += 1;
-                }
-                None => break,
+            if fast_segment(&seg, &self.block) {
+                seg.flags |= FAST;
             }
+            let _ = SEGMENTS.push(seg);
+            self.buffered.push(&seg);
+            made += 1;
+            room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
         }
         if made > 0 {
             let short = self
@@ -100,8 +112,13 @@ impl Motion {
             SHORT_AT.store(short as u8, Relaxed);
         }
         self.stepper.kick();
+        if self.cancel && self.prep.hold_state() == Hold::Stopped && !self.stepper.is_running() {
+            self.abort();
+            freed = true;
+        }
         let work = !self.prep.is_idle() || !PLANNER.with(|p| p.is_idle());
-        (freed, made == max && work && SEGMENTS.free() > 0)
+        let held = self.prep.hold_state() == Hold::Stopped;
+        (freed, made == max && work && !held && room)
     }
 
     /// Where the last queued move ends, steps.
@@ -115,6 +132,49 @@ impl Motion {
             && self.prep.is_idle()
             && SEGMENTS.is_empty()
             && !self.stepper.is_running()
+    }
+
+    pub fn state(&self) -> State {
+        match self.prep.hold_state() {
+            Hold::Off if self.is_idle() => State::Idle,
+            Hold::Off => State::Run,
+            Hold::Braking => State::Hold { standing: false },
+            Hold::Stopped => State::Hold {
+                standing: !self.stepper.is_running(),
+            },
+        }
+    }
+
+    /// Feed hold: brake to a stop on the path (after the queued motion).
+    pub fn hold(&mut self) {
+        self.prep.hold();
+    }
+
+    /// Go on after a feed hold; false when none is on.
+    pub fn resume(&mut self) -> bool {
+        !self.cancel && PLANNER.with(|p| self.prep.resume(p))
+    }
+
+    /// Brake to a stop and drop the rest of the queued motion: the machine
+    /// then stands, idle, where it stopped (a jog cancelled, a card pulled).
+    pub fn cancel(&mut self) {
+        if !self.is_idle() {
+            self.hold();
+            self.cancel = true;
+        }
+    }
+
+    /// Stop at once (Ctrl-X): no more steps, the queued motion dropped, the
+    /// position as the pulses left it. Steps may have been lost if the
+    /// motors were moving fast.
+    pub fn abort(&mut self) {
+        let at = self.stepper.abort();
+        SEGMENTS.clear();
+        BLOCKS.clear();
+        PLANNER.with(|p| p.clear(at));
+        self.prep.clear();
+        self.buffered = Buffered::new();
+        self.cancel = false;
     }
 
     /// Take new machine figures (a `$` setting); only when idle.

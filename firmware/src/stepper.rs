@@ -24,7 +24,7 @@ use core::ptr::{read_volatile, write_volatile};
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::{port_bit, Port, DRIVERS};
-use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK};
+use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK, STOP};
 
 /// Segments waiting for the interrupt (11 bytes each).
 pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
@@ -179,6 +179,9 @@ pub struct Exec {
     dir_setup_ticks: u16,
     late: u16,
     underruns: u16,
+    /// The current segment is a hold's stop ([`STOP`]): running out of
+    /// segments after it is no underrun.
+    stop: u8,
 }
 
 #[doc(hidden)]
@@ -217,6 +220,7 @@ pub static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {
     dir_setup_ticks: 80,
     late: 0,
     underruns: 0,
+    stop: 0,
 }));
 
 #[inline(always)]
@@ -336,6 +340,21 @@ impl Stepper {
         };
     }
 
+    /// Stop at once: no event after this, the executor reset to where the
+    /// pulses left it (returned). The queues are the caller's to clear.
+    pub fn abort(&mut self) -> PerAxis<i32> {
+        halt();
+        let at = self.position();
+        let e = exec();
+        e.running = false;
+        e.new_dir = None;
+        e.wait = 0;
+        e.waiting = 0;
+        e.fast_ok = 0;
+        self.set_position(at);
+        at
+    }
+
     pub fn is_running(&self) -> bool {
         avr_device::interrupt::free(|_| exec().running)
     }
@@ -345,6 +364,18 @@ impl Stepper {
     pub fn faults(&self) -> (u16, u16) {
         avr_device::interrupt::free(|_| (exec().late, exec().underruns))
     }
+}
+
+/// No more step events: the compare interrupt off. From any context (the
+/// receive interrupt on Ctrl-X); the step interrupt is never mid-event
+/// then, as nothing preempts it. Pins stay low: a pulse is raised and
+/// dropped within one run of the step interrupt.
+#[inline(always)]
+pub fn halt() {
+    avr_device::interrupt::free(|_| {
+        // SAFETY: a masked read-modify-write of the Timer1 mask register.
+        unsafe { write_volatile(TIMSK1, read_volatile(TIMSK1) & !OCIE1A) }
+    });
 }
 
 /// Steps axis `i` made in the first `n` events of `block`: the DDA's closed
@@ -427,6 +458,7 @@ fn load_segment(e: &mut Exec) -> bool {
     e.left = seg.count;
     e.block_left -= seg.count as u32;
     e.fast_ok = seg.flags & FAST;
+    e.stop = seg.flags & STOP;
     true
 }
 
@@ -562,7 +594,7 @@ pub fn on_compare() -> bool {
             e.running = false;
             // Dry in the middle of a block: the preparer fell behind.
             e.fast_ok = 0;
-            if e.block_left > 0 {
+            if e.block_left > 0 && e.stop == 0 {
                 e.underruns = e.underruns.saturating_add(1);
             }
             write_volatile(TIMSK1, read_volatile(TIMSK1) & !OCIE1A);

@@ -68,7 +68,8 @@ pub struct Segment {
     pub add: i32,
     /// Events in this segment, ≥ 1.
     pub count: u16,
-    /// [`NEW_BLOCK`]: load the next [`StepBlock`] before the first event.
+    /// [`NEW_BLOCK`]: load the next [`StepBlock`] before the first event;
+    /// [`STOP`]: a hold stands after the last.
     pub flags: u8,
 }
 
@@ -76,3 +77,7 @@ pub struct Segment {
 /// interrupt pops a [`StepBlock`], sets the DIR pins and resets the DDA
 /// counters to `events / 2`.
 pub const NEW_BLOCK: u8 = 1;
+
+/// [`Segment::flags`] bit: a hold's stop, short of the block's end. The
+/// interrupt then runs out of segments mid-block on purpose (no underrun).
+pub const STOP: u8 = 2;

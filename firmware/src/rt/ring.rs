@@ -51,6 +51,12 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         self.len() == 0
     }
 
+    /// Consumer: drop everything queued (its producer must be quiet, or
+    /// its new items may go too).
+    pub fn clear(&self) {
+        self.tail.store(self.head.load(Relaxed), Relaxed);
+    }
+
     /// Free slots (one stays empty to tell full from empty).
     pub fn free(&self) -> usize {
         N - 1 - self.len()

@@ -9,7 +9,7 @@ use super::number::Number;
 use super::system::SystemBuilder;
 use super::words::Words;
 
-/// Longest line, characters (without `\r`, `\n` and realtime bytes).
+/// Longest line, characters (without its line end and realtime bytes).
 pub const MAX_LINE: u8 = 80;
 
 /// Where in the line the next byte falls.
@@ -46,10 +46,13 @@ enum Statement {
 }
 
 /// The streaming command-line parser: push every received byte, act on
-/// what comes out. Each `\n` yields exactly one line result (`ok` or
-/// `error:` for the host); realtime bytes yield at once.
+/// what comes out. Each line end — `\n`, `\r` or `\r\n` (PuTTY's Enter
+/// sends a bare `\r`) — yields exactly one line result (`ok` or `error:`
+/// for the host); realtime bytes yield at once.
 #[derive(Clone, Debug)]
 pub struct Parser {
+    /// The last byte ended a line with `\r`: a `\n` now ends no other.
+    after_cr: bool,
     /// Characters of this line so far = column of the last one.
     column: u8,
     /// XOR of the bytes before `*`.
@@ -68,6 +71,7 @@ impl Default for Parser {
 impl Parser {
     pub const fn new() -> Parser {
         Parser {
+            after_cr: false,
             column: 0,
             xor: 0,
             lexeme: Lexeme::Code,
@@ -80,14 +84,20 @@ impl Parser {
     pub fn push(&mut self, byte: u8) -> Option<Result<Input, Error>> {
         if let Some(realtime) = Realtime::from_byte(byte) {
             if realtime == Realtime::Reset {
-                *self = Parser::new();
+                // The line so far is dropped; where lines end is not.
+                *self = Parser {
+                    after_cr: self.after_cr,
+                    ..Parser::new()
+                };
             }
             return Some(Ok(Input::Realtime(realtime)));
         }
+        let after_cr = core::mem::take(&mut self.after_cr);
         match byte {
-            b'\r' => None,
-            b'\n' => {
+            b'\n' if after_cr => None,
+            b'\r' | b'\n' => {
                 let line = core::mem::take(self).finish();
+                self.after_cr = byte == b'\r';
                 Some(line)
             }
             _ => {

@@ -8,6 +8,7 @@ mod render;
 
 use super::*;
 use crate::units::Milli;
+use std::format;
 use std::vec::Vec;
 
 /// Every non-`None` result of pushing `bytes`.
@@ -16,12 +17,13 @@ fn push_all(parser: &mut Parser, bytes: &[u8]) -> Vec<Result<Input, Error>> {
 }
 
 /// The result of one line: `text` and a newline into a fresh parser, which
-/// must answer exactly once, at the newline.
+/// must answer exactly once (at its line end: the newline, or a `\r` that
+/// ends `text`).
 fn parse(text: &str) -> Result<Input, Error> {
     let mut parser = Parser::new();
-    let early = push_all(&mut parser, text.as_bytes());
-    assert_eq!(early, [], "{text:?} answered before its newline");
-    parser.push(b'\n').expect("a newline always answers")
+    let mut out = push_all(&mut parser, format!("{text}\n").as_bytes());
+    assert_eq!(out.len(), 1, "{text:?} answered {out:?}");
+    out.remove(0)
 }
 
 /// XOR of the bytes of `text`: the checksum Marlin hosts append.

@@ -59,6 +59,15 @@ impl<const N: usize> Buffered<N> {
         self.next = (self.next + 1) % N;
     }
 
+    /// How long the newest `len` segments last, µs (the queue's motion
+    /// when `len` is its length).
+    pub fn queued_us(&self, len: usize) -> u32 {
+        (0..len.min(N))
+            .map(|back| u32::from(self.units[(self.next + N - 1 - back) % N]))
+            .sum::<u32>()
+            * u32::from(UNIT_US)
+    }
+
     /// The queue is short when it holds this many segments or fewer: the
     /// newest segments, counted back until they last `budget_us` (the
     /// oldest queued go first, so the queue then holds less than that).
@@ -111,5 +120,7 @@ mod tests {
         // The newest alone lasts 25 ms, with the next 27 ms, …, 31 ms.
         assert_eq!(b.short_at(30_000), 3);
         assert_eq!(b.short_at(20_000), 0);
+        assert_eq!(b.queued_us(3), 25_000 + 2 * 2000);
+        assert_eq!(b.queued_us(100), 25_000 + 7 * 2000, "at most N remembered");
     }
 }

@@ -12,7 +12,7 @@
 //!   truncation < 256.
 
 use super::trapezoid::{cbrt_floor_approx, Phase, Trapezoid};
-use super::{Segment, NEW_BLOCK, SUBTICKS_PER_S as Q};
+use super::{Segment, NEW_BLOCK, STOP, SUBTICKS_PER_S as Q};
 use crate::units::div_round;
 
 /// Longest ramp segment: bounds the `add` rounding error.
@@ -186,6 +186,9 @@ impl Preparer {
         let n = seg.count as i64;
         self.now += n * seg.interval as i64 + seg.add as i64 * n * (n - 1) / 2;
         self.done += seg.count as u32;
+        if self.is_stopped() {
+            seg.flags |= STOP;
+        }
         Some(seg)
     }
 

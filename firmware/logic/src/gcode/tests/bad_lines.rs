@@ -113,9 +113,18 @@ fn overlong_lines_fail_at_column_81_and_the_next_line_parses() {
 }
 
 #[test]
-fn carriage_returns_do_not_count_as_columns() {
-    let e = parse("G1\r\r X\r1 X2").unwrap_err();
-    assert_eq!((e.code(), e.column()), (25, Some(7)));
+fn cr_lf_and_crlf_each_end_one_line() {
+    let mut parser = Parser::new();
+    let out = push_all(&mut parser, b"M17\rM18\nM114\r\nM400\r\r\n\n");
+    let lines: Vec<_> = out.iter().map(|r| r.as_ref().map(|i| match i {
+        Input::Line(l) => l.command,
+        _ => Command::Empty,
+    })).collect();
+    use Command::*;
+    assert_eq!(
+        lines,
+        [Ok(EnableDrivers), Ok(DisableDrivers), Ok(ReportPosition), Ok(WaitIdle), Ok(Empty), Ok(Empty)]
+    );
 }
 
 /// A `ufmt` writer into a host string.

@@ -92,7 +92,7 @@ proptest! {
 
     #[test]
     fn random_bytes_never_panic_and_each_newline_answers_once(
-        bytes in prop::collection::vec(prop_oneof![any::<u8>(), prop::sample::select(&b"GXN*;() 1.-\n$="[..])], 0..300),
+        bytes in prop::collection::vec(prop_oneof![any::<u8>(), prop::sample::select(&b"GXN*;() 1.-\n\r$="[..])], 0..300),
     ) {
         let mut parser = Parser::new();
         let mut lines = 0;
@@ -100,15 +100,25 @@ proptest! {
             match parser.push(b) {
                 Some(Ok(Input::Realtime(r))) => prop_assert_eq!(Realtime::from_byte(b), Some(r)),
                 Some(_) => {
-                    prop_assert_eq!(b, b'\n');
+                    prop_assert!(b == b'\n' || b == b'\r');
                     lines += 1;
                 }
-                None => prop_assert!(b != b'\n' && Realtime::from_byte(b).is_none()),
+                None => prop_assert!(Realtime::from_byte(b).is_none()),
             }
         }
-        prop_assert_eq!(lines, bytes.iter().filter(|&&b| b == b'\n').count());
-        // Whatever came before, the parser is clean after the next newline.
-        let out: Vec<_> = b"\nG91 G1 C1\n".iter().filter_map(|&b| parser.push(b)).collect();
+        // Line ends: every `\r`, and every `\n` not right after one
+        // (realtime bytes in between do not count).
+        let line_bytes: Vec<u8> =
+            bytes.iter().copied().filter(|&b| Realtime::from_byte(b).is_none()).collect();
+        let ends = line_bytes
+            .iter()
+            .enumerate()
+            .filter(|&(i, &b)| b == b'\r' || (b == b'\n' && (i == 0 || line_bytes[i - 1] != b'\r')))
+            .count();
+        prop_assert_eq!(lines, ends);
+        // Whatever came before, the parser is clean after the next line end
+        // (a `\n` right after a `\r` ends none).
+        let out: Vec<_> = b"\rG91 G1 C1\n".iter().filter_map(|&b| parser.push(b)).collect();
         let expected = line(Command::Linear).distance(Distance::Relative).at(AxisWord::C, 1_000);
         prop_assert_eq!(out.len(), 2);
         prop_assert_eq!(&out[1], &Ok(Input::Line(expected)));
