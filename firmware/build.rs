@@ -1,5 +1,45 @@
-//! Stamp the firmware with the git commit it was built from (for the banner).
+//! Stamp the firmware with the git commit it was built from (for the
+//! banner), and link avr-gcc's hand-written arithmetic in place of the
+//! Rust builtins.
+//!
+//! Rust's `compiler_builtins` defines the soft-float and wide-division
+//! routines (`__mulsf3`, `__udivdi3`, …) as weak symbols written in
+//! portable Rust: on the AVR an `f32` multiply costs ~1100 cycles, a
+//! `u64` division several thousand. avr-libc's `libm.a` and avr-gcc's
+//! `libgcc.a` hold the same routines in assembly (same ABI, several times
+//! faster). Linked as objects, their strong definitions replace the weak
+//! ones; an archive alone would not (a weak definition already satisfies
+//! the reference). Their own helpers (`__fp_round`, …) come from the
+//! archives as usual.
+use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// Members of avr-libc's `libm.a`: single-precision arithmetic.
+const LIBM: &[&str] = &[
+    "addsf3.o",
+    "mulsf3.o",
+    "divsf3.o",
+    "cmpsf2.o",
+    "gesf2.o",
+    "unordsf2.o",
+    "fixsfsi.o",
+    "fixunssfsi.o",
+    "floatsisf.o",
+    "fixsfdi.o",
+    "floatdisf.o",
+    "floatundisf.o",
+];
+
+/// Members of avr-gcc's `libgcc.a`: integer division and 64-bit multiply.
+const LIBGCC: &[&str] = &[
+    "_udivmodhi4.o",
+    "_divmodhi4.o",
+    "_udivmodsi4.o",
+    "_divmodsi4.o",
+    "_udivdi3.o",
+    "_divdi3.o",
+    "_muldi3.o",
+];
 
 fn main() {
     let hash = Command::new("git")
@@ -12,4 +52,43 @@ fn main() {
     println!("cargo:rustc-env=TAUT_GIT_HASH={hash}");
     println!("cargo:rerun-if-changed=../.git/HEAD");
     println!("cargo:rerun-if-changed=../.git/index");
+    println!("cargo:rerun-if-changed=build.rs");
+
+    if std::env::var("CARGO_CFG_TARGET_ARCH").as_deref() != Ok("avr") {
+        return;
+    }
+    let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
+    for (archive, members) in [(gcc_file("libm.a"), LIBM), (gcc_file("-libgcc"), LIBGCC)] {
+        extract(&archive, members, &out);
+        for m in members {
+            println!("cargo:rustc-link-arg={}", out.join(m).display());
+        }
+    }
+    // After the objects: the archives are searched in order.
+    println!("cargo:rustc-link-arg=-lm");
+    println!("cargo:rustc-link-arg=-lgcc");
+}
+
+/// Where avr-gcc keeps `name` for the ATmega2560 (`-libgcc`: libgcc.a).
+fn gcc_file(name: &str) -> PathBuf {
+    let arg = match name {
+        "-libgcc" => "-print-libgcc-file-name".to_string(),
+        _ => format!("-print-file-name={name}"),
+    };
+    let o = Command::new("avr-gcc")
+        .args(["-mmcu=atmega2560", &arg])
+        .output()
+        .expect("avr-gcc (Debian gcc-avr) is needed to link the firmware");
+    PathBuf::from(String::from_utf8(o.stdout).unwrap().trim())
+}
+
+fn extract(archive: &Path, members: &[&str], into: &Path) {
+    let st = Command::new("avr-ar")
+        .arg("x")
+        .arg(archive)
+        .args(members)
+        .current_dir(into)
+        .status()
+        .expect("avr-ar (Debian binutils-avr) is needed to link the firmware");
+    assert!(st.success(), "avr-ar x {} {members:?}", archive.display());
 }

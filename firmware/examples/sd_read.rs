@@ -9,8 +9,10 @@
 use panic_halt as _;
 use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{clock, gpio::Pins, usart};
-use taut_firmware::card::{CardReader, Poll, Request, What, CARD_IN, CARD_OUT};
+use taut_firmware::card::CardReader;
 use taut_firmware::info;
+use taut_firmware::queues::{Request, Signal, What, CARD_IN, CARD_OUT};
+use taut_firmware::rt::Poll;
 use taut_logic::job::FileName;
 
 #[avr_device::entry]
@@ -38,7 +40,9 @@ fn main() -> ! {
     let start = clock::micros();
     let mut bytes: u32 = 0;
     loop {
-        if reader.poll(clock::millis(), false) == Poll::Blocked && CARD_OUT.is_empty() {
+        if reader.poll(clock::millis(), false) == Poll::Wait(Signal::CardRoom)
+            && CARD_OUT.is_empty()
+        {
             break;
         }
         match CARD_OUT.pop().map(|m| m.what) {

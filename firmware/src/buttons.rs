@@ -1,23 +1,15 @@
 //! The machine's four buttons (RAMPS end-stop inputs, see `pinmap`). The
 //! millisecond tick samples the pins — only while a button is down or has
-//! just changed — into [`SAMPLES`]; the buttons task debounces them
+//! just changed — into `SAMPLES`; the buttons task debounces them
 //! (`taut_logic::buttons`) and sends the presses to the job through
-//! [`BUTTONS`].
+//! `BUTTONS` (`queues`).
 
 use crate::board::gpio::{Pin, PullUp};
-use crate::rt::Ring;
+use crate::queues::{BUTTONS, SAMPLES};
 use core::cell::UnsafeCell;
 use embedded_hal::digital::InputPin;
-use taut_logic::buttons::{ButtonEvent, Buttons, DEBOUNCE_MS};
+use taut_logic::buttons::{Buttons, DEBOUNCE_MS};
 use taut_logic::pinmap::Button;
-
-/// Tick → buttons task: one raw sample (bit `Button as u8` = pressed) per
-/// millisecond while active. Full: the sample is refused and counted (the
-/// task fell 15 ms behind; a press then counts a little late).
-pub static SAMPLES: Ring<u8, 16> = Ring::new();
-/// Buttons task → job. Full: refused and counted (the job is far behind a
-/// human's presses).
-pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
 
 /// The end-stop inputs of the RAMPS board: X-MAX (green), X-MIN, Y-MIN,
 /// Z-MIN (white).

@@ -10,7 +10,8 @@
 
 use crate::board::delay::Delay;
 use crate::board::spi::CardSpi;
-use crate::rt::Ring;
+use crate::queues::{CardMsg, Request, Signal, What, CARD_IN, CARD_OUT, CHUNK};
+use crate::rt::Poll;
 use crate::{info, warn};
 use core::mem::{offset_of, size_of};
 use embedded_hal::spi::SpiDevice;
@@ -19,63 +20,12 @@ use embedded_sdmmc::{Block, BlockDevice, BlockIdx, SdCard};
 use taut_logic::fat::{BlockRead, FatError, File, Volume, BLOCK};
 use taut_logic::job::FileName;
 
-/// File bytes per message.
-pub const CHUNK: usize = 32;
-
-/// What the reader tells the job. `ticket` numbers the `Open` request a
-/// file message answers, so the job can drop what an older request sent.
-#[derive(Clone, Copy)]
-pub struct CardMsg {
-    pub ticket: u8,
-    pub what: What,
-}
-
-#[derive(Clone, Copy)]
-pub enum What {
-    Inserted,
-    Removed,
-    /// The next bytes of the file.
-    Data {
-        len: u8,
-        bytes: [u8; CHUNK],
-    },
-    End,
-    /// No such file on the card.
-    Missing,
-    /// The card failed mid-file (a `Removed` follows), or holds no FAT volume.
-    Failed,
-}
-
-/// What the job asks of the reader.
-#[derive(Clone, Copy)]
-pub enum Request {
-    /// Stream this file from its start (dropping the one being read).
-    Open(FileName, u8),
-}
-
 /// Free slots the reader waits for before a step of work: the most one
 /// step sends (the last chunk of a block and `End`, or `Failed` and
 /// `Removed`). The job wakes the reader when there are this many.
 pub const ROOM: usize = 2;
 
-/// Reader → job. Full: the reader keeps its block and waits.
-pub static CARD_OUT: Ring<CardMsg, 4> = Ring::new();
-/// Job → reader.
-pub static CARD_IN: Ring<Request, 2> = Ring::new();
-
 type Sd = SdCard<CardSpi, Delay>;
-
-/// What the reader wants next.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Poll {
-    /// Nothing to do until a request, or the next presence check in this
-    /// many ms.
-    Idle(u16),
-    /// More to read: run again.
-    More,
-    /// `CARD_OUT` is full: run again when the job has taken from it.
-    Blocked,
-}
 
 enum Slot {
     Empty,
@@ -130,39 +80,40 @@ impl CardReader {
         }
     }
 
-    /// One step of work at millisecond `now`; see [`Poll`]. While the
-    /// machine is `moving`, an empty slot is not probed (next second).
-    pub fn poll(&mut self, now: u32, moving: bool) -> Poll {
+    /// One step of work at millisecond `now`. Between requests it sleeps
+    /// until the next check is due. While the machine is `moving`, an
+    /// empty slot is not probed (next second).
+    pub fn poll(&mut self, now: u32, moving: bool) -> Poll<Signal> {
         let due = now.wrapping_sub(self.check_at) as i32 >= 0;
         if due {
             self.check_at = now.wrapping_add(CHECK_MS);
         }
         let poll = self.work(due && !(moving && matches!(self.slot, Slot::Empty)));
         match poll {
-            Poll::Idle(_) => Poll::Idle(self.check_at.wrapping_sub(now).min(CHECK_MS) as u16),
+            Poll::Idle => Poll::After(self.check_at.wrapping_sub(now).min(CHECK_MS) as u16),
             _ => poll,
         }
     }
 
-    /// The step of work; `check`: look for the card or at it. Its `Idle`
-    /// carries no delay: `poll` puts in the time to the next check.
-    fn work(&mut self, check: bool) -> Poll {
+    /// The step of work; `check`: look for the card or at it. `Idle`: until
+    /// the next check (`poll` puts in the time).
+    fn work(&mut self, check: bool) -> Poll<Signal> {
         match self.slot {
             Slot::Empty if check => self.look_for_card(),
-            Slot::Empty => Poll::Idle(0),
+            Slot::Empty => Poll::Idle,
             Slot::Mounted(volume) => {
                 if let Some(Request::Open(name, ticket)) = CARD_IN.peek() {
                     if CARD_OUT.free() < ROOM {
-                        return Poll::Blocked;
+                        return Poll::Wait(Signal::CardRoom);
                     }
                     let _ = CARD_IN.pop();
                     self.open(volume, name, ticket);
-                    return Poll::More;
+                    return Poll::Again;
                 }
                 match volume {
                     Some(v) if self.file.is_some() => self.stream(v),
                     _ if check => self.check_still_there(),
-                    _ => Poll::Idle(0),
+                    _ => Poll::Idle,
                 }
             }
         }
@@ -173,9 +124,9 @@ impl CardReader {
         let _ = CARD_OUT.push(CardMsg { ticket, what });
     }
 
-    fn look_for_card(&mut self) -> Poll {
+    fn look_for_card(&mut self) -> Poll<Signal> {
         if CARD_OUT.free() < ROOM {
-            return Poll::Blocked;
+            return Poll::Wait(Signal::CardRoom);
         }
         let present = self.sd.spi(|spi| {
             spi.bus.slow_speed();
@@ -183,14 +134,14 @@ impl CardReader {
             answers_cmd0(spi)
         });
         if !present {
-            return Poll::Idle(0);
+            return Poll::Idle;
         }
         self.sd.mark_card_uninit();
         let blocks = match self.sd.num_bytes() {
             Ok(bytes) => (bytes / BLOCK as u64) as u32,
             Err(_) => {
                 warn!("card: no answer to init");
-                return Poll::Idle(0);
+                return Poll::Idle;
             }
         };
         self.sd.spi(|spi| spi.bus.full_speed());
@@ -207,7 +158,7 @@ impl CardReader {
             Err(FatError::Device(_)) => {
                 warn!("card: read failed");
                 self.sd.mark_card_uninit();
-                return Poll::Idle(0);
+                return Poll::Idle;
             }
             Err(_) => {
                 warn!("card: no FAT16/FAT32 volume");
@@ -216,7 +167,7 @@ impl CardReader {
         };
         self.slot = Slot::Mounted(volume);
         Self::send(What::Inserted, 0);
-        Poll::Idle(0)
+        Poll::Idle
     }
 
     fn open(&mut self, volume: Option<Volume>, name: FileName, ticket: u8) {
@@ -239,13 +190,13 @@ impl CardReader {
     }
 
     /// Sends what is left of the block, then reads the next one.
-    fn stream(&mut self, volume: Volume) -> Poll {
+    fn stream(&mut self, volume: Volume) -> Poll<Signal> {
         let Some((mut file, ticket)) = self.file else {
-            return Poll::Idle(0);
+            return Poll::Idle;
         };
         while self.at < self.len {
             if CARD_OUT.free() == 0 {
-                return Poll::Blocked;
+                return Poll::Wait(Signal::CardRoom);
             }
             let from = self.at as usize;
             let n = (self.len - self.at).min(CHUNK as u16);
@@ -261,41 +212,41 @@ impl CardReader {
             self.at += n;
         }
         if CARD_OUT.free() < ROOM {
-            return Poll::Blocked;
+            return Poll::Wait(Signal::CardRoom);
         }
         match file.read_next(&volume, &mut Device(&self.sd), &mut self.block.contents) {
             Ok(0) => {
                 self.file = None;
                 Self::send(What::End, ticket);
-                Poll::Idle(0)
+                Poll::Idle
             }
             Ok(n) => {
                 self.file = Some((file, ticket));
                 self.at = 0;
                 self.len = n as u16;
-                Poll::More
+                Poll::Again
             }
             Err(FatError::Device(_)) => {
                 self.removed(ticket);
-                Poll::Idle(0)
+                Poll::Idle
             }
             Err(_) => {
                 warn!("card: broken cluster chain");
                 self.file = None;
                 Self::send(What::Failed, ticket);
-                Poll::Idle(0)
+                Poll::Idle
             }
         }
     }
 
-    fn check_still_there(&mut self) -> Poll {
+    fn check_still_there(&mut self) -> Poll<Signal> {
         if CARD_OUT.free() < ROOM {
-            return Poll::Blocked;
+            return Poll::Wait(Signal::CardRoom);
         }
         if self.sd.num_bytes().is_err() {
             self.removed(0);
         }
-        Poll::Idle(0)
+        Poll::Idle
     }
 
     /// The card stopped answering: pulled out (or dead, which the user

@@ -1,41 +1,31 @@
 //! The serial console: G-code lines in, `ok` / `error:<code>` out, Grbl
 //! style. Grbl's `protocol` + `gcode` interpreter stage: the parser (host-
 //! tested in `taut_logic::gcode`) turns bytes into lines; this file carries
-//! them out against the motion task's state.
+//! them out against the motion task's state. Real-time commands never get
+//! here (`realtime`).
+//!
+//! The console owns the machine's motion only while no string-art job
+//! does: during a job it refuses motion, drivers and settings, and still
+//! answers reads. Targets outside an axis's soft limits are refused before
+//! anything moves; a feed below [`MIN_FEED`] is refused, one above an
+//! axis's maximum rate is clamped to it (by the planner).
 
-use crate::board::{clock, usart};
-use crate::job::{Hold, CLAIMS_TX, HOLDS};
+use crate::board::clock;
 use crate::motion::Motion;
-use crate::rt::stack;
-use crate::{flash_str, warn};
+use crate::queues::{Signal, JOB_CLAIMS_TX, RX};
+use crate::reply::{self, Fixed, REPORTED_AXES};
+use crate::rt::{stack, Poll};
 use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{Command, Distance, Error, Input, Line, Parser, Realtime, SystemLine};
+use taut_logic::gcode::{
+    Command, Distance, Error, ErrorKind, Input, Line, Parser, SystemLine, MIN_FEED,
+};
 use taut_logic::kinematics::{Kinematics, Position};
 use taut_logic::planner::Feed;
 use taut_logic::settings;
 use taut_logic::units::Milli;
 use ufmt::{uWrite, uwrite};
-
-/// Longest reply line; a line is only executed when its reply fits.
-const REPLY_ROOM: usize = 72;
-
-/// What the console waits for when it returns.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Poll {
-    /// Nothing more to read.
-    Drained,
-    /// A line waits for planner room or for motion to finish: run again
-    /// when the motion task makes progress.
-    Motion,
-    /// Try again after this many ms (dwell, serial output full).
-    After(u16),
-    /// One line was carried out and more input may wait: run again after
-    /// the tasks already ready (a task's run stays short, so the motion
-    /// task is never held up by a burst of lines).
-    Yield,
-}
 
 pub struct Console {
     parser: Parser,
@@ -49,6 +39,9 @@ pub struct Console {
     feed: Option<Milli>,
     /// Commanded position in milli-units (G-code coordinates).
     target: Position,
+    /// The motion epoch `target` agrees with: a stop that dropped queued
+    /// moves starts a new one, and the target is then read back.
+    epoch: u8,
 }
 
 #[derive(Clone, Copy)]
@@ -57,61 +50,17 @@ enum Listing {
     Queues(u8),
 }
 
-/// A reply line assembled on the stack and queued whole.
-struct Reply(heapless::Vec<u8, REPLY_ROOM>);
-
-impl uWrite for Reply {
-    type Error = ();
-    fn write_str(&mut self, s: &str) -> Result<(), ()> {
-        self.0.extend_from_slice(s.as_bytes()).map_err(|_| ())
-    }
+/// Who may move the machine now.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Owner {
+    Console,
+    /// A string-art job is drilling or winding (or paused in it).
+    Job,
 }
 
-impl Reply {
-    fn new() -> Reply {
-        Reply(heapless::Vec::new())
-    }
-    fn send(mut self) {
-        let _ = self.0.push(b'\n');
-        // Room was checked before the line ran (REPLY_ROOM).
-        usart::send(&self.0);
-    }
-}
-
-fn ok() {
-    usart::send(b"ok\n");
-}
-
-fn reply_error(e: &Error) {
-    let mut r = Reply::new();
-    let _ = uwrite!(r, "error:{} ", e.code());
-    let _ = uwrite!(r, "{}", e.message());
-    if let Some(c) = e.column() {
-        let _ = uwrite!(r, " (col {})", c);
-    }
-    r.send();
-}
-
-/// A fixed-point value as `-12.345`.
-struct Fixed(Milli);
-
-impl ufmt::uDisplay for Fixed {
-    fn fmt<W: uWrite + ?Sized>(&self, f: &mut ufmt::Formatter<'_, W>) -> Result<(), W::Error> {
-        let v = self.0 .0;
-        if v < 0 {
-            f.write_str("-")?;
-        }
-        let a = v.unsigned_abs();
-        let frac = a % 1000;
-        uwrite!(f, "{}.", a / 1000)?;
-        if frac < 100 {
-            f.write_str("0")?;
-        }
-        if frac < 10 {
-            f.write_str("0")?;
-        }
-        uwrite!(f, "{}", frac)
-    }
+fn refuse(kind: ErrorKind) -> Option<Poll<Signal>> {
+    reply::error(&Error::new(kind, 0));
+    None
 }
 
 impl Console {
@@ -125,60 +74,98 @@ impl Console {
             rapid: true,
             feed: None,
             target: [Milli::ZERO; AXES],
+            epoch: 0,
         }
     }
 
+    /// Ctrl-X: the line in progress, a waiting line and a listing are
+    /// dropped with the bytes not yet read; modal state is Grbl's default.
+    pub fn reset(&mut self) {
+        let epoch = self.epoch;
+        *self = Console::new();
+        self.epoch = epoch;
+        RX.clear();
+    }
+
     /// Read and carry out input until it runs out or must wait.
-    pub fn poll(&mut self, m: &mut Motion, kin: &impl Kinematics, cfg: &mut MachineConfig) -> Poll {
+    pub fn poll(
+        &mut self,
+        m: &mut Motion,
+        kin: &impl Kinematics,
+        cfg: &mut MachineConfig,
+        owner: Owner,
+    ) -> Poll<Signal> {
+        if self.epoch != m.epoch() {
+            self.epoch = m.epoch();
+            self.target = kin.forward(&m.target());
+        }
         loop {
-            if usart::TX.free() < REPLY_ROOM || CLAIMS_TX.load(Relaxed) {
+            if !reply::room() || JOB_CLAIMS_TX.load(Relaxed) {
                 return Poll::After(2);
             }
             if let Some(listing) = self.listing {
                 self.list(listing, cfg);
-                return Poll::Yield;
+                return Poll::Again;
             }
             if let Some(line) = self.held.take() {
-                if let Some(wait) = self.execute(&line, m, kin) {
+                if let Some(wait) = self.execute(&line, m, kin, cfg, owner) {
                     self.held = Some(line);
                     return wait;
                 }
-                continue;
+                // One line per run: the other tasks get their turn.
+                return Poll::Again;
             }
-            let Some(byte) = usart::RX.pop() else {
-                return Poll::Drained;
+            let Some(byte) = RX.pop() else {
+                return Poll::Idle;
             };
             match self.parser.push(byte) {
-                None => {}
-                Some(Err(e)) => reply_error(&e),
+                None | Some(Ok(Input::Realtime(_))) => {}
+                Some(Err(e)) => reply::error(&e),
                 Some(Ok(Input::Line(line))) => self.held = Some(line),
-                Some(Ok(Input::System(s))) => self.system(s, m, cfg),
-                Some(Ok(Input::Realtime(r))) => self.realtime(r, m, kin),
+                Some(Ok(Input::System(s))) => self.system(s, m, cfg, owner),
             }
         }
     }
 
     /// Carry out one line; `Some(wait)` when it cannot run yet.
-    fn execute(&mut self, line: &Line, m: &mut Motion, kin: &impl Kinematics) -> Option<Poll> {
+    fn execute(
+        &mut self,
+        line: &Line,
+        m: &mut Motion,
+        kin: &impl Kinematics,
+        cfg: &MachineConfig,
+        owner: Owner,
+    ) -> Option<Poll<Signal>> {
+        let has_axes = line.axes.iter().any(Option::is_some);
+        let moves = has_axes
+            || matches!(
+                line.command,
+                Command::EnableDrivers | Command::DisableDrivers | Command::SetPosition
+            );
+        if moves && owner == Owner::Job {
+            return refuse(ErrorKind::JobOwnsMotion);
+        }
+        if line.f.is_some_and(|f| f.0 < MIN_FEED) {
+            return refuse(ErrorKind::FeedTooLow);
+        }
         if let Some(d) = line.distance {
             self.distance = d;
         }
         if let Some(f) = line.f {
             self.feed = Some(f);
         }
-        let has_axes = line.axes.iter().any(Option::is_some);
         match line.command {
             Command::Rapid | Command::Linear => {
                 self.rapid = line.command == Command::Rapid;
                 if has_axes {
-                    return self.move_to(line, m, kin);
+                    return self.move_to(line, m, kin, cfg);
                 }
             }
-            Command::Empty if has_axes => return self.move_to(line, m, kin),
+            Command::Empty if has_axes => return self.move_to(line, m, kin, cfg),
             Command::Empty => {}
             Command::Dwell => {
                 if !m.is_idle() {
-                    return Some(Poll::Motion);
+                    return Some(Poll::Wait(Signal::Motion));
                 }
                 let now = clock::millis();
                 let until = *self
@@ -191,20 +178,21 @@ impl Console {
                 self.dwell_until = None;
             }
             Command::SetPosition | Command::DisableDrivers | Command::WaitIdle if !m.is_idle() => {
-                return Some(Poll::Motion);
+                return Some(Poll::Wait(Signal::Motion));
             }
             Command::SetPosition => {
-                let words = kin.words();
-                for (i, w) in words.iter().enumerate() {
+                let mut at = self.target;
+                for (i, w) in kin.words().iter().enumerate() {
                     if let Some(v) = letter_value(line, *w) {
-                        self.target[i] = v;
+                        at[i] = v;
                     }
                 }
-                match kin.inverse(&self.target) {
-                    Ok(steps) => m.set_position(steps),
-                    Err(_) => {
-                        return reply(Error::new(taut_logic::gcode::ErrorKind::InvalidTarget, 0))
+                match kin.inverse(&at) {
+                    Ok(steps) => {
+                        m.set_position(steps);
+                        self.target = at;
                     }
+                    Err(_) => return refuse(ErrorKind::InvalidTarget),
                 }
             }
             Command::EnableDrivers => m.drivers.set(0xFF, true),
@@ -212,22 +200,26 @@ impl Console {
             Command::WaitIdle => {}
             Command::ReportPosition => report_position(m, kin),
         }
-        ok();
+        reply::ok();
         None
     }
 
-    fn move_to(&mut self, line: &Line, m: &mut Motion, kin: &impl Kinematics) -> Option<Poll> {
+    fn move_to(
+        &mut self,
+        line: &Line,
+        m: &mut Motion,
+        kin: &impl Kinematics,
+        cfg: &MachineConfig,
+    ) -> Option<Poll<Signal>> {
+        if !m.position_known() {
+            return refuse(ErrorKind::Locked);
+        }
         let feed = if self.rapid {
             Feed::Rapid
         } else {
             match self.feed {
                 Some(f) => Feed::PerMinute(f),
-                None => {
-                    return reply(Error::new(
-                        taut_logic::gcode::ErrorKind::UndefinedFeedRate,
-                        0,
-                    ))
-                }
+                None => return refuse(ErrorKind::UndefinedFeedRate),
             }
         };
         let mut target = self.target;
@@ -239,20 +231,27 @@ impl Console {
                 };
             }
         }
+        let outside = cfg.axes.iter().zip(&target).any(|(a, t)| {
+            let (min, max) = a.travel;
+            a.soft_limits && (*t < min || *t > max)
+        });
+        if outside {
+            return refuse(ErrorKind::TravelExceeded);
+        }
         // Converted once from the absolute target: relative moves never drift.
         let steps = match kin.inverse(&target) {
             Ok(s) => s,
-            Err(_) => return reply(Error::new(taut_logic::gcode::ErrorKind::InvalidTarget, 0)),
+            Err(_) => return refuse(ErrorKind::InvalidTarget),
         };
         if m.push(steps, feed).is_err() {
-            return Some(Poll::Motion);
+            return Some(Poll::Wait(Signal::Motion));
         }
         self.target = target;
-        ok();
+        reply::ok();
         None
     }
 
-    fn system(&mut self, s: SystemLine, m: &mut Motion, cfg: &mut MachineConfig) {
+    fn system(&mut self, s: SystemLine, m: &mut Motion, cfg: &mut MachineConfig, owner: Owner) {
         match s {
             SystemLine::PrintSettings => {
                 self.listing = Some(Listing::Settings(0));
@@ -263,7 +262,7 @@ impl Console {
                 return;
             }
             SystemLine::Stack => {
-                let mut r = Reply::new();
+                let mut r = reply::line();
                 let _ = uwrite!(
                     r,
                     "[stack peak {} B, headroom {} B]",
@@ -272,27 +271,31 @@ impl Console {
                 );
                 r.send();
             }
+            SystemLine::Unlock => m.unlock(),
+            SystemLine::Set { .. } if owner == Owner::Job => {
+                return reply::error(&Error::new(ErrorKind::JobOwnsMotion, 0));
+            }
+            SystemLine::Set { .. } if !m.is_idle() => {
+                return reply::error(&Error::new(ErrorKind::NotIdle, 0));
+            }
             SystemLine::Set { key, value } => {
-                if !m.is_idle() {
-                    return reply_error(&Error::new(taut_logic::gcode::ErrorKind::NotIdle, 0));
-                }
-                if settings::set(cfg, &key, &value).is_err() {
-                    return reply_error(&Error::new(
-                        taut_logic::gcode::ErrorKind::InvalidStatement,
-                        0,
-                    ));
+                if let Err(e) = settings::set(cfg, &key, &value) {
+                    // `$key=value`: the value starts after `$`, the key, `=`.
+                    let col = (key.len() + 3 + e.at).min(u8::MAX as usize) as u8;
+                    let invalid = Error::new(ErrorKind::InvalidStatement, col);
+                    return reply::error_because(&invalid, Some(e.kind));
                 }
                 m.configure(cfg);
             }
         }
-        ok();
+        reply::ok();
     }
 
     /// One line of a listing per call: the TX ring never overflows.
     fn list(&mut self, listing: Listing, cfg: &MachineConfig) {
         self.listing = match listing {
             Listing::Settings(next) => settings::all().nth(next).map(|s| {
-                let mut r = Reply::new();
+                let mut r = reply::line();
                 let _ = uwrite!(r, "${}={}", s, s.get(cfg));
                 r.send();
                 Listing::Settings(next + 1)
@@ -302,38 +305,15 @@ impl Console {
             }
         };
         if self.listing.is_none() {
-            ok();
-        }
-    }
-
-    fn realtime(&mut self, r: Realtime, m: &mut Motion, kin: &impl Kinematics) {
-        match r {
-            Realtime::Status => {
-                let mut rep = Reply::new();
-                let state = if m.is_idle() {
-                    flash_str!("Idle")
-                } else {
-                    flash_str!("Run")
-                };
-                let _ = uwrite!(rep, "<{}|MPos:", state);
-                let pos = kin.forward(&m.stepper.position());
-                for (i, p) in pos.iter().enumerate() {
-                    let _ = uwrite!(rep, "{}{}", if i > 0 { "," } else { "" }, Fixed(*p));
-                }
-                let _ = rep.write_str(">");
-                rep.send();
-            }
-            // The job pauses after its current move and resumes (`job`).
-            Realtime::FeedHold => push_hold(Hold::Pause),
-            Realtime::CycleStart => push_hold(Hold::Resume),
-            Realtime::Reset => {}
+            reply::ok();
         }
     }
 }
 
-fn reply(e: Error) -> Option<Poll> {
-    reply_error(&e);
-    None
+impl Default for Console {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 fn letter_value(line: &Line, letter: u8) -> Option<Milli> {
@@ -343,24 +323,19 @@ fn letter_value(line: &Line, letter: u8) -> Option<Milli> {
         .and_then(|w| line.axis(*w))
 }
 
-/// `M114`: `C:1.000 X:0.000 Z:0.000 A:0.000 Count C:27 X:0 Z:0 A:0`.
+/// `M114`: `C:1.000 X:0.000 Z:0.000 Count C:27 X:0 Z:0` (the executed
+/// position).
 fn report_position(m: &Motion, kin: &impl Kinematics) {
     let steps = m.stepper.position();
     let pos = kin.forward(&steps);
     let words = kin.words();
-    let mut r = Reply::new();
-    for i in 0..AXES {
+    let mut r = reply::line();
+    for i in 0..REPORTED_AXES {
         let _ = uwrite!(r, "{}:{} ", words[i] as char, Fixed(pos[i]));
     }
     let _ = r.write_str("Count");
-    for i in 0..AXES {
+    for i in 0..REPORTED_AXES {
         let _ = uwrite!(r, " {}:{}", words[i] as char, steps[i]);
     }
     r.send();
-}
-
-fn push_hold(h: Hold) {
-    if HOLDS.push(h).is_err() {
-        warn!("hold queue full");
-    }
 }

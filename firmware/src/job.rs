@@ -6,12 +6,14 @@
 //! Log lines wait for room in the TX ring rather than being dropped: the
 //! prompts and the bad-file messages must reach the user.
 
-use crate::board::usart;
-use crate::card::{CardMsg, Request, What, CARD_IN, CARD_OUT, CHUNK};
 use crate::motion::Motion;
-use crate::rt::Ring;
+use crate::queues::{
+    CardMsg, Control, Request, Signal, What, BUTTONS, CARD_IN, CARD_OUT, CHUNK, JOB_CLAIMS_TX,
+    JOB_CONTROL, TX,
+};
+use crate::rt::Poll;
 use crate::{error, info, report, texts};
-use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
+use core::sync::atomic::Ordering::Relaxed;
 use heapless::Deque;
 use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
@@ -22,39 +24,11 @@ use taut_logic::planner::Feed;
 use taut_logic::stringart::job::{Action, Event, Job, State};
 use taut_logic::stringart::Step;
 
-/// The console's `!` and `~`, for the job.
-#[derive(Clone, Copy)]
-pub enum Hold {
-    Pause,
-    Resume,
-}
-
-/// Console → job.
-pub static HOLDS: Ring<Hold, 4> = Ring::new();
-
-/// The job waits for room in the TX ring for a line it must not drop (a
-/// prompt, a bad file's message): the console holds its replies meanwhile,
-/// or a stream of replies would keep the ring full for as long as it lasts.
-pub static CLAIMS_TX: AtomicBool = AtomicBool::new(false);
-
 /// Room for a whole log line, claimed from the console while there is none.
 fn room_for_a_line() -> bool {
-    let room = usart::TX.free() >= LINE_ROOM;
-    CLAIMS_TX.store(!room, Relaxed);
+    let room = TX.free() >= LINE_ROOM;
+    JOB_CLAIMS_TX.store(!room, Relaxed);
     room
-}
-
-/// What the job task wants next.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Poll {
-    /// Wait for input (a button, the card, the console).
-    Idle,
-    /// Run again.
-    Again,
-    /// Run when the motion task has freed planner room or gone idle.
-    Motion,
-    /// Run in this many ms (a dwell, or the TX ring draining).
-    After(u16),
 }
 
 /// Steps handed to the planner per run, to keep runs short.
@@ -123,6 +97,12 @@ impl JobTask {
         }
     }
 
+    /// The job drills or winds (or is paused in it): the console may not
+    /// move the machine.
+    pub fn owns_motion(&self) -> bool {
+        self.job.owns_motion()
+    }
+
     /// Once at boot: drivers off, waiting for a card.
     pub fn power_on(&mut self, now: u32) {
         self.event(Event::PowerOn, now);
@@ -130,9 +110,9 @@ impl JobTask {
 
     /// One run: carry out the pending actions and then each input in turn
     /// (while their log lines fit), feed winding its nails, then move.
-    pub fn poll(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> Poll {
+    pub fn poll(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> Poll<Signal> {
         // Claimed again below if still needed.
-        CLAIMS_TX.store(false, Relaxed);
+        JOB_CLAIMS_TX.store(false, Relaxed);
         loop {
             if let Some(p) = self.carry_out(m) {
                 return p;
@@ -148,7 +128,7 @@ impl JobTask {
                 break;
             }
         }
-        if CLAIMS_TX.load(Relaxed) {
+        if JOB_CLAIMS_TX.load(Relaxed) {
             // Card messages wait for room for the line they may end in.
             return Poll::After(5);
         }
@@ -168,14 +148,25 @@ impl JobTask {
 
     /// The next input: a button, a card message, the console. False: none.
     fn input(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> bool {
-        if let Some(b) = crate::buttons::BUTTONS.pop() {
+        if let Some(b) = BUTTONS.pop() {
             self.event(Event::Button(b), now);
             return true;
         }
-        if let Some(h) = HOLDS.pop() {
-            let e = match h {
-                Hold::Pause => Event::Pause,
-                Hold::Resume => Event::Resume,
+        if let Some(c) = JOB_CONTROL.pop() {
+            let e = match c {
+                Control::Resume => Event::Resume,
+                Control::Abort => {
+                    // The machine stopped and its queues were emptied: the
+                    // steps in hand and the wait for them are gone too.
+                    self.pulling = false;
+                    self.settling = false;
+                    self.pending = None;
+                    self.dwell_until = None;
+                    if matches!(self.stream, Stream::Pattern(_)) {
+                        self.stream = Stream::None;
+                    }
+                    Event::Abort
+                }
             };
             self.event(e, now);
             return true;
@@ -311,7 +302,7 @@ impl JobTask {
     }
 
     /// Carry out actions while their log lines fit; `Some` to stop the run.
-    fn carry_out(&mut self, m: &mut Motion) -> Option<Poll> {
+    fn carry_out(&mut self, m: &mut Motion) -> Option<Poll<Signal>> {
         while let Some(&a) = self.todo.front() {
             let logs = matches!(
                 a,
@@ -339,12 +330,28 @@ impl JobTask {
                     self.stream = Stream::Pattern(Pattern::new(self.nails, skip));
                     self.open(FileName::Poradi);
                 }
+                Action::StopMotion | Action::NextMoves if !m.is_idle() => {
+                    // A console jog is running (the job's own steps are all
+                    // done when it acts): the job takes over once it ends,
+                    // or once it has been stopped.
+                    if a == Action::StopMotion {
+                        m.cancel();
+                    }
+                    let _ = self.todo.push_front(a);
+                    return Some(Poll::Wait(Signal::Motion));
+                }
+                Action::DriversOff(mask) if m.busy_axes() & mask != 0 => {
+                    // Never from under an axis that a jog is moving.
+                    let _ = self.todo.push_front(a);
+                    return Some(Poll::Wait(Signal::Motion));
+                }
+                Action::StopMotion => {}
                 Action::DriversOn(mask) => m.drivers.set(mask, true),
                 Action::DriversOff(mask) => m.drivers.set(mask, false),
                 Action::SetZero(_) if !m.is_idle() => {
                     // A console jog still running: zero where it ends.
                     let _ = self.todo.push_front(a);
-                    return Some(Poll::Motion);
+                    return Some(Poll::Wait(Signal::Motion));
                 }
                 Action::SetZero(axis) => {
                     let mut at = m.target();
@@ -360,7 +367,7 @@ impl JobTask {
 
     /// Hand the job's steps to the planner; report `MotionDone` when the
     /// machine stands after the last one.
-    fn run_steps(&mut self, m: &mut Motion, now: u32) -> Poll {
+    fn run_steps(&mut self, m: &mut Motion, now: u32) -> Poll<Signal> {
         if let Some(until) = self.dwell_until {
             let left = until.wrapping_sub(now) as i32;
             if left > 0 {
@@ -389,13 +396,13 @@ impl JobTask {
                     }
                     if m.push(at, Feed::Rapid).is_err() {
                         self.pending = Some(step);
-                        return Poll::Motion;
+                        return Poll::Wait(Signal::Motion);
                     }
                 }
                 // Dwells and driver switches wait for the machine to stand.
                 _ if !m.is_idle() => {
                     self.pending = Some(step);
-                    return Poll::Motion;
+                    return Poll::Wait(Signal::Motion);
                 }
                 Step::Dwell(ms) => {
                     self.dwell_until = Some(now.wrapping_add(ms as u32));
@@ -406,7 +413,7 @@ impl JobTask {
         }
         if self.settling {
             if !m.is_idle() {
-                return Poll::Motion;
+                return Poll::Wait(Signal::Motion);
             }
             self.settling = false;
             self.event(Event::MotionDone, now);

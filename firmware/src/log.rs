@@ -27,8 +27,8 @@ pub const MAX_LEVEL: Level = if cfg!(feature = "log-debug") {
     Level::Info
 };
 
-/// Longest line; longer ones are cut and end in `~`.
-const LINE: usize = 96;
+/// Longest line, newline included; longer ones are cut and end in `~`.
+pub const LINE: usize = 96;
 
 static DROPPED: Mutex<Cell<u16>> = Mutex::new(Cell::new(0));
 
@@ -66,6 +66,21 @@ impl Line {
         l
     }
 
+    /// A console reply: no level, time or module. Replies and log lines
+    /// share this type, so each value's `ufmt` code exists once.
+    pub fn bare() -> Line {
+        Line {
+            buf: heapless::Vec::new(),
+            cut: false,
+        }
+    }
+
+    /// Queue a reply whole; the caller made room (`reply::room`).
+    pub fn send(mut self) {
+        let _ = self.buf.push(b'\n');
+        usart::send(&self.buf);
+    }
+
     /// Queue the line, or count it as dropped.
     pub fn emit(mut self) {
         if self.cut {
@@ -77,7 +92,7 @@ impl Line {
         if dropped > 0 {
             let mut note = Line::new(Level::Warn, crate::flash_str!("log"));
             let _ = ufmt::uwrite!(note, "{}{}\n", dropped, crate::flash_str!(" lines dropped"));
-            if note.buf.len() + self.buf.len() > usart::TX.free() {
+            if note.buf.len() + self.buf.len() > crate::queues::TX.free() {
                 return count_drop();
             }
             usart::send(&note.buf);

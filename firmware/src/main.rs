@@ -3,22 +3,26 @@
 //! The machine at a glance, RTIC style. Hardware tasks (interrupts) do the
 //! least work possible and spawn software tasks; software tasks run to
 //! completion from the dispatcher, highest priority first, FIFO within a
-//! priority, and never preempt each other.
+//! priority, and never preempt each other. Every queue and flag they share
+//! is in `queues`; a task that must wait returns `rt::Poll`, and
+//! [`reschedule`] runs it again after a delay or on a [`Signal`].
 //!
-//! | task | kind | priority | input | shared with |
+//! | task | kind | priority | input | output |
 //! | --- | --- | --- | --- | --- |
-//! | `TIMER1_COMPA` step events | interrupt | above all | `SEGMENTS`, `BLOCKS` rings | motion |
-//! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `SAMPLES` → buttons |
-//! | `USART0_RX` / `USART0_UDRE` | interrupts | | `RX` / `TX` rings | console, logger |
+//! | `TIMER1_COMPA` step events | interrupt | above all | `SEGMENTS`, `BLOCKS` | STEP/DIR pins |
+//! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `SAMPLES` |
+//! | `USART0_RX` | interrupt | | a byte | `REALTIME` (`?` `!` `~` Ctrl-X, which also stops the steps), else `RX` |
+//! | `USART0_UDRE` | interrupt | | `TX` | the wire |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
-//! | `Refill` planner → segments while the queue holds < 30 ms of motion | software | 3 | `MOTION` | console, job |
-//! | `Console` G-code line in, reply out | software | 2 | `RX` | `MOTION`, `HOLDS` → job |
-//! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` → job |
-//! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `HOLDS` | `MOTION`, `CARD_IN` → card |
-//! | `Card` SD reader: one block per run | software | 1 | `CARD_IN`, every 1 s | `CARD_OUT` → job |
-//! | `Motion` planner → segments, background | software | 1 | `MOTION` | console, job |
+//! | `Realtime` status, hold, resume, reset | software | 4 | `REALTIME` | `TX`, `JOB_CONTROL` |
+//! | `Refill` planner → segments while the queue holds < 30 ms of motion | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
+//! | `Console` one G-code line per run | software | 2 | `RX` | planner, `TX` |
+//! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` |
+//! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `JOB_CONTROL` | planner, `CARD_IN`, `TX`; signals `CardRoom` |
 //! | `Led` status LED pattern (timed edges: runs before the long tasks) | software | 2 | its timer | |
-//! | `Logger` deferred reports | software | 0 | every 1 s | |
+//! | `Card` SD reader: one block per run | software | 1 | `CARD_IN`, every 1 s | `CARD_OUT` |
+//! | `Motion` planner → segments, background | software | 1 | planner | as `Refill` |
+//! | `Logger` deferred reports | software | 0 | every 1 s | `TX` |
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt, asm_experimental_arch)]
@@ -31,19 +35,21 @@ use taut_firmware::board::{
     self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
 };
 use taut_firmware::buttons::{self, ButtonPins, Debounce};
-use taut_firmware::card::{self, CardReader, Poll as CardPoll, CARD_IN, CARD_OUT};
-use taut_firmware::console::{Console, Poll};
+use taut_firmware::card::{self, CardReader};
+use taut_firmware::console::{Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
-use taut_firmware::job::{JobTask, Poll as JobPoll, HOLDS};
+use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
+use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL};
+use taut_firmware::realtime::{self, Requests};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
-use taut_firmware::rt::{stack, TaskCell};
+use taut_firmware::rt::{stack, Poll, TaskCell};
 use taut_firmware::stepper::{self, Stepper};
 use taut_firmware::{
     board::usart::{RXCIE0, UDRIE0},
     nested_vector, step_vector,
 };
-use taut_firmware::{flash_str, info, warn};
+use taut_firmware::{flash_str, info, reply, warn};
 use taut_logic::config::MachineConfig;
 use taut_logic::kinematics::Linear;
 use taut_logic::sched::{Ready, TaskId, Timers};
@@ -51,6 +57,7 @@ use taut_logic::sched::{Ready, TaskId, Timers};
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Task {
     Timers,
+    Realtime,
     Refill,
     Motion,
     Console,
@@ -65,8 +72,9 @@ const _: () = assert!(Task::ALL.len() <= 16, "interrupt spawns are a bit per tas
 
 impl Task {
     /// Every task, in discriminant order (`Task::X as u8` indexes it).
-    const ALL: [Task; 9] = [
+    const ALL: [Task; 10] = [
         Task::Timers,
+        Task::Realtime,
         Task::Refill,
         Task::Motion,
         Task::Console,
@@ -92,6 +100,7 @@ impl TaskId for Task {
     }
     fn priority(self) -> u8 {
         match self {
+            Task::Realtime => 4,
             Task::Timers | Task::Refill => 3,
             Task::Console | Task::Buttons | Task::Job | Task::Led => 2,
             Task::Card | Task::Motion => 1,
@@ -103,19 +112,16 @@ impl TaskId for Task {
 /// Task ids spawned by interrupts, moved into `READY` by the dispatcher.
 static SPAWNED: Spawned = Spawned::new();
 // Software tasks only: no masking needed.
-static READY: TaskCell<Ready<Task, 9, 4>> = TaskCell::new(Ready::new());
+static READY: TaskCell<Ready<Task, 10, 5>> = TaskCell::new(Ready::new());
 static TIMERS: TaskCell<Timers<Task, 8>> = TaskCell::new(Timers::new());
+/// Tasks waiting for each [`Signal`] (bit = task).
+static WAITING: TaskCell<[u16; 2]> = TaskCell::new([0; 2]);
 static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
 static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
 static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
 static DEBOUNCE: TaskCell<Debounce> = TaskCell::new(Debounce::new());
 static JOB: TaskCell<JobTask> = TaskCell::new(JobTask::new());
 static CARD: TaskCell<Option<CardReader>> = TaskCell::new(None);
-/// The console and the job wait for the motion task (planner room or idle).
-static CONSOLE_WAITS_MOTION: TaskCell<bool> = TaskCell::new(false);
-static JOB_WAITS_MOTION: TaskCell<bool> = TaskCell::new(false);
-/// The card reader waits for room in `CARD_OUT`.
-static CARD_WAITS_JOB: TaskCell<bool> = TaskCell::new(false);
 
 /// Boot blink of the status LED: this many flashes, 100 ms on, 100 ms off.
 const BOOT_BLINKS: u32 = 3;
@@ -123,6 +129,24 @@ const LOGGER_PERIOD_MS: u32 = 1000;
 
 fn spawn(task: Task) {
     READY.with(|r| r.spawn(task));
+}
+
+/// Run `task` again as its `poll` asks.
+fn reschedule(task: Task, poll: Poll<Signal>) {
+    match poll {
+        Poll::Idle => {}
+        Poll::Again => spawn(task),
+        Poll::After(ms) => spawn_after(task, ms as u32),
+        Poll::Wait(s) => WAITING.with(|w| w[s as usize] |= 1 << task as u8),
+    }
+}
+
+/// `s` happened: run the tasks waiting for it.
+fn signal(s: Signal) {
+    let waiting = WAITING.with(|w| core::mem::take(&mut w[s as usize]));
+    for task in Task::ALL.iter().filter(|&&t| waiting >> t as u8 & 1 != 0) {
+        spawn(*task);
+    }
 }
 
 fn task_of(id: u8) -> Task {
@@ -167,6 +191,7 @@ fn main() -> ! {
         &watchdog,
         |task| match task {
             Task::Timers => timers(),
+            Task::Realtime => realtime(),
             Task::Refill | Task::Motion => motion(),
             Task::Console => console(),
             Task::Buttons => buttons(),
@@ -255,9 +280,9 @@ fn timers() {
 
 #[inline(never)]
 fn motion() {
-    /// Segments per run: a ramp segment costs up to ~4 ms, so a run stays
-    /// under ~8 ms and the other tasks get their turn between runs.
-    const BATCH: usize = 2;
+    /// Segments per run: a segment that starts a block costs up to ~7 ms
+    /// (the block's profile), so one per run keeps `?` answered in 10 ms.
+    const BATCH: usize = 1;
     let (freed, more, idle) = MOTION.with(|m| {
         let m = m.as_mut().unwrap();
         let (freed, more) = m.refill(BATCH);
@@ -267,12 +292,7 @@ fn motion() {
         spawn(refill_task());
     }
     if freed || idle {
-        if CONSOLE_WAITS_MOTION.with(|w| core::mem::take(w)) {
-            spawn(Task::Console);
-        }
-        if JOB_WAITS_MOTION.with(|w| core::mem::take(w)) {
-            spawn(Task::Job);
-        }
+        signal(Signal::Motion);
     }
 }
 
@@ -288,23 +308,64 @@ fn refill_task() -> Task {
 
 #[inline(never)]
 fn console() {
+    let owner = match JOB.with(|j| j.owns_motion()) {
+        true => Owner::Job,
+        false => Owner::Console,
+    };
     let poll = MOTION.with(|m| {
         CONFIG.with(|cfg| {
             let kin = Linear::cylindrical(cfg);
-            CONSOLE.with(|c| c.poll(m.as_mut().unwrap(), &kin, cfg))
+            CONSOLE.with(|c| c.poll(m.as_mut().unwrap(), &kin, cfg, owner))
         })
     });
     // New moves may be queued: the motion task feeds them to the stepper.
     spawn(Task::Motion);
-    match poll {
-        Poll::Drained => {}
-        Poll::Motion => CONSOLE_WAITS_MOTION.with(|w| *w = true),
-        Poll::After(ms) => spawn_after(Task::Console, ms as u32),
-        Poll::Yield => spawn(Task::Console),
+    reschedule(Task::Console, poll);
+}
+
+/// Real-time commands, in the order that makes sense when several came
+/// together: reset, hold, resume, status.
+#[inline(never)]
+fn realtime() {
+    let r = Requests::take();
+    MOTION.with(|m| {
+        let m = m.as_mut().unwrap();
+        if r.reset() {
+            m.stop_now();
+            CONSOLE.with(|c| c.reset());
+            control_job(Control::Abort);
+            if m.position_known() {
+                info!("reset");
+            } else {
+                warn!("reset during motion: position unknown until G92, $X or zeroing");
+            }
+        }
+        if r.hold() {
+            m.hold();
+        }
+        if r.resume() && !m.resume() {
+            control_job(Control::Resume);
+        }
+        if r.status() {
+            if reply::room() {
+                CONFIG.with(|cfg| realtime::status(m, &Linear::cylindrical(cfg)));
+            } else {
+                realtime::status_later();
+                spawn_after(Task::Realtime, 1);
+            }
+        }
+    });
+    // A hold or a resume changes what the motion task prepares; a reset
+    // frees the planner for whoever waits.
+    spawn(Task::Refill);
+    signal(Signal::Motion);
+}
+
+fn control_job(c: Control) {
+    if JOB_CONTROL.push(c).is_err() {
+        warn!("job control queue full");
     }
-    if !HOLDS.is_empty() {
-        spawn(Task::Job);
-    }
+    spawn(Task::Job);
 }
 
 /// Debounce the tick's samples; presses go to the job.
@@ -321,16 +382,12 @@ fn job() {
     let poll =
         MOTION.with(|m| CONFIG.with(|cfg| JOB.with(|j| j.poll(m.as_mut().unwrap(), cfg, now))));
     spawn(Task::Motion);
-    match poll {
-        JobPoll::Idle => {}
-        JobPoll::Again => spawn(Task::Job),
-        JobPoll::Motion => JOB_WAITS_MOTION.with(|w| *w = true),
-        JobPoll::After(ms) => spawn_after(Task::Job, ms as u32),
-    }
-    if !CARD_IN.is_empty()
-        || (CARD_OUT.free() >= card::ROOM && CARD_WAITS_JOB.with(|w| core::mem::take(w)))
-    {
+    reschedule(Task::Job, poll);
+    if !CARD_IN.is_empty() {
         spawn(Task::Card);
+    }
+    if CARD_OUT.free() >= card::ROOM {
+        signal(Signal::CardRoom);
     }
 }
 
@@ -340,11 +397,8 @@ fn card() {
     // Looking for a card holds the bus at the slow init clock for ~1.5 ms:
     // not while the machine moves (the refill would wait).
     let moving = MOTION.with(|m| !m.as_ref().unwrap().is_idle());
-    match CARD.with(|c| c.as_mut().unwrap().poll(now, moving)) {
-        CardPoll::Idle(ms) => spawn_after(Task::Card, ms as u32),
-        CardPoll::More => spawn(Task::Card),
-        CardPoll::Blocked => CARD_WAITS_JOB.with(|w| *w = true),
-    }
+    let poll = CARD.with(|c| c.as_mut().unwrap().poll(now, moving));
+    reschedule(Task::Card, poll);
     if !CARD_OUT.is_empty() {
         spawn(Task::Job);
     }
@@ -424,8 +478,11 @@ extern "avr-interrupt" fn timer0_compa() {
 }
 
 extern "avr-interrupt" fn usart0_rx() {
-    usart::on_receive();
-    spawn_from_isr(&SPAWNED, Task::Console as u8);
+    let task = match usart::on_receive(realtime::on_receive) {
+        true => Task::Realtime,
+        false => Task::Console,
+    };
+    spawn_from_isr(&SPAWNED, task as u8);
 }
 
 extern "avr-interrupt" fn usart0_udre() {

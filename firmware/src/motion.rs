@@ -4,8 +4,9 @@
 //! abandons the rest of the queued motion (a pulled card).
 
 use crate::drivers::Drivers;
+use crate::queues::{BLOCKS, SEGMENTS, SEGMENTS_CAPACITY};
 use crate::rt::TaskCell;
-use crate::stepper::{fast_segment, Stepper, BLOCKS, FAST, SEGMENTS, SEGMENTS_CAPACITY};
+use crate::stepper::{fast_segment, Stepper, FAST};
 use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
@@ -44,7 +45,9 @@ pub enum State {
     Idle,
     Run,
     /// A feed hold braking (`Hold:1` in Grbl's words) or standing (`Hold:0`).
-    Hold { standing: bool },
+    Hold {
+        standing: bool,
+    },
 }
 
 pub struct Motion {
@@ -55,6 +58,15 @@ pub struct Motion {
     block: StepBlock,
     /// Drop the queued motion once a hold has brought the machine to rest.
     cancel: bool,
+    /// Bumped by every stop that drops queued moves: whoever queued them
+    /// reads the position back.
+    epoch: u8,
+    /// Stopped at once while moving: steps may have been lost, so motion
+    /// waits for the position to be set again (Grbl's alarm lock).
+    lost: bool,
+    /// Axes (bit = index) that moves queued since the machine last stood
+    /// have moved or will move.
+    busy: u8,
     pub stepper: Stepper,
     pub drivers: Drivers,
 }
@@ -67,6 +79,9 @@ impl Motion {
             buffered: Buffered::new(),
             block: StepBlock::default(),
             cancel: false,
+            epoch: 0,
+            lost: false,
+            busy: 0,
             stepper,
             drivers,
         }
@@ -74,7 +89,21 @@ impl Motion {
 
     /// Queue a move to the absolute step `target`; `Full` is back-pressure.
     pub fn push(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
-        PLANNER.with(|p| p.push(target, feed))
+        let from = self.target();
+        PLANNER.with(|p| p.push(target, feed))?;
+        for (i, (a, b)) in from.iter().zip(&target).enumerate() {
+            self.busy |= ((a != b) as u8) << i;
+        }
+        Ok(())
+    }
+
+    /// Axes (bit = index) moving now or queued to: switching one of their
+    /// drivers must wait until the machine stands.
+    pub fn busy_axes(&mut self) -> u8 {
+        if self.is_idle() {
+            self.busy = 0;
+        }
+        self.busy
     }
 
     /// Move planned blocks into the interrupt's queues, at most `max`
@@ -165,9 +194,18 @@ impl Motion {
     }
 
     /// Stop at once (Ctrl-X): no more steps, the queued motion dropped, the
-    /// position as the pulses left it. Steps may have been lost if the
-    /// motors were moving fast.
-    pub fn abort(&mut self) {
+    /// position as the pulses left it. If the motors were moving, steps
+    /// may have been lost: the position is unknown until set again.
+    pub fn stop_now(&mut self) {
+        if self.stepper.is_running() {
+            self.lost = true;
+        }
+        self.abort();
+    }
+
+    /// Drop the queued motion with the machine at rest (or stopped at once).
+    fn abort(&mut self) {
+        self.epoch = self.epoch.wrapping_add(1);
         let at = self.stepper.abort();
         SEGMENTS.clear();
         BLOCKS.clear();
@@ -188,5 +226,21 @@ impl Motion {
     pub fn set_position(&mut self, steps: PerAxis<i32>) {
         PLANNER.with(|p| p.set_position(steps));
         self.stepper.set_position(steps);
+        self.lost = false;
+    }
+
+    /// The position is trusted (not lost by a stop at once during motion).
+    pub fn position_known(&self) -> bool {
+        !self.lost
+    }
+
+    /// `$X`: trust the position again without setting it.
+    pub fn unlock(&mut self) {
+        self.lost = false;
+    }
+
+    /// See the `epoch` field.
+    pub fn epoch(&self) -> u8 {
+        self.epoch
     }
 }

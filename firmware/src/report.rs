@@ -2,11 +2,7 @@
 //! a job: how full each queue got, what it refused, what the step interrupt
 //! missed.
 
-use crate::board::usart;
-use crate::buttons::{BUTTONS, SAMPLES};
-use crate::card::{CARD_IN, CARD_OUT};
-use crate::job::HOLDS;
-use crate::stepper::{BLOCKS, SEGMENTS};
+use crate::queues::{BLOCKS, BUTTONS, CARD_IN, CARD_OUT, JOB_CONTROL, RX, SAMPLES, SEGMENTS, TX};
 use crate::{flash_str, info};
 use taut_logic::sched::QueueStats;
 
@@ -21,8 +17,8 @@ fn queue(name: crate::board::flash::FlashStr, s: QueueStats, capacity: usize) {
 /// interrupt, then dropped log lines; line `i` of them. False past the end.
 pub fn queue_line(i: u8) -> bool {
     match i {
-        0 => queue(flash_str!("rx"), usart::RX.stats(), usart::RX.capacity()),
-        1 => queue(flash_str!("tx"), usart::TX.stats(), usart::TX.capacity()),
+        0 => queue(flash_str!("rx"), RX.stats(), RX.capacity()),
+        1 => queue(flash_str!("tx"), TX.stats(), TX.capacity()),
         2 => queue(
             flash_str!("segments"),
             SEGMENTS.stats(),
@@ -37,7 +33,11 @@ pub fn queue_line(i: u8) -> bool {
             SAMPLES.capacity(),
         ),
         7 => queue(flash_str!("buttons"), BUTTONS.stats(), BUTTONS.capacity()),
-        8 => queue(flash_str!("holds"), HOLDS.stats(), HOLDS.capacity()),
+        8 => queue(
+            flash_str!("job control"),
+            JOB_CONTROL.stats(),
+            JOB_CONTROL.capacity(),
+        ),
         9 => info!("log dropped:", crate::log::dropped()),
         _ => return false,
     }

@@ -18,7 +18,7 @@
 
 pub mod fast;
 
-use crate::rt::Ring;
+use crate::queues::{BLOCKS, SEGMENTS};
 use core::cell::UnsafeCell;
 use core::ptr::{read_volatile, write_volatile};
 use taut_logic::axis::{PerAxis, AXES};
@@ -26,12 +26,6 @@ use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::{port_bit, Port, DRIVERS};
 use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK, STOP};
 
-/// Segments waiting for the interrupt (11 bytes each).
-pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
-/// Slots of the segment ring (one fewer can be queued).
-pub const SEGMENTS_CAPACITY: usize = 32;
-/// Blocks waiting for their first segment (21 bytes each).
-pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
 /// Refill the queues when this few segments are left.
 pub(crate) const LOW_WATER: usize = 24;
 

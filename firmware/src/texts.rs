@@ -5,6 +5,7 @@
 use crate::board::flash::FlashStr;
 use crate::flash_str;
 use taut_logic::axis::Axis;
+use taut_logic::gcode::ErrorKind;
 use taut_logic::stringart::job::{Msg, Phase, Prompt, State};
 
 /// `match value { pattern => the flash copy of representative.method() }`.
@@ -60,5 +61,35 @@ pub fn msg(m: Msg) -> FlashStr {
         NoCard => NoCard,
         PatternLost => PatternLost,
         Resumed => Resumed,
+        Aborted => Aborted,
+    ])
+}
+
+/// Grbl's error texts of the console's replies.
+pub fn error(e: ErrorKind) -> FlashStr {
+    use ErrorKind::*;
+    in_flash!(e, message, [
+        ExpectedCommandLetter => ExpectedCommandLetter,
+        BadNumberFormat => BadNumberFormat,
+        InvalidStatement => InvalidStatement,
+        NegativeValue => NegativeValue,
+        NotIdle => NotIdle,
+        Locked => Locked,
+        LineOverflow => LineOverflow,
+        TravelExceeded => TravelExceeded,
+        UnsupportedCommand => UnsupportedCommand,
+        ModalGroupViolation => ModalGroupViolation,
+        UndefinedFeedRate => UndefinedFeedRate,
+        AxisWordConflict => AxisWordConflict,
+        RepeatedWord => RepeatedWord,
+        NoAxisWords => NoAxisWords,
+        InvalidLineNumber => InvalidLineNumber,
+        ValueWordMissing => ValueWordMissing,
+        UnusedAxisWords => UnusedAxisWords,
+        InvalidTarget => InvalidTarget,
+        UnusedValueWords => UnusedValueWords,
+        BadChecksum => BadChecksum,
+        JobOwnsMotion => JobOwnsMotion,
+        FeedTooLow => FeedTooLow,
     ])
 }

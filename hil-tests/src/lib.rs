@@ -151,3 +151,40 @@ pub fn assert_step_interrupt_never_masked_long(sim: &sim::Sim) {
         "interrupts masked {masked} cycles at {at:#x}"
     );
 }
+
+/// Net steps of the three machine axes (base, radial, drill) counted on
+/// their STEP and DIR pins.
+pub fn steps_on_pins(sim: &sim::Sim) -> [i64; 3] {
+    use taut_logic::axis::Axis;
+    [Axis::Base, Axis::Radial, Axis::Drill].map(|axis| {
+        let d = taut_logic::pinmap::driver(axis);
+        sim.net_steps(d.step, d.dir, true)
+    })
+}
+
+/// The executed position `M114` reports, in steps (`Count C:… X:… Z:…`).
+pub fn reported_steps(sim: &mut sim::Sim) -> [i64; 3] {
+    let start = sim.uart_bytes().len();
+    send_ok(sim, "M114", std::time::Duration::from_secs(1));
+    let text = String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned();
+    let count = text
+        .lines()
+        .find_map(|l| l.split_once("Count "))
+        .unwrap_or_else(|| panic!("no M114 line in {text:?}"))
+        .1;
+    let mut out = [0; 3];
+    for (i, word) in count.split_whitespace().take(3).enumerate() {
+        out[i] = word[2..].parse().unwrap();
+    }
+    out
+}
+
+/// The last 2000 characters of the serial log, for failure messages.
+pub fn log_tail(sim: &sim::Sim) -> String {
+    let t = sim.uart_text();
+    let mut from = t.len().saturating_sub(2000);
+    while !t.is_char_boundary(from) {
+        from += 1;
+    }
+    t[from..].to_string()
+}

@@ -1,7 +1,7 @@
 //! Issue 6: the buttons on the release image — a zeroing button's two
 //! presses take the current position as that axis's zero (driver off in
 //! between); a long press of green pauses drilling after the current hole
-//! and a short one resumes; the serial `!` and `~` do the same.
+//! and a short one resumes. (The serial `!`, `~` and Ctrl-X: `realtime.rs`.)
 
 use hil_tests::sim::operator::message;
 use hil_tests::sim::sdcard::SdImage;
@@ -141,25 +141,5 @@ fn a_long_press_pauses_after_the_hole_and_a_short_press_resumes() {
     wait_for(&mut sim, "resumed", Duration::from_secs(1));
     sim.run_for(Duration::from_secs(2));
     assert!(pulses(&sim, Axis::Base) + pulses(&sim, Axis::Drill) > still[0] + still[2]);
-    assert_ram_budget(&sim);
-}
-
-#[test]
-fn serial_feed_hold_and_resume_pause_the_job_the_same_way() {
-    let mut sim = prepared();
-    press(&mut sim, Button::Confirm, 150);
-    wait_for(&mut sim, "drill 1/24", Duration::from_secs(30));
-    sim.uart_send(b"!");
-    wait_for(
-        &mut sim,
-        ">>> paused: press green to resume",
-        Duration::from_secs(30),
-    );
-    let stopped = settle(&mut sim);
-    sim.run_for(Duration::from_secs(2));
-    assert_eq!(all_pulses(&sim), stopped, "nothing moves while paused");
-    sim.uart_send(b"~");
-    wait_for(&mut sim, "resumed", Duration::from_secs(1));
-    wait_for(&mut sim, "drill 2/24", Duration::from_secs(30));
     assert_ram_budget(&sim);
 }

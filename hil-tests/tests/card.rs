@@ -175,7 +175,7 @@ fn every_bad_file_gets_its_message_and_nothing_moves() {
         ),
         (
             &[("param.txt", big_param), ("poradi.txt", b"4,0,7,13")],
-            "poradi.txt:1:1: declared 4 nails, found 3",
+            "poradi.txt:1:1: declared 4 connections, found 3",
         ),
         (
             &[("param.txt", big_param), ("poradi.txt", b"3,0;7,13")],

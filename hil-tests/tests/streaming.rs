@@ -4,7 +4,9 @@
 //! watchdog reset, every line answered `ok`, and the final `M114` equal to
 //! the sum of the moves and to the pulses counted on the pins.
 
-use hil_tests::{boot_machine, pulses, send_ok, sim::Outcome, sim::Sim};
+use hil_tests::{
+    boot_machine, log_tail, reported_steps, send_ok, sim::Outcome, sim::Sim, steps_on_pins,
+};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
@@ -36,8 +38,13 @@ fn moves(full: usize) -> usize {
 
 /// Stream `lines`, each after the previous reply, optionally with a `?`
 /// every `status_every` of simulated time; every reply must be `ok`.
-fn stream(sim: &mut Sim, lines: &[String], status_every: Option<Duration>) {
+/// Returns the longest time a `?` waited for its report, ms.
+fn stream(sim: &mut Sim, lines: &[String], status_every: Option<Duration>) -> f64 {
     let mut next_status = sim.time_s();
+    // `?` sent and not yet answered: when, and how many reports before.
+    let mut asked: Option<(f64, usize)> = None;
+    let mut worst = 0.0f64;
+    let reports = |s: &Sim| s.uart_text().matches('<').count();
     for (n, line) in lines.iter().enumerate() {
         let start = sim.uart_bytes().len();
         sim.uart_send(format!("{line}\n").as_bytes());
@@ -46,81 +53,73 @@ fn stream(sim: &mut Sim, lines: &[String], status_every: Option<Duration>) {
             assert!(
                 matches!(out, Outcome::Running),
                 "line {n} {line:?}: {out:?}\n{}",
-                tail(sim)
+                log_tail(sim)
             );
+            if let Some((at, before)) = asked {
+                if reports(sim) > before {
+                    worst = worst.max((sim.time_s() - at) * 1000.0);
+                    asked = None;
+                }
+            }
             if let Some(every) = status_every {
-                if sim.time_s() >= next_status {
+                if asked.is_none() && sim.time_s() >= next_status {
+                    asked = Some((sim.time_s(), reports(sim)));
                     sim.uart_send(b"?");
                     next_status = sim.time_s() + every.as_secs_f64();
                 }
             }
             let text = String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned();
-            if let Some(reply) = text.lines().find(|l| *l == "ok" || l.starts_with("error")) {
-                assert_eq!(reply, "ok", "line {n} {line:?}\n{}", tail(sim));
+            let mut complete = text
+                .split_inclusive('\n')
+                .filter_map(|l| l.strip_suffix('\n'));
+            if let Some(reply) = complete.find(|l| *l == "ok" || l.starts_with("error")) {
+                assert_eq!(reply, "ok", "line {n} {line:?}\n{}", log_tail(sim));
                 break;
             }
         }
     }
-}
-
-fn tail(sim: &Sim) -> String {
-    let t = sim.uart_text();
-    t[t.len().saturating_sub(2000)..].to_string()
-}
-
-/// The executed position `M114` reports, in steps (`Count C:… X:… Z:…`).
-fn reported_steps(sim: &mut Sim) -> [i64; 3] {
-    let start = sim.uart_bytes().len();
-    send_ok(sim, "M114", Duration::from_secs(1));
-    let text = String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned();
-    let count = text
-        .lines()
-        .find_map(|l| l.split_once("Count "))
-        .unwrap_or_else(|| panic!("no M114 line in {text:?}"))
-        .1;
-    let mut out = [0; 3];
-    for (i, word) in count.split_whitespace().take(3).enumerate() {
-        out[i] = word[2..].parse().unwrap();
-    }
-    out
-}
-
-fn steps_on_pins(sim: &Sim) -> [i64; 3] {
-    let net = |axis: Axis| {
-        let d = taut_logic::pinmap::driver(axis);
-        sim.net_steps(d.step, d.dir, true)
-    };
-    [net(Axis::Base), net(Axis::Radial), net(Axis::Drill)]
+    worst
 }
 
 /// Stream, wait for the end of motion, and check the machine stands where
 /// the moves add up to (`expected` steps), on the pins and in `M114`.
 fn check_stream(sim: &mut Sim, lines: &[String], status: Option<Duration>, expected: [i64; 3]) {
-    stream(sim, lines, status);
+    let worst_status_ms = stream(sim, lines, status);
     send_ok(sim, "M400", Duration::from_secs(600));
-    assert_eq!(sim.watchdog_resets(), 0, "{}", tail(sim));
+    assert_eq!(sim.watchdog_resets(), 0, "{}", log_tail(sim));
     assert_eq!(steps_on_pins(sim), expected, "pulses on the pins");
     assert_eq!(reported_steps(sim), expected, "M114");
     let text = sim.uart_text();
-    assert!(!text.contains("step late"), "{}", tail(sim));
+    assert!(!text.contains("step late"), "{}", log_tail(sim));
+    if status.is_some() {
+        // Answered from the receive path, whatever the console is doing.
+        assert!(worst_status_ms <= 10.0, "a `?` waited {worst_status_ms} ms");
+    }
     hil_tests::assert_ram_budget(sim);
 }
 
-/// Relative moves of `mm` on the radial axis at the maximum rate, in runs
-/// of 100 that go out, out, back (inside the carriage's travel).
+/// Steps of an absolute target on the string-art machine's axes.
+fn steps_of(c_deg: f64, x_mm: f64, z_mm: f64) -> [i64; 3] {
+    let cfg = MachineConfig::STRING_ART;
+    let to = |i: usize, v: f64| {
+        let milli = taut_logic::units::Milli((v * 1000.0).round() as i32);
+        cfg.axes[i].steps_per_unit.steps(milli) as i64
+    };
+    [to(0, c_deg), to(1, x_mm), to(2, z_mm)]
+}
+
+/// Relative moves of `mm` on the radial axis at the maximum rate from
+/// 200 mm inside the board's edge, in runs of 100 that go out, out, back
+/// (inside the carriage's travel).
 fn radial_pieces(mm: f64, n: usize) -> (Vec<String>, [i64; 3]) {
-    let mut lines = vec!["G91".to_string()];
-    let mut um = 0i32;
+    let mut lines = vec!["G0 X-200".to_string(), "G91".to_string()];
+    let mut x = -200.0;
     for k in 0..n {
         let d = if k / 100 % 3 == 2 { -mm } else { mm };
         lines.push(format!("G1 X{d} F60000"));
-        um += (d * 1000.0).round() as i32;
+        x += d;
     }
-    let spu = MachineConfig::STRING_ART.axes[Axis::Radial.index()].steps_per_unit;
-    (
-        lines,
-        [0, spu.steps(taut_logic::units::Milli(um)) as i64, 0],
-    )
+    (lines, steps_of(0.0, (x * 1000.0f64).round() / 1000.0, 0.0))
 }
 
 fn boot_enabled() -> Sim {
@@ -145,4 +144,66 @@ fn tiny_moves_at_full_rate_0_1_mm() {
 fn tiny_moves_at_full_rate_0_3_mm() {
     let (lines, expected) = radial_pieces(0.3, moves(5000));
     check_stream(&mut boot_enabled(), &lines, None, expected);
+}
+
+/// A circle of 5 mm radius drawn by the radial and drill axes in 2000
+/// straight pieces (what a plotter's curves are), at the maximum feed.
+#[test]
+fn a_circle_of_2000_pieces() {
+    let pieces = 2000;
+    let (cx, cz, r) = (-10.0f64, -10.0f64, 5.0f64);
+    let at = |k: usize| {
+        let a = k as f64 * std::f64::consts::TAU / pieces as f64;
+        (cx + r * a.cos(), cz + r * a.sin())
+    };
+    let mut lines = vec!["G90".to_string()];
+    lines.extend((0..=pieces).map(|k| {
+        let (x, z) = at(k);
+        format!("G1 X{x:.3} Z{z:.3} F60000")
+    }));
+    let (x, z) = at(pieces);
+    let (x, z) = (
+        format!("{x:.3}").parse().unwrap(),
+        format!("{z:.3}").parse().unwrap(),
+    );
+    check_stream(&mut boot_enabled(), &lines, None, steps_of(0.0, x, z));
+}
+
+/// Random move lengths (0.01–3 units) and feeds (10 units/min to the
+/// maximum) on all three axes, absolute, from a list of seeds; the last
+/// one with a `?` every 50 ms, each answered within 10 ms.
+#[test]
+fn random_moves_and_feeds_from_seeds() {
+    for (seed, status) in [(1u64, false), (7, false), (1234, true)] {
+        let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+        let (mut c, mut x, mut z) = (0.0f64, -100.0f64, -10.0f64);
+        let mut lines = vec!["G90".to_string()];
+        for _ in 0..moves(3000) {
+            let step = |rng: &mut Rng| (rng.below(3000) as f64 + 10.0) / 1000.0;
+            let sign = |rng: &mut Rng| if rng.below(2) == 0 { -1.0 } else { 1.0 };
+            match rng.below(3) {
+                0 => c += sign(&mut rng) * step(&mut rng),
+                1 => x = (x + sign(&mut rng) * step(&mut rng)).clamp(-400.0, 20.0),
+                _ => z = (z + sign(&mut rng) * step(&mut rng)).clamp(-25.0, 10.0),
+            }
+            let feed = 10 + rng.below(6000);
+            lines.push(format!("G1 C{c:.3} X{x:.3} Z{z:.3} F{feed}"));
+        }
+        let status = status.then_some(Duration::from_millis(50));
+        let round = |v: f64| format!("{v:.3}").parse::<f64>().unwrap();
+        let expected = steps_of(round(c), round(x), round(z));
+        check_stream(&mut boot_enabled(), &lines, status, expected);
+    }
+}
+
+/// Tiny moves at full rate with a `?` every 50 ms.
+#[test]
+fn tiny_moves_with_status_reports() {
+    let (lines, expected) = radial_pieces(0.1, moves(5000));
+    check_stream(
+        &mut boot_enabled(),
+        &lines,
+        Some(Duration::from_millis(50)),
+        expected,
+    );
 }

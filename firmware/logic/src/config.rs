@@ -2,8 +2,9 @@
 //! string-art machine's (`shared/spec/string-art-machine.md`); `machine.txt`
 //! on the card and `$` settings override them.
 
-use crate::axis::{PerAxis, AXES};
-use crate::units::StepsPerUnit;
+use crate::axis::{Axis, PerAxis};
+use crate::job::error::ErrorKind;
+use crate::units::{Milli, StepsPerUnit};
 
 /// Per-axis figures. Rates are in steps so the step generator never converts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,6 +19,11 @@ pub struct AxisConfig {
     pub dir_high_is_positive: bool,
     /// Level of the ENABLE pin that switches the driver on.
     pub enable_active_high: bool,
+    /// Soft limits: the console refuses a target outside `travel` before
+    /// any step. Off for an axis that turns freely (the base).
+    pub soft_limits: bool,
+    /// Travel allowed, thousandths of the unit, from the axis's zero.
+    pub travel: (Milli, Milli),
 }
 
 /// Pulse timing of the STEP/DIR/ENABLE interface, µs.
@@ -47,25 +53,40 @@ pub const TB6600: PulseTiming = PulseTiming {
     enable_setup_us: 5,
 };
 
-const fn string_art_axis(steps_per_unit: StepsPerUnit) -> AxisConfig {
+const fn string_art_axis(steps_per_unit: StepsPerUnit, travel: Option<(i32, i32)>) -> AxisConfig {
+    let (soft_limits, (min, max)) = match travel {
+        Some(t) => (true, t),
+        None => (false, (0, 0)),
+    };
     AxisConfig {
         steps_per_unit,
         max_rate: 2000,
         accel: 500,
         dir_high_is_positive: true,
         enable_active_high: true,
+        soft_limits,
+        travel: (Milli::from_units(min), Milli::from_units(max)),
     }
 }
+
+/// The radial carriage's travel from its zero at the board's edge: to the
+/// centre of a 45 cm board inwards, and past the outer winding radius
+/// (nail radius + 2.9 cm, nails 1.5 cm inside the edge) outwards.
+pub const RADIAL_TRAVEL_MM: (i32, i32) = (-450, 30);
+/// The drill's travel from its zero on the board's surface (positive is
+/// down, along the tilted axis): 3 cm up, and the 1 cm hole (10.4 mm of
+/// travel at 74.333°) with 1.6 mm to spare down.
+pub const DRILL_TRAVEL_MM: (i32, i32) = (-30, 12);
 
 impl MachineConfig {
     /// The string-art machine: base 200×6×8 = 9600 steps per turn, radial
     /// 200/5 mm × 8 = 32 steps/mm, drill 200/12 mm × 8 = 1600 steps per 12 mm.
     pub const STRING_ART: MachineConfig = MachineConfig {
         axes: [
-            string_art_axis(StepsPerUnit::new(9600, 360)),
-            string_art_axis(StepsPerUnit::new(32, 1)),
-            string_art_axis(StepsPerUnit::new(1600, 12)),
-            string_art_axis(StepsPerUnit::new(80, 1)),
+            string_art_axis(StepsPerUnit::new(9600, 360), None),
+            string_art_axis(StepsPerUnit::new(32, 1), Some(RADIAL_TRAVEL_MM)),
+            string_art_axis(StepsPerUnit::new(1600, 12), Some(DRILL_TRAVEL_MM)),
+            string_art_axis(StepsPerUnit::new(80, 1), None),
         ],
         pulse: TB6600,
         junction_deviation_um: 10,
@@ -75,22 +96,31 @@ impl MachineConfig {
         &self.axes[i]
     }
 
-    /// Check the figures a user may have overridden; returns the name of the
-    /// first bad field.
-    pub fn validate(&self) -> Result<(), &'static str> {
-        for a in &self.axes[..AXES] {
-            if a.steps_per_unit.num == 0 || a.steps_per_unit.den == 0 {
-                return Err("steps_per_unit");
+    /// Check the figures a user may have overridden, each and against
+    /// each other; the error says what is wrong.
+    pub fn validate(&self) -> Result<(), ErrorKind> {
+        for (a, axis) in Axis::ALL.into_iter().zip(&self.axes) {
+            if axis.steps_per_unit.num == 0 || axis.steps_per_unit.den == 0 {
+                return Err(ErrorKind::Invalid("steps_per_unit"));
             }
-            if a.max_rate == 0 || a.max_rate > 200_000 {
-                return Err("max_rate");
+            if axis.max_rate == 0 || axis.max_rate > 200_000 {
+                return Err(ErrorKind::Invalid("max_rate"));
             }
-            if a.accel == 0 {
-                return Err("accel");
+            if axis.accel == 0 {
+                return Err(ErrorKind::Invalid("accel"));
+            }
+            if axis.travel.0 > axis.travel.1 {
+                return Err(ErrorKind::Invalid("travel_min above travel_max"));
+            }
+            // The pulse must fit the step period at the highest rate, with
+            // as long a low time (the step interrupt holds it high).
+            let max_us = 500_000 / axis.max_rate;
+            if u32::from(self.pulse.step_pulse_us) > max_us {
+                return Err(ErrorKind::PulseTooLong { axis: a, max_us });
             }
         }
         if self.pulse.step_pulse_us == 0 {
-            return Err("step_pulse_us");
+            return Err(ErrorKind::Invalid("step_pulse_us"));
         }
         Ok(())
     }
@@ -105,7 +135,6 @@ impl Default for MachineConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::units::Milli;
 
     #[test]
     fn defaults_match_the_spec() {
@@ -114,5 +143,20 @@ mod tests {
         assert_eq!(c.axes[1].steps_per_unit.steps(Milli(10_000)), 320);
         assert_eq!(c.axes[2].steps_per_unit.steps(Milli(120_000)), 16000);
         assert!(c.validate().is_ok());
+    }
+
+    #[test]
+    fn a_pulse_longer_than_half_a_step_at_the_max_rate_is_refused() {
+        let mut c = MachineConfig::default();
+        c.pulse.step_pulse_us = 250;
+        assert!(c.validate().is_ok(), "2000 steps/s: 500 µs periods");
+        c.pulse.step_pulse_us = 251;
+        assert_eq!(
+            c.validate(),
+            Err(ErrorKind::PulseTooLong {
+                axis: Axis::Base,
+                max_us: 250
+            })
+        );
     }
 }

@@ -37,7 +37,7 @@ mod words;
 #[cfg(test)]
 mod tests;
 
-pub use error::{Error, ErrorKind};
+pub use error::{Error, ErrorKind, MIN_FEED};
 pub use line::{AxisWord, Command, Distance, Input, Line, Realtime, AXIS_WORDS};
 pub use number::parse_milli;
 pub use parser::{Parser, MAX_LINE};

@@ -18,7 +18,7 @@ mod tests;
 
 use crate::axis::{PerAxis, AXES};
 use crate::config::MachineConfig;
-use crate::segment::{StepBlock, Trapezoid};
+use crate::segment::{Speeds, StepBlock, Trapezoid};
 use crate::units::Milli;
 use junction::{Corner, Geometry};
 
@@ -225,9 +225,11 @@ impl Planner {
             profile: Trapezoid::new(
                 b.step.events,
                 b.accel,
-                to_events(b.entry_sqr),
-                b.nominal_ev_sqr,
-                to_events(exit_sqr),
+                &Speeds {
+                    entry_sqr: to_events(b.entry_sqr),
+                    cruise_sqr: b.nominal_ev_sqr,
+                    exit_sqr: to_events(exit_sqr),
+                },
             ),
         })
     }

@@ -8,8 +8,8 @@
 use crate::axis::{Axis, AXES};
 use crate::config::MachineConfig;
 use crate::job::error::ErrorKind;
-use crate::job::num::{parse_ratio, parse_u32, trim, NumError};
-use crate::units::StepsPerUnit;
+use crate::job::num::{parse_milli, parse_ratio, parse_u32, trim, NumError};
+use crate::units::{Milli, StepsPerUnit};
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
 /// A setting value that did not fit: what, and at which byte of the value.
@@ -28,6 +28,11 @@ pub enum AxisField {
     DirInvert,
     /// 1: the driver is on while ENABLE is high.
     EnableActiveHigh,
+    /// 1: targets outside the travel are refused (Grbl's `$20`, per axis).
+    SoftLimits,
+    /// The travel's ends, units from the zero (Grbl's `$130…`, both ends).
+    TravelMin,
+    TravelMax,
 }
 
 /// The machine-wide figures.
@@ -50,14 +55,19 @@ pub enum Setting {
 pub enum Value {
     Number(u32),
     Ratio(StepsPerUnit),
+    /// Thousandths of a unit, printed `-450.000`.
+    Milli(Milli),
 }
 
-const AXIS_FIELDS: [AxisField; 5] = [
+const AXIS_FIELDS: [AxisField; 8] = [
     AxisField::StepsPerUnit,
     AxisField::MaxRate,
     AxisField::Accel,
     AxisField::DirInvert,
     AxisField::EnableActiveHigh,
+    AxisField::SoftLimits,
+    AxisField::TravelMin,
+    AxisField::TravelMax,
 ];
 
 const GLOBAL_FIELDS: [GlobalField; 4] = [
@@ -78,6 +88,9 @@ impl AxisField {
             AxisField::Accel => "accel",
             AxisField::DirInvert => "dir_invert",
             AxisField::EnableActiveHigh => "enable_active_high",
+            AxisField::SoftLimits => "soft_limits",
+            AxisField::TravelMin => "travel_min",
+            AxisField::TravelMax => "travel_max",
         }
     }
 }
@@ -158,6 +171,9 @@ impl Setting {
                     AxisField::Accel => axis.accel,
                     AxisField::DirInvert => !axis.dir_high_is_positive as u32,
                     AxisField::EnableActiveHigh => axis.enable_active_high as u32,
+                    AxisField::SoftLimits => axis.soft_limits as u32,
+                    AxisField::TravelMin => return Value::Milli(axis.travel.0),
+                    AxisField::TravelMax => return Value::Milli(axis.travel.1),
                 }
             }
             Setting::Global(GlobalField::StepPulseUs) => p.step_pulse_us as u32,
@@ -179,8 +195,21 @@ impl Setting {
         }
     }
 
-    /// Sets this setting from its text; nothing changes on an error.
+    /// Sets this setting from its text and checks the whole configuration
+    /// ([`MachineConfig::validate`]); nothing changes on an error.
     pub fn set(self, cfg: &mut MachineConfig, text: &[u8]) -> Result<(), SettingError> {
+        let mut new = *cfg;
+        self.set_field(&mut new, text)?;
+        new.validate().map_err(|kind| NumError {
+            at: trim(text).0,
+            kind,
+        })?;
+        *cfg = new;
+        Ok(())
+    }
+
+    /// Sets this setting's field alone.
+    fn set_field(self, cfg: &mut MachineConfig, text: &[u8]) -> Result<(), SettingError> {
         let (lead, text) = trim(text);
         let fail = |at, kind| NumError {
             at: lead + at,
@@ -212,6 +241,9 @@ impl Setting {
                     AxisField::Accel => axis.accel = number()?,
                     AxisField::DirInvert => axis.dir_high_is_positive = number()? == 0,
                     AxisField::EnableActiveHigh => axis.enable_active_high = number()? == 1,
+                    AxisField::SoftLimits => axis.soft_limits = number()? == 1,
+                    AxisField::TravelMin => axis.travel.0 = parse_milli(text).map_err(located)?,
+                    AxisField::TravelMax => axis.travel.1 = parse_milli(text).map_err(located)?,
                 }
             }
             // The ranges keep these within u8.
@@ -242,6 +274,19 @@ impl uDisplay for Value {
             Value::Number(n) => uwrite!(f, "{}", n),
             Value::Ratio(r) if r.den == 1 => uwrite!(f, "{}", r.num),
             Value::Ratio(r) => uwrite!(f, "{}/{}", r.num, r.den),
+            Value::Milli(m) => {
+                let (sign, a) = (if m.0 < 0 { "-" } else { "" }, m.0.unsigned_abs());
+                uwrite!(f, "{}{}.", sign, a / 1000)?;
+                let frac = a % 1000;
+                let pad = if frac < 10 {
+                    "00"
+                } else if frac < 100 {
+                    "0"
+                } else {
+                    ""
+                };
+                uwrite!(f, "{}{}", pad, frac)
+            }
         }
     }
 }
@@ -266,12 +311,16 @@ mod tests {
         assert_eq!(lines.len(), COUNT);
         assert_eq!(lines[0], "base_steps_per_unit = 9600/360");
         assert_eq!(lines[1], "base_max_rate = 2000");
-        assert_eq!(lines[5], "radial_steps_per_unit = 32");
-        assert_eq!(lines[10], "drill_steps_per_unit = 1600/12");
-        assert_eq!(lines[18], "aux_dir_invert = 0");
-        assert_eq!(lines[19], "aux_enable_active_high = 1");
-        assert_eq!(lines[20], "step_pulse_us = 5");
-        assert_eq!(lines[23], "junction_deviation_um = 10");
+        assert_eq!(lines[5], "base_soft_limits = 0");
+        assert_eq!(lines[8], "radial_steps_per_unit = 32");
+        assert_eq!(lines[13], "radial_soft_limits = 1");
+        assert_eq!(lines[14], "radial_travel_min = -450.000");
+        assert_eq!(lines[15], "radial_travel_max = 30.000");
+        assert_eq!(lines[16], "drill_steps_per_unit = 1600/12");
+        assert_eq!(lines[27], "aux_dir_invert = 0");
+        assert_eq!(lines[28], "aux_enable_active_high = 1");
+        assert_eq!(lines[32], "step_pulse_us = 5");
+        assert_eq!(lines[35], "junction_deviation_um = 10");
         for (i, s) in all().enumerate() {
             assert_eq!(s.index(), i);
         }
@@ -362,14 +411,23 @@ mod tests {
                 Setting::Axis(_, AxisField::StepsPerUnit) => std::format!("{}/{}", n.max(1), den),
                 _ => std::format!("{n}"),
             };
-            if set(&mut cfg, &show(&s), &text).is_ok() {
+            let listed = match s {
+                Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax) => std::format!("{n}.000"),
                 // A ratio over 1 is listed as a whole number.
-                let listed = text.strip_suffix("/1").unwrap_or(&text);
-                prop_assert_eq!(show(&s.get(&cfg)), listed);
-                prop_assert!(cfg.validate().is_ok());
-            } else {
-                let (min, max) = s.range();
-                prop_assert!(!(min..=max).contains(&n));
+                _ => text.strip_suffix("/1").unwrap_or(&text).into(),
+            };
+            match set(&mut cfg, &show(&s), &text) {
+                Ok(()) => {
+                    prop_assert_eq!(show(&s.get(&cfg)), listed);
+                    prop_assert!(cfg.validate().is_ok());
+                }
+                Err(e) => {
+                    // Out of the setting's range, or at odds with the others.
+                    let (min, max) = s.range();
+                    let at_odds = matches!(e.kind, ErrorKind::PulseTooLong { .. } | ErrorKind::Invalid(_));
+                    prop_assert!(!(min..=max).contains(&n) || at_odds, "{:?}", e);
+                    prop_assert_eq!(cfg, MachineConfig::STRING_ART);
+                }
             }
         }
     }

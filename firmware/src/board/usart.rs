@@ -1,15 +1,10 @@
-//! USART0, the serial console: 115200 8N1. Transmit goes through a 128-byte
+//! USART0, the serial console: 115200 8N1. Transmit goes through the `TX`
 //! ring drained by the data-register-empty interrupt, so writing never waits
-//! for the wire; received bytes go into a 64-byte ring filled by the receive
-//! interrupt.
+//! for the wire; received bytes go into the `RX` ring, filled by the receive
+//! interrupt (`queues`).
 
-use crate::rt::Ring;
+use crate::queues::{RX, TX};
 use avr_device::atmega2560::USART0;
-
-/// Bytes waiting for the wire; refusals are log lines dropped whole.
-pub static TX: Ring<u8, 128> = Ring::new();
-/// Bytes received and not yet parsed; refusals are bytes lost to overrun.
-pub static RX: Ring<u8, 64> = Ring::new();
 
 pub struct Usart0;
 
@@ -61,10 +56,16 @@ pub fn on_data_register_empty() {
     }
 }
 
-/// The `USART0_RX` handler, entered with its interrupt switched off.
-pub fn on_receive() {
+/// The `USART0_RX` handler, entered with its interrupt switched off: the
+/// byte goes to `take` (real-time commands), or when it declines, into
+/// `RX`. Returns what `take` said.
+pub fn on_receive(take: impl FnOnce(u8) -> bool) -> bool {
     let b = regs().udr0().read().bits();
-    // A full ring counts the lost byte (the sender ignored flow control).
-    let _ = RX.push(b);
+    let taken = take(b);
+    if !taken {
+        // A full ring counts the lost byte (the sender ignored flow control).
+        let _ = RX.push(b);
+    }
     avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.rxcie0().set_bit()));
+    taken
 }

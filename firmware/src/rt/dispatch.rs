@@ -13,42 +13,18 @@
 //! loses nothing; tasks flagged between two dispatches enter their
 //! priority's FIFO in task order.)
 
-use super::TaskCell;
+use super::{Flags, TaskCell};
 use crate::board::watchdog::Watchdog;
 use core::arch::asm;
-use core::cell::UnsafeCell;
 use taut_logic::sched::{Ready, Round, TaskId};
 
 /// Tasks spawned from interrupts and not yet in the ready set: bit = id.
-pub struct Spawned(UnsafeCell<u16>);
-
-// SAFETY: every access is a read-modify-write with interrupts masked.
-unsafe impl Sync for Spawned {}
-
-impl Spawned {
-    pub const fn new() -> Self {
-        Spawned(UnsafeCell::new(0))
-    }
-
-    /// Take every flag (dispatcher side).
-    fn take(&self) -> u16 {
-        // SAFETY: masked read-modify-write (see `Sync`).
-        avr_device::interrupt::free(|_| unsafe { core::mem::take(&mut *self.0.get()) })
-    }
-
-    /// With interrupts masked (the idle path): the two bytes agree.
-    fn is_empty(&self) -> bool {
-        // SAFETY: called with interrupts masked, so no handler writes it.
-        unsafe { core::ptr::read_volatile(self.0.get()) == 0 }
-    }
-}
+pub type Spawned = Flags;
 
 /// From an interrupt handler: make task `id` (below 16) ready.
 #[inline(always)]
 pub fn spawn_from_isr(spawned: &Spawned, id: u8) {
-    // Masked: a nested handler may be setting another bit.
-    // SAFETY: masked read-modify-write (see `Sync`).
-    avr_device::interrupt::free(|_| unsafe { *spawned.0.get() |= 1 << id });
+    spawned.set(id);
 }
 
 pub fn run<T: TaskId, const N: usize, const P: usize>(
@@ -76,7 +52,7 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
             continue;
         }
         avr_device::interrupt::disable();
-        if spawned.is_empty() {
+        if spawned.is_empty_masked() {
             // `sei` takes effect after the next instruction, so an interrupt
             // arriving now still wakes this `sleep`: no lost wake-up.
             // SAFETY: re-enables interrupts, as they were before `disable`.

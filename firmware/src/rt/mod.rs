@@ -3,10 +3,25 @@
 //! `taut_logic::sched` (host-tested); the app holds it in `TaskCell` statics.
 
 pub mod dispatch;
+pub mod flags;
 pub mod nested;
 pub mod ring;
 pub mod stack;
 pub mod task_cell;
 
+pub use flags::Flags;
+
+/// What a software task wants after a run; the app reschedules it.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Poll<S> {
+    /// Nothing until new input spawns it.
+    Idle,
+    /// Run again, after the tasks already ready (a long job, in pieces).
+    Again,
+    /// Run again in this many ms.
+    After(u16),
+    /// Run again when the app signals `S`.
+    Wait(S),
+}
 pub use ring::Ring;
 pub use task_cell::TaskCell;

@@ -2,7 +2,7 @@
 //! one at a time from the dispatcher, so they never preempt each other and
 //! need no critical section: the planner's look-ahead can run for
 //! milliseconds without ever masking the step interrupt. Interrupt handlers
-//! must not touch a `TaskCell` (they use a `Ring` or `dispatch::Spawned`).
+//! must not touch a `TaskCell` (they use a `Ring` or `Flags`).
 
 use core::cell::{Cell, UnsafeCell};
 

@@ -10,7 +10,8 @@
 //! decides per segment whether its events may take this path (`fast_ok`)
 //! and takes every other event: segment ends, DDA, long waits, DIR.
 
-use super::{Exec, FAST, LOW_WATER, MAP, MIN_LEAD, SEGMENTS};
+use super::{Exec, FAST, LOW_WATER, MAP, MIN_LEAD};
+use crate::queues::SEGMENTS;
 use crate::rt::Ring;
 use core::mem::offset_of;
 use taut_logic::segment::{Segment, NEW_BLOCK};
@@ -216,7 +217,7 @@ macro_rules! step_vector {
                 "pop r23", "pop r22", "pop r21", "pop r20", "pop r19", "pop r18",
                 "rjmp 2b",
                 e = sym $crate::stepper::EXEC,
-                ring = sym $crate::stepper::SEGMENTS,
+                ring = sym $crate::queues::SEGMENTS,
                 head = const $crate::stepper::fast::RING_HEAD,
                 tail = const $crate::stepper::fast::RING_TAIL,
                 ring_mask = const $crate::stepper::fast::RING_MASK,

@@ -41,12 +41,24 @@ pub enum ErrorKind {
     UnusedValueWords = 36,
     /// A setting or a `G92` while motion is under way (interpreter).
     NotIdle = 8,
+    /// Motion while the position is unknown (a stop at once during
+    /// motion): Grbl's alarm lock, lifted by `G92` or `$X`.
+    Locked = 9,
+    /// A target outside an axis's soft limits (interpreter).
+    TravelExceeded = 15,
     /// A target the kinematics cannot reach or the step counter cannot
     /// hold (interpreter).
     InvalidTarget = 33,
     /// `*` checksum wrong, malformed, or followed by more words.
     BadChecksum = 70,
+    /// Motion, drivers or settings while a string-art job runs (taut's).
+    JobOwnsMotion = 71,
+    /// `F` below [`MIN_FEED`] (taut's: Grbl creeps instead).
+    FeedTooLow = 72,
 }
+
+/// The slowest feed rate accepted, thousandths of a unit per minute.
+pub const MIN_FEED: i32 = 10_000;
 
 impl ErrorKind {
     /// Short text; every string costs SRAM on the AVR.
@@ -68,8 +80,12 @@ impl ErrorKind {
             ErrorKind::UnusedAxisWords => "Unused axis words",
             ErrorKind::UnusedValueWords => "Unused value words",
             ErrorKind::NotIdle => "Not idle",
+            ErrorKind::Locked => "Position unknown: G92 or $X first",
+            ErrorKind::TravelExceeded => "Travel exceeded (soft limit)",
             ErrorKind::InvalidTarget => "Invalid target",
             ErrorKind::BadChecksum => "Bad checksum",
+            ErrorKind::JobOwnsMotion => "A job is running",
+            ErrorKind::FeedTooLow => "Feed rate below 10/min",
         }
     }
 }

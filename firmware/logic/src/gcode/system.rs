@@ -18,6 +18,9 @@ pub enum SystemLine {
     QueueStats,
     /// `$S`: stack high-water mark.
     Stack,
+    /// `$X`: take the position as known again after a stop at once
+    /// (Grbl's alarm unlock).
+    Unlock,
     /// `$<key>=<value>`, both as typed; the settings module interprets
     /// them (e.g. with [`parse_milli`](super::parse_milli)).
     Set { key: SystemText, value: SystemText },
@@ -90,6 +93,7 @@ impl SystemBuilder {
             "$" => Ok(SystemLine::PrintSettings),
             "Q" | "q" => Ok(SystemLine::QueueStats),
             "S" | "s" => Ok(SystemLine::Stack),
+            "X" | "x" => Ok(SystemLine::Unlock),
             _ => Err(Error::new(ErrorKind::InvalidStatement, self.dollar)),
         }
     }

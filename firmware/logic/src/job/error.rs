@@ -68,6 +68,12 @@ pub enum ErrorKind {
     },
     /// The machine configuration as a whole is inconsistent (names the field).
     Invalid(&'static str),
+    /// The step pulse does not fit half the step period at an axis's
+    /// highest rate: at most `max_us`.
+    PulseTooLong {
+        axis: crate::axis::Axis,
+        max_us: u32,
+    },
 }
 
 /// An error in a job file. `line == 0` means the whole file (no position).
@@ -121,9 +127,15 @@ impl uDisplay for ErrorKind {
                 uwrite!(f, "nail {} out of range (nails: {})", index, nails)
             }
             ErrorKind::Count { declared, found } => {
-                uwrite!(f, "declared {} nails, found {}", declared, found)
+                uwrite!(f, "declared {} connections, found {}", declared, found)
             }
             ErrorKind::Invalid(field) => uwrite!(f, "invalid {}", field),
+            ErrorKind::PulseTooLong { axis, max_us } => uwrite!(
+                f,
+                "step pulse over half a step at {}_max_rate: {} us at most",
+                axis.name(),
+                max_us
+            ),
         }
     }
 }

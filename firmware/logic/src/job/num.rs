@@ -2,7 +2,7 @@
 //! (no floats between the text and the machine).
 
 use crate::job::error::ErrorKind;
-use crate::units::StepsPerUnit;
+use crate::units::{Milli, StepsPerUnit};
 
 /// A number that did not parse: what, and at which byte of the text.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,6 +83,21 @@ pub fn parse_fixed(s: &[u8], decimals: u32) -> Result<u32, NumError> {
         value = value.checked_mul(10).ok_or(TOO_BIG)?;
     }
     value.checked_add(round_up as u32).ok_or(TOO_BIG)
+}
+
+/// A signed decimal in thousandths: `-450.5` is `-450_500`.
+pub fn parse_milli(s: &[u8]) -> Result<Milli, NumError> {
+    let (negative, digits) = match s.split_first() {
+        Some((b'-', rest)) => (true, rest),
+        _ => (false, s),
+    };
+    let skip = negative as usize;
+    let v = parse_fixed(digits, 3).map_err(|e| NumError {
+        at: e.at + skip,
+        ..e
+    })?;
+    let v = i32::try_from(v).map_err(|_| TOO_BIG)?;
+    Ok(Milli(if negative { -v } else { v }))
 }
 
 /// Steps per unit as `num/den` (`1600/12`) or a decimal (`26.5` = 53/2).

@@ -228,9 +228,12 @@ mod tests {
                 "3,\r\n0,\r\n  250",
                 "poradi.txt:3:3: nail 250 out of range (nails: 250)",
             ),
-            ("3,0,1", "poradi.txt:1:1: declared 3 nails, found 2"),
-            ("\n 2,0,1,2,3,", "poradi.txt:2:2: declared 2 nails, found 4"),
-            ("5", "poradi.txt:1:1: declared 5 nails, found 0"),
+            ("3,0,1", "poradi.txt:1:1: declared 3 connections, found 2"),
+            (
+                "\n 2,0,1,2,3,",
+                "poradi.txt:2:2: declared 2 connections, found 4",
+            ),
+            ("5", "poradi.txt:1:1: declared 5 connections, found 0"),
             ("0", "poradi.txt:1:1: expected 1 to 1000000"),
             ("2,0,,1", "poradi.txt:1:5: expected a number"),
             (",2,0,1", "poradi.txt:1:1: expected a number"),
@@ -258,7 +261,10 @@ mod tests {
             "poradi.txt:1:7: nail 250 out of range (nails: 250)"
         );
         let err = read_in_chunks(b"3,1,2", 250, 2).unwrap_err();
-        assert_eq!(show(&err), "poradi.txt:1:1: declared 3 nails, found 2");
+        assert_eq!(
+            show(&err),
+            "poradi.txt:1:1: declared 3 connections, found 2"
+        );
     }
 
     /// A file as a generator would write it: random blanks and line breaks

@@ -50,23 +50,25 @@ impl<T: TaskId, const N: usize, const P: usize> Ready<T, N, P> {
 
     /// Takes the task to run now: the oldest spawn at the highest level.
     pub fn pop(&mut self) -> Option<T> {
-        for level in (0..P).rev() {
-            if let Some(task) = self.head[level] {
-                let i = task.index();
-                self.head[level] = self.link[i];
-                if self.head[level].is_none() {
-                    self.tail[level] = None;
-                }
-                self.pending[i] = false;
-                return Some(task);
-            }
+        (0..P as u8).rev().find_map(|level| self.pop_level(level))
+    }
+
+    /// The oldest spawn at priority `level`, if any.
+    pub fn pop_level(&mut self, level: u8) -> Option<T> {
+        let l = level as usize;
+        let task = self.head[l]?;
+        let i = task.index();
+        self.head[l] = self.link[i];
+        if self.head[l].is_none() {
+            self.tail[l] = None;
         }
-        None
+        self.pending[i] = false;
+        Some(task)
     }
 
     /// Like [`Ready::pop`], among the tasks whose bit (`1 << index`) is
     /// set in `among` only: the oldest spawn at the highest level of those.
-    pub fn pop_among(&mut self, among: u32) -> Option<T> {
+    pub fn pop_among(&mut self, among: u16) -> Option<T> {
         for level in (0..P).rev() {
             let mut prev: Option<T> = None;
             let mut at = self.head[level];
@@ -90,11 +92,18 @@ impl<T: TaskId, const N: usize, const P: usize> Ready<T, N, P> {
         None
     }
 
-    /// The pending tasks as a bit set (`1 << index`).
-    pub fn pending_mask(&self) -> u32 {
-        (0..T::COUNT)
-            .filter(|&i| self.pending[i])
-            .fold(0, |m, i| m | 1 << i)
+    /// The pending tasks as a bit set (`1 << index`; at most 16 tasks).
+    pub fn pending_mask(&self) -> u16 {
+        const { assert!(T::COUNT <= 16, "a bit per task in a u16") };
+        let mut mask = 0u16;
+        let mut bit = 1u16;
+        for &pending in &self.pending[..T::COUNT] {
+            if pending {
+                mask |= bit;
+            }
+            bit <<= 1;
+        }
+        mask
     }
 
     pub fn is_pending(&self, task: T) -> bool {
@@ -208,10 +217,10 @@ mod tests {
         }
 
         fn pop(&mut self) -> Option<Tk> {
-            self.pop_among(u32::MAX)
+            self.pop_among(u16::MAX)
         }
 
-        fn pop_among(&mut self, among: u32) -> Option<Tk> {
+        fn pop_among(&mut self, among: u16) -> Option<Tk> {
             let best = (0..self.waiting.len())
                 .filter(|&i| among >> self.waiting[i].0.id & 1 != 0)
                 .min_by_key(|&i| {
@@ -253,10 +262,10 @@ mod tests {
                     }
                     Op::Pop => prop_assert_eq!(r.pop(), m.pop()),
                     Op::PopAmong(mask) => {
-                        prop_assert_eq!(r.pop_among(mask as u32), m.pop_among(mask as u32))
+                        prop_assert_eq!(r.pop_among(mask as u16), m.pop_among(mask as u16))
                     }
                 }
-                let model_mask = m.waiting.iter().fold(0, |a, (t, _)| a | 1 << t.id);
+                let model_mask = m.waiting.iter().fold(0u16, |a, (t, _)| a | 1 << t.id);
                 prop_assert_eq!(r.pending_mask(), model_mask);
                 prop_assert_eq!(r.is_idle(), m.waiting.is_empty());
             }

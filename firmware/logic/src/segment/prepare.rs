@@ -11,7 +11,7 @@
 //! - lag carried from the previous segment ≤ 66; the interrupt's tick
 //!   truncation < 256.
 
-use super::trapezoid::{cbrt_floor_approx, Phase, Trapezoid};
+use super::trapezoid::{cbrt_floor_approx, Phase, Speeds, Trapezoid};
 use super::{Segment, NEW_BLOCK, STOP, SUBTICKS_PER_S as Q};
 use crate::units::div_round;
 
@@ -124,7 +124,12 @@ impl Preparer {
     /// speed² it will have (the next block must enter no faster).
     pub fn restart(&mut self) -> u64 {
         let left = self.events - self.before - self.done;
-        let leg = Trapezoid::new(left, self.accel, 0, self.cruise_sqr, self.exit_sqr);
+        let speeds = Speeds {
+            entry_sqr: 0,
+            cruise_sqr: self.cruise_sqr,
+            exit_sqr: self.exit_sqr,
+        };
+        let leg = Trapezoid::new(left, self.accel, &speeds);
         self.switch(leg);
         leg.exit_sqr()
     }
@@ -140,7 +145,14 @@ impl Preparer {
         // Standing already: an empty leg (a profile needs an event).
         let leg = match n {
             0 => Trapezoid::ZERO,
-            n => Trapezoid::new(n as u32, self.accel, v_sqr, v_sqr, end_sqr),
+            n => {
+                let speeds = Speeds {
+                    entry_sqr: v_sqr,
+                    cruise_sqr: v_sqr,
+                    exit_sqr: end_sqr,
+                };
+                Trapezoid::new(n as u32, self.accel, &speeds)
+            }
         };
         self.switch(leg);
         end_sqr

@@ -18,9 +18,11 @@ impl Ramp {
         Trapezoid::new(
             self.events,
             self.accel,
-            self.v0_sqr,
-            self.cruise_sqr,
-            self.v1_sqr,
+            &Speeds {
+                entry_sqr: self.v0_sqr,
+                cruise_sqr: self.cruise_sqr,
+                exit_sqr: self.v1_sqr,
+            },
         )
     }
 

@@ -64,15 +64,34 @@ impl Trapezoid {
     };
 }
 
+/// Speeds² of a profile, events²/s²: where it starts, the most it may
+/// reach, where it ends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Speeds {
+    pub entry_sqr: u64,
+    pub cruise_sqr: u64,
+    pub exit_sqr: u64,
+}
+
 /// Largest acceleration in events/s² the fixed-point arithmetic allows.
 pub const MAX_ACCEL: u32 = 1 << 24;
 
 impl Trapezoid {
-    /// The fastest profile over `events` events that starts at `entry_sqr`,
-    /// never exceeds `cruise_sqr` and ends at `exit_sqr`. Entry and exit are
-    /// clamped to what `accel` allows over the block (the planner already
-    /// guarantees this up to rounding).
-    pub fn new(events: u32, accel: u32, entry_sqr: u64, cruise_sqr: u64, exit_sqr: u64) -> Self {
+    /// The fastest profile over `events` events that starts at the entry
+    /// speed, never exceeds the cruise speed and ends at the exit speed.
+    /// Entry and exit are clamped to what `accel` allows over the block
+    /// (the planner already guarantees this up to rounding).
+    ///
+    /// The speeds come by reference: on the AVR, arguments beyond 18 bytes
+    /// go on the stack, and the compiler passes stacked `u64`s wrongly
+    /// (seen here: the cruise speed arrived as garbage once this function
+    /// stopped being inlined).
+    pub fn new(events: u32, accel: u32, speeds: &Speeds) -> Self {
+        let Speeds {
+            entry_sqr,
+            cruise_sqr,
+            exit_sqr,
+        } = *speeds;
         let a = accel.clamp(1, MAX_ACCEL) as u64;
         let two_a = 2 * a;
         let two_ae = two_a * events as u64;

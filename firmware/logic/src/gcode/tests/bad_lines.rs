@@ -13,7 +13,7 @@ const BAD: &[(&str, u8, u8)] = &[
     ("G1 X1-", 2, 6),
     ("G1 X2147483.648", 2, 15),
     ("G1 X99999999", 2, 11),
-    ("$X", 3, 1),
+    ("$Y", 3, 1),
     ("$$$", 3, 3),
     ("$=5", 3, 2),
     ("$key=", 3, 6),
@@ -116,14 +116,26 @@ fn overlong_lines_fail_at_column_81_and_the_next_line_parses() {
 fn cr_lf_and_crlf_each_end_one_line() {
     let mut parser = Parser::new();
     let out = push_all(&mut parser, b"M17\rM18\nM114\r\nM400\r\r\n\n");
-    let lines: Vec<_> = out.iter().map(|r| r.as_ref().map(|i| match i {
-        Input::Line(l) => l.command,
-        _ => Command::Empty,
-    })).collect();
+    let lines: Vec<_> = out
+        .iter()
+        .map(|r| {
+            r.as_ref().map(|i| match i {
+                Input::Line(l) => l.command,
+                _ => Command::Empty,
+            })
+        })
+        .collect();
     use Command::*;
     assert_eq!(
         lines,
-        [Ok(EnableDrivers), Ok(DisableDrivers), Ok(ReportPosition), Ok(WaitIdle), Ok(Empty), Ok(Empty)]
+        [
+            Ok(EnableDrivers),
+            Ok(DisableDrivers),
+            Ok(ReportPosition),
+            Ok(WaitIdle),
+            Ok(Empty),
+            Ok(Empty)
+        ]
     );
 }
 

@@ -86,10 +86,13 @@ pub enum Event<'c> {
     /// Every step taken from [`super::Job::next_step`] has been carried
     /// out, and `next_step` returned `None`.
     MotionDone,
-    /// Serial `!`.
+    /// Pause after the current hole or wrap (as a long press of green).
     Pause,
-    /// Serial `~`.
+    /// Serial `~` with no feed hold to end: resume a paused job.
     Resume,
+    /// Serial Ctrl-X: the machine was stopped at once and the queued steps
+    /// dropped; the job ends where it is (the axes need zeroing again).
+    Abort,
     /// The next nail index of `poradi.txt`, while [`super::Job::wants_nail`].
     Nail(u16),
     /// The card could not deliver the next index while winding.
@@ -117,6 +120,8 @@ pub enum Msg {
     /// Winding lost its pattern stream; it waits for the card.
     PatternLost,
     Resumed,
+    /// Ended by Ctrl-X.
+    Aborted,
 }
 
 impl Msg {
@@ -136,6 +141,7 @@ impl Msg {
             Msg::NoCard => "no card",
             Msg::PatternLost => "pattern lost",
             Msg::Resumed => "resumed",
+            Msg::Aborted => "job stopped by Ctrl-X",
         }
     }
 }
@@ -190,7 +196,11 @@ pub enum Action {
     OpenPattern {
         skip: u32,
     },
-    /// Switch the drivers in the mask (bit = axis index) on / off.
+    /// Stop any motion under way (a console jog) and drop what is queued,
+    /// before what follows (the card went while the machine may move).
+    StopMotion,
+    /// Switch the drivers in the mask (bit = axis index) on / off, once
+    /// the machine stands.
     DriversOn(u8),
     DriversOff(u8),
     /// Take the axis's current position as its zero.

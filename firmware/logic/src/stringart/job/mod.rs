@@ -132,6 +132,12 @@ impl Job {
         self.motion.as_mut()?.next()
     }
 
+    /// Drilling or winding, or paused inside them: the job owns the
+    /// machine's motion, and nothing else may move it.
+    pub fn owns_motion(&self) -> bool {
+        self.phase().is_some()
+    }
+
     /// Winding wants the next index of the pattern ([`Event::Nail`]).
     pub fn wants_nail(&self) -> bool {
         !self.lost && self.motion.as_ref().is_some_and(Motion::wants_nail)
@@ -168,6 +174,7 @@ impl Job {
             }
             Event::Pause => self.pause(o, now_ms),
             Event::Resume => self.resume(o, now_ms),
+            Event::Abort => self.abort(o),
             Event::Nail(j) => self.nail(j, o, now_ms),
             Event::PatternLost => {
                 if self.phase() == Some(Phase::Winding) {
@@ -248,6 +255,7 @@ impl Job {
                 // Nothing done yet: start over, with the drivers off as
                 // whenever the job waits for a card.
                 o.push(Action::Log(Msg::CardRemoved));
+                o.push(Action::StopMotion);
                 o.push(Action::DriversOff(MACHINE_DRIVERS));
                 self.restart(o);
             }
@@ -489,6 +497,19 @@ impl Job {
         } else {
             self.advance(o, now_ms);
         }
+    }
+
+    /// Ctrl-X: the steps handed out are gone, the job ends. The drivers
+    /// keep holding; the next job starts over from its card.
+    fn abort(&mut self, o: &mut Out) {
+        if self.phase().is_none() {
+            return;
+        }
+        self.motion = None;
+        self.moving = false;
+        self.lost = false;
+        o.push(Action::Log(Msg::Aborted));
+        self.enter(State::End, o);
     }
 
     fn nail(&mut self, j: u16, o: &mut Out, now_ms: u32) {

@@ -479,6 +479,28 @@ fn serial_pause_and_resume_while_winding() {
 }
 
 #[test]
+fn ctrl_x_ends_the_job_where_it_is_with_the_drivers_holding() {
+    let mut b = Bench::new(HEX, &PATTERN);
+    b.ready();
+    assert_eq!(b.send(Event::Abort), [], "nothing to stop");
+    b.green();
+    b.batch();
+    assert_eq!(
+        b.send(Event::Abort),
+        [
+            Action::Log(Msg::Aborted),
+            Action::Enter(State::End),
+            Action::Prompt(Prompt::Finished)
+        ]
+    );
+    assert_eq!(b.job.next_step(), None, "no step after the stop");
+    assert_eq!(b.drivers, ALL, "the drivers keep holding");
+    assert_eq!(b.send(Event::MotionDone), []);
+    // Green starts over: a new job from a card.
+    assert_eq!(b.green()[0], Action::Enter(State::WaitingForCard));
+}
+
+#[test]
 fn pause_and_resume_before_the_batch_has_finished() {
     let mut b = Bench::new(HEX, &PATTERN);
     b.ready();
@@ -561,6 +583,7 @@ fn card_removed_before_drilling_starts_over() {
         b.send(Event::CardRemoved),
         [
             Action::Log(Msg::CardRemoved),
+            Action::StopMotion,
             Action::DriversOff(ALL),
             Action::Enter(State::WaitingForCard),
             Action::Prompt(Prompt::InsertCard)

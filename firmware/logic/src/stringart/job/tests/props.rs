@@ -33,6 +33,7 @@ fn event(k: usize, nail: u16) -> Event<'static> {
         8 => Event::Resume,
         9 => Event::Nail(nail),
         10 => Event::PatternLost,
+        27 => Event::Abort,
         11..=14 => Event::Button(ButtonEvent::Pressed(button)),
         15..=18 => Event::Button(ButtonEvent::Released {
             button,
@@ -50,7 +51,7 @@ fn event(k: usize, nail: u16) -> Event<'static> {
 /// resets are rare, green and the motion loop common.
 fn ops() -> impl Strategy<Value = Vec<(Op, u16)>> {
     let op = prop_oneof![
-        1 => (0usize..27).prop_map(Op::Send),
+        1 => (0usize..28).prop_map(Op::Send),
         2 => Just(Op::Send(1)),
         2 => Just(Op::Send(3)),
         4 => Just(Op::Send(15)),

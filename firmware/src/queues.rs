@@ -1,0 +1,101 @@
+//! Every queue, mailbox and flag that tasks and interrupts share, and the
+//! messages they carry: the `app`'s (src/main.rs) table in code. A full
+//! ring is back-pressure — the producer keeps its message and tries again
+//! — and every ring counts what it sent, refused, and its high-water mark
+//! (`$Q`, and the end of a job).
+
+use crate::rt::{Flags, Ring};
+use core::sync::atomic::AtomicBool;
+use taut_logic::buttons::ButtonEvent;
+use taut_logic::job::FileName;
+use taut_logic::segment::{Segment, StepBlock};
+
+/// UART receive interrupt → console: line bytes (real-time commands are
+/// taken out before). Full: the byte is lost and counted (the sender
+/// ignored flow control).
+pub static RX: Ring<u8, 64> = Ring::new();
+/// Console, job, logger → UART transmit interrupt. Replies wait for room;
+/// a log line without room is dropped whole and counted.
+pub static TX: Ring<u8, 128> = Ring::new();
+/// UART receive interrupt → `Realtime` task: `?`, `!`, `~`, Ctrl-X.
+pub static REALTIME: Flags = Flags::new();
+
+/// Motion task → step interrupt: segments, and the blocks they start.
+pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
+/// Slots of the segment ring (one fewer can be queued).
+pub const SEGMENTS_CAPACITY: usize = 32;
+pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
+
+/// Tick → buttons task: one raw sample (bit `Button as u8` = pressed) per
+/// millisecond while active. Full: the sample is refused and counted (the
+/// task fell 15 ms behind; a press then counts a little late).
+pub static SAMPLES: Ring<u8, 16> = Ring::new();
+/// Buttons task → job. Full: refused and counted (the job is far behind a
+/// human's presses).
+pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
+
+/// Job → card reader.
+pub static CARD_IN: Ring<Request, 2> = Ring::new();
+/// Card reader → job. Full: the reader keeps its block and waits.
+pub static CARD_OUT: Ring<CardMsg, 4> = Ring::new();
+/// File bytes per message.
+pub const CHUNK: usize = 32;
+
+/// `Realtime` task → job: `~` with no feed hold, Ctrl-X.
+pub static JOB_CONTROL: Ring<Control, 4> = Ring::new();
+
+/// The job waits for room in the TX ring for a line it must not drop (a
+/// prompt, a bad file's message): the console holds its replies meanwhile,
+/// or a stream of replies would keep the ring full for as long as it lasts.
+pub static JOB_CLAIMS_TX: AtomicBool = AtomicBool::new(false);
+
+/// What the job asks of the card reader.
+#[derive(Clone, Copy)]
+pub enum Request {
+    /// Stream this file from its start (dropping the one being read); the
+    /// number is the ticket its messages carry.
+    Open(FileName, u8),
+}
+
+/// What the card reader tells the job. `ticket` numbers the `Open` request
+/// a file message answers, so the job can drop what an older one sent.
+#[derive(Clone, Copy)]
+pub struct CardMsg {
+    pub ticket: u8,
+    pub what: What,
+}
+
+#[derive(Clone, Copy)]
+pub enum What {
+    Inserted,
+    Removed,
+    /// The next bytes of the file.
+    Data {
+        len: u8,
+        bytes: [u8; CHUNK],
+    },
+    End,
+    /// No such file on the card.
+    Missing,
+    /// The card failed mid-file (a `Removed` follows), or holds no FAT volume.
+    Failed,
+}
+
+/// The console's word for the job.
+#[derive(Clone, Copy)]
+pub enum Control {
+    /// `~` with no feed hold on: resume a paused job.
+    Resume,
+    /// Ctrl-X: the machine was stopped at once; end the job.
+    Abort,
+}
+
+/// Conditions a task can wait for ([`crate::rt::Poll::Wait`]): the app
+/// runs the waiting tasks when the condition's producer signals it.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Signal {
+    /// The motion task freed planner room or the machine came to rest.
+    Motion,
+    /// The job took messages from [`CARD_OUT`].
+    CardRoom,
+}

@@ -1,0 +1,93 @@
+//! Grbl's real-time commands, acted on in the receive path: the receive
+//! interrupt takes `?`, `!`, `~` and Ctrl-X out of the byte stream, so
+//! they never wait behind a line. Ctrl-X stops the steps there and then;
+//! the rest is flagged for the `Realtime` task (the highest software
+//! priority), which also writes the status report.
+
+use crate::flash_str;
+use crate::motion::{Motion, State};
+use crate::queues::REALTIME;
+use crate::reply::{self, Fixed, REPORTED_AXES};
+use crate::stepper;
+use taut_logic::gcode::Realtime;
+use taut_logic::kinematics::Kinematics;
+use ufmt::{uWrite, uwrite};
+
+const STATUS: u8 = 0;
+const HOLD: u8 = 1;
+const RESUME: u8 = 2;
+const RESET: u8 = 3;
+
+/// The receive interrupt's part: true when `byte` was a real-time command
+/// (flagged: spawn the task), which is then not line input.
+#[inline(always)]
+pub fn on_receive(byte: u8) -> bool {
+    let bit = match Realtime::from_byte(byte) {
+        None => return false,
+        Some(Realtime::Status) => STATUS,
+        Some(Realtime::FeedHold) => HOLD,
+        Some(Realtime::CycleStart) => RESUME,
+        Some(Realtime::Reset) => {
+            stepper::halt();
+            RESET
+        }
+    };
+    REALTIME.set(bit);
+    true
+}
+
+/// The commands taken for one run of the task, in the order they act:
+/// reset, hold, resume, status.
+#[derive(Clone, Copy)]
+pub struct Requests(u16);
+
+impl Requests {
+    pub fn take() -> Requests {
+        Requests(REALTIME.take())
+    }
+
+    fn has(self, bit: u8) -> bool {
+        self.0 >> bit & 1 != 0
+    }
+
+    pub fn reset(self) -> bool {
+        self.has(RESET)
+    }
+
+    pub fn hold(self) -> bool {
+        self.has(HOLD)
+    }
+
+    pub fn resume(self) -> bool {
+        self.has(RESUME)
+    }
+
+    pub fn status(self) -> bool {
+        self.has(STATUS)
+    }
+}
+
+/// Ask again for a status report that found no room in the TX ring.
+pub fn status_later() {
+    REALTIME.set(STATUS);
+}
+
+/// `<Idle|MPos:0.000,12.500,-3.000>`: the state and the position as the
+/// pulses left it, in the machine's units (Grbl's status report).
+pub fn status(m: &Motion, kin: &impl Kinematics) {
+    let mut r = reply::line();
+    let state = match m.state() {
+        _ if !m.position_known() => flash_str!("Alarm"),
+        State::Idle => flash_str!("Idle"),
+        State::Run => flash_str!("Run"),
+        State::Hold { standing: true } => flash_str!("Hold:0"),
+        State::Hold { standing: false } => flash_str!("Hold:1"),
+    };
+    let _ = uwrite!(r, "<{}|MPos:", state);
+    let pos = kin.forward(&m.stepper.position());
+    for (i, p) in pos.iter().take(REPORTED_AXES).enumerate() {
+        let _ = uwrite!(r, "{}{}", if i > 0 { "," } else { "" }, Fixed(*p));
+    }
+    let _ = r.write_str(">");
+    r.send();
+}

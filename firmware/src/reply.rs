@@ -1,0 +1,77 @@
+//! Console replies: `ok`, `error:<code> <text>`, reports. A reply line is
+//! assembled on the stack and queued whole, never cut: it runs only once
+//! the TX ring has [`ROOM`] free bytes, and no reply is longer.
+
+use crate::board::usart;
+use crate::log::Line;
+use crate::texts;
+use taut_logic::gcode::Error;
+use taut_logic::job::error::ErrorKind;
+use taut_logic::units::Milli;
+use ufmt::{uWrite, uwrite};
+
+/// Longest reply line, its newline included: `M114` at the extremes of
+/// three axes is 93 bytes.
+pub const ROOM: usize = crate::log::LINE;
+
+/// Axes in position reports: the machine's three (the aux channel is
+/// not reported).
+pub const REPORTED_AXES: usize = 3;
+
+/// A reply line being assembled (the log's line type: see `Line::bare`).
+pub type Reply = Line;
+
+pub fn line() -> Reply {
+    Line::bare()
+}
+
+/// There is room in the TX ring for any reply.
+pub fn room() -> bool {
+    crate::queues::TX.free() >= ROOM
+}
+
+pub fn ok() {
+    usart::send(b"ok\n");
+}
+
+/// `error:<code> <text> (col <c>)`.
+pub fn error(e: &Error) {
+    error_because(e, None);
+}
+
+/// `error:<code> <text>[: <why>] (col <c>)`: `why` from the settings'
+/// and job files' own errors.
+#[inline(never)]
+pub fn error_because(e: &Error, why: Option<ErrorKind>) {
+    let mut r = line();
+    let _ = uwrite!(r, "error:{} {}", e.code(), texts::error(e.kind()));
+    if let Some(why) = why {
+        let _ = uwrite!(r, ": {}", why);
+    }
+    if let Some(c) = e.column() {
+        let _ = uwrite!(r, " (col {})", c);
+    }
+    r.send();
+}
+
+/// A fixed-point value as `-12.345`.
+pub struct Fixed(pub Milli);
+
+impl ufmt::uDisplay for Fixed {
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut ufmt::Formatter<'_, W>) -> Result<(), W::Error> {
+        let v = self.0 .0;
+        if v < 0 {
+            f.write_str("-")?;
+        }
+        let a = v.unsigned_abs();
+        let frac = a % 1000;
+        uwrite!(f, "{}.", a / 1000)?;
+        if frac < 100 {
+            f.write_str("0")?;
+        }
+        if frac < 10 {
+            f.write_str("0")?;
+        }
+        uwrite!(f, "{}", frac)
+    }
+}

@@ -1,0 +1,44 @@
+//! Bits that interrupts set and a task takes: which tasks an interrupt
+//! spawned, which real-time commands arrived. Setting is one masked `|=`
+//! (a nested handler may be setting another bit), so an interrupt masks
+//! the step interrupt for a few cycles only.
+
+use core::cell::UnsafeCell;
+
+pub struct Flags(UnsafeCell<u16>);
+
+// SAFETY: every access is a read-modify-write with interrupts masked, or
+// a read with interrupts masked (`is_empty`).
+unsafe impl Sync for Flags {}
+
+impl Flags {
+    pub const fn new() -> Self {
+        Flags(UnsafeCell::new(0))
+    }
+
+    /// Set bit `bit` (below 16). From interrupts or tasks.
+    #[inline(always)]
+    pub fn set(&self, bit: u8) {
+        // SAFETY: masked read-modify-write (see `Sync`).
+        avr_device::interrupt::free(|_| unsafe { *self.0.get() |= 1 << bit });
+    }
+
+    /// Take every bit set so far.
+    pub fn take(&self) -> u16 {
+        // SAFETY: masked read-modify-write (see `Sync`).
+        avr_device::interrupt::free(|_| unsafe { core::mem::take(&mut *self.0.get()) })
+    }
+
+    /// With interrupts masked (the dispatcher's idle path): the two bytes
+    /// agree.
+    pub fn is_empty_masked(&self) -> bool {
+        // SAFETY: called with interrupts masked, so no handler writes it.
+        unsafe { core::ptr::read_volatile(self.0.get()) == 0 }
+    }
+}
+
+impl Default for Flags {
+    fn default() -> Self {
+        Self::new()
+    }
+}
