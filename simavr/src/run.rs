@@ -155,7 +155,6 @@ impl Sim {
         let sp = self.sp();
         if sp < self.min_sp {
             self.min_sp = sp;
-            self.min_sp_pc = pc_before;
             // The last push wrote at sp + 1.
             if u32::from(sp) + 1 < u32::from(self.ram_limit) {
                 return Some(Outcome::StackOverflow {

@@ -57,8 +57,6 @@ pub struct Sim {
     pub(crate) elf: Option<ElfInfo>,
     pub(crate) ram_limit: u16,
     pub(crate) min_sp: u16,
-    /// The instruction that pushed the stack to `min_sp`.
-    pub(crate) min_sp_pc: u32,
     /// Watched program addresses and the cycles execution reached them.
     pub(crate) pc_watches: Vec<(u32, Vec<u64>)>,
     pub(crate) resets: u32,
@@ -176,7 +174,6 @@ impl Sim {
             elf,
             ram_limit,
             min_sp: RAM_END,
-            min_sp_pc: 0,
             pc_watches: Vec::new(),
             resets: 0,
             last_avr_cycle: 0,
@@ -244,7 +241,6 @@ impl Sim {
         }
     }
 
-    /// Lowest stack pointer seen (checked after every instruction).
     /// Record every cycle at which execution reaches byte address `pc` (an
     /// interrupt vector, a task's entry): latencies measured exactly.
     pub fn watch_pc(&mut self, pc: u32) {
@@ -259,12 +255,9 @@ impl Sim {
             .map_or(&[], |w| &w.1)
     }
 
-    /// Where the stack was deepest: the instruction's byte address.
-    pub fn stack_peak_pc(&self) -> u32 {
-        self.min_sp_pc
-    }
-
-    pub fn stack_high_water(&self) -> u16 {
+    /// Lowest stack pointer seen, an address (checked after every
+    /// instruction); `peak_stack_bytes` says how deep that is.
+    pub fn lowest_sp(&self) -> u16 {
         self.min_sp
     }
 
