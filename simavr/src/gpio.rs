@@ -4,7 +4,6 @@
 use crate::clock::{cycles_in, cycles_to_ns};
 use crate::hooks::{self, PinHook};
 use crate::input;
-use crate::pins;
 use crate::probe::{self, Probe};
 use crate::sim::{ioctl, Sim, StepDir};
 use crate::vcd;
@@ -12,6 +11,7 @@ use simavr_ffi as ffi;
 use std::os::raw::c_void;
 use std::path::Path;
 use std::time::Duration;
+use taut_logic::pinmap::{self, Port, PIN_COUNT};
 
 impl Sim {
     /// simavr's IRQ for a board pin's level.
@@ -19,12 +19,12 @@ impl Sim {
     /// # Panics
     /// On a pin number past D69.
     fn pin_irq(&self, pin: u8) -> *mut ffi::avr_irq_t {
-        let (port, bit) = pins::port_bit(pin).unwrap_or_else(|| panic!("no board pin D{pin}"));
+        let (port, bit) = board_pin(pin);
         // SAFETY: the avr_t is live; an ioctl query has no side effect.
         unsafe {
             ffi::avr_io_getirq(
                 self.avr.as_ptr(),
-                ioctl(b'i', b'o', b'g', port as u8),
+                ioctl(b'i', b'o', b'g', port.letter() as u8),
                 bit as i32,
             )
         }
@@ -148,13 +148,13 @@ impl Sim {
     /// state, so simavr keeps it when the firmware rewrites the port (it would
     /// otherwise re-apply the pull-up), and raised on the pin.
     pub(crate) fn drive(&mut self, pin: u8, high: bool) {
-        let (port, bit) = pins::port_bit(pin).unwrap_or_else(|| panic!("no board pin D{pin}"));
-        let slot = &mut self.external[(port as u8 - b'A') as usize];
+        let (port, bit) = board_pin(pin);
+        let slot = &mut self.external[port as usize];
         slot.0 |= 1 << bit;
         slot.1 = (slot.1 & !(1 << bit)) | (u8::from(high) << bit);
         // SAFETY: avr_ioport_external_t is plain C data, valid zeroed.
         let mut ext: ffi::avr_ioport_external_t = unsafe { std::mem::zeroed() };
-        ext.set_name(port as u8 as _);
+        ext.set_name(port.letter() as u8 as _);
         ext.set_mask(slot.0 as _);
         ext.set_value(slot.1 as _);
         let irq = self.pin_irq(pin);
@@ -163,7 +163,7 @@ impl Sim {
         unsafe {
             ffi::avr_ioctl(
                 self.avr.as_ptr(),
-                ioctl(b'i', b'o', b'p', port as u8),
+                ioctl(b'i', b'o', b'p', port.letter() as u8),
                 &mut ext as *mut _ as *mut c_void,
             );
             ffi::avr_raise_irq(irq, u32::from(high));
@@ -190,4 +190,13 @@ impl Sim {
             })
             .collect()
     }
+}
+
+/// Port and bit of a board pin.
+///
+/// # Panics
+/// On a pin number past D69.
+fn board_pin(pin: u8) -> (Port, u8) {
+    assert!(pin < PIN_COUNT, "no board pin D{pin}");
+    pinmap::port_bit(pin)
 }

@@ -14,7 +14,6 @@ mod input;
 pub mod operator;
 mod outcome;
 pub mod picture;
-pub mod pins;
 pub mod probe;
 pub mod replay;
 pub mod report;

@@ -65,8 +65,8 @@ pub struct Sim {
     /// A fatal ending, repeated by every later run.
     pub(crate) ended: Option<Outcome>,
     pub(crate) schedule: PinSchedule,
-    /// Externally driven pins per port A..L: (mask, levels).
-    pub(crate) external: [(u8, u8); 12],
+    /// Externally driven pins per port, in `Port` order: (mask, levels).
+    pub(crate) external: [(u8, u8); 11],
     pub(crate) step_dir: Vec<StepDir>,
     /// Simulated cycles and host time of the last run.
     pub(crate) last_speed: Option<(u64, Duration)>,
@@ -179,7 +179,7 @@ impl Sim {
             last_avr_cycle: 0,
             ended: None,
             schedule: PinSchedule::default(),
-            external: [(0, 0); 12],
+            external: [(0, 0); 11],
             step_dir: Vec::new(),
             last_speed: None,
             masked: MaskedSpans::default(),

@@ -18,15 +18,15 @@
 //! - The callback runs only inside simavr calls made by `Sim`'s `&mut self`
 //!   methods; no Rust reference into the slot lives across such a call.
 
-use super::{SdCard, SdImage, SdStats, CS_PIN};
+use super::{SdCard, SdImage, SdStats};
 use crate::clock::cycles_in;
 use crate::hooks::Shared;
-use crate::pins;
 use crate::sim::{ioctl, Sim};
 use simavr_ffi as ffi;
 use std::ffi::CStr;
 use std::os::raw::c_void;
 use std::time::Duration;
+use taut_logic::pinmap;
 
 /// Names our I/O module; its address identifies it in simavr's list.
 static KIND: &CStr = c"taut-sd";
@@ -174,7 +174,7 @@ impl Sim {
 
     fn install_slot(&mut self) -> *mut Slot {
         let avr = self.avr.as_ptr();
-        let (port, bit) = pins::port_bit(CS_PIN).expect("D53 exists");
+        let (port, bit) = pinmap::port_bit(pinmap::SD_CS);
         // SAFETY: the avr_t is live; ioctl queries have no side effect; the
         // module and slot outlive every callback (module invariants).
         unsafe {
@@ -184,7 +184,11 @@ impl Sim {
             };
             let slot = Box::into_raw(Box::new(Slot {
                 shared: self.shared.as_ptr(),
-                cs: ffi::avr_io_getirq(avr, ioctl(b'i', b'o', b'g', port as u8), bit as i32),
+                cs: ffi::avr_io_getirq(
+                    avr,
+                    ioctl(b'i', b'o', b'g', port.letter() as u8),
+                    bit as i32,
+                ),
                 spi_in: spi(ffi::SPI_IRQ_INPUT),
                 card: None,
                 plan: Vec::new(),

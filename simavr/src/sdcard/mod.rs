@@ -22,6 +22,3 @@ pub use card::{
 pub use fault::ReadFault;
 pub use image::{SdImage, BLOCK};
 pub use stats::SdStats;
-
-/// Board pin of the card's chip select.
-pub const CS_PIN: u8 = 53;
