@@ -10,7 +10,7 @@
 //!   such a call, so each callback's `&mut Shared` is the only one.
 
 use crate::probe::Probe;
-use crate::uart::Uart;
+use crate::serial::SerialLine;
 use simavr_ffi::{avr_irq_t, avr_t};
 use std::os::raw::c_void;
 
@@ -21,7 +21,7 @@ pub(crate) struct Shared {
     /// Bumped by every callback: tells the run loop something happened.
     pub events: u64,
     pub probes: Vec<Probe>,
-    pub uart: Uart,
+    pub uart: SerialLine,
     /// Address of the first invalid opcode executed.
     pub bad_opcode_pc: Option<u32>,
 }

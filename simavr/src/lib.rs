@@ -20,6 +20,7 @@ pub mod report;
 mod run;
 pub mod sdcard;
 pub mod sdimage;
+mod serial;
 mod sim;
 pub mod uart;
 pub mod vcd;

@@ -5,7 +5,7 @@
 use crate::clock::cycles_in;
 use crate::outcome::Outcome;
 use crate::sim::Sim;
-use crate::uart::CYCLES_PER_BYTE;
+use crate::serial::{self, CYCLES_PER_BYTE};
 use simavr_ffi as ffi;
 use std::time::{Duration, Instant};
 
@@ -80,9 +80,9 @@ impl Sim {
         self.run_until(
             |sim| {
                 let tx = &sim.shared().uart.tx;
-                let from = crate::uart::resume_from(searched.min(tx.len()), needle.len());
+                let from = serial::resume_from(searched.min(tx.len()), needle.len());
                 searched = tx.len();
-                crate::uart::contains(&tx[from..], &needle)
+                serial::contains(&tx[from..], &needle)
             },
             timeout,
         )

@@ -16,7 +16,7 @@ use crate::elf::{self, ElfInfo, RAM_END, RAM_START};
 use crate::hooks::{self, PinHook, Shared};
 use crate::input::PinSchedule;
 use crate::outcome::Outcome;
-use crate::uart::Uart;
+use crate::serial::SerialLine;
 use crate::{Error, Result};
 use simavr_ffi as ffi;
 use std::ffi::CString;
@@ -122,7 +122,7 @@ impl Sim {
             cycle_base: 0,
             events: 0,
             probes: Vec::new(),
-            uart: Uart::default(),
+            uart: SerialLine::default(),
             bad_opcode_pc: None,
         }));
         let param = shared as *mut c_void;
