@@ -96,7 +96,9 @@ impl Sim {
         let slot = &mut self.shared_mut().sd;
         slot.apply_due(now);
         let card_due = slot.next_due().unwrap_or(u64::MAX);
-        let mut next = self.schedule.next_due().unwrap_or(u64::MAX).min(card_due);
+        let bytes_due = self.shared_mut().uart.release_due(now).unwrap_or(u64::MAX);
+        let mut next = self.schedule.next_due().unwrap_or(u64::MAX);
+        next = next.min(card_due).min(bytes_due);
         let uart = &self.shared().uart;
         if uart.rx_ready && !uart.rx.is_empty() {
             if now >= uart.next_rx_cycle {

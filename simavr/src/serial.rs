@@ -21,6 +21,29 @@ pub(crate) struct SerialLine {
     pub rx_ready: bool,
     /// Earliest cycle the next byte may start, one byte time after the last.
     pub next_rx_cycle: u64,
+    /// Bytes planned for later cycles, earliest first.
+    planned: Vec<(u64, Vec<u8>)>,
+}
+
+impl SerialLine {
+    /// Plans `bytes` for cycle `at`, after bytes already planned for then.
+    pub fn plan(&mut self, at: u64, bytes: &[u8]) {
+        let index = self.planned.partition_point(|(when, _)| *when <= at);
+        self.planned.insert(index, (at, bytes.to_vec()));
+    }
+
+    /// Puts the planned bytes due by `now` on the line ahead of the bytes
+    /// still queued, as a sender slips its real-time commands into a
+    /// stream; returns the cycle of the next planned bytes.
+    pub fn release_due(&mut self, now: u64) -> Option<u64> {
+        let due = self.planned.partition_point(|(at, _)| *at <= now);
+        for (_, bytes) in self.planned.drain(..due).rev() {
+            for &b in bytes.iter().rev() {
+                self.rx.push_front(b);
+            }
+        }
+        self.planned.first().map(|(at, _)| *at)
+    }
 }
 
 /// Start of the window to search after `seen` bytes were already searched
@@ -40,6 +63,22 @@ mod tests {
     #[test]
     fn byte_time() {
         assert_eq!(CYCLES_PER_BYTE, 1388);
+    }
+
+    #[test]
+    fn planned_bytes_go_ahead_of_queued_ones_when_due() {
+        let mut line = SerialLine::default();
+        line.rx.extend(b"G1 X5\n");
+        line.plan(200, b"~");
+        line.plan(100, b"!");
+        line.plan(100, b"?");
+        assert_eq!(line.release_due(99), Some(100));
+        assert_eq!(line.rx, b"G1 X5\n");
+        line.rx.pop_front();
+        assert_eq!(line.release_due(150), Some(200));
+        assert_eq!(line.rx, b"!?1 X5\n");
+        assert_eq!(line.release_due(200), None);
+        assert_eq!(line.rx, b"~!?1 X5\n");
     }
 
     #[test]

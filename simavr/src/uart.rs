@@ -1,7 +1,9 @@
 //! USART0 as the host sees it: bytes the firmware sent, and bytes waiting to
 //! be received, fed at the pace of a 115200 8N1 line.
 
+use crate::clock::cycles_in;
 use crate::sim::Sim;
+use std::time::Duration;
 
 pub use crate::serial::{BAUD, CYCLES_PER_BYTE};
 
@@ -28,7 +30,15 @@ impl Sim {
         self.shared_mut().uart.rx.extend(bytes);
     }
 
-    /// Bytes queued by `uart_send` not yet delivered.
+    /// Plans bytes for USART0 at simulated time `at` since power-on, sent
+    /// whatever the firmware says: when due they go on the line ahead of
+    /// bytes still queued (even mid-line), as a G-code sender slips in its
+    /// real-time commands (`?`, `!`, `~`, Ctrl-X), then one per byte time.
+    pub fn uart_send_at(&mut self, at: Duration, bytes: &[u8]) {
+        self.shared_mut().uart.plan(cycles_in(at), bytes);
+    }
+
+    /// Bytes queued by `uart_send` (or planned and due) not yet delivered.
     pub fn uart_pending(&self) -> usize {
         self.shared().uart.rx.len()
     }
