@@ -21,6 +21,7 @@ pub mod probe;
 pub mod replay;
 pub mod report;
 mod run;
+pub mod scenario;
 pub mod sdcard;
 pub mod sdimage;
 mod serial;
