@@ -10,6 +10,8 @@
 //!   hold it as their `param` (see `hooks`). It is freed after the `avr_t` is
 //!   terminated, so no callback can outlive it. All access goes through the
 //!   raw pointer, in short scopes that never span a simavr call.
+//! - `uart_input`, the IRQs `pin_irq` returns and the SD slot's wires belong
+//!   to that `avr_t` and live exactly as long as it.
 //! - `Sim` is neither `Send` nor `Sync` (raw pointers): callbacks always run
 //!   on the owning thread.
 
