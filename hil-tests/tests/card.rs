@@ -115,6 +115,45 @@ fn a_card_inserted_three_seconds_after_boot_is_found() {
     assert_ram_budget(&sim);
 }
 
+/// A block that comes with a bad CRC once is a failed read, which the
+/// firmware takes for a pulled card; it finds the card again at its next
+/// look and reads the files whole. Then the card is pulled and put back at
+/// set times (as `taut-sim --pull-card-at/--reinsert-at` do).
+#[test]
+fn a_bad_crc_once_and_a_card_pulled_and_put_back_end_in_a_good_read() {
+    use hil_tests::sim::sdcard::{CardFault, SdCard};
+    let image = card(&[("param.txt", PARAM), ("poradi.txt", PORADI)]);
+    let block = image.first_block_of("poradi.txt").unwrap();
+    let mut sd = SdCard::new(image);
+    sd.inject(CardFault::CrcOnce(block));
+    let mut sim = boot_machine();
+    sim.insert_sd(sd);
+    wait_for(
+        &mut sim,
+        "poradi.txt: read failed",
+        Duration::from_millis(1500),
+    );
+    wait_for(&mut sim, "card out", Duration::from_millis(100));
+    wait_for(&mut sim, "files ok:", Duration::from_millis(1500));
+    let now = Duration::from_secs_f64(sim.time_s());
+    sim.sd_remove_at(now + Duration::from_millis(500));
+    sim.sd_reinsert_at(now + Duration::from_millis(2500));
+    let seen = sim.uart_bytes().len();
+    let wait_for_new = |sim: &mut Sim, text: &str, timeout: Duration| {
+        let new = |s: &Sim| String::from_utf8_lossy(&s.uart_bytes()[seen..]).contains(text);
+        let end = sim.run_until(new, timeout);
+        assert_eq!(end, Outcome::Done, "{text:?}:\n{}", sim.uart_text());
+    };
+    wait_for_new(&mut sim, "card out", Duration::from_millis(2000));
+    assert!(!sim.sd_present());
+    wait_for_new(&mut sim, "files ok:", Duration::from_millis(3000));
+    assert!(sim.time_s() > (now + Duration::from_millis(2500)).as_secs_f64());
+    let after = String::from_utf8_lossy(&sim.uart_bytes()[seen..]).into_owned();
+    assert!(!after.contains("read failed"), "{after}");
+    no_motion(&sim);
+    assert_ram_budget(&sim);
+}
+
 /// Every way the job files can be wrong, and the one line each gets.
 #[test]
 fn every_bad_file_gets_its_message_and_nothing_moves() {

@@ -52,7 +52,7 @@ fn runaway_recursion_is_a_stack_overflow() {
         sp + 1 < limit && sp + 64 > limit,
         "sp {sp:#x}, limit {limit:#x}"
     );
-    assert_eq!(sim.stack_high_water(), sp);
+    assert_eq!(sim.lowest_sp(), sp);
     assert_eq!(sim.peak_stack_bytes(), 0x21FF - sp);
 }
 

@@ -173,3 +173,29 @@ fn three_hundred_sixty_relative_degrees_make_exactly_one_turn() {
         sim.uart_text()
     );
 }
+
+/// `?` sent at set times (as `taut-sim --at` does), even into the middle of
+/// a streamed line, gets a status report, and every line still gets its
+/// own `ok` and its moves.
+#[test]
+fn status_queries_at_set_times_leave_streamed_lines_whole() {
+    let mut sim = boot();
+    send(&mut sim, "M17", Duration::from_millis(100));
+    send(&mut sim, "G91", Duration::from_millis(100));
+    let now = Duration::from_secs_f64(sim.time_s());
+    // Bytes go one per 87 µs: this `?` lands after the line's third byte.
+    sim.uart_send_at(now + Duration::from_micros(200), b"?");
+    sim.uart_send_at(now + Duration::from_millis(300), b"?");
+    send(&mut sim, "G1 X10 F1200", Duration::from_millis(100));
+    sim.run_for(Duration::from_millis(400));
+    send(&mut sim, "G1 X-10", Duration::from_millis(100));
+    send(&mut sim, "M400", Duration::from_secs(3));
+    let text = sim.uart_text();
+    let reports: Vec<&str> = text.lines().filter(|l| l.starts_with('<')).collect();
+    assert_eq!(reports.len(), 2, "{text}");
+    assert!(reports[0].starts_with("<Idle|"), "{reports:?}");
+    assert!(reports[1].starts_with("<Run|"), "{reports:?}");
+    assert!(!text.contains("error"), "{text}");
+    assert!(sim.probed("radial_step").rising_count() > 0);
+    assert_eq!(steps(&sim, Axis::Radial), 0, "there and back");
+}

@@ -29,7 +29,7 @@ impl Sim {
         let mut found = None;
         let out = self.run_until(
             |s| {
-                found = reply_in(&s.uart_bytes()[start..]);
+                found = reply_after(s.uart_bytes(), start);
                 found.is_some()
             },
             timeout,
@@ -38,16 +38,22 @@ impl Sim {
     }
 }
 
-/// The first `ok` / `error:` reply line in `text`.
-fn reply_in(text: &[u8]) -> Option<Reply> {
-    let text = std::str::from_utf8(text).ok()?;
-    let mut lines = text.split_inclusive('\n').filter(|l| l.ends_with('\n'));
+/// The first `ok` / `error:` reply line of `out` that ends past byte
+/// `start`; a line under way at `start` is judged whole. Every other line
+/// (log lines, the status reports `<…>` a `?` asks for, a banner) is
+/// skipped, and so is a line not yet ended.
+fn reply_after(out: &[u8], start: usize) -> Option<Reply> {
+    let from = out[..start]
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    let mut lines = out[from..].split_inclusive(|&b| b == b'\n');
     lines.find_map(|l| {
-        let l = l.trim_end();
-        if l == "ok" {
+        let l = l.strip_suffix(b"\n")?.trim_ascii_end();
+        if l == b"ok" {
             Some(Reply::Ok)
-        } else if l.starts_with("error:") {
-            Some(Reply::Error(l.to_string()))
+        } else if l.starts_with(b"error:") {
+            Some(Reply::Error(String::from_utf8_lossy(l).into_owned()))
         } else {
             None
         }
@@ -60,16 +66,33 @@ mod tests {
 
     #[test]
     fn replies_are_found_among_log_lines() {
-        assert_eq!(reply_in(b"[I 1 x] hello\nok\n"), Some(Reply::Ok));
+        let reply = |text: &[u8]| reply_after(text, 0);
+        assert_eq!(reply(b"[I 1 x] hello\nok\n"), Some(Reply::Ok));
         assert_eq!(
-            reply_in(b"[I 1 x] hello\nok"),
+            reply(b"[I 1 x] hello\nok"),
             None,
             "an unfinished line is no reply"
         );
         assert_eq!(
-            reply_in(b"error:20 Unsupported command (col 1)\n"),
+            reply(b"error:20 Unsupported command (col 1)\r\n"),
             Some(Reply::Error("error:20 Unsupported command (col 1)".into()))
         );
-        assert_eq!(reply_in(b"[I 1 look] ok\n"), None);
+        assert_eq!(reply(b"[I 1 look] ok\n"), None);
+    }
+
+    #[test]
+    fn status_reports_and_lines_under_way_are_no_replies() {
+        let out = b"ok\r\n<Idle|MPos:0.000,1.000,0.000>\r\n<Run|MPos:0.5";
+        assert_eq!(reply_after(out, 4), None, "the earlier line's ok");
+        let out = [&out[..], b",0.000,0.000>\r\nok\r\n"].concat();
+        assert_eq!(reply_after(&out, 4), Some(Reply::Ok));
+        // A status report under way when the line was sent is judged whole,
+        // even one whose tail looks like a reply.
+        let out = b"<Idle|MPos:0.000,1.000,0.000,ok\n>\n";
+        assert_eq!(reply_after(out, out.len() - 5), None);
+        assert_eq!(
+            reply_after(b"[I 2 job] state: \xff\nok\n", 3),
+            Some(Reply::Ok)
+        );
     }
 }

@@ -2,40 +2,14 @@
 //! driven as a button or a sensor would.
 
 use crate::clock::{cycles_in, cycles_to_ns};
-use crate::hooks::{self, PinHook};
 use crate::input;
-use crate::pins;
-use crate::probe::{self, Probe};
-use crate::sim::{ioctl, Sim, StepDir};
+use crate::probe::{self, Probe, StepDir};
+use crate::sim::Sim;
 use crate::vcd;
-use simavr_ffi as ffi;
-use std::os::raw::c_void;
 use std::path::Path;
 use std::time::Duration;
 
 impl Sim {
-    /// simavr's IRQ for a board pin's level.
-    ///
-    /// # Panics
-    /// On a pin number past D69.
-    fn pin_irq(&self, pin: u8) -> *mut ffi::avr_irq_t {
-        let (port, bit) = pins::port_bit(pin).unwrap_or_else(|| panic!("no board pin D{pin}"));
-        // SAFETY: the avr_t is live; an ioctl query has no side effect.
-        unsafe {
-            ffi::avr_io_getirq(
-                self.avr.as_ptr(),
-                ioctl(b'i', b'o', b'g', port as u8),
-                bit as i32,
-            )
-        }
-    }
-
-    /// Level of a board pin now: the driven output when it is an output.
-    pub fn pin_level(&self, pin: u8) -> bool {
-        // SAFETY: `pin_irq` returns a live IRQ of our avr_t.
-        unsafe { (*self.pin_irq(pin)).value & 0xff != 0 }
-    }
-
     /// Records every edge of board pin `pin` from now on, as signal `name`.
     ///
     /// # Panics
@@ -45,23 +19,13 @@ impl Sim {
             self.shared().probes.iter().all(|p| p.name() != name),
             "probe name {name} used twice"
         );
-        let irq = self.pin_irq(pin);
         let initial = self.pin_level(pin);
-        let shared = self.shared.as_ptr();
         let index = {
             let probes = &mut self.shared_mut().probes;
             probes.push(Probe::new(name, pin, initial));
             probes.len() - 1
         };
-        let hook = Box::new(PinHook {
-            shared,
-            probe: index,
-        });
-        let param = &*hook as *const PinHook as *mut c_void;
-        self.pin_hooks.push(hook);
-        // SAFETY: the hook is boxed (stable address) and kept in `pin_hooks`
-        // until the Sim drops, after the avr_t is terminated.
-        unsafe { ffi::avr_irq_register_notify(irq, Some(hooks::on_pin), param) };
+        self.notify_pin(pin, index);
     }
 
     /// Probes a STEP/DIR pair as `{axis}_step` and `{axis}_dir`; reports give
@@ -141,32 +105,6 @@ impl Sim {
         let plan = input::bounce(self.cycles(), settled, bounces, cycles_in(period));
         for (cycle, high) in plan {
             self.schedule.push(cycle, pin, high);
-        }
-    }
-
-    /// Sets a pin's external level now: recorded as the port's external
-    /// state, so simavr keeps it when the firmware rewrites the port (it would
-    /// otherwise re-apply the pull-up), and raised on the pin.
-    pub(crate) fn drive(&mut self, pin: u8, high: bool) {
-        let (port, bit) = pins::port_bit(pin).unwrap_or_else(|| panic!("no board pin D{pin}"));
-        let slot = &mut self.external[(port as u8 - b'A') as usize];
-        slot.0 |= 1 << bit;
-        slot.1 = (slot.1 & !(1 << bit)) | (u8::from(high) << bit);
-        // SAFETY: avr_ioport_external_t is plain C data, valid zeroed.
-        let mut ext: ffi::avr_ioport_external_t = unsafe { std::mem::zeroed() };
-        ext.set_name(port as u8 as _);
-        ext.set_mask(slot.0 as _);
-        ext.set_value(slot.1 as _);
-        let irq = self.pin_irq(pin);
-        // SAFETY: live avr_t and IRQ; the ioctl copies the struct; callbacks
-        // triggered by the raise only touch `Shared`, not borrowed here.
-        unsafe {
-            ffi::avr_ioctl(
-                self.avr.as_ptr(),
-                ioctl(b'i', b'o', b'p', port as u8),
-                &mut ext as *mut _ as *mut c_void,
-            );
-            ffi::avr_raise_irq(irq, u32::from(high));
         }
     }
 

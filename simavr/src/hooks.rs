@@ -8,25 +8,64 @@
 //!   methods (`avr_run`, `avr_raise_irq`, `avr_ioctl`), on the thread that
 //!   owns the `Sim`, and no Rust reference into `Shared` is alive across
 //!   such a call, so each callback's `&mut Shared` is the only one.
+//! - The raw pointers in `Shared` (the `avr_t`, the SD slot's IRQs) point
+//!   into that same `avr_t` and are private here: other modules reach
+//!   `Shared`'s plain data only.
 
 use crate::probe::Probe;
-use crate::uart::Uart;
+use crate::sdcard::slot::Slot;
+use crate::serial::SerialLine;
 use simavr_ffi::{avr_irq_t, avr_t};
 use std::os::raw::c_void;
 
 pub(crate) struct Shared {
-    pub avr: *mut avr_t,
+    avr: *mut avr_t,
     /// Cycles run before the last reset (simavr zeroes its counter on reset).
     pub cycle_base: u64,
     /// Bumped by every callback: tells the run loop something happened.
     pub events: u64,
     pub probes: Vec<Probe>,
-    pub uart: Uart,
+    pub uart: SerialLine,
     /// Address of the first invalid opcode executed.
     pub bad_opcode_pc: Option<u32>,
+    /// The SD card slot: what answers the SPI bytes once it is wired.
+    pub sd: Slot,
+    /// The slot's wires, once connected.
+    spi: Option<SpiWires>,
+}
+
+/// simavr's IRQs the SD card slot reads and writes.
+#[derive(Clone, Copy)]
+pub(crate) struct SpiWires {
+    /// The chip select pin's level.
+    pub cs: *mut avr_irq_t,
+    /// SPI input: what the card drives on MISO lands in SPDR.
+    pub miso: *mut avr_irq_t,
 }
 
 impl Shared {
+    pub fn new(avr: *mut avr_t) -> Shared {
+        Shared {
+            avr,
+            cycle_base: 0,
+            events: 0,
+            probes: Vec::new(),
+            uart: SerialLine::default(),
+            bad_opcode_pc: None,
+            sd: Slot::default(),
+            spi: None,
+        }
+    }
+
+    /// The SD slot is wired to the SPI bus.
+    pub fn spi_wired(&self) -> bool {
+        self.spi.is_some()
+    }
+
+    pub fn wire_spi(&mut self, wires: SpiWires) {
+        self.spi = Some(wires);
+    }
+
     /// Cycles since power-on, across resets.
     pub fn now(&self) -> u64 {
         // SAFETY: `avr` is valid while `Shared` is reachable (see module doc).
@@ -85,6 +124,21 @@ pub(crate) unsafe extern "C" fn on_bad_opcode(_irq: *mut avr_irq_t, _op: u32, pa
         shared.bad_opcode_pc = Some((*shared.avr).pc);
     }
     shared.events += 1;
+}
+
+/// A byte the MCU clocked out through SPDR: the card in the slot (if any)
+/// sees it with the chip select level of this moment, and its answer is put
+/// back into SPDR before the firmware can read it.
+///
+/// # Safety
+/// As `on_uart_tx`, and `spi` is set.
+pub(crate) unsafe extern "C" fn on_spi_byte(_irq: *mut avr_irq_t, mosi: u32, param: *mut c_void) {
+    let shared = &mut *(param as *mut Shared);
+    let Some(wires) = shared.spi else { return };
+    let cs_low = (*wires.cs).value & 0xFF == 0;
+    let miso = shared.sd.exchange(mosi as u8, cs_low);
+    // Writes SPDR; `shared` is not used past this call.
+    simavr_ffi::avr_raise_irq(wires.miso, u32::from(miso));
 }
 
 /// simavr's default sleeps in real time; the harness wants simulated time

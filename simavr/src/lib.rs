@@ -2,8 +2,10 @@
 //! load a firmware ELF, run it for a simulated time or until a condition
 //! holds, watch its pins and its serial port, drive its inputs, and learn
 //! whether it crashed, hung, was reset by its watchdog or overflowed its
-//! stack. Every `unsafe` call into simavr stays inside this crate.
+//! stack. Every `unsafe` call into simavr, and every raw pointer to its
+//! objects, stays in `sim` and `hooks`.
 
+mod card_slot;
 pub mod clock;
 pub mod console;
 pub mod elf;
@@ -11,16 +13,18 @@ mod error;
 mod gpio;
 mod hooks;
 mod input;
+mod masked;
 pub mod operator;
 mod outcome;
 pub mod picture;
-pub mod pins;
 pub mod probe;
 pub mod replay;
 pub mod report;
 mod run;
+pub mod scenario;
 pub mod sdcard;
 pub mod sdimage;
+mod serial;
 mod sim;
 pub mod uart;
 pub mod vcd;

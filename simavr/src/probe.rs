@@ -107,6 +107,13 @@ impl Probe {
     }
 }
 
+/// A STEP/DIR pair whose net steps go into reports.
+pub(crate) struct StepDir {
+    pub step: u8,
+    pub dir: u8,
+    pub dir_high_is_positive: bool,
+}
+
 /// Steps a STEP/DIR driver would have made: every rising STEP edge counts one,
 /// positive when DIR was at the level meaning positive at that instant.
 pub fn net_steps(step: &Probe, dir: &Probe, dir_high_is_positive: bool) -> i64 {

@@ -4,9 +4,8 @@
 
 use crate::clock::cycles_in;
 use crate::outcome::Outcome;
-use crate::sim::Sim;
-use crate::uart::CYCLES_PER_BYTE;
-use simavr_ffi as ffi;
+use crate::serial::{self, CYCLES_PER_BYTE};
+use crate::sim::{Core, Executed, Sim};
 use std::time::{Duration, Instant};
 
 /// A predicate is checked after anything a callback reported, and at least
@@ -49,14 +48,15 @@ impl Sim {
         let outcome = loop {
             let now = self.cycles();
             let events = self.shared().events;
+            // Inputs first: `done` sees the world as of this cycle.
+            if now >= next_input || seen_events != Some(events) {
+                next_input = self.apply_inputs(now);
+            }
             if now >= next_poll || seen_events != Some(events) {
                 if done(self) {
                     break Outcome::Done;
                 }
                 next_poll = now + POLL_CYCLES;
-            }
-            if now >= next_input || seen_events != Some(events) {
-                next_input = self.apply_inputs(now);
             }
             seen_events = Some(self.shared().events);
             if now >= deadline {
@@ -80,9 +80,9 @@ impl Sim {
         self.run_until(
             |sim| {
                 let tx = &sim.shared().uart.tx;
-                let from = crate::uart::resume_from(searched.min(tx.len()), needle.len());
+                let from = serial::resume_from(searched.min(tx.len()), needle.len());
                 searched = tx.len();
-                crate::uart::contains(&tx[from..], &needle)
+                serial::contains(&tx[from..], &needle)
             },
             timeout,
         )
@@ -93,16 +93,19 @@ impl Sim {
         while let Some((pin, high)) = self.schedule.pop_due(now) {
             self.drive(pin, high);
         }
+        let slot = &mut self.shared_mut().sd;
+        slot.apply_due(now);
+        let card_due = slot.next_due().unwrap_or(u64::MAX);
+        let bytes_due = self.shared_mut().uart.release_due(now).unwrap_or(u64::MAX);
         let mut next = self.schedule.next_due().unwrap_or(u64::MAX);
+        next = next.min(card_due).min(bytes_due);
         let uart = &self.shared().uart;
         if uart.rx_ready && !uart.rx.is_empty() {
             if now >= uart.next_rx_cycle {
                 let uart = &mut self.shared_mut().uart;
                 let byte = uart.rx.pop_front().unwrap_or_default();
                 uart.next_rx_cycle = now + CYCLES_PER_BYTE;
-                // SAFETY: `uart_input` is UART0's input IRQ of our live avr_t;
-                // no reference into `Shared` is held across the call.
-                unsafe { ffi::avr_raise_irq(self.uart_input, byte as u32) };
+                self.raise_uart_rx(byte);
             }
             next = next.min(self.shared().uart.next_rx_cycle);
         }
@@ -112,14 +115,13 @@ impl Sim {
     /// Executes one instruction (or one sleep stretch) and says whether it
     /// ended the run.
     fn step(&mut self) -> Option<Outcome> {
-        let avr = self.avr.as_ptr();
-        // SAFETY: `avr` is live (Sim invariants); callbacks it triggers only
-        // touch `Shared`, and no reference into it is held here.
-        let (pc_before, state, pc, cycle) = unsafe {
-            let pc_before = (*avr).pc;
-            let state = ffi::avr_run(avr) as u32;
-            (pc_before, state, (*avr).pc, (*avr).cycle)
-        };
+        let Executed {
+            pc_before,
+            pc,
+            avr_cycle: cycle,
+            interrupts_on,
+            core,
+        } = self.execute();
         if cycle < self.last_avr_cycle {
             // Only a reset sets simavr's counter back, and in a run only the
             // watchdog resets.
@@ -132,19 +134,17 @@ impl Sim {
             return Some(Outcome::WatchdogReset { count: self.resets });
         }
         self.last_avr_cycle = cycle;
-        // SAFETY: as above; `sreg` is simavr's unpacked status register.
-        let enabled = unsafe { (*avr).sreg[7] } != 0;
         let now = self.shared().cycle_base + cycle;
-        self.masked.observe(now, pc, enabled);
+        self.masked.observe(now, pc, interrupts_on);
         for (at, hits) in &mut self.pc_watches {
             if *at == pc {
                 hits.push(now);
             }
         }
-        match state {
-            ffi::cpu_Crashed => return Some(Outcome::Crashed { pc: pc_before }),
-            ffi::cpu_Done => return Some(Outcome::Hung { pc: pc_before }),
-            _ => {}
+        match core {
+            Core::Crashed => return Some(Outcome::Crashed { pc: pc_before }),
+            Core::Hung => return Some(Outcome::Hung { pc: pc_before }),
+            Core::Running => {}
         }
         if let Some(pc) = self.shared().bad_opcode_pc {
             return Some(Outcome::Crashed { pc });
@@ -155,7 +155,6 @@ impl Sim {
         let sp = self.sp();
         if sp < self.min_sp {
             self.min_sp = sp;
-            self.min_sp_pc = pc_before;
             // The last push wrote at sp + 1.
             if u32::from(sp) + 1 < u32::from(self.ram_limit) {
                 return Some(Outcome::StackOverflow {

@@ -1,5 +1,7 @@
 //! A simulated ATmega2560 at 16 MHz: setting it up from an ELF or from raw
-//! machine code, tearing it down, and its clock and stack figures.
+//! machine code, tearing it down, its clock and stack figures, and every
+//! touch of simavr's own objects (the `avr_t`, its IRQs, `avr_run`): the
+//! other modules see safe methods only.
 //!
 //! Safety invariants of `Sim` (every `unsafe` block below relies on them):
 //! - `avr` points to the `avr_t` simavr allocated for this `Sim` alone; it is
@@ -8,15 +10,19 @@
 //!   hold it as their `param` (see `hooks`). It is freed after the `avr_t` is
 //!   terminated, so no callback can outlive it. All access goes through the
 //!   raw pointer, in short scopes that never span a simavr call.
+//! - `uart_input`, the IRQs `pin_irq` returns and the SD slot's wires belong
+//!   to that `avr_t` and live exactly as long as it.
 //! - `Sim` is neither `Send` nor `Sync` (raw pointers): callbacks always run
 //!   on the owning thread.
 
 use crate::clock::{self, FREQ_HZ};
 use crate::elf::{self, ElfInfo, RAM_END, RAM_START};
-use crate::hooks::{self, PinHook, Shared};
+use crate::hooks::{self, PinHook, Shared, SpiWires};
 use crate::input::PinSchedule;
+use crate::masked::MaskedSpans;
 use crate::outcome::Outcome;
-use crate::uart::Uart;
+use crate::probe::StepDir;
+use crate::sdcard::slot::Slot;
 use crate::{Error, Result};
 use simavr_ffi as ffi;
 use std::ffi::CString;
@@ -24,6 +30,7 @@ use std::os::raw::c_void;
 use std::path::Path;
 use std::ptr::NonNull;
 use std::time::Duration;
+use taut_logic::pinmap::{self, Port, PIN_COUNT};
 
 extern "C" {
     /// simavr allocates the `avr_t` with `malloc`; `avr_terminate` does not
@@ -36,29 +43,20 @@ const SPL: usize = 0x5D;
 const SPH: usize = 0x5E;
 
 /// The number simavr builds an ioctl code from four characters with.
-pub(crate) const fn ioctl(a: u8, b: u8, c: u8, d: u8) -> u32 {
+const fn ioctl(a: u8, b: u8, c: u8, d: u8) -> u32 {
     (a as u32) << 24 | (b as u32) << 16 | (c as u32) << 8 | d as u32
 }
 
-/// A STEP/DIR pair whose net steps go into reports.
-pub(crate) struct StepDir {
-    pub step: u8,
-    pub dir: u8,
-    pub dir_high_is_positive: bool,
-}
-
 pub struct Sim {
-    pub(crate) avr: NonNull<ffi::avr_t>,
-    pub(crate) shared: NonNull<Shared>,
+    avr: NonNull<ffi::avr_t>,
+    shared: NonNull<Shared>,
     /// Boxed: simavr holds their addresses, which must survive the Vec growing.
     #[allow(clippy::vec_box)]
-    pub(crate) pin_hooks: Vec<Box<PinHook>>,
-    pub(crate) uart_input: *mut ffi::avr_irq_t,
+    pin_hooks: Vec<Box<PinHook>>,
+    uart_input: *mut ffi::avr_irq_t,
     pub(crate) elf: Option<ElfInfo>,
     pub(crate) ram_limit: u16,
     pub(crate) min_sp: u16,
-    /// The instruction that pushed the stack to `min_sp`.
-    pub(crate) min_sp_pc: u32,
     /// Watched program addresses and the cycles execution reached them.
     pub(crate) pc_watches: Vec<(u32, Vec<u64>)>,
     pub(crate) resets: u32,
@@ -67,8 +65,8 @@ pub struct Sim {
     /// A fatal ending, repeated by every later run.
     pub(crate) ended: Option<Outcome>,
     pub(crate) schedule: PinSchedule,
-    /// Externally driven pins per port A..L: (mask, levels).
-    pub(crate) external: [(u8, u8); 12],
+    /// Externally driven pins per port, in `Port` order: (mask, levels).
+    external: [(u8, u8); 11],
     pub(crate) step_dir: Vec<StepDir>,
     /// Simulated cycles and host time of the last run.
     pub(crate) last_speed: Option<(u64, Duration)>,
@@ -119,14 +117,7 @@ impl Sim {
     /// Wires the harness into an initialised MCU with its code loaded.
     fn attach(avr: NonNull<ffi::avr_t>, elf: Option<ElfInfo>, ram_limit: u16) -> Sim {
         let a = avr.as_ptr();
-        let shared = Box::into_raw(Box::new(Shared {
-            avr: a,
-            cycle_base: 0,
-            events: 0,
-            probes: Vec::new(),
-            uart: Uart::default(),
-            bad_opcode_pc: None,
-        }));
+        let shared = Box::into_raw(Box::new(Shared::new(a)));
         let param = shared as *mut c_void;
         // SAFETY: `a` is a live, initialised avr_t; `param` outlives it (see
         // module invariants); the callbacks match simavr's signatures.
@@ -176,13 +167,12 @@ impl Sim {
             elf,
             ram_limit,
             min_sp: RAM_END,
-            min_sp_pc: 0,
             pc_watches: Vec::new(),
             resets: 0,
             last_avr_cycle: 0,
             ended: None,
             schedule: PinSchedule::default(),
-            external: [(0, 0); 12],
+            external: [(0, 0); 11],
             step_dir: Vec::new(),
             last_speed: None,
             masked: MaskedSpans::default(),
@@ -244,7 +234,6 @@ impl Sim {
         }
     }
 
-    /// Lowest stack pointer seen (checked after every instruction).
     /// Record every cycle at which execution reaches byte address `pc` (an
     /// interrupt vector, a task's entry): latencies measured exactly.
     pub fn watch_pc(&mut self, pc: u32) {
@@ -259,12 +248,9 @@ impl Sim {
             .map_or(&[], |w| &w.1)
     }
 
-    /// Where the stack was deepest: the instruction's byte address.
-    pub fn stack_peak_pc(&self) -> u32 {
-        self.min_sp_pc
-    }
-
-    pub fn stack_high_water(&self) -> u16 {
+    /// Lowest stack pointer seen, an address (checked after every
+    /// instruction); `peak_stack_bytes` says how deep that is.
+    pub fn lowest_sp(&self) -> u16 {
         self.min_sp
     }
 
@@ -284,29 +270,18 @@ impl Sim {
     /// delay itself). It bounds how late that interrupt can start. Returns
     /// (cycles, byte address where the span began).
     pub fn max_masked_cycles(&self, exempt: u32) -> (u64, u32) {
-        self.masked
-            .longest
-            .iter()
-            .filter(|(_, pc)| *pc != exempt)
-            .fold(
-                (0, 0),
-                |best, &(c, pc)| if c > best.0 { (c, pc) } else { best },
-            )
+        self.masked.longest_except(exempt)
     }
 
     /// Spans that began at `pc` (an interrupt vector: its handler's runs):
     /// (count, mean cycles, longest cycles).
     pub fn masked_stats(&self, pc: u32) -> Option<(u64, f64, u64)> {
-        let &(_, n, total) = self.masked.totals.iter().find(|t| t.0 == pc)?;
-        let &(max, _) = self.masked.longest.iter().find(|l| l.1 == pc)?;
-        Some((n, total as f64 / n as f64, max))
+        self.masked.stats(pc)
     }
 
     /// Every masked span's longest duration by start address, longest first.
     pub fn masked_spans(&self) -> Vec<(u64, u32)> {
-        let mut v = self.masked.longest.clone();
-        v.sort_unstable_by(|a, b| b.cmp(a));
-        v
+        self.masked.by_length()
     }
 
     /// Overrides the end of statics (raw programs have no symbols).
@@ -315,47 +290,166 @@ impl Sim {
     }
 }
 
-/// Interrupt-masked spans by the address they began at (the vector for an
-/// interrupt entry, the instruction after `cli` otherwise).
-#[derive(Default)]
-pub(crate) struct MaskedSpans {
-    /// Start cycle and address of the span under way.
-    pub(crate) open: Option<(u64, u32)>,
-    /// Longest span per start address.
-    pub(crate) longest: Vec<(u64, u32)>,
-    /// Per start address: number of spans and their total cycles.
-    pub(crate) totals: Vec<(u32, u64, u64)>,
-    /// Interrupts were enabled once: start-up (masked from reset) is over.
-    pub(crate) started: bool,
+/// What one `avr_run` did.
+pub(crate) struct Executed {
+    /// Byte address of the instruction that ran.
+    pub pc_before: u32,
+    /// Byte address of the next one.
+    pub pc: u32,
+    /// simavr's own cycle counter afterwards: it drops on reset.
+    pub avr_cycle: u64,
+    /// The I flag afterwards.
+    pub interrupts_on: bool,
+    pub core: Core,
 }
 
-impl MaskedSpans {
-    /// Called after every instruction with the I flag.
-    pub(crate) fn observe(&mut self, cycle: u64, pc: u32, enabled: bool) {
-        if !self.started {
-            self.started = enabled;
-            return;
-        }
-        match (self.open, enabled) {
-            (None, false) => self.open = Some((cycle, pc)),
-            (Some((start, at)), true) => {
-                self.open = None;
-                let len = cycle - start;
-                match self.longest.iter_mut().find(|(_, p)| *p == at) {
-                    Some(e) => e.0 = e.0.max(len),
-                    None => self.longest.push((len, at)),
-                }
-                match self.totals.iter_mut().find(|(p, _, _)| *p == at) {
-                    Some(t) => {
-                        t.1 += 1;
-                        t.2 += len;
-                    }
-                    None => self.totals.push((at, 1, len)),
-                }
-            }
-            _ => {}
+/// The core's state as simavr left it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Core {
+    Running,
+    Crashed,
+    /// Asleep with interrupts masked: nothing can wake it.
+    Hung,
+}
+
+/// The wires between simavr and the outside world: pins, USART0's input,
+/// the SD card slot on the SPI bus.
+impl Sim {
+    /// Executes one instruction (or one sleep stretch).
+    pub(crate) fn execute(&mut self) -> Executed {
+        let avr = self.avr.as_ptr();
+        // SAFETY: `avr` is live (invariants); callbacks it triggers only
+        // touch `Shared`, and no reference into it is held here. `sreg` is
+        // simavr's unpacked status register.
+        let (pc_before, state, pc, avr_cycle, interrupts_on) = unsafe {
+            let pc_before = (*avr).pc;
+            let state = ffi::avr_run(avr) as u32;
+            (
+                pc_before,
+                state,
+                (*avr).pc,
+                (*avr).cycle,
+                (*avr).sreg[7] != 0,
+            )
+        };
+        let core = match state {
+            ffi::cpu_Crashed => Core::Crashed,
+            ffi::cpu_Done => Core::Hung,
+            _ => Core::Running,
+        };
+        Executed {
+            pc_before,
+            pc,
+            avr_cycle,
+            interrupts_on,
+            core,
         }
     }
+
+    /// Puts one byte on USART0's receive line now.
+    pub(crate) fn raise_uart_rx(&mut self, byte: u8) {
+        // SAFETY: `uart_input` is UART0's input IRQ of our live avr_t; the
+        // caller holds no reference into `Shared` across the call.
+        unsafe { ffi::avr_raise_irq(self.uart_input, u32::from(byte)) };
+    }
+
+    /// simavr's IRQ for a board pin's level.
+    ///
+    /// # Panics
+    /// On a pin number past D69.
+    fn pin_irq(&self, pin: u8) -> *mut ffi::avr_irq_t {
+        let (port, bit) = board_pin(pin);
+        // SAFETY: the avr_t is live; an ioctl query has no side effect.
+        unsafe {
+            ffi::avr_io_getirq(
+                self.avr.as_ptr(),
+                ioctl(b'i', b'o', b'g', port.letter() as u8),
+                i32::from(bit),
+            )
+        }
+    }
+
+    /// Level of a board pin now: the driven output when it is an output.
+    pub fn pin_level(&self, pin: u8) -> bool {
+        // SAFETY: `pin_irq` returns a live IRQ of our avr_t.
+        unsafe { (*self.pin_irq(pin)).value & 0xff != 0 }
+    }
+
+    /// Has every level change of `pin` recorded by probe number `probe`.
+    pub(crate) fn notify_pin(&mut self, pin: u8, probe: usize) {
+        let irq = self.pin_irq(pin);
+        let hook = Box::new(PinHook {
+            shared: self.shared.as_ptr(),
+            probe,
+        });
+        let param = &*hook as *const PinHook as *mut c_void;
+        self.pin_hooks.push(hook);
+        // SAFETY: the hook is boxed (stable address) and kept in `pin_hooks`
+        // until the Sim drops, after the avr_t is terminated.
+        unsafe { ffi::avr_irq_register_notify(irq, Some(hooks::on_pin), param) };
+    }
+
+    /// Sets a pin's external level now: recorded as the port's external
+    /// state, so simavr keeps it when the firmware rewrites the port (it would
+    /// otherwise re-apply the pull-up), and raised on the pin.
+    pub(crate) fn drive(&mut self, pin: u8, high: bool) {
+        let (port, bit) = board_pin(pin);
+        let slot = &mut self.external[port as usize];
+        slot.0 |= 1 << bit;
+        slot.1 = (slot.1 & !(1 << bit)) | (u8::from(high) << bit);
+        // SAFETY: avr_ioport_external_t is plain C data, valid zeroed.
+        let mut ext: ffi::avr_ioport_external_t = unsafe { std::mem::zeroed() };
+        ext.set_name(port.letter() as u8 as _);
+        ext.set_mask(slot.0 as _);
+        ext.set_value(slot.1 as _);
+        let irq = self.pin_irq(pin);
+        // SAFETY: live avr_t and IRQ; the ioctl copies the struct; callbacks
+        // triggered by the raise only touch `Shared`, not borrowed here.
+        unsafe {
+            ffi::avr_ioctl(
+                self.avr.as_ptr(),
+                ioctl(b'i', b'o', b'p', port.letter() as u8),
+                &mut ext as *mut _ as *mut c_void,
+            );
+            ffi::avr_raise_irq(irq, u32::from(high));
+        }
+    }
+
+    /// The SD card slot, wired to the SPI bus on first use. Until then the
+    /// bus has no card model at all and reads whatever simavr leaves in SPDR.
+    pub(crate) fn sd_slot_mut(&mut self) -> &mut Slot {
+        if !self.shared().spi_wired() {
+            self.wire_sd_slot();
+        }
+        &mut self.shared_mut().sd
+    }
+
+    fn wire_sd_slot(&mut self) {
+        let cs = self.pin_irq(pinmap::SD_CS);
+        let avr = self.avr.as_ptr();
+        // simavr names the ATmega2560's only SPI 0 (not '0').
+        let spi = |n: u32| {
+            // SAFETY: the avr_t is live; an ioctl query has no side effect.
+            unsafe { ffi::avr_io_getirq(avr, ioctl(b's', b'p', b'i', 0), n as i32) }
+        };
+        let (miso, mosi) = (spi(ffi::SPI_IRQ_INPUT), spi(ffi::SPI_IRQ_OUTPUT));
+        assert!(!cs.is_null() && !miso.is_null() && !mosi.is_null());
+        self.shared_mut().wire_spi(SpiWires { cs, miso });
+        let param = self.shared.as_ptr() as *mut c_void;
+        // SAFETY: `param` is our `Shared`, which outlives the avr_t
+        // (invariants), its wires now set; the callback matches simavr's
+        // signature.
+        unsafe { ffi::avr_irq_register_notify(mosi, Some(hooks::on_spi_byte), param) };
+    }
+}
+
+/// Port and bit of a board pin.
+///
+/// # Panics
+/// On a pin number past D69.
+fn board_pin(pin: u8) -> (Port, u8) {
+    assert!(pin < PIN_COUNT, "no board pin D{pin}");
+    pinmap::port_bit(pin)
 }
 
 impl Drop for Sim {

@@ -1,27 +1,11 @@
 //! USART0 as the host sees it: bytes the firmware sent, and bytes waiting to
 //! be received, fed at the pace of a 115200 8N1 line.
 
-use crate::clock::FREQ_HZ;
+use crate::clock::cycles_in;
 use crate::sim::Sim;
-use std::collections::VecDeque;
+use std::time::Duration;
 
-/// Line rate of the host side.
-pub const BAUD: u64 = 115_200;
-/// One byte on an 8N1 line is 10 bits: ~1389 cycles at 115200 baud.
-pub const CYCLES_PER_BYTE: u64 = FREQ_HZ * 10 / BAUD;
-
-#[derive(Default)]
-pub(crate) struct Uart {
-    /// Everything transmitted since the last `take`.
-    pub tx: Vec<u8>,
-    /// Bytes for the firmware, not yet on the line.
-    pub rx: VecDeque<u8>,
-    /// simavr's receive FIFO has room and the receiver is on (XON seen, no
-    /// XOFF since): bytes raised now are not lost.
-    pub rx_ready: bool,
-    /// Earliest cycle the next byte may start, one byte time after the last.
-    pub next_rx_cycle: u64,
-}
+pub use crate::serial::{BAUD, CYCLES_PER_BYTE};
 
 impl Sim {
     /// Bytes USART0 transmitted since the last `take_uart`.
@@ -46,37 +30,16 @@ impl Sim {
         self.shared_mut().uart.rx.extend(bytes);
     }
 
-    /// Bytes queued by `uart_send` not yet delivered.
+    /// Plans bytes for USART0 at simulated time `at` since power-on, sent
+    /// whatever the firmware says: when due they go on the line ahead of
+    /// bytes still queued (even mid-line), as a G-code sender slips in its
+    /// real-time commands (`?`, `!`, `~`, Ctrl-X), then one per byte time.
+    pub fn uart_send_at(&mut self, at: Duration, bytes: &[u8]) {
+        self.shared_mut().uart.plan(cycles_in(at), bytes);
+    }
+
+    /// Bytes queued by `uart_send` (or planned and due) not yet delivered.
     pub fn uart_pending(&self) -> usize {
         self.shared().uart.rx.len()
-    }
-}
-
-/// Start of the window to search after `seen` bytes were already searched
-/// for a needle of `len` bytes: a match may straddle the old end.
-pub(crate) fn resume_from(seen: usize, len: usize) -> usize {
-    seen.saturating_sub(len.saturating_sub(1))
-}
-
-pub(crate) fn contains(hay: &[u8], needle: &[u8]) -> bool {
-    needle.is_empty() || hay.windows(needle.len()).any(|w| w == needle)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn byte_time() {
-        assert_eq!(CYCLES_PER_BYTE, 1388);
-    }
-
-    #[test]
-    fn incremental_search_finds_straddling_match() {
-        let text = b"boot ok\r\n";
-        let seen = 6; // "boot o" was searched already
-        let from = resume_from(seen, 2);
-        assert!(contains(&text[from..], b"ok"));
-        assert!(!contains(&text[resume_from(9, 4)..], b"boot"));
     }
 }

@@ -143,3 +143,22 @@ fn fat16_with_multi_block_clusters_reads_back() {
     let layout = check(FatChoice::Fat16, 26 << 20);
     assert!(layout.bytes_per_cluster > BLOCK as u32, "{layout:?}");
 }
+
+/// A file's first data block, as a card fault aimed at the file finds it.
+#[test]
+fn a_files_first_block_holds_its_first_bytes() {
+    use taut_simavr::sdcard::SdImage;
+    for fat in [FatChoice::Fat16, FatChoice::Fat32] {
+        let (dir, files) = common::job_folder(&format!("first-{fat:?}"), 2000);
+        let image = SdImage::from_bytes(build_image_with_layout(&dir, fat).unwrap().0);
+        std::fs::remove_dir_all(&dir).unwrap();
+        for name in ["param.txt", "PORADI.TXT", "big.bin"] {
+            let lba = image.first_block_of(name).unwrap();
+            let want = &files[if name == "big.bin" { "BIG.BIN" } else { name }];
+            let n = want.len().min(BLOCK);
+            assert_eq!(image.block(lba)[..n], want[..n], "{fat:?} {name}");
+        }
+        assert_eq!(image.first_block_of("EMPTY"), None, "no data block");
+        assert_eq!(image.first_block_of("nothere.txt"), None);
+    }
+}

@@ -127,7 +127,7 @@ fn pushing_forever_overflows_the_stack() {
             limit: 0x1000
         }
     );
-    assert_eq!(sim.stack_high_water(), 0x0FFE);
+    assert_eq!(sim.lowest_sp(), 0x0FFE);
     assert_eq!(sim.peak_stack_bytes(), 0x21FF - 0x0FFE);
 }
 

@@ -202,3 +202,28 @@ fn faults_reach_the_card_in_the_slot() {
     assert_eq!(all[..4], [idle, [0xFF; 3], [0xFF; 3], idle], "{all:?}");
     assert_eq!(sim.sd_stats().unwrap().cmd(0), 4);
 }
+
+#[test]
+fn a_card_pulled_and_put_back_is_the_same_card_powered_up_afresh() {
+    let mut sim = Sim::from_program(&cmd0_loop()).unwrap();
+    sim.insert_sd(SdImage::blank(64));
+    sim.sd_remove_at(us(1000));
+    sim.sd_reinsert_at(us(2000));
+    sim.run_for(us(1000));
+    assert!(!sim.sd_present(), "out at 1 ms sharp");
+    assert!(sim.sd_stats().is_none());
+    let out = answers(&sim).len();
+    sim.run_for(us(999));
+    assert!(!sim.sd_present());
+    let while_out = answers(&sim);
+    assert!(while_out.len() >= out + 2);
+    // The loop under way at the removal may have had its answer already.
+    assert!(while_out[out + 1..].iter().all(|a| *a == [0xFF; 3]));
+    sim.run_for(us(1));
+    assert!(sim.sd_present(), "back at 2 ms");
+    let count_back = sim.sd_stats().unwrap().cmd(0);
+    assert!(count_back >= 2, "the same card: its counters kept");
+    sim.run_for(us(1000));
+    assert_eq!(answers(&sim).last(), Some(&[0xFF, R1_IDLE, 0xFF]));
+    assert!(sim.sd_stats().unwrap().cmd(0) > count_back);
+}

@@ -175,6 +175,20 @@ mod tests {
     }
 
     #[test]
+    fn every_port_bit_is_one_board_pin() {
+        let mut all: std::vec::Vec<_> = (0..PIN_COUNT)
+            .map(|pin| {
+                let (port, bit) = port_bit(pin);
+                (port as u8, bit)
+            })
+            .collect();
+        all.sort_unstable();
+        all.dedup();
+        assert_eq!(all.len(), usize::from(PIN_COUNT));
+        assert!(all.iter().all(|&(_, bit)| bit < 8));
+    }
+
+    #[test]
     fn no_pin_is_used_twice() {
         let mut used = std::vec::Vec::new();
         for d in DRIVERS {

@@ -5,43 +5,79 @@
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::{self, Button};
 use taut_simavr::operator::{Operator, Seen};
-use taut_simavr::sdcard::SdImage;
+use taut_simavr::scenario::{self, FaultSpec, TimedBytes};
+use taut_simavr::sdcard::{SdCard, SdImage};
 use taut_simavr::{picture, replay};
 use taut_simavr::{Outcome, Reply, Sim};
 
 const USAGE: &str = "\
-usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]] [--auto-confirm]
-                   [--send FILE] [--for SECONDS] [--vcd PATH] [--png PATH]
-                   [--report PATH] [--echo]
+usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
+                   [--pull-card-at SECONDS]... [--reinsert-at SECONDS]...
+                   [--card-fault SPEC]...] [--auto-confirm] [--send FILE]
+                   [--at SECONDS:BYTES]... [--for SECONDS] [--vcd PATH]
+                   [--png PATH] [--report PATH] [--echo]
   --sd PATH       put a virtual SD card in the slot: an image file, or a
                   folder, imaged on the fly (FAT16 or FAT32 by size)
   --sd-insert-at SECONDS
                   insert that card later instead of at power-on
+  --pull-card-at SECONDS
+                  take the card out at that simulated time: from then on
+                  the slot is empty (MISO reads high); repeatable
+  --reinsert-at SECONDS
+                  put the same card back (what was written to it and its
+                  faults not yet triggered kept); it powers up afresh, as a
+                  card does when it goes in; repeatable, each after a pull
+  --card-fault SPEC
+                  a fault of the card; repeatable. SPEC is one of
+                    crc-once:BLOCK     the next read of BLOCK has a bad CRC16,
+                                       once; later reads are fine
+                    bad-block:BLOCK    every read of BLOCK fails as a worn-out
+                                       block does: R1 fine, then data error
+                                       token 0x04 (card ECC failed)
+                    crc-once-at:SECONDS  the first data block the card sends
+                                       after that time has a bad CRC16
+                  BLOCK is a block number (LBA, decimal or 0x hex) or a file
+                  name in the card's root folder: its first data block
   --send FILE     stream FILE's lines to the serial console, each after the
                   previous one's ok/error, then run until motion is idle
+  --at SECONDS:BYTES
+                  send BYTES to the serial console at that simulated time,
+                  without waiting for any reply, ahead of a --send line still
+                  on its way (as a sender's real-time commands: ? ! ~ and
+                  Ctrl-X \\x18); escapes \\xHH \\n \\r \\t \\0 \\\\; repeatable.
+                  A whole G-code line sent so gets its own ok, which --send
+                  may take for its line's: use lines without --send
   --for SECONDS   simulated time to run (default 5; with --send: extra time
-                  after motion is idle, default 0)
+                  after motion is idle, default 0). Without --for the run
+                  also goes on until 1 s after the last planned event
+                  (--at, --pull-card-at, --reinsert-at, crc-once-at)
   --vcd PATH      write a VCD trace of every probed pin
   --png PATH      draw the string-art job from the step pulses alone (the
                   board from the card's param.txt; needs --sd)
   --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
   --auto-confirm  press the green button whenever the job asks for it, and
                   run until the job is done (or --for SECONDS, default 7200)
-  --echo          print the firmware's serial output as it runs";
+  --echo          print the firmware's serial output as it runs
+  --help, -h      this text
+Times are simulated seconds since power-on (0.25, 3).";
 
 struct Args {
     elf: PathBuf,
     sd: Option<PathBuf>,
-    sd_insert_at: Option<f64>,
+    sd_insert_at: Option<Duration>,
+    pulls: Vec<Duration>,
+    reinserts: Vec<Duration>,
+    faults: Vec<FaultSpec>,
     send: Option<PathBuf>,
-    seconds: Option<f64>,
+    at: Vec<TimedBytes>,
+    seconds: Option<Duration>,
     vcd: Option<PathBuf>,
     png: Option<PathBuf>,
     report: Option<PathBuf>,
@@ -55,7 +91,11 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         elf,
         sd: None,
         sd_insert_at: None,
+        pulls: Vec::new(),
+        reinserts: Vec::new(),
+        faults: Vec::new(),
         send: None,
+        at: Vec::new(),
         seconds: None,
         vcd: None,
         png: None,
@@ -65,17 +105,18 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     };
     while let Some(a) = it.next() {
         let mut value = || it.next().ok_or(format!("{a} needs a value"));
+        let time = |text: String| scenario::seconds(&text).map_err(|e| format!("{a}: {e}"));
         match a.as_str() {
-            "--for" => args.seconds = Some(value()?.parse().map_err(|e| format!("--for: {e}"))?),
+            "--for" => args.seconds = Some(time(value()?)?),
             "--sd" => args.sd = Some(value()?.into()),
-            "--sd-insert-at" => {
-                args.sd_insert_at = Some(
-                    value()?
-                        .parse()
-                        .map_err(|e| format!("--sd-insert-at: {e}"))?,
-                )
-            }
+            "--sd-insert-at" => args.sd_insert_at = Some(time(value()?)?),
+            "--pull-card-at" => args.pulls.push(time(value()?)?),
+            "--reinsert-at" => args.reinserts.push(time(value()?)?),
+            "--card-fault" => args.faults.push(value()?.parse()?),
             "--send" => args.send = Some(value()?.into()),
+            "--at" => args
+                .at
+                .push(value()?.parse().map_err(|e| format!("--at {e}"))?),
             "--vcd" => args.vcd = Some(value()?.into()),
             "--png" => args.png = Some(value()?.into()),
             "--report" => args.report = Some(value()?.into()),
@@ -84,10 +125,31 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             _ => return Err(format!("unknown option {a}")),
         }
     }
-    if (args.sd_insert_at.is_some() || args.png.is_some()) && args.sd.is_none() {
-        return Err("--sd-insert-at and --png need --sd".into());
+    let card_options = args.sd_insert_at.is_some()
+        || args.png.is_some()
+        || !args.pulls.is_empty()
+        || !args.reinserts.is_empty()
+        || !args.faults.is_empty();
+    if card_options && args.sd.is_none() {
+        return Err(
+            "--sd-insert-at, --pull-card-at, --reinsert-at, --card-fault and --png need --sd"
+                .into(),
+        );
     }
+    scenario::check_card_plan(args.sd_insert_at, &args.pulls, &args.reinserts)?;
     Ok(args)
+}
+
+impl Args {
+    /// The simulated time of the last planned event.
+    fn last_planned(&self) -> Option<Duration> {
+        let times = self.at.iter().map(|t| t.at);
+        let faults = self.faults.iter().filter_map(FaultSpec::at);
+        (times.chain(self.pulls.iter().copied()))
+            .chain(self.reinserts.iter().copied())
+            .chain(faults)
+            .max()
+    }
 }
 
 /// Probes with the documented signal names: `<axis>_step|dir|en`,
@@ -108,7 +170,7 @@ fn probe_machine(sim: &mut Sim) {
 /// reply), then wait until motion is idle (`M400`).
 fn stream(
     sim: &mut Sim,
-    file: &std::path::Path,
+    file: &Path,
     echo: bool,
     printed: &mut usize,
 ) -> Result<(), Box<dyn std::error::Error>> {
@@ -133,17 +195,45 @@ fn stream(
     Ok(())
 }
 
+/// Puts the card of `path` in the slot (at power-on or `--sd-insert-at`)
+/// with its faults, pulls and re-insertions planned; returns its
+/// `param.txt`.
+fn put_card(sim: &mut Sim, path: &Path, args: &Args) -> Result<Option<Vec<u8>>, String> {
+    let image = SdImage::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let param = image.read_file("param.txt");
+    let mut planned = Vec::new();
+    let mut card = SdCard::new(image);
+    for spec in &args.faults {
+        match spec.resolve(card.image())? {
+            (None, fault) => card.inject(fault),
+            (Some(at), fault) => planned.push((at, fault)),
+        }
+    }
+    match args.sd_insert_at {
+        Some(at) => sim.sd_insert_at(at, card),
+        None => sim.insert_sd(card),
+    }
+    for &at in &args.pulls {
+        sim.sd_remove_at(at);
+    }
+    for &at in &args.reinserts {
+        sim.sd_reinsert_at(at);
+    }
+    for (at, fault) in planned {
+        sim.sd_fault_at(at, fault);
+    }
+    Ok(param)
+}
+
 fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     let mut sim = Sim::load(&args.elf)?;
     probe_machine(&mut sim);
-    let mut param = None;
-    if let Some(path) = &args.sd {
-        let card = SdImage::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        param = card.read_file("param.txt");
-        match args.sd_insert_at {
-            Some(s) => sim.sd_insert_at(Duration::from_secs_f64(s), card),
-            None => sim.insert_sd(card),
-        }
+    let param = match &args.sd {
+        Some(path) => put_card(&mut sim, path, &args)?,
+        None => None,
+    };
+    for t in &args.at {
+        sim.uart_send_at(t.at, &t.bytes);
     }
     let wall = Instant::now();
     let mut printed = 0;
@@ -161,7 +251,11 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         Operator::default()
     };
     let mut bar = Bar::default();
-    let total = Duration::from_secs_f64(args.seconds.unwrap_or(default));
+    let mut total = args.seconds.unwrap_or(Duration::from_secs_f64(default));
+    if let (None, Some(last)) = (args.seconds, args.last_planned()) {
+        let now = Duration::from_secs_f64(sim.time_s());
+        total = total.max((last + Duration::from_secs(1)).saturating_sub(now));
+    }
     let slice = Duration::from_millis(10);
     let mut outcome = Outcome::Running;
     let mut elapsed = Duration::ZERO;
@@ -300,6 +394,73 @@ fn main() -> ExitCode {
         Err(e) => {
             eprintln!("taut-sim: {e}");
             ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(line: &str) -> Result<Args, String> {
+        parse(line.split(' ').map(String::from))
+    }
+
+    /// The usage names every option this file matches on, and only those.
+    #[test]
+    fn usage_names_every_option() {
+        let is_option = |w: &str| {
+            w.len() > 2
+                && w.starts_with("--")
+                && w.chars().all(|c| c.is_ascii_lowercase() || c == '-')
+        };
+        let known: Vec<&str> = include_str!("taut-sim.rs")
+            .split('"')
+            .filter(|w| is_option(w))
+            .collect();
+        assert!(known.len() > 10, "{known:?}");
+        for option in &known {
+            assert!(USAGE.contains(option), "{option} missing from the usage");
+            let e = args(&format!("fw.elf {option} 1"))
+                .err()
+                .unwrap_or_default();
+            let unknown = e == format!("unknown option {option}");
+            assert!(!unknown || *option == "--help", "{option}: {e}");
+        }
+        let named = USAGE.split(|c: char| c.is_whitespace() || "[],".contains(c));
+        for option in named.filter(|w| is_option(w)) {
+            assert!(known.contains(&option), "{option} in the usage only");
+        }
+    }
+
+    #[test]
+    fn a_fault_scenario_parses_whole() {
+        let a = args(
+            "fw.elf --sd card --pull-card-at 2 --reinsert-at 4.5 --pull-card-at 6 \
+             --card-fault crc-once:poradi.txt --card-fault crc-once-at:3 \
+             --at 1:? --at 2.5:\\x18 --for 8",
+        )
+        .unwrap();
+        assert_eq!(a.pulls, [2.0, 6.0].map(Duration::from_secs_f64));
+        assert_eq!(a.reinserts, [Duration::from_secs_f64(4.5)]);
+        assert_eq!(a.faults.len(), 2);
+        assert_eq!(a.at[1].bytes, [0x18]);
+        assert_eq!(a.seconds, Some(Duration::from_secs(8)));
+        assert_eq!(a.last_planned(), Some(Duration::from_secs(6)));
+    }
+
+    #[test]
+    fn card_options_need_a_card_and_a_sensible_plan() {
+        for line in [
+            "fw.elf --pull-card-at 2",
+            "fw.elf --card-fault bad-block:3",
+            "fw.elf --sd c --reinsert-at 2",
+            "fw.elf --sd c --pull-card-at 2 --pull-card-at 3",
+            "fw.elf --sd c --card-fault crc-twice:3",
+            "fw.elf --at 2",
+            "fw.elf --for -1",
+        ] {
+            assert!(args(line).is_err(), "{line}");
         }
     }
 }

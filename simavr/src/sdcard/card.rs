@@ -9,7 +9,7 @@
 //! reads 0xFF, the idle level of MISO.
 
 use super::crc::{crc16, crc7};
-use super::fault::{Faults, ReadFault, PULL_AFTER};
+use super::fault::{CardFault, Faults, ReadFault, PULL_AFTER};
 use super::image::{SdImage, BLOCK};
 use super::registers;
 use super::stats::SdStats;
@@ -119,6 +119,12 @@ pub struct SdCard {
     faults: Faults,
     stats: SdStats,
     pulled: bool,
+}
+
+impl From<SdImage> for SdCard {
+    fn from(image: SdImage) -> SdCard {
+        SdCard::new(image)
+    }
 }
 
 impl SdCard {
@@ -231,6 +237,19 @@ impl SdCard {
         self.faults.corrupt_crc = true;
     }
 
+    /// The next read of `block` carries a wrong CRC16; later reads are fine.
+    pub fn corrupt_crc_once(&mut self, block: u32) {
+        self.faults.crc_once.insert(block);
+    }
+
+    pub fn inject(&mut self, fault: CardFault) {
+        match fault {
+            CardFault::CrcNext => self.corrupt_crc_next(),
+            CardFault::CrcOnce(block) => self.corrupt_crc_once(block),
+            CardFault::BadBlock(block) => self.fail_read(block),
+        }
+    }
+
     /// The card is pulled out halfway through the next data block, read or
     /// written; it is silent from then on.
     pub fn remove_during_transfer(&mut self) {
@@ -240,6 +259,21 @@ impl SdCard {
     /// Forgets every injected fault not yet triggered.
     pub fn clear_faults(&mut self) {
         self.faults = Faults::default();
+    }
+
+    /// Put (back) in a slot: powered up uninitialised, nothing in flight.
+    /// Its image, counters and untriggered faults stay.
+    pub(crate) fn power_up(&mut self) {
+        self.state = State::PowerOn;
+        self.crc_on = false;
+        self.app_cmd = false;
+        self.polls_left = self.config.init_polls;
+        self.frame_len = 0;
+        self.out.clear();
+        self.block_in_flight = None;
+        self.transfer = Transfer::None;
+        self.faults.pull_countdown = None;
+        self.pulled = false;
     }
 
     fn next_out(&mut self) -> u8 {
@@ -459,7 +493,8 @@ impl SdCard {
             }
             Some(ReadFault::NoToken) => false,
             None => {
-                self.queue_data(&self.image.block(n));
+                let corrupt = self.faults.crc_once.remove(&n);
+                self.queue_data(&self.image.block(n), corrupt);
                 self.block_in_flight = Some(self.out.len());
                 true
             }
@@ -469,16 +504,17 @@ impl SdCard {
     fn send_register(&mut self, reg: [u8; 16]) {
         self.out.push_back(0);
         self.queue_ff(self.config.read_latency);
-        self.queue_data(&reg);
+        self.queue_data(&reg, false);
     }
 
-    /// Token, data and CRC16 of a data block the card sends.
-    fn queue_data(&mut self, data: &[u8]) {
+    /// Token, data and CRC16 of a data block the card sends; the CRC is
+    /// wrong when `corrupt` or when `corrupt_crc_next` asked for it.
+    fn queue_data(&mut self, data: &[u8], corrupt: bool) {
         self.arm_pull(self.out.len() as u32);
         self.out.push_back(TOKEN_START);
         self.out.extend(data);
         let mut crc = crc16(data);
-        if std::mem::take(&mut self.faults.corrupt_crc) {
+        if corrupt || std::mem::take(&mut self.faults.corrupt_crc) {
             crc ^= 0x0001;
         }
         self.out.extend(crc.to_be_bytes());

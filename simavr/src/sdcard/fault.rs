@@ -1,6 +1,22 @@
 //! Faults a test can inject into a virtual card.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// A fault for a card: injected at once (`SdCard::inject`) or at a planned
+/// simulated time (`Sim::sd_fault_at`). Blocks are numbered as LBAs (block
+/// 0 is the card's first), whatever the card's addressing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CardFault {
+    /// The next data block the card sends (a read block, or a register
+    /// while the host initialises it) carries a wrong CRC16.
+    CrcNext,
+    /// The next read of this block carries a wrong CRC16; later reads are
+    /// fine.
+    CrcOnce(u32),
+    /// Every read of this block fails as a worn-out block does: R1 is fine,
+    /// then error token 0x04 (card ECC failed) instead of the data.
+    BadBlock(u32),
+}
 
 /// How a read of a failing block goes wrong.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,6 +32,8 @@ pub enum ReadFault {
 pub(crate) struct Faults {
     /// Blocks whose every read fails.
     pub bad_blocks: BTreeMap<u32, ReadFault>,
+    /// Blocks whose next read carries a wrong CRC16.
+    pub crc_once: BTreeSet<u32>,
     /// Commands still to be ignored (no response at all).
     pub mute_commands: u32,
     /// The next data block the card sends carries a wrong CRC16.

@@ -3,6 +3,7 @@
 
 use std::io;
 use std::path::Path;
+use taut_logic::fat::{BlockRead, Volume};
 
 pub const BLOCK: usize = 512;
 
@@ -85,16 +86,7 @@ impl SdImage {
     /// A file of the root directory (8.3 name, any case), read with the
     /// firmware's own FAT reader (`taut_logic::fat`); `None` if missing.
     pub fn read_file(&self, name: &str) -> Option<Vec<u8>> {
-        use taut_logic::fat::{BlockRead, Volume};
-        struct Blocks<'a>(&'a SdImage);
-        impl BlockRead for Blocks<'_> {
-            type Error = std::convert::Infallible;
-            fn read_block(&mut self, lba: u32, buf: &mut [u8; BLOCK]) -> Result<(), Self::Error> {
-                *buf = self.0.block(lba);
-                Ok(())
-            }
-        }
-        let (mut dev, mut buf) = (Blocks(self), [0; BLOCK]);
+        let (mut dev, mut buf) = (Blocks::new(self), [0; BLOCK]);
         let volume = Volume::mount(&mut dev, &mut buf).ok()?;
         let mut file = volume.open(&mut dev, &mut buf, name.as_bytes()).ok()?;
         let mut out = Vec::new();
@@ -106,6 +98,20 @@ impl SdImage {
         }
     }
 
+    /// The LBA of a root file's first data block (8.3 name, any case): the
+    /// block a fault aimed at the file hits. `None` for a missing or empty
+    /// file.
+    pub fn first_block_of(&self, name: &str) -> Option<u32> {
+        let (mut dev, mut buf) = (Blocks::new(self), [0; BLOCK]);
+        let volume = Volume::mount(&mut dev, &mut buf).ok()?;
+        let mut file = volume.open(&mut dev, &mut buf, name.as_bytes()).ok()?;
+        // The first block of a file is read alone, without a FAT lookup.
+        match file.read_next(&volume, &mut dev, &mut buf).ok()? {
+            0 => None,
+            _ => dev.last,
+        }
+    }
+
     /// Writes block `n`, growing the image when it lies past the end.
     pub fn write_block(&mut self, n: u32, data: &[u8; BLOCK]) {
         let start = n as usize * BLOCK;
@@ -113,6 +119,27 @@ impl SdImage {
             self.bytes.resize(start + BLOCK, 0);
         }
         self.bytes[start..start + BLOCK].copy_from_slice(data);
+    }
+}
+
+/// The image as the FAT reader's device, noting the last block read.
+struct Blocks<'a> {
+    image: &'a SdImage,
+    last: Option<u32>,
+}
+
+impl<'a> Blocks<'a> {
+    fn new(image: &'a SdImage) -> Blocks<'a> {
+        Blocks { image, last: None }
+    }
+}
+
+impl BlockRead for Blocks<'_> {
+    type Error = std::convert::Infallible;
+    fn read_block(&mut self, lba: u32, buf: &mut [u8; BLOCK]) -> Result<(), Self::Error> {
+        *buf = self.image.block(lba);
+        self.last = Some(lba);
+        Ok(())
     }
 }
 

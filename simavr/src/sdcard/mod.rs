@@ -3,14 +3,17 @@
 //! Simplified Specification describes it.
 //!
 //! `SdCard` is the card alone, a pure byte-exchange state machine usable
-//! without a simulator; `bus` wires it to simavr's SPI and to `Sim`.
+//! without a simulator; `slot::Slot` holds it where simavr's SPI bus
+//! reaches it (wired in `sim`), with the changes planned for later.
+//! Nothing here depends on the simulator: `card_slot` gives `Sim` its
+//! card methods.
 
-mod bus;
 mod card;
 pub mod crc;
 mod fault;
 mod image;
 mod registers;
+pub(crate) mod slot;
 mod stats;
 #[cfg(test)]
 mod tests;
@@ -19,9 +22,6 @@ pub use card::{
     CardKind, SdCard, SdConfig, DATA_ACCEPTED, DATA_CRC_ERROR, DATA_WRITE_ERROR, R1_ADDRESS,
     R1_CRC, R1_IDLE, R1_ILLEGAL, R1_PARAMETER, TOKEN_MULTI_WRITE, TOKEN_START, TOKEN_STOP_TRAN,
 };
-pub use fault::ReadFault;
+pub use fault::{CardFault, ReadFault};
 pub use image::{SdImage, BLOCK};
 pub use stats::SdStats;
-
-/// Board pin of the card's chip select.
-pub const CS_PIN: u8 = 53;

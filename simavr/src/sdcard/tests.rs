@@ -350,3 +350,129 @@ fn a_card_pulled_mid_block_goes_silent() {
     assert_eq!(response(&mut c, 16), None);
     assert_eq!(c.stats().blocks_read, 0);
 }
+
+#[test]
+fn crc_once_hits_one_read_of_its_block_only() {
+    let mut c = card(CardKind::Sdhc, 16);
+    init(&mut c);
+    c.corrupt_crc_once(3);
+    let read_block = |c: &mut SdCard, n: u32| {
+        assert_eq!(command(c, 17, n), 0);
+        let (token, data, crc) = data_block(c, BLOCK);
+        assert_eq!((token, &data[..]), (TOKEN_START, &c.image().block(n)[..]));
+        crc == crc16(&data)
+    };
+    assert!(read_block(&mut c, 2), "other blocks read fine");
+    assert!(!read_block(&mut c, 3), "the first read of block 3 is bad");
+    assert!(read_block(&mut c, 3), "the second one is fine");
+    // In a multiple-block read too.
+    c.corrupt_crc_once(5);
+    assert_eq!(command(&mut c, 18, 4), 0);
+    let good: Vec<bool> = (0..3)
+        .map(|_| {
+            let (_, data, crc) = data_block(&mut c, BLOCK);
+            crc == crc16(&data)
+        })
+        .collect();
+    assert_eq!(good, [true, false, true]);
+}
+
+#[test]
+fn injected_faults_act_as_their_methods() {
+    let mut c = card(CardKind::Sdsc, 16);
+    init(&mut c);
+    c.inject(CardFault::BadBlock(4));
+    c.inject(CardFault::CrcNext);
+    for _ in 0..2 {
+        assert_eq!(command(&mut c, 17, 4 * 512), 0);
+        assert_eq!(data_block(&mut c, 0).0, 0x04, "card ECC failed, every time");
+    }
+    assert_eq!(command(&mut c, 17, 2 * 512), 0);
+    let (_, data, crc) = data_block(&mut c, BLOCK);
+    assert_ne!(crc, crc16(&data), "the next block sent after CrcNext");
+    c.inject(CardFault::CrcOnce(2));
+    assert_eq!(command(&mut c, 17, 2 * 512), 0);
+    let (_, data, crc) = data_block(&mut c, BLOCK);
+    assert_ne!(crc, crc16(&data));
+}
+
+#[test]
+fn a_card_put_back_powers_up_with_its_image_counters_and_faults() {
+    let mut c = card(CardKind::Sdhc, 16);
+    init(&mut c);
+    c.fail_read(5);
+    assert_eq!(command(&mut c, 24, 1), 0);
+    assert_eq!(
+        write_block(&mut c, TOKEN_START, &[0x5A; BLOCK], 0),
+        DATA_ACCEPTED
+    );
+    assert_eq!(command(&mut c, 17, 2), 0);
+    c.power_up();
+    assert!(!c.is_ready());
+    assert_eq!(read(&mut c, 8), [0xFF; 8], "the block in flight is gone");
+    send(&mut c, &frame(17, 2));
+    assert_eq!(response(&mut c, 16), None, "SD bus mode until CMD0");
+    init(&mut c);
+    assert_eq!(c.image().block(1), [0x5A; BLOCK]);
+    assert_eq!(c.stats().blocks_written, 1);
+    assert_eq!(command(&mut c, 17, 5), 0);
+    assert_eq!(data_block(&mut c, 0).0, 0x04, "still a bad block");
+}
+
+#[test]
+fn a_slot_applies_planned_changes_in_time_then_plan_order() {
+    use slot::Change;
+    let mut s = slot::Slot::default();
+    assert_eq!(s.exchange(0x40, true), 0xFF, "empty: MISO floats high");
+    s.plan(0, 30, Change::Reinsert);
+    s.plan(0, 10, Change::Insert(Box::new(card(CardKind::Sdhc, 8))));
+    s.plan(0, 20, Change::Remove);
+    s.plan(0, 30, Change::Fault(CardFault::BadBlock(2)));
+    assert_eq!(s.next_due(), Some(10));
+    s.apply_due(9);
+    assert!(s.card().is_none());
+    s.apply_due(10);
+    init(s.card_mut().unwrap());
+    let seen = s.card().unwrap().stats().commands;
+    s.apply_due(29);
+    assert!(s.card().is_none(), "out at 20");
+    assert_eq!(s.exchange(0x40, true), 0xFF);
+    s.apply_due(30);
+    assert_eq!(s.next_due(), None);
+    let c = s.card_mut().expect("the same card back");
+    assert_eq!(c.stats().commands, seen, "its counters kept");
+    assert!(!c.is_ready(), "powered up afresh");
+    init(c);
+    assert_eq!(command(c, 17, 2), 0);
+    assert_eq!(data_block(c, 0).0, 0x04, "the fault planned after it");
+}
+
+#[test]
+fn a_fault_planned_for_an_empty_slot_waits_for_the_next_card() {
+    let mut s = slot::Slot::default();
+    s.plan(5, 5, slot::Change::Fault(CardFault::CrcOnce(3)));
+    s.insert(card(CardKind::Sdhc, 8));
+    let c = s.card_mut().unwrap();
+    init(c);
+    assert_eq!(command(c, 17, 3), 0);
+    let (_, data, crc) = data_block(c, BLOCK);
+    assert_ne!(crc, crc16(&data));
+}
+
+#[test]
+fn reinsertion_pushes_back_a_card_that_pulled_itself_out() {
+    let mut s = slot::Slot::default();
+    s.insert(card(CardKind::Sdhc, 8));
+    let c = s.card_mut().unwrap();
+    init(c);
+    c.remove_during_transfer();
+    assert_eq!(command(c, 17, 1), 0);
+    read(c, 600);
+    assert!(c.is_pulled());
+    s.plan(0, 0, slot::Change::Reinsert);
+    let c = s.card_mut().unwrap();
+    assert!(!c.is_pulled());
+    init(c);
+    assert_eq!(command(c, 17, 1), 0);
+    assert_eq!(data_block(c, BLOCK).0, TOKEN_START);
+}
