@@ -77,17 +77,22 @@ impl Line {
 
     /// Queue a reply whole; the caller made room (`reply::room`).
     pub fn send(mut self) {
-        let _ = self.buf.push(b'\n');
+        self.end();
         usart::send(&self.buf);
     }
 
-    /// Queue the line, or count it as dropped.
-    pub fn emit(mut self) {
-        if self.cut {
+    /// The newline, always: a line that did not fit ends in `~` first.
+    fn end(&mut self) {
+        if self.cut || self.buf.is_full() {
             self.buf.truncate(LINE - 2);
             let _ = self.buf.push(b'~');
         }
         let _ = self.buf.push(b'\n');
+    }
+
+    /// Queue the line, or count it as dropped.
+    pub fn emit(mut self) {
+        self.end();
         let dropped = dropped();
         if dropped > 0 {
             let mut note = Line::new(Level::Warn, crate::flash_str!("log"));

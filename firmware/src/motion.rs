@@ -21,9 +21,10 @@ use taut_logic::segment::{Buffered, StepBlock};
 const URGENT_BUDGET_US: u32 = 30_000;
 /// Fewer segments than this are always urgent.
 const URGENT_MIN: u8 = 2;
-/// The queue holds no more motion than this: a feed hold brakes from the
-/// last segment queued, so this bounds how long a hold waits to begin.
-const QUEUED_MAX_US: u32 = 60_000;
+/// The queue holds no more motion than this (plus one segment, 25 ms at
+/// most): a feed hold brakes from the last segment queued, so this bounds
+/// how long a hold waits to begin.
+const QUEUED_MAX_US: u32 = 50_000;
 
 /// At or below this many queued segments the refill is urgent: as many of
 /// the newest as last less than the budget. Set by the refill, read by the

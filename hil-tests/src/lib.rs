@@ -188,3 +188,53 @@ pub fn log_tail(sim: &sim::Sim) -> String {
     }
     t[from..].to_string()
 }
+
+/// Highest acceleration of a pulse train, steps/s²: speeds from windows of
+/// `window` pulses, then the change between windows. Exact for uniform
+/// acceleration and insensitive to the ±1 µs placement of single pulses.
+pub fn max_accel(rises: &[u64], window: usize) -> f64 {
+    let t: Vec<f64> = rises.iter().map(|&c| c as f64 / 16e6).collect();
+    let mut prev: Option<(f64, f64)> = None;
+    let mut max: f64 = 0.0;
+    for i in (0..t.len().saturating_sub(window)).step_by(window) {
+        let (t0, t1) = (t[i], t[i + window]);
+        let v = window as f64 / (t1 - t0);
+        let mid = (t0 + t1) / 2.0;
+        if let Some((pv, pm)) = prev {
+            max = max.max(((v - pv) / (mid - pm)).abs());
+        }
+        prev = Some((v, mid));
+    }
+    max
+}
+
+/// Rising-edge cycles of a probed STEP pin.
+pub fn rising(sim: &sim::Sim, name: &str) -> Vec<u64> {
+    sim.probed(name)
+        .edges()
+        .iter()
+        .filter(|e| e.high)
+        .map(|e| e.cycle)
+        .collect()
+}
+
+/// STEP pulses of the three machine axes so far.
+pub fn all_pulses(sim: &sim::Sim) -> [usize; 3] {
+    use taut_logic::axis::Axis;
+    [Axis::Base, Axis::Radial, Axis::Drill].map(|a| pulses(sim, a))
+}
+
+/// Runs until no axis has stepped for a second (at most 30 s): the pulse
+/// counts then.
+pub fn settle(sim: &mut sim::Sim) -> [usize; 3] {
+    let mut last = all_pulses(sim);
+    for _ in 0..30 {
+        sim.run_for(std::time::Duration::from_secs(1));
+        let now = all_pulses(sim);
+        if now == last {
+            return now;
+        }
+        last = now;
+    }
+    panic!("still moving after 30 s:\n{}", sim.uart_text());
+}

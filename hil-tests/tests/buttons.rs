@@ -7,8 +7,8 @@ use hil_tests::sim::operator::message;
 use hil_tests::sim::sdcard::SdImage;
 use hil_tests::sim::Sim;
 use hil_tests::{
-    assert_ram_budget, assert_step_interrupt_never_masked_long, boot_machine, pulses,
-    sample_card_dir, send_ok, wait_for,
+    all_pulses, assert_ram_budget, assert_step_interrupt_never_masked_long, boot_machine, pulses,
+    sample_card_dir, send_ok, settle, wait_for,
 };
 use std::time::Duration;
 use taut_logic::axis::Axis;
@@ -39,25 +39,6 @@ fn driver_on(sim: &Sim, axis: Axis) -> bool {
 fn base_steps(sim: &Sim) -> i64 {
     let d = driver(Axis::Base);
     sim.net_steps(d.step, d.dir, true)
-}
-
-fn all_pulses(sim: &Sim) -> [usize; 3] {
-    [Axis::Base, Axis::Radial, Axis::Drill].map(|a| pulses(sim, a))
-}
-
-/// Runs until no axis has stepped for a second (at most 30 s): the pulse
-/// counts then.
-fn settle(sim: &mut Sim) -> [usize; 3] {
-    let mut last = all_pulses(sim);
-    for _ in 0..30 {
-        sim.run_for(Duration::from_secs(1));
-        let now = all_pulses(sim);
-        if now == last {
-            return now;
-        }
-        last = now;
-    }
-    panic!("still moving after 30 s:\n{}", sim.uart_text());
 }
 
 fn log_has(sim: &Sim, text: &str) -> bool {

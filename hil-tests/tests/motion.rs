@@ -2,7 +2,7 @@
 //! pulses, with the configured pulse width and DIR set-up, and a velocity
 //! profile within the configured acceleration.
 
-use hil_tests::{firmware_elf, sim::Outcome, sim::Sim};
+use hil_tests::{firmware_elf, max_accel, rising, sim::Outcome, sim::Sim};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
@@ -56,16 +56,6 @@ fn absolute_moves_give_exact_pulse_counts() {
     );
 }
 
-/// Rising-edge cycles of a STEP pin.
-fn rising(sim: &Sim, name: &str) -> Vec<u64> {
-    sim.probed(name)
-        .edges()
-        .iter()
-        .filter(|e| e.high)
-        .map(|e| e.cycle)
-        .collect()
-}
-
 #[test]
 fn pulse_width_and_dir_setup_hold_the_tb6600_timing() {
     let mut sim = boot();
@@ -109,25 +99,6 @@ fn pulse_width_and_dir_setup_hold_the_tb6600_timing() {
     }
     assert_eq!(steps(&sim, Axis::Base), 0);
     assert!(!sim.uart_text().contains("late"), "{}", sim.uart_text());
-}
-
-/// Speed from window averages of pulse times, then acceleration between
-/// windows: exact for uniform acceleration, and insensitive to the ±1 µs
-/// placement of single pulses.
-fn max_accel(rises: &[u64], window: usize) -> f64 {
-    let t: Vec<f64> = rises.iter().map(|&c| c as f64 / 16e6).collect();
-    let mut prev: Option<(f64, f64)> = None;
-    let mut max: f64 = 0.0;
-    for i in (0..t.len().saturating_sub(window)).step_by(window) {
-        let (t0, t1) = (t[i], t[i + window]);
-        let v = window as f64 / (t1 - t0);
-        let mid = (t0 + t1) / 2.0;
-        if let Some((pv, pm)) = prev {
-            max = max.max(((v - pv) / (mid - pm)).abs());
-        }
-        prev = Some((v, mid));
-    }
-    max
 }
 
 #[test]

@@ -8,7 +8,6 @@ use hil_tests::{
     boot_machine, log_tail, reported_steps, send_ok, sim::Outcome, sim::Sim, steps_on_pins,
 };
 use std::time::Duration;
-use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
 
 /// A tiny seeded generator (xorshift): the same moves on every run.

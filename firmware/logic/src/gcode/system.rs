@@ -5,7 +5,7 @@ use super::error::{Error, ErrorKind};
 use heapless::String;
 
 /// Longest `$` key and value, characters.
-pub const SYSTEM_TEXT: usize = 16;
+pub const SYSTEM_TEXT: usize = 24;
 
 /// A key or value of a `$` line.
 pub type SystemText = String<SYSTEM_TEXT, u8>;

@@ -132,7 +132,7 @@ impl uDisplay for ErrorKind {
             ErrorKind::Invalid(field) => uwrite!(f, "invalid {}", field),
             ErrorKind::PulseTooLong { axis, max_us } => uwrite!(
                 f,
-                "step pulse over half a step at {}_max_rate: {} us at most",
+                "pulse over half a step at {}_max_rate: {} us at most",
                 axis.name(),
                 max_us
             ),

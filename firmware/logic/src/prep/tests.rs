@@ -13,8 +13,7 @@ fn square() -> MachineConfig {
         steps_per_unit: StepsPerUnit::new(100, 1),
         max_rate: 4000,
         accel: 1000,
-        dir_high_is_positive: true,
-        enable_active_high: true,
+        ..MachineConfig::STRING_ART.axes[0]
     };
     MachineConfig {
         axes: [axis; AXES],

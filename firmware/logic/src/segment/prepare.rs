@@ -19,6 +19,9 @@ use crate::units::div_round;
 const MAX_RAMP_EVENTS: u32 = 128;
 /// Longest cruise segment: bounds the `interval` rounding error.
 const MAX_CRUISE_EVENTS: u32 = 4096;
+/// No segment lasts longer than this (1/40 s): a feed hold brakes from the
+/// last segment queued, so this bounds how long it waits to begin.
+const MAX_SEGMENT_PER_S: u64 = 40;
 /// `d ≤ 43·∛τ²` keeps the quadratic fit's error ≤ 2048 sub-ticks.
 const FIT_GAIN: u64 = 43;
 
@@ -179,7 +182,12 @@ impl Preparer {
         let k0 = self.done;
         let mut seg = match self.profile.phase_after(k0) {
             None => self.fit(k0, 1),
-            Some((Phase::Cruise, end)) => self.cruise(k0, (end - k0).min(MAX_CRUISE_EVENTS)),
+            Some((Phase::Cruise, end)) => {
+                let n = (end - k0)
+                    .min(MAX_CRUISE_EVENTS)
+                    .min(self.profile.cruise_events_in(Q / MAX_SEGMENT_PER_S));
+                self.cruise(k0, n.max(1))
+            }
             Some((Phase::Accel, end)) => {
                 let n = self.ramp_run(k0).min(end - k0);
                 self.fit(k0, n)
@@ -215,7 +223,8 @@ impl Preparer {
         let c = cbrt_floor_approx(to_stop);
         let duration = FIT_GAIN * c * c;
         let n = duration / (Q / v);
-        n.clamp(1, MAX_RAMP_EVENTS as u64) as u32
+        n.min(v / MAX_SEGMENT_PER_S)
+            .clamp(1, MAX_RAMP_EVENTS as u64) as u32
     }
 
     /// Sub-ticks from the last placed event to the ideal time of `k`.

@@ -181,7 +181,8 @@ fn string_art_ramp_is_accurate_and_compact() {
 
 #[test]
 fn fast_cruise_is_few_segments() {
-    // 40 kHz for one second after a steep ramp.
+    // 40 kHz for one second after a steep ramp: segments of 25 ms (a
+    // hold waits for the queued ones), 1000 events each.
     let r = Ramp {
         events: 40_000,
         accel: 200_000,
@@ -191,7 +192,8 @@ fn fast_cruise_is_few_segments() {
     };
     assert!(worst_error(&[r]) <= TOLERANCE_TICKS as f64);
     let (segs, _) = prepare(&[r]);
-    assert!(segs.len() <= 40_000 / 4096 + 1, "{}", segs.len());
+    assert!(segs.len() <= 40 + 1, "{}", segs.len());
+    assert!(segs.iter().all(|s| s.duration_us() <= 25_000));
 }
 
 #[test]

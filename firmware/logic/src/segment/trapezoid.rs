@@ -141,6 +141,12 @@ impl Trapezoid {
         self.cruise_sqr
     }
 
+    /// Cruise events that fit in `subticks` (at least one).
+    pub fn cruise_events_in(&self, subticks: u64) -> u32 {
+        let n = (subticks << (31 - self.shift)) / self.cruise_iv.max(1);
+        n.clamp(1, u32::MAX as u64) as u32
+    }
+
     /// Speed² at the last event, events²/s².
     pub fn exit_sqr(&self) -> u64 {
         self.v1_sqr
