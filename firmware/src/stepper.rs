@@ -3,11 +3,11 @@
 //!
 //! Per event, in `TIMER1_COMPA`: raise the STEP pins chosen at the previous
 //! event (first, so pulse timing does not depend on the work below: one
-//! store per port, through the PINx toggle registers), advance the
+//! store per port, through the PINx toggle registers), drop them once the
+//! pulse width has passed (so every pulse is as long as set), advance the
 //! Klipper-style timing (`time += interval; interval += add`, 24.8 fixed
 //! point), run the DDA for the next event, program the compare register,
-//! drop the STEP pins once the pulse width has passed, and only then change
-//! DIR for a new block. Times are absolute (the compare register advances by
+//! and only then change DIR for a new block. Times are absolute (the compare register advances by
 //! the interval), so a late interrupt never shifts the events after it.
 //! Waits longer than the 16-bit timer are split.
 //!
@@ -577,9 +577,12 @@ pub fn on_compare() -> bool {
             advance_compare(e);
             return false;
         }
-        // The assembly entry (`fast.rs`) raised the pins already.
-        let masks = e.masks;
+        // The assembly entry (`fast.rs`) raised the pins already. The pulse
+        // ends at its set width, before the work below (a new segment, the
+        // DDA) that can take longer than the pulse.
         let raised = e.raised;
+        while read_volatile(TCNT1).wrapping_sub(raised) < e.pulse_ticks {}
+        toggle_steps(&e.masks);
         e.left -= 1;
         let loaded = e.left == 0 && load_segment_cold(e);
         if e.left > 0 {
@@ -593,8 +596,6 @@ pub fn on_compare() -> bool {
             }
             write_volatile(TIMSK1, read_volatile(TIMSK1) & !OCIE1A);
         }
-        while read_volatile(TCNT1).wrapping_sub(raised) < e.pulse_ticks {}
-        toggle_steps(&masks);
         if let Some(dir) = e.new_dir.take() {
             write_dir(dir, e.dir_high_positive);
             // Keep the DIR set-up time before the next STEP edge (only

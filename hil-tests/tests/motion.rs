@@ -56,6 +56,33 @@ fn absolute_moves_give_exact_pulse_counts() {
     );
 }
 
+/// Cycles from the compare match to where the interrupt's general path
+/// (a segment's first event, the DDA) can end a pulse: pulses set shorter
+/// last this long there.
+const PULSE_FLOOR: u64 = 130;
+
+/// A longer pulse setting is kept exactly too, on every pulse (within the
+/// 2 µs the drop takes).
+#[test]
+fn a_longer_pulse_setting_gives_every_pulse_that_width() {
+    let mut sim = boot();
+    send(&mut sim, "$step_pulse_us=40", Duration::from_millis(100));
+    send(&mut sim, "M17", Duration::from_millis(100));
+    send(&mut sim, "G0 C10 X3 Z1", Duration::from_millis(100));
+    send(&mut sim, "M400", Duration::from_secs(20));
+    for axis in ["base", "radial", "drill"] {
+        let step = sim.probed(&format!("{axis}_step"));
+        let (min, max) = (
+            step.min_high_cycles().unwrap(),
+            step.max_high_cycles().unwrap(),
+        );
+        assert!(
+            min >= 640 && max <= 640 + 32,
+            "{axis} pulses {min}..{max} cycles"
+        );
+    }
+}
+
 #[test]
 fn pulse_width_and_dir_setup_hold_the_tb6600_timing() {
     let mut sim = boot();
@@ -73,10 +100,16 @@ fn pulse_width_and_dir_setup_hold_the_tb6600_timing() {
     let pulse = MachineConfig::STRING_ART.pulse;
     for axis in ["base", "radial", "drill"] {
         let step = sim.probed(&format!("{axis}_step"));
-        let high_us = step.min_high_us().unwrap();
+        // Every pulse as long as set, and no longer than the general
+        // path's entry (~130 cycles) needs before it can drop it.
+        let (min, max) = (
+            step.min_high_cycles().unwrap(),
+            step.max_high_cycles().unwrap(),
+        );
+        let set = pulse.step_pulse_us as u64 * 16;
         assert!(
-            high_us >= pulse.step_pulse_us as f64,
-            "{axis} pulse {high_us} µs"
+            min >= set && max <= set.max(PULSE_FLOOR) + 32,
+            "{axis} pulses {min}..{max} cycles, set {set}"
         );
         // DIR set-up: every DIR edge is at least 5 µs before the next STEP rise
         // (and after the previous STEP fall).

@@ -92,6 +92,15 @@ impl Probe {
             .min()
     }
 
+    /// Longest time the pin stayed high, in cycles.
+    pub fn max_high_cycles(&self) -> Option<u64> {
+        self.edges
+            .windows(2)
+            .filter(|w| w[0].high && !w[1].high)
+            .map(|w| w[1].cycle - w[0].cycle)
+            .max()
+    }
+
     /// Shortest time between two rising edges, in cycles.
     pub fn min_period_cycles(&self) -> Option<u64> {
         let rises: Vec<u64> = self.rising().map(|e| e.cycle).collect();
