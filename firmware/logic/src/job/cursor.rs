@@ -1,6 +1,11 @@
 //! Where in a file a byte is: 1-based line and column, a UTF-8 byte-order
-//! mark at the very start skipped. Shared by every job-file tokenizer, so
-//! chunk boundaries cannot change a reported position.
+//! mark at the very start skipped, lines ended by LF, CR or CRLF (files
+//! saved on old Macs end lines in CR only). Shared by every job-file
+//! tokenizer, so chunk boundaries cannot change a reported position. It
+//! also tells a text file from what is not one: UTF-16 (a byte-order mark
+//! `FF FE` / `FE FF`), or a control byte no text file holds.
+
+use crate::job::error::ErrorKind;
 
 const BOM: [u8; 3] = [0xEF, 0xBB, 0xBF];
 
@@ -12,12 +17,18 @@ pub enum Feed {
     /// Process these bytes held back as a possible mark (they were not one),
     /// then the byte itself.
     Pass { held: &'static [u8] },
+    /// Not a text file this machine reads: stop at this byte.
+    Bad(ErrorKind),
 }
 
 #[derive(Clone, Copy, Debug)]
 pub struct Cursor {
     /// Bytes of the mark matched so far; `u8::MAX` once past the start.
     bom: u8,
+    /// The first byte of the file, while the second is awaited.
+    first: Option<u8>,
+    /// The last byte processed was a CR: a LF now ends no other line.
+    after_cr: bool,
     line: u32,
     /// Characters seen on this line; the column of the last one.
     col: u32,
@@ -33,13 +44,26 @@ impl Cursor {
     pub const fn new() -> Self {
         Cursor {
             bom: 0,
+            first: None,
+            after_cr: false,
             line: 1,
             col: 0,
         }
     }
 
-    /// First look at a byte from the file: is it part of the leading mark?
+    /// First look at a byte from the file: is it part of the leading mark,
+    /// or a sign that this is no text file?
     pub fn feed(&mut self, b: u8) -> Feed {
+        let utf16 = matches!((self.first.take(), b), (Some(0xFF), 0xFE) | (Some(0xFE), 0xFF));
+        if self.line == 1 && self.col == 0 && self.bom == 0 {
+            self.first = Some(b);
+        }
+        if utf16 {
+            return Feed::Bad(ErrorKind::Utf16);
+        }
+        if b < 0x20 && !matches!(b, b'\t' | b'\n' | b'\r') {
+            return Feed::Bad(ErrorKind::NotText { byte: b });
+        }
         let matched = self.bom as usize;
         if matched < BOM.len() {
             if b == BOM[matched] {
@@ -58,15 +82,25 @@ impl Cursor {
     /// Columns count characters: UTF-8 continuation bytes share their
     /// character's column.
     pub fn advance(&mut self, b: u8) -> (u32, u32) {
+        let crlf = core::mem::replace(&mut self.after_cr, b == b'\r') && b == b'\n';
+        if crlf {
+            // The LF of a CRLF: the line ended at its CR.
+            return (self.line - 1, 0);
+        }
         if b & 0xC0 != 0x80 {
             self.col += 1;
         }
         let here = (self.line, self.col);
-        if b == b'\n' {
+        if Self::ends_line(b) {
             self.line += 1;
             self.col = 0;
         }
         here
+    }
+
+    /// `b` ends a line (a CR, or a LF that follows none).
+    pub fn ends_line(b: u8) -> bool {
+        matches!(b, b'\n' | b'\r')
     }
 
     /// Where the next byte would be: the end-of-file position at the end.
@@ -110,6 +144,31 @@ mod tests {
         let bytes: Vec<u8> = out.iter().map(|o| o.0).collect();
         assert_eq!(bytes, b"\xEF\xBBx");
         assert_eq!(out[2], (b'x', 1, 2), "0xEF 0xBB is one (broken) character");
+    }
+
+    #[test]
+    fn lf_cr_and_crlf_each_end_one_line() {
+        let out = run(b"a\nb\rc\r\nd");
+        let at = |ch: u8| out.iter().find(|o| o.0 == ch).map(|o| (o.1, o.2));
+        assert_eq!(at(b'b'), Some((2, 1)));
+        assert_eq!(at(b'c'), Some((3, 1)));
+        assert_eq!(at(b'd'), Some((4, 1)));
+    }
+
+    #[test]
+    fn utf16_and_control_bytes_are_not_text() {
+        let mut c = Cursor::new();
+        assert!(matches!(c.feed(0xFF), Feed::Pass { .. }));
+        assert_eq!(c.feed(0xFE), Feed::Bad(ErrorKind::Utf16));
+        let mut c = Cursor::new();
+        assert_eq!(c.feed(b'1'), Feed::Pass { held: &[] });
+        assert_eq!(c.feed(0), Feed::Bad(ErrorKind::NotText { byte: 0 }));
+        // `FF FE` after the start is just bad UTF-8, left to the parser.
+        let mut c = Cursor::new();
+        c.feed(b'a');
+        c.advance(b'a');
+        c.feed(0xFF);
+        assert!(matches!(c.feed(0xFE), Feed::Pass { .. }));
     }
 
     #[test]

@@ -68,6 +68,13 @@ pub enum ErrorKind {
     },
     /// The machine configuration as a whole is inconsistent (names the field).
     Invalid(&'static str),
+    /// The file is UTF-16 (starts with its byte-order mark).
+    Utf16,
+    /// A control byte no text file holds (a binary file, or UTF-16
+    /// without its mark).
+    NotText {
+        byte: u8,
+    },
     /// The step pulse does not fit half the step period at an axis's
     /// highest rate: at most `max_us`.
     PulseTooLong {
@@ -130,6 +137,8 @@ impl uDisplay for ErrorKind {
                 uwrite!(f, "declared {} connections, found {}", declared, found)
             }
             ErrorKind::Invalid(field) => uwrite!(f, "invalid {}", field),
+            ErrorKind::Utf16 => f.write_str("UTF-16 text: save it as UTF-8 or ASCII"),
+            ErrorKind::NotText { byte } => uwrite!(f, "not a text file (byte {})", byte),
             ErrorKind::PulseTooLong { axis, max_us } => uwrite!(
                 f,
                 "pulse over half a step at {}_max_rate: {} us at most",

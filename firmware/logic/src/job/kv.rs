@@ -1,7 +1,7 @@
 //! `key = value` lines, read as a stream: bytes arrive in chunks of any
 //! size and a line may span chunks, so only the current line is kept
-//! (at most [`MAX_LINE`] bytes). Accepts `#` comments, blank lines, CRLF,
-//! blanks around `=` and a byte-order mark at the start.
+//! (at most [`MAX_LINE`] bytes). Accepts `#` comments, blank lines, LF, CR
+//! or CRLF line ends, blanks around `=` and a byte-order mark at the start.
 
 use crate::job::cursor::{Cursor, Feed};
 use crate::job::error::{ErrorKind, FileError, FileName};
@@ -47,6 +47,10 @@ impl KvReader {
     pub fn push(&mut self, b: u8) -> Result<Option<Item<'_>>, FileError> {
         match self.cursor.feed(b) {
             Feed::Skip => return Ok(None),
+            Feed::Bad(kind) => {
+                let (line, col) = self.cursor.next_pos();
+                return Err(FileError::at(self.file, line, col, kind));
+            }
             // Held bytes are never a newline, so they cannot end a line.
             Feed::Pass { held } => {
                 for &h in held {
@@ -82,7 +86,7 @@ impl KvReader {
             self.in_comment = false;
         }
         let (line, col) = self.cursor.advance(b);
-        if b == b'\n' {
+        if Cursor::ends_line(b) {
             self.ended = Some(line);
             return Ok(());
         }

@@ -47,6 +47,10 @@ impl List {
     pub fn push(&mut self, b: u8) -> Result<Option<Number>, FileError> {
         match self.cursor.feed(b) {
             Feed::Skip => Ok(None),
+            Feed::Bad(kind) => {
+                let (line, col) = self.cursor.next_pos();
+                Err(FileError::at(self.file, line, col, kind))
+            }
             // Held bytes are not digits: they fail, never complete a number.
             Feed::Pass { held } => {
                 for &h in held {

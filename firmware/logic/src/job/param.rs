@@ -180,7 +180,7 @@ impl Seen {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::in_every_chunking;
+    use crate::job::error::tests::{in_every_chunking, show};
     use proptest::prelude::*;
     use std::string::String;
 
@@ -227,9 +227,25 @@ mod tests {
                 "tvar=1000\nnails=3\nradius_cm=1000",
                 params(1000, 3, 10_000_000),
             ),
+            // Lines ended by CR only (old Mac editors).
+            (
+                "tvar = 0\rpocet_hrebiku = 250\rpolomer_matrice = 40.2\r",
+                params(0, 250, 402_000),
+            ),
         ];
         for (text, expected) in good {
             assert_eq!(parse(text), Ok(*expected), "{text:?}");
+        }
+    }
+
+    #[test]
+    fn a_utf16_file_is_named_as_such() {
+        for text in [&b"\xFF\xFEt\0v\0a\0r\0"[..], b"\xFE\xFF\0t\0v"] {
+            for chunk in 1..text.len() {
+                let e = parse_in_chunks(text, chunk).map_err(|e| show(&e));
+                let utf16 = "param.txt:1:2: UTF-16 text: save it as UTF-8 or ASCII";
+                assert_eq!(e, Err(utf16.into()), "chunk {chunk}");
+            }
         }
     }
 
@@ -300,6 +316,14 @@ mod tests {
             (
                 "tvar = 4\nnails = 250\nradius_cm = 4.3284",
                 "param.txt:3:13: expected more than 4.3284 cm",
+            ),
+            (
+                "tvar = 0\rnails = 25O\r",
+                "param.txt:2:11: expected a number",
+            ),
+            (
+                "tvar = 0\n\x01\x02",
+                "param.txt:2:1: not a text file (byte 1)",
             ),
         ];
         for (text, message) in bad {

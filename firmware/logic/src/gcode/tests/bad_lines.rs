@@ -18,7 +18,7 @@ const BAD: &[(&str, u8, u8)] = &[
     ("$=5", 3, 2),
     ("$key=", 3, 6),
     ("$a-b=1", 3, 3),
-    ("$abcdefghijklmnopq=1", 3, 18),
+    ("$abcdefghijklmnopqrstuvwxy=1", 3, 26),
     ("G1 X1 F-5", 4, 7),
     ("G4 P-1", 4, 4),
     ("G2 X1", 20, 1),
