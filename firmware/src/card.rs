@@ -1,22 +1,27 @@
 //! The SD reader task's state: the card on SPI (embedded-sdmmc's `SdCard`
 //! driver), its FAT volume (`taut_logic::fat`), and the file being
-//! streamed to the job through [`CARD_OUT`] in small chunks.
+//! streamed to the job through `CARD_OUT` in small chunks.
 //!
 //! One run does at most one card operation (a presence check, a mount, one
 //! block read), then returns: the bus is free between runs and other tasks
 //! interleave. Modules have no card-detect pin, so an absent card is
-//! probed for every second with a single CMD0, and a present, idle card is
-//! asked for its CSD every second; a failing read is a removal.
+//! probed for every second with a single CMD0, and a card in the slot is
+//! asked for its CSD every second, also while a file streams (a pulled
+//! card is noticed between block reads). A block read that fails with a
+//! CRC error or an error token is tried [`TRIES`] times; a block that
+//! never reads makes the card faulty, reported once, and it is not read
+//! again until it has been taken out. Any other failure is a removal.
 
 use crate::board::delay::Delay;
+use crate::board::flash::FlashStr;
 use crate::board::spi::CardSpi;
-use crate::queues::{CardMsg, Request, Signal, What, CARD_IN, CARD_OUT, CHUNK};
+use crate::queues::{CardMsg, Request, Signal, What, CARD_IN, CARD_OUT, CHUNK, TX};
 use crate::rt::Poll;
-use crate::{info, warn};
+use crate::{error, flash_str, info, warn};
 use core::mem::{offset_of, size_of};
 use embedded_hal::spi::SpiDevice;
 use embedded_sdmmc::sdcard::spi::AcquireOpts;
-use embedded_sdmmc::{Block, BlockDevice, BlockIdx, SdCard};
+use embedded_sdmmc::{Block, BlockDevice, BlockIdx, SdCard, SdCardError};
 use taut_logic::fat::{BlockRead, FatError, File, Volume, BLOCK};
 use taut_logic::job::FileName;
 
@@ -25,12 +30,21 @@ use taut_logic::job::FileName;
 /// `Removed`). The job wakes the reader when there are this many.
 pub const ROOM: usize = 2;
 
+/// Reads of one block before the card counts as faulty.
+pub const TRIES: u8 = 3;
+
+/// How often an empty slot is probed and a card checked, ms.
+pub const CHECK_MS: u32 = 1000;
+
 type Sd = SdCard<CardSpi, Delay>;
 
 enum Slot {
     Empty,
     /// A card with a FAT volume, `None` when it has none.
     Mounted(Option<Volume>),
+    /// In the slot, but a block would not read: nothing more is read from
+    /// it until it is taken out.
+    Faulty,
 }
 
 pub struct CardReader {
@@ -42,24 +56,48 @@ pub struct CardReader {
     /// Bytes of `block` not yet sent: `at..len`.
     at: u16,
     len: u16,
+    /// Failed reads of the block being read.
+    failures: u8,
+    /// A block that never read, to report once the TX ring has room for
+    /// the line (it must not be dropped): its number, how it failed, the
+    /// file's ticket.
+    faulty: Option<(u32, FlashStr, u8)>,
     /// When the card is next looked for or checked.
     check_at: u32,
 }
 
-/// How often an empty slot is probed and an idle card checked, ms.
-pub const CHECK_MS: u32 = 1000;
-
 // The FAT reader fills `Block::contents` through a `[u8; 512]` view.
 const _: () = assert!(size_of::<Block>() == BLOCK && offset_of!(Block, contents) == 0);
 
-struct Device<'a>(&'a Sd);
+/// The card as the FAT reader's block device; remembers the last block
+/// asked for, to name it when it fails.
+struct Device<'a> {
+    sd: &'a Sd,
+    lba: u32,
+}
 
 impl BlockRead for Device<'_> {
-    type Error = embedded_sdmmc::SdCardError;
+    type Error = SdCardError;
     fn read_block(&mut self, lba: u32, buf: &mut [u8; BLOCK]) -> Result<(), Self::Error> {
+        self.lba = lba;
         // SAFETY: `Block` is exactly one `[u8; 512]` at offset 0 (asserted above).
         let block = unsafe { &mut *(buf as *mut [u8; BLOCK] as *mut Block) };
-        self.0.read(core::slice::from_mut(block), BlockIdx(lba))
+        self.sd.read(core::slice::from_mut(block), BlockIdx(lba))
+    }
+}
+
+/// What a failed read was: a bad block (worth reading again), or no card.
+enum Failure {
+    /// The block came with a wrong CRC16, or the card sent an error token.
+    Block(FlashStr),
+    Gone,
+}
+
+fn failure(e: &SdCardError) -> Failure {
+    match e {
+        SdCardError::CrcError(..) => Failure::Block(flash_str!("CRC error")),
+        SdCardError::ReadError => Failure::Block(flash_str!("error token")),
+        _ => Failure::Gone,
     }
 }
 
@@ -76,46 +114,49 @@ impl CardReader {
             block: Block::new(),
             at: 0,
             len: 0,
+            failures: 0,
+            faulty: None,
             check_at: 0,
         }
     }
 
-    /// One step of work at millisecond `now`. Between requests it sleeps
-    /// until the next check is due. While the machine is `moving`, an
-    /// empty slot is not probed (next second).
+    /// One step of work at millisecond `now`; between requests it waits
+    /// for the app's once-a-second wake-up (`CHECK_MS`). While the machine
+    /// is `moving`, an empty slot is not probed (the probe holds the bus at
+    /// the slow init clock).
     pub fn poll(&mut self, now: u32, moving: bool) -> Poll<Signal> {
-        let due = now.wrapping_sub(self.check_at) as i32 >= 0;
-        if due {
+        if let Some((lba, what, ticket)) = self.faulty {
+            return self.report_faulty(lba, what, ticket);
+        }
+        if now.wrapping_sub(self.check_at) as i32 >= 0 {
+            if CARD_OUT.free() < ROOM {
+                return Poll::Wait(Signal::CardRoom);
+            }
             self.check_at = now.wrapping_add(CHECK_MS);
-        }
-        let poll = self.work(due && !(moving && matches!(self.slot, Slot::Empty)));
-        match poll {
-            Poll::Idle => Poll::After(self.check_at.wrapping_sub(now).min(CHECK_MS) as u16),
-            _ => poll,
-        }
-    }
-
-    /// The step of work; `check`: look for the card or at it. `Idle`: until
-    /// the next check (`poll` puts in the time).
-    fn work(&mut self, check: bool) -> Poll<Signal> {
-        match self.slot {
-            Slot::Empty if check => self.look_for_card(),
-            Slot::Empty => Poll::Idle,
-            Slot::Mounted(volume) => {
-                if let Some(Request::Open(name, ticket)) = CARD_IN.peek() {
-                    if CARD_OUT.free() < ROOM {
-                        return Poll::Wait(Signal::CardRoom);
+            match self.slot {
+                Slot::Empty if moving => {}
+                Slot::Empty => return self.look_for_card(),
+                _ => {
+                    if !self.still_there() {
+                        return Poll::Idle;
                     }
-                    let _ = CARD_IN.pop();
-                    self.open(volume, name, ticket);
-                    return Poll::Again;
-                }
-                match volume {
-                    Some(v) if self.file.is_some() => self.stream(v),
-                    _ if check => self.check_still_there(),
-                    _ => Poll::Idle,
                 }
             }
+        }
+        let Slot::Mounted(volume) = self.slot else {
+            return Poll::Idle;
+        };
+        if let Some(Request::Open(name, ticket)) = CARD_IN.peek() {
+            if CARD_OUT.free() < ROOM {
+                return Poll::Wait(Signal::CardRoom);
+            }
+            let _ = CARD_IN.pop();
+            self.open(volume, name, ticket);
+            return Poll::Again;
+        }
+        match volume {
+            Some(v) if self.file.is_some() => self.stream(v),
+            _ => Poll::Idle,
         }
     }
 
@@ -125,9 +166,6 @@ impl CardReader {
     }
 
     fn look_for_card(&mut self) -> Poll<Signal> {
-        if CARD_OUT.free() < ROOM {
-            return Poll::Wait(Signal::CardRoom);
-        }
         let present = self.sd.spi(|spi| {
             spi.bus.slow_speed();
             spi.idle_clocks(10);
@@ -145,7 +183,11 @@ impl CardReader {
             }
         };
         self.sd.spi(|spi| spi.bus.full_speed());
-        let volume = match Volume::mount(&mut Device(&self.sd), &mut self.block.contents) {
+        let mut dev = Device {
+            sd: &self.sd,
+            lba: 0,
+        };
+        let volume = match Volume::mount(&mut dev, &mut self.block.contents) {
             Ok(v) => {
                 info!(
                     "card: ",
@@ -155,16 +197,23 @@ impl CardReader {
                 );
                 Some(v)
             }
-            Err(FatError::Device(_)) => {
-                warn!("card: read failed");
-                self.sd.mark_card_uninit();
-                return Poll::Idle;
+            Err(FatError::Device(e)) => {
+                let lba = dev.lba;
+                return match failure(&e) {
+                    Failure::Block(what) => self.bad_block(lba, what, 0),
+                    Failure::Gone => {
+                        warn!("card: read failed");
+                        self.sd.mark_card_uninit();
+                        Poll::Idle
+                    }
+                };
             }
             Err(_) => {
-                warn!("card: no FAT16/FAT32 volume");
+                warn!("card: no FAT16/FAT32 volume on the card: format it FAT32");
                 None
             }
         };
+        self.failures = 0;
         self.slot = Slot::Mounted(volume);
         Self::send(What::Inserted, 0);
         Poll::Idle
@@ -177,14 +226,23 @@ impl CardReader {
         let Some(v) = volume else {
             return Self::send(What::Failed, ticket);
         };
-        match v.open(
-            &mut Device(&self.sd),
-            &mut self.block.contents,
-            name.name().as_bytes(),
-        ) {
+        let mut dev = Device {
+            sd: &self.sd,
+            lba: 0,
+        };
+        match v.open(&mut dev, &mut self.block.contents, name.name().as_bytes()) {
             Ok(f) => self.file = Some((f, ticket)),
             Err(FatError::NotFound) => Self::send(What::Missing, ticket),
-            Err(FatError::Device(_)) => self.removed(ticket),
+            Err(FatError::Device(e)) => {
+                let lba = dev.lba;
+                match failure(&e) {
+                    // Reading the directory failed: the job asks again.
+                    Failure::Block(what) => {
+                        let _ = self.bad_block(lba, what, ticket);
+                    }
+                    Failure::Gone => self.removed(ticket),
+                }
+            }
             Err(_) => Self::send(What::Failed, ticket),
         }
     }
@@ -214,21 +272,32 @@ impl CardReader {
         if CARD_OUT.free() < ROOM {
             return Poll::Wait(Signal::CardRoom);
         }
-        match file.read_next(&volume, &mut Device(&self.sd), &mut self.block.contents) {
+        let mut dev = Device {
+            sd: &self.sd,
+            lba: 0,
+        };
+        match file.read_next(&volume, &mut dev, &mut self.block.contents) {
             Ok(0) => {
                 self.file = None;
                 Self::send(What::End, ticket);
                 Poll::Idle
             }
             Ok(n) => {
+                self.failures = 0;
                 self.file = Some((file, ticket));
                 self.at = 0;
                 self.len = n as u16;
                 Poll::Again
             }
-            Err(FatError::Device(_)) => {
-                self.removed(ticket);
-                Poll::Idle
+            Err(FatError::Device(e)) => {
+                let lba = dev.lba;
+                match failure(&e) {
+                    Failure::Block(what) => self.bad_block(lba, what, ticket),
+                    Failure::Gone => {
+                        self.removed(ticket);
+                        Poll::Idle
+                    }
+                }
             }
             Err(_) => {
                 warn!("card: broken cluster chain");
@@ -239,14 +308,46 @@ impl CardReader {
         }
     }
 
-    fn check_still_there(&mut self) -> Poll<Signal> {
-        if CARD_OUT.free() < ROOM {
-            return Poll::Wait(Signal::CardRoom);
+    /// Block `lba` did not read (`what`): read it again, up to [`TRIES`]
+    /// times; then the card is faulty and its file failed.
+    fn bad_block(&mut self, lba: u32, what: FlashStr, ticket: u8) -> Poll<Signal> {
+        self.failures += 1;
+        if self.failures < TRIES {
+            warn!("card: block ", lba, " ", what, ", reading it again");
+            return Poll::Again;
         }
-        if self.sd.num_bytes().is_err() {
-            self.removed(0);
+        self.failures = 0;
+        self.slot = Slot::Faulty;
+        self.faulty = Some((lba, what, ticket));
+        self.report_faulty(lba, what, ticket)
+    }
+
+    /// Say once that the card is failing (waiting for room for the line),
+    /// and fail the file (or the directory it was looked up in); a card
+    /// that failed while mounted was never announced to the job.
+    fn report_faulty(&mut self, lba: u32, what: FlashStr, ticket: u8) -> Poll<Signal> {
+        if TX.free() < crate::log::LINE || CARD_OUT.free() < ROOM {
+            return Poll::After(2);
+        }
+        self.faulty = None;
+        error!(
+            "card: block ",
+            lba, " ", what, " ", TRIES, " times: the card is failing, replace it"
+        );
+        if self.file.take().is_some() || ticket != 0 {
+            Self::send(What::Failed, ticket);
         }
         Poll::Idle
+    }
+
+    /// Is the card still in the slot? Asks for its CSD; a removal is
+    /// reported.
+    fn still_there(&mut self) -> bool {
+        if self.sd.num_bytes().is_ok() {
+            return true;
+        }
+        self.removed(self.file.map_or(0, |(_, t)| t));
+        false
     }
 
     /// The card stopped answering: pulled out (or dead, which the user
@@ -255,6 +356,7 @@ impl CardReader {
         if self.file.take().is_some() {
             Self::send(What::Failed, ticket);
         }
+        self.failures = 0;
         self.sd.mark_card_uninit();
         self.slot = Slot::Empty;
         Self::send(What::Removed, 0);

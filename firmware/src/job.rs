@@ -243,6 +243,7 @@ impl JobTask {
                     params: c.params,
                     count: c.count,
                     config,
+                    id: c.id,
                 };
                 self.event(event, now);
             }

@@ -153,14 +153,9 @@ fn task_of(id: u8) -> Task {
     Task::ALL[id as usize]
 }
 
-/// Spawn `task` in `ms`, replacing its earlier timers: a task spawned
-/// often (by every received byte) must not fill the timer slots with
-/// wake-ups it no longer needs.
+/// Spawn `task` in `ms`, replacing its earlier one-shot timer.
 fn spawn_after(task: Task, ms: u32) {
-    arm(|t, now| {
-        t.cancel(task);
-        t.spawn_after(task, now, ms).is_ok()
-    });
+    arm(|t, now| t.spawn_after(task, now, ms).is_ok());
 }
 
 fn spawn_every(task: Task, ms: u32) {
@@ -256,6 +251,7 @@ fn init() -> Watchdog {
     LED.with(|l| *l = Some((status_led, clock::millis())));
     spawn(Task::Led);
     spawn_every(Task::Logger, LOGGER_PERIOD_MS);
+    spawn_every(Task::Card, card::CHECK_MS);
     JOB.with(|j| j.power_on(clock::millis()));
     spawn(Task::Job);
     spawn(Task::Card);

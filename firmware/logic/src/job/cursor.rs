@@ -54,7 +54,10 @@ impl Cursor {
     /// First look at a byte from the file: is it part of the leading mark,
     /// or a sign that this is no text file?
     pub fn feed(&mut self, b: u8) -> Feed {
-        let utf16 = matches!((self.first.take(), b), (Some(0xFF), 0xFE) | (Some(0xFE), 0xFF));
+        let utf16 = matches!(
+            (self.first.take(), b),
+            (Some(0xFF), 0xFE) | (Some(0xFE), 0xFF)
+        );
         if self.line == 1 && self.col == 0 && self.bom == 0 {
             self.first = Some(b);
         }

@@ -6,7 +6,8 @@
 //! The firmware opens [`Files::file`], feeds its bytes to [`Files::push`]
 //! and answers its end with [`Files::end`] (or [`Files::missing`] when the
 //! card has no such file), until one of them returns [`Next::Done`] or an
-//! error.
+//! error. Each file's length and checksum are kept ([`CardId`]): a card put
+//! back mid-job is the job's card only if both files are the same.
 
 use crate::config::MachineConfig;
 use crate::job::error::{ErrorKind, FileError, FileName};
@@ -22,6 +23,38 @@ pub struct Checked {
     pub config: MachineConfig,
     /// Connections in `poradi.txt`.
     pub count: u32,
+    pub id: CardId,
+}
+
+/// A file's length and a Fletcher-style checksum of its bytes (two
+/// wrapping sums: a few cycles a byte on the AVR).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FileSum {
+    pub len: u32,
+    a: u16,
+    b: u16,
+}
+
+impl FileSum {
+    pub const fn new() -> Self {
+        FileSum { len: 0, a: 0, b: 0 }
+    }
+
+    pub fn add(&mut self, bytes: &[u8]) {
+        for &x in bytes {
+            self.a = self.a.wrapping_add(x as u16);
+            self.b = self.b.wrapping_add(self.a);
+        }
+        self.len = self.len.wrapping_add(bytes.len() as u32);
+    }
+}
+
+/// The job's files as the card holds them: another card with the same
+/// board and count but another pattern is another job.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CardId {
+    pub param: FileSum,
+    pub poradi: FileSum,
 }
 
 /// After a file: open the next one, or all are read.
@@ -39,6 +72,7 @@ enum Stage {
 
 pub struct Files {
     stage: Stage,
+    id: CardId,
 }
 
 impl Default for Files {
@@ -51,6 +85,7 @@ impl Files {
     pub fn new() -> Self {
         Files {
             stage: Stage::Param(ParamFile::new()),
+            id: CardId::default(),
         }
     }
 
@@ -65,9 +100,15 @@ impl Files {
 
     pub fn push(&mut self, chunk: &[u8]) -> Result<(), FileError> {
         match &mut self.stage {
-            Stage::Param(p) => p.push(chunk),
+            Stage::Param(p) => {
+                self.id.param.add(chunk);
+                p.push(chunk)
+            }
             Stage::Machine(_, m) => m.push(chunk),
-            Stage::Poradi(_, _, c) => c.push(chunk),
+            Stage::Poradi(_, _, c) => {
+                self.id.poradi.add(chunk);
+                c.push(chunk)
+            }
         }
     }
 
@@ -91,6 +132,7 @@ impl Files {
                     params: *params,
                     config: *config,
                     count: c.finish()?,
+                    id: self.id,
                 }));
             }
         }
@@ -163,6 +205,22 @@ mod tests {
         ])
         .unwrap();
         assert_ne!(c.config, MachineConfig::STRING_ART);
+    }
+
+    #[test]
+    fn the_same_board_and_count_with_another_pattern_is_another_card() {
+        let card = |pattern: &'static [u8]| {
+            read(&[
+                (FileName::Param, Some(PARAM)),
+                (FileName::Poradi, Some(pattern)),
+            ])
+            .unwrap()
+        };
+        let (a, b) = (card(b"3, 0,12, 23"), card(b"3, 0,13, 22"));
+        assert_eq!((a.params, a.count), (b.params, b.count));
+        assert_ne!(a.id, b.id);
+        assert_eq!(a.id, card(b"3, 0,12, 23").id);
+        assert_eq!(a.id.poradi.len, 11);
     }
 
     #[test]

@@ -35,9 +35,16 @@ impl<T: TaskId, const N: usize> Timers<T, N> {
         Timers { slots: [None; N] }
     }
 
-    /// Spawns `task` once, `delay_ms` after `now_ms` (clamped to 2^31-1 ms).
-    /// A task may have several timers armed; each fires on its own.
+    /// Spawns `task` once, `delay_ms` after `now_ms` (clamped to 2^31-1 ms),
+    /// replacing its one-shot timer if it had one: a task spawned often
+    /// (by every received byte) must not fill the slots with wake-ups it
+    /// no longer needs. Its periodic timer, if any, keeps running.
     pub fn spawn_after(&mut self, task: T, now_ms: u32, delay_ms: u32) -> Result<(), Full> {
+        for slot in &mut self.slots {
+            if slot.is_some_and(|t| t.task.index() == task.index() && t.period == 0) {
+                *slot = None;
+            }
+        }
         self.arm(task, now_ms.wrapping_add(delay_ms.min(MAX_DELAY)), 0)
     }
 
@@ -53,18 +60,6 @@ impl<T: TaskId, const N: usize> Timers<T, N> {
         let free = self.slots.iter_mut().find(|s| s.is_none()).ok_or(Full)?;
         *free = Some(Timer { task, at, period });
         Ok(())
-    }
-
-    /// Disarms every timer of `task`; `false` if it had none.
-    pub fn cancel(&mut self, task: T) -> bool {
-        let mut found = false;
-        for slot in &mut self.slots {
-            if slot.is_some_and(|t| t.task.index() == task.index()) {
-                *slot = None;
-                found = true;
-            }
-        }
-        found
     }
 
     /// The most overdue timer at `now_ms`, if any is due; re-arms it if
@@ -133,6 +128,7 @@ mod tests {
     const A: Tk = tk(0, 1);
     const B: Tk = tk(1, 1);
     const C: Tk = tk(2, 2);
+    const D: Tk = tk(3, 0);
 
     #[test]
     fn one_shot_fires_once_at_its_deadline() {
@@ -186,17 +182,19 @@ mod tests {
     }
 
     #[test]
-    fn full_and_cancel() {
+    fn a_new_delay_replaces_the_one_shot_and_keeps_the_period() {
         let mut t = Tm::new();
         t.spawn_after(A, 0, 5).unwrap();
         t.every(A, 0, 7).unwrap();
         t.spawn_after(B, 0, 9).unwrap();
         t.spawn_after(C, 0, 9).unwrap();
-        assert_eq!(t.spawn_after(C, 0, 1), Err(Full));
-        assert!(t.cancel(A));
-        assert!(!t.cancel(A));
-        assert_eq!(t.ms_to_next(0), Some(9));
-        assert_eq!(t.spawn_after(C, 0, 1), Ok(()), "cancel frees slots");
+        assert_eq!(t.spawn_after(D, 0, 1), Err(Full));
+        // A's one-shot is replaced in its own slot: no slot is needed.
+        t.spawn_after(A, 0, 3).unwrap();
+        assert_eq!(t.ms_to_next(0), Some(3));
+        assert_eq!(t.due(3), Some(A));
+        assert_eq!(t.due(3), None);
+        assert_eq!(t.due(7), Some(A), "the period goes on");
     }
 
     #[test]
@@ -204,14 +202,14 @@ mod tests {
         let mut t = Tm::new();
         let mut r: Ready<Tk, 8, 4> = Ready::new();
         t.spawn_after(B, 0, 2).unwrap();
-        t.spawn_after(A, 0, 1).unwrap();
+        t.every(A, 0, 1).unwrap();
         t.spawn_after(A, 0, 3).unwrap();
         t.spawn_after(C, 0, 50).unwrap();
-        assert_eq!(t.fire_due(10, &mut r), 2, "second A coalesces");
+        assert_eq!(t.fire_due(10, &mut r), 2, "A's two timers coalesce");
         assert_eq!(r.pop(), Some(A));
         assert_eq!(r.pop(), Some(B));
         assert_eq!(r.pop(), None);
-        assert_eq!(t.ms_to_next(10), Some(40));
+        assert_eq!(t.ms_to_next(10), Some(1), "A's period goes on");
     }
 
     #[test]

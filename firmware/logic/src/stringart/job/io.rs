@@ -5,6 +5,7 @@ use super::progress::Progress;
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;
 use crate::config::MachineConfig;
+use crate::job::files::CardId;
 use crate::job::param::Params;
 
 /// The two phases that move the machine.
@@ -78,6 +79,9 @@ pub enum Event<'c> {
         params: Params,
         count: u32,
         config: &'c MachineConfig,
+        /// The files' lengths and checksums: a card back mid-job must
+        /// hold the very same.
+        id: CardId,
     },
     /// The answer to [`Action::ReadFiles`] when a file is missing or bad
     /// (the firmware logs the [`crate::job::FileError`] itself).

@@ -45,6 +45,7 @@ use crate::axis::Axis;
 use crate::buttons::{ButtonEvent, LONG_PRESS_MS};
 use crate::config::MachineConfig;
 use crate::geometry::Board;
+use crate::job::files::CardId;
 use crate::job::param::Params;
 use crate::pinmap::Button;
 use crate::units::Milli;
@@ -65,8 +66,8 @@ enum Card {
 /// The job's files, and the planners made from them at reading time (so
 /// a board that cannot be made is refused before anything moves).
 struct Plan {
-    params: Params,
     count: u32,
+    id: CardId,
     board: Board,
     drilling: Option<Drilling>,
     winder: Option<Winder>,
@@ -160,7 +161,8 @@ impl Job {
                 params,
                 count,
                 config,
-            } => self.files_valid(params, count, config, o),
+                id,
+            } => self.files_valid(params, count, id, config, o),
             Event::FilesInvalid => self.files_invalid(o),
             Event::Button(b) => self.button(b, o, now_ms),
             Event::MotionDone => {
@@ -276,9 +278,16 @@ impl Job {
         }
     }
 
-    fn files_valid(&mut self, params: Params, count: u32, config: &MachineConfig, o: &mut Out) {
+    fn files_valid(
+        &mut self,
+        params: Params,
+        count: u32,
+        id: CardId,
+        config: &MachineConfig,
+        o: &mut Out,
+    ) {
         if self.state == State::Reading {
-            match Self::plan(params, count, config) {
+            match Self::plan(params, count, id, config) {
                 Some(plan) => {
                     self.plan = Some(plan);
                     self.card = Card::Present;
@@ -296,10 +305,7 @@ impl Job {
         if self.card != Card::Checking {
             return;
         }
-        let same = self
-            .plan
-            .as_ref()
-            .is_some_and(|p| p.params == params && p.count == count);
+        let same = self.plan.as_ref().is_some_and(|p| p.id == id);
         if !same {
             self.card = Card::Absent;
             o.push(Action::Log(Msg::OtherCard));
@@ -319,12 +325,12 @@ impl Job {
         }
     }
 
-    fn plan(params: Params, count: u32, config: &MachineConfig) -> Option<Plan> {
+    fn plan(params: Params, count: u32, id: CardId, config: &MachineConfig) -> Option<Plan> {
         let radius = Milli(i32::try_from(params.radius_um).ok()?);
         let board = Board::new(params.shape, params.nails, radius).ok()?;
         Some(Plan {
-            params,
             count,
+            id,
             board,
             drilling: Some(Drilling::new(board, config)),
             winder: Some(Winder::new(board, config).ok()?),

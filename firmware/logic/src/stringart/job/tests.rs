@@ -17,10 +17,20 @@ const CONFIG: MachineConfig = MachineConfig::STRING_ART;
 const ALL: u8 = MACHINE_DRIVERS;
 
 fn valid(params: Params, count: u32) -> Event<'static> {
+    valid_pattern(params, count, 0)
+}
+
+/// Files of this board and count with pattern number `pattern`.
+fn valid_pattern(params: Params, count: u32, pattern: u8) -> Event<'static> {
+    let mut id = CardId::default();
+    id.param.add(std::format!("{params:?}").as_bytes());
+    id.poradi.add(&count.to_le_bytes());
+    id.poradi.add(&[pattern]);
     Event::FilesValid {
         params,
         count,
         config: &CONFIG,
+        id,
     }
 }
 
@@ -606,9 +616,15 @@ fn card_out_while_drilling_is_needed_back_for_winding() {
         b.green(),
         [Action::Log(Msg::NoCard), Action::Prompt(Prompt::InsertCard)]
     );
-    // Another job's card does not count.
+    // Another job's card does not count, even with the same board and
+    // count (another pattern).
     assert_eq!(b.send(Event::CardInserted), [Action::ReadFiles]);
     assert_eq!(b.send(valid(HEX, 6)), [Action::Log(Msg::OtherCard)]);
+    b.sends(&[Event::CardRemoved, Event::CardInserted]);
+    assert_eq!(
+        b.send(valid_pattern(HEX, 5, 1)),
+        [Action::Log(Msg::OtherCard)]
+    );
     assert_eq!(b.green()[0], Action::Log(Msg::NoCard));
     b.sends(&[Event::CardRemoved, Event::CardInserted]);
     assert_eq!(b.send(Event::FilesInvalid), [Action::Log(Msg::OtherCard)]);
