@@ -102,6 +102,12 @@ fn cruise(elf: &Path, axes: &[Axis], rate: u32) -> Option<(f64, f64, f64)> {
             &format!("${}_accel=2000000", a.name()),
             Duration::from_millis(200),
         );
+        // A cruise of 1.3 s runs far past the machine's travel.
+        send(
+            &mut sim,
+            &format!("${}_soft_limits=0", a.name()),
+            Duration::from_millis(200),
+        );
     }
     send(&mut sim, "M17", Duration::from_millis(200));
     // 1.3 s worth of events on every axis, equal counts.
@@ -152,7 +158,10 @@ fn max_rate(elf: &Path, axes: &[Axis]) -> (u32, f64, f64, f64) {
         }
         c.filter(|c| c.0 <= TOLERANCE_US)
     };
-    let (mut lo, mut hi) = (5_000u32, 200_000u32);
+    // The firmware refuses rates whose step period is under twice the
+    // pulse: the default 5 µs pulse allows 100 000 steps/s.
+    let pulse_us = taut_logic::config::MachineConfig::STRING_ART.pulse.step_pulse_us as u32;
+    let (mut lo, mut hi) = (5_000u32, 500_000 / pulse_us + 1_000);
     let mut best = ok(lo)
         .map(|c| (lo, c.0, c.1, c.2))
         .unwrap_or((0, f64::NAN, f64::NAN, f64::NAN));
