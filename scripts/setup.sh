@@ -52,6 +52,7 @@ PIN_HASH=$(sed -n 's/^# *commit-hash: *\([0-9a-f]*\).*/\1/p' "$TOOLCHAIN_FILE")
 export RUSTUP_AUTO_INSTALL=0 # a probe must not start a download
 TOOLCHAINS="${RUSTUP_HOME:-$HOME/.rustup}/toolchains"
 HOST=$(rustup show 2>/dev/null | sed -n 's/^Default host: *//p')
+[ -n "$HOST" ] || { echo "setup: cannot tell rustup's host triple (rustup show)" >&2; exit 1; }
 PIN_DIR="$TOOLCHAINS/$PIN-$HOST"
 
 # The commit of an installed toolchain's rustc (its folder), or nothing.
