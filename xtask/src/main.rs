@@ -5,23 +5,27 @@
 mod bench;
 mod demo;
 mod firmware;
+mod fuzz;
 mod run;
 
 use run::{cargo, root, Result};
 use std::process::ExitCode;
+use std::time::Instant;
 
 const HELP: &str = "\
 usage: cargo xtask <command> [args]
 
   demo              build everything and run the main job on the simulated machine
-  test              host unit tests of every crate + simtest
+  test              host unit tests of every crate, the fuzz targets (40 s each), simtest
+  fuzz [TARGET] [--seconds N] [--seed N]
+                    build the libFuzzer targets and run each N seconds (default all, 40 s)
   simtest           build the firmware images and run the HIL tests in simavr
   build             release ELF + Intel HEX + size report
   sim [args]        run the firmware in simavr (see `cargo xtask sim --help`)
   sdimage DIR -o IMG  build a FAT card image from a folder (dd it to a real card)
   bench             measure, write target/bench.json, print a table
   flash             flash a Mega 2560 through ravedude
-  setup             install what is missing (apt packages, rust-src)
+  setup             install what is missing (apt packages, the pinned nightly)
 ";
 
 fn main() -> ExitCode {
@@ -38,6 +42,13 @@ fn main() -> ExitCode {
         "build" => run::setup().and_then(|_| firmware::build_release().map(|img| img.print_size())),
         "test" => test(),
         "simtest" => run::setup().and_then(|_| simtest()),
+        "fuzz" if rest.iter().any(|a| a == "-h" || a == "--help") => {
+            println!("{}", fuzz::USAGE);
+            Ok(())
+        }
+        "fuzz" => {
+            fuzz::Plan::parse(rest).and_then(|plan| run::setup().and_then(|_| fuzz::run(&plan)))
+        }
         "sim" => run::setup().and_then(|_| sim(rest)),
         "sdimage" => run::setup().and_then(|_| run::bin("taut-sdimage", rest)),
         "demo" => run::setup().and_then(|_| demo::run()),
@@ -59,10 +70,20 @@ fn main() -> ExitCode {
 }
 
 fn test() -> Result<()> {
+    let start = Instant::now();
     run::setup()?;
     println!("== host unit tests");
     cargo(&["test", "--workspace", "--exclude", "hil-tests"], &root())?;
-    simtest()
+    let host = start.elapsed().as_secs();
+    fuzz::run(&fuzz::Plan::test())?;
+    let fuzz = start.elapsed().as_secs() - host;
+    simtest()?;
+    let total = start.elapsed().as_secs();
+    println!(
+        "== all tests passed in {total} s (host unit tests {host} s, fuzz {fuzz} s, firmware and HIL tests {} s)",
+        total - host - fuzz
+    );
+    Ok(())
 }
 
 fn simtest() -> Result<()> {

@@ -83,14 +83,14 @@ impl Cursor {
 
     /// Account for a byte being processed; returns its (line, column).
     /// Columns count characters: UTF-8 continuation bytes share their
-    /// character's column.
+    /// character's column (see [`starts_char`]), so no byte is in column 0.
     pub fn advance(&mut self, b: u8) -> (u32, u32) {
         let crlf = core::mem::replace(&mut self.after_cr, b == b'\r') && b == b'\n';
         if crlf {
             // The LF of a CRLF: the line ended at its CR.
             return (self.line - 1, 0);
         }
-        if b & 0xC0 != 0x80 {
+        if starts_char(b, self.col) {
             self.col += 1;
         }
         let here = (self.line, self.col);
@@ -110,6 +110,19 @@ impl Cursor {
     pub fn next_pos(&self) -> (u32, u32) {
         (self.line, self.col + 1)
     }
+}
+
+/// Whether byte `b`, after `col` characters of its line, starts a character:
+/// any byte but a UTF-8 continuation byte, and also a stray continuation byte
+/// at the start of a line (invalid UTF-8; it has no character to join).
+pub fn starts_char(b: u8, col: u32) -> bool {
+    b & 0xC0 != 0x80 || col == 0
+}
+
+/// The number of characters in `line`, the start of a line.
+pub fn chars(line: &[u8]) -> u32 {
+    line.iter()
+        .fold(0, |n, &b| n + u32::from(starts_char(b, n)))
 }
 
 #[cfg(test)]
@@ -178,5 +191,15 @@ mod tests {
     fn columns_count_characters() {
         let out = run("ě=1".as_bytes());
         assert_eq!(out[2], (b'=', 1, 2));
+        assert_eq!(chars("ě=1".as_bytes()), 3);
+    }
+
+    #[test]
+    fn stray_continuation_bytes_start_a_line_in_column_1() {
+        let out = run(b"a\n\x88\x88=");
+        assert_eq!(out[2], (0x88, 2, 1));
+        assert_eq!(out[3], (0x88, 2, 1));
+        assert_eq!(out[4], (b'=', 2, 2));
+        assert_eq!(chars(b"\x88\x88="), 2);
     }
 }

@@ -108,8 +108,7 @@ impl KvReader {
     /// The item of the completed line `line`, `None` for a blank line.
     fn item(&self, line: u32) -> Result<Option<Item<'_>>, FileError> {
         let text = &self.buf[..self.len as usize];
-        let col =
-            |offset: usize| 1 + text[..offset].iter().filter(|&&b| b & 0xC0 != 0x80).count() as u32;
+        let col = |offset: usize| 1 + super::cursor::chars(&text[..offset]);
         let (start, content) = trim(text);
         if content.is_empty() {
             return Ok(None);
@@ -199,6 +198,9 @@ mod tests {
             err(1, 35, LineTooLong),
             "multi-byte characters may fill the buffer first"
         );
+        // Found by the `param` fuzz target: the error was in column 0.
+        assert_eq!(read(&[0x88; 65]), err(1, 1, LineTooLong));
+        assert_eq!(read(b"\x88 5\n"), err(1, 1, ExpectedKeyValue));
     }
 
     #[test]
