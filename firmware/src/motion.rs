@@ -108,14 +108,21 @@ impl Motion {
     }
 
     /// Move planned blocks into the interrupt's queues, at most `max`
-    /// segments (a ramp segment costs up to ~4 ms here: runs stay short so
-    /// other tasks interleave), and start the interrupt. Returns (a planner
-    /// slot was freed, more can be prepared).
+    /// pieces of work (a block's profile, a segment: up to a few ms each;
+    /// runs stay short so other tasks interleave), and start the interrupt.
+    /// Returns (a planner slot was freed, more can be prepared).
     pub fn refill(&mut self, max: usize) -> (bool, bool) {
         let mut freed = false;
         let mut made = 0;
         let mut room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
         while room && made < max && self.buffered.queued_us(SEGMENTS.len()) < QUEUED_MAX_US {
+            // A block's profile and a segment each count as one piece of
+            // work (each costs up to a few ms).
+            if PLANNER.with(|p| self.prep.load(p)) {
+                freed = true;
+                made += 1;
+                continue;
+            }
             let Some(cut) = PLANNER.with(|p| self.prep.next(p)) else {
                 break;
             };

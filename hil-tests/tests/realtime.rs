@@ -39,7 +39,7 @@ fn enabled() -> Sim {
 fn status(sim: &mut Sim) -> (String, f64) {
     let start = sim.uart_bytes().len();
     let t0 = sim.time_s();
-    sim.uart_send(b"?");
+    sim.uart_send_at(Duration::from_secs_f64(t0), b"?");
     let mut first = None;
     let done = sim.run_until(
         |s| {

@@ -63,7 +63,8 @@ fn stream(sim: &mut Sim, lines: &[String], status_every: Option<Duration>) -> f6
             if let Some(every) = status_every {
                 if asked.is_none() && sim.time_s() >= next_status {
                     asked = Some((sim.time_s(), reports(sim)));
-                    sim.uart_send(b"?");
+                    // Slipped in ahead of the line being sent, as senders do.
+                    sim.uart_send_at(Duration::from_secs_f64(sim.time_s()), b"?");
                     next_status = sim.time_s() + every.as_secs_f64();
                 }
             }

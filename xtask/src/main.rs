@@ -20,6 +20,9 @@ usage: cargo xtask <command> [args]
   fuzz [TARGET] [--seconds N] [--seed N]
                     build the libFuzzer targets and run each N seconds (default all, 40 s)
   simtest           build the firmware images and run the HIL tests in simavr
+  soak              the HIL tests at full size (5000-move streams, 100 wraps of a
+                    10 000-connection job, a 1 000 000-connection pattern, fuzzing
+                    10 min a target): tens of minutes
   build             release ELF + Intel HEX + size report
   sim [args]        run the firmware in simavr (see `cargo xtask sim --help`)
   sdimage DIR -o IMG  build a FAT card image from a folder (dd it to a real card)
@@ -42,6 +45,7 @@ fn main() -> ExitCode {
         "build" => run::setup().and_then(|_| firmware::build_release().map(|img| img.print_size())),
         "test" => test(),
         "simtest" => run::setup().and_then(|_| simtest()),
+        "soak" => run::setup().and_then(|_| soak()),
         "fuzz" if rest.iter().any(|a| a == "-h" || a == "--help") => {
             println!("{}", fuzz::USAGE);
             Ok(())
@@ -92,6 +96,24 @@ fn simtest() -> Result<()> {
     img.print_size();
     println!("== HIL tests (release firmware in simavr)");
     cargo(&["test", "-p", "hil-tests"], &root())
+}
+
+/// The campaigns too long for CI: every HIL test at its full size
+/// (`TAUT_SOAK=1`) with the ignored (soak-only) ones, then longer fuzzing.
+fn soak() -> Result<()> {
+    let img = firmware::build_release()?;
+    firmware::build_examples()?;
+    img.print_size();
+    println!("== HIL tests at full size (TAUT_SOAK=1)");
+    let mut c = run::cargo_cmd(
+        &["test", "-p", "hil-tests", "--", "--include-ignored"],
+        &root(),
+    );
+    run::status(c.env("TAUT_SOAK", "1"))?;
+    fuzz::run(&fuzz::Plan::parse(&[
+        "--seconds".to_string(),
+        "600".to_string(),
+    ])?)
 }
 
 /// Run `taut-sim` (the simulator CLI in simavr/) on the release image.

@@ -70,6 +70,17 @@ impl Prep {
         self.cut.is_idle()
     }
 
+    /// Take the next block from `planner` now if the last is all cut (its
+    /// profile costs about as much as a segment: a caller keeping its runs
+    /// short does this in a run of its own). True if it took one.
+    pub fn load(&mut self, planner: &mut Planner) -> bool {
+        if !self.cut.is_idle() {
+            return false;
+        }
+        self.block = self.take(planner);
+        self.block.is_some()
+    }
+
     /// The next segment, taking the next block from `planner` when the last
     /// is cut; `None` when there is nothing to cut or a hold has stopped.
     pub fn next(&mut self, planner: &mut Planner) -> Option<Cut> {
