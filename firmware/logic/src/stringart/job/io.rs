@@ -1,29 +1,13 @@
 //! What the job hears ([`Event`]) and what it asks the firmware to do
 //! ([`Action`]), with the texts the firmware logs.
 
+use super::phase::Phase;
 use super::progress::Progress;
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;
 use crate::config::MachineConfig;
 use crate::job::files::CardId;
 use crate::job::param::Params;
-
-/// The two phases that move the machine.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Phase {
-    Drilling,
-    Winding,
-}
-
-impl Phase {
-    /// Progress lines start with this: `drill 12/24`, `wind 1234/3000`.
-    pub const fn name(self) -> &'static str {
-        match self {
-            Phase::Drilling => "drill",
-            Phase::Winding => "wind",
-        }
-    }
-}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum State {

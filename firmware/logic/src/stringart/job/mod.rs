@@ -34,10 +34,12 @@
 
 mod io;
 mod motion;
+mod phase;
 mod progress;
 
-pub use io::{Action, Actions, Event, Msg, Phase, Prompt, State, PROMPT_MARK};
+pub use io::{Action, Actions, Event, Msg, Prompt, State, PROMPT_MARK};
 pub use motion::FEED;
+pub use phase::Phase;
 pub use progress::{left_s, Progress};
 
 use super::{bit, Drilling, Step, Winder, MACHINE_DRIVERS};
