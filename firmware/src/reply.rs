@@ -6,7 +6,7 @@ use crate::board::usart;
 use crate::log::Line;
 use crate::texts;
 use taut_logic::gcode::Error;
-use taut_logic::job::error::ErrorKind;
+use taut_logic::text::ErrorKind;
 use taut_logic::units::Milli;
 use ufmt::{uWrite, uwrite};
 

@@ -3,7 +3,7 @@
 //! on the card and `$` settings override them.
 
 use crate::axis::{Axis, PerAxis};
-use crate::job::error::ErrorKind;
+use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
 
 /// Per-axis figures. Rates are in steps so the step generator never converts.

@@ -28,4 +28,5 @@ pub mod sched;
 pub mod segment;
 pub mod settings;
 pub mod stringart;
+pub mod text;
 pub mod units;

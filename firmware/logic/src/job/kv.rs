@@ -4,8 +4,9 @@
 //! or CRLF line ends, blanks around `=` and a byte-order mark at the start.
 
 use crate::job::cursor::{Cursor, Feed};
-use crate::job::error::{ErrorKind, FileError, FileName};
-use crate::job::num::trim;
+use crate::job::error::{FileError, FileName};
+use crate::text::num::trim;
+use crate::text::ErrorKind;
 
 /// Longest line accepted, comment included, in characters.
 pub const MAX_LINE: usize = 64;

@@ -3,8 +3,9 @@
 //! numbers, an optional trailing comma. O(1) memory.
 
 use crate::job::cursor::{Cursor, Feed};
-use crate::job::error::{ErrorKind, FileError, FileName};
-use crate::job::num::push_digit;
+use crate::job::error::{FileError, FileName};
+use crate::text::num::push_digit;
+use crate::text::ErrorKind;
 
 /// A number of the list and where its first digit is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

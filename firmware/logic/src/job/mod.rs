@@ -12,8 +12,7 @@ pub mod files;
 pub mod kv;
 pub mod list;
 pub mod machine;
-pub mod num;
 pub mod param;
 pub mod poradi;
 
-pub use error::{ErrorKind, FileError, FileName};
+pub use error::{FileError, FileName};

@@ -114,7 +114,7 @@ impl Reporter {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::show;
+    use crate::text::error::tests::show;
 
     #[test]
     fn lines_read_as_the_issue_shows() {
