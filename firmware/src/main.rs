@@ -183,7 +183,7 @@ fn main() -> ! {
         &READY,
         task_of,
         clock::millis,
-        &watchdog,
+        || watchdog.feed(),
         |task| match task {
             Task::Timers => timers(),
             Task::Realtime => realtime(),
