@@ -7,7 +7,7 @@
 use crate::rt::{Flags, Ring};
 use core::sync::atomic::AtomicBool;
 use taut_logic::buttons::ButtonEvent;
-use taut_logic::job::FileName;
+use taut_logic::files::FileName;
 use taut_logic::segment::{Segment, StepBlock};
 
 /// UART receive interrupt → console: line bytes (real-time commands are

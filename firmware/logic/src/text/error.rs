@@ -11,7 +11,7 @@ pub enum ErrorKind {
     NotFound,
     /// Nothing but blanks and comments.
     Empty,
-    /// A `key = value` line longer than [`crate::job::kv::MAX_LINE`].
+    /// A `key = value` line longer than [`crate::files::kv::MAX_LINE`].
     LineTooLong,
     /// A line that is neither blank, a comment nor `key = value`.
     ExpectedKeyValue,

@@ -6,8 +6,8 @@ use super::progress::Progress;
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;
 use crate::config::MachineConfig;
-use crate::job::files::CardId;
-use crate::job::param::Params;
+use crate::files::check::CardId;
+use crate::files::param::Params;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum State {
@@ -58,7 +58,7 @@ pub enum Event<'c> {
     CardInserted,
     CardRemoved,
     /// The answer to [`Action::ReadFiles`]: `param.txt` and `machine.txt`
-    /// read, `poradi.txt` checked completely ([`crate::job::poradi::PoradiCheck`]).
+    /// read, `poradi.txt` checked completely ([`crate::files::poradi::PoradiCheck`]).
     FilesValid {
         params: Params,
         count: u32,
@@ -68,7 +68,7 @@ pub enum Event<'c> {
         id: CardId,
     },
     /// The answer to [`Action::ReadFiles`] when a file is missing or bad
-    /// (the firmware logs the [`crate::job::FileError`] itself).
+    /// (the firmware logs the [`crate::files::FileError`] itself).
     FilesInvalid,
     Button(ButtonEvent),
     /// Every step taken from [`super::Job::next_step`] has been carried
@@ -179,7 +179,7 @@ pub enum Action {
     /// Read and check the card's files; answer with `FilesValid` or
     /// `FilesInvalid`.
     ReadFiles,
-    /// Open `poradi.txt` for streaming ([`crate::job::poradi::PoradiReader`])
+    /// Open `poradi.txt` for streaming ([`crate::files::poradi::PoradiReader`])
     /// and pass over its first `skip` nail indices (already fed).
     OpenPattern {
         skip: u32,

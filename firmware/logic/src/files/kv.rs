@@ -3,8 +3,8 @@
 //! (at most [`MAX_LINE`] bytes). Accepts `#` comments, blank lines, LF, CR
 //! or CRLF line ends, blanks around `=` and a byte-order mark at the start.
 
-use crate::job::cursor::{Cursor, Feed};
-use crate::job::error::{FileError, FileName};
+use crate::files::cursor::{Cursor, Feed};
+use crate::files::error::{FileError, FileName};
 use crate::text::num::trim;
 use crate::text::ErrorKind;
 

@@ -2,8 +2,8 @@
 //! `3000,0,159,\r\n 251, 56,` — blanks and line breaks anywhere between
 //! numbers, an optional trailing comma. O(1) memory.
 
-use crate::job::cursor::{Cursor, Feed};
-use crate::job::error::{FileError, FileName};
+use crate::files::cursor::{Cursor, Feed};
+use crate::files::error::{FileError, FileName};
 use crate::text::num::push_digit;
 use crate::text::ErrorKind;
 

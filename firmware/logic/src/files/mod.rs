@@ -6,9 +6,9 @@
 //!   validated in one pass, then streamed again while winding.
 //! - `machine.txt` ([`machine`]): optional overrides of the machine settings.
 
+pub mod check;
 pub mod cursor;
 pub mod error;
-pub mod files;
 pub mod kv;
 pub mod list;
 pub mod machine;

@@ -4,8 +4,8 @@
 //! ([`PoradiCheck`]), then streamed again while winding ([`PoradiReader`]):
 //! O(C) reads in all, O(1) memory.
 
-use crate::job::error::{FileError, FileName};
-use crate::job::list::{List, Number};
+use crate::files::error::{FileError, FileName};
+use crate::files::list::{List, Number};
 use crate::text::ErrorKind;
 
 /// Most connections a job may declare.

@@ -10,10 +10,10 @@
 //! back mid-job is the job's card only if both files are the same.
 
 use crate::config::MachineConfig;
-use crate::job::error::{FileError, FileName};
-use crate::job::machine::MachineFile;
-use crate::job::param::{ParamFile, Params};
-use crate::job::poradi::PoradiCheck;
+use crate::files::error::{FileError, FileName};
+use crate::files::machine::MachineFile;
+use crate::files::param::{ParamFile, Params};
+use crate::files::poradi::PoradiCheck;
 use crate::text::ErrorKind;
 
 /// What the card holds, once every file checked out.

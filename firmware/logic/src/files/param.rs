@@ -8,8 +8,8 @@
 //! Keys are the original firmware's or their English aliases (`shape`,
 //! `nails`, `radius_cm`), in any case. Each must appear exactly once.
 
-use crate::job::error::{FileError, FileName};
-use crate::job::kv::{Item, KvReader};
+use crate::files::error::{FileError, FileName};
+use crate::files::kv::{Item, KvReader};
 use crate::text::num::{parse_fixed, parse_u32, NumError};
 use crate::text::ErrorKind;
 
@@ -181,7 +181,7 @@ impl Seen {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::in_every_chunking;
+    use crate::files::error::tests::in_every_chunking;
     use crate::text::error::tests::show;
     use proptest::prelude::*;
     use std::string::String;
