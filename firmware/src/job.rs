@@ -22,7 +22,7 @@ use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::planner::Feed;
 use taut_logic::stringart::job::{Action, Event, Job, State};
-use taut_logic::stringart::Step;
+use taut_logic::stringart::MachineStep;
 
 /// Room for a whole log line, claimed from the console while there is none.
 fn room_for_a_line() -> bool {
@@ -69,7 +69,7 @@ pub struct JobTask {
     /// for the machine to stand.
     pulling: bool,
     settling: bool,
-    pending: Option<Step>,
+    pending: Option<MachineStep>,
     dwell_until: Option<u32>,
     /// Queue figures are logged line by line after a job ends.
     report_line: Option<u8>,
@@ -388,7 +388,7 @@ impl JobTask {
                 break;
             };
             match step {
-                Step::Move(targets) => {
+                MachineStep::Move(targets) => {
                     let mut at = m.target();
                     for i in 0..AXES {
                         if let Some(t) = targets[i] {
@@ -405,11 +405,11 @@ impl JobTask {
                     self.pending = Some(step);
                     return Poll::Wait(Signal::Motion);
                 }
-                Step::Dwell(ms) => {
+                MachineStep::Dwell(ms) => {
                     self.dwell_until = Some(now.wrapping_add(ms as u32));
                     return Poll::After(ms);
                 }
-                Step::Drivers { mask, on } => m.drivers.set(mask, on),
+                MachineStep::Drivers { mask, on } => m.drivers.set(mask, on),
             }
         }
         if self.settling {

@@ -34,7 +34,7 @@ use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{
     self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
 };
-use taut_firmware::buttons::{self, ButtonPins, Debounce};
+use taut_firmware::buttons::{self, ButtonPins, ButtonsTask};
 use taut_firmware::card::{self, CardReader};
 use taut_firmware::console::{Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
@@ -119,7 +119,7 @@ static WAITING: TaskCell<[u16; 2]> = TaskCell::new([0; 2]);
 static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
 static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
 static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
-static DEBOUNCE: TaskCell<Debounce> = TaskCell::new(Debounce::new());
+static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::new(ButtonsTask::new());
 static JOB: TaskCell<JobTask> = TaskCell::new(JobTask::new());
 static CARD: TaskCell<Option<CardReader>> = TaskCell::new(None);
 
@@ -367,7 +367,7 @@ fn control_job(c: Control) {
 /// Debounce the tick's samples; presses go to the job.
 #[inline(never)]
 fn buttons() {
-    if DEBOUNCE.with(|d| d.poll()) {
+    if BUTTONS_TASK.with(|d| d.poll()) {
         spawn(Task::Job);
     }
 }

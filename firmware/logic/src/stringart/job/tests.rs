@@ -49,11 +49,11 @@ fn board(params: Params) -> Board {
 }
 
 /// The whole drilling / winding sequence as the planners make it.
-fn drilled(params: Params) -> Vec<Step> {
+fn drilled(params: Params) -> Vec<MachineStep> {
     Drilling::new(board(params), &CONFIG).collect()
 }
 
-fn wound(params: Params, pattern: &[u16]) -> Vec<Step> {
+fn wound(params: Params, pattern: &[u16]) -> Vec<MachineStep> {
     let winder = Winder::new(board(params), &CONFIG).unwrap();
     Winding::new(winder, pattern.iter().copied())
         .map(Result::unwrap)
@@ -70,7 +70,7 @@ struct Bench {
     /// Next index of the pattern the card reader delivers.
     at: usize,
     /// Steps carried out, and every action seen.
-    steps: Vec<Step>,
+    steps: Vec<MachineStep>,
     actions: Vec<Action>,
     pulling: bool,
     drivers: u8,
@@ -146,15 +146,15 @@ impl Bench {
         self.pulling = false;
         while let Some(step) = self.job.next_step() {
             match step {
-                Step::Move(t) => {
+                MachineStep::Move(t) => {
                     for (p, t) in self.pos.iter_mut().zip(t) {
                         *p = t.unwrap_or(*p);
                     }
                     self.now += 500;
                 }
-                Step::Dwell(ms) => self.now += ms as u32,
-                Step::Drivers { mask, on: true } => self.drivers |= mask,
-                Step::Drivers { mask, on: false } => self.drivers &= !mask,
+                MachineStep::Dwell(ms) => self.now += ms as u32,
+                MachineStep::Drivers { mask, on: true } => self.drivers |= mask,
+                MachineStep::Drivers { mask, on: false } => self.drivers &= !mask,
             }
             self.steps.push(step);
             self.feed();
@@ -416,9 +416,9 @@ fn long_press_pauses_after_the_batch_and_a_short_press_resumes() {
     );
     // The hole is finished first: its dwell and retract still come (the
     // machine stands with the drill raised), then nothing.
-    let rest: std::vec::Vec<Step> = core::iter::from_fn(|| b.job.next_step()).collect();
+    let rest: std::vec::Vec<MachineStep> = core::iter::from_fn(|| b.job.next_step()).collect();
     assert!(
-        matches!(rest[..], [Step::Dwell(_), Step::Move(_)]),
+        matches!(rest[..], [MachineStep::Dwell(_), MachineStep::Move(_)]),
         "{rest:?}"
     );
     b.steps.extend(rest);
@@ -752,7 +752,7 @@ fn winding_waits_for_the_card_reader() {
     b.green();
     // The reader is slow: nothing fed yet. The entry needs no index.
     b.pulling = false;
-    let entry: Vec<Step> = core::iter::from_fn(|| b.job.next_step()).collect();
+    let entry: Vec<MachineStep> = core::iter::from_fn(|| b.job.next_step()).collect();
     assert_eq!(entry.len(), 4);
     assert_eq!(b.send(Event::MotionDone), [], "no index yet: it waits");
     assert!(b.job.wants_nail());
