@@ -20,6 +20,7 @@ pub struct Drivers {
     pins: EnablePins,
     active_high: PerAxis<bool>,
     setup_us: u32,
+    /// Drivers on (bit = axis): the set-up wait is only for one coming on.
     on: u8,
 }
 
@@ -42,11 +43,6 @@ impl Drivers {
             self.active_high[i] = config.axes[i].enable_active_high;
         }
         self.setup_us = config.pulse.enable_setup_us as u32;
-    }
-
-    /// Bit `i` set: axis `i` is on.
-    pub fn on_mask(&self) -> u8 {
-        self.on
     }
 
     /// Switch the drivers in `mask` on or off. After switching one on, wait

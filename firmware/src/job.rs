@@ -1,5 +1,5 @@
 //! The job task's state: the string-art job (`taut_logic::stringart::job`)
-//! fed by the buttons, the card reader and the console's `!`/`~`, its
+//! fed by the buttons, the card reader and the console's `~` and Ctrl-X, its
 //! actions carried out here — log lines, card requests, drivers, zeroing,
 //! and the machine's steps handed to the planner.
 //!

@@ -70,19 +70,6 @@ impl<const N: u8, M> Pin<N, M> {
         Self::write_level(true);
         Pin { _mode: PhantomData }
     }
-
-    pub fn into_floating_input(self) -> Pin<N, Floating> {
-        Self::set_ddr(false);
-        Self::write_level(false);
-        Pin { _mode: PhantomData }
-    }
-}
-
-impl<const N: u8> Pin<N, Output> {
-    pub fn toggle(&mut self) {
-        let (pin, _, _, mask) = Self::REGS;
-        unsafe { write_volatile(pin, mask) }
-    }
 }
 
 impl<const N: u8, M> embedded_hal::digital::ErrorType for Pin<N, M> {

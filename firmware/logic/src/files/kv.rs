@@ -76,11 +76,6 @@ impl KvReader {
         self.item(line)
     }
 
-    /// Where the file ended (or the next byte would be).
-    pub fn end_pos(&self) -> (u32, u32) {
-        self.cursor.next_pos()
-    }
-
     fn byte(&mut self, b: u8) -> Result<(), FileError> {
         if self.ended.take().is_some() {
             self.len = 0;

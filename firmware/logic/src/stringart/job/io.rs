@@ -74,8 +74,6 @@ pub enum Event<'c> {
     /// Every step taken from [`super::Job::next_step`] has been carried
     /// out, and `next_step` returned `None`.
     MotionDone,
-    /// Pause after the current hole or wrap (as a long press of green).
-    Pause,
     /// Serial `~` with no feed hold to end: resume a paused job.
     Resume,
     /// Serial Ctrl-X: the machine was stopped at once and the queued steps

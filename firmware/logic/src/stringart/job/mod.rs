@@ -12,8 +12,9 @@
 //! card through [`Event::Nail`] whenever [`Job::wants_nail`].
 //!
 //! Steps come in batches of one hole or one wrap: a pause (a long press of
-//! green, or `!`) stops the machine when the current batch is done — drill
-//! raised, needle inside the ring — with the drivers holding.
+//! green) stops the machine when the current batch is done — drill raised,
+//! needle inside the ring — with the drivers holding. (The console's `!` is
+//! a feed hold of the motion, not a pause of the job.)
 //!
 //! Buttons: green confirms on a short press (released before 2 s) and
 //! pauses drilling or winding on a long press; the white zeroing buttons
@@ -44,7 +45,7 @@ pub use progress::{left_s, Progress};
 
 use super::{bit, Drilling, MachineStep, Winder, MACHINE_DRIVERS};
 use crate::axis::Axis;
-use crate::buttons::{ButtonEvent, LONG_PRESS_MS};
+use crate::buttons::ButtonEvent;
 use crate::config::MachineConfig;
 use crate::files::check::CardId;
 use crate::files::param::Params;
@@ -177,7 +178,6 @@ impl Job {
                     self.advance(o, now_ms);
                 }
             }
-            Event::Pause => self.pause(o, now_ms),
             Event::Resume => self.resume(o, now_ms),
             Event::Abort => self.abort(o),
             Event::Nail(j) => self.nail(j, o, now_ms),
@@ -366,10 +366,7 @@ impl Job {
                 }
             }
             ButtonEvent::LongPress(Button::Confirm) => self.pause(o, now_ms),
-            ButtonEvent::Released {
-                button: Button::Confirm,
-                held_ms,
-            } if held_ms < LONG_PRESS_MS => self.confirm(o, now_ms),
+            e if e.is_short_press(Button::Confirm) => self.confirm(o, now_ms),
             _ => {}
         }
     }

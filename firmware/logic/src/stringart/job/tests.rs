@@ -44,6 +44,9 @@ fn short(button: Button) -> [Event<'static>; 2] {
     ]
 }
 
+/// Green held for 2 s: pause after the current hole or wrap.
+const LONG_GREEN: Event<'static> = Event::Button(ButtonEvent::LongPress(Button::Confirm));
+
 fn board(params: Params) -> Board {
     Board::new(params.shape, params.nails, Milli(params.radius_um as i32)).unwrap()
 }
@@ -406,7 +409,7 @@ fn long_press_pauses_after_the_batch_and_a_short_press_resumes() {
     b.pulling = false;
     b.steps
         .extend([b.job.next_step().unwrap(), b.job.next_step().unwrap()]);
-    let long = b.send(Event::Button(ButtonEvent::LongPress(Button::Confirm)));
+    let long = b.send(LONG_GREEN);
     assert_eq!(
         long,
         [
@@ -446,30 +449,27 @@ fn long_press_pauses_after_the_batch_and_a_short_press_resumes() {
     // Nothing lost, nothing repeated.
     assert_eq!(b.steps, drilled(HEX));
     // A long press outside drilling and winding does nothing.
-    assert_eq!(
-        b.send(Event::Button(ButtonEvent::LongPress(Button::Confirm))),
-        []
-    );
+    assert_eq!(b.send(LONG_GREEN), []);
 }
 
 #[test]
-fn serial_pause_and_resume_while_winding() {
+fn long_press_pauses_winding_and_serial_resume_resumes() {
     let mut b = Bench::new(HEX, &PATTERN);
     b.ready();
-    assert_eq!(b.send(Event::Pause), [], "nothing to pause");
+    assert_eq!(b.send(LONG_GREEN), [], "nothing to pause");
     b.green();
     b.run();
     b.green();
     b.batch(); // the entry
     b.batch(); // nail 0
     assert_eq!(
-        b.send(Event::Pause),
+        b.send(LONG_GREEN),
         [
             Action::Enter(State::Paused(Phase::Winding)),
             Action::Prompt(Prompt::Resume)
         ]
     );
-    assert_eq!(b.send(Event::Pause), [], "already paused");
+    assert_eq!(b.send(LONG_GREEN), [], "already paused");
     // The batch the firmware was already asked for is empty, and then
     // nothing more is asked for.
     let len = b.steps.len();
@@ -518,7 +518,7 @@ fn pause_and_resume_before_the_batch_has_finished() {
     b.pulling = false;
     let step = b.job.next_step().unwrap();
     b.steps.push(step);
-    b.send(Event::Pause);
+    b.send(LONG_GREEN);
     // Resumed while the machine is still moving: keep pulling.
     assert_eq!(b.send(Event::Resume).last(), Some(&Action::NextMoves));
     assert!(b.pulling);
