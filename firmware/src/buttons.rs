@@ -50,6 +50,7 @@ static SAMPLER: Sampler = Sampler(UnsafeCell::new(None));
 
 /// Hand the pins to the tick; call before interrupts are enabled.
 pub fn start(pins: ButtonPins) {
+    // SAFETY: see `Sampler`; interrupts are masked besides.
     avr_device::interrupt::free(|_| unsafe { *SAMPLER.0.get() = Some((pins, 0, u8::MAX)) });
 }
 

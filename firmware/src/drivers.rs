@@ -1,5 +1,6 @@
 //! The drivers' ENABLE inputs (TB6600 ENA): switching a motor's holding
 //! current on and off, with the ENABLE-to-DIR set-up time kept.
+#![deny(unsafe_code)]
 
 use crate::board::delay::Delay;
 use crate::board::gpio::{Output, Pin};

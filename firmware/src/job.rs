@@ -5,6 +5,7 @@
 //!
 //! Log lines wait for room in the TX ring rather than being dropped: the
 //! prompts and the bad-file messages must reach the user.
+#![deny(unsafe_code)]
 
 use crate::motion::Motion;
 use crate::queues::{

@@ -3,6 +3,7 @@
 //! ring is back-pressure — the producer keeps its message and tries again
 //! — and every ring counts what it sent, refused, and its high-water mark
 //! (`$Q`, and the end of a job).
+#![deny(unsafe_code)]
 
 use crate::rt::{Flags, Ring};
 use core::sync::atomic::AtomicBool;

@@ -528,6 +528,9 @@ unsafe fn schedule_next(e: &mut Exec) {
 
 /// Move the compare register towards the pending event by at most
 /// `WAIT_PART` ticks at a time, flagging an event that can no longer be on time.
+///
+/// # Safety
+/// Timer1 registers; called from the interrupt or with it masked.
 #[inline(always)]
 unsafe fn advance_compare(e: &mut Exec) {
     let part = if e.wait > LONG_WAIT {
@@ -548,6 +551,9 @@ unsafe fn advance_compare(e: &mut Exec) {
 }
 
 /// Toggle the STEP pins of `m`: one store per port.
+///
+/// # Safety
+/// STEP pin registers; called from the interrupt.
 #[inline(always)]
 unsafe fn toggle_steps(m: &[u8; SLOTS]) {
     if !slot_pin(0).is_null() {

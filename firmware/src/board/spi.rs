@@ -39,6 +39,7 @@ impl Spi {
     }
 
     fn exchange(&mut self, out: u8) -> u8 {
+        // SAFETY: SPDR takes any byte.
         self.spi.spdr().write(|w| unsafe { w.bits(out) });
         while self.spi.spsr().read().spif().bit_is_clear() {}
         self.spi.spdr().read().bits()
