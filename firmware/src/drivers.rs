@@ -8,6 +8,7 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::config::MachineConfig;
+use taut_logic::pinmap::DRIVERS;
 
 /// RAMPS X/Y/Z/E0 ENABLE pins (see `taut_logic::pinmap::DRIVERS`).
 pub struct EnablePins {
@@ -16,6 +17,11 @@ pub struct EnablePins {
     pub drill: Pin<62, Output>,
     pub aux: Pin<24, Output>,
 }
+
+const _: () = {
+    assert!(DRIVERS[0].enable == 38 && DRIVERS[1].enable == 56);
+    assert!(DRIVERS[2].enable == 62 && DRIVERS[3].enable == 24);
+};
 
 pub struct Drivers {
     pins: EnablePins,

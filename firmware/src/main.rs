@@ -44,7 +44,7 @@ use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL};
 use taut_firmware::realtime::{self, Requests};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{stack, Poll, TaskCell};
-use taut_firmware::stepper::{self, Stepper};
+use taut_firmware::stepper::{self, StepDirPins, Stepper};
 use taut_firmware::{
     board::usart::{RXCIE0, UDRIE0},
     nested_vector, step_vector,
@@ -220,7 +220,17 @@ fn init() -> Watchdog {
         aux: pins.d24.into_output(),
     };
     let drivers = Drivers::new(enable, &config);
-    let stepper = Stepper::new(StepTimer::start(dp.TC1), &config);
+    let step_dir = StepDirPins {
+        base_step: pins.a0.into_output_at(false),
+        base_dir: pins.a1.into_output_at(false),
+        radial_step: pins.a6.into_output_at(false),
+        radial_dir: pins.a7.into_output_at(false),
+        drill_step: pins.d46.into_output_at(false),
+        drill_dir: pins.d48.into_output_at(false),
+        aux_step: pins.d26.into_output_at(false),
+        aux_dir: pins.d28.into_output_at(false),
+    };
+    let stepper = Stepper::new(step_dir, StepTimer::start(dp.TC1), &config);
     MOTION.with(|m| *m = Some(Motion::new(&config, stepper, drivers)));
     let spi = CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53);
     CARD.with(|c| *c = Some(CardReader::new(spi)));
@@ -419,6 +429,7 @@ fn logger() {
 
 /// The status LED and when its boot pattern started.
 static LED: TaskCell<Option<(Pin<13, Output>, u32)>> = TaskCell::new(None);
+const _: () = assert!(taut_logic::pinmap::STATUS_LED == 13);
 
 /// The status LED: `BOOT_BLINKS` flashes of 100 ms at boot, then off.
 #[inline(never)]
