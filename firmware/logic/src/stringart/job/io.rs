@@ -132,10 +132,10 @@ impl Msg {
     }
 }
 
-/// What a waiting state waits for. Texts are short: on the AVR they live
-/// in SRAM. Prompts that green answers contain
+/// What a waiting state waits for. Prompts that green answers contain
 /// `press green`, so a test bench can answer them; the card prompts do
-/// not (green cannot help there).
+/// not (green cannot help there). The firmware logs a copy of each text
+/// made in flash at compile time, as it does for [`Msg`] and [`State`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Prompt {
     InsertCard,
