@@ -13,7 +13,7 @@ use taut_firmware::card::CardReader;
 use taut_firmware::info;
 use taut_firmware::queues::{Request, Signal, What, CARD_IN, CARD_OUT};
 use taut_firmware::rt::Poll;
-use taut_logic::job::FileName;
+use taut_logic::files::FileName;
 
 #[avr_device::entry]
 fn main() -> ! {

@@ -44,7 +44,7 @@ fn main() -> ! {
         &READY,
         |_| Stuck,
         clock::millis,
-        &watchdog,
+        || watchdog.feed(),
         |_| {
             warn!("task entering an endless loop");
             loop {

@@ -8,7 +8,7 @@ use crate::board::gpio::{Pin, PullUp};
 use crate::queues::{BUTTONS, SAMPLES};
 use core::cell::UnsafeCell;
 use embedded_hal::digital::InputPin;
-use taut_logic::buttons::{Buttons, DEBOUNCE_MS};
+use taut_logic::buttons::{Debouncer, DEBOUNCE_MS};
 use taut_logic::pinmap::Button;
 
 /// The end-stop inputs of the RAMPS board: X-MAX (green), X-MIN, Y-MIN,
@@ -50,6 +50,7 @@ static SAMPLER: Sampler = Sampler(UnsafeCell::new(None));
 
 /// Hand the pins to the tick; call before interrupts are enabled.
 pub fn start(pins: ButtonPins) {
+    // SAFETY: see `Sampler`; interrupts are masked besides.
     avr_device::interrupt::free(|_| unsafe { *SAMPLER.0.get() = Some((pins, 0, u8::MAX)) });
 }
 
@@ -72,20 +73,20 @@ pub fn sample() -> bool {
 }
 
 /// The buttons task's state: the debouncer.
-pub struct Debounce(Buttons);
+pub struct ButtonsTask(Debouncer);
 
-impl Default for Debounce {
+impl Default for ButtonsTask {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl Debounce {
+impl ButtonsTask {
     pub const fn new() -> Self {
-        Debounce(Buttons::new())
+        ButtonsTask(Debouncer::new())
     }
 
-    /// Debounce every queued sample; true when events went to the job.
+    /// ButtonsTask every queued sample; true when events went to the job.
     pub fn poll(&mut self) -> bool {
         let mut sent = false;
         while let Some(raw) = SAMPLES.pop() {

@@ -23,7 +23,7 @@ use embedded_hal::spi::SpiDevice;
 use embedded_sdmmc::sdcard::spi::AcquireOpts;
 use embedded_sdmmc::{Block, BlockDevice, BlockIdx, SdCard, SdCardError};
 use taut_logic::fat::{BlockRead, FatError, File, Volume, BLOCK};
-use taut_logic::job::FileName;
+use taut_logic::files::FileName;
 
 /// Free slots the reader waits for before a step of work: the most one
 /// step sends (the last chunk of a block and `End`, or `Failed` and

@@ -9,6 +9,7 @@
 //! answers reads. Targets outside an axis's soft limits are refused before
 //! anything moves; a feed below [`MIN_FEED`] is refused, one above an
 //! axis's maximum rate is clamped to it (by the planner).
+#![deny(unsafe_code)]
 
 use crate::board::clock;
 use crate::motion::Motion;

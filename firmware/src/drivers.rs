@@ -1,5 +1,6 @@
 //! The drivers' ENABLE inputs (TB6600 ENA): switching a motor's holding
 //! current on and off, with the ENABLE-to-DIR set-up time kept.
+#![deny(unsafe_code)]
 
 use crate::board::delay::Delay;
 use crate::board::gpio::{Output, Pin};
@@ -7,6 +8,7 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::config::MachineConfig;
+use taut_logic::pinmap::DRIVERS;
 
 /// RAMPS X/Y/Z/E0 ENABLE pins (see `taut_logic::pinmap::DRIVERS`).
 pub struct EnablePins {
@@ -16,10 +18,16 @@ pub struct EnablePins {
     pub aux: Pin<24, Output>,
 }
 
+const _: () = {
+    assert!(DRIVERS[0].enable == 38 && DRIVERS[1].enable == 56);
+    assert!(DRIVERS[2].enable == 62 && DRIVERS[3].enable == 24);
+};
+
 pub struct Drivers {
     pins: EnablePins,
     active_high: PerAxis<bool>,
     setup_us: u32,
+    /// Drivers on (bit = axis): the set-up wait is only for one coming on.
     on: u8,
 }
 
@@ -42,11 +50,6 @@ impl Drivers {
             self.active_high[i] = config.axes[i].enable_active_high;
         }
         self.setup_us = config.pulse.enable_setup_us as u32;
-    }
-
-    /// Bit `i` set: axis `i` is on.
-    pub fn on_mask(&self) -> u8 {
-        self.on
     }
 
     /// Switch the drivers in `mask` on or off. After switching one on, wait

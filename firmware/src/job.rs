@@ -1,10 +1,11 @@
 //! The job task's state: the string-art job (`taut_logic::stringart::job`)
-//! fed by the buttons, the card reader and the console's `!`/`~`, its
+//! fed by the buttons, the card reader and the console's `~` and Ctrl-X, its
 //! actions carried out here — log lines, card requests, drivers, zeroing,
 //! and the machine's steps handed to the planner.
 //!
 //! Log lines wait for room in the TX ring rather than being dropped: the
 //! prompts and the bad-file messages must reach the user.
+#![deny(unsafe_code)]
 
 use crate::motion::Motion;
 use crate::queues::{
@@ -17,12 +18,12 @@ use core::sync::atomic::Ordering::Relaxed;
 use heapless::Deque;
 use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
-use taut_logic::job::files::{Files, Next};
-use taut_logic::job::poradi::PoradiReader;
-use taut_logic::job::{FileError, FileName};
+use taut_logic::files::check::{Files, Next};
+use taut_logic::files::poradi::PoradiReader;
+use taut_logic::files::{FileError, FileName};
 use taut_logic::planner::Feed;
 use taut_logic::stringart::job::{Action, Event, Job, State};
-use taut_logic::stringart::Step;
+use taut_logic::stringart::MachineStep;
 
 /// Room for a whole log line, claimed from the console while there is none.
 fn room_for_a_line() -> bool {
@@ -69,7 +70,7 @@ pub struct JobTask {
     /// for the machine to stand.
     pulling: bool,
     settling: bool,
-    pending: Option<Step>,
+    pending: Option<MachineStep>,
     dwell_until: Option<u32>,
     /// Queue figures are logged line by line after a job ends.
     report_line: Option<u8>,
@@ -388,7 +389,7 @@ impl JobTask {
                 break;
             };
             match step {
-                Step::Move(targets) => {
+                MachineStep::Move(targets) => {
                     let mut at = m.target();
                     for i in 0..AXES {
                         if let Some(t) = targets[i] {
@@ -405,11 +406,11 @@ impl JobTask {
                     self.pending = Some(step);
                     return Poll::Wait(Signal::Motion);
                 }
-                Step::Dwell(ms) => {
+                MachineStep::Dwell(ms) => {
                     self.dwell_until = Some(now.wrapping_add(ms as u32));
                     return Poll::After(ms);
                 }
-                Step::Drivers { mask, on } => m.drivers.set(mask, on),
+                MachineStep::Drivers { mask, on } => m.drivers.set(mask, on),
             }
         }
         if self.settling {

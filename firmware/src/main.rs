@@ -34,7 +34,7 @@ use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{
     self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
 };
-use taut_firmware::buttons::{self, ButtonPins, Debounce};
+use taut_firmware::buttons::{self, ButtonPins, ButtonsTask};
 use taut_firmware::card::{self, CardReader};
 use taut_firmware::console::{Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
@@ -44,7 +44,7 @@ use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL};
 use taut_firmware::realtime::{self, Requests};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{stack, Poll, TaskCell};
-use taut_firmware::stepper::{self, Stepper};
+use taut_firmware::stepper::{self, StepDirPins, Stepper};
 use taut_firmware::{
     board::usart::{RXCIE0, UDRIE0},
     nested_vector, step_vector,
@@ -119,7 +119,7 @@ static WAITING: TaskCell<[u16; 2]> = TaskCell::new([0; 2]);
 static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
 static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
 static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
-static DEBOUNCE: TaskCell<Debounce> = TaskCell::new(Debounce::new());
+static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::new(ButtonsTask::new());
 static JOB: TaskCell<JobTask> = TaskCell::new(JobTask::new());
 static CARD: TaskCell<Option<CardReader>> = TaskCell::new(None);
 
@@ -183,7 +183,7 @@ fn main() -> ! {
         &READY,
         task_of,
         clock::millis,
-        &watchdog,
+        || watchdog.feed(),
         |task| match task {
             Task::Timers => timers(),
             Task::Realtime => realtime(),
@@ -220,7 +220,17 @@ fn init() -> Watchdog {
         aux: pins.d24.into_output(),
     };
     let drivers = Drivers::new(enable, &config);
-    let stepper = Stepper::new(StepTimer::start(dp.TC1), &config);
+    let step_dir = StepDirPins {
+        base_step: pins.a0.into_output_at(false),
+        base_dir: pins.a1.into_output_at(false),
+        radial_step: pins.a6.into_output_at(false),
+        radial_dir: pins.a7.into_output_at(false),
+        drill_step: pins.d46.into_output_at(false),
+        drill_dir: pins.d48.into_output_at(false),
+        aux_step: pins.d26.into_output_at(false),
+        aux_dir: pins.d28.into_output_at(false),
+    };
+    let stepper = Stepper::new(step_dir, StepTimer::start(dp.TC1), &config);
     MOTION.with(|m| *m = Some(Motion::new(&config, stepper, drivers)));
     let spi = CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53);
     CARD.with(|c| *c = Some(CardReader::new(spi)));
@@ -367,7 +377,7 @@ fn control_job(c: Control) {
 /// Debounce the tick's samples; presses go to the job.
 #[inline(never)]
 fn buttons() {
-    if DEBOUNCE.with(|d| d.poll()) {
+    if BUTTONS_TASK.with(|d| d.poll()) {
         spawn(Task::Job);
     }
 }
@@ -419,6 +429,7 @@ fn logger() {
 
 /// The status LED and when its boot pattern started.
 static LED: TaskCell<Option<(Pin<13, Output>, u32)>> = TaskCell::new(None);
+const _: () = assert!(taut_logic::pinmap::STATUS_LED == 13);
 
 /// The status LED: `BOOT_BLINKS` flashes of 100 ms at boot, then off.
 #[inline(never)]

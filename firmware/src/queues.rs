@@ -3,11 +3,12 @@
 //! ring is back-pressure — the producer keeps its message and tries again
 //! — and every ring counts what it sent, refused, and its high-water mark
 //! (`$Q`, and the end of a job).
+#![deny(unsafe_code)]
 
 use crate::rt::{Flags, Ring};
 use core::sync::atomic::AtomicBool;
 use taut_logic::buttons::ButtonEvent;
-use taut_logic::job::FileName;
+use taut_logic::files::FileName;
 use taut_logic::segment::{Segment, StepBlock};
 
 /// UART receive interrupt → console: line bytes (real-time commands are

@@ -3,6 +3,7 @@
 //! they never wait behind a line. Ctrl-X stops the steps there and then;
 //! the rest is flagged for the `Realtime` task (the highest software
 //! priority), which also writes the status report.
+#![deny(unsafe_code)]
 
 use crate::flash_str;
 use crate::motion::{Motion, State};

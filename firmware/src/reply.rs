@@ -1,12 +1,13 @@
 //! Console replies: `ok`, `error:<code> <text>`, reports. A reply line is
 //! assembled on the stack and queued whole, never cut: it runs only once
 //! the TX ring has [`ROOM`] free bytes, and no reply is longer.
+#![deny(unsafe_code)]
 
 use crate::board::usart;
 use crate::log::Line;
 use crate::texts;
 use taut_logic::gcode::Error;
-use taut_logic::job::error::ErrorKind;
+use taut_logic::text::ErrorKind;
 use taut_logic::units::Milli;
 use ufmt::{uWrite, uwrite};
 

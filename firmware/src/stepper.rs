@@ -18,6 +18,8 @@
 
 pub mod fast;
 
+use crate::board::gpio::{regs, Output, Pin};
+use crate::board::step_timer::StepTimer;
 use crate::queues::{BLOCKS, SEGMENTS};
 use core::cell::UnsafeCell;
 use core::ptr::{read_volatile, write_volatile};
@@ -92,6 +94,7 @@ const fn slot_pin(s: usize) -> *mut u8 {
     }
 }
 
+/// A DIR pin's PINx (toggle) and PORTx registers and its bit.
 struct PinReg {
     pin: *mut u8,
     port: *mut u8,
@@ -99,21 +102,10 @@ struct PinReg {
 }
 
 const fn reg(n: u8) -> PinReg {
-    let (port, bit) = port_bit(n);
-    let pin = port.pin_register() as *mut u8;
-    PinReg {
-        pin,
-        port: pin.wrapping_add(2),
-        mask: 1 << bit,
-    }
+    let (pin, _ddr, port, mask) = regs(n);
+    PinReg { pin, port, mask }
 }
 
-const STEP: [PinReg; AXES] = [
-    reg(DRIVERS[0].step),
-    reg(DRIVERS[1].step),
-    reg(DRIVERS[2].step),
-    reg(DRIVERS[3].step),
-];
 const DIR: [PinReg; AXES] = [
     reg(DRIVERS[0].dir),
     reg(DRIVERS[1].dir),
@@ -229,13 +221,38 @@ pub fn take_refill() -> bool {
     avr_device::interrupt::free(|_| core::mem::take(&mut exec().refill) != 0)
 }
 
-/// Owner of the STEP and DIR pins: constructing it proves they are outputs.
-pub struct Stepper(());
+/// RAMPS X/Y/Z/E0 STEP and DIR pins, low outputs. The interrupt writes
+/// them through the register addresses worked out from
+/// `taut_logic::pinmap::DRIVERS` (one store per port); these tokens prove
+/// that those pins are outputs and the stepper's alone.
+pub struct StepDirPins {
+    pub base_step: Pin<54, Output>,
+    pub base_dir: Pin<55, Output>,
+    pub radial_step: Pin<60, Output>,
+    pub radial_dir: Pin<61, Output>,
+    pub drill_step: Pin<46, Output>,
+    pub drill_dir: Pin<48, Output>,
+    pub aux_step: Pin<26, Output>,
+    pub aux_dir: Pin<28, Output>,
+}
+
+const _: () = {
+    assert!(DRIVERS[0].step == 54 && DRIVERS[0].dir == 55);
+    assert!(DRIVERS[1].step == 60 && DRIVERS[1].dir == 61);
+    assert!(DRIVERS[2].step == 46 && DRIVERS[2].dir == 48);
+    assert!(DRIVERS[3].step == 26 && DRIVERS[3].dir == 28);
+};
+
+/// Owner of the STEP and DIR pins and of Timer1.
+pub struct Stepper {
+    _pins: StepDirPins,
+    _timer: StepTimer,
+}
 
 impl Stepper {
-    /// Takes the pins as outputs (STEP low) and the pulse timing and DIR
-    /// polarity from `config`. Timer1 must run at clk/1 (`StepTimer`).
-    pub fn new(_timer: crate::board::step_timer::StepTimer, config: &MachineConfig) -> Stepper {
+    /// Takes the pins, and the pulse timing and DIR polarity from
+    /// `config`. Timer1 must run at clk/1 (`StepTimer`).
+    pub fn new(pins: StepDirPins, timer: StepTimer, config: &MachineConfig) -> Stepper {
         let e = exec();
         e.pulse_ticks = config.pulse.step_pulse_us as u16 * 16;
         e.dir_setup_ticks = config.pulse.dir_setup_us as u16 * 16;
@@ -244,17 +261,11 @@ impl Stepper {
             if config.axes[i].dir_high_is_positive {
                 e.dir_high_positive |= 1 << i;
             }
-            // SAFETY: DDR is PIN+1; these pins belong to the stepper alone,
-            // and nothing else runs during start-up.
-            unsafe {
-                for r in [&STEP[i], &DIR[i]] {
-                    write_volatile(r.port, read_volatile(r.port) & !r.mask);
-                    let ddr = r.pin.wrapping_add(1);
-                    write_volatile(ddr, read_volatile(ddr) | r.mask);
-                }
-            }
         }
-        Stepper(())
+        Stepper {
+            _pins: pins,
+            _timer: timer,
+        }
     }
 
     pub fn set_timing(&mut self, pulse: &taut_logic::config::PulseTiming) {
@@ -528,6 +539,9 @@ unsafe fn schedule_next(e: &mut Exec) {
 
 /// Move the compare register towards the pending event by at most
 /// `WAIT_PART` ticks at a time, flagging an event that can no longer be on time.
+///
+/// # Safety
+/// Timer1 registers; called from the interrupt or with it masked.
 #[inline(always)]
 unsafe fn advance_compare(e: &mut Exec) {
     let part = if e.wait > LONG_WAIT {
@@ -548,6 +562,9 @@ unsafe fn advance_compare(e: &mut Exec) {
 }
 
 /// Toggle the STEP pins of `m`: one store per port.
+///
+/// # Safety
+/// STEP pin registers; called from the interrupt.
 #[inline(always)]
 unsafe fn toggle_steps(m: &[u8; SLOTS]) {
     if !slot_pin(0).is_null() {

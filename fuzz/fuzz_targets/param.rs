@@ -4,8 +4,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use taut_logic::job::param::{radius_limit_um, ParamFile, Params, MAX_NAILS, MAX_SHAPE};
-use taut_logic::job::FileError;
+use taut_logic::files::param::{radius_limit_um, ParamFile, Params, MAX_NAILS, MAX_SHAPE};
+use taut_logic::files::FileError;
 
 fn parse(text: &[u8], chunk: usize) -> Result<Params, FileError> {
     let mut p = ParamFile::new();

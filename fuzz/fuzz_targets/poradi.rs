@@ -4,8 +4,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use taut_logic::job::poradi::{PoradiCheck, PoradiReader};
-use taut_logic::job::FileError;
+use taut_logic::files::poradi::{PoradiCheck, PoradiReader};
+use taut_logic::files::FileError;
 
 fn check(text: &[u8], nails: u16, chunk: usize) -> Result<u32, FileError> {
     let mut c = PoradiCheck::new(nails);

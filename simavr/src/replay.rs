@@ -31,8 +31,8 @@ pub use ring::Ring;
 use crate::vcd::Signal;
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
+use taut_logic::files::param::ParamFile;
 use taut_logic::geometry::Board;
-use taut_logic::job::param::ParamFile;
 
 /// The axes of the string-art machine, in [`Trace`]'s order.
 pub const MACHINE_AXES: [Axis; 3] = [Axis::Base, Axis::Radial, Axis::Drill];

@@ -41,8 +41,8 @@ impl ButtonEvent {
 /// What one tick found: at most one event per button.
 pub type ButtonEvents = heapless::Vec<ButtonEvent, 4>;
 
-/// The debouncer.
-pub struct Buttons {
+/// The debouncer of the four buttons: raw samples in, events out.
+pub struct Debouncer {
     /// Debounced levels, one bit per button.
     stable: u8,
     /// Consecutive ms the raw level has differed from the stable one.
@@ -51,16 +51,16 @@ pub struct Buttons {
     held: [u16; 4],
 }
 
-impl Default for Buttons {
+impl Default for Debouncer {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl Buttons {
+impl Debouncer {
     /// All buttons released.
     pub const fn new() -> Self {
-        Buttons {
+        Debouncer {
             stable: 0,
             differing: [0; 4],
             held: [0; 4],
@@ -124,7 +124,7 @@ mod tests {
     const BASE: u8 = 1 << Button::ZeroBase as u8;
 
     /// Feeds `(level, ms)` runs; returns the events with the ms they came at.
-    fn run(b: &mut Buttons, runs: &[(u8, u32)]) -> Vec<(u32, ButtonEvent)> {
+    fn run(b: &mut Debouncer, runs: &[(u8, u32)]) -> Vec<(u32, ButtonEvent)> {
         let mut t = 0;
         let mut out = Vec::new();
         for &(level, ms) in runs {
@@ -138,7 +138,7 @@ mod tests {
 
     #[test]
     fn clean_short_press() {
-        let mut b = Buttons::new();
+        let mut b = Debouncer::new();
         let ev = run(&mut b, &[(0, 10), (GREEN, 150), (0, 100)]);
         assert_eq!(
             ev,
@@ -159,7 +159,7 @@ mod tests {
 
     #[test]
     fn bounce_is_one_press_and_one_release() {
-        let mut b = Buttons::new();
+        let mut b = Debouncer::new();
         let mut runs = Vec::new();
         // 40 ms of contact bounce (3 ms on, 2 ms off), held, then 30 ms of
         // bounce on release.
@@ -182,7 +182,7 @@ mod tests {
 
     #[test]
     fn a_glitch_shorter_than_the_debounce_time_is_ignored() {
-        let mut b = Buttons::new();
+        let mut b = Debouncer::new();
         assert!(run(&mut b, &[(GREEN, 19), (0, 100)]).is_empty());
         // And while held, a 19 ms drop does not release it.
         let ev = run(&mut b, &[(GREEN, 100), (0, 19), (GREEN, 100)]);
@@ -191,7 +191,7 @@ mod tests {
 
     #[test]
     fn long_press_once_then_a_long_release() {
-        let mut b = Buttons::new();
+        let mut b = Debouncer::new();
         let ev = run(&mut b, &[(GREEN, 5000), (0, 50)]);
         assert_eq!(
             ev,
@@ -212,7 +212,7 @@ mod tests {
 
     #[test]
     fn a_very_long_press_saturates_without_a_second_long_press() {
-        let mut b = Buttons::new();
+        let mut b = Debouncer::new();
         let ev = run(&mut b, &[(GREEN, 70_000), (0, 20)]);
         let longs = ev
             .iter()
@@ -230,7 +230,7 @@ mod tests {
 
     #[test]
     fn buttons_are_independent() {
-        let mut b = Buttons::new();
+        let mut b = Debouncer::new();
         let ev = run(&mut b, &[(GREEN | BASE, 30), (GREEN, 30), (0, 30)]);
         assert_eq!(
             ev,
@@ -260,7 +260,7 @@ mod tests {
         /// button, and a press is reported only after 20 ms of pressed level.
         #[test]
         fn presses_and_releases_alternate(runs in proptest::collection::vec((0u8..16, 1u32..60), 1..80)) {
-            let mut b = Buttons::new();
+            let mut b = Debouncer::new();
             let mut down = [false; 4];
             let mut longs = [0; 4];
             for (_, e) in run(&mut b, &runs) {

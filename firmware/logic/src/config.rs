@@ -1,9 +1,9 @@
 //! The machine's figures in one typed structure. Defaults are the
-//! string-art machine's (`shared/spec/string-art-machine.md`); `machine.txt`
+//! string-art machine's (`docs/string-art-machine.md`); `machine.txt`
 //! on the card and `$` settings override them.
 
 use crate::axis::{Axis, PerAxis};
-use crate::job::error::ErrorKind;
+use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
 
 /// Per-axis figures. Rates are in steps so the step generator never converts.

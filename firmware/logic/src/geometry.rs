@@ -1,5 +1,5 @@
-//! Nail geometry of the string-art board (`shared/spec/string-art-machine.md`)
-//! and its conversion to absolute step targets.
+//! Nail geometry of the string-art board (`docs/string-art-machine.md`) and
+//! its conversion to absolute step targets.
 //!
 //! Nail `i` of `N` sits at `f(i/N)·(R − 1.5 cm)`: on a circle (shape 0) or on
 //! a regular n-gon with vertex 0 at angle 0 (shape n ≥ 3). Angles are in

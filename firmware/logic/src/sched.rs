@@ -14,8 +14,8 @@
 //!   from interrupts interleaved between `pop()` calls.
 //! - **At most once**: spawning a task that is already pending is a no-op
 //!   (`spawn` returns `false`) and does not move it in the queue. Its work is
-//!   carried by its own message [`Channel`], so nothing is lost: the task
-//!   drains its channel when it runs.
+//!   carried by its input queue, so nothing is lost: the task drains its
+//!   queue when it runs.
 //! - **Run to completion**: a task is taken off the ready set when `pop()`
 //!   returns it, so it may be spawned again (even by itself) while running
 //!   and will then run once more after the tasks already queued at its level.
@@ -26,16 +26,14 @@
 //! Deadlines are compared by signed distance, so the clock may wrap freely as
 //! long as no delay exceeds `i32::MAX` ms (about 24.8 days).
 
-mod channel;
+mod queue_stats;
 mod ready;
 mod round;
-mod stack;
 mod timers;
 
-pub use channel::{Channel, QueueStats};
+pub use queue_stats::QueueStats;
 pub use ready::Ready;
 pub use round::Round;
-pub use stack::stack_high_water;
 pub use timers::{Full, Timers};
 
 /// A software task's identity: the firmware's task enum implements this.

@@ -7,8 +7,8 @@
 
 use crate::axis::{Axis, AXES};
 use crate::config::MachineConfig;
-use crate::job::error::ErrorKind;
-use crate::job::num::{parse_milli, parse_ratio, parse_u32, trim, NumError};
+use crate::text::num::{parse_milli, parse_ratio, parse_u32, trim, NumError};
+use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
@@ -294,7 +294,7 @@ impl uDisplay for Value {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::show;
+    use crate::text::error::tests::show;
     use proptest::prelude::*;
     use std::string::String;
     use std::vec::Vec;

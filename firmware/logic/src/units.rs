@@ -14,10 +14,6 @@ impl Milli {
     pub const fn from_units(units: i32) -> Milli {
         Milli(units * Self::SCALE)
     }
-
-    pub fn to_f32(self) -> f32 {
-        self.0 as f32 / Self::SCALE as f32
-    }
 }
 
 /// Steps per axis unit as an exact ratio `num / den` (e.g. the drill's

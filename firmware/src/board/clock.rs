@@ -16,6 +16,7 @@ impl Clock {
         tc0.tccr0a().write(|w| w.wgm0().ctc());
         tc0.tccr0b().write(|w| w.cs0().prescale_64());
         // After the mode is complete (simavr checks it on OCR writes).
+        // SAFETY: OCR0A takes any 8-bit compare value.
         tc0.ocr0a().write(|w| unsafe { w.bits(249) });
         tc0.timsk0().write(|w| w.ocie0a().set_bit());
         Clock

@@ -13,7 +13,9 @@ pub struct FlashStr {
 }
 
 impl FlashStr {
-    /// Only for statics placed in `.progmem.data` by [`flash_str!`].
+    /// # Safety
+    /// `ptr` and `len` must be a static placed in `.progmem.data` by
+    /// [`flash_str!`]: `byte` reads it from flash with `lpm`.
     #[doc(hidden)]
     pub const unsafe fn from_progmem(ptr: *const u8, len: usize) -> FlashStr {
         FlashStr {
@@ -92,9 +94,13 @@ pub const fn after_crate_name(path: &str) -> usize {
 macro_rules! flash_str {
     ($s:expr) => {{
         const LEN: usize = $s.len();
+        // Allowed here: the modules using the macro deny unsafe code.
+        #[allow(unsafe_code)]
         #[link_section = ".progmem.data"]
         static S: [u8; LEN] = $crate::board::flash::bytes::<LEN>($s, 0);
+        #[allow(unsafe_code)]
         // SAFETY: S is a progmem static of LEN bytes.
-        unsafe { $crate::board::flash::FlashStr::from_progmem(S.as_ptr(), LEN) }
+        let s = unsafe { $crate::board::flash::FlashStr::from_progmem(S.as_ptr(), LEN) };
+        s
     }};
 }

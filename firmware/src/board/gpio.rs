@@ -23,7 +23,7 @@ pub struct Pin<const N: u8, M> {
 pub(crate) const fn regs(n: u8) -> (*mut u8, *mut u8, *mut u8, u8) {
     let (port, bit) = port_bit(n);
     let pin = port.pin_register() as *mut u8;
-    // SAFETY of later use: PINx, DDRx, PORTx are consecutive I/O registers.
+    // PINx, DDRx, PORTx are consecutive I/O registers.
     (pin, pin.wrapping_add(1), pin.wrapping_add(2), 1 << bit)
 }
 
@@ -32,7 +32,8 @@ impl<const N: u8, M> Pin<N, M> {
 
     fn set_ddr(output: bool) {
         let (_, ddr, _, mask) = Self::REGS;
-        // DDR bits of a port are shared with other pins: modify atomically.
+        // SAFETY: DDRx of this pin's port (`regs`). Its other bits belong to
+        // other pins: the read-modify-write is atomic, interrupts masked.
         avr_device::interrupt::free(|_| unsafe {
             let v = read_volatile(ddr);
             write_volatile(ddr, if output { v | mask } else { v & !mask });
@@ -41,7 +42,9 @@ impl<const N: u8, M> Pin<N, M> {
 
     fn write_level(high: bool) {
         let (pin, _, port, mask) = Self::REGS;
-        // Only this pin's owner writes this bit, so read-then-toggle is safe.
+        // SAFETY: PORTx and PINx of this pin's port (`regs`). Only this
+        // pin's owner writes this bit, so read-then-toggle cannot race, and
+        // the toggle register changes no other bit.
         unsafe {
             if (read_volatile(port) & mask != 0) != high {
                 write_volatile(pin, mask);
@@ -51,6 +54,7 @@ impl<const N: u8, M> Pin<N, M> {
 
     fn read_level() -> bool {
         let (pin, _, _, mask) = Self::REGS;
+        // SAFETY: reading PINx of this pin's port has no side effect.
         unsafe { read_volatile(pin) & mask != 0 }
     }
 
@@ -69,19 +73,6 @@ impl<const N: u8, M> Pin<N, M> {
         Self::set_ddr(false);
         Self::write_level(true);
         Pin { _mode: PhantomData }
-    }
-
-    pub fn into_floating_input(self) -> Pin<N, Floating> {
-        Self::set_ddr(false);
-        Self::write_level(false);
-        Pin { _mode: PhantomData }
-    }
-}
-
-impl<const N: u8> Pin<N, Output> {
-    pub fn toggle(&mut self) {
-        let (pin, _, _, mask) = Self::REGS;
-        unsafe { write_volatile(pin, mask) }
     }
 }
 
@@ -103,6 +94,7 @@ impl<const N: u8> embedded_hal::digital::OutputPin for Pin<N, Output> {
 impl<const N: u8> embedded_hal::digital::StatefulOutputPin for Pin<N, Output> {
     fn is_set_high(&mut self) -> Result<bool, Infallible> {
         let (_, _, port, mask) = Self::REGS;
+        // SAFETY: reading PORTx of this pin's port has no side effect.
         Ok(unsafe { read_volatile(port) } & mask != 0)
     }
     fn is_set_low(&mut self) -> Result<bool, Infallible> {

@@ -43,6 +43,7 @@ impl ResetCause {
         } else {
             ResetCause::Unknown
         };
+        // SAFETY: 0 is a valid MCUSR value: every reset flag cleared.
         cpu.mcusr().write(|w| unsafe { w.bits(0) });
         cause
     }

@@ -7,6 +7,7 @@ use avr_device::atmega2560::SPI;
 use core::convert::Infallible;
 use embedded_hal::digital::OutputPin;
 use embedded_hal::spi::{Operation, SpiBus};
+use taut_logic::pinmap::{SD_CS, SD_MISO, SD_MOSI, SD_SCK};
 
 pub struct Spi {
     spi: SPI,
@@ -39,6 +40,7 @@ impl Spi {
     }
 
     fn exchange(&mut self, out: u8) -> u8 {
+        // SAFETY: SPDR takes any byte.
         self.spi.spdr().write(|w| unsafe { w.bits(out) });
         while self.spi.spsr().read().spif().bit_is_clear() {}
         self.spi.spdr().read().bits()
@@ -87,11 +89,14 @@ impl embedded_hal::spi::SpiBus<u8> for Spi {
 }
 
 /// The SD card's SPI device: the bus with chip select on D53, low for the
-/// length of each transaction (embedded-hal's `SpiDevice`).
+/// length of each transaction (embedded-hal's `SpiDevice`). The pins are the
+/// hardware SPI's, which the pin map names.
 pub struct CardSpi {
     pub bus: Spi,
     cs: Pin<53, Output>,
 }
+
+const _: () = assert!(SD_SCK == 52 && SD_MOSI == 51 && SD_MISO == 50 && SD_CS == 53);
 
 impl CardSpi {
     /// The card on the hardware SPI, deselected, at the slow init clock.

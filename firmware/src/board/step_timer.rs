@@ -12,6 +12,8 @@ pub struct StepTimer {
 
 impl StepTimer {
     pub fn start(tc1: TC1) -> StepTimer {
+        // SAFETY: 0 is a valid TCCR1A value: normal mode, compare outputs
+        // disconnected (the stepper drives its pins itself).
         tc1.tccr1a().write(|w| unsafe { w.bits(0) });
         tc1.tccr1b().write(|w| w.cs1().direct());
         StepTimer { _tc1: tc1 }

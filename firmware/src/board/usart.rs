@@ -49,6 +49,7 @@ pub const UDRIE0: u8 = 5;
 /// send one byte, and switch it back on while more are waiting.
 pub fn on_data_register_empty() {
     if let Some(b) = TX.pop() {
+        // SAFETY: UDR0 takes any byte.
         regs().udr0().write(|w| unsafe { w.bits(b) });
         if !TX.is_empty() {
             avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.udrie0().set_bit()));

@@ -31,6 +31,7 @@ impl Watchdog {
             self.wdt
                 .wdtcsr()
                 .write(|w| w.wdce().set_bit().wde().set_bit());
+            // SAFETY: 0 is a valid WDTCSR value: watchdog off, no interrupt.
             self.wdt.wdtcsr().write(|w| unsafe { w.bits(0) });
         });
         self.wdt

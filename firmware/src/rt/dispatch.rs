@@ -14,7 +14,6 @@
 //! priority's FIFO in task order.)
 
 use super::{Flags, TaskCell};
-use crate::board::watchdog::Watchdog;
 use core::arch::asm;
 use taut_logic::sched::{Ready, Round, TaskId};
 
@@ -32,7 +31,7 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
     ready: &TaskCell<Ready<T, N, P>>,
     task: fn(u8) -> T,
     millis: fn() -> u32,
-    watchdog: &Watchdog,
+    feed_watchdog: impl Fn(),
     mut dispatch: impl FnMut(T),
 ) -> ! {
     // SAFETY: SMCR (0x53): sleep enable, idle mode (timers and UART run).
@@ -47,7 +46,7 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
                 }
             });
         }
-        if let Some(t) = ready.with(|r| round.next(r, millis(), || watchdog.feed())) {
+        if let Some(t) = ready.with(|r| round.next(r, millis(), &feed_watchdog)) {
             dispatch(t);
             continue;
         }

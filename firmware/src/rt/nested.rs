@@ -12,6 +12,8 @@
 #[macro_export]
 macro_rules! nested_vector {
     ($vector:ident, $handler:path) => {
+        // SAFETY: only the vector table jumps here; the body changes no
+        // register and ends in the handler, which returns with `reti`.
         #[unsafe(naked)]
         #[unsafe(no_mangle)]
         pub unsafe extern "C" fn $vector() {
@@ -22,6 +24,8 @@ macro_rules! nested_vector {
     // address `reg` with `keep` (its enable bit cleared) first, preserving
     // r24 and SREG.
     ($vector:ident, $handler:path, reg = $reg:literal, keep = $keep:literal) => {
+        // SAFETY: only the vector table jumps here; r24 and SREG are
+        // restored before the jump to the handler, which returns with `reti`.
         #[unsafe(naked)]
         #[unsafe(no_mangle)]
         pub unsafe extern "C" fn $vector() {

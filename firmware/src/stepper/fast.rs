@@ -87,6 +87,10 @@ pub const PIN2: u16 = pin(2);
 #[macro_export]
 macro_rules! step_vector {
     ($slow:path) => {
+        // SAFETY: only the vector table jumps here. Every register the
+        // body uses, and SREG, is restored before `reti` or before the jump
+        // to `$slow` (an `avr-interrupt` handler that returns with `reti`);
+        // `EXEC` and `SEGMENTS` are the step interrupt's, as in `on_compare`.
         #[unsafe(naked)]
         #[unsafe(no_mangle)]
         pub unsafe extern "C" fn __vector_17() {

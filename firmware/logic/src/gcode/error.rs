@@ -61,7 +61,7 @@ pub enum ErrorKind {
 pub const MIN_FEED: i32 = 10_000;
 
 impl ErrorKind {
-    /// Short text; every string costs SRAM on the AVR.
+    /// Grbl's text (the firmware logs a copy made in flash at compile time).
     pub const fn message(self) -> &'static str {
         match self {
             ErrorKind::ExpectedCommandLetter => "Expected command letter",

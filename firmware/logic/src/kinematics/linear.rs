@@ -5,8 +5,8 @@
 //!   seen from above), radial carriage `X` (mm, positive outwards, zero with
 //!   the tool at the board's edge) and drill/needle `Z` (mm along the tilted
 //!   tool axis, positive down into the board);
-//! - cartesian X/Y plotters (seed 001's drum, seed 002's flatbed): X and Y on
-//!   channels 0 and 1, the pen's Z on channel 2. For the drum, Y's steps per
+//! - cartesian X/Y plotters (a drum plotter, a flatbed plotter made from an
+//!   old printer): X and Y on channels 0 and 1, the pen's Z on channel 2. For the drum, Y's steps per
 //!   mm are those of the paper's surface (drum steps per turn / circumference).
 
 use super::{ChannelScale, KinError, Kinematics, Position, Steps};
@@ -129,8 +129,8 @@ mod cartesian_tests {
     use crate::units::{Milli, StepsPerUnit};
     use proptest::prelude::*;
 
-    /// Seed 002: 0.025 mm per step on X and Y; seed 001's drum: 2048 steps
-    /// per turn of a 90 mm tube (π·90 ≈ 282.743 mm ≈ 282743/1000).
+    /// The flatbed plotter: 0.025 mm per step on X and Y; the drum plotter:
+    /// 2048 steps per turn of a 90 mm tube (π·90 ≈ 282.743 mm ≈ 282743/1000).
     fn kin() -> Linear {
         Linear::cartesian(ChannelScale([
             StepsPerUnit::new(40, 1),
@@ -141,12 +141,12 @@ mod cartesian_tests {
     }
 
     #[test]
-    fn seed_002_resolution() {
+    fn flatbed_plotter_resolution() {
         let k = kin();
         let pos = [Milli(140_000), Milli(0), Milli(1000), Milli(0)];
         assert_eq!(k.inverse(&pos), Ok([5600, 0, 100, 0]));
-        // 0.0125 mm is half a step: rounds away from zero (seed 001's v3
-        // fix: round, never truncate).
+        // 0.0125 mm is half a step: rounds away from zero (round, never
+        // truncate: truncating cost the drum plotter's first firmware accuracy).
         assert_eq!(
             k.inverse(&[Milli(13), Milli(0), Milli(0), Milli(0)])
                 .unwrap()[0],

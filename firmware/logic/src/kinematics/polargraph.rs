@@ -1,4 +1,4 @@
-//! Two-string hanging plotter (seed 003's whiteboard machine). The left
+//! Two-string hanging plotter (the whiteboard machine). The left
 //! motor's string leaves its pulley at (0, 0), the right one's at (D, 0),
 //! y up; the pen hangs below (y < 0) where the strings meet. Channel 0 winds
 //! the left string, channel 1 the right one (both in mm of string), channel 2

@@ -1,9 +1,9 @@
-//! SCARA arm (seed 004, Klipper's formulas). Channel 0 turns the shoulder,
+//! SCARA arm (Klipper's formulas). Channel 0 turns the shoulder,
 //! channel 1 the elbow's motor, both in degrees; the elbow's belt passes
 //! through the shoulder joint, so turning the shoulder also turns the elbow
 //! by 1/ECR (the elbow crosstalk ratio ECR = n_S / n_E). At zero steps both
 //! arms point along +y. Angles are counted counter-clockwise from +y, so
-//! x = −sin: the seed's sign convention.
+//! x = −sin: the original arm's sign convention.
 //!
 //! The inverse takes the elbow bent to positive angles (one of the two
 //! solutions) and the shoulder in (−360°, 180°]; the workspace should not
@@ -66,7 +66,8 @@ impl Kinematics for Scara {
             return Err(KinError::Unreachable);
         }
         let shoulder = libm::atan2f(x, y) - acos_clamped((h2 + l1 * l1 - l2 * l2) / (2.0 * l1 * h));
-        // The seed prints "+ L1² + L2²" here; the law of cosines has minus.
+        // The original arm's notes print "+ L1² + L2²" here; the law of
+        // cosines has minus.
         let elbow =
             shoulder * self.crosstalk + acos_clamped((h2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2));
         let mut steps = self.scale.all_steps(pos)?;

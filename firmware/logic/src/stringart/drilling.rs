@@ -5,7 +5,9 @@
 //! hole the tool goes back to nail 0's angle at the board's edge (the zero
 //! pose) and the drivers are switched off.
 
-use super::{Step, DRILL_ANGLE_DEG, DRILL_CLEARANCE_MM, DWELL_MS, HOLE_DEPTH_MM, MACHINE_DRIVERS};
+use super::{
+    MachineStep, DRILL_ANGLE_DEG, DRILL_CLEARANCE_MM, DWELL_MS, HOLE_DEPTH_MM, MACHINE_DRIVERS,
+};
 use crate::axis::{Axis, AXES};
 use crate::config::MachineConfig;
 use crate::fmath;
@@ -56,39 +58,39 @@ impl Drilling {
     }
 
     /// Base and carriage together over nail `i`, the shorter way round.
-    fn over_nail(&mut self, i: u16) -> Step {
+    fn over_nail(&mut self, i: u16) -> MachineStep {
         let nail = self.board.nail(i);
         self.base = self.scale.shorter_rotation(self.base, nail.angle);
         let mut t = [None; AXES];
         t[Axis::Base.index()] = Some(self.base);
         t[Axis::Radial.index()] = Some(self.scale.radial_steps(&self.board, nail.radius));
-        Step::Move(t)
+        MachineStep::Move(t)
     }
 }
 
 impl Drilling {
     /// After the last hole: back to nail 0's angle with the tool at the
     /// board's edge (the zero pose), clear of the nails about to go in.
-    fn home(&mut self) -> Step {
+    fn home(&mut self) -> MachineStep {
         self.base = self
             .scale
             .shorter_rotation(self.base, self.board.nail(0).angle);
         let mut t = [None; AXES];
         t[Axis::Base.index()] = Some(self.base);
         t[Axis::Radial.index()] = Some(0);
-        Step::Move(t)
+        MachineStep::Move(t)
     }
 }
 
 impl Iterator for Drilling {
-    type Item = Step;
+    type Item = MachineStep;
 
-    fn next(&mut self) -> Option<Step> {
+    fn next(&mut self) -> Option<MachineStep> {
         let (step, next) = match self.stage {
-            Stage::Raise => (Step::to(Axis::Drill, self.raised), Stage::Approach),
+            Stage::Raise => (MachineStep::to(Axis::Drill, self.raised), Stage::Approach),
             Stage::Approach => (self.over_nail(self.nail), Stage::Plunge),
-            Stage::Plunge => (Step::to(Axis::Drill, self.plunged), Stage::Dwell),
-            Stage::Dwell => (Step::Dwell(DWELL_MS), Stage::Retract),
+            Stage::Plunge => (MachineStep::to(Axis::Drill, self.plunged), Stage::Dwell),
+            Stage::Dwell => (MachineStep::Dwell(DWELL_MS), Stage::Retract),
             Stage::Retract => {
                 self.nail += 1;
                 let next = if self.nail < self.board.nails() {
@@ -96,11 +98,11 @@ impl Iterator for Drilling {
                 } else {
                     Stage::Home
                 };
-                (Step::to(Axis::Drill, self.raised), next)
+                (MachineStep::to(Axis::Drill, self.raised), next)
             }
             Stage::Home => (self.home(), Stage::Off),
             Stage::Off => (
-                Step::Drivers {
+                MachineStep::Drivers {
                     mask: MACHINE_DRIVERS,
                     on: false,
                 },
@@ -119,20 +121,26 @@ mod tests {
     use crate::units::Milli;
     use std::vec::Vec;
 
-    fn mv(base: i32, radial: i32) -> Step {
-        Step::Move([Some(base), Some(radial), None, None])
+    fn mv(base: i32, radial: i32) -> MachineStep {
+        MachineStep::Move([Some(base), Some(radial), None, None])
     }
 
     #[test]
     fn hexagon_of_24_nails_exactly() {
         let board = Board::new(6, 24, Milli(402_000)).unwrap();
-        let steps: Vec<Step> = Drilling::new(board, &MachineConfig::STRING_ART).collect();
+        let steps: Vec<MachineStep> = Drilling::new(board, &MachineConfig::STRING_ART).collect();
         // 10 mm / sin(74.333°) = 10.386 mm = 1384.8 drill steps.
-        let (up, down) = (Step::to(Axis::Drill, -1385), Step::to(Axis::Drill, 1385));
+        let (up, down) = (
+            MachineStep::to(Axis::Drill, -1385),
+            MachineStep::to(Axis::Drill, 1385),
+        );
         assert_eq!(steps.len(), 1 + 24 * 4 + 2);
         assert_eq!(steps[0], up);
         // Nail 0: vertex at 0°, 387 mm = 15 mm inside the edge = −480 steps.
-        assert_eq!(steps[1..5], [mv(0, -480), down, Step::Dwell(250), up]);
+        assert_eq!(
+            steps[1..5],
+            [mv(0, -480), down, MachineStep::Dwell(250), up]
+        );
         // Nail 1: 13.898°, 348.837 mm → 371 base, −1701 radial steps.
         assert_eq!(steps[5], mv(371, -1701));
         // Nail 2: the edge's midpoint, 30°, 335.152 mm.
@@ -145,7 +153,7 @@ mod tests {
             steps[97..],
             [
                 mv(9600, 0),
-                Step::Drivers {
+                MachineStep::Drivers {
                     mask: 0b111,
                     on: false
                 }
@@ -160,7 +168,7 @@ mod tests {
         let mut holes = Vec::new();
         let mut base = 0;
         for step in Drilling::new(board, &MachineConfig::STRING_ART) {
-            if let Step::Move(t) = step {
+            if let MachineStep::Move(t) = step {
                 if t[0].is_some() || t[1].is_some() {
                     assert!(drill < 0, "{step:?} with the drill at {drill}");
                 }

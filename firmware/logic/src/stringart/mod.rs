@@ -26,9 +26,9 @@ pub const DWELL_MS: u16 = 250;
 pub const INNER_MARGIN_MM: f32 = 20.0;
 pub const OUTER_MARGIN_MM: f32 = 29.0;
 
-/// One thing the machine does, in order.
+/// One thing the machine does, in order: a move, a dwell, a driver switch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Step {
+pub enum MachineStep {
     /// Move the axes that have a target to it (absolute steps). They start
     /// together, each within its own speed and acceleration, and the next
     /// step waits until all have arrived.
@@ -39,16 +39,21 @@ pub enum Step {
     Drivers { mask: u8, on: bool },
 }
 
-impl Step {
+impl MachineStep {
     /// A move of one axis.
-    pub fn to(axis: Axis, target: i32) -> Step {
+    pub fn to(axis: Axis, target: i32) -> MachineStep {
         let mut t = [None; AXES];
         t[axis.index()] = Some(target);
-        Step::Move(t)
+        MachineStep::Move(t)
     }
 }
 
-/// The driver bit of an axis, for [`Step::Drivers`].
+/// The steps' old name, kept only for `xtask` (being changed in another
+/// branch): drop it once `xtask` says `MachineStep`.
+#[doc(hidden)]
+pub use MachineStep as Step;
+
+/// The driver bit of an axis, for [`MachineStep::Drivers`].
 pub const fn bit(axis: Axis) -> u8 {
     1 << axis as u8
 }

@@ -11,7 +11,7 @@ use std::vec::Vec;
 
 const R: Milli = Milli(402_000);
 
-fn wind(board: Board, pattern: &[u16]) -> Vec<Step> {
+fn wind(board: Board, pattern: &[u16]) -> Vec<MachineStep> {
     let winder = Winder::new(board, &MachineConfig::STRING_ART).unwrap();
     Winding::new(winder, pattern.iter().copied())
         .map(Result::unwrap)
@@ -22,12 +22,15 @@ fn wind(board: Board, pattern: &[u16]) -> Vec<Step> {
 fn hexagon_of_24_nails_wound_exactly() {
     let board = Board::new(6, 24, R).unwrap();
     let steps = wind(board, &[0, 7, 13, 23, 2]);
-    let (base, radial) = (|t| Step::to(Axis::Base, t), |t| Step::to(Axis::Radial, t));
+    let (base, radial) = (
+        |t| MachineStep::to(Axis::Base, t),
+        |t| MachineStep::to(Axis::Radial, t),
+    );
     // Inner: 335.152 − 20 mm = 86.848 mm inside the edge = −2779 steps.
     // Outer of a vertex nail: 387 + 29 = 416 mm = +448 steps; of nails 7,
     // 13, 23 (348.837 mm): −773; of nail 2 (335.152 mm): −1211.
     let mut expect = std::vec![
-        Step::Drivers {
+        MachineStep::Drivers {
             mask: 0b100,
             on: false
         },
@@ -44,7 +47,7 @@ fn hexagon_of_24_nails_wound_exactly() {
     ] {
         expect.extend([base(wrap[0]), radial(wrap[1]), base(wrap[2]), radial(-2779)]);
     }
-    expect.push(Step::Drivers {
+    expect.push(MachineStep::Drivers {
         mask: 0b111,
         on: false,
     });
@@ -111,8 +114,10 @@ impl Replay {
         (0..self.board.nails()).any(|k| self.scale.base_steps(self.board.gap_after(k)) == b)
     }
 
-    fn apply(&mut self, step: &Step) -> Result<(), TestCaseError> {
-        let Step::Move(t) = step else { return Ok(()) };
+    fn apply(&mut self, step: &MachineStep) -> Result<(), TestCaseError> {
+        let MachineStep::Move(t) = step else {
+            return Ok(());
+        };
         prop_assert!(t[2].is_none(), "the needle's height never changes");
         if let Some(b) = t[0] {
             prop_assert!(t[1].is_none(), "turning and moving radially at once");
@@ -178,7 +183,7 @@ proptest! {
             replay.apply(step)?;
         }
         prop_assert_eq!(&replay.wrapped, &pattern);
-        prop_assert_eq!(steps.last(), Some(&Step::Drivers { mask: MACHINE_DRIVERS, on: false }));
+        prop_assert_eq!(steps.last(), Some(&MachineStep::Drivers { mask: MACHINE_DRIVERS, on: false }));
     }
 }
 
@@ -188,9 +193,9 @@ fn trapezoid_times_by_hand() {
     // 2000 steps never reach 2000 steps/s: 2·√(2000/500) = 4 s. 10 000
     // steps: 5 s at full rate + 4 s of ramps = 9 s.
     let steps = [
-        Step::Move([Some(10_000), Some(2000), None, None]),
-        Step::Dwell(250),
-        Step::to(Axis::Base, 12_000),
+        MachineStep::Move([Some(10_000), Some(2000), None, None]),
+        MachineStep::Dwell(250),
+        MachineStep::to(Axis::Base, 12_000),
     ];
     assert!((machine_time(steps, &c, Overlap::Together) - (9.0 + 0.25 + 4.0)).abs() < 1e-9);
     assert!((machine_time(steps, &c, Overlap::Sequential) - (9.0 + 4.0 + 0.25 + 4.0)).abs() < 1e-9);

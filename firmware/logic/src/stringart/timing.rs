@@ -2,7 +2,7 @@
 //! a trapezoidal profile (rest to rest, its own max rate and acceleration).
 //! Host-side: f64, never on the AVR.
 
-use super::Step;
+use super::MachineStep;
 use crate::axis::AXES;
 use crate::config::{AxisConfig, MachineConfig};
 
@@ -29,7 +29,7 @@ fn trapezoid(steps: u32, axis: &AxisConfig) -> f64 {
 
 /// Seconds the machine takes for `steps`, starting at all-zero positions.
 pub fn machine_time(
-    steps: impl IntoIterator<Item = Step>,
+    steps: impl IntoIterator<Item = MachineStep>,
     config: &MachineConfig,
     overlap: Overlap,
 ) -> f64 {
@@ -37,7 +37,7 @@ pub fn machine_time(
     let mut total = 0.0;
     for step in steps {
         match step {
-            Step::Move(targets) => {
+            MachineStep::Move(targets) => {
                 let mut longest: f64 = 0.0;
                 for (i, t) in targets.iter().enumerate() {
                     if let Some(t) = *t {
@@ -51,8 +51,8 @@ pub fn machine_time(
                 }
                 total += longest;
             }
-            Step::Dwell(ms) => total += ms as f64 / 1000.0,
-            Step::Drivers { .. } => {}
+            MachineStep::Dwell(ms) => total += ms as f64 / 1000.0,
+            MachineStep::Drivers { .. } => {}
         }
     }
     total

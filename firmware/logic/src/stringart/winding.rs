@@ -8,7 +8,7 @@
 //! inside a gap, and turns only well inside the ring or beyond the nail it
 //! wraps. Every target is absolute, from the nail index: no drift.
 
-use super::{bit, Step, INNER_MARGIN_MM, OUTER_MARGIN_MM};
+use super::{bit, MachineStep, INNER_MARGIN_MM, OUTER_MARGIN_MM};
 use crate::axis::Axis;
 use crate::config::MachineConfig;
 use crate::geometry::{Board, StepScale};
@@ -39,14 +39,14 @@ pub struct Wrap {
 }
 
 impl Iterator for Wrap {
-    type Item = Step;
+    type Item = MachineStep;
 
-    fn next(&mut self) -> Option<Step> {
+    fn next(&mut self) -> Option<MachineStep> {
         let i = self.next as usize;
         let target = *self.targets.get(i)?;
         self.next += 1;
         const AXES: [Axis; 4] = [Axis::Base, Axis::Radial, Axis::Base, Axis::Radial];
-        Some(Step::to(AXES[i], target))
+        Some(MachineStep::to(AXES[i], target))
     }
 }
 
@@ -69,19 +69,19 @@ impl Winder {
 
     /// The drill's driver off (the needle holds its height unpowered),
     /// then the entry move.
-    pub fn entry(&mut self) -> [Step; 4] {
+    pub fn entry(&mut self) -> [MachineStep; 4] {
         let gap = self
             .scale
             .shorter_rotation(self.base, self.board.gap_after(0));
         self.base = self.scale.shorter_rotation(gap, self.board.nail(0).angle);
         [
-            Step::Drivers {
+            MachineStep::Drivers {
                 mask: bit(Axis::Drill),
                 on: false,
             },
-            Step::to(Axis::Base, gap),
-            Step::to(Axis::Radial, self.inner),
-            Step::to(Axis::Base, self.base),
+            MachineStep::to(Axis::Base, gap),
+            MachineStep::to(Axis::Radial, self.inner),
+            MachineStep::to(Axis::Base, self.base),
         ]
     }
 
@@ -110,8 +110,8 @@ impl Winder {
     }
 
     /// All drivers off at the end of the job.
-    pub fn finish(&self) -> Step {
-        Step::Drivers {
+    pub fn finish(&self) -> MachineStep {
+        MachineStep::Drivers {
             mask: super::MACHINE_DRIVERS,
             on: false,
         }
@@ -122,7 +122,7 @@ impl Winder {
 pub struct Winding<I> {
     winder: Winder,
     pattern: I,
-    entry: Option<core::array::IntoIter<Step, 4>>,
+    entry: Option<core::array::IntoIter<MachineStep, 4>>,
     wrap: Option<Wrap>,
     finished: bool,
 }
@@ -140,7 +140,7 @@ impl<I: Iterator<Item = u16>> Winding<I> {
 }
 
 impl<I: Iterator<Item = u16>> Iterator for Winding<I> {
-    type Item = Result<Step, WindError>;
+    type Item = Result<MachineStep, WindError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         if self.finished {

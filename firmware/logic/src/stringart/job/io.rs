@@ -1,29 +1,13 @@
 //! What the job hears ([`Event`]) and what it asks the firmware to do
 //! ([`Action`]), with the texts the firmware logs.
 
+use super::phase::Phase;
 use super::progress::Progress;
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;
 use crate::config::MachineConfig;
-use crate::job::files::CardId;
-use crate::job::param::Params;
-
-/// The two phases that move the machine.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Phase {
-    Drilling,
-    Winding,
-}
-
-impl Phase {
-    /// Progress lines start with this: `drill 12/24`, `wind 1234/3000`.
-    pub const fn name(self) -> &'static str {
-        match self {
-            Phase::Drilling => "drill",
-            Phase::Winding => "wind",
-        }
-    }
-}
+use crate::files::check::CardId;
+use crate::files::param::Params;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum State {
@@ -74,7 +58,7 @@ pub enum Event<'c> {
     CardInserted,
     CardRemoved,
     /// The answer to [`Action::ReadFiles`]: `param.txt` and `machine.txt`
-    /// read, `poradi.txt` checked completely ([`crate::job::poradi::PoradiCheck`]).
+    /// read, `poradi.txt` checked completely ([`crate::files::poradi::PoradiCheck`]).
     FilesValid {
         params: Params,
         count: u32,
@@ -84,14 +68,12 @@ pub enum Event<'c> {
         id: CardId,
     },
     /// The answer to [`Action::ReadFiles`] when a file is missing or bad
-    /// (the firmware logs the [`crate::job::FileError`] itself).
+    /// (the firmware logs the [`crate::files::FileError`] itself).
     FilesInvalid,
     Button(ButtonEvent),
     /// Every step taken from [`super::Job::next_step`] has been carried
     /// out, and `next_step` returned `None`.
     MotionDone,
-    /// Pause after the current hole or wrap (as a long press of green).
-    Pause,
     /// Serial `~` with no feed hold to end: resume a paused job.
     Resume,
     /// Serial Ctrl-X: the machine was stopped at once and the queued steps
@@ -150,10 +132,10 @@ impl Msg {
     }
 }
 
-/// What a waiting state waits for. Texts are short: on the AVR they live
-/// in SRAM. Prompts that green answers contain
+/// What a waiting state waits for. Prompts that green answers contain
 /// `press green`, so a test bench can answer them; the card prompts do
-/// not (green cannot help there).
+/// not (green cannot help there). The firmware logs a copy of each text
+/// made in flash at compile time, as it does for [`Msg`] and [`State`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Prompt {
     InsertCard,
@@ -195,7 +177,7 @@ pub enum Action {
     /// Read and check the card's files; answer with `FilesValid` or
     /// `FilesInvalid`.
     ReadFiles,
-    /// Open `poradi.txt` for streaming ([`crate::job::poradi::PoradiReader`])
+    /// Open `poradi.txt` for streaming ([`crate::files::poradi::PoradiReader`])
     /// and pass over its first `skip` nail indices (already fed).
     OpenPattern {
         skip: u32,

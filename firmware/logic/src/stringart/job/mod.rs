@@ -1,4 +1,4 @@
-//! The string-art job as a state machine (`shared/spec/string-art-machine.md`):
+//! The string-art job as a state machine (`docs/string-art-machine.md`):
 //! waiting for card → reading → prep drill → drilling → waiting for nails →
 //! winding → end → waiting for card, with `paused` inside drilling and
 //! winding and `bad files` when the card's files are unusable.
@@ -6,14 +6,15 @@
 //! Event-driven: the firmware turns buttons, the card and the console into
 //! [`Event`]s, calls [`Job::on`] and carries out the returned [`Action`]s in
 //! order. While the job is drilling or winding, the firmware pulls the
-//! machine's [`Step`]s from [`Job::next_step`] after each
+//! machine's [`MachineStep`]s from [`Job::next_step`] after each
 //! [`Action::NextMoves`] until it returns `None`, runs them, and then sends
 //! [`Event::MotionDone`]. While winding it feeds the pattern read from the
 //! card through [`Event::Nail`] whenever [`Job::wants_nail`].
 //!
 //! Steps come in batches of one hole or one wrap: a pause (a long press of
-//! green, or `!`) stops the machine when the current batch is done — drill
-//! raised, needle inside the ring — with the drivers holding.
+//! green) stops the machine when the current batch is done — drill raised,
+//! needle inside the ring — with the drivers holding. (The console's `!` is
+//! a feed hold of the motion, not a pause of the job.)
 //!
 //! Buttons: green confirms on a short press (released before 2 s) and
 //! pauses drilling or winding on a long press; the white zeroing buttons
@@ -33,23 +34,25 @@
 //! ```
 
 mod io;
-mod motion;
+mod phase;
+mod phase_steps;
 mod progress;
 
-pub use io::{Action, Actions, Event, Msg, Phase, Prompt, State, PROMPT_MARK};
-pub use motion::FEED;
+pub use io::{Action, Actions, Event, Msg, Prompt, State, PROMPT_MARK};
+pub use phase::Phase;
+pub use phase_steps::FEED;
 pub use progress::{left_s, Progress};
 
-use super::{bit, Drilling, Step, Winder, MACHINE_DRIVERS};
+use super::{bit, Drilling, MachineStep, Winder, MACHINE_DRIVERS};
 use crate::axis::Axis;
-use crate::buttons::{ButtonEvent, LONG_PRESS_MS};
+use crate::buttons::ButtonEvent;
 use crate::config::MachineConfig;
+use crate::files::check::CardId;
+use crate::files::param::Params;
 use crate::geometry::Board;
-use crate::job::files::CardId;
-use crate::job::param::Params;
 use crate::pinmap::Button;
 use crate::units::Milli;
-use motion::Motion;
+use phase_steps::PhaseSteps;
 
 /// Where the card stands, as far as the job knows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,7 +80,8 @@ pub struct Job {
     state: State,
     card: Card,
     plan: Option<Plan>,
-    motion: Option<Motion>,
+    /// The running (or paused) phase's steps.
+    steps: Option<PhaseSteps>,
     /// Axes whose zeroing button was pressed once: driver off, zero pending.
     loose: u8,
     /// `NextMoves` sent, `MotionDone` not yet received.
@@ -109,7 +113,7 @@ impl Job {
             state: State::WaitingForCard,
             card: Card::Absent,
             plan: None,
-            motion: None,
+            steps: None,
             loose: 0,
             moving: false,
             lost: false,
@@ -124,13 +128,13 @@ impl Job {
     /// or outside drilling and winding. A pause takes effect at the end of
     /// the batch: its remaining steps still come (drill raised, needle
     /// inside the ring before the machine stands).
-    pub fn next_step(&mut self) -> Option<Step> {
+    pub fn next_step(&mut self) -> Option<MachineStep> {
         let finishing = matches!(self.state, State::Paused(_))
-            && self.motion.as_ref().is_some_and(Motion::mid_batch);
+            && self.steps.as_ref().is_some_and(PhaseSteps::mid_batch);
         if !self.state.is_running() && !finishing {
             return None;
         }
-        self.motion.as_mut()?.next()
+        self.steps.as_mut()?.next()
     }
 
     /// Drilling or winding, or paused inside them: the job owns the
@@ -141,7 +145,7 @@ impl Job {
 
     /// Winding wants the next index of the pattern ([`Event::Nail`]).
     pub fn wants_nail(&self) -> bool {
-        !self.lost && self.motion.as_ref().is_some_and(Motion::wants_nail)
+        !self.lost && self.steps.as_ref().is_some_and(PhaseSteps::wants_nail)
     }
 
     /// Handles one event; `now_ms` is the firmware's millisecond clock
@@ -167,14 +171,13 @@ impl Job {
             Event::Button(b) => self.button(b, o, now_ms),
             Event::MotionDone => {
                 self.moving = false;
-                if let Some(m) = &mut self.motion {
+                if let Some(m) = &mut self.steps {
                     m.release();
                 }
                 if self.state.is_running() {
                     self.advance(o, now_ms);
                 }
             }
-            Event::Pause => self.pause(o, now_ms),
             Event::Resume => self.resume(o, now_ms),
             Event::Abort => self.abort(o),
             Event::Nail(j) => self.nail(j, o, now_ms),
@@ -217,7 +220,7 @@ impl Job {
     /// Back to the start: the job and its files are dropped.
     fn restart(&mut self, o: &mut Out) {
         self.plan = None;
-        self.motion = None;
+        self.steps = None;
         self.loose = 0;
         self.enter(State::WaitingForCard, o);
         if self.card == Card::Fresh {
@@ -315,7 +318,7 @@ impl Job {
         o.push(Action::Log(Msg::CardOk));
         if self.lost {
             self.lost = false;
-            let skip = self.motion.as_ref().map_or(0, Motion::fed);
+            let skip = self.steps.as_ref().map_or(0, PhaseSteps::fed);
             o.push(Action::OpenPattern { skip });
         }
         match self.state {
@@ -363,10 +366,7 @@ impl Job {
                 }
             }
             ButtonEvent::LongPress(Button::Confirm) => self.pause(o, now_ms),
-            ButtonEvent::Released {
-                button: Button::Confirm,
-                held_ms,
-            } if held_ms < LONG_PRESS_MS => self.confirm(o, now_ms),
+            e if e.is_short_press(Button::Confirm) => self.confirm(o, now_ms),
             _ => {}
         }
     }
@@ -410,9 +410,9 @@ impl Job {
         let Some(drilling) = plan.drilling.take() else {
             return;
         };
-        let mut motion = Motion::drill(drilling, plan.board.nails(), now_ms);
-        let first = motion.reporter.first(now_ms);
-        self.motion = Some(motion);
+        let mut steps = PhaseSteps::drill(drilling, plan.board.nails(), now_ms);
+        let first = steps.reporter.first(now_ms);
+        self.steps = Some(steps);
         self.enter(State::Drilling, o);
         o.push(Action::DriversOn(MACHINE_DRIVERS));
         o.push(Action::Progress(first));
@@ -424,9 +424,9 @@ impl Job {
         let Some(winder) = plan.winder.take() else {
             return;
         };
-        let mut motion = Motion::wind(winder, plan.count, now_ms);
-        let first = motion.reporter.first(now_ms);
-        self.motion = Some(motion);
+        let mut steps = PhaseSteps::wind(winder, plan.count, now_ms);
+        let first = steps.reporter.first(now_ms);
+        self.steps = Some(steps);
         self.enter(State::Winding, o);
         // Drilling came home a whole number of turns from the base's zero,
         // and the winder counts from zero: without this, an unzeroed base
@@ -447,7 +447,7 @@ impl Job {
     /// The machine has carried out every step handed out: report, then
     /// the next batch, or the end of the phase.
     fn advance(&mut self, o: &mut Out, now_ms: u32) {
-        let Some(m) = &mut self.motion else { return };
+        let Some(m) = &mut self.steps else { return };
         if let Some(p) = m.reporter.update(m.done, now_ms) {
             o.push(Action::Progress(p));
         }
@@ -455,7 +455,7 @@ impl Job {
             if let Some(p) = m.reporter.finish(now_ms) {
                 o.push(Action::Progress(p));
             }
-            self.motion = None;
+            self.steps = None;
             // The phase's last step switched the drivers off.
             let next = match self.state {
                 State::Drilling => State::WaitingForNails,
@@ -471,7 +471,7 @@ impl Job {
         let Some(phase) = self.phase().filter(|_| self.state.is_running()) else {
             return;
         };
-        if let Some(m) = &mut self.motion {
+        if let Some(m) = &mut self.steps {
             m.reporter.pause(now_ms);
         }
         self.enter(State::Paused(phase), o);
@@ -486,7 +486,7 @@ impl Job {
             o.push(Action::Prompt(Prompt::InsertCard));
             return;
         }
-        if let Some(m) = &mut self.motion {
+        if let Some(m) = &mut self.steps {
             m.reporter.resume(now_ms);
         }
         o.push(Action::Log(Msg::Resumed));
@@ -511,7 +511,7 @@ impl Job {
         if self.phase().is_none() {
             return;
         }
-        self.motion = None;
+        self.steps = None;
         self.moving = false;
         self.lost = false;
         o.push(Action::Log(Msg::Aborted));
@@ -529,7 +529,7 @@ impl Job {
             self.lose_pattern(o, now_ms);
             return;
         }
-        let Some(m) = &mut self.motion else { return };
+        let Some(m) = &mut self.steps else { return };
         m.feed(j);
         if self.state == State::Winding && !self.moving {
             // It was waiting for this index.

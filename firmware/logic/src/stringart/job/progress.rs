@@ -3,7 +3,7 @@
 //! spent so far (pauses excluded). Integer maths, a division or two per
 //! line, never per step.
 
-use super::io::Phase;
+use super::phase::Phase;
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
 /// One progress line: `wind 1234/3000 left 3720s`.
@@ -114,7 +114,7 @@ impl Reporter {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::show;
+    use crate::text::error::tests::show;
 
     #[test]
     fn lines_read_as_the_issue_shows() {

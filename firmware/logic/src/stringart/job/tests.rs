@@ -44,16 +44,19 @@ fn short(button: Button) -> [Event<'static>; 2] {
     ]
 }
 
+/// Green held for 2 s: pause after the current hole or wrap.
+const LONG_GREEN: Event<'static> = Event::Button(ButtonEvent::LongPress(Button::Confirm));
+
 fn board(params: Params) -> Board {
     Board::new(params.shape, params.nails, Milli(params.radius_um as i32)).unwrap()
 }
 
 /// The whole drilling / winding sequence as the planners make it.
-fn drilled(params: Params) -> Vec<Step> {
+fn drilled(params: Params) -> Vec<MachineStep> {
     Drilling::new(board(params), &CONFIG).collect()
 }
 
-fn wound(params: Params, pattern: &[u16]) -> Vec<Step> {
+fn wound(params: Params, pattern: &[u16]) -> Vec<MachineStep> {
     let winder = Winder::new(board(params), &CONFIG).unwrap();
     Winding::new(winder, pattern.iter().copied())
         .map(Result::unwrap)
@@ -70,7 +73,7 @@ struct Bench {
     /// Next index of the pattern the card reader delivers.
     at: usize,
     /// Steps carried out, and every action seen.
-    steps: Vec<Step>,
+    steps: Vec<MachineStep>,
     actions: Vec<Action>,
     pulling: bool,
     drivers: u8,
@@ -146,15 +149,15 @@ impl Bench {
         self.pulling = false;
         while let Some(step) = self.job.next_step() {
             match step {
-                Step::Move(t) => {
+                MachineStep::Move(t) => {
                     for (p, t) in self.pos.iter_mut().zip(t) {
                         *p = t.unwrap_or(*p);
                     }
                     self.now += 500;
                 }
-                Step::Dwell(ms) => self.now += ms as u32,
-                Step::Drivers { mask, on: true } => self.drivers |= mask,
-                Step::Drivers { mask, on: false } => self.drivers &= !mask,
+                MachineStep::Dwell(ms) => self.now += ms as u32,
+                MachineStep::Drivers { mask, on: true } => self.drivers |= mask,
+                MachineStep::Drivers { mask, on: false } => self.drivers &= !mask,
             }
             self.steps.push(step);
             self.feed();
@@ -406,7 +409,7 @@ fn long_press_pauses_after_the_batch_and_a_short_press_resumes() {
     b.pulling = false;
     b.steps
         .extend([b.job.next_step().unwrap(), b.job.next_step().unwrap()]);
-    let long = b.send(Event::Button(ButtonEvent::LongPress(Button::Confirm)));
+    let long = b.send(LONG_GREEN);
     assert_eq!(
         long,
         [
@@ -416,9 +419,9 @@ fn long_press_pauses_after_the_batch_and_a_short_press_resumes() {
     );
     // The hole is finished first: its dwell and retract still come (the
     // machine stands with the drill raised), then nothing.
-    let rest: std::vec::Vec<Step> = core::iter::from_fn(|| b.job.next_step()).collect();
+    let rest: std::vec::Vec<MachineStep> = core::iter::from_fn(|| b.job.next_step()).collect();
     assert!(
-        matches!(rest[..], [Step::Dwell(_), Step::Move(_)]),
+        matches!(rest[..], [MachineStep::Dwell(_), MachineStep::Move(_)]),
         "{rest:?}"
     );
     b.steps.extend(rest);
@@ -446,30 +449,27 @@ fn long_press_pauses_after_the_batch_and_a_short_press_resumes() {
     // Nothing lost, nothing repeated.
     assert_eq!(b.steps, drilled(HEX));
     // A long press outside drilling and winding does nothing.
-    assert_eq!(
-        b.send(Event::Button(ButtonEvent::LongPress(Button::Confirm))),
-        []
-    );
+    assert_eq!(b.send(LONG_GREEN), []);
 }
 
 #[test]
-fn serial_pause_and_resume_while_winding() {
+fn long_press_pauses_winding_and_serial_resume_resumes() {
     let mut b = Bench::new(HEX, &PATTERN);
     b.ready();
-    assert_eq!(b.send(Event::Pause), [], "nothing to pause");
+    assert_eq!(b.send(LONG_GREEN), [], "nothing to pause");
     b.green();
     b.run();
     b.green();
     b.batch(); // the entry
     b.batch(); // nail 0
     assert_eq!(
-        b.send(Event::Pause),
+        b.send(LONG_GREEN),
         [
             Action::Enter(State::Paused(Phase::Winding)),
             Action::Prompt(Prompt::Resume)
         ]
     );
-    assert_eq!(b.send(Event::Pause), [], "already paused");
+    assert_eq!(b.send(LONG_GREEN), [], "already paused");
     // The batch the firmware was already asked for is empty, and then
     // nothing more is asked for.
     let len = b.steps.len();
@@ -518,7 +518,7 @@ fn pause_and_resume_before_the_batch_has_finished() {
     b.pulling = false;
     let step = b.job.next_step().unwrap();
     b.steps.push(step);
-    b.send(Event::Pause);
+    b.send(LONG_GREEN);
     // Resumed while the machine is still moving: keep pulling.
     assert_eq!(b.send(Event::Resume).last(), Some(&Action::NextMoves));
     assert!(b.pulling);
@@ -752,7 +752,7 @@ fn winding_waits_for_the_card_reader() {
     b.green();
     // The reader is slow: nothing fed yet. The entry needs no index.
     b.pulling = false;
-    let entry: Vec<Step> = core::iter::from_fn(|| b.job.next_step()).collect();
+    let entry: Vec<MachineStep> = core::iter::from_fn(|| b.job.next_step()).collect();
     assert_eq!(entry.len(), 4);
     assert_eq!(b.send(Event::MotionDone), [], "no index yet: it waits");
     assert!(b.job.wants_nail());

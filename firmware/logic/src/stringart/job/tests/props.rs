@@ -29,7 +29,7 @@ fn event(k: usize, nail: u16) -> Event<'static> {
         4 => valid(SMALL, 6),
         5 => Event::FilesInvalid,
         6 => Event::MotionDone,
-        7 => Event::Pause,
+        7 => LONG_GREEN,
         8 => Event::Resume,
         9 => Event::Nail(nail),
         10 => Event::PatternLost,

@@ -2,9 +2,10 @@
 //! `3000,0,159,\r\n 251, 56,` — blanks and line breaks anywhere between
 //! numbers, an optional trailing comma. O(1) memory.
 
-use crate::job::cursor::{Cursor, Feed};
-use crate::job::error::{ErrorKind, FileError, FileName};
-use crate::job::num::push_digit;
+use crate::files::cursor::{Cursor, Feed};
+use crate::files::error::{FileError, FileName};
+use crate::text::num::push_digit;
+use crate::text::ErrorKind;
 
 /// A number of the list and where its first digit is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,14 +6,13 @@
 //!   validated in one pass, then streamed again while winding.
 //! - `machine.txt` ([`machine`]): optional overrides of the machine settings.
 
+pub mod check;
 pub mod cursor;
 pub mod error;
-pub mod files;
 pub mod kv;
 pub mod list;
 pub mod machine;
-pub mod num;
 pub mod param;
 pub mod poradi;
 
-pub use error::{ErrorKind, FileError, FileName};
+pub use error::{FileError, FileName};

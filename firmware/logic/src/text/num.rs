@@ -1,7 +1,7 @@
-//! Numbers of the job files, parsed straight into integers and fixed point
-//! (no floats between the text and the machine).
+//! Numbers of the job files and settings, parsed straight into integers
+//! and fixed point (no floats between the text and the machine).
 
-use crate::job::error::ErrorKind;
+use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
 
 /// A number that did not parse: what, and at which byte of the text.

@@ -9,9 +9,10 @@
 //! the whole file is good: a bad file changes nothing.
 
 use crate::config::MachineConfig;
-use crate::job::error::{ErrorKind, FileError, FileName};
-use crate::job::kv::{Item, KvReader};
+use crate::files::error::{FileError, FileName};
+use crate::files::kv::{Item, KvReader};
 use crate::settings::{Setting, SettingError, COUNT};
+use crate::text::ErrorKind;
 
 const FILE: FileName = FileName::Machine;
 
@@ -74,7 +75,8 @@ fn apply(cfg: &mut MachineConfig, seen: &mut u64, item: Item<'_>) -> Result<(), 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::{in_every_chunking, show};
+    use crate::files::error::tests::in_every_chunking;
+    use crate::text::error::tests::show;
     use crate::units::StepsPerUnit;
     use proptest::prelude::*;
     use std::string::String;

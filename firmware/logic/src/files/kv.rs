@@ -3,9 +3,10 @@
 //! (at most [`MAX_LINE`] bytes). Accepts `#` comments, blank lines, LF, CR
 //! or CRLF line ends, blanks around `=` and a byte-order mark at the start.
 
-use crate::job::cursor::{Cursor, Feed};
-use crate::job::error::{ErrorKind, FileError, FileName};
-use crate::job::num::trim;
+use crate::files::cursor::{Cursor, Feed};
+use crate::files::error::{FileError, FileName};
+use crate::text::num::trim;
+use crate::text::ErrorKind;
 
 /// Longest line accepted, comment included, in characters.
 pub const MAX_LINE: usize = 64;
@@ -73,11 +74,6 @@ impl KvReader {
         let (line, _) = self.cursor.next_pos();
         self.ended = Some(line);
         self.item(line)
-    }
-
-    /// Where the file ended (or the next byte would be).
-    pub fn end_pos(&self) -> (u32, u32) {
-        self.cursor.next_pos()
     }
 
     fn byte(&mut self, b: u8) -> Result<(), FileError> {

@@ -1,26 +1,8 @@
-//! The one error type of every job file: which file, where, and what was
-//! expected, printed as a single log line `file:line:col: message`.
+//! What can be wrong with a value the machine reads as text: in a job
+//! file, a `machine.txt` override, a `$` setting, or the configuration as a
+//! whole. Printed as the tail of the one-line messages.
 
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
-
-/// The files the machine reads from the card.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FileName {
-    Param,
-    Poradi,
-    Machine,
-}
-
-impl FileName {
-    /// The 8.3 name on the card (matched case-insensitively).
-    pub const fn name(self) -> &'static str {
-        match self {
-            FileName::Param => "param.txt",
-            FileName::Poradi => "poradi.txt",
-            FileName::Machine => "machine.txt",
-        }
-    }
-}
 
 /// What went wrong. Messages are short: on the AVR every string lives in SRAM.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,7 +11,7 @@ pub enum ErrorKind {
     NotFound,
     /// Nothing but blanks and comments.
     Empty,
-    /// A `key = value` line longer than [`crate::job::kv::MAX_LINE`].
+    /// A `key = value` line longer than [`crate::files::kv::MAX_LINE`].
     LineTooLong,
     /// A line that is neither blank, a comment nor `key = value`.
     ExpectedKeyValue,
@@ -83,33 +65,6 @@ pub enum ErrorKind {
     },
 }
 
-/// An error in a job file. `line == 0` means the whole file (no position).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct FileError {
-    pub file: FileName,
-    /// 1-based line; 0 for errors about the whole file.
-    pub line: u32,
-    /// 1-based column in characters.
-    pub col: u32,
-    pub kind: ErrorKind,
-}
-
-impl FileError {
-    pub const fn at(file: FileName, line: u32, col: u32, kind: ErrorKind) -> Self {
-        FileError {
-            file,
-            line,
-            col,
-            kind,
-        }
-    }
-
-    /// An error about the whole file, printed without line and column.
-    pub const fn whole(file: FileName, kind: ErrorKind) -> Self {
-        Self::at(file, 0, 0, kind)
-    }
-}
-
 impl uDisplay for ErrorKind {
     fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
         match *self {
@@ -149,16 +104,6 @@ impl uDisplay for ErrorKind {
     }
 }
 
-impl uDisplay for FileError {
-    fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
-        f.write_str(self.file.name())?;
-        if self.line != 0 {
-            uwrite!(f, ":{}:{}", self.line, self.col)?;
-        }
-        uwrite!(f, ": {}", self.kind)
-    }
-}
-
 /// `40.2` for 402000 µm: whole centimetres, then only the decimals needed.
 fn write_um_as_cm<W: uWrite + ?Sized>(f: &mut Formatter<'_, W>, um: u32) -> Result<(), W::Error> {
     uwrite!(f, "{}", um / 10_000)?;
@@ -195,42 +140,6 @@ pub(crate) mod tests {
         let mut t = Text(String::new());
         uwrite!(t, "{}", value).unwrap();
         t.0
-    }
-
-    /// Parses `text` whole and in chunks of every size with
-    /// `parse_in_chunks(bytes, chunk)`; all must agree. Errors as printed.
-    pub fn in_every_chunking<T: PartialEq + core::fmt::Debug>(
-        text: &str,
-        parse_in_chunks: impl Fn(&[u8], usize) -> Result<T, FileError>,
-    ) -> Result<T, String> {
-        let whole = parse_in_chunks(text.as_bytes(), text.len().max(1));
-        for chunk in 1..text.len() {
-            assert_eq!(
-                parse_in_chunks(text.as_bytes(), chunk),
-                whole,
-                "chunk {chunk}"
-            );
-        }
-        whole.map_err(|e| show(&e))
-    }
-
-    #[test]
-    fn one_line_per_error() {
-        let e = FileError::at(
-            FileName::Poradi,
-            3,
-            14,
-            ErrorKind::Nail {
-                index: 251,
-                nails: 250,
-            },
-        );
-        assert_eq!(
-            show(&e),
-            "poradi.txt:3:14: nail 251 out of range (nails: 250)"
-        );
-        let e = FileError::whole(FileName::Param, ErrorKind::Empty);
-        assert_eq!(show(&e), "param.txt: empty file");
     }
 
     #[test]

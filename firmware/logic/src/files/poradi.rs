@@ -4,8 +4,9 @@
 //! ([`PoradiCheck`]), then streamed again while winding ([`PoradiReader`]):
 //! O(C) reads in all, O(1) memory.
 
-use crate::job::error::{ErrorKind, FileError, FileName};
-use crate::job::list::{List, Number};
+use crate::files::error::{FileError, FileName};
+use crate::files::list::{List, Number};
+use crate::text::ErrorKind;
 
 /// Most connections a job may declare.
 pub const MAX_CONNECTIONS: u32 = 1_000_000;
@@ -142,7 +143,7 @@ impl PoradiReader {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::show;
+    use crate::text::error::tests::show;
     use proptest::prelude::*;
     use std::string::String;
     use std::vec::Vec;

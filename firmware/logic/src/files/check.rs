@@ -10,10 +10,11 @@
 //! back mid-job is the job's card only if both files are the same.
 
 use crate::config::MachineConfig;
-use crate::job::error::{ErrorKind, FileError, FileName};
-use crate::job::machine::MachineFile;
-use crate::job::param::{ParamFile, Params};
-use crate::job::poradi::PoradiCheck;
+use crate::files::error::{FileError, FileName};
+use crate::files::machine::MachineFile;
+use crate::files::param::{ParamFile, Params};
+use crate::files::poradi::PoradiCheck;
+use crate::text::ErrorKind;
 
 /// What the card holds, once every file checked out.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -154,7 +155,7 @@ impl Files {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::show;
+    use crate::text::error::tests::show;
 
     const PARAM: &[u8] = b"tvar = 6\npocet_hrebiku = 24\npolomer_matrice = 20\n";
 

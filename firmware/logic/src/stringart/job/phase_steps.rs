@@ -3,9 +3,9 @@
 //! machine in a safe pose (drill raised, needle inside the ring) with a
 //! whole number of units done, and a pause stops there at the latest.
 
-use super::io::Phase;
+use super::phase::Phase;
 use super::progress::Reporter;
-use crate::stringart::{Drilling, Step, Winder, Wrap};
+use crate::stringart::{Drilling, MachineStep, Winder, Wrap};
 
 /// Nail indices buffered ahead of the winder: the card is read while the
 /// machine moves.
@@ -24,7 +24,7 @@ enum Work {
     Wind {
         winder: Winder,
         /// The entry move, until it has been handed out.
-        entry: Option<core::array::IntoIter<Step, 4>>,
+        entry: Option<core::array::IntoIter<MachineStep, 4>>,
         wrap: Option<Wrap>,
         feed: heapless::Deque<u16, FEED>,
         /// Indices received so far (the buffered ones included).
@@ -32,7 +32,8 @@ enum Work {
     },
 }
 
-pub(super) struct Motion {
+/// The steps of drilling or winding, with the count of units done.
+pub(super) struct PhaseSteps {
     work: Work,
     /// Units (holes, wraps) whose last step has been handed out.
     pub done: u32,
@@ -46,7 +47,7 @@ pub(super) struct Motion {
     pub reporter: Reporter,
 }
 
-impl Motion {
+impl PhaseSteps {
     pub fn drill(drilling: Drilling, nails: u16, now_ms: u32) -> Self {
         Self::new(
             Work::Drill {
@@ -72,7 +73,7 @@ impl Motion {
     }
 
     fn new(work: Work, phase: Phase, total: u32, now_ms: u32) -> Self {
-        Motion {
+        PhaseSteps {
             work,
             done: 0,
             total,
@@ -94,13 +95,13 @@ impl Motion {
         self.started && !self.hold && !self.exhausted
     }
 
-    pub fn next(&mut self) -> Option<Step> {
+    pub fn next(&mut self) -> Option<MachineStep> {
         let step = self.step();
         self.started |= step.is_some();
         step
     }
 
-    fn step(&mut self) -> Option<Step> {
+    fn step(&mut self) -> Option<MachineStep> {
         if self.hold || self.exhausted {
             return None;
         }
@@ -117,7 +118,7 @@ impl Motion {
                     self.done += 1;
                     self.hold = true;
                 }
-                *after_dwell = matches!(step, Step::Dwell(_));
+                *after_dwell = matches!(step, MachineStep::Dwell(_));
                 Some(step)
             }
             Work::Wind {

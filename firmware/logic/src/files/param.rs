@@ -8,9 +8,10 @@
 //! Keys are the original firmware's or their English aliases (`shape`,
 //! `nails`, `radius_cm`), in any case. Each must appear exactly once.
 
-use crate::job::error::{ErrorKind, FileError, FileName};
-use crate::job::kv::{Item, KvReader};
-use crate::job::num::{parse_fixed, parse_u32, NumError};
+use crate::files::error::{FileError, FileName};
+use crate::files::kv::{Item, KvReader};
+use crate::text::num::{parse_fixed, parse_u32, NumError};
+use crate::text::ErrorKind;
 
 /// Most corners of a polygonal board.
 pub const MAX_SHAPE: u16 = 1000;
@@ -180,7 +181,8 @@ impl Seen {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::job::error::tests::{in_every_chunking, show};
+    use crate::files::error::tests::in_every_chunking;
+    use crate::text::error::tests::show;
     use proptest::prelude::*;
     use std::string::String;
 

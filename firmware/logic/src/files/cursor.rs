@@ -5,7 +5,7 @@
 //! also tells a text file from what is not one: UTF-16 (a byte-order mark
 //! `FF FE` / `FE FF`), or a control byte no text file holds.
 
-use crate::job::error::ErrorKind;
+use crate::text::ErrorKind;
 
 const BOM: [u8; 3] = [0xEF, 0xBB, 0xBF];
 

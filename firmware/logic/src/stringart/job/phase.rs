@@ -1,0 +1,19 @@
+//! The two phases of the job that move the machine: shared by its events,
+//! its progress lines and its batches of steps.
+
+/// The two phases that move the machine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    Drilling,
+    Winding,
+}
+
+impl Phase {
+    /// Progress lines start with this: `drill 12/24`, `wind 1234/3000`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Phase::Drilling => "drill",
+            Phase::Winding => "wind",
+        }
+    }
+}
