@@ -78,12 +78,12 @@ pub fn run() -> Result<()> {
 /// move together and one after another.
 fn estimate(folder: &std::path::Path) -> Result<(f64, f64)> {
     use taut_logic::config::MachineConfig;
+    use taut_logic::files::param::ParamFile;
+    use taut_logic::files::poradi::PoradiReader;
     use taut_logic::geometry::Board;
-    use taut_logic::job::param::ParamFile;
-    use taut_logic::job::poradi::PoradiReader;
-    use taut_logic::stringart::{machine_time, Drilling, Overlap, Step, Winder, Winding};
+    use taut_logic::stringart::{machine_time, Drilling, MachineStep, Overlap, Winder, Winding};
     use taut_logic::units::Milli;
-    let bad = |e: taut_logic::job::FileError| format!("{e:?}");
+    let bad = |e: taut_logic::files::FileError| format!("{e:?}");
     let mut param = ParamFile::new();
     param
         .push(&std::fs::read(folder.join("param.txt"))?)
@@ -101,7 +101,7 @@ fn estimate(folder: &std::path::Path) -> Result<(f64, f64)> {
     let c = MachineConfig::STRING_ART;
     let board = Board::new(p.shape, p.nails, Milli(p.radius_um as i32)).map_err(|e| e.message())?;
     let winder = Winder::new(board, &c).map_err(|e| format!("{e:?}"))?;
-    let steps: Vec<Step> = Drilling::new(board, &c)
+    let steps: Vec<MachineStep> = Drilling::new(board, &c)
         .chain(Winding::new(winder, nails.into_iter()).map_while(|s| s.ok()))
         .collect();
     Ok((

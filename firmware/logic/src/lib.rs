@@ -30,8 +30,3 @@ pub mod settings;
 pub mod stringart;
 pub mod text;
 pub mod units;
-
-/// The job files' old path, kept only for `xtask` (being changed in another
-/// branch): drop it once `xtask` says `taut_logic::files`.
-#[doc(hidden)]
-pub use files as job;

@@ -48,11 +48,6 @@ impl MachineStep {
     }
 }
 
-/// The steps' old name, kept only for `xtask` (being changed in another
-/// branch): drop it once `xtask` says `MachineStep`.
-#[doc(hidden)]
-pub use MachineStep as Step;
-
 /// The driver bit of an axis, for [`MachineStep::Drivers`].
 pub const fn bit(axis: Axis) -> u8 {
     1 << axis as u8
