@@ -238,3 +238,11 @@ pub fn settle(sim: &mut sim::Sim) -> [usize; 3] {
     }
     panic!("still moving after 30 s:\n{}", sim.uart_text());
 }
+
+/// Hold `button` for `ms`, release it, then 100 ms for it to settle.
+pub fn press(sim: &mut sim::Sim, button: taut_logic::pinmap::Button, ms: u64) {
+    sim.press(button.pin());
+    sim.run_for(std::time::Duration::from_millis(ms));
+    sim.release(button.pin());
+    sim.run_for(std::time::Duration::from_millis(100));
+}

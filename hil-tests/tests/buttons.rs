@@ -7,21 +7,13 @@ use hil_tests::sim::operator::message;
 use hil_tests::sim::sdcard::SdImage;
 use hil_tests::sim::Sim;
 use hil_tests::{
-    all_pulses, assert_ram_budget, assert_step_interrupt_never_masked_long, boot_machine, pulses,
-    sample_card_dir, send_ok, settle, wait_for,
+    all_pulses, assert_ram_budget, assert_step_interrupt_never_masked_long, boot_machine, press,
+    pulses, sample_card_dir, send_ok, settle, wait_for,
 };
 use std::time::Duration;
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::{driver, Button};
-
-/// Held for `ms`, then released, then 100 ms to settle.
-fn press(sim: &mut Sim, button: Button, ms: u64) {
-    sim.press(button.pin());
-    sim.run_for(Duration::from_millis(ms));
-    sim.release(button.pin());
-    sim.run_for(Duration::from_millis(100));
-}
 
 /// Booted with the sample card, in the preparation state before drilling.
 fn prepared() -> Sim {

@@ -8,7 +8,7 @@ use hil_tests::sim::replay::{board_from_param, JobReplay};
 use hil_tests::sim::sdcard::{CardFault, SdCard, SdImage};
 use hil_tests::sim::{Outcome, Sim};
 use hil_tests::{
-    assert_ram_budget, boot_machine, card, log_tail, pulses, rising, send_ok, steps_on_pins,
+    assert_ram_budget, boot_machine, card, log_tail, press, pulses, rising, send_ok, steps_on_pins,
     wait_for,
 };
 use std::time::Duration;
@@ -32,9 +32,27 @@ fn count(sim: &Sim, text: &str) -> usize {
 }
 
 fn press_green(sim: &mut Sim) {
-    sim.press(Button::Confirm.pin());
-    sim.run_for(Duration::from_millis(150));
-    sim.release(Button::Confirm.pin());
+    press(sim, Button::Confirm, 150);
+}
+
+/// Runs until the log shows `text` (within `limit_s` of machine time),
+/// asking `?` every `every`: the longest a report took to start, ms.
+fn worst_status_until(sim: &mut Sim, text: &str, limit_s: f64, every: Duration) -> f64 {
+    let mut worst = 0.0f64;
+    while !sim.uart_text().contains(text) {
+        assert!(sim.time_s() < limit_s, "{}", log_tail(sim));
+        let start = sim.uart_bytes().len();
+        let t0 = sim.time_s();
+        sim.uart_send(b"?");
+        let out = sim.run_until(
+            |s| s.uart_bytes()[start..].contains(&b'<'),
+            Duration::from_millis(100),
+        );
+        assert_eq!(out, Outcome::Done, "{}", log_tail(sim));
+        worst = worst.max((sim.time_s() - t0) * 1000.0);
+        sim.run_for(every);
+    }
+    worst
 }
 
 /// `count` nail indices of `nails`, comma-separated after the count: a
@@ -223,20 +241,7 @@ fn a_100000_connection_pattern_is_checked_without_stalling_the_console() {
     let mut sim = boot_machine();
     sim.insert_sd(image);
     wait_for(&mut sim, "state: reading", Duration::from_secs(2));
-    let mut worst = 0.0f64;
-    while !sim.uart_text().contains("files ok:") {
-        assert!(sim.time_s() < 60.0, "{}", log_tail(&sim));
-        let start = sim.uart_bytes().len();
-        let t0 = sim.time_s();
-        sim.uart_send(b"?");
-        let out = sim.run_until(
-            |s| s.uart_bytes()[start..].contains(&b'<'),
-            Duration::from_millis(100),
-        );
-        assert_eq!(out, Outcome::Done, "{}", log_tail(&sim));
-        worst = worst.max((sim.time_s() - t0) * 1000.0);
-        sim.run_for(Duration::from_millis(200));
-    }
+    let worst = worst_status_until(&mut sim, "files ok:", 60.0, Duration::from_millis(200));
     assert!(sim.uart_text().contains("connections 100000"));
     assert!(worst <= 10.0, "`?` waited {worst:.1} ms during the check");
     assert_eq!(sim.watchdog_resets(), 0);
@@ -255,20 +260,7 @@ fn a_million_connection_pattern_is_checked_while_the_machine_works() {
     wait_for(&mut sim, "state: reading", Duration::from_secs(2));
     send_ok(&mut sim, "M17", Duration::from_secs(1));
     send_ok(&mut sim, "G0 C3600", Duration::from_secs(1));
-    let mut worst = 0.0f64;
-    while !sim.uart_text().contains("files ok:") {
-        assert!(sim.time_s() < 300.0, "{}", log_tail(&sim));
-        let start = sim.uart_bytes().len();
-        let t0 = sim.time_s();
-        sim.uart_send(b"?");
-        let out = sim.run_until(
-            |s| s.uart_bytes()[start..].contains(&b'<'),
-            Duration::from_millis(100),
-        );
-        assert_eq!(out, Outcome::Done, "{}", log_tail(&sim));
-        worst = worst.max((sim.time_s() - t0) * 1000.0);
-        sim.run_for(Duration::from_millis(500));
-    }
+    let worst = worst_status_until(&mut sim, "files ok:", 300.0, Duration::from_millis(500));
     assert!(sim.uart_text().contains("connections 1000000"));
     assert!(worst <= 10.0, "`?` waited {worst:.1} ms during the check");
     send_ok(&mut sim, "M400", Duration::from_secs(300));

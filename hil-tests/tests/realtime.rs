@@ -7,8 +7,8 @@
 use hil_tests::sim::sdcard::SdImage;
 use hil_tests::sim::{Reply, Sim};
 use hil_tests::{
-    assert_ram_budget, boot_machine, log_tail, max_accel, reported_steps, rising, sample_card_dir,
-    send_ok, settle, steps_on_pins, wait_for,
+    assert_ram_budget, boot_machine, log_tail, max_accel, press, reported_steps, rising,
+    sample_card_dir, send_ok, settle, steps_on_pins, wait_for,
 };
 use std::time::Duration;
 use taut_logic::axis::Axis;
@@ -204,17 +204,21 @@ fn soft_limits_and_slow_feeds_are_refused_with_zero_steps() {
     assert_eq!(steps_on_pins(&sim), [19200, 469 * 32, 0]);
 }
 
+/// The sample job's card in, green pressed: drilling.
+fn drilling() -> Sim {
+    let mut sim = boot_machine();
+    sim.insert_sd(SdImage::from_path(&sample_card_dir()).unwrap());
+    wait_for(&mut sim, "press green to drill", Duration::from_secs(3));
+    press(&mut sim, Button::Confirm, 150);
+    wait_for(&mut sim, "state: drilling", Duration::from_secs(1));
+    sim
+}
+
 /// While the job drills (and while it is paused) the console refuses
 /// motion, drivers and settings, and still answers reads and `?`.
 #[test]
 fn the_console_cannot_move_the_machine_during_a_job() {
-    let mut sim = boot_machine();
-    sim.insert_sd(SdImage::from_path(&sample_card_dir()).unwrap());
-    wait_for(&mut sim, "press green to drill", Duration::from_secs(3));
-    sim.press(Button::Confirm.pin());
-    sim.run_for(Duration::from_millis(150));
-    sim.release(Button::Confirm.pin());
-    wait_for(&mut sim, "state: drilling", Duration::from_secs(1));
+    let mut sim = drilling();
     sim.run_for(Duration::from_millis(1500));
     for line in [
         "G0 C10",
@@ -229,9 +233,7 @@ fn the_console_cannot_move_the_machine_during_a_job() {
     send(&mut sim, "M114");
     assert!(status(&mut sim).0.starts_with("<Run|"));
     // Paused inside the job: still the job's.
-    sim.press(Button::Confirm.pin());
-    sim.run_for(Duration::from_millis(2200));
-    sim.release(Button::Confirm.pin());
+    press(&mut sim, Button::Confirm, 2200);
     wait_for(&mut sim, ">>> paused", Duration::from_secs(30));
     // The hole in progress is finished first.
     settle(&mut sim);
@@ -246,12 +248,7 @@ fn the_console_cannot_move_the_machine_during_a_job() {
 /// goes on; Ctrl-X ends the job with the drivers holding.
 #[test]
 fn hold_and_ctrl_x_during_a_job() {
-    let mut sim = boot_machine();
-    sim.insert_sd(SdImage::from_path(&sample_card_dir()).unwrap());
-    wait_for(&mut sim, "press green to drill", Duration::from_secs(3));
-    sim.press(Button::Confirm.pin());
-    sim.run_for(Duration::from_millis(150));
-    sim.release(Button::Confirm.pin());
+    let mut sim = drilling();
     wait_for(&mut sim, "drill 1/24", Duration::from_secs(30));
     sim.run_for(Duration::from_millis(700));
     sim.uart_send(b"!");

@@ -109,13 +109,13 @@ fn steps_of(c_deg: f64, x_mm: f64, z_mm: f64) -> [i64; 3] {
 }
 
 /// Relative moves of `mm` on the radial axis at the maximum rate from
-/// 200 mm inside the board's edge, in runs of 100 that go out, out, back
-/// (inside the carriage's travel).
+/// 200 mm inside the board's edge, in runs of 100 that go out, out, back,
+/// back (inside the carriage's travel, however many).
 fn radial_pieces(mm: f64, n: usize) -> (Vec<String>, [i64; 3]) {
     let mut lines = vec!["G0 X-200".to_string(), "G91".to_string()];
     let mut x = -200.0;
     for k in 0..n {
-        let d = if k / 100 % 3 == 2 { -mm } else { mm };
+        let d = if k / 100 % 4 < 2 { mm } else { -mm };
         lines.push(format!("G1 X{d} F60000"));
         x += d;
     }

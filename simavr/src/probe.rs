@@ -83,22 +83,22 @@ impl Probe {
         self.edges.iter().filter(|e| e.high)
     }
 
-    /// Shortest completed high pulse, in cycles.
-    pub fn min_high_cycles(&self) -> Option<u64> {
+    /// Every completed high pulse's length, in cycles.
+    fn high_cycles(&self) -> impl Iterator<Item = u64> + '_ {
         self.edges
             .windows(2)
             .filter(|w| w[0].high && !w[1].high)
             .map(|w| w[1].cycle - w[0].cycle)
-            .min()
     }
 
-    /// Longest time the pin stayed high, in cycles.
+    /// Shortest completed high pulse, in cycles.
+    pub fn min_high_cycles(&self) -> Option<u64> {
+        self.high_cycles().min()
+    }
+
+    /// Longest completed high pulse, in cycles.
     pub fn max_high_cycles(&self) -> Option<u64> {
-        self.edges
-            .windows(2)
-            .filter(|w| w[0].high && !w[1].high)
-            .map(|w| w[1].cycle - w[0].cycle)
-            .max()
+        self.high_cycles().max()
     }
 
     /// Shortest time between two rising edges, in cycles.

@@ -132,6 +132,23 @@ impl Default for MachineConfig {
     }
 }
 
+/// Two identical axes, 100 steps per unit, 4000 steps/s, 1000 steps/s²,
+/// junction deviation 50 µm: corners are plain geometry (planner tests).
+#[cfg(test)]
+pub(crate) fn square() -> MachineConfig {
+    let axis = AxisConfig {
+        steps_per_unit: StepsPerUnit::new(100, 1),
+        max_rate: 4000,
+        accel: 1000,
+        ..MachineConfig::STRING_ART.axes[0]
+    };
+    MachineConfig {
+        axes: [axis; crate::axis::AXES],
+        junction_deviation_um: 50,
+        ..MachineConfig::STRING_ART
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

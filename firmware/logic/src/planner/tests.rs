@@ -1,24 +1,8 @@
 use super::*;
-use crate::config::AxisConfig;
+use crate::config::square;
 use crate::segment::{expand, Event, Preparer, Segment, TICK_HZ};
-use crate::units::StepsPerUnit;
 use proptest::prelude::*;
 use std::vec::Vec;
-
-/// Two identical axes, 100 steps per unit, so corners are plain geometry.
-fn square() -> MachineConfig {
-    let axis = AxisConfig {
-        steps_per_unit: StepsPerUnit::new(100, 1),
-        max_rate: 4000,
-        accel: 1000,
-        ..MachineConfig::STRING_ART.axes[0]
-    };
-    MachineConfig {
-        axes: [axis; AXES],
-        junction_deviation_um: 50,
-        ..MachineConfig::STRING_ART
-    }
-}
 
 fn entries(p: &Planner) -> Vec<u64> {
     (0..p.len)

@@ -1,26 +1,10 @@
 use super::*;
 use crate::axis::{PerAxis, AXES};
-use crate::config::{AxisConfig, MachineConfig};
+use crate::config::square;
 use crate::planner::{Feed, Full};
 use crate::segment::{expand, Event, TICK_HZ};
-use crate::units::StepsPerUnit;
 use proptest::prelude::*;
 use std::vec::Vec;
-
-/// Two identical axes, 100 steps per unit, 4000 steps/s, 1000 steps/s².
-fn square() -> MachineConfig {
-    let axis = AxisConfig {
-        steps_per_unit: StepsPerUnit::new(100, 1),
-        max_rate: 4000,
-        accel: 1000,
-        ..MachineConfig::STRING_ART.axes[0]
-    };
-    MachineConfig {
-        axes: [axis; AXES],
-        junction_deviation_um: 50,
-        ..MachineConfig::STRING_ART
-    }
-}
 
 const ACCEL: f64 = 1000.0;
 
