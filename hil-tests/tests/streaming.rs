@@ -25,8 +25,9 @@ impl Rng {
     }
 }
 
-/// How many moves a stress test streams: the 5000 under
-/// `cargo xtask soak` (`TAUT_SOAK=1`), a tenth in the everyday run.
+/// How many random moves a seed streams: the full campaign under
+/// `cargo xtask soak` (`TAUT_SOAK=1`), a tenth in the everyday run (slow
+/// feeds make it long). The fixed-length streams always run whole.
 fn moves(full: usize) -> usize {
     if std::env::var_os("TAUT_SOAK").is_some() {
         full
@@ -130,19 +131,19 @@ fn boot_enabled() -> Sim {
 
 #[test]
 fn tiny_moves_at_full_rate_0_05_mm() {
-    let (lines, expected) = radial_pieces(0.05, moves(5000));
+    let (lines, expected) = radial_pieces(0.05, 5000);
     check_stream(&mut boot_enabled(), &lines, None, expected);
 }
 
 #[test]
 fn tiny_moves_at_full_rate_0_1_mm() {
-    let (lines, expected) = radial_pieces(0.1, moves(5000));
+    let (lines, expected) = radial_pieces(0.1, 5000);
     check_stream(&mut boot_enabled(), &lines, None, expected);
 }
 
 #[test]
 fn tiny_moves_at_full_rate_0_3_mm() {
-    let (lines, expected) = radial_pieces(0.3, moves(5000));
+    let (lines, expected) = radial_pieces(0.3, 5000);
     check_stream(&mut boot_enabled(), &lines, None, expected);
 }
 
@@ -199,7 +200,7 @@ fn random_moves_and_feeds_from_seeds() {
 /// Tiny moves at full rate with a `?` every 50 ms.
 #[test]
 fn tiny_moves_with_status_reports() {
-    let (lines, expected) = radial_pieces(0.1, moves(5000));
+    let (lines, expected) = radial_pieces(0.1, 5000);
     check_stream(
         &mut boot_enabled(),
         &lines,
