@@ -1,14 +1,14 @@
 //! The serial console: G-code lines in, `ok` / `error:<code>` out, Grbl
-//! style. Grbl's `protocol` + `gcode` interpreter stage: the parser (host-
-//! tested in `taut_logic::gcode`) turns bytes into lines; this file carries
-//! them out against the motion task's state. Real-time commands never get
-//! here (`realtime`).
+//! style — the I/O around the interpreter. The parser (`taut_logic::gcode`)
+//! turns bytes into lines, the interpreter (`taut_logic::interp`, both
+//! host-tested) turns a line into an order with the modal state it leaves;
+//! this file carries the order out against the motion task's state and
+//! only then commits the line. Real-time commands never get here
+//! (`realtime`).
 //!
 //! The console owns the machine's motion only while no string-art job
-//! does: during a job it refuses motion, drivers and settings, and still
-//! answers reads. Targets outside an axis's soft limits are refused before
-//! anything moves; a feed below [`MIN_FEED`] is refused, one above an
-//! axis's maximum rate is clamped to it (by the planner).
+//! does: during a job the interpreter refuses motion, drivers and `G92`,
+//! and settings are refused here; reads are answered.
 #![deny(unsafe_code)]
 
 use crate::board::clock;
@@ -17,15 +17,11 @@ use crate::queues::{Signal, JOB_CLAIMS_TX, RX};
 use crate::reply::{self, Fixed, REPORTED_AXES};
 use crate::rt::{stack, Poll};
 use core::sync::atomic::Ordering::Relaxed;
-use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{
-    Command, Distance, Error, ErrorKind, Input, Line, Parser, SystemLine, MIN_FEED,
-};
-use taut_logic::kinematics::{Kinematics, Position};
-use taut_logic::planner::Feed;
+use taut_logic::gcode::{Error, ErrorKind, Input, Line, Parser, SystemLine};
+use taut_logic::interp::{Allowed, Interpreter, Order};
+use taut_logic::kinematics::Kinematics;
 use taut_logic::settings;
-use taut_logic::units::Milli;
 use ufmt::{uWrite, uwrite};
 
 pub struct Console {
@@ -35,13 +31,10 @@ pub struct Console {
     dwell_until: Option<u32>,
     /// `$$` or `$Q` in progress: its next line.
     listing: Option<Listing>,
-    distance: Distance,
-    rapid: bool,
-    feed: Option<Milli>,
-    /// Commanded position in milli-units (G-code coordinates).
-    target: Position,
-    /// The motion epoch `target` agrees with: a stop that dropped queued
-    /// moves starts a new one, and the target is then read back.
+    interp: Interpreter,
+    /// The motion epoch the interpreter's position agrees with: a stop that
+    /// dropped queued moves starts a new one, and the position is then
+    /// read back.
     epoch: u8,
 }
 
@@ -59,11 +52,6 @@ pub enum Owner {
     Job,
 }
 
-fn refuse(kind: ErrorKind) -> Option<Poll<Signal>> {
-    reply::error(&Error::new(kind, 0));
-    None
-}
-
 impl Console {
     pub const fn new() -> Console {
         Console {
@@ -71,10 +59,7 @@ impl Console {
             held: None,
             dwell_until: None,
             listing: None,
-            distance: Distance::Absolute,
-            rapid: true,
-            feed: None,
-            target: [Milli::ZERO; AXES],
+            interp: Interpreter::new(),
             epoch: 0,
         }
     }
@@ -82,9 +67,11 @@ impl Console {
     /// Ctrl-X: the line in progress, a waiting line and a listing are
     /// dropped with the bytes not yet read; modal state is Grbl's default.
     pub fn reset(&mut self) {
-        let epoch = self.epoch;
-        *self = Console::new();
-        self.epoch = epoch;
+        self.parser = Parser::new();
+        self.held = None;
+        self.dwell_until = None;
+        self.listing = None;
+        self.interp.reset();
         RX.clear();
     }
 
@@ -98,7 +85,7 @@ impl Console {
     ) -> Poll<Signal> {
         if self.epoch != m.epoch() {
             self.epoch = m.epoch();
-            self.target = kin.forward(&m.target());
+            self.interp.resync(kin.forward(&m.target()));
         }
         loop {
             if !reply::room() || JOB_CLAIMS_TX.load(Relaxed) {
@@ -109,9 +96,20 @@ impl Console {
                 return Poll::Again;
             }
             if let Some(line) = self.held.take() {
-                if let Some(wait) = self.execute(&line, m, kin, cfg, owner) {
-                    self.held = Some(line);
-                    return wait;
+                let allowed = Allowed {
+                    motion: owner == Owner::Console,
+                    position_known: m.position_known(),
+                };
+                match self.interp.plan(&line, kin, cfg, allowed) {
+                    Err(kind) => reply::error(&Error::new(kind, 0)),
+                    Ok(planned) => {
+                        if let Some(wait) = self.carry_out(planned.order, m, kin) {
+                            self.held = Some(line);
+                            return wait;
+                        }
+                        self.interp.commit(planned);
+                        reply::ok();
+                    }
                 }
                 // One line per run: the other tasks get their turn.
                 return Poll::Again;
@@ -128,127 +126,43 @@ impl Console {
         }
     }
 
-    /// Carry out one line; `Some(wait)` when it cannot run yet.
-    fn execute(
+    /// Carry out an order; `Some(wait)` when it cannot run yet.
+    fn carry_out(
         &mut self,
-        line: &Line,
+        order: Order,
         m: &mut Motion,
         kin: &impl Kinematics,
-        cfg: &MachineConfig,
-        owner: Owner,
     ) -> Option<Poll<Signal>> {
-        let has_axes = line.axes.iter().any(Option::is_some);
-        let moves = has_axes
-            || matches!(
-                line.command,
-                Command::EnableDrivers | Command::DisableDrivers | Command::SetPosition
-            );
-        if moves && owner == Owner::Job {
-            return refuse(ErrorKind::JobOwnsMotion);
+        let after_motion = matches!(
+            order,
+            Order::Dwell { .. }
+                | Order::SetPosition { .. }
+                | Order::Drivers { on: false }
+                | Order::WaitIdle
+        );
+        if after_motion && !m.is_idle() {
+            return Some(Poll::Wait(Signal::Motion));
         }
-        if line.f.is_some_and(|f| f.0 < MIN_FEED) {
-            return refuse(ErrorKind::FeedTooLow);
-        }
-        if let Some(d) = line.distance {
-            self.distance = d;
-        }
-        if let Some(f) = line.f {
-            self.feed = Some(f);
-        }
-        match line.command {
-            Command::Rapid | Command::Linear => {
-                self.rapid = line.command == Command::Rapid;
-                if has_axes {
-                    return self.move_to(line, m, kin, cfg);
-                }
-            }
-            Command::Empty if has_axes => return self.move_to(line, m, kin, cfg),
-            Command::Empty => {}
-            Command::Dwell => {
-                if !m.is_idle() {
+        match order {
+            Order::None | Order::WaitIdle => {}
+            Order::Move { steps, feed } => {
+                if m.push(steps, feed).is_err() {
                     return Some(Poll::Wait(Signal::Motion));
                 }
+            }
+            Order::Dwell { ms } => {
                 let now = clock::millis();
-                let until = *self
-                    .dwell_until
-                    .get_or_insert(now.wrapping_add(line.p.map_or(0, |p| p.0 as u32)));
+                let until = *self.dwell_until.get_or_insert(now.wrapping_add(ms));
                 let left = until.wrapping_sub(now) as i32;
                 if left > 0 {
                     return Some(Poll::After(left.min(u16::MAX as i32) as u16));
                 }
                 self.dwell_until = None;
             }
-            Command::SetPosition | Command::DisableDrivers | Command::WaitIdle if !m.is_idle() => {
-                return Some(Poll::Wait(Signal::Motion));
-            }
-            Command::SetPosition => {
-                let mut at = self.target;
-                for (i, w) in kin.words().iter().enumerate() {
-                    if let Some(v) = letter_value(line, *w) {
-                        at[i] = v;
-                    }
-                }
-                match kin.inverse(&at) {
-                    Ok(steps) => {
-                        m.set_position(steps);
-                        self.target = at;
-                    }
-                    Err(_) => return refuse(ErrorKind::InvalidTarget),
-                }
-            }
-            Command::EnableDrivers => m.drivers.set(0xFF, true),
-            Command::DisableDrivers => m.drivers.set(0xFF, false),
-            Command::WaitIdle => {}
-            Command::ReportPosition => report_position(m, kin),
+            Order::SetPosition { steps } => m.set_position(steps),
+            Order::Drivers { on } => m.drivers.set(0xFF, on),
+            Order::ReportPosition => report_position(m, kin),
         }
-        reply::ok();
-        None
-    }
-
-    fn move_to(
-        &mut self,
-        line: &Line,
-        m: &mut Motion,
-        kin: &impl Kinematics,
-        cfg: &MachineConfig,
-    ) -> Option<Poll<Signal>> {
-        if !m.position_known() {
-            return refuse(ErrorKind::Locked);
-        }
-        let feed = if self.rapid {
-            Feed::Rapid
-        } else {
-            match self.feed {
-                Some(f) => Feed::PerMinute(f),
-                None => return refuse(ErrorKind::UndefinedFeedRate),
-            }
-        };
-        let mut target = self.target;
-        for (i, w) in kin.words().iter().enumerate() {
-            if let Some(v) = letter_value(line, *w) {
-                target[i] = match self.distance {
-                    Distance::Absolute => v,
-                    Distance::Relative => Milli(target[i].0.saturating_add(v.0)),
-                };
-            }
-        }
-        let outside = cfg.axes.iter().zip(&target).any(|(a, t)| {
-            let (min, max) = a.travel;
-            a.soft_limits && (*t < min || *t > max)
-        });
-        if outside {
-            return refuse(ErrorKind::TravelExceeded);
-        }
-        // Converted once from the absolute target: relative moves never drift.
-        let steps = match kin.inverse(&target) {
-            Ok(s) => s,
-            Err(_) => return refuse(ErrorKind::InvalidTarget),
-        };
-        if m.push(steps, feed).is_err() {
-            return Some(Poll::Wait(Signal::Motion));
-        }
-        self.target = target;
-        reply::ok();
         None
     }
 
@@ -315,13 +229,6 @@ impl Default for Console {
     fn default() -> Self {
         Self::new()
     }
-}
-
-fn letter_value(line: &Line, letter: u8) -> Option<Milli> {
-    taut_logic::gcode::AxisWord::ALL
-        .iter()
-        .find(|w| w.letter() == letter)
-        .and_then(|w| line.axis(*w))
 }
 
 /// `M114`: `C:1.000 X:0.000 Z:0.000 Count C:27 X:0 Z:0` (the executed

@@ -203,3 +203,23 @@ fn status_queries_at_set_times_leave_streamed_lines_whole() {
     assert!(sim.probed("radial_step").rising_count() > 0);
     assert_eq!(steps(&sim, Axis::Radial), 0, "there and back");
 }
+
+/// A line that fails changes no modal state: after `G91 G1 X1` without a
+/// feed rate (error 22) the console is still in `G90 G0`.
+#[test]
+fn a_refused_line_leaves_the_modes_as_they_were() {
+    let mut sim = boot();
+    send(&mut sim, "M17", Duration::from_millis(100));
+    match sim.send_line("G91 G1 X1", Duration::from_millis(100)) {
+        Ok(hil_tests::sim::Reply::Error(e)) => assert!(e.starts_with("error:22 "), "{e}"),
+        other => panic!("{other:?}"),
+    }
+    send(&mut sim, "X5", Duration::from_millis(100));
+    send(&mut sim, "X5", Duration::from_millis(100));
+    send(&mut sim, "M400", Duration::from_secs(5));
+    assert_eq!(
+        steps(&sim, Axis::Radial),
+        160,
+        "absolute: 5 mm once, not twice"
+    );
+}

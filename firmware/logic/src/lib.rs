@@ -20,6 +20,7 @@ pub mod files;
 pub mod fmath;
 pub mod gcode;
 pub mod geometry;
+pub mod interp;
 pub mod kinematics;
 pub mod pinmap;
 pub mod planner;
