@@ -88,7 +88,7 @@ impl Prep {
             if self.cut.is_idle() {
                 self.block = Some(self.take(planner)?);
             }
-            if let Some(segment) = self.cut.next() {
+            if let Some(segment) = self.cut.next_segment() {
                 let block = self.block.take();
                 return Some(Cut { block, segment });
             }

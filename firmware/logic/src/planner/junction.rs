@@ -81,8 +81,9 @@ impl Geometry {
         let (mut accel, mut rate) = (MAX_ACCEL as u64, u32::MAX as u64);
         for i in 0..AXES {
             let n = step.steps[i] as u64;
-            if n > 0 {
-                accel = accel.min(self.accel[i] as u64 * e / n);
+            // An axis that does not move sets no limit.
+            if let Some(a) = (self.accel[i] as u64 * e).checked_div(n) {
+                accel = accel.min(a);
                 rate = rate.min(self.max_rate[i] as u64 * e / n);
             }
         }

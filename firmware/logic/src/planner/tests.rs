@@ -88,7 +88,7 @@ fn run(
         let planned = p.take().unwrap();
         blocks.push(planned.block);
         prep.start(planned.profile);
-        while let Some(s) = prep.next() {
+        while let Some(s) = prep.next_segment() {
             segs.push(s);
         }
     };

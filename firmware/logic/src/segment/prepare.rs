@@ -80,7 +80,7 @@ impl Preparer {
         self.before + self.done >= self.events
     }
 
-    /// A hold stopped the block short of its end: [`Preparer::next`] has
+    /// A hold stopped the block short of its end: [`Preparer::next_segment`] has
     /// nothing until [`Preparer::restart`].
     pub fn is_stopped(&self) -> bool {
         self.done >= self.profile.events() && !self.is_idle()
@@ -175,7 +175,7 @@ impl Preparer {
     }
 
     /// The next segment of the current leg, `None` when it is done.
-    pub fn next(&mut self) -> Option<Segment> {
+    pub fn next_segment(&mut self) -> Option<Segment> {
         if self.done >= self.profile.events() {
             return None;
         }

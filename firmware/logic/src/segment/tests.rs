@@ -88,7 +88,7 @@ fn prepare(ramps: &[Ramp]) -> (Vec<Segment>, Vec<StepBlock>) {
             events: r.events,
             dir: 1,
         });
-        while let Some(s) = prep.next() {
+        while let Some(s) = prep.next_segment() {
             segs.push(s);
         }
         assert!(prep.is_idle());
