@@ -250,8 +250,8 @@ fn try_run_one(bins: &Path, target: &'static str, plan: &Plan) -> Result<Outcome
     // A crash, a hang or out of memory: libFuzzer saved the input.
     let input = text
         .lines()
-        .filter_map(|l| l.split_once("Test unit written to ").map(|(_, p)| p.trim()))
-        .last();
+        .rev()
+        .find_map(|l| l.split_once("Test unit written to ").map(|(_, p)| p.trim()));
     let mut report = format!("fuzz {target}: FAILED ({st}) after {secs} s\n");
     for l in what_failed(&text) {
         report += &format!("  | {l}\n");
@@ -304,9 +304,9 @@ fn stats(log: &str) -> String {
     };
     let runs = log
         .lines()
+        .rev()
         .filter_map(|l| l.strip_prefix("Done "))
-        .filter_map(|l| l.split_whitespace().next())
-        .last();
+        .find_map(|l| l.split_whitespace().next());
     // `#123 DONE cov: …` (not the `###### Recommended dictionary` lines).
     let last = log
         .lines()
