@@ -310,11 +310,11 @@ fn stats(log: &str) -> String {
     // `#123 DONE cov: …` (not the `###### Recommended dictionary` lines).
     let last = log
         .lines()
-        .filter(|l| {
+        .rev()
+        .find(|l| {
             l.strip_prefix('#')
                 .is_some_and(|r| r.starts_with(|c: char| c.is_ascii_digit()))
         })
-        .last()
         .unwrap_or("");
     let mut parts = vec![];
     if let Some(r) = runs {
