@@ -35,6 +35,8 @@ pub const TRIES: u8 = 3;
 
 /// How often an empty slot is probed and a card checked, ms.
 pub const CHECK_MS: u32 = 1000;
+/// How much earlier than a second after the last check the next may come.
+const CHECK_SLACK_MS: u32 = 100;
 
 type Sd = SdCard<CardSpi, Delay>;
 
@@ -132,7 +134,9 @@ impl CardReader {
             if CARD_OUT.free() < ROOM {
                 return Poll::Wait(Signal::CardRoom);
             }
-            self.check_at = now.wrapping_add(CHECK_MS);
+            // Due again at the app's next once-a-second wake-up, even if
+            // that comes a little early against this run.
+            self.check_at = now.wrapping_add(CHECK_MS - CHECK_SLACK_MS);
             match self.slot {
                 Slot::Empty if moving => {}
                 Slot::Empty => return self.look_for_card(),

@@ -36,6 +36,8 @@ pub struct Console {
     /// dropped queued moves starts a new one, and the position is then
     /// read back.
     epoch: u8,
+    /// A `$` setting changed since the app last asked.
+    settings_changed: bool,
 }
 
 #[derive(Clone, Copy)]
@@ -61,7 +63,14 @@ impl Console {
             listing: None,
             interp: Interpreter::new(),
             epoch: 0,
+            settings_changed: false,
         }
+    }
+
+    /// Whether a `$` setting changed since the last call (the app then has
+    /// the settings stored).
+    pub fn take_settings_changed(&mut self) -> bool {
+        core::mem::take(&mut self.settings_changed)
     }
 
     /// Ctrl-X: the line in progress, a waiting line and a listing are
@@ -201,6 +210,7 @@ impl Console {
                     return reply::error_because(&invalid, Some(e.kind));
                 }
                 m.configure(cfg);
+                self.settings_changed = true;
             }
         }
         reply::ok();

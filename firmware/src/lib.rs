@@ -18,4 +18,5 @@ pub mod reply;
 pub mod report;
 pub mod rt;
 pub mod stepper;
+pub mod store;
 pub mod texts;

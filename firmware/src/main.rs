@@ -23,12 +23,14 @@
 //! | `Card` SD reader: one block per run | software | 1 | `CARD_IN`, every 1 s | `CARD_OUT` |
 //! | `Motion` planner → segments, background | software | 1 | planner | as `Refill` |
 //! | `Logger` deferred reports | software | 0 | every 1 s | `TX` |
+//! | `Store` settings → EEPROM, a changed byte per run | software | 0 | signal `Settings` | EEPROM |
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt, asm_experimental_arch)]
 
 use embedded_hal::digital::OutputPin;
 use panic_halt as _;
+use taut_firmware::board::eeprom::Eeprom;
 use taut_firmware::board::gpio::{Output, Pin};
 use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{
@@ -40,11 +42,12 @@ use taut_firmware::console::{Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
-use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL};
+use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL, SIGNALS};
 use taut_firmware::realtime::{self, Requests};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{stack, Poll, TaskCell};
 use taut_firmware::stepper::{self, StepDirPins, Stepper};
+use taut_firmware::store::Store;
 use taut_firmware::{
     board::usart::{RXCIE0, UDRIE0},
     nested_vector, step_vector,
@@ -66,13 +69,14 @@ enum Task {
     Card,
     Logger,
     Led,
+    Store,
 }
 
 const _: () = assert!(Task::ALL.len() <= 16, "interrupt spawns are a bit per task");
 
 impl Task {
     /// Every task, in discriminant order (`Task::X as u8` indexes it).
-    const ALL: [Task; 10] = [
+    const ALL: [Task; 11] = [
         Task::Timers,
         Task::Realtime,
         Task::Refill,
@@ -83,6 +87,7 @@ impl Task {
         Task::Card,
         Task::Logger,
         Task::Led,
+        Task::Store,
     ];
 }
 const _: () = {
@@ -104,7 +109,7 @@ impl TaskId for Task {
             Task::Timers | Task::Refill => 3,
             Task::Console | Task::Buttons | Task::Job | Task::Led => 2,
             Task::Card | Task::Motion => 1,
-            Task::Logger => 0,
+            Task::Logger | Task::Store => 0,
         }
     }
 }
@@ -112,16 +117,17 @@ impl TaskId for Task {
 /// Task ids spawned by interrupts, moved into `READY` by the dispatcher.
 static SPAWNED: Spawned = Spawned::new();
 // Software tasks only: no masking needed.
-static READY: TaskCell<Ready<Task, 10, 5>> = TaskCell::new(Ready::new());
+static READY: TaskCell<Ready<Task, 11, 5>> = TaskCell::new(Ready::new());
 static TIMERS: TaskCell<Timers<Task, 8>> = TaskCell::new(Timers::new());
 /// Tasks waiting for each [`Signal`] (bit = task).
-static WAITING: TaskCell<[u16; 2]> = TaskCell::new([0; 2]);
+static WAITING: TaskCell<[u16; SIGNALS]> = TaskCell::new([0; SIGNALS]);
 static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
 static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
 static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
 static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::new(ButtonsTask::new());
 static JOB: TaskCell<JobTask> = TaskCell::new(JobTask::new());
 static CARD: TaskCell<Option<CardReader>> = TaskCell::new(None);
+static STORE: TaskCell<Option<Store>> = TaskCell::new(None);
 
 /// Boot blink of the status LED: this many flashes, 100 ms on, 100 ms off.
 const BOOT_BLINKS: u32 = 3;
@@ -193,6 +199,7 @@ fn main() -> ! {
             Task::Job => job(),
             Task::Card => card(),
             Task::Logger => logger(),
+            Task::Store => store(),
             Task::Led => led(),
         },
     )
@@ -212,7 +219,10 @@ fn init() -> Watchdog {
     let status_led = pins.d13.into_output_at(false);
     clock::Clock::start(dp.TC0);
     usart::Usart0::start(dp.USART0);
-    let config = MachineConfig::STRING_ART;
+    let mut store = Store::new(Eeprom::new(dp.EEPROM));
+    let (config, store_now) = store.load(&MachineConfig::STRING_ART);
+    CONFIG.with(|c| *c = config);
+    STORE.with(|s| *s = Some(store));
     let enable = EnablePins {
         base: pins.d38.into_output(),
         radial: pins.a2.into_output(),
@@ -258,6 +268,10 @@ fn init() -> Watchdog {
     if reset == ResetCause::Watchdog {
         warn!("watchdog reset: a task did not return");
     }
+    match store_now {
+        true => spawn(Task::Store),
+        false => reschedule(Task::Store, Poll::Wait(Signal::Settings)),
+    }
     LED.with(|l| *l = Some((status_led, clock::millis())));
     spawn(Task::Led);
     spawn_every(Task::Logger, LOGGER_PERIOD_MS);
@@ -286,8 +300,8 @@ fn timers() {
 
 #[inline(never)]
 fn motion() {
-    /// Segments per run: a segment that starts a block costs up to ~7 ms
-    /// (the block's profile), so one per run keeps `?` answered in 10 ms.
+    /// Pieces of work per run (a block's profile or a segment, up to ~4 ms
+    /// each): one keeps `?` answered in 10 ms.
     const BATCH: usize = 1;
     let (freed, more, idle) = MOTION.with(|m| {
         let m = m.as_mut().unwrap();
@@ -327,6 +341,9 @@ fn console() {
     // New moves may be queued: the motion task feeds them to the stepper.
     spawn(Task::Motion);
     reschedule(Task::Console, poll);
+    if CONSOLE.with(|c| c.take_settings_changed()) {
+        signal(Signal::Settings);
+    }
 }
 
 /// Real-time commands, in the order that makes sense when several came
@@ -408,6 +425,13 @@ fn card() {
     if !CARD_OUT.is_empty() {
         spawn(Task::Job);
     }
+}
+
+/// Settings into EEPROM, a changed byte per run.
+#[inline(never)]
+fn store() {
+    let poll = CONFIG.with(|cfg| STORE.with(|s| s.as_mut().unwrap().poll(cfg)));
+    reschedule(Task::Store, poll);
 }
 
 /// Deferred reports: dropped log lines, step-timing faults.

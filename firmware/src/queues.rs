@@ -99,4 +99,9 @@ pub enum Signal {
     Motion,
     /// The job took messages from [`CARD_OUT`].
     CardRoom,
+    /// A `$` setting changed: the store writes it to EEPROM.
+    Settings,
 }
+
+/// Number of [`Signal`]s.
+pub const SIGNALS: usize = 3;

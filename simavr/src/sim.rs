@@ -43,6 +43,9 @@ const SPL: usize = 0x5D;
 const SPH: usize = 0x5E;
 
 /// The number simavr builds an ioctl code from four characters with.
+/// EEPROM bytes of the ATmega2560.
+pub const EEPROM_BYTES: usize = 4096;
+
 const fn ioctl(a: u8, b: u8, c: u8, d: u8) -> u32 {
     (a as u32) << 24 | (b as u32) << 16 | (c as u32) << 8 | d as u32
 }
@@ -412,6 +415,37 @@ impl Sim {
                 &mut ext as *mut _ as *mut c_void,
             );
             ffi::avr_raise_irq(irq, u32::from(high));
+        }
+    }
+
+    /// The EEPROM's contents (4 KiB on the ATmega2560).
+    pub fn eeprom(&self) -> Vec<u8> {
+        let mut bytes = vec![0xFF; EEPROM_BYTES];
+        self.eeprom_ioctl(b'g', &mut bytes);
+        bytes
+    }
+
+    /// Load `bytes` into the EEPROM from its start (before a run: a power
+    /// cycle keeps only the EEPROM).
+    pub fn set_eeprom(&mut self, bytes: &[u8]) {
+        let mut copy = bytes[..bytes.len().min(EEPROM_BYTES)].to_vec();
+        self.eeprom_ioctl(b's', &mut copy);
+    }
+
+    fn eeprom_ioctl(&self, op: u8, bytes: &mut [u8]) {
+        let mut desc = ffi::avr_eeprom_desc_t {
+            ee: bytes.as_mut_ptr(),
+            offset: 0,
+            size: bytes.len() as u32,
+        };
+        // SAFETY: live avr_t; `desc` points into `bytes`, which outlives the
+        // call; simavr copies at most `size` bytes between it and the EEPROM.
+        unsafe {
+            ffi::avr_ioctl(
+                self.avr.as_ptr(),
+                ioctl(b'e', b'e', op, b'p'),
+                &mut desc as *mut _ as *mut c_void,
+            );
         }
     }
 

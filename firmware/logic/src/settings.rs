@@ -12,6 +12,8 @@ use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
+pub mod image;
+
 /// A setting value that did not fit: what, and at which byte of the value.
 pub type SettingError = NumError;
 
@@ -198,63 +200,96 @@ impl Setting {
     /// Sets this setting from its text and checks the whole configuration
     /// ([`MachineConfig::validate`]); nothing changes on an error.
     pub fn set(self, cfg: &mut MachineConfig, text: &[u8]) -> Result<(), SettingError> {
-        let mut new = *cfg;
-        self.set_field(&mut new, text)?;
-        new.validate().map_err(|kind| NumError {
-            at: trim(text).0,
-            kind,
+        let (lead, trimmed) = trim(text);
+        let value = self.parse_value(trimmed).map_err(|e| NumError {
+            at: lead + e.at,
+            kind: e.kind,
         })?;
+        self.put(cfg, value)
+            .map_err(|kind| NumError { at: lead, kind })
+    }
+
+    /// The value `text` (trimmed) gives this setting, in the setting's kind.
+    fn parse_value(self, text: &[u8]) -> Result<Value, SettingError> {
+        Ok(match self {
+            Setting::Axis(_, AxisField::StepsPerUnit) => Value::Ratio(parse_ratio(text)?),
+            Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax) => {
+                Value::Milli(parse_milli(text)?)
+            }
+            _ => Value::Number(parse_u32(text)?),
+        })
+    }
+
+    /// Sets this setting to `value` (of the setting's kind) if it is in its
+    /// range and the whole configuration stays valid; nothing changes on
+    /// an error.
+    pub fn put(self, cfg: &mut MachineConfig, value: Value) -> Result<(), ErrorKind> {
+        self.check(value)?;
+        let mut new = *cfg;
+        self.force(&mut new, value);
+        new.validate()?;
         *cfg = new;
         Ok(())
     }
 
-    /// Sets this setting's field alone.
-    fn set_field(self, cfg: &mut MachineConfig, text: &[u8]) -> Result<(), SettingError> {
-        let (lead, text) = trim(text);
-        let fail = |at, kind| NumError {
-            at: lead + at,
-            kind,
-        };
-        let located = |e: NumError| fail(e.at, e.kind);
-        let number = || {
-            let n = parse_u32(text).map_err(located)?;
-            let (min, max) = self.range();
-            match (min..=max).contains(&n) {
-                true => Ok(n),
-                false => Err(fail(0, ErrorKind::Range { min, max })),
-            }
-        };
-        let ratio = || {
-            let r = parse_ratio(text).map_err(located)?;
-            match r.num != 0 && r.den != 0 {
-                true => Ok(r),
-                false => Err(fail(0, ErrorKind::Invalid(AxisField::StepsPerUnit.name()))),
-            }
-        };
-        let p = &mut cfg.pulse;
-        match self {
-            Setting::Axis(a, field) => {
-                let axis = &mut cfg.axes[a.index()];
-                match field {
-                    AxisField::StepsPerUnit => axis.steps_per_unit = ratio()?,
-                    AxisField::MaxRate => axis.max_rate = number()?,
-                    AxisField::Accel => axis.accel = number()?,
-                    AxisField::DirInvert => axis.dir_high_is_positive = number()? == 0,
-                    AxisField::EnableActiveHigh => axis.enable_active_high = number()? == 1,
-                    AxisField::SoftLimits => axis.soft_limits = number()? == 1,
-                    AxisField::TravelMin => axis.travel.0 = parse_milli(text).map_err(located)?,
-                    AxisField::TravelMax => axis.travel.1 = parse_milli(text).map_err(located)?,
+    /// Whether `value` is of this setting's kind and in its range.
+    pub fn check(self, value: Value) -> Result<(), ErrorKind> {
+        match (self, value) {
+            (Setting::Axis(_, AxisField::StepsPerUnit), Value::Ratio(r)) => {
+                match r.num != 0 && r.den != 0 {
+                    true => Ok(()),
+                    false => Err(ErrorKind::Invalid(AxisField::StepsPerUnit.name())),
                 }
             }
-            // The ranges keep these within u8.
-            Setting::Global(GlobalField::StepPulseUs) => p.step_pulse_us = number()? as u8,
-            Setting::Global(GlobalField::DirSetupUs) => p.dir_setup_us = number()? as u8,
-            Setting::Global(GlobalField::EnableSetupUs) => p.enable_setup_us = number()? as u8,
-            Setting::Global(GlobalField::JunctionDeviationUm) => {
-                cfg.junction_deviation_um = number()?
+            (Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax), Value::Milli(_)) => {
+                Ok(())
             }
+            (Setting::Axis(_, AxisField::StepsPerUnit), _)
+            | (Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax), _) => {
+                Err(ErrorKind::NotANumber)
+            }
+            (_, Value::Number(n)) => {
+                let (min, max) = self.range();
+                match (min..=max).contains(&n) {
+                    true => Ok(()),
+                    false => Err(ErrorKind::Range { min, max }),
+                }
+            }
+            _ => Err(ErrorKind::NotANumber),
         }
-        Ok(())
+    }
+
+    /// Sets the field, unchecked (a value of another kind is ignored):
+    /// callers check it first.
+    pub(crate) fn force(self, cfg: &mut MachineConfig, value: Value) {
+        let n = match value {
+            Value::Number(n) => n,
+            _ => 0,
+        };
+        match (self, value) {
+            (Setting::Axis(a, field), _) => {
+                let axis = &mut cfg.axes[a.index()];
+                match (field, value) {
+                    (AxisField::StepsPerUnit, Value::Ratio(r)) => axis.steps_per_unit = r,
+                    (AxisField::TravelMin, Value::Milli(m)) => axis.travel.0 = m,
+                    (AxisField::TravelMax, Value::Milli(m)) => axis.travel.1 = m,
+                    (AxisField::MaxRate, Value::Number(_)) => axis.max_rate = n,
+                    (AxisField::Accel, Value::Number(_)) => axis.accel = n,
+                    (AxisField::DirInvert, Value::Number(_)) => axis.dir_high_is_positive = n == 0,
+                    (AxisField::EnableActiveHigh, Value::Number(_)) => {
+                        axis.enable_active_high = n == 1
+                    }
+                    (AxisField::SoftLimits, Value::Number(_)) => axis.soft_limits = n == 1,
+                    _ => {}
+                }
+            }
+            (_, Value::Ratio(_) | Value::Milli(_)) => {}
+            // The ranges keep these within u8.
+            (Setting::Global(GlobalField::StepPulseUs), _) => cfg.pulse.step_pulse_us = n as u8,
+            (Setting::Global(GlobalField::DirSetupUs), _) => cfg.pulse.dir_setup_us = n as u8,
+            (Setting::Global(GlobalField::EnableSetupUs), _) => cfg.pulse.enable_setup_us = n as u8,
+            (Setting::Global(GlobalField::JunctionDeviationUm), _) => cfg.junction_deviation_um = n,
+        }
     }
 }
 

@@ -3,6 +3,7 @@
 
 pub mod clock;
 pub mod delay;
+pub mod eeprom;
 pub mod flash;
 pub mod gpio;
 pub mod spi;

@@ -1,0 +1,145 @@
+//! The settings as the EEPROM keeps them: `taut`, a format version, every
+//! setting in `$$` order (whole numbers and millis as 4 bytes, ratios as
+//! 8, little-endian), then a Fletcher-16 checksum of all that. Read back
+//! only whole: a blank EEPROM, another version, a wrong checksum or a value
+//! the firmware would refuse gives the defaults (and one warning line)
+//! rather than anything half-read.
+//!
+//! Written by streaming [`bytes`] (no copy in RAM: the firmware compares
+//! each byte with the EEPROM and writes only those that differ).
+
+use super::{all, Setting, Value};
+use crate::config::MachineConfig;
+use crate::units::{Milli, StepsPerUnit};
+
+pub const MAGIC: [u8; 4] = *b"taut";
+/// Bumped whenever the settings or their kinds change.
+pub const VERSION: u8 = 1;
+const HEADER: usize = MAGIC.len() + 1;
+
+/// Why the image was not taken.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unusable {
+    /// Never written (erased EEPROM reads 0xFF).
+    Blank,
+    /// Written by a firmware with another settings format.
+    OtherVersion(u8),
+    /// Corrupted (a cut in mid-write, a worn cell).
+    Checksum,
+    /// Consistent, but a value this firmware refuses.
+    Refused(Setting),
+    /// Values this firmware refuses together (a pulse too long for a rate).
+    Inconsistent,
+}
+
+fn width(s: Setting) -> usize {
+    match s {
+        Setting::Axis(_, super::AxisField::StepsPerUnit) => 8,
+        _ => 4,
+    }
+}
+
+/// Bytes of an image.
+pub fn len() -> usize {
+    HEADER + all().map(width).sum::<usize>() + 2
+}
+
+/// The image of `cfg`, byte by byte.
+pub fn bytes(cfg: &MachineConfig) -> impl Iterator<Item = u8> + '_ {
+    let body = MAGIC
+        .into_iter()
+        .chain([VERSION])
+        .chain(all().flat_map(move |s| value_bytes(s.get(cfg))));
+    let mut sum = Fletcher::new();
+    let mut tail = 0;
+    body.map(Some).chain([None, None]).map(move |b| match b {
+        Some(b) => {
+            sum.add(b);
+            b
+        }
+        None => {
+            tail += 1;
+            sum.value().to_le_bytes()[tail - 1]
+        }
+    })
+}
+
+/// Value bytes: up to 8, the unused ones skipped.
+fn value_bytes(v: Value) -> impl Iterator<Item = u8> {
+    let (buf, n) = match v {
+        Value::Number(n) => (widen(n.to_le_bytes()), 4),
+        Value::Milli(m) => (widen(m.0.to_le_bytes()), 4),
+        Value::Ratio(r) => {
+            let mut b = [0; 8];
+            b[..4].copy_from_slice(&r.num.to_le_bytes());
+            b[4..].copy_from_slice(&r.den.to_le_bytes());
+            (b, 8)
+        }
+    };
+    buf.into_iter().take(n)
+}
+
+fn widen(b: [u8; 4]) -> [u8; 8] {
+    [b[0], b[1], b[2], b[3], 0, 0, 0, 0]
+}
+
+/// Reads an image through `read(i)` (byte `i` of the EEPROM) onto the
+/// defaults `base`.
+pub fn decode(read: impl Fn(usize) -> u8, base: &MachineConfig) -> Result<MachineConfig, Unusable> {
+    if (0..HEADER).all(|i| read(i) == 0xFF) {
+        return Err(Unusable::Blank);
+    }
+    let magic_ok = (0..MAGIC.len()).all(|i| read(i) == MAGIC[i]);
+    if magic_ok && read(MAGIC.len()) != VERSION {
+        return Err(Unusable::OtherVersion(read(MAGIC.len())));
+    }
+    let n = len();
+    let mut sum = Fletcher::new();
+    (0..n - 2).for_each(|i| sum.add(read(i)));
+    if !magic_ok || u16::from_le_bytes([read(n - 2), read(n - 1)]) != sum.value() {
+        return Err(Unusable::Checksum);
+    }
+    let word = |i: usize| u32::from_le_bytes([read(i), read(i + 1), read(i + 2), read(i + 3)]);
+    let mut cfg = *base;
+    let mut at = HEADER;
+    for s in all() {
+        let value = match s.get(base) {
+            Value::Number(_) => Value::Number(word(at)),
+            Value::Milli(_) => Value::Milli(Milli(word(at) as i32)),
+            Value::Ratio(_) => Value::Ratio(StepsPerUnit::new(word(at), word(at + 4))),
+        };
+        at += width(s);
+        s.check(value).map_err(|_| Unusable::Refused(s))?;
+        s.force(&mut cfg, value);
+    }
+    // Each value in range; now the set as a whole.
+    match cfg.validate() {
+        Ok(()) => Ok(cfg),
+        Err(_) => Err(Unusable::Inconsistent),
+    }
+}
+
+/// Fletcher-16: two running sums mod 255 (catches swapped and zeroed
+/// bytes, which a plain sum misses).
+struct Fletcher {
+    a: u16,
+    b: u16,
+}
+
+impl Fletcher {
+    const fn new() -> Self {
+        Fletcher { a: 0, b: 0 }
+    }
+
+    fn add(&mut self, x: u8) {
+        self.a = (self.a + x as u16) % 255;
+        self.b = (self.b + self.a) % 255;
+    }
+
+    fn value(&self) -> u16 {
+        self.b << 8 | self.a
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,66 @@
+use super::*;
+use crate::settings::set;
+use std::vec::Vec;
+
+const BASE: MachineConfig = MachineConfig::STRING_ART;
+
+fn image(cfg: &MachineConfig) -> Vec<u8> {
+    bytes(cfg).collect()
+}
+
+fn read(img: &[u8]) -> Result<MachineConfig, Unusable> {
+    decode(|i| img[i], &BASE)
+}
+
+#[test]
+fn an_image_reads_back_as_the_settings_it_was_made_of() {
+    let mut cfg = BASE;
+    set(&mut cfg, "base_max_rate", "1500").unwrap();
+    set(&mut cfg, "drill_steps_per_unit", "1600/10").unwrap();
+    set(&mut cfg, "radial_travel_min", "-201.5").unwrap();
+    set(&mut cfg, "step_pulse_us", "7").unwrap();
+    let img = image(&cfg);
+    assert_eq!(img.len(), len());
+    assert_eq!(&img[..4], b"taut");
+    assert_eq!(read(&img), Ok(cfg));
+    assert_eq!(read(&image(&BASE)), Ok(BASE));
+}
+
+#[test]
+fn blank_other_and_corrupt_images_give_reasons_not_garbage() {
+    assert_eq!(read(&[0xFF; 512]), Err(Unusable::Blank));
+    let mut img = image(&BASE);
+    img[4] = VERSION + 1;
+    assert_eq!(read(&img), Err(Unusable::OtherVersion(VERSION + 1)));
+    // Any single byte changed, or two swapped, is caught.
+    let good = image(&BASE);
+    for i in 5..good.len() {
+        let mut bad = good.clone();
+        bad[i] ^= 0x10;
+        assert_eq!(read(&bad), Err(Unusable::Checksum), "byte {i}");
+    }
+    let mut swapped = good.clone();
+    swapped.swap(10, 20);
+    assert_eq!(read(&swapped), Err(Unusable::Checksum));
+    // A cut mid-write: the first half new, the rest old.
+    let mut new = BASE;
+    set(&mut new, "base_accel", "750").unwrap();
+    let newer = image(&new);
+    let mut half: Vec<u8> = newer[..30].to_vec();
+    half.extend_from_slice(&good[30..]);
+    assert_ne!(half, good);
+    assert_eq!(read(&half), Err(Unusable::Checksum));
+}
+
+#[test]
+fn a_consistent_image_with_a_refused_value_is_refused() {
+    // Hand-made: a max rate of 0, with a checksum that matches.
+    let mut body: Vec<u8> = image(&BASE);
+    body.truncate(len() - 2);
+    let at = 5 + 8; // base_max_rate follows base_steps_per_unit (8 bytes)
+    body[at..at + 4].copy_from_slice(&0u32.to_le_bytes());
+    let mut sum = Fletcher::new();
+    body.iter().for_each(|&b| sum.add(b));
+    body.extend_from_slice(&sum.value().to_le_bytes());
+    assert!(matches!(read(&body), Err(Unusable::Refused(_))));
+}
