@@ -22,7 +22,7 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                    [--pull-card-at SECONDS]... [--reinsert-at SECONDS]...
                    [--card-fault SPEC]...] [--auto-confirm] [--send FILE]
                    [--at SECONDS:BYTES]... [--for SECONDS] [--vcd PATH]
-                   [--png PATH] [--report PATH] [--echo]
+                   [--png PATH] [--report PATH] [--eeprom FILE] [--echo]
   --sd PATH       put a virtual SD card in the slot: an image file, or a
                   folder, imaged on the fly (FAT16 or FAT32 by size)
   --sd-insert-at SECONDS
@@ -62,6 +62,9 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
   --png PATH      draw the string-art job from the step pulses alone (the
                   board from the card's param.txt; needs --sd)
   --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
+  --eeprom FILE   the EEPROM's contents (settings): loaded at power-on if the
+                  file exists, saved when the run ends (a power cycle keeps
+                  only the EEPROM: run again with the same file)
   --auto-confirm  press the green button whenever the job asks for it, and
                   run until the job is done (or --for SECONDS, default 7200)
   --echo          print the firmware's serial output as it runs
@@ -81,6 +84,7 @@ struct Args {
     vcd: Option<PathBuf>,
     png: Option<PathBuf>,
     report: Option<PathBuf>,
+    eeprom: Option<PathBuf>,
     echo: bool,
     auto_confirm: bool,
 }
@@ -100,6 +104,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         vcd: None,
         png: None,
         report: None,
+        eeprom: None,
         echo: false,
         auto_confirm: false,
     };
@@ -120,6 +125,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--vcd" => args.vcd = Some(value()?.into()),
             "--png" => args.png = Some(value()?.into()),
             "--report" => args.report = Some(value()?.into()),
+            "--eeprom" => args.eeprom = Some(value()?.into()),
             "--echo" => args.echo = true,
             "--auto-confirm" => args.auto_confirm = true,
             _ => return Err(format!("unknown option {a}")),
@@ -227,6 +233,9 @@ fn put_card(sim: &mut Sim, path: &Path, args: &Args) -> Result<Option<Vec<u8>>, 
 
 fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     let mut sim = Sim::load(&args.elf)?;
+    if let Some(path) = args.eeprom.as_ref().filter(|p| p.exists()) {
+        sim.set_eeprom(&std::fs::read(path)?);
+    }
     probe_machine(&mut sim);
     let param = match &args.sd {
         Some(path) => put_card(&mut sim, path, &args)?,
@@ -278,6 +287,9 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     }
     bar.finish();
     let wall_s = wall.elapsed().as_secs_f64();
+    if let Some(path) = &args.eeprom {
+        std::fs::write(path, sim.eeprom())?;
+    }
     if let Some(path) = &args.vcd {
         sim.write_vcd(path)?;
     }
