@@ -11,6 +11,7 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod arc;
 pub mod axis;
 pub mod buttons;
 pub mod config;

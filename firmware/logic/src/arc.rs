@@ -1,0 +1,223 @@
+//! Arcs (`G2`/`G3`) cut into chords, as Grbl's `mc_arc` does: the centre
+//! from the `I J K` offsets or from the radius `R`, the angular travel
+//! (clockwise or not, a full circle when the end is the start), then
+//! chords short enough that none strays more than the tolerance from the
+//! circle. The chord ends come from rotating the radius vector by a fixed
+//! small angle (four multiplications a chord) and, every
+//! [`EXACT_EVERY`] chords, from sine and cosine, so rounding never builds
+//! up; the last chord ends exactly on the target. An axis outside the
+//! plane moves linearly along the arc (a helix).
+
+use crate::axis::AXES;
+use crate::fmath;
+use crate::kinematics::Position;
+use crate::units::Milli;
+use core::f32::consts::TAU;
+
+/// Chords between exact recomputations of the rotation.
+pub const EXACT_EVERY: u32 = 12;
+
+/// An end further than this from the circle through the start is a bad
+/// target (Grbl's 0.005 mm and 0.1 %).
+const RADIUS_SLACK: f32 = 5.0;
+const RADIUS_SLACK_REL: f32 = 0.001;
+
+/// Why an arc cannot be made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArcError {
+    /// The end is not on the circle through the start (centre form).
+    EndOffCircle,
+    /// No circle of that radius joins start and end (radius form).
+    RadiusTooSmall,
+}
+
+/// The arc's plane: the indices (in a [`Position`]) of its two axes, and
+/// of the axis that moves linearly along it, if any.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Plane {
+    pub axis_0: usize,
+    pub axis_1: usize,
+    pub linear: Option<usize>,
+}
+
+/// An arc being cut: an iterator over its chords' end positions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Arc {
+    plane: Plane,
+    start: Position,
+    end: Position,
+    /// Centre in the plane, and the radius, milli-units.
+    centre: [f32; 2],
+    radius: f32,
+    /// Angle of the start from the centre, and the angle each chord turns.
+    start_angle: f32,
+    step: f32,
+    /// cos and sin of `step`.
+    rotation: [f32; 2],
+    /// The radius vector of the last chord end, relative to the centre.
+    vector: [f32; 2],
+    chords: u32,
+    done: u32,
+}
+
+impl Arc {
+    /// From the centre's offsets from the start (`I J K` of the plane's
+    /// axes), `clockwise` for `G2`. The end may be the start: a full
+    /// circle.
+    pub fn from_centre(
+        start: Position,
+        end: Position,
+        plane: Plane,
+        offset: [Milli; 2],
+        clockwise: bool,
+        tolerance: Milli,
+    ) -> Result<Arc, ArcError> {
+        let (x0, y0) = (start[plane.axis_0].0 as f32, start[plane.axis_1].0 as f32);
+        let centre = [x0 + offset[0].0 as f32, y0 + offset[1].0 as f32];
+        let r = fmath::sqrt(sq(offset[0].0 as f32) + sq(offset[1].0 as f32));
+        let (x1, y1) = (end[plane.axis_0].0 as f32, end[plane.axis_1].0 as f32);
+        let r_end = fmath::sqrt(sq(x1 - centre[0]) + sq(y1 - centre[1]));
+        let off = (r - r_end).abs();
+        if off > RADIUS_SLACK && off > RADIUS_SLACK_REL * r {
+            return Err(ArcError::EndOffCircle);
+        }
+        Ok(Arc::new(start, end, plane, centre, r, clockwise, tolerance))
+    }
+
+    /// From the radius `R`: the shorter arc, or the longer one for a
+    /// negative radius (Grbl's rule); `clockwise` for `G2`.
+    pub fn from_radius(
+        start: Position,
+        end: Position,
+        plane: Plane,
+        radius: Milli,
+        clockwise: bool,
+        tolerance: Milli,
+    ) -> Result<Arc, ArcError> {
+        let (x0, y0) = (start[plane.axis_0].0 as f32, start[plane.axis_1].0 as f32);
+        let x = end[plane.axis_0].0 as f32 - x0;
+        let y = end[plane.axis_1].0 as f32 - y0;
+        let r = radius.0 as f32;
+        let h2 = 4.0 * r * r - x * x - y * y;
+        let chord = fmath::sqrt(x * x + y * y);
+        if h2 < 0.0 || chord == 0.0 {
+            return Err(ArcError::RadiusTooSmall);
+        }
+        // Signed distance of the centre from the chord's midpoint, over
+        // half the chord; its sign picks the centre's side.
+        let mut h = -fmath::sqrt(h2) / chord;
+        if !clockwise {
+            h = -h;
+        }
+        if r < 0.0 {
+            h = -h;
+        }
+        let centre = [x0 + 0.5 * (x - y * h), y0 + 0.5 * (y + x * h)];
+        Ok(Arc::new(start, end, plane, centre, r.abs(), clockwise, tolerance))
+    }
+
+    fn new(
+        start: Position,
+        end: Position,
+        plane: Plane,
+        centre: [f32; 2],
+        r: f32,
+        clockwise: bool,
+        tolerance: Milli,
+    ) -> Arc {
+        let v0 = [
+            start[plane.axis_0].0 as f32 - centre[0],
+            start[plane.axis_1].0 as f32 - centre[1],
+        ];
+        let v1 = [
+            end[plane.axis_0].0 as f32 - centre[0],
+            end[plane.axis_1].0 as f32 - centre[1],
+        ];
+        let mut travel = fmath::atan2(v0[0] * v1[1] - v0[1] * v1[0], v0[0] * v1[0] + v0[1] * v1[1]);
+        // A turn of nothing is a full circle (the end is the start).
+        const EPSILON: f32 = 5e-7;
+        if clockwise && travel >= -EPSILON {
+            travel -= TAU;
+        } else if !clockwise && travel <= EPSILON {
+            travel += TAU;
+        }
+        // A chord whose sagitta is the tolerance spans 2·√(t(2r − t)).
+        let t = (tolerance.0.max(1) as f32).min(r);
+        let half_chord = fmath::sqrt(t * (2.0 * r - t));
+        // Rounded up (Grbl rounds down, and strays a little past it).
+        let chords = ((0.5 * travel * r).abs() / half_chord) as u32 + 1;
+        let step = travel / chords as f32;
+        let (sin, cos) = fmath::sin_cos(step);
+        Arc {
+            plane,
+            start,
+            end,
+            centre,
+            radius: r,
+            start_angle: fmath::atan2(v0[1], v0[0]),
+            step,
+            rotation: [cos, sin],
+            vector: v0,
+            chords,
+            done: 0,
+        }
+    }
+
+    /// Chords in all.
+    pub fn chords(&self) -> u32 {
+        self.chords
+    }
+}
+
+impl Iterator for Arc {
+    type Item = Position;
+
+    /// The next chord's end.
+    fn next(&mut self) -> Option<Position> {
+        if self.done >= self.chords {
+            return None;
+        }
+        self.done += 1;
+        if self.done == self.chords {
+            return Some(self.end);
+        }
+        let k = self.done;
+        if k % EXACT_EVERY == 0 {
+            let (sin, cos) = fmath::sin_cos(self.start_angle + k as f32 * self.step);
+            self.vector = [self.radius * cos, self.radius * sin];
+        } else {
+            let [c, s] = self.rotation;
+            let [x, y] = self.vector;
+            self.vector = [x * c - y * s, x * s + y * c];
+        }
+        let p = &self.plane;
+        let mut at: Position = self.start;
+        at[p.axis_0] = Milli(round(self.centre[0] + self.vector[0]));
+        at[p.axis_1] = Milli(round(self.centre[1] + self.vector[1]));
+        if let Some(l) = p.linear {
+            let span = self.end[l].0 as i64 - self.start[l].0 as i64;
+            at[l] = Milli(self.start[l].0 + (span * k as i64 / self.chords as i64) as i32);
+        }
+        for i in 0..AXES {
+            if i != p.axis_0 && i != p.axis_1 && Some(i) != p.linear {
+                at[i] = self.end[i];
+            }
+        }
+        Some(at)
+    }
+}
+
+fn sq(x: f32) -> f32 {
+    x * x
+}
+
+fn round(x: f32) -> i32 {
+    if x >= 0.0 {
+        (x + 0.5) as i32
+    } else {
+        (x - 0.5) as i32
+    }
+}
+
+#[cfg(test)]
+mod tests;
