@@ -4,7 +4,8 @@
 //! host-tested) turns a line into an order with the modal state it leaves;
 //! this file carries the order out against the motion task's state and
 //! only then commits the line. Real-time commands never get here
-//! (`realtime`).
+//! (`realtime`). An arc is queued chord by chord, a chord a run, and
+//! answered `ok` once its last chord is queued, as Grbl does.
 //!
 //! The console owns the machine's motion only while no string-art job
 //! does: during a job the interpreter refuses motion, drivers and `G92`,
@@ -17,17 +18,19 @@ use crate::queues::{Signal, JOB_CLAIMS_TX, RX};
 use crate::reply::{self, Fixed, REPORTED_AXES};
 use crate::rt::{stack, Poll};
 use core::sync::atomic::Ordering::Relaxed;
+use taut_logic::arc::Arc;
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Error, ErrorKind, Input, Line, Parser, SystemLine};
 use taut_logic::interp::{Allowed, Interpreter, Order};
 use taut_logic::kinematics::Kinematics;
+use taut_logic::planner::Feed;
 use taut_logic::settings;
 use ufmt::{uWrite, uwrite};
 
 pub struct Console {
     parser: Parser,
-    /// A line read but not yet carried out (back-pressure).
-    held: Option<Line>,
+    /// The line being carried out while it waits for room.
+    pending: Option<Pending>,
     dwell_until: Option<u32>,
     /// `$$` or `$Q` in progress: its next line.
     listing: Option<Listing>,
@@ -38,6 +41,13 @@ pub struct Console {
     epoch: u8,
     /// A `$` setting changed since the app last asked.
     settings_changed: bool,
+}
+
+enum Pending {
+    /// Read but not yet carried out (back-pressure).
+    Line(Line),
+    /// An arc whose line was taken, its chords not all queued yet.
+    Arc { arc: Arc, feed: Feed },
 }
 
 #[derive(Clone, Copy)]
@@ -58,7 +68,7 @@ impl Console {
     pub const fn new() -> Console {
         Console {
             parser: Parser::new(),
-            held: None,
+            pending: None,
             dwell_until: None,
             listing: None,
             interp: Interpreter::new(),
@@ -77,7 +87,7 @@ impl Console {
     /// dropped with the bytes not yet read; modal state is Grbl's default.
     pub fn reset(&mut self) {
         self.parser = Parser::new();
-        self.held = None;
+        self.pending = None;
         self.dwell_until = None;
         self.listing = None;
         self.interp.reset();
@@ -94,6 +104,9 @@ impl Console {
     ) -> Poll<Signal> {
         if self.epoch != m.epoch() {
             self.epoch = m.epoch();
+            if let Some(Pending::Arc { .. }) = self.pending {
+                self.pending = None;
+            }
             self.interp.resync(kin.forward(&m.target()));
         }
         loop {
@@ -104,7 +117,14 @@ impl Console {
                 self.list(listing, cfg);
                 return Poll::Again;
             }
-            if let Some(line) = self.held.take() {
+            // Copied out by itself: a whole `Pending` is arc-sized.
+            let line = match &self.pending {
+                Some(Pending::Arc { .. }) => return self.next_chord(m, kin),
+                Some(Pending::Line(line)) => Some(*line),
+                None => None,
+            };
+            if let Some(line) = line {
+                self.pending = None;
                 let allowed = Allowed {
                     motion: owner == Owner::Console,
                     position_known: m.position_known(),
@@ -112,12 +132,14 @@ impl Console {
                 match self.interp.plan(&line, kin, cfg, allowed) {
                     Err(kind) => reply::error(&Error::new(kind, 0)),
                     Ok(planned) => {
-                        if let Some(wait) = self.carry_out(planned.order, m, kin) {
-                            self.held = Some(line);
+                        if let Some(wait) = self.carry_out(&planned.order, m, kin) {
+                            self.pending = Some(Pending::Line(line));
                             return wait;
                         }
                         self.interp.commit(planned);
-                        reply::ok();
+                        if self.pending.is_none() {
+                            reply::ok();
+                        }
                     }
                 }
                 // One line per run: the other tasks get their turn.
@@ -129,7 +151,7 @@ impl Console {
             match self.parser.push(byte) {
                 None | Some(Ok(Input::Realtime(_))) => {}
                 Some(Err(e)) => reply::error(&e),
-                Some(Ok(Input::Line(line))) => self.held = Some(line),
+                Some(Ok(Input::Line(line))) => self.pending = Some(Pending::Line(line)),
                 Some(Ok(Input::System(s))) => self.system(s, m, cfg, owner),
             }
         }
@@ -138,7 +160,7 @@ impl Console {
     /// Carry out an order; `Some(wait)` when it cannot run yet.
     fn carry_out(
         &mut self,
-        order: Order,
+        order: &Order,
         m: &mut Motion,
         kin: &impl Kinematics,
     ) -> Option<Poll<Signal>> {
@@ -155,26 +177,66 @@ impl Console {
         match order {
             Order::None | Order::WaitIdle => {}
             Order::Move { steps, feed } => {
-                if m.push(steps, feed).is_err() {
+                if m.push(*steps, *feed).is_err() {
                     return Some(Poll::Wait(Signal::Motion));
                 }
             }
             Order::Dwell { ms } => {
                 let now = clock::millis();
-                let until = *self.dwell_until.get_or_insert(now.wrapping_add(ms));
+                let until = *self.dwell_until.get_or_insert(now.wrapping_add(*ms));
                 let left = until.wrapping_sub(now) as i32;
                 if left > 0 {
                     return Some(Poll::After(left.min(u16::MAX as i32) as u16));
                 }
                 self.dwell_until = None;
             }
-            Order::SetPosition { steps } => m.set_position(steps),
-            Order::Drivers { on } => m.drivers.set(0xFF, on),
+            Order::Arc { arc, feed } => {
+                self.pending = Some(Pending::Arc {
+                    arc: *arc,
+                    feed: *feed,
+                })
+            }
+            Order::SetPosition { steps } => m.set_position(*steps),
+            Order::Drivers { on } => m.drivers.set(0xFF, *on),
             Order::ReportPosition => report_position(m, kin),
         }
         None
     }
 
+    /// Queue the arc's next chord; `ok` once the last one is queued. Out
+    /// of line: its copy of the arc stays off the console's frame.
+    #[inline(never)]
+    fn next_chord(&mut self, m: &mut Motion, kin: &impl Kinematics) -> Poll<Signal> {
+        let Some(Pending::Arc { arc, feed }) = self.pending.as_mut() else {
+            return Poll::Again;
+        };
+        // Cut a chord only when the planner can take it.
+        if !m.has_room() {
+            return Poll::Wait(Signal::Motion);
+        }
+        let before = *arc;
+        match arc.next().map(|p| kin.inverse(&p)) {
+            Some(Ok(steps)) => {
+                if m.push(steps, *feed).is_err() {
+                    *arc = before;
+                    return Poll::Wait(Signal::Motion);
+                }
+            }
+            None => {
+                self.pending = None;
+                reply::ok();
+            }
+            // The interpreter checked every chord: not reached.
+            Some(Err(_)) => {
+                self.pending = None;
+                self.interp.resync(kin.forward(&m.target()));
+                reply::error(&Error::new(ErrorKind::InvalidTarget, 0));
+            }
+        }
+        Poll::Again
+    }
+
+    #[inline(never)]
     fn system(&mut self, s: SystemLine, m: &mut Motion, cfg: &mut MachineConfig, owner: Owner) {
         match s {
             SystemLine::PrintSettings => {
@@ -217,6 +279,7 @@ impl Console {
     }
 
     /// One line of a listing per call: the TX ring never overflows.
+    #[inline(never)]
     fn list(&mut self, listing: Listing, cfg: &MachineConfig) {
         self.listing = match listing {
             Listing::Settings(next) => settings::all().nth(next).map(|s| {
@@ -243,6 +306,7 @@ impl Default for Console {
 
 /// `M114`: `C:1.000 X:0.000 Z:0.000 Count C:27 X:0 Z:0` (the executed
 /// position).
+#[inline(never)]
 fn report_position(m: &Motion, kin: &impl Kinematics) {
     let steps = m.stepper.position();
     let pos = kin.forward(&steps);

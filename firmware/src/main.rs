@@ -220,8 +220,13 @@ fn init() -> Watchdog {
     clock::Clock::start(dp.TC0);
     usart::Usart0::start(dp.USART0);
     let mut store = Store::new(Eeprom::new(dp.EEPROM));
-    let (config, store_now) = store.load(&MachineConfig::STRING_ART);
-    CONFIG.with(|c| *c = config);
+    // CONFIG starts as the defaults (naming the constant here would keep a
+    // second copy of it in SRAM).
+    let (config, store_now) = CONFIG.with(|c| {
+        let (config, store_now) = store.load(c);
+        *c = config;
+        (config, store_now)
+    });
     STORE.with(|s| *s = Some(store));
     let enable = EnablePins {
         base: pins.d38.into_output(),

@@ -99,6 +99,11 @@ impl Motion {
         Ok(())
     }
 
+    /// Whether the planner has room for a move.
+    pub fn has_room(&self) -> bool {
+        !PLANNER.with(|p| p.is_full())
+    }
+
     /// Axes (bit = index) moving now or queued to: switching one of their
     /// drivers must wait until the machine stands.
     pub fn busy_axes(&mut self) -> u8 {

@@ -246,3 +246,30 @@ pub fn press(sim: &mut sim::Sim, button: taut_logic::pinmap::Button, ms: u64) {
     sim.release(button.pin());
     sim.run_for(std::time::Duration::from_millis(100));
 }
+
+/// The machine's path rebuilt from its STEP and DIR pins alone: after
+/// every STEP pulse of any of the three axes (base, radial, drill), its
+/// cycle and the three step counts then.
+pub fn track(sim: &sim::Sim) -> Vec<(u64, [i64; 3])> {
+    use taut_logic::axis::Axis;
+    let mut steps: Vec<(u64, usize, i64)> = Vec::new();
+    for (i, axis) in [Axis::Base, Axis::Radial, Axis::Drill]
+        .into_iter()
+        .enumerate()
+    {
+        let step = sim.probed(&format!("{}_step", axis.name()));
+        let dir = sim.probed(&format!("{}_dir", axis.name()));
+        for e in step.edges().iter().filter(|e| e.high) {
+            steps.push((e.cycle, i, if dir.level_at(e.cycle) { 1 } else { -1 }));
+        }
+    }
+    steps.sort_unstable();
+    let mut at = [0i64; 3];
+    steps
+        .into_iter()
+        .map(|(cycle, i, d)| {
+            at[i] += d;
+            (cycle, at)
+        })
+        .collect()
+}

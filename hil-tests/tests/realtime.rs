@@ -162,11 +162,15 @@ fn ctrl_x_stops_at_once_and_locks_motion_until_the_position_is_set() {
 fn status_within_10_ms_behind_a_full_planner_and_during_a_dwell() {
     let mut sim = enabled();
     send(&mut sim, "G91");
-    // Sixteen moves fill the planner; the next line waits for room.
-    for _ in 0..17 {
-        sim.uart_send(b"G0 C5\n");
+    // Sixteen moves fill the planner; the next line waits for room. Sent
+    // as a sender with flow control does: never more than the 63-byte
+    // receive ring holds unread.
+    for batch in [9, 8] {
+        for _ in 0..batch {
+            sim.uart_send(b"G0 C5\n");
+        }
+        sim.run_for(Duration::from_millis(250));
     }
-    sim.run_for(Duration::from_millis(500));
     for _ in 0..5 {
         let (report, ms) = status(&mut sim);
         assert!(report.starts_with("<Run|"), "{report}");

@@ -155,6 +155,7 @@ impl Sim {
         let sp = self.sp();
         if sp < self.min_sp {
             self.min_sp = sp;
+            self.min_sp_pc = pc;
             // The last push wrote at sp + 1.
             if u32::from(sp) + 1 < u32::from(self.ram_limit) {
                 return Some(Outcome::StackOverflow {

@@ -60,6 +60,8 @@ pub struct Sim {
     pub(crate) elf: Option<ElfInfo>,
     pub(crate) ram_limit: u16,
     pub(crate) min_sp: u16,
+    /// Where the program was when the stack was deepest (byte address).
+    pub(crate) min_sp_pc: u32,
     /// Watched program addresses and the cycles execution reached them.
     pub(crate) pc_watches: Vec<(u32, Vec<u64>)>,
     pub(crate) resets: u32,
@@ -170,6 +172,7 @@ impl Sim {
             elf,
             ram_limit,
             min_sp: RAM_END,
+            min_sp_pc: 0,
             pc_watches: Vec::new(),
             resets: 0,
             last_avr_cycle: 0,
@@ -260,6 +263,12 @@ impl Sim {
     /// Most stack ever in use, in bytes.
     pub fn peak_stack_bytes(&self) -> u16 {
         RAM_END - self.min_sp
+    }
+
+    /// The program counter (byte address) at the deepest stack: look it
+    /// up with `avr-addr2line -fe taut.elf`.
+    pub fn peak_stack_pc(&self) -> u32 {
+        self.min_sp_pc
     }
 
     /// First address past the statics: the stack must stay above it.

@@ -12,7 +12,7 @@ use crate::axis::AXES;
 use crate::fmath;
 use crate::kinematics::Position;
 use crate::units::Milli;
-use core::f32::consts::TAU;
+use core::f32::consts::{FRAC_PI_2, TAU};
 
 /// Chords between exact recomputations of the rotation.
 pub const EXACT_EVERY: u32 = 12;
@@ -40,6 +40,18 @@ pub struct Plane {
     pub linear: Option<usize>,
 }
 
+/// What an arc is asked for besides its circle: its ends, plane, turn
+/// (`clockwise` for `G2`) and how far its chords may stray. Passed by
+/// reference: the AVR backend garbles arguments passed on the stack.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sweep {
+    pub start: Position,
+    pub end: Position,
+    pub plane: Plane,
+    pub clockwise: bool,
+    pub tolerance: Milli,
+}
+
 /// An arc being cut: an iterator over its chords' end positions.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Arc {
@@ -64,14 +76,11 @@ impl Arc {
     /// From the centre's offsets from the start (`I J K` of the plane's
     /// axes), `clockwise` for `G2`. The end may be the start: a full
     /// circle.
-    pub fn from_centre(
-        start: Position,
-        end: Position,
-        plane: Plane,
-        offset: [Milli; 2],
-        clockwise: bool,
-        tolerance: Milli,
-    ) -> Result<Arc, ArcError> {
+    #[inline(never)]
+    pub fn from_centre(sweep: &Sweep, offset: [Milli; 2]) -> Result<Arc, ArcError> {
+        let Sweep {
+            start, end, plane, ..
+        } = *sweep;
         let (x0, y0) = (start[plane.axis_0].0 as f32, start[plane.axis_1].0 as f32);
         let centre = [x0 + offset[0].0 as f32, y0 + offset[1].0 as f32];
         let r = fmath::sqrt(sq(offset[0].0 as f32) + sq(offset[1].0 as f32));
@@ -81,19 +90,20 @@ impl Arc {
         if off > RADIUS_SLACK && off > RADIUS_SLACK_REL * r {
             return Err(ArcError::EndOffCircle);
         }
-        Ok(Arc::new(start, end, plane, centre, r, clockwise, tolerance))
+        Ok(Arc::new(sweep, centre, r))
     }
 
     /// From the radius `R`: the shorter arc, or the longer one for a
     /// negative radius (Grbl's rule); `clockwise` for `G2`.
-    pub fn from_radius(
-        start: Position,
-        end: Position,
-        plane: Plane,
-        radius: Milli,
-        clockwise: bool,
-        tolerance: Milli,
-    ) -> Result<Arc, ArcError> {
+    #[inline(never)]
+    pub fn from_radius(sweep: &Sweep, radius: Milli) -> Result<Arc, ArcError> {
+        let Sweep {
+            start,
+            end,
+            plane,
+            clockwise,
+            ..
+        } = *sweep;
         let (x0, y0) = (start[plane.axis_0].0 as f32, start[plane.axis_1].0 as f32);
         let x = end[plane.axis_0].0 as f32 - x0;
         let y = end[plane.axis_1].0 as f32 - y0;
@@ -113,18 +123,17 @@ impl Arc {
             h = -h;
         }
         let centre = [x0 + 0.5 * (x - y * h), y0 + 0.5 * (y + x * h)];
-        Ok(Arc::new(start, end, plane, centre, r.abs(), clockwise, tolerance))
+        Ok(Arc::new(sweep, centre, r.abs()))
     }
 
-    fn new(
-        start: Position,
-        end: Position,
-        plane: Plane,
-        centre: [f32; 2],
-        r: f32,
-        clockwise: bool,
-        tolerance: Milli,
-    ) -> Arc {
+    fn new(sweep: &Sweep, centre: [f32; 2], r: f32) -> Arc {
+        let Sweep {
+            start,
+            end,
+            plane,
+            clockwise,
+            tolerance,
+        } = *sweep;
         let v0 = [
             start[plane.axis_0].0 as f32 - centre[0],
             start[plane.axis_1].0 as f32 - centre[1],
@@ -167,6 +176,50 @@ impl Arc {
     pub fn chords(&self) -> u32 {
         self.chords
     }
+
+    /// The smallest box (least and greatest corner) holding every chord
+    /// end: both ends, and the circle's extremes the arc passes. Chords
+    /// lie inside the circle, so the box holds the whole path: checked
+    /// against the travel before anything moves.
+    #[inline(never)]
+    pub fn bounds(&self) -> (Position, Position) {
+        let mut lo = self.start;
+        let mut hi = self.start;
+        for i in 0..AXES {
+            lo[i] = lo[i].min(self.end[i]);
+            hi[i] = hi[i].max(self.end[i]);
+        }
+        let travel = self.step * self.chords as f32;
+        let (from, to) = if travel < 0.0 {
+            (self.start_angle + travel, self.start_angle)
+        } else {
+            (self.start_angle, self.start_angle + travel)
+        };
+        // Each quarter turn k·π/2 the arc sweeps is an extreme: +axis_0,
+        // +axis_1, −axis_0, −axis_1 in turn. Rounded as a chord end is,
+        // with a little slack for the rotation's error.
+        let mut k = (from / FRAC_PI_2) as i32 - 1;
+        while k as f32 * FRAC_PI_2 <= to {
+            if k as f32 * FRAC_PI_2 >= from {
+                let (i, sign) = match k.rem_euclid(4) {
+                    0 => (0, 1.0),
+                    1 => (1, 1.0),
+                    2 => (0, -1.0),
+                    _ => (1, -1.0),
+                };
+                let axis = if i == 0 {
+                    self.plane.axis_0
+                } else {
+                    self.plane.axis_1
+                };
+                let extreme = Milli(round(self.centre[i] + sign * (self.radius + 0.01)));
+                lo[axis] = lo[axis].min(extreme);
+                hi[axis] = hi[axis].max(extreme);
+            }
+            k += 1;
+        }
+        (lo, hi)
+    }
 }
 
 impl Iterator for Arc {
@@ -182,7 +235,7 @@ impl Iterator for Arc {
             return Some(self.end);
         }
         let k = self.done;
-        if k % EXACT_EVERY == 0 {
+        if k.is_multiple_of(EXACT_EVERY) {
             let (sin, cos) = fmath::sin_cos(self.start_angle + k as f32 * self.step);
             self.vector = [self.radius * cos, self.radius * sin];
         } else {
@@ -198,9 +251,9 @@ impl Iterator for Arc {
             let span = self.end[l].0 as i64 - self.start[l].0 as i64;
             at[l] = Milli(self.start[l].0 + (span * k as i64 / self.chords as i64) as i32);
         }
-        for i in 0..AXES {
+        for (i, (a, e)) in at.iter_mut().zip(&self.end).enumerate() {
             if i != p.axis_0 && i != p.axis_1 && Some(i) != p.linear {
-                at[i] = self.end[i];
+                *a = *e;
             }
         }
         Some(at)

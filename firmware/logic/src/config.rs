@@ -44,6 +44,9 @@ pub struct MachineConfig {
     /// Grbl's junction deviation, µm: how far the path may cut a corner at
     /// the junction speed. Larger means faster corners.
     pub junction_deviation_um: u32,
+    /// How far an arc's chords may stray from the circle, µm (Grbl's
+    /// `$12`, 0.01 mm by default).
+    pub arc_tolerance_um: u32,
 }
 
 /// TB6600 defaults: 5 µs pulse, 5 µs DIR set-up, 5 µs ENABLE set-up.
@@ -90,6 +93,7 @@ impl MachineConfig {
         ],
         pulse: TB6600,
         junction_deviation_um: 10,
+        arc_tolerance_um: 10,
     };
 
     pub fn axis(&self, i: usize) -> &AxisConfig {

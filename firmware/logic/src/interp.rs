@@ -9,21 +9,33 @@
 //! fails — or waits for planner room and is planned again — changes no
 //! modal state: `G91 G1 X1` without a feed rate is refused and leaves the
 //! interpreter in `G90`/`G0` as it was.
+//!
+//! Arcs (`G2`/`G3`) are checked whole before anything moves — the end on
+//! the circle, a radius that reaches, the whole path inside the soft limits
+//! and the kinematics' reach — and handed over as an [`Arc`] whose chords
+//! the caller queues one by one.
 
+use crate::arc::{self, Arc, ArcError, Sweep};
 use crate::config::MachineConfig;
-use crate::gcode::{AxisWord, Command, Distance, ErrorKind, Line, MIN_FEED};
+use crate::gcode::{AxisWord, Command, Distance, ErrorKind, Line, Plane, MIN_FEED};
 use crate::kinematics::{Kinematics, Position, Steps};
 use crate::planner::Feed;
 use crate::units::Milli;
 
 /// What a line asks of the machine.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Order {
     /// Nothing but modal state (`G91`, `F100`, a blank line).
     None,
     /// Move to these absolute motor steps.
     Move {
         steps: Steps,
+        feed: Feed,
+    },
+    /// Move along these chords (positions in G-code coordinates, each
+    /// converted with [`Kinematics::inverse`], which cannot fail for them).
+    Arc {
+        arc: Arc,
         feed: Feed,
     },
     /// Wait this long once motion is done.
@@ -52,18 +64,27 @@ pub struct Allowed {
     pub position_known: bool,
 }
 
+/// The motion mode: what a line of bare axis words does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Motion {
+    Rapid,
+    Linear,
+    ArcCw,
+    ArcCcw,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Modal {
     distance: Distance,
-    /// `G0` (else `G1`).
-    rapid: bool,
+    motion: Motion,
+    plane: Plane,
     feed: Option<Milli>,
     /// Commanded position in milli-units (G-code coordinates).
     target: Position,
 }
 
 /// A line checked and ready to carry out, with the modal state it leaves.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Planned {
     pub order: Order,
     next: Modal,
@@ -80,12 +101,13 @@ impl Default for Interpreter {
 }
 
 impl Interpreter {
-    /// Grbl's power-on state: `G90 G0`, no feed rate, at zero.
+    /// Grbl's power-on state: `G90 G0 G17`, no feed rate, at zero.
     pub const fn new() -> Self {
         Interpreter {
             modal: Modal {
                 distance: Distance::Absolute,
-                rapid: true,
+                motion: Motion::Rapid,
+                plane: Plane::Xy,
                 feed: None,
                 target: [Milli::ZERO; crate::axis::AXES],
             },
@@ -112,7 +134,9 @@ impl Interpreter {
     }
 
     /// Check `line` and work out its order; the modal state is unchanged
-    /// until [`Interpreter::commit`].
+    /// until [`Interpreter::commit`]. Never inlined: its temporaries (an
+    /// arc's) stay out of the caller's frame on the AVR's small stack.
+    #[inline(never)]
     pub fn plan(
         &self,
         line: &Line,
@@ -121,7 +145,7 @@ impl Interpreter {
         allowed: Allowed,
     ) -> Result<Planned, ErrorKind> {
         let mut next = self.modal;
-        let has_axes = line.axes.iter().any(Option::is_some);
+        let has_axes = line.has_axes();
         let moves = has_axes
             || matches!(
                 line.command,
@@ -130,19 +154,35 @@ impl Interpreter {
         if moves && !allowed.motion {
             return Err(ErrorKind::JobOwnsMotion);
         }
-        if line.f.is_some_and(|f| f.0 < MIN_FEED) {
+        if line.f.get().is_some_and(|f| f.0 < MIN_FEED) {
             return Err(ErrorKind::FeedTooLow);
         }
         if let Some(d) = line.distance {
             next.distance = d;
         }
         if line.f.is_some() {
-            next.feed = line.f;
+            next.feed = line.f.get();
+        }
+        if let Some(p) = line.plane {
+            next.plane = p;
         }
         let order = match line.command {
-            Command::Rapid | Command::Linear | Command::Empty => {
-                if line.command != Command::Empty {
-                    next.rapid = line.command == Command::Rapid;
+            Command::Rapid
+            | Command::Linear
+            | Command::ArcCw
+            | Command::ArcCcw
+            | Command::Empty => {
+                next.motion = match line.command {
+                    Command::Rapid => Motion::Rapid,
+                    Command::Linear => Motion::Linear,
+                    Command::ArcCw => Motion::ArcCw,
+                    Command::ArcCcw => Motion::ArcCcw,
+                    _ => next.motion,
+                };
+                let arc = matches!(next.motion, Motion::ArcCw | Motion::ArcCcw);
+                // `I J K R` only with an arc that moves (Grbl's error 36).
+                if line.has_arc_words() && !(arc && has_axes) {
+                    return Err(ErrorKind::UnusedValueWords);
                 }
                 if !has_axes {
                     return Ok(Planned {
@@ -150,21 +190,22 @@ impl Interpreter {
                         next,
                     });
                 }
-                let feed = match (next.rapid, next.feed) {
-                    (true, _) => Feed::Rapid,
-                    (false, Some(f)) => Feed::PerMinute(f),
-                    (false, None) => return Err(ErrorKind::UndefinedFeedRate),
+                let feed = match (next.motion, next.feed) {
+                    (Motion::Rapid, _) => Feed::Rapid,
+                    (_, Some(f)) => Feed::PerMinute(f),
+                    (_, None) => return Err(ErrorKind::UndefinedFeedRate),
                 };
                 if !allowed.position_known {
                     return Err(ErrorKind::Locked);
                 }
                 next.target = self.destination(line, kin, next.distance);
-                let outside = cfg.axes.iter().zip(&next.target).any(|(a, t)| {
-                    let (min, max) = a.travel;
-                    a.soft_limits && (*t < min || *t > max)
-                });
-                if outside {
-                    return Err(ErrorKind::TravelExceeded);
+                check_travel(cfg, &next.target, &next.target)?;
+                if arc {
+                    let arc = self.arc(line, kin, cfg, &next)?;
+                    return Ok(Planned {
+                        order: Order::Arc { arc, feed },
+                        next,
+                    });
                 }
                 // Converted once from the absolute target: relative moves
                 // never drift.
@@ -174,7 +215,7 @@ impl Interpreter {
                 Order::Move { steps, feed }
             }
             Command::Dwell => Order::Dwell {
-                ms: line.p.map_or(0, |p| p.0.max(0) as u32),
+                ms: line.p.get().map_or(0, |p| p.0.max(0) as u32),
             },
             Command::SetPosition => {
                 for (i, w) in kin.words().iter().enumerate() {
@@ -201,6 +242,62 @@ impl Interpreter {
         self.modal = planned.next;
     }
 
+    /// The arc `line` asks for, from the commanded position to
+    /// `next.target` in `next.plane`: checked whole.
+    fn arc(
+        &self,
+        line: &Line,
+        kin: &impl Kinematics,
+        cfg: &MachineConfig,
+        next: &Modal,
+    ) -> Result<Arc, ErrorKind> {
+        let [w0, w1, w2] = next.plane.axes();
+        let index = |w: AxisWord| kin.words().iter().position(|l| *l == w.letter());
+        let (Some(axis_0), Some(axis_1)) = (index(w0), index(w1)) else {
+            return Err(ErrorKind::ArcNoAxisInPlane);
+        };
+        if line.axis(w0).is_none() && line.axis(w1).is_none() {
+            return Err(ErrorKind::ArcNoAxisInPlane);
+        }
+        let plane = arc::Plane {
+            axis_0,
+            axis_1,
+            linear: index(w2),
+        };
+        let (start, end) = (self.modal.target, next.target);
+        let sweep = Sweep {
+            start,
+            end,
+            plane,
+            clockwise: next.motion == Motion::ArcCw,
+            tolerance: Milli(cfg.arc_tolerance_um.min(i32::MAX as u32) as i32),
+        };
+        let arc = match line.r.get() {
+            Some(_) if start[axis_0] == end[axis_0] && start[axis_1] == end[axis_1] => {
+                return Err(ErrorKind::InvalidTarget);
+            }
+            Some(r) => Arc::from_radius(&sweep, r),
+            None => {
+                // `I J K` are the offsets along X Y Z.
+                let offset = |w: AxisWord| line.offsets[w.index() - AxisWord::X.index()].get();
+                if offset(w0).is_none() && offset(w1).is_none() {
+                    return Err(ErrorKind::ArcNoOffsetInPlane);
+                }
+                let o = [
+                    offset(w0).unwrap_or(Milli::ZERO),
+                    offset(w1).unwrap_or(Milli::ZERO),
+                ];
+                Arc::from_centre(&sweep, o)
+            }
+        }
+        .map_err(|e| match e {
+            ArcError::EndOffCircle => ErrorKind::InvalidTarget,
+            ArcError::RadiusTooSmall => ErrorKind::ArcRadiusInvalid,
+        })?;
+        check_arc(&arc, kin, cfg)?;
+        Ok(arc)
+    }
+
     /// Where the axis words of `line` take the commanded position.
     fn destination(&self, line: &Line, kin: &impl Kinematics, distance: Distance) -> Position {
         let mut target = self.modal.target;
@@ -213,6 +310,37 @@ impl Interpreter {
             }
         }
         target
+    }
+}
+
+/// Refuses an arc that leaves the soft limits or the machine's reach.
+/// Out of line: the AVR's stack is small, the arc's caller deep.
+#[inline(never)]
+fn check_arc(arc: &Arc, kin: &impl Kinematics, cfg: &MachineConfig) -> Result<(), ErrorKind> {
+    let (lo, hi) = arc.bounds();
+    check_travel(cfg, &lo, &hi)?;
+    // A linear kinematics reaches the whole box if it reaches its
+    // corners; any other is asked for every chord end.
+    let reaches = |p: &Position| kin.inverse(p).is_ok();
+    let reached = match kin.is_linear() {
+        true => reaches(&lo) && reaches(&hi),
+        false => { *arc }.all(|p| reaches(&p)),
+    };
+    match reached {
+        true => Ok(()),
+        false => Err(ErrorKind::InvalidTarget),
+    }
+}
+
+/// Refuses a path whose box `lo..=hi` leaves an axis's soft limits.
+fn check_travel(cfg: &MachineConfig, lo: &Position, hi: &Position) -> Result<(), ErrorKind> {
+    let outside = cfg.axes.iter().zip(lo.iter().zip(hi)).any(|(a, (l, h))| {
+        let (min, max) = a.travel;
+        a.soft_limits && (*l < min || *h > max)
+    });
+    match outside {
+        true => Err(ErrorKind::TravelExceeded),
+        false => Ok(()),
     }
 }
 

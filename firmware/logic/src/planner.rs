@@ -131,10 +131,15 @@ impl Planner {
         }
     }
 
+    /// Whether [`Planner::push`] would refuse for want of room.
+    pub fn is_full(&self) -> bool {
+        self.len == PLANNER_BLOCKS
+    }
+
     /// Adds a move to the absolute step position `target`. A move of no
     /// step is dropped.
     pub fn push(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
-        if self.len == PLANNER_BLOCKS {
+        if self.is_full() {
             return Err(Full);
         }
         let mut step = StepBlock::default();

@@ -51,7 +51,7 @@ impl Default for Prep {
 }
 
 impl Prep {
-    pub const fn new() -> Self {
+    pub fn new() -> Self {
         Prep {
             cut: Preparer::new(),
             hold: Hold::Off,

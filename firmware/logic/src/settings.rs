@@ -44,6 +44,7 @@ pub enum GlobalField {
     DirSetupUs,
     EnableSetupUs,
     JunctionDeviationUm,
+    ArcToleranceUm,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,11 +73,12 @@ const AXIS_FIELDS: [AxisField; 8] = [
     AxisField::TravelMax,
 ];
 
-const GLOBAL_FIELDS: [GlobalField; 4] = [
+const GLOBAL_FIELDS: [GlobalField; 5] = [
     GlobalField::StepPulseUs,
     GlobalField::DirSetupUs,
     GlobalField::EnableSetupUs,
     GlobalField::JunctionDeviationUm,
+    GlobalField::ArcToleranceUm,
 ];
 
 /// Number of settings; [`Setting::index`] is below it.
@@ -104,6 +106,7 @@ impl GlobalField {
             GlobalField::DirSetupUs => "dir_setup_us",
             GlobalField::EnableSetupUs => "enable_setup_us",
             GlobalField::JunctionDeviationUm => "junction_deviation_um",
+            GlobalField::ArcToleranceUm => "arc_tolerance_um",
         }
     }
 }
@@ -182,6 +185,7 @@ impl Setting {
             Setting::Global(GlobalField::DirSetupUs) => p.dir_setup_us as u32,
             Setting::Global(GlobalField::EnableSetupUs) => p.enable_setup_us as u32,
             Setting::Global(GlobalField::JunctionDeviationUm) => cfg.junction_deviation_um,
+            Setting::Global(GlobalField::ArcToleranceUm) => cfg.arc_tolerance_um,
         })
     }
 
@@ -193,6 +197,7 @@ impl Setting {
             Setting::Axis(_, _) => (0, 1),
             Setting::Global(GlobalField::StepPulseUs) => (1, 255),
             Setting::Global(GlobalField::JunctionDeviationUm) => (0, 100_000),
+            Setting::Global(GlobalField::ArcToleranceUm) => (1, 100_000),
             Setting::Global(_) => (0, 255),
         }
     }
@@ -289,6 +294,7 @@ impl Setting {
             (Setting::Global(GlobalField::DirSetupUs), _) => cfg.pulse.dir_setup_us = n as u8,
             (Setting::Global(GlobalField::EnableSetupUs), _) => cfg.pulse.enable_setup_us = n as u8,
             (Setting::Global(GlobalField::JunctionDeviationUm), _) => cfg.junction_deviation_um = n,
+            (Setting::Global(GlobalField::ArcToleranceUm), _) => cfg.arc_tolerance_um = n,
         }
     }
 }
@@ -356,6 +362,7 @@ mod tests {
         assert_eq!(lines[28], "aux_enable_active_high = 1");
         assert_eq!(lines[32], "step_pulse_us = 5");
         assert_eq!(lines[35], "junction_deviation_um = 10");
+        assert_eq!(lines[36], "arc_tolerance_um = 10");
         for (i, s) in all().enumerate() {
             assert_eq!(s.index(), i);
         }
@@ -384,6 +391,7 @@ mod tests {
         set(&mut cfg, "base_accel", " 750 ").unwrap();
         set(&mut cfg, "enable_setup_us", "0").unwrap();
         set(&mut cfg, "junction_deviation_um", "20").unwrap();
+        set(&mut cfg, "arc_tolerance_um", "2").unwrap();
         assert_eq!(cfg.axes[2].steps_per_unit, StepsPerUnit::new(1600, 12));
         assert_eq!(cfg.axes[1].steps_per_unit, StepsPerUnit::new(53, 2));
         assert!(!cfg.axes[1].dir_high_is_positive);
@@ -391,6 +399,7 @@ mod tests {
         assert_eq!(cfg.axes[0].accel, 750);
         assert_eq!(cfg.pulse.enable_setup_us, 0);
         assert_eq!(cfg.junction_deviation_um, 20);
+        assert_eq!(cfg.arc_tolerance_um, 2);
     }
 
     #[test]

@@ -2,6 +2,8 @@
 //! [`Milli`] (thousandths of a unit: µm or millidegrees) so no float is
 //! needed between the text and the step count.
 
+use core::num::NonZeroU32;
+
 /// A length in µm or an angle in millidegrees: thousandths of the axis unit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Milli(pub i32);
@@ -13,6 +15,48 @@ impl Milli {
 
     pub const fn from_units(units: i32) -> Milli {
         Milli(units * Self::SCALE)
+    }
+}
+
+/// An optional [`Milli`] in four bytes where `Option` takes eight: parsed
+/// lines wait in SRAM. `i32::MIN`, below any value the parser reads,
+/// cannot be held (it reads back as none).
+#[derive(Clone, Copy, Default, PartialEq, Eq)]
+pub struct MaybeMilli(Option<NonZeroU32>);
+
+impl MaybeMilli {
+    pub const NONE: MaybeMilli = MaybeMilli(None);
+
+    pub const fn new(value: Option<Milli>) -> MaybeMilli {
+        match value {
+            Some(m) => MaybeMilli(NonZeroU32::new(m.0 as u32 ^ SIGN)),
+            None => MaybeMilli::NONE,
+        }
+    }
+
+    pub const fn get(self) -> Option<Milli> {
+        match self.0 {
+            Some(bits) => Some(Milli((bits.get() ^ SIGN) as i32)),
+            None => None,
+        }
+    }
+
+    pub const fn is_some(self) -> bool {
+        self.0.is_some()
+    }
+}
+
+const SIGN: u32 = 1 << 31;
+
+impl From<Option<Milli>> for MaybeMilli {
+    fn from(value: Option<Milli>) -> Self {
+        MaybeMilli::new(value)
+    }
+}
+
+impl core::fmt::Debug for MaybeMilli {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        self.get().fmt(f)
     }
 }
 
@@ -62,6 +106,23 @@ pub fn div_round(n: i64, d: i64) -> i64 {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn maybe_milli_is_four_bytes_and_holds_zero_and_the_extremes() {
+        assert_eq!(core::mem::size_of::<MaybeMilli>(), 4);
+        for v in [0, 1, -1, i32::MAX, -i32::MAX] {
+            assert_eq!(MaybeMilli::new(Some(Milli(v))).get(), Some(Milli(v)));
+        }
+        assert_eq!(MaybeMilli::new(None).get(), None);
+        assert!(!MaybeMilli::NONE.is_some());
+    }
+
+    proptest! {
+        #[test]
+        fn maybe_milli_reads_back_what_it_was_given(v in -i32::MAX..=i32::MAX) {
+            prop_assert_eq!(MaybeMilli::new(Some(Milli(v))).get(), Some(Milli(v)));
+        }
+    }
 
     #[test]
     fn one_degree_steps_accumulate_exactly() {

@@ -46,9 +46,15 @@ pub enum ErrorKind {
     Locked = 9,
     /// A target outside an axis's soft limits (interpreter).
     TravelExceeded = 15,
+    /// An arc without an axis word of its plane (interpreter).
+    ArcNoAxisInPlane = 32,
     /// A target the kinematics cannot reach or the step counter cannot
-    /// hold (interpreter).
+    /// hold, or an arc's end off its circle (interpreter).
     InvalidTarget = 33,
+    /// No circle of the arc's `R` joins its ends (interpreter).
+    ArcRadiusInvalid = 34,
+    /// An arc with neither `R` nor an offset of its plane (interpreter).
+    ArcNoOffsetInPlane = 35,
     /// `*` checksum wrong, malformed, or followed by more words.
     BadChecksum = 70,
     /// Motion, drivers or settings while a string-art job runs (taut's).
@@ -83,6 +89,9 @@ impl ErrorKind {
             ErrorKind::Locked => "Position unknown: G92 or $X first",
             ErrorKind::TravelExceeded => "Travel exceeded (soft limit)",
             ErrorKind::InvalidTarget => "Invalid target",
+            ErrorKind::ArcNoAxisInPlane => "Arc without an axis of its plane",
+            ErrorKind::ArcRadiusInvalid => "Arc radius invalid",
+            ErrorKind::ArcNoOffsetInPlane => "Arc without R or an offset of its plane",
             ErrorKind::BadChecksum => "Bad checksum",
             ErrorKind::JobOwnsMotion => "A job is running",
             ErrorKind::FeedTooLow => "Feed rate below 10/min",

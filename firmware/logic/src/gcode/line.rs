@@ -2,7 +2,7 @@
 //! or a realtime byte.
 
 use super::system::SystemLine;
-use crate::units::Milli;
+use crate::units::{MaybeMilli, Milli};
 
 /// Axis letters the command line accepts. Which channel each drives is the
 /// kinematics' business (string art: C base °, X radial mm, Z drill mm).
@@ -58,6 +58,28 @@ pub enum Distance {
     Relative,
 }
 
+/// `G17`/`G18`/`G19`: the plane arcs turn in, modal like [`Distance`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Plane {
+    /// `G17`: X then Y (offsets `I J`).
+    Xy,
+    /// `G18`: Z then X (offsets `K I`).
+    Zx,
+    /// `G19`: Y then Z (offsets `J K`).
+    Yz,
+}
+
+impl Plane {
+    /// The plane's two axes in order, and the third (linear) one.
+    pub const fn axes(self) -> [AxisWord; 3] {
+        match self {
+            Plane::Xy => [AxisWord::X, AxisWord::Y, AxisWord::Z],
+            Plane::Zx => [AxisWord::Z, AxisWord::X, AxisWord::Y],
+            Plane::Yz => [AxisWord::Y, AxisWord::Z, AxisWord::X],
+        }
+    }
+}
+
 /// The one command of a line (taut runs at most one per line).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Command {
@@ -69,6 +91,10 @@ pub enum Command {
     /// `G1`. The parser does not check that a feed rate was ever given
     /// (Grbl's error 22): only the interpreter knows the modal `F`.
     Linear,
+    /// `G2`: a clockwise arc in the plane, from `I J K` or `R`.
+    ArcCw,
+    /// `G3`: the same, counter-clockwise.
+    ArcCcw,
     /// `G4 P<seconds>`: `p` holds thousandths of a second, i.e. ms.
     Dwell,
     /// `G92`: the axis words name the current position.
@@ -85,10 +111,12 @@ pub enum Command {
 
 impl Command {
     /// Every command.
-    pub const ALL: [Command; 9] = [
+    pub const ALL: [Command; 11] = [
         Command::Empty,
         Command::Rapid,
         Command::Linear,
+        Command::ArcCw,
+        Command::ArcCcw,
         Command::Dwell,
         Command::SetPosition,
         Command::EnableDrivers,
@@ -104,6 +132,8 @@ impl Command {
         Some(match (letter, number.0) {
             (b'G', 0) => Command::Rapid,
             (b'G', 1000) => Command::Linear,
+            (b'G', 2000) => Command::ArcCw,
+            (b'G', 3000) => Command::ArcCcw,
             (b'G', 4000) => Command::Dwell,
             (b'G', 92_000) => Command::SetPosition,
             (b'M', 17_000) => Command::EnableDrivers,
@@ -119,7 +149,11 @@ impl Command {
     pub(super) const fn uses_axes(self) -> bool {
         matches!(
             self,
-            Command::Rapid | Command::Linear | Command::SetPosition
+            Command::Rapid
+                | Command::Linear
+                | Command::ArcCw
+                | Command::ArcCcw
+                | Command::SetPosition
         )
     }
 }
@@ -133,13 +167,18 @@ pub struct Line {
     /// The `*` checksum; present only if it matched.
     pub checksum: Option<u8>,
     pub distance: Option<Distance>,
+    pub plane: Option<Plane>,
     pub command: Command,
     /// Axis words, indexed by [`AxisWord::index`].
-    pub axes: [Option<Milli>; AXIS_WORDS],
+    pub axes: [MaybeMilli; AXIS_WORDS],
     /// Feed rate, units per minute, never negative.
-    pub f: Option<Milli>,
+    pub f: MaybeMilli,
     /// `P`, only with `G4`: seconds in thousandths, i.e. milliseconds.
-    pub p: Option<Milli>,
+    pub p: MaybeMilli,
+    /// `I J K`: an arc's centre, offset from its start, per axis X Y Z.
+    pub offsets: [MaybeMilli; 3],
+    /// `R`: an arc's radius (negative: the longer way round).
+    pub r: MaybeMilli,
 }
 
 impl Line {
@@ -148,14 +187,26 @@ impl Line {
         n: None,
         checksum: None,
         distance: None,
+        plane: None,
         command: Command::Empty,
-        axes: [None; AXIS_WORDS],
-        f: None,
-        p: None,
+        axes: [MaybeMilli::NONE; AXIS_WORDS],
+        f: MaybeMilli::NONE,
+        p: MaybeMilli::NONE,
+        offsets: [MaybeMilli::NONE; 3],
+        r: MaybeMilli::NONE,
     };
 
     pub fn axis(&self, word: AxisWord) -> Option<Milli> {
-        self.axes[word.index()]
+        self.axes[word.index()].get()
+    }
+
+    pub fn has_axes(&self) -> bool {
+        self.axes.iter().any(|a| a.is_some())
+    }
+
+    /// Whether the line has an arc's `I J K` or `R`.
+    pub fn has_arc_words(&self) -> bool {
+        self.r.is_some() || self.offsets.iter().any(|o| o.is_some())
     }
 }
 

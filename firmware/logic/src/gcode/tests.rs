@@ -49,18 +49,18 @@ trait Build {
 
 impl Build for Line {
     fn at(mut self, word: AxisWord, milli: i32) -> Line {
-        self.axes[word.index()] = Some(Milli(milli));
+        self.axes[word.index()] = Some(Milli(milli)).into();
         self
     }
     fn f(self, milli: i32) -> Line {
         Line {
-            f: Some(Milli(milli)),
+            f: Some(Milli(milli)).into(),
             ..self
         }
     }
     fn p(self, milli: i32) -> Line {
         Line {
-            p: Some(Milli(milli)),
+            p: Some(Milli(milli)).into(),
             ..self
         }
     }

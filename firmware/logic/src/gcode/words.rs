@@ -4,9 +4,9 @@
 //! then only skipped.
 
 use super::error::{Error, ErrorKind};
-use super::line::{AxisWord, Command, Distance, Line};
+use super::line::{AxisWord, Command, Distance, Line, Plane};
 use super::number::Number;
-use crate::units::Milli;
+use crate::units::{MaybeMilli, Milli};
 
 /// Largest line number, as in Grbl.
 const MAX_LINE_NUMBER: u32 = 9_999_999;
@@ -27,8 +27,11 @@ pub(super) struct Words {
     // Columns of words checked once the line is complete; 0 = absent.
     command_column: u8,
     distance_column: u8,
+    plane_column: u8,
     axis_column: u8,
     p_column: u8,
+    /// The first `I J K R`.
+    arc_column: u8,
 }
 
 impl Words {
@@ -39,8 +42,10 @@ impl Words {
             error: None,
             command_column: 0,
             distance_column: 0,
+            plane_column: 0,
             axis_column: 0,
             p_column: 0,
+            arc_column: 0,
         }
     }
 
@@ -121,7 +126,7 @@ impl Words {
             if slot.is_some() {
                 return error(ErrorKind::RepeatedWord);
             }
-            *slot = Some(value);
+            *slot = MaybeMilli::new(Some(value));
             if self.axis_column == 0 {
                 self.axis_column = column;
             }
@@ -138,6 +143,34 @@ impl Words {
                 } else {
                     Distance::Relative
                 });
+                Ok(())
+            }
+            b'G' if matches!(value.0, 17_000..=19_000) && value.0 % 1000 == 0 => {
+                if self.plane_column != 0 {
+                    return error(ErrorKind::ModalGroupViolation);
+                }
+                self.plane_column = column;
+                self.line.plane = Some(match value.0 {
+                    17_000 => Plane::Xy,
+                    18_000 => Plane::Zx,
+                    _ => Plane::Yz,
+                });
+                Ok(())
+            }
+            b'I' | b'J' | b'K' | b'R' => {
+                let slot = match letter {
+                    b'R' => &mut self.line.r,
+                    b'I' => &mut self.line.offsets[0],
+                    b'J' => &mut self.line.offsets[1],
+                    _ => &mut self.line.offsets[2],
+                };
+                if slot.is_some() {
+                    return error(ErrorKind::RepeatedWord);
+                }
+                *slot = MaybeMilli::new(Some(value));
+                if self.arc_column == 0 {
+                    self.arc_column = column;
+                }
                 Ok(())
             }
             b'G' | b'M' => {
@@ -175,7 +208,7 @@ impl Words {
                 if value.0 < 0 {
                     return error(ErrorKind::NegativeValue);
                 }
-                *slot = Some(value);
+                *slot = MaybeMilli::new(Some(value));
                 Ok(())
             }
             _ => error(ErrorKind::UnsupportedCommand),
@@ -195,7 +228,7 @@ impl Words {
             Command::Dwell if has_axes => {
                 return fail(ErrorKind::UnusedAxisWords, self.axis_column)
             }
-            Command::Dwell if line.p.is_none() => {
+            Command::Dwell if !line.p.is_some() => {
                 return fail(ErrorKind::ValueWordMissing, self.command_column)
             }
             Command::SetPosition if !has_axes => {
@@ -213,6 +246,16 @@ impl Words {
         }
         if line.p.is_some() && line.command != Command::Dwell {
             return fail(ErrorKind::UnusedValueWords, self.p_column);
+        }
+        // Arc words only with an arc (or axis words in an arc's modal
+        // mode: the interpreter decides), and `R` or `I J K`, not both.
+        let arc = matches!(
+            line.command,
+            Command::ArcCw | Command::ArcCcw | Command::Empty
+        );
+        let offsets = line.offsets.iter().any(|o| o.is_some());
+        if self.arc_column != 0 && (!arc || (offsets && line.r.is_some())) {
+            return fail(ErrorKind::UnusedValueWords, self.arc_column);
         }
         Ok(line)
     }

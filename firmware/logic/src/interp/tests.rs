@@ -165,3 +165,107 @@ fn dwell_and_drivers() {
     assert_eq!(run(&mut i, "M84", FREE), Ok(Order::Drivers { on: false }));
     assert_eq!(run(&mut i, "G91", FREE), Ok(Order::None));
 }
+
+/// The chord ends of an arc order, in milli-units of X and Z.
+fn chords(order: Result<Order, ErrorKind>) -> Vec<(i32, i32)> {
+    match order {
+        Ok(Order::Arc { arc, feed }) => {
+            assert_eq!(feed, Feed::PerMinute(Milli(100_000)));
+            arc.map(|p| (p[1].0, p[2].0)).collect()
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn arcs_in_the_zx_plane_end_exactly_and_stay_on_the_circle() {
+    let mut i = Interpreter::new();
+    // G18: Z then X, offsets K then I. Centre X5 Z0, radius 5, half a turn.
+    let ends = chords(run(&mut i, "G18 G2 X10 I5 F100", FREE));
+    assert_eq!(*ends.last().unwrap(), (10_000, 0));
+    assert!(ends.len() > 10, "{} chords", ends.len());
+    for (x, z) in &ends {
+        let d = (((x - 5_000) as f64).powi(2) + (*z as f64).powi(2)).sqrt();
+        assert!((d - 5_000.0).abs() <= 1.5, "{x} {z}");
+    }
+    // G2 in ZX (Z right, X up) is clockwise: from X0 through Z-5.
+    assert!(ends.iter().all(|(_, z)| *z <= 0));
+    assert_eq!(i.target()[1], Milli(10_000));
+    // Modal: bare axis words continue the arc, here relative and back.
+    run(&mut i, "G91", FREE).unwrap();
+    let back = chords(run(&mut i, "X-10 R5", FREE));
+    assert_eq!(*back.last().unwrap(), (0, 0));
+    assert!(
+        back.iter().all(|(_, z)| *z >= 0),
+        "clockwise, the other half"
+    );
+}
+
+#[test]
+fn arcs_are_refused_whole_before_anything_moves() {
+    let mut i = Interpreter::new();
+    let refused = [
+        // The circle passes X40, beyond the radial's travel (30).
+        ("G18 G2 X0 I20 F100", ErrorKind::TravelExceeded),
+        // A whole turn of radius 12.5 reaches Z+12.5, past the drill's
+        // travel (12), though both its ends are inside.
+        ("G18 G3 X0 I12.5 F100", ErrorKind::TravelExceeded),
+        // The string-art machine has no Y: no arc in XY.
+        ("G17 G2 X10 I5 F100", ErrorKind::ArcNoAxisInPlane),
+        ("G18 G2 C10 I5 F100", ErrorKind::ArcNoAxisInPlane),
+        ("G18 G2 X10 J5 F100", ErrorKind::ArcNoOffsetInPlane),
+        ("G18 G2 X10 I4 F100", ErrorKind::InvalidTarget),
+        ("G18 G2 X10 R4 F100", ErrorKind::ArcRadiusInvalid),
+        ("G18 G2 X0 R4 F100", ErrorKind::InvalidTarget),
+        ("G18 G2 X10 I5", ErrorKind::UndefinedFeedRate),
+        ("I5 X10", ErrorKind::UnusedValueWords),
+        ("G18 G2 I5 F100", ErrorKind::UnusedValueWords),
+    ];
+    for (text, kind) in refused {
+        assert_eq!(run(&mut i, text, FREE).err(), Some(kind), "{text}");
+        // No mode changed: a bare X is still an absolute rapid.
+        assert_eq!(
+            run(&mut i, "X1", FREE),
+            Ok(Order::Move {
+                steps: [0, 32, 0, 0],
+                feed: Feed::Rapid
+            }),
+            "after {text}"
+        );
+        run(&mut i, "X0", FREE).unwrap();
+    }
+    let job = Allowed {
+        motion: false,
+        ..FREE
+    };
+    let lost = Allowed {
+        position_known: false,
+        ..FREE
+    };
+    assert_eq!(
+        run(&mut i, "G18 G2 X10 I5 F100", job).err(),
+        Some(ErrorKind::JobOwnsMotion)
+    );
+    assert_eq!(
+        run(&mut i, "G18 G2 X10 I5 F100", lost).err(),
+        Some(ErrorKind::Locked)
+    );
+}
+
+#[test]
+fn a_full_circle_and_the_long_way_round() {
+    let mut i = Interpreter::new();
+    let circle = chords(run(&mut i, "G18 G3 X0 I5 F100", FREE));
+    assert_eq!(*circle.last().unwrap(), (0, 0));
+    let (min, max) = circle.iter().fold((i32::MAX, i32::MIN), |(a, b), (x, _)| {
+        (a.min(*x), b.max(*x))
+    });
+    assert!((min, max) == (0, 10_000), "a whole turn: X {min}..{max}");
+    // R negative: more than half a turn, so the path reaches past the
+    // chord's far side.
+    let short = chords(run(&mut i, "G2 X6 R5", FREE));
+    run(&mut i, "G0 X0", FREE).unwrap();
+    let long = chords(run(&mut i, "G2 X6 R-5", FREE));
+    assert!(long.len() > short.len());
+    assert!(long.iter().any(|(x, _)| *x > 6_000) && short.iter().all(|(x, _)| *x <= 6_000));
+}

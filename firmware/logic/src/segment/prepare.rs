@@ -61,9 +61,9 @@ impl Default for Preparer {
 }
 
 impl Preparer {
-    pub const fn new() -> Self {
+    pub fn new() -> Self {
         Preparer {
-            profile: Trapezoid::ZERO,
+            profile: Trapezoid::idle(),
             done: 0,
             now: 0,
             fresh: false,
@@ -147,7 +147,7 @@ impl Preparer {
         };
         // Standing already: an empty leg (a profile needs an event).
         let leg = match n {
-            0 => Trapezoid::ZERO,
+            0 => Trapezoid::idle(),
             n => {
                 let speeds = Speeds {
                     entry_sqr: v_sqr,

@@ -42,26 +42,31 @@ pub struct Trapezoid {
 }
 
 impl Trapezoid {
-    /// No events: the preparer's idle state.
-    pub const ZERO: Trapezoid = Trapezoid {
-        events: 0,
-        accel: 1,
-        two_a: 2,
-        v0_sqr: 0,
-        v1_sqr: 0,
-        cruise_sqr: 0,
-        shift: 0,
-        s0: 0,
-        s1: 0,
-        acc2: 0,
-        dec2: 0,
-        cruise_iv: 0,
-        t_acc: 0,
-        t_dec: 0,
-        t_end: 0,
-        k_acc: 0,
-        k_dec: 0,
-    };
+    /// No events: the preparer's idle state. Built at run time: a
+    /// constant this size would be copied from a template that the AVR
+    /// keeps in SRAM (120 bytes); this is a clear and two stores.
+    pub fn idle() -> Trapezoid {
+        let one = core::hint::black_box(1);
+        Trapezoid {
+            events: 0,
+            accel: one,
+            two_a: 2 * one,
+            v0_sqr: 0,
+            v1_sqr: 0,
+            cruise_sqr: 0,
+            shift: 0,
+            s0: 0,
+            s1: 0,
+            acc2: 0,
+            dec2: 0,
+            cruise_iv: 0,
+            t_acc: 0,
+            t_dec: 0,
+            t_end: 0,
+            k_acc: 0,
+            k_dec: 0,
+        }
+    }
 }
 
 /// Speeds² of a profile, events²/s²: where it starts, the most it may
@@ -113,7 +118,7 @@ impl Trapezoid {
             shift,
             acc2: peak - v0_sqr,
             dec2: peak - v1_sqr,
-            ..Self::ZERO
+            ..Self::idle()
         };
         let sp = t.scaled_speed(peak);
         t.s0 = t.scaled_speed(v0_sqr);

@@ -21,7 +21,10 @@ const BAD: &[(&str, u8, u8)] = &[
     ("$abcdefghijklmnopqrstuvwxy=1", 3, 26),
     ("G1 X1 F-5", 4, 7),
     ("G4 P-1", 4, 4),
-    ("G2 X1", 20, 1),
+    ("G5 X1", 20, 1),
+    ("G2 X1 I1 R1", 36, 7),
+    ("G1 X1 I1", 36, 7),
+    ("G17 G18", 21, 5),
     ("G38.2 Z-1", 20, 1),
     ("G1.5 X1", 20, 1),
     ("M3", 20, 1),
@@ -93,9 +96,9 @@ fn a_corrupted_byte_is_reported_as_a_checksum_error() {
 
 #[test]
 fn errors_carry_the_line_number_for_a_resend() {
-    let e = parse("N42 G2 X1").unwrap_err();
+    let e = parse("N42 G5 X1").unwrap_err();
     assert_eq!((e.code(), e.line_number()), (20, Some(42)));
-    assert_eq!(parse("G2 N42").unwrap_err().line_number(), None);
+    assert_eq!(parse("G5 N42").unwrap_err().line_number(), None);
 }
 
 #[test]

@@ -1,5 +1,6 @@
 use super::render::{render, Choices};
 use super::*;
+use crate::units::MaybeMilli;
 use proptest::prelude::*;
 use std::{format, string::String, vec::Vec};
 
@@ -9,6 +10,14 @@ fn milli() -> impl Strategy<Value = Milli> {
 
 fn command() -> impl Strategy<Value = Command> {
     prop::sample::select(&Command::ALL[..])
+}
+
+fn plane() -> impl Strategy<Value = Option<Plane>> {
+    prop::option::of(prop_oneof![
+        Just(Plane::Xy),
+        Just(Plane::Zx),
+        Just(Plane::Yz)
+    ])
 }
 
 /// Any line the parser can produce, its words consistent with its command.
@@ -26,28 +35,42 @@ fn any_line() -> impl Strategy<Value = Line> {
         prop::option::of(positive.clone()),
         positive,
         prop::option::of(0u32..=9_999_999),
+        (
+            plane(),
+            prop::array::uniform3(prop::option::of(milli())),
+            milli(),
+            any::<bool>(),
+        ),
     )
-        .prop_map(|(command, distance, mut axes, f, p, n)| {
-            let takes_axes = matches!(
-                command,
-                Command::Empty | Command::Rapid | Command::Linear | Command::SetPosition
-            );
-            if !takes_axes {
-                axes = [None; AXIS_WORDS];
-            } else if command == Command::SetPosition && axes.iter().all(Option::is_none) {
-                axes[AxisWord::Z.index()] = Some(Milli(0));
-            }
-            let p = (command == Command::Dwell).then_some(p);
-            Line {
-                n,
-                checksum: None,
-                distance,
-                command,
-                axes,
-                f,
-                p,
-            }
-        })
+        .prop_map(
+            |(command, distance, mut axes, f, p, n, (plane, mut offsets, r, radius))| {
+                let takes_axes = command.uses_axes() || command == Command::Empty;
+                if !takes_axes {
+                    axes = [None; AXIS_WORDS];
+                } else if command == Command::SetPosition && axes.iter().all(Option::is_none) {
+                    axes[AxisWord::Z.index()] = Some(Milli(0));
+                }
+                let p = (command == Command::Dwell).then_some(p);
+                // `R` or offsets, and only on an arc (or a line of axis words).
+                let arc = matches!(command, Command::ArcCw | Command::ArcCcw | Command::Empty);
+                let r = (arc && radius).then_some(r);
+                if !arc || radius {
+                    offsets = [None; 3];
+                }
+                Line {
+                    n,
+                    checksum: None,
+                    distance,
+                    plane,
+                    command,
+                    axes: axes.map(MaybeMilli::new),
+                    f: f.into(),
+                    p: p.into(),
+                    offsets: offsets.map(MaybeMilli::new),
+                    r: r.into(),
+                }
+            },
+        )
 }
 
 /// The reference: `int.frac` (frac as typed) rounded to thousandths, half

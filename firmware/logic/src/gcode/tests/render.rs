@@ -70,6 +70,8 @@ fn command_words(command: Command) -> Option<(u8, &'static [&'static str])> {
         Command::Empty => return None,
         Command::Rapid => (b'G', &["0", "00", "0.0"]),
         Command::Linear => (b'G', &["1", "01", "1."]),
+        Command::ArcCw => (b'G', &["2", "02"]),
+        Command::ArcCcw => (b'G', &["3", "03.0"]),
         Command::Dwell => (b'G', &["4", "04"]),
         Command::SetPosition => (b'G', &["92", "92.000"]),
         Command::EnableDrivers => (b'M', &["17"]),
@@ -106,7 +108,24 @@ fn words(c: &mut Choices, line: &Line) -> Vec<String> {
             word(c, w.letter(), text);
         }
     }
-    for (l, value) in [(b'F', line.f), (b'P', line.p)] {
+    if let Some(p) = line.plane {
+        let number = match p {
+            Plane::Xy => "17",
+            Plane::Zx => "18",
+            Plane::Yz => "19",
+        };
+        word(c, b'G', number.into());
+    }
+    let [i, j, k] = line.offsets;
+    for (l, value) in [
+        (b'F', line.f),
+        (b'P', line.p),
+        (b'I', i),
+        (b'J', j),
+        (b'K', k),
+        (b'R', line.r),
+    ] {
+        let value = value.get();
         if let Some(m) = value {
             let text = number(c, m);
             word(c, l, text);
