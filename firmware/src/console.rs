@@ -4,8 +4,9 @@
 //! host-tested) turns a line into an order with the modal state it leaves;
 //! this file carries the order out against the motion task's state and
 //! only then commits the line. Real-time commands never get here
-//! (`realtime`). An arc is queued chord by chord, a chord a run, and
-//! answered `ok` once its last chord is queued, as Grbl does.
+//! (`realtime`). An arc, or a straight move of a machine whose kinematics
+//! are not linear, is queued piece by piece, a piece a run, and answered
+//! `ok` once its last piece is queued, as Grbl does.
 //!
 //! The console owns the machine's motion only while no string-art job
 //! does: during a job the interpreter refuses motion, drivers and `G92`,
@@ -18,10 +19,10 @@ use crate::queues::{Signal, JOB_CLAIMS_TX, RX};
 use crate::reply::{self, Fixed, REPORTED_AXES};
 use crate::rt::{stack, Poll};
 use core::sync::atomic::Ordering::Relaxed;
-use taut_logic::arc::Arc;
+use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Error, ErrorKind, Input, Line, Parser, SystemLine};
-use taut_logic::interp::{Allowed, Interpreter, Order};
+use taut_logic::interp::{Allowed, Interpreter, Order, Path};
 use taut_logic::kinematics::Kinematics;
 use taut_logic::planner::Feed;
 use taut_logic::settings;
@@ -46,8 +47,8 @@ pub struct Console {
 enum Pending {
     /// Read but not yet carried out (back-pressure).
     Line(Line),
-    /// An arc whose line was taken, its chords not all queued yet.
-    Arc { arc: Arc, feed: Feed },
+    /// A path whose line was taken, its pieces not all queued yet.
+    Path { path: Path, feed: Feed },
 }
 
 #[derive(Clone, Copy)]
@@ -104,7 +105,7 @@ impl Console {
     ) -> Poll<Signal> {
         if self.epoch != m.epoch() {
             self.epoch = m.epoch();
-            if let Some(Pending::Arc { .. }) = self.pending {
+            if let Some(Pending::Path { .. }) = self.pending {
                 self.pending = None;
             }
             self.interp.resync(kin.forward(&m.target()));
@@ -119,7 +120,7 @@ impl Console {
             }
             // Copied out by itself: a whole `Pending` is arc-sized.
             let line = match &self.pending {
-                Some(Pending::Arc { .. }) => return self.next_chord(m, kin),
+                Some(Pending::Path { .. }) => return self.next_piece(m, kin),
                 Some(Pending::Line(line)) => Some(*line),
                 None => None,
             };
@@ -190,9 +191,9 @@ impl Console {
                 }
                 self.dwell_until = None;
             }
-            Order::Arc { arc, feed } => {
-                self.pending = Some(Pending::Arc {
-                    arc: *arc,
+            Order::Path { path, feed } => {
+                self.pending = Some(Pending::Path {
+                    path: *path,
                     feed: *feed,
                 })
             }
@@ -203,22 +204,22 @@ impl Console {
         None
     }
 
-    /// Queue the arc's next chord; `ok` once the last one is queued. Out
-    /// of line: its copy of the arc stays off the console's frame.
+    /// Queue the path's next piece; `ok` once the last one is queued. Out
+    /// of line: its copy of the path stays off the console's frame.
     #[inline(never)]
-    fn next_chord(&mut self, m: &mut Motion, kin: &impl Kinematics) -> Poll<Signal> {
-        let Some(Pending::Arc { arc, feed }) = self.pending.as_mut() else {
+    fn next_piece(&mut self, m: &mut Motion, kin: &impl Kinematics) -> Poll<Signal> {
+        let Some(Pending::Path { path, feed }) = self.pending.as_mut() else {
             return Poll::Again;
         };
-        // Cut a chord only when the planner can take it.
+        // Cut a piece only when the planner can take it.
         if !m.has_room() {
             return Poll::Wait(Signal::Motion);
         }
-        let before = *arc;
-        match arc.next().map(|p| kin.inverse(&p)) {
+        let before = *path;
+        match path.next().map(|p| kin.inverse(&p)) {
             Some(Ok(steps)) => {
                 if m.push(steps, *feed).is_err() {
-                    *arc = before;
+                    *path = before;
                     return Poll::Wait(Signal::Motion);
                 }
             }
@@ -265,6 +266,7 @@ impl Console {
                 return reply::error(&Error::new(ErrorKind::NotIdle, 0));
             }
             SystemLine::Set { key, value } => {
+                let machine = cfg.machine;
                 if let Err(e) = settings::set(cfg, &key, &value) {
                     // `$key=value`: the value starts after `$`, the key, `=`.
                     let col = (key.len() + 3 + e.at).min(u8::MAX as usize) as u8;
@@ -272,6 +274,14 @@ impl Console {
                     return reply::error_because(&invalid, Some(e.kind));
                 }
                 m.configure(cfg);
+                if cfg.machine != machine {
+                    // Another machine: where it stands is its zero, and its
+                    // modal state starts afresh.
+                    m.set_position([0; AXES]);
+                    self.interp = Interpreter::new();
+                    // Resynced on the next run, through the new kinematics.
+                    self.epoch = m.epoch().wrapping_add(1);
+                }
                 self.settings_changed = true;
             }
         }
@@ -282,9 +292,9 @@ impl Console {
     #[inline(never)]
     fn list(&mut self, listing: Listing, cfg: &MachineConfig) {
         self.listing = match listing {
-            Listing::Settings(next) => settings::all().nth(next).map(|s| {
+            Listing::Settings(next) => settings::Setting::at(next).map(|s| {
                 let mut r = reply::line();
-                let _ = uwrite!(r, "${}={}", s, s.get(cfg));
+                let _ = uwrite!(r, "${}={}", settings::Named(s, cfg.machine), s.get(cfg));
                 r.send();
                 Listing::Settings(next + 1)
             }),

@@ -54,7 +54,7 @@ use taut_firmware::{
 };
 use taut_firmware::{flash_str, info, reply, warn};
 use taut_logic::config::MachineConfig;
-use taut_logic::kinematics::Linear;
+use taut_logic::kinematics::AnyKinematics;
 use taut_logic::sched::{Ready, TaskId, Timers};
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -124,6 +124,8 @@ static WAITING: TaskCell<[u16; SIGNALS]> = TaskCell::new([0; SIGNALS]);
 static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
 static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
 static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
+/// The kinematics of `CONFIG`, rebuilt when a setting changes.
+static KIN: TaskCell<Option<AnyKinematics>> = TaskCell::new(None);
 static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::new(ButtonsTask::new());
 static JOB: TaskCell<JobTask> = TaskCell::new(JobTask::new());
 static CARD: TaskCell<Option<CardReader>> = TaskCell::new(None);
@@ -228,6 +230,8 @@ fn init() -> Watchdog {
         (config, store_now)
     });
     STORE.with(|s| *s = Some(store));
+    // Settings are only taken whole, kinematics included: never `None`.
+    KIN.with(|k| *k = AnyKinematics::of(&config).ok());
     let enable = EnablePins {
         base: pins.d38.into_output(),
         radial: pins.a2.into_output(),
@@ -339,15 +343,20 @@ fn console() {
     };
     let poll = MOTION.with(|m| {
         CONFIG.with(|cfg| {
-            let kin = Linear::cylindrical(cfg);
-            CONSOLE.with(|c| c.poll(m.as_mut().unwrap(), &kin, cfg, owner))
+            KIN.with(|kin| {
+                let kin = kin.as_ref().unwrap();
+                CONSOLE.with(|c| c.poll(m.as_mut().unwrap(), kin, cfg, owner))
+            })
         })
     });
     // New moves may be queued: the motion task feeds them to the stepper.
     spawn(Task::Motion);
     reschedule(Task::Console, poll);
     if CONSOLE.with(|c| c.take_settings_changed()) {
+        CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
         signal(Signal::Settings);
+        // The string-art job runs only on its machine.
+        spawn(Task::Job);
     }
 }
 
@@ -376,7 +385,7 @@ fn realtime() {
         }
         if r.status() {
             if reply::room() {
-                CONFIG.with(|cfg| realtime::status(m, &Linear::cylindrical(cfg)));
+                KIN.with(|kin| realtime::status(m, kin.as_ref().unwrap()));
             } else {
                 realtime::status_later();
                 spawn_after(Task::Realtime, 1);
@@ -406,6 +415,9 @@ fn buttons() {
 
 #[inline(never)]
 fn job() {
+    if !CONFIG.with(|cfg| cfg.machine.is_string_art()) {
+        return;
+    }
     let now = clock::millis();
     let poll =
         MOTION.with(|m| CONFIG.with(|cfg| JOB.with(|j| j.poll(m.as_mut().unwrap(), cfg, now))));

@@ -162,7 +162,7 @@ fn ctrl_x_stops_at_once_and_locks_motion_until_the_position_is_set() {
 fn status_within_10_ms_behind_a_full_planner_and_during_a_dwell() {
     let mut sim = enabled();
     send(&mut sim, "G91");
-    // Sixteen moves fill the planner; the next line waits for room. Sent
+    // Fourteen moves fill the planner; the next line waits for room. Sent
     // as a sender with flow control does: never more than the 63-byte
     // receive ring holds unread.
     for batch in [9, 8] {

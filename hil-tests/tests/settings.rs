@@ -44,7 +44,8 @@ fn settings_survive_a_power_cycle() {
         "settings: EEPROM blank: defaults",
         Duration::from_millis(100),
     );
-    sim.run_for(Duration::from_secs(1));
+    // 199 bytes at 3.4 ms each, a byte a run of the lowest task.
+    sim.run_for(Duration::from_secs(2));
     assert_eq!(
         stored(&sim),
         Ok(MachineConfig::STRING_ART),
@@ -64,6 +65,14 @@ fn settings_survive_a_power_cycle() {
     assert_eq!(listed(&mut again, "radial_travel_min"), "-300.000");
     // In force, not only listed: the soft limit moved with it.
     send(&mut again, "G0 X-299");
+    // Another machine, and one of its settings, kept too.
+    send_ok(&mut again, "M400", Duration::from_secs(30));
+    send(&mut again, "$machine=flatbed");
+    send(&mut again, "$x_travel_max=150");
+    again.run_for(Duration::from_secs(2));
+    let mut third = power_on(&again.eeprom());
+    assert_eq!(listed(&mut third, "machine"), "flatbed");
+    assert_eq!(listed(&mut third, "x_travel_max"), "150.000");
 }
 
 #[test]

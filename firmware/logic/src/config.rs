@@ -3,6 +3,7 @@
 //! on the card and `$` settings override them.
 
 use crate::axis::{Axis, PerAxis};
+use crate::machine::Machine;
 use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
 
@@ -47,6 +48,32 @@ pub struct MachineConfig {
     /// How far an arc's chords may stray from the circle, µm (Grbl's
     /// `$12`, 0.01 mm by default).
     pub arc_tolerance_um: u32,
+    /// Which of the five machines this is.
+    pub machine: Machine,
+    /// Its arms or strings, for the machines that have them.
+    pub geometry: Geometry,
+}
+
+/// The arm or string geometry of the non-linear machines, mm.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Geometry {
+    /// SCARA: the arms L1, L2. Whiteboard: `length_1` is the distance
+    /// between the two strings' exits; `length_2` is unused.
+    pub lengths: [Milli; 2],
+    /// SCARA: the shoulder joint's place in the drawing's frame.
+    /// Whiteboard: the drawing's (0, 0) from the left string's exit (y up,
+    /// so below the motors is negative).
+    pub origin: [Milli; 2],
+    /// SCARA: the elbow crosstalk ratio n_S / n_E (0/1: none).
+    pub crosstalk: StepsPerUnit,
+}
+
+impl Geometry {
+    pub const NONE: Geometry = Geometry {
+        lengths: [Milli(0); 2],
+        origin: [Milli(0); 2],
+        crosstalk: StepsPerUnit::new(0, 1),
+    };
 }
 
 /// TB6600 defaults: 5 µs pulse, 5 µs DIR set-up, 5 µs ENABLE set-up.
@@ -55,22 +82,6 @@ pub const TB6600: PulseTiming = PulseTiming {
     dir_setup_us: 5,
     enable_setup_us: 5,
 };
-
-const fn string_art_axis(steps_per_unit: StepsPerUnit, travel: Option<(i32, i32)>) -> AxisConfig {
-    let (soft_limits, (min, max)) = match travel {
-        Some(t) => (true, t),
-        None => (false, (0, 0)),
-    };
-    AxisConfig {
-        steps_per_unit,
-        max_rate: 2000,
-        accel: 500,
-        dir_high_is_positive: true,
-        enable_active_high: true,
-        soft_limits,
-        travel: (Milli::from_units(min), Milli::from_units(max)),
-    }
-}
 
 /// The radial carriage's travel from its zero at the board's edge: to the
 /// centre of a 45 cm board inwards, and past the outer winding radius
@@ -84,17 +95,74 @@ pub const DRILL_TRAVEL_MM: (i32, i32) = (-30, 12);
 impl MachineConfig {
     /// The string-art machine: base 200×6×8 = 9600 steps per turn, radial
     /// 200/5 mm × 8 = 32 steps/mm, drill 200/12 mm × 8 = 1600 steps per 12 mm.
-    pub const STRING_ART: MachineConfig = MachineConfig {
-        axes: [
-            string_art_axis(StepsPerUnit::new(9600, 360), None),
-            string_art_axis(StepsPerUnit::new(32, 1), Some(RADIAL_TRAVEL_MM)),
-            string_art_axis(StepsPerUnit::new(1600, 12), Some(DRILL_TRAVEL_MM)),
-            string_art_axis(StepsPerUnit::new(80, 1), None),
-        ],
-        pulse: TB6600,
-        junction_deviation_um: 10,
-        arc_tolerance_um: 10,
-    };
+    pub const STRING_ART: MachineConfig = MachineConfig::defaults(Machine::StringArt);
+
+    /// The seed's figures.
+    #[inline(never)]
+    pub const fn defaults(machine: Machine) -> MachineConfig {
+        match machine {
+            // Built like the plotters' (a copy of one constant would be a
+            // second template in SRAM on the AVR).
+            Machine::StringArt => {
+                let mut cfg = plotter(
+                    machine,
+                    [
+                        axis(StepsPerUnit::new(9600, 360), 2000, 500, None),
+                        axis(StepsPerUnit::new(32, 1), 2000, 500, Some(RADIAL_TRAVEL_MM)),
+                    ],
+                );
+                cfg.axes[2] = axis(
+                    StepsPerUnit::new(1600, 12),
+                    2000,
+                    500,
+                    Some(DRILL_TRAVEL_MM),
+                );
+                cfg
+            }
+            // 28BYJ-48: 2048 steps a turn; a GT2 belt pulls 40 mm a turn;
+            // the 90 mm drum carries π·90 mm of paper a turn.
+            Machine::Drum => plotter(
+                machine,
+                [
+                    axis(StepsPerUnit::new(2048, 40), 600, 1500, Some((0, 200))),
+                    axis(StepsPerUnit::new(2_048_000, 282_743), 600, 1500, None),
+                ],
+            ),
+            // EasyDriver at 1/8 step: 0.025 mm a step; X 140 mm.
+            Machine::Flatbed => plotter(
+                machine,
+                [
+                    axis(StepsPerUnit::new(40, 1), 2000, 4000, Some((0, 140))),
+                    axis(StepsPerUnit::new(40, 1), 2000, 4000, None),
+                ],
+            ),
+            // 2000 steps a turn on a 9-tooth sprocket of ½" chain
+            // (114.3 mm a turn); the motors 1.2 m apart, the drawing's
+            // origin 0.6 m right of and below the left one.
+            Machine::Whiteboard => {
+                let chain = axis(StepsPerUnit::new(20_000, 1143), 2000, 1000, None);
+                let mut cfg = plotter(machine, [chain, chain]);
+                cfg.geometry = Geometry {
+                    lengths: [Milli::from_units(1200), Milli(0)],
+                    origin: [Milli::from_units(600), Milli::from_units(-600)],
+                    crosstalk: StepsPerUnit::new(0, 1),
+                };
+                cfg
+            }
+            // Marlin's MORGAN_SCARA figures: 150 mm arms, the shoulder at
+            // (100, −56); 200 × 16 steps and a 3:1 belt a turn, ECR 3.
+            Machine::Scara => {
+                let joint = axis(StepsPerUnit::new(9600, 360), 2000, 2000, None);
+                let mut cfg = plotter(machine, [joint, joint]);
+                cfg.geometry = Geometry {
+                    lengths: [Milli::from_units(150), Milli::from_units(150)],
+                    origin: [Milli::from_units(100), Milli::from_units(-56)],
+                    crosstalk: StepsPerUnit::new(3, 1),
+                };
+                cfg
+            }
+        }
+    }
 
     pub fn axis(&self, i: usize) -> &AxisConfig {
         &self.axes[i]
@@ -120,7 +188,11 @@ impl MachineConfig {
             // as long a low time (the step interrupt holds it high).
             let max_us = 500_000 / axis.max_rate;
             if u32::from(self.pulse.step_pulse_us) > max_us {
-                return Err(ErrorKind::PulseTooLong { axis: a, max_us });
+                return Err(ErrorKind::PulseTooLong {
+                    axis: a,
+                    machine: self.machine,
+                    max_us,
+                });
             }
         }
         if self.pulse.step_pulse_us == 0 {
@@ -133,6 +205,42 @@ impl MachineConfig {
 impl Default for MachineConfig {
     fn default() -> Self {
         Self::STRING_ART
+    }
+}
+
+/// A plotter axis: `travel` in mm enables the soft limits.
+const fn axis(
+    steps_per_unit: StepsPerUnit,
+    max_rate: u32,
+    accel: u32,
+    travel: Option<(i32, i32)>,
+) -> AxisConfig {
+    let (soft_limits, (min, max)) = match travel {
+        Some(t) => (true, t),
+        None => (false, (0, 0)),
+    };
+    AxisConfig {
+        steps_per_unit,
+        max_rate,
+        accel,
+        dir_high_is_positive: true,
+        enable_active_high: true,
+        soft_limits,
+        travel: (Milli::from_units(min), Milli::from_units(max)),
+    }
+}
+
+/// Two drawing axes; the third channel is a spare Z (the pen is a
+/// servo), the fourth the spare E0 driver.
+const fn plotter(machine: Machine, xy: [AxisConfig; 2]) -> MachineConfig {
+    let spare = axis(StepsPerUnit::new(80, 1), 2000, 500, None);
+    MachineConfig {
+        axes: [xy[0], xy[1], spare, spare],
+        pulse: TB6600,
+        junction_deviation_um: 10,
+        arc_tolerance_um: 10,
+        machine,
+        geometry: Geometry::NONE,
     }
 }
 
@@ -176,6 +284,7 @@ mod tests {
             c.validate(),
             Err(ErrorKind::PulseTooLong {
                 axis: Axis::Base,
+                machine: Machine::StringArt,
                 max_us: 250
             })
         );

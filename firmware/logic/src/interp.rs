@@ -18,7 +18,7 @@
 use crate::arc::{self, Arc, ArcError, Sweep};
 use crate::config::MachineConfig;
 use crate::gcode::{AxisWord, Command, Distance, ErrorKind, Line, Plane, MIN_FEED};
-use crate::kinematics::{Kinematics, Position, Steps};
+use crate::kinematics::{Kinematics, Position, Segmenter, Steps};
 use crate::planner::Feed;
 use crate::units::Milli;
 
@@ -32,10 +32,10 @@ pub enum Order {
         steps: Steps,
         feed: Feed,
     },
-    /// Move along these chords (positions in G-code coordinates, each
+    /// Move along these pieces (positions in G-code coordinates, each
     /// converted with [`Kinematics::inverse`], which cannot fail for them).
-    Arc {
-        arc: Arc,
+    Path {
+        path: Path,
         feed: Feed,
     },
     /// Wait this long once motion is done.
@@ -53,6 +53,30 @@ pub enum Order {
     /// Answer once motion is done.
     WaitIdle,
     ReportPosition,
+}
+
+/// Longest piece of a straight move on a machine whose kinematics are
+/// not linear, µm: within it the path bends far less than a step.
+pub const SEGMENT_UM: u32 = 1000;
+
+/// A move cut into pieces: an arc's chords, or a straight move's pieces
+/// on a machine whose kinematics are not linear.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Path {
+    Arc(Arc),
+    Line(Segmenter),
+}
+
+impl Iterator for Path {
+    type Item = Position;
+
+    /// The next piece's end.
+    fn next(&mut self) -> Option<Position> {
+        match self {
+            Path::Arc(arc) => arc.next(),
+            Path::Line(line) => line.next(),
+        }
+    }
 }
 
 /// What the machine allows the console now.
@@ -201,11 +225,22 @@ impl Interpreter {
                 next.target = self.destination(line, kin, next.distance);
                 check_travel(cfg, &next.target, &next.target)?;
                 if arc {
-                    let arc = self.arc(line, kin, cfg, &next)?;
-                    return Ok(Planned {
-                        order: Order::Arc { arc, feed },
+                    let planned = Planned {
+                        order: Order::Path {
+                            path: Path::Arc(self.arc(line, kin, cfg, &next)?),
+                            feed,
+                        },
                         next,
-                    });
+                    };
+                    return match planned.order {
+                        Order::Path { ref path, .. } if !reaches(path, kin) => {
+                            Err(ErrorKind::InvalidTarget)
+                        }
+                        _ => Ok(planned),
+                    };
+                }
+                if !kin.is_linear() {
+                    return self.pieces(feed, kin, next);
                 }
                 // Converted once from the absolute target: relative moves
                 // never drift.
@@ -234,6 +269,25 @@ impl Interpreter {
             Command::ReportPosition => Order::ReportPosition,
         };
         Ok(Planned { order, next })
+    }
+
+    /// A straight move cut into pieces, if the machine reaches every one.
+    /// Out of line: its pieces stay off the stack of the other moves.
+    #[inline(never)]
+    fn pieces(&self, feed: Feed, kin: &impl Kinematics, next: Modal) -> Result<Planned, ErrorKind> {
+        let path = Path::Line(Segmenter::new(
+            kin,
+            self.modal.target,
+            &next.target,
+            SEGMENT_UM,
+        ));
+        match reaches(&path, kin) {
+            true => Ok(Planned {
+                order: Order::Path { path, feed },
+                next,
+            }),
+            false => Err(ErrorKind::InvalidTarget),
+        }
     }
 
     /// The order of `planned` was carried out: take the modal state it
@@ -320,16 +374,25 @@ fn check_arc(arc: &Arc, kin: &impl Kinematics, cfg: &MachineConfig) -> Result<()
     let (lo, hi) = arc.bounds();
     check_travel(cfg, &lo, &hi)?;
     // A linear kinematics reaches the whole box if it reaches its
-    // corners; any other is asked for every chord end.
-    let reaches = |p: &Position| kin.inverse(p).is_ok();
-    let reached = match kin.is_linear() {
-        true => reaches(&lo) && reaches(&hi),
-        false => { *arc }.all(|p| reaches(&p)),
-    };
+    // corners; any other is asked for every chord end by the caller.
+    let reached = !kin.is_linear() || (kin.inverse(&lo).is_ok() && kin.inverse(&hi).is_ok());
     match reached {
         true => Ok(()),
         false => Err(ErrorKind::InvalidTarget),
     }
+}
+
+/// Whether the machine reaches `path`: a linear machine does if it
+/// reaches the path's box (`check_arc`, and a line's target); any other is
+/// asked for every piece.
+fn reaches(path: &Path, kin: &impl Kinematics) -> bool {
+    kin.is_linear() || every_piece_reached(path, kin)
+}
+
+/// Out of line: its copy of the path stays off the linear machines' stack.
+#[inline(never)]
+fn every_piece_reached(path: &Path, kin: &impl Kinematics) -> bool {
+    { *path }.all(|p| kin.inverse(&p).is_ok())
 }
 
 /// Refuses a path whose box `lo..=hi` leaves an axis's soft limits.

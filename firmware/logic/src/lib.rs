@@ -23,6 +23,7 @@ pub mod gcode;
 pub mod geometry;
 pub mod interp;
 pub mod kinematics;
+pub mod machine;
 pub mod pinmap;
 pub mod planner;
 pub mod prep;

@@ -7,6 +7,8 @@
 
 use crate::axis::{Axis, AXES};
 use crate::config::MachineConfig;
+use crate::kinematics::AnyKinematics;
+use crate::machine::Machine;
 use crate::text::num::{parse_milli, parse_ratio, parse_u32, trim, NumError};
 use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
@@ -40,11 +42,24 @@ pub enum AxisField {
 /// The machine-wide figures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GlobalField {
+    /// Which machine: `string_art`, `drum`, `flatbed`, `whiteboard`,
+    /// `scara`. Setting it loads that machine's defaults whole, so it comes
+    /// first in `$$` and in `machine.txt`.
+    Machine,
     StepPulseUs,
     DirSetupUs,
     EnableSetupUs,
     JunctionDeviationUm,
     ArcToleranceUm,
+    /// SCARA: the arms; whiteboard: `length_1` is the motors' distance.
+    Length1,
+    Length2,
+    /// SCARA: the shoulder's place; whiteboard: the drawing's origin from
+    /// the left motor.
+    OriginX,
+    OriginY,
+    /// SCARA: the elbow crosstalk ratio (0: none).
+    Crosstalk,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,6 +75,7 @@ pub enum Value {
     Ratio(StepsPerUnit),
     /// Thousandths of a unit, printed `-450.000`.
     Milli(Milli),
+    Machine(Machine),
 }
 
 const AXIS_FIELDS: [AxisField; 8] = [
@@ -73,12 +89,18 @@ const AXIS_FIELDS: [AxisField; 8] = [
     AxisField::TravelMax,
 ];
 
-const GLOBAL_FIELDS: [GlobalField; 5] = [
+const GLOBAL_FIELDS: [GlobalField; 11] = [
+    GlobalField::Machine,
     GlobalField::StepPulseUs,
     GlobalField::DirSetupUs,
     GlobalField::EnableSetupUs,
     GlobalField::JunctionDeviationUm,
     GlobalField::ArcToleranceUm,
+    GlobalField::Length1,
+    GlobalField::Length2,
+    GlobalField::OriginX,
+    GlobalField::OriginY,
+    GlobalField::Crosstalk,
 ];
 
 /// Number of settings; [`Setting::index`] is below it.
@@ -107,16 +129,28 @@ impl GlobalField {
             GlobalField::EnableSetupUs => "enable_setup_us",
             GlobalField::JunctionDeviationUm => "junction_deviation_um",
             GlobalField::ArcToleranceUm => "arc_tolerance_um",
+            GlobalField::Machine => "machine",
+            GlobalField::Length1 => "length_1",
+            GlobalField::Length2 => "length_2",
+            GlobalField::OriginX => "origin_x",
+            GlobalField::OriginY => "origin_y",
+            GlobalField::Crosstalk => "crosstalk",
         }
     }
 }
 
-/// Every setting in `$$` order: per axis, then the machine-wide ones.
+/// Every setting in `$$` order: the machine, per axis, then the other
+/// machine-wide ones.
 pub fn all() -> impl Iterator<Item = Setting> {
     let per_axis = Axis::ALL
         .into_iter()
         .flat_map(|a| AXIS_FIELDS.into_iter().map(move |f| Setting::Axis(a, f)));
-    per_axis.chain(GLOBAL_FIELDS.into_iter().map(Setting::Global))
+    let globals = GLOBAL_FIELDS.into_iter().map(Setting::Global);
+    globals
+        .clone()
+        .take(1)
+        .chain(per_axis)
+        .chain(globals.skip(1))
 }
 
 /// Calls `f` with every setting and its value, in `$$` order.
@@ -126,9 +160,10 @@ pub fn for_each(cfg: &MachineConfig, mut f: impl FnMut(Setting, Value)) {
     }
 }
 
-/// Sets the named setting (name in any case) from its text.
+/// Sets the named setting (name in any case, axes named as `cfg`'s
+/// machine names them) from its text.
 pub fn set(cfg: &mut MachineConfig, key: &str, value: &str) -> Result<(), SettingError> {
-    let setting = Setting::parse(key.as_bytes()).ok_or(NumError {
+    let setting = Setting::parse(key.as_bytes(), cfg.machine).ok_or(NumError {
         at: 0,
         kind: ErrorKind::UnknownKey,
     })?;
@@ -136,10 +171,10 @@ pub fn set(cfg: &mut MachineConfig, key: &str, value: &str) -> Result<(), Settin
 }
 
 impl Setting {
-    /// The setting named `key`, in any case.
-    pub fn parse(key: &[u8]) -> Option<Setting> {
+    /// The setting named `key`, in any case, on `machine`.
+    pub fn parse(key: &[u8], machine: Machine) -> Option<Setting> {
         for axis in Axis::ALL {
-            let prefix = axis.name().as_bytes();
+            let prefix = machine.channel(axis).as_bytes();
             let named = key.len() > prefix.len()
                 && key[..prefix.len()].eq_ignore_ascii_case(prefix)
                 && key[prefix.len()] == b'_';
@@ -157,16 +192,32 @@ impl Setting {
             .map(Setting::Global)
     }
 
+    /// The setting at `index` in [`all`]. Worked out rather than looked
+    /// up: a table would sit in SRAM on the AVR.
+    pub fn at(index: usize) -> Option<Setting> {
+        let per_axis = AXES * AXIS_FIELDS.len();
+        match index {
+            0 => Some(Setting::Global(GlobalField::Machine)),
+            i if i <= per_axis => {
+                let (axis, field) = ((i - 1) / AXIS_FIELDS.len(), (i - 1) % AXIS_FIELDS.len());
+                Some(Setting::Axis(Axis::ALL[axis], AXIS_FIELDS[field]))
+            }
+            i => GLOBAL_FIELDS.get(i - per_axis).map(|g| Setting::Global(*g)),
+        }
+    }
+
     /// Position in [`all`], below [`COUNT`].
     pub fn index(self) -> usize {
         match self {
-            Setting::Axis(a, f) => a.index() * AXIS_FIELDS.len() + f as usize,
+            Setting::Global(GlobalField::Machine) => 0,
+            Setting::Axis(a, f) => 1 + a.index() * AXIS_FIELDS.len() + f as usize,
+            // `Machine` is field 0.
             Setting::Global(g) => AXES * AXIS_FIELDS.len() + g as usize,
         }
     }
 
     pub fn get(self, cfg: &MachineConfig) -> Value {
-        let p = &cfg.pulse;
+        let (p, g) = (&cfg.pulse, &cfg.geometry);
         Value::Number(match self {
             Setting::Axis(a, field) => {
                 let axis = &cfg.axes[a.index()];
@@ -186,6 +237,12 @@ impl Setting {
             Setting::Global(GlobalField::EnableSetupUs) => p.enable_setup_us as u32,
             Setting::Global(GlobalField::JunctionDeviationUm) => cfg.junction_deviation_um,
             Setting::Global(GlobalField::ArcToleranceUm) => cfg.arc_tolerance_um,
+            Setting::Global(GlobalField::Machine) => return Value::Machine(cfg.machine),
+            Setting::Global(GlobalField::Length1) => return Value::Milli(g.lengths[0]),
+            Setting::Global(GlobalField::Length2) => return Value::Milli(g.lengths[1]),
+            Setting::Global(GlobalField::OriginX) => return Value::Milli(g.origin[0]),
+            Setting::Global(GlobalField::OriginY) => return Value::Milli(g.origin[1]),
+            Setting::Global(GlobalField::Crosstalk) => return Value::Ratio(g.crosstalk),
         })
     }
 
@@ -216,7 +273,21 @@ impl Setting {
 
     /// The value `text` (trimmed) gives this setting, in the setting's kind.
     fn parse_value(self, text: &[u8]) -> Result<Value, SettingError> {
+        use GlobalField::*;
         Ok(match self {
+            Setting::Global(Machine) => match crate::machine::Machine::parse(text) {
+                Some(m) => Value::Machine(m),
+                None => {
+                    return Err(NumError {
+                        at: 0,
+                        kind: ErrorKind::UnknownMachine,
+                    })
+                }
+            },
+            Setting::Global(Length1 | Length2 | OriginX | OriginY) => {
+                Value::Milli(parse_milli(text)?)
+            }
+            Setting::Global(Crosstalk) => Value::Ratio(parse_ratio(text)?),
             Setting::Axis(_, AxisField::StepsPerUnit) => Value::Ratio(parse_ratio(text)?),
             Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax) => {
                 Value::Milli(parse_milli(text)?)
@@ -230,16 +301,33 @@ impl Setting {
     /// an error.
     pub fn put(self, cfg: &mut MachineConfig, value: Value) -> Result<(), ErrorKind> {
         self.check(value)?;
-        let mut new = *cfg;
-        self.force(&mut new, value);
-        new.validate()?;
+        let new = match value {
+            // Another machine: its defaults, whole.
+            Value::Machine(m) => MachineConfig::defaults(m),
+            _ => {
+                let mut new = *cfg;
+                self.force(&mut new, value);
+                new
+            }
+        };
+        check_whole(&new)?;
         *cfg = new;
         Ok(())
     }
 
     /// Whether `value` is of this setting's kind and in its range.
     pub fn check(self, value: Value) -> Result<(), ErrorKind> {
+        use GlobalField::*;
         match (self, value) {
+            (Setting::Global(Machine), Value::Machine(_)) => Ok(()),
+            (Setting::Global(Length1 | Length2 | OriginX | OriginY), Value::Milli(_)) => Ok(()),
+            (Setting::Global(Crosstalk), Value::Ratio(r)) => match r.den != 0 {
+                true => Ok(()),
+                false => Err(ErrorKind::Invalid(Crosstalk.name())),
+            },
+            (Setting::Global(Machine | Length1 | Length2 | OriginX | OriginY | Crosstalk), _) => {
+                Err(ErrorKind::NotANumber)
+            }
             (Setting::Axis(_, AxisField::StepsPerUnit), Value::Ratio(r)) => {
                 match r.num != 0 && r.den != 0 {
                     true => Ok(()),
@@ -288,21 +376,44 @@ impl Setting {
                     _ => {}
                 }
             }
-            (_, Value::Ratio(_) | Value::Milli(_)) => {}
+            (Setting::Global(GlobalField::Machine), Value::Machine(m)) => cfg.machine = m,
+            (Setting::Global(GlobalField::Length1), Value::Milli(m)) => cfg.geometry.lengths[0] = m,
+            (Setting::Global(GlobalField::Length2), Value::Milli(m)) => cfg.geometry.lengths[1] = m,
+            (Setting::Global(GlobalField::OriginX), Value::Milli(m)) => cfg.geometry.origin[0] = m,
+            (Setting::Global(GlobalField::OriginY), Value::Milli(m)) => cfg.geometry.origin[1] = m,
+            (Setting::Global(GlobalField::Crosstalk), Value::Ratio(r)) => {
+                cfg.geometry.crosstalk = r
+            }
+            (_, Value::Ratio(_) | Value::Milli(_) | Value::Machine(_)) => {}
             // The ranges keep these within u8.
             (Setting::Global(GlobalField::StepPulseUs), _) => cfg.pulse.step_pulse_us = n as u8,
             (Setting::Global(GlobalField::DirSetupUs), _) => cfg.pulse.dir_setup_us = n as u8,
             (Setting::Global(GlobalField::EnableSetupUs), _) => cfg.pulse.enable_setup_us = n as u8,
             (Setting::Global(GlobalField::JunctionDeviationUm), _) => cfg.junction_deviation_um = n,
             (Setting::Global(GlobalField::ArcToleranceUm), _) => cfg.arc_tolerance_um = n,
+            (Setting::Global(_), Value::Number(_)) => {}
         }
     }
 }
 
-impl uDisplay for Setting {
+/// The configuration as a whole: each figure's bounds, and a geometry its
+/// machine's kinematics can use.
+pub fn check_whole(cfg: &MachineConfig) -> Result<(), ErrorKind> {
+    cfg.validate()?;
+    match AnyKinematics::of(cfg) {
+        Ok(_) => Ok(()),
+        Err(_) => Err(ErrorKind::Invalid("geometry")),
+    }
+}
+
+/// A setting's name as `machine` calls it: `radial_max_rate`,
+/// `x_max_rate`, `step_pulse_us`.
+pub struct Named(pub Setting, pub Machine);
+
+impl uDisplay for Named {
     fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
-        match *self {
-            Setting::Axis(a, field) => uwrite!(f, "{}_{}", a.name(), field.name()),
+        match self.0 {
+            Setting::Axis(a, field) => uwrite!(f, "{}_{}", self.1.channel(a), field.name()),
             Setting::Global(g) => f.write_str(g.name()),
         }
     }
@@ -313,6 +424,7 @@ impl uDisplay for Value {
     fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
         match *self {
             Value::Number(n) => uwrite!(f, "{}", n),
+            Value::Machine(m) => f.write_str(m.name()),
             Value::Ratio(r) if r.den == 1 => uwrite!(f, "{}", r.num),
             Value::Ratio(r) => uwrite!(f, "{}/{}", r.num, r.den),
             Value::Milli(m) => {
@@ -342,7 +454,9 @@ mod tests {
 
     fn listing(cfg: &MachineConfig) -> Vec<String> {
         let mut lines = Vec::new();
-        for_each(cfg, |s, v| lines.push(show(&s) + " = " + &show(&v)));
+        for_each(cfg, |s, v| {
+            lines.push(show(&Named(s, cfg.machine)) + " = " + &show(&v))
+        });
         lines
     }
 
@@ -350,22 +464,36 @@ mod tests {
     fn listing_shows_every_setting_once_with_defaults() {
         let lines = listing(&MachineConfig::STRING_ART);
         assert_eq!(lines.len(), COUNT);
-        assert_eq!(lines[0], "base_steps_per_unit = 9600/360");
-        assert_eq!(lines[1], "base_max_rate = 2000");
-        assert_eq!(lines[5], "base_soft_limits = 0");
-        assert_eq!(lines[8], "radial_steps_per_unit = 32");
-        assert_eq!(lines[13], "radial_soft_limits = 1");
-        assert_eq!(lines[14], "radial_travel_min = -450.000");
-        assert_eq!(lines[15], "radial_travel_max = 30.000");
-        assert_eq!(lines[16], "drill_steps_per_unit = 1600/12");
-        assert_eq!(lines[27], "aux_dir_invert = 0");
-        assert_eq!(lines[28], "aux_enable_active_high = 1");
-        assert_eq!(lines[32], "step_pulse_us = 5");
-        assert_eq!(lines[35], "junction_deviation_um = 10");
-        assert_eq!(lines[36], "arc_tolerance_um = 10");
+        assert_eq!(lines[0], "machine = string_art");
+        assert_eq!(lines[1], "base_steps_per_unit = 9600/360");
+        assert_eq!(lines[2], "base_max_rate = 2000");
+        assert_eq!(lines[6], "base_soft_limits = 0");
+        assert_eq!(lines[9], "radial_steps_per_unit = 32");
+        assert_eq!(lines[14], "radial_soft_limits = 1");
+        assert_eq!(lines[15], "radial_travel_min = -450.000");
+        assert_eq!(lines[16], "radial_travel_max = 30.000");
+        assert_eq!(lines[17], "drill_steps_per_unit = 1600/12");
+        assert_eq!(lines[28], "aux_dir_invert = 0");
+        assert_eq!(lines[29], "aux_enable_active_high = 1");
+        assert_eq!(lines[33], "step_pulse_us = 5");
+        assert_eq!(lines[36], "junction_deviation_um = 10");
+        assert_eq!(lines[37], "arc_tolerance_um = 10");
+        assert_eq!(lines[38], "length_1 = 0.000");
+        assert_eq!(lines[42], "crosstalk = 0");
+        // Another machine names its channels its own way.
+        let scara = listing(&MachineConfig::defaults(Machine::Scara));
+        assert_eq!(scara[0], "machine = scara");
+        assert_eq!(scara[1], "shoulder_steps_per_unit = 9600/360");
+        assert_eq!(scara[9], "elbow_steps_per_unit = 9600/360");
+        assert_eq!(scara[38], "length_1 = 150.000");
+        assert_eq!(scara[40], "origin_x = 100.000");
+        assert_eq!(scara[41], "origin_y = -56.000");
+        assert_eq!(scara[42], "crosstalk = 3");
         for (i, s) in all().enumerate() {
             assert_eq!(s.index(), i);
+            assert_eq!(Setting::at(i), Some(s));
         }
+        assert_eq!(Setting::at(COUNT), None);
     }
 
     #[test]
@@ -400,6 +528,25 @@ mod tests {
         assert_eq!(cfg.pulse.enable_setup_us, 0);
         assert_eq!(cfg.junction_deviation_um, 20);
         assert_eq!(cfg.arc_tolerance_um, 2);
+    }
+
+    #[test]
+    fn another_machine_loads_its_defaults_and_names() {
+        let mut cfg = MachineConfig::STRING_ART;
+        set(&mut cfg, "base_max_rate", "1500").unwrap();
+        set(&mut cfg, "machine", " Flatbed ").unwrap();
+        assert_eq!(cfg, MachineConfig::defaults(Machine::Flatbed));
+        set(&mut cfg, "x_travel_max", "150").unwrap();
+        assert_eq!(cfg.axes[0].travel.1, Milli(150_000));
+        let e = set(&mut cfg, "radial_max_rate", "100").unwrap_err();
+        assert_eq!(e.kind, ErrorKind::UnknownKey);
+        let e = set(&mut cfg, "machine", " polar").unwrap_err();
+        assert_eq!((e.at, e.kind), (1, ErrorKind::UnknownMachine));
+        // A geometry its kinematics cannot use is refused.
+        set(&mut cfg, "machine", "whiteboard").unwrap();
+        let e = set(&mut cfg, "origin_y", "5").unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Invalid("geometry"));
+        assert_eq!(cfg, MachineConfig::defaults(Machine::Whiteboard));
     }
 
     #[test]
@@ -451,16 +598,26 @@ mod tests {
         fn any_accepted_value_is_listed_as_set(index in 0..COUNT, n in 0u32..300_000, den in 1u32..1000) {
             let mut cfg = MachineConfig::STRING_ART;
             let s = all().nth(index).unwrap();
+            let ratio = matches!(
+                s,
+                Setting::Axis(_, AxisField::StepsPerUnit) | Setting::Global(GlobalField::Crosstalk)
+            );
+            let milli = matches!(
+                s.get(&cfg),
+                Value::Milli(_)
+            );
             let text = match s {
-                Setting::Axis(_, AxisField::StepsPerUnit) => std::format!("{}/{}", n.max(1), den),
+                _ if ratio => std::format!("{}/{}", n.max(1), den),
+                Setting::Global(GlobalField::Machine) => Machine::ALL[n as usize % 5].name().into(),
                 _ => std::format!("{n}"),
             };
             let listed = match s {
-                Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax) => std::format!("{n}.000"),
+                _ if milli => std::format!("{n}.000"),
                 // A ratio over 1 is listed as a whole number.
                 _ => text.strip_suffix("/1").unwrap_or(&text).into(),
             };
-            match set(&mut cfg, &show(&s), &text) {
+            let name = show(&Named(s, cfg.machine));
+            match set(&mut cfg, &name, &text) {
                 Ok(()) => {
                     prop_assert_eq!(show(&s.get(&cfg)), listed);
                     prop_assert!(cfg.validate().is_ok());

@@ -11,7 +11,7 @@
 use crate::config::MachineConfig;
 use crate::files::error::{FileError, FileName};
 use crate::files::kv::{Item, KvReader};
-use crate::settings::{Setting, SettingError, COUNT};
+use crate::settings::{GlobalField, Setting, SettingError, COUNT};
 use crate::text::ErrorKind;
 
 const FILE: FileName = FileName::Machine;
@@ -60,10 +60,14 @@ impl MachineFile {
 
 fn apply(cfg: &mut MachineConfig, seen: &mut u64, item: Item<'_>) -> Result<(), FileError> {
     let at_key = |kind| FileError::at(FILE, item.line, item.key_col, kind);
-    let setting = Setting::parse(item.key).ok_or(at_key(ErrorKind::UnknownKey))?;
+    let setting = Setting::parse(item.key, cfg.machine).ok_or(at_key(ErrorKind::UnknownKey))?;
     let bit = 1u64 << setting.index();
     if *seen & bit != 0 {
         return Err(at_key(ErrorKind::DuplicateKey));
+    }
+    // The machine loads its defaults whole: it would undo the lines above.
+    if setting == Setting::Global(GlobalField::Machine) && *seen != 0 {
+        return Err(at_key(ErrorKind::Invalid("machine: the first key")));
     }
     *seen |= bit;
     // Values are trimmed ASCII up to any error, so bytes are columns.
@@ -173,7 +177,7 @@ mod tests {
                 axis.steps_per_unit = StepsPerUnit::new(num, den);
             }
             let mut text = String::new();
-            crate::settings::for_each(&cfg, |s, v| text += &(show(&s) + " = " + &show(&v) + "\n"));
+            crate::settings::for_each(&cfg, |s, v| text += &(show(&crate::settings::Named(s, cfg.machine)) + " = " + &show(&v) + "\n"));
             prop_assert_eq!(parse_in_chunks(text.as_bytes(), chunk), Ok(cfg));
         }
     }

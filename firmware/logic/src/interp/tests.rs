@@ -169,7 +169,10 @@ fn dwell_and_drivers() {
 /// The chord ends of an arc order, in milli-units of X and Z.
 fn chords(order: Result<Order, ErrorKind>) -> Vec<(i32, i32)> {
     match order {
-        Ok(Order::Arc { arc, feed }) => {
+        Ok(Order::Path {
+            path: Path::Arc(arc),
+            feed,
+        }) => {
             assert_eq!(feed, Feed::PerMinute(Milli(100_000)));
             arc.map(|p| (p[1].0, p[2].0)).collect()
         }
@@ -268,4 +271,35 @@ fn a_full_circle_and_the_long_way_round() {
     let long = chords(run(&mut i, "G2 X6 R-5", FREE));
     assert!(long.len() > short.len());
     assert!(long.iter().any(|(x, _)| *x > 6_000) && short.iter().all(|(x, _)| *x <= 6_000));
+}
+
+#[test]
+fn straight_moves_of_an_arm_are_cut_into_pieces_that_it_reaches() {
+    use crate::kinematics::AnyKinematics;
+    use crate::machine::Machine;
+    let cfg = MachineConfig::defaults(Machine::Scara);
+    let kin = AnyKinematics::of(&cfg).unwrap();
+    let mut i = Interpreter::new();
+    i.resync(kin.forward(&[0; crate::axis::AXES]));
+    let plan = |i: &mut Interpreter, text| {
+        let planned = i.plan(&line(text), &kin, &cfg, FREE)?;
+        i.commit(planned);
+        Ok::<_, ErrorKind>(planned.order)
+    };
+    plan(&mut i, "G0 X100 Y150").unwrap();
+    let ends: Vec<Position> = match plan(&mut i, "G1 X130 Y110 F600") {
+        Ok(Order::Path {
+            path: Path::Line(line),
+            ..
+        }) => line.collect(),
+        other => panic!("{other:?}"),
+    };
+    // 50 mm in pieces of at most 1 mm, on the line, the last one exact.
+    assert_eq!(ends.len(), 50);
+    assert_eq!(ends[24][..2], [Milli(115_000), Milli(130_000)]);
+    assert_eq!(ends[49][..2], [Milli(130_000), Milli(110_000)]);
+    // Out of the arms' reach (300 mm from the shoulder at 100, −56): refused
+    // whole, nothing changes.
+    assert_eq!(plan(&mut i, "G1 X100 Y250"), Err(ErrorKind::InvalidTarget));
+    assert_eq!(i.target()[..2], [Milli(130_000), Milli(110_000)]);
 }

@@ -12,6 +12,7 @@
 use super::{ChannelScale, KinError, Kinematics, Position, Steps};
 use crate::axis::AXES;
 use crate::config::MachineConfig;
+use crate::machine::{CARTESIAN, CYLINDRICAL};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Linear {
@@ -19,11 +20,6 @@ pub struct Linear {
     /// The G-code letter of each channel.
     pub words: [u8; AXES],
 }
-
-/// The string-art machine's words.
-pub const CYLINDRICAL: [u8; AXES] = *b"CXZA";
-/// A plotter's words.
-pub const CARTESIAN: [u8; AXES] = *b"XYZA";
 
 impl Linear {
     /// The string-art machine, with the figures of `config`.

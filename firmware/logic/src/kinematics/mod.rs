@@ -20,13 +20,14 @@ mod polargraph;
 mod scara;
 mod segmenter;
 
-pub use linear::{Linear, CARTESIAN, CYLINDRICAL};
+pub use linear::Linear;
 pub use polargraph::Polargraph;
 pub use scara::Scara;
 pub use segmenter::Segmenter;
 
 use crate::axis::{PerAxis, AXES};
 use crate::config::MachineConfig;
+use crate::machine::Machine;
 use crate::units::{div_round, Milli, StepsPerUnit};
 
 /// Machine coordinates, one per channel, in thousandths of the unit.
@@ -132,6 +133,21 @@ pub enum AnyKinematics {
     Linear(Linear),
     Polargraph(Polargraph),
     Scara(Scara),
+}
+
+impl AnyKinematics {
+    /// The kinematics of the configured machine; an error when its
+    /// geometry cannot be (arms of no length, a drawing above the motors).
+    pub fn of(cfg: &MachineConfig) -> Result<AnyKinematics, KinError> {
+        let scale = ChannelScale::from_config(cfg);
+        let g = &cfg.geometry;
+        Ok(match cfg.machine {
+            Machine::StringArt => AnyKinematics::Linear(Linear::cylindrical(cfg)),
+            Machine::Drum | Machine::Flatbed => AnyKinematics::Linear(Linear::cartesian(scale)),
+            Machine::Whiteboard => AnyKinematics::Polargraph(Polargraph::new(&scale, g)?),
+            Machine::Scara => AnyKinematics::Scara(Scara::new(&scale, g)?),
+        })
+    }
 }
 
 impl Kinematics for AnyKinematics {

@@ -7,7 +7,8 @@
 
 use super::{milli, mm, ChannelScale, KinError, Kinematics, Position, Steps};
 use crate::axis::AXES;
-use crate::units::Milli;
+use crate::config::Geometry;
+use crate::fmath;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Polargraph {
@@ -22,11 +23,12 @@ pub struct Polargraph {
 
 impl Polargraph {
     /// `origin` must hang below the motors, between them or not.
-    pub fn new(scale: ChannelScale, distance: Milli, origin: [Milli; 2]) -> Result<Self, KinError> {
+    /// `lengths[0]` is the distance between the strings' exits.
+    pub fn new(scale: &ChannelScale, g: &Geometry) -> Result<Self, KinError> {
         let mut k = Polargraph {
-            scale,
-            distance: mm(distance),
-            origin: [mm(origin[0]), mm(origin[1])],
+            scale: *scale,
+            distance: mm(g.lengths[0]),
+            origin: [mm(g.origin[0]), mm(g.origin[1])],
             home: [0.0; 2],
         };
         if k.distance <= 0.0 {
@@ -42,11 +44,13 @@ impl Polargraph {
             return Err(KinError::Unreachable);
         }
         let dx = self.distance - x;
-        Ok([libm::sqrtf(x * x + y * y), libm::sqrtf(dx * dx + y * y)])
+        Ok([fmath::sqrt(x * x + y * y), fmath::sqrt(dx * dx + y * y)])
     }
 }
 
 impl Kinematics for Polargraph {
+    // Out of line: one copy of the float maths, whoever calls.
+    #[inline(never)]
     fn inverse(&self, pos: &Position) -> Result<Steps, KinError> {
         let p = [self.origin[0] + mm(pos[0]), self.origin[1] + mm(pos[1])];
         let len = self.lengths(p)?;
@@ -57,13 +61,14 @@ impl Kinematics for Polargraph {
         Ok(steps)
     }
 
+    #[inline(never)]
     fn forward(&self, steps: &Steps) -> Position {
         let l = self.home[0] + self.scale.value_f32(0, steps[0]);
         let r = self.home[1] + self.scale.value_f32(1, steps[1]);
         let d = self.distance;
         // Intersection of the two circles, the lower one.
         let x = (l * l - r * r + d * d) / (2.0 * d);
-        let y = -libm::sqrtf((l * l - x * x).max(0.0));
+        let y = -fmath::sqrt((l * l - x * x).max(0.0));
         let mut pos = self.scale.all_milli(steps);
         pos[0] = milli(x - self.origin[0]);
         pos[1] = milli(y - self.origin[1]);
@@ -80,17 +85,26 @@ impl Kinematics for Polargraph {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+    use crate::units::Milli;
     use crate::units::StepsPerUnit;
     use proptest::prelude::*;
+
+    pub(crate) fn geometry(distance: i32, origin: [i32; 2]) -> Geometry {
+        Geometry {
+            lengths: [Milli(distance), Milli(0)],
+            origin: origin.map(Milli),
+            ..Geometry::NONE
+        }
+    }
 
     /// Motors 1.2 m apart, origin 0.6 m below their middle; 2000 steps per
     /// turn of a 40 mm sprocket: 50 steps/mm (20 µm per step).
     fn kin() -> Polargraph {
         let s = StepsPerUnit::new(50, 1);
         let scale = ChannelScale([s, s, s, s]);
-        Polargraph::new(scale, Milli(1_200_000), [Milli(600_000), Milli(-600_000)]).unwrap()
+        Polargraph::new(&scale, &geometry(1_200_000, [600_000, -600_000])).unwrap()
     }
 
     #[test]
@@ -121,12 +135,7 @@ mod tests {
             Err(KinError::Unreachable)
         );
         let s = StepsPerUnit::new(50, 1);
-        assert!(Polargraph::new(
-            ChannelScale([s; 4]),
-            Milli(1_000_000),
-            [Milli(0), Milli(10)]
-        )
-        .is_err());
+        assert!(Polargraph::new(&ChannelScale([s; 4]), &geometry(1_000_000, [0, 10])).is_err());
     }
 
     proptest! {

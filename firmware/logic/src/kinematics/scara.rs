@@ -11,7 +11,8 @@
 
 use super::{milli, mm, ChannelScale, KinError, Kinematics, Position, Steps};
 use crate::axis::AXES;
-use crate::units::Milli;
+use crate::config::Geometry;
+use crate::fmath;
 use core::f32::consts::PI;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,43 +30,47 @@ pub struct Scara {
 const DEG: f32 = 180.0 / PI;
 
 impl Scara {
-    pub fn new(
-        scale: ChannelScale,
-        l1: Milli,
-        l2: Milli,
-        offset: [Milli; 2],
-        ecr: Option<f32>,
-    ) -> Result<Self, KinError> {
-        if l1.0 <= 0 || l2.0 <= 0 || ecr == Some(0.0) {
+    /// `lengths` are L1 and L2, `origin` the shoulder's place, `crosstalk`
+    /// the ECR (0: none).
+    pub fn new(scale: &ChannelScale, g: &Geometry) -> Result<Self, KinError> {
+        let [l1, l2] = g.lengths;
+        let ecr = g.crosstalk;
+        if l1.0 <= 0 || l2.0 <= 0 || ecr.den == 0 {
             return Err(KinError::Unreachable);
         }
         Ok(Scara {
-            scale,
+            scale: *scale,
             l1: mm(l1),
             l2: mm(l2),
-            offset: [mm(offset[0]), mm(offset[1])],
-            crosstalk: ecr.map_or(0.0, |e| 1.0 / e),
+            offset: [mm(g.origin[0]), mm(g.origin[1])],
+            crosstalk: match ecr.num {
+                0 => 0.0,
+                n => ecr.den as f32 / n as f32,
+            },
         })
     }
 }
 
 /// acos of a cosine that float rounding may push just past ±1.
 fn acos_clamped(c: f32) -> f32 {
-    libm::acosf(c.clamp(-1.0, 1.0))
+    let c = c.clamp(-1.0, 1.0);
+    fmath::atan2(fmath::sqrt(1.0 - c * c), c)
 }
 
 impl Kinematics for Scara {
+    // Out of line: one copy of the float maths, whoever calls.
+    #[inline(never)]
     fn inverse(&self, pos: &Position) -> Result<Steps, KinError> {
         let (l1, l2) = (self.l1, self.l2);
         let x = -(mm(pos[0]) - self.offset[0]);
         let y = mm(pos[1]) - self.offset[1];
         let h2 = x * x + y * y;
-        let h = libm::sqrtf(h2);
+        let h = fmath::sqrt(h2);
         // Reach, with 1 µm of slack for the decimal input.
         if h == 0.0 || h > l1 + l2 + 0.001 || h < (l1 - l2).abs() - 0.001 {
             return Err(KinError::Unreachable);
         }
-        let shoulder = libm::atan2f(x, y) - acos_clamped((h2 + l1 * l1 - l2 * l2) / (2.0 * l1 * h));
+        let shoulder = fmath::atan2(x, y) - acos_clamped((h2 + l1 * l1 - l2 * l2) / (2.0 * l1 * h));
         // The original arm's notes print "+ L1² + L2²" here; the law of
         // cosines has minus.
         let elbow =
@@ -76,13 +81,16 @@ impl Kinematics for Scara {
         Ok(steps)
     }
 
+    #[inline(never)]
     fn forward(&self, steps: &Steps) -> Position {
         let a = self.scale.value_f32(0, steps[0]) / DEG;
         let b = self.scale.value_f32(1, steps[1]) / DEG;
         let s = a;
         let e = b - a * self.crosstalk;
-        let x = -libm::sinf(s) * self.l1 - libm::sinf(s + e) * self.l2 + self.offset[0];
-        let y = libm::cosf(s) * self.l1 + libm::cosf(s + e) * self.l2 + self.offset[1];
+        let (sin_s, cos_s) = fmath::sin_cos(s);
+        let (sin_se, cos_se) = fmath::sin_cos(s + e);
+        let x = -sin_s * self.l1 - sin_se * self.l2 + self.offset[0];
+        let y = cos_s * self.l1 + cos_se * self.l2 + self.offset[1];
         let mut pos = self.scale.all_milli(steps);
         pos[0] = milli(x);
         pos[1] = milli(y);
@@ -101,6 +109,7 @@ impl Kinematics for Scara {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::units::Milli;
     use crate::units::StepsPerUnit;
     use proptest::prelude::*;
 
@@ -109,14 +118,12 @@ mod tests {
     fn kin() -> Scara {
         let s = StepsPerUnit::new(12_800, 360);
         let scale = ChannelScale([s, s, StepsPerUnit::new(100, 1), s]);
-        Scara::new(
-            scale,
-            Milli(150_000),
-            Milli(120_000),
-            [Milli(10_000), Milli(20_000)],
-            Some(3.0),
-        )
-        .unwrap()
+        let g = Geometry {
+            lengths: [Milli(150_000), Milli(120_000)],
+            origin: [Milli(10_000), Milli(20_000)],
+            crosstalk: StepsPerUnit::new(3, 1),
+        };
+        Scara::new(&scale, &g).unwrap()
     }
 
     #[test]

@@ -2,25 +2,26 @@
 //! kinematics that are not linear (Marlin's and Klipper's approach). Each
 //! piece's endpoint is interpolated from the absolute start and end in
 //! integers and converted by the inverse from scratch, so no error piles up
-//! from piece to piece; the last piece ends exactly on the target.
+//! from piece to piece; the last piece ends exactly on the target. Each
+//! piece's end goes through the kinematics' inverse where it is queued.
 
-use super::{KinError, Kinematics, Position, Steps};
+use super::{Kinematics, Position};
 use crate::axis::AXES;
 use crate::segment::isqrt;
 use crate::units::{div_round, Milli};
 
-pub struct Segmenter<'a, K: Kinematics> {
-    kin: &'a K,
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Segmenter {
     from: Position,
     delta: [i64; AXES],
     pieces: u32,
     done: u32,
 }
 
-impl<'a, K: Kinematics> Segmenter<'a, K> {
+impl Segmenter {
     /// `segment_len` in thousandths of the unit (µm); a linear kinematics
     /// gets a single piece. The length counts every coordinate.
-    pub fn new(kin: &'a K, from: Position, to: Position, segment_len: u32) -> Self {
+    pub fn new(kin: &impl Kinematics, from: Position, to: &Position, segment_len: u32) -> Self {
         let delta: [i64; AXES] = core::array::from_fn(|i| to[i].0 as i64 - from[i].0 as i64);
         let pieces = if kin.is_linear() {
             1
@@ -33,7 +34,6 @@ impl<'a, K: Kinematics> Segmenter<'a, K> {
             len.div_ceil(seg).clamp(1, u32::MAX as u64) as u32
         };
         Segmenter {
-            kin,
             from,
             delta,
             pieces,
@@ -46,8 +46,8 @@ impl<'a, K: Kinematics> Segmenter<'a, K> {
     }
 }
 
-impl<K: Kinematics> Iterator for Segmenter<'_, K> {
-    type Item = Result<Steps, KinError>;
+impl Iterator for Segmenter {
+    type Item = Position;
 
     fn next(&mut self) -> Option<Self::Item> {
         if self.done == self.pieces {
@@ -58,7 +58,7 @@ impl<K: Kinematics> Iterator for Segmenter<'_, K> {
         let point: Position = core::array::from_fn(|i| {
             Milli(self.from[i].0 + div_round(self.delta[i] * k, n) as i32)
         });
-        Some(self.kin.inverse(&point))
+        Some(point)
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
@@ -77,12 +77,8 @@ mod tests {
 
     fn polargraph() -> Polargraph {
         let s = StepsPerUnit::new(50, 1);
-        Polargraph::new(
-            ChannelScale([s; 4]),
-            Milli(1_200_000),
-            [Milli(600_000), Milli(-600_000)],
-        )
-        .unwrap()
+        let g = super::super::polargraph::tests::geometry(1_200_000, [600_000, -600_000]);
+        Polargraph::new(&ChannelScale([s; 4]), &g).unwrap()
     }
 
     fn pos(x: i32, y: i32) -> Position {
@@ -92,13 +88,12 @@ mod tests {
     #[test]
     fn linear_kinematics_take_one_piece() {
         let k = Linear::cylindrical(&MachineConfig::STRING_ART);
-        let mut s = Segmenter::new(
-            &k,
-            pos(0, 0),
-            [Milli(90_000), Milli(-5000), Milli(0), Milli(0)],
-            1000,
+        let to = [Milli(90_000), Milli(-5000), Milli(0), Milli(0)];
+        let mut s = Segmenter::new(&k, pos(0, 0), &to, 1000);
+        assert_eq!(
+            s.next().map(|p| k.inverse(&p)),
+            Some(Ok([2400, -160, 0, 0]))
         );
-        assert_eq!(s.next(), Some(Ok([2400, -160, 0, 0])));
         assert_eq!(s.next(), None);
     }
 
@@ -107,14 +102,14 @@ mod tests {
         let k = polargraph();
         // 3-4-5: 50 mm in 1 mm pieces is exactly 50; 50.001 mm needs 51.
         assert_eq!(
-            Segmenter::new(&k, pos(0, 0), pos(30_000, 40_000), 1000).pieces(),
+            Segmenter::new(&k, pos(0, 0), &pos(30_000, 40_000), 1000).pieces(),
             50
         );
         assert_eq!(
-            Segmenter::new(&k, pos(0, 0), pos(30_000, 40_001), 1000).pieces(),
+            Segmenter::new(&k, pos(0, 0), &pos(30_000, 40_001), 1000).pieces(),
             51
         );
-        assert_eq!(Segmenter::new(&k, pos(5, 5), pos(5, 5), 1000).count(), 1);
+        assert_eq!(Segmenter::new(&k, pos(5, 5), &pos(5, 5), 1000).count(), 1);
     }
 
     proptest! {
@@ -124,11 +119,11 @@ mod tests {
         fn pieces_follow_the_line(x0 in -500_000i32..500_000, y0 in -400_000i32..300_000, x1 in -500_000i32..500_000, y1 in -400_000i32..300_000, seg in 500u32..20_000) {
             let k = polargraph();
             let (a, b) = (pos(x0, y0), pos(x1, y1));
-            let s = Segmenter::new(&k, a, b, seg);
+            let s = Segmenter::new(&k, a, &b, seg);
             let n = s.pieces();
             let mut last = None;
             for (i, piece) in s.enumerate() {
-                let steps = piece.unwrap();
+                let steps = k.inverse(&piece).unwrap();
                 let p = k.forward(&steps);
                 let t = (i + 1) as f64 / n as f64;
                 let ideal = [x0 as f64 + t * (x1 - x0) as f64, y0 as f64 + t * (y1 - y0) as f64];

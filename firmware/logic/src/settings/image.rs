@@ -10,11 +10,12 @@
 
 use super::{all, Setting, Value};
 use crate::config::MachineConfig;
+use crate::machine::Machine;
 use crate::units::{Milli, StepsPerUnit};
 
 pub const MAGIC: [u8; 4] = *b"taut";
 /// Bumped whenever the settings or their kinds change.
-pub const VERSION: u8 = 2;
+pub const VERSION: u8 = 3;
 const HEADER: usize = MAGIC.len() + 1;
 
 /// Why the image was not taken.
@@ -35,6 +36,7 @@ pub enum Unusable {
 fn width(s: Setting) -> usize {
     match s {
         Setting::Axis(_, super::AxisField::StepsPerUnit) => 8,
+        Setting::Global(super::GlobalField::Crosstalk) => 8,
         _ => 4,
     }
 }
@@ -69,6 +71,7 @@ fn value_bytes(v: Value) -> impl Iterator<Item = u8> {
     let (buf, n) = match v {
         Value::Number(n) => (widen(n.to_le_bytes()), 4),
         Value::Milli(m) => (widen(m.0.to_le_bytes()), 4),
+        Value::Machine(m) => (widen((m as u32).to_le_bytes()), 4),
         Value::Ratio(r) => {
             let mut b = [0; 8];
             b[..4].copy_from_slice(&r.num.to_le_bytes());
@@ -106,6 +109,10 @@ pub fn decode(read: impl Fn(usize) -> u8, base: &MachineConfig) -> Result<Machin
         let value = match s.get(base) {
             Value::Number(_) => Value::Number(word(at)),
             Value::Milli(_) => Value::Milli(Milli(word(at) as i32)),
+            Value::Machine(_) => match u8::try_from(word(at)).ok().and_then(Machine::from_index) {
+                Some(m) => Value::Machine(m),
+                None => return Err(Unusable::Refused(s)),
+            },
             Value::Ratio(_) => Value::Ratio(StepsPerUnit::new(word(at), word(at + 4))),
         };
         at += width(s);
@@ -113,7 +120,7 @@ pub fn decode(read: impl Fn(usize) -> u8, base: &MachineConfig) -> Result<Machin
         s.force(&mut cfg, value);
     }
     // Each value in range; now the set as a whole.
-    match cfg.validate() {
+    match super::check_whole(&cfg) {
         Ok(()) => Ok(cfg),
         Err(_) => Err(Unusable::Inconsistent),
     }

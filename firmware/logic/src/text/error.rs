@@ -16,6 +16,8 @@ pub enum ErrorKind {
     /// A line that is neither blank, a comment nor `key = value`.
     ExpectedKeyValue,
     UnknownKey,
+    /// `machine = ` names none of the five.
+    UnknownMachine,
     DuplicateKey,
     /// A required key never appeared; carries its names as `name/alias`.
     MissingKey(&'static str),
@@ -61,6 +63,7 @@ pub enum ErrorKind {
     /// highest rate: at most `max_us`.
     PulseTooLong {
         axis: crate::axis::Axis,
+        machine: crate::machine::Machine,
         max_us: u32,
     },
 }
@@ -73,6 +76,7 @@ impl uDisplay for ErrorKind {
             ErrorKind::LineTooLong => f.write_str("line too long (max 64)"),
             ErrorKind::ExpectedKeyValue => f.write_str("expected key = value"),
             ErrorKind::UnknownKey => f.write_str("unknown key"),
+            ErrorKind::UnknownMachine => f.write_str("unknown machine"),
             ErrorKind::DuplicateKey => f.write_str("duplicate key"),
             ErrorKind::MissingKey(key) => uwrite!(f, "missing key {}", key),
             ErrorKind::NotANumber => f.write_str("expected a number"),
@@ -94,10 +98,14 @@ impl uDisplay for ErrorKind {
             ErrorKind::Invalid(field) => uwrite!(f, "invalid {}", field),
             ErrorKind::Utf16 => f.write_str("UTF-16 text: save it as UTF-8 or ASCII"),
             ErrorKind::NotText { byte } => uwrite!(f, "not a text file (byte {})", byte),
-            ErrorKind::PulseTooLong { axis, max_us } => uwrite!(
+            ErrorKind::PulseTooLong {
+                axis,
+                machine,
+                max_us,
+            } => uwrite!(
                 f,
                 "pulse over half a step at {}_max_rate: {} us at most",
-                axis.name(),
+                machine.channel(axis),
                 max_us
             ),
         }

@@ -64,3 +64,21 @@ fn a_consistent_image_with_a_refused_value_is_refused() {
     body.extend_from_slice(&sum.value().to_le_bytes());
     assert!(matches!(read(&body), Err(Unusable::Refused(_))));
 }
+
+#[test]
+fn the_machine_and_its_geometry_are_kept() {
+    let mut cfg = BASE;
+    set(&mut cfg, "machine", "scara").unwrap();
+    set(&mut cfg, "length_2", "120").unwrap();
+    set(&mut cfg, "crosstalk", "62/20").unwrap();
+    set(&mut cfg, "elbow_max_rate", "1500").unwrap();
+    assert_eq!(read(&image(&cfg)), Ok(cfg));
+    // A machine number no firmware has: refused whole.
+    let mut img = image(&cfg);
+    img[HEADER] = 9;
+    let n = img.len();
+    let mut sum = Fletcher::new();
+    img[..n - 2].iter().for_each(|&b| sum.add(b));
+    img[n - 2..].copy_from_slice(&sum.value().to_le_bytes());
+    assert!(matches!(read(&img), Err(Unusable::Refused(_))));
+}

@@ -1,0 +1,86 @@
+//! The five machines one image drives, chosen at run time (`$machine=`):
+//! their names, what each calls its channels and its G-code words. Their
+//! defaults (the seeds' figures) are `MachineConfig::defaults`, their
+//! kinematics `AnyKinematics::of`.
+
+use crate::axis::{Axis, AXES};
+
+/// The string-art machine's words: base `C`, radial `X`, drill `Z`.
+pub const CYLINDRICAL: [u8; AXES] = *b"CXZA";
+/// A plotter's or an arm's words.
+pub const CARTESIAN: [u8; AXES] = *b"XYZA";
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Machine {
+    /// The rotating board, radial carriage and drill.
+    #[default]
+    StringArt = 0,
+    /// Seed 001: X along the drum, Y the drum's turn (mm of paper).
+    Drum = 1,
+    /// Seed 002: X 140 mm, homed at start-up; Y the paper feed.
+    Flatbed = 2,
+    /// Seed 003: two motors hang the pen on strings or chains.
+    Whiteboard = 3,
+    /// Seed 004: shoulder and elbow, Klipper's kinematics.
+    Scara = 4,
+}
+
+impl Machine {
+    pub const ALL: [Machine; 5] = [
+        Machine::StringArt,
+        Machine::Drum,
+        Machine::Flatbed,
+        Machine::Whiteboard,
+        Machine::Scara,
+    ];
+
+    /// The name `$machine=` takes and `$$` prints.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Machine::StringArt => "string_art",
+            Machine::Drum => "drum",
+            Machine::Flatbed => "flatbed",
+            Machine::Whiteboard => "whiteboard",
+            Machine::Scara => "scara",
+        }
+    }
+
+    /// The machine named `name`, in any case.
+    pub fn parse(name: &[u8]) -> Option<Machine> {
+        Machine::ALL
+            .into_iter()
+            .find(|m| name.eq_ignore_ascii_case(m.name().as_bytes()))
+    }
+
+    pub fn from_index(i: u8) -> Option<Machine> {
+        Machine::ALL.get(i as usize).copied()
+    }
+
+    /// What the machine calls each channel: setting names
+    /// (`<channel>_max_rate`), log lines and the VCD's signals.
+    pub const fn channel(self, axis: Axis) -> &'static str {
+        let names = match self {
+            Machine::StringArt => ["base", "radial", "drill", "aux"],
+            Machine::Drum | Machine::Flatbed => ["x", "y", "z", "aux"],
+            Machine::Whiteboard => ["left", "right", "z", "aux"],
+            Machine::Scara => ["shoulder", "elbow", "z", "aux"],
+        };
+        names[axis.index()]
+    }
+
+    /// The G-code word of each coordinate.
+    pub const fn words(self) -> [u8; AXES] {
+        match self {
+            Machine::StringArt => CYLINDRICAL,
+            _ => CARTESIAN,
+        }
+    }
+
+    /// Whether the string-art job (drill and wind from the card) runs.
+    pub const fn is_string_art(self) -> bool {
+        matches!(self, Machine::StringArt)
+    }
+}
+
+#[cfg(test)]
+mod tests;
