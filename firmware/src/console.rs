@@ -20,7 +20,7 @@ use crate::reply::{self, Fixed, REPORTED_AXES};
 use crate::rt::{stack, Poll};
 use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::AXES;
-use taut_logic::config::MachineConfig;
+use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::gcode::{Error, ErrorKind, Input, Line, Parser, SystemLine};
 use taut_logic::interp::{Allowed, Interpreter, Order, Path};
 use taut_logic::kinematics::Kinematics;
@@ -168,6 +168,8 @@ impl Console {
         let after_motion = matches!(
             order,
             Order::Dwell { .. }
+                | Order::Pen { .. }
+                | Order::Pause
                 | Order::SetPosition { .. }
                 | Order::Drivers { on: false }
                 | Order::WaitIdle
@@ -182,15 +184,16 @@ impl Console {
                     return Some(Poll::Wait(Signal::Motion));
                 }
             }
-            Order::Dwell { ms } => {
-                let now = clock::millis();
-                let until = *self.dwell_until.get_or_insert(now.wrapping_add(*ms));
-                let left = until.wrapping_sub(now) as i32;
-                if left > 0 {
-                    return Some(Poll::After(left.min(u16::MAX as i32) as u16));
+            Order::Dwell { ms } => return self.dwell(*ms),
+            Order::Pen { deg, ms } => {
+                // Set once, then its settle time like a dwell.
+                if self.dwell_until.is_none() {
+                    m.pen.set_pulse_us(PenConfig::pulse_us(*deg));
                 }
-                self.dwell_until = None;
+                return self.dwell(u32::from(*ms));
             }
+            // Held like `!`: `~` or the green button goes on.
+            Order::Pause => m.hold(),
             Order::Path { path, feed } => {
                 self.pending = Some(Pending::Path {
                     path: *path,
@@ -201,6 +204,18 @@ impl Console {
             Order::Drivers { on } => m.drivers.set(0xFF, *on),
             Order::ReportPosition => report_position(m, kin),
         }
+        None
+    }
+
+    /// Wait `ms` from the first call (motion done): `Some(wait)` until then.
+    fn dwell(&mut self, ms: u32) -> Option<Poll<Signal>> {
+        let now = clock::millis();
+        let until = *self.dwell_until.get_or_insert(now.wrapping_add(ms));
+        let left = until.wrapping_sub(now) as i32;
+        if left > 0 {
+            return Some(Poll::After(left.min(u16::MAX as i32) as u16));
+        }
+        self.dwell_until = None;
         None
     }
 

@@ -9,7 +9,7 @@
 //!
 //! | task | kind | priority | input | output |
 //! | --- | --- | --- | --- | --- |
-//! | `TIMER1_COMPA` step events | interrupt | above all | `SEGMENTS`, `BLOCKS` | STEP/DIR pins |
+//! | `TIMER3_COMPA` step events | interrupt | above all | `SEGMENTS`, `BLOCKS` | STEP/DIR pins |
 //! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `SAMPLES` |
 //! | `USART0_RX` | interrupt | | a byte | `REALTIME` (`?` `!` `~` Ctrl-X, which also stops the steps), else `RX` |
 //! | `USART0_UDRE` | interrupt | | `TX` | the wire |
@@ -32,6 +32,7 @@ use embedded_hal::digital::OutputPin;
 use panic_halt as _;
 use taut_firmware::board::eeprom::Eeprom;
 use taut_firmware::board::gpio::{Output, Pin};
+use taut_firmware::board::servo::PenServo;
 use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{
     self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
@@ -42,7 +43,7 @@ use taut_firmware::console::{Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
-use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL, SIGNALS};
+use taut_firmware::queues::{Control, Signal, BUTTONS, CARD_IN, CARD_OUT, JOB_CONTROL, SIGNALS};
 use taut_firmware::realtime::{self, Requests};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{stack, Poll, TaskCell};
@@ -53,8 +54,10 @@ use taut_firmware::{
     nested_vector, step_vector,
 };
 use taut_firmware::{flash_str, info, reply, warn};
-use taut_logic::config::MachineConfig;
+use taut_logic::buttons::ButtonEvent;
+use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::kinematics::AnyKinematics;
+use taut_logic::pinmap::Button;
 use taut_logic::sched::{Ready, TaskId, Timers};
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -249,8 +252,15 @@ fn init() -> Watchdog {
         aux_step: pins.d26.into_output_at(false),
         aux_dir: pins.d28.into_output_at(false),
     };
-    let stepper = Stepper::new(step_dir, StepTimer::start(dp.TC1), &config);
-    MOTION.with(|m| *m = Some(Motion::new(&config, stepper, drivers)));
+    let stepper = Stepper::new(step_dir, StepTimer::start(dp.TC3), &config);
+    // The pen starts up, whatever the machine (SERVO0 is unused on the
+    // string-art machine).
+    let pen = PenServo::start(
+        dp.TC1,
+        pins.d11.into_output(),
+        PenConfig::pulse_us(config.pen.up_deg),
+    );
+    MOTION.with(|m| *m = Some(Motion::new(&config, stepper, drivers, pen)));
     let spi = CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53);
     CARD.with(|c| *c = Some(CardReader::new(spi)));
     buttons::start(ButtonPins {
@@ -416,6 +426,13 @@ fn buttons() {
 #[inline(never)]
 fn job() {
     if !CONFIG.with(|cfg| cfg.machine.is_string_art()) {
+        // A plotter: the green button goes on after `M0`, as `~` does.
+        while let Some(event) = BUTTONS.pop() {
+            if event == ButtonEvent::Pressed(Button::Confirm) {
+                MOTION.with(|m| m.as_mut().unwrap().resume());
+                spawn(Task::Refill);
+            }
+        }
         return;
     }
     let now = clock::millis();

@@ -4,6 +4,7 @@
 //! abandons the rest of the queued motion (a pulled card).
 #![deny(unsafe_code)]
 
+use crate::board::servo::PenServo;
 use crate::drivers::Drivers;
 use crate::queues::{BLOCKS, SEGMENTS, SEGMENTS_CAPACITY};
 use crate::rt::TaskCell;
@@ -71,10 +72,17 @@ pub struct Motion {
     busy: u8,
     pub stepper: Stepper,
     pub drivers: Drivers,
+    /// The plotters' pen on SERVO0.
+    pub pen: PenServo,
 }
 
 impl Motion {
-    pub fn new(config: &MachineConfig, stepper: Stepper, drivers: Drivers) -> Motion {
+    pub fn new(
+        config: &MachineConfig,
+        stepper: Stepper,
+        drivers: Drivers,
+        pen: PenServo,
+    ) -> Motion {
         PLANNER.with(|p| p.configure(config));
         Motion {
             prep: Prep::new(),
@@ -86,6 +94,7 @@ impl Motion {
             busy: 0,
             stepper,
             drivers,
+            pen,
         }
     }
 

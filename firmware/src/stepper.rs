@@ -1,7 +1,7 @@
 //! The step interrupt: executes [`Segment`]s exactly as
 //! `taut_logic::segment::expand` replays them on the host.
 //!
-//! Per event, in `TIMER1_COMPA`: raise the STEP pins chosen at the previous
+//! Per event, in `TIMER3_COMPA`: raise the STEP pins chosen at the previous
 //! event (first, so pulse timing does not depend on the work below: one
 //! store per port, through the PINx toggle registers), drop them once the
 //! pulse width has passed (so every pulse is as long as set), advance the
@@ -31,13 +31,14 @@ use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK, STOP};
 /// Refill the queues when this few segments are left.
 pub(crate) const LOW_WATER: usize = 24;
 
-/// Timer1 registers (data-space addresses).
-const TCNT1: *mut u16 = 0x84 as *mut u16;
-const OCR1A: *mut u16 = 0x88 as *mut u16;
-const TIMSK1: *mut u8 = 0x6F as *mut u8;
-const TIFR1: *mut u8 = 0x36 as *mut u8;
-const OCIE1A: u8 = 1 << 1;
-const OCF1A: u8 = 1 << 1;
+/// Timer3 registers (data-space addresses). Timer1 drives the pen servo
+/// on OC1A (D11, RAMPS SERVO0).
+const TCNT3: *mut u16 = 0x94 as *mut u16;
+const OCR3A: *mut u16 = 0x98 as *mut u16;
+const TIMSK3: *mut u8 = 0x71 as *mut u8;
+const TIFR3: *mut u8 = 0x38 as *mut u8;
+const OCIE3A: u8 = 1 << 1;
+const OCF3A: u8 = 1 << 1;
 
 /// Compare times closer than this to "now" would be missed by the 16-bit
 /// timer: the event is late and fired this many ticks from now instead.
@@ -125,7 +126,7 @@ pub struct Exec {
     /// `wait` is not zero: the next compare match is a split wait, not an
     /// event (a byte, for the assembly entry).
     waiting: u8,
-    /// TCNT1 when the assembly entry raised the pending event's pins.
+    /// TCNT3 when the assembly entry raised the pending event's pins.
     raised: u16,
     /// Set by the assembly path when it took a segment and the queue is
     /// low; the tick handler passes it on as a refill request.
@@ -136,9 +137,9 @@ pub struct Exec {
     left: u16,
     interval: u32,
     add: i32,
-    /// Sub-tick fraction of the pending event's time (OCR1A holds the ticks).
+    /// Sub-tick fraction of the pending event's time (OCR3A holds the ticks).
     frac: u8,
-    /// Ticks still to wait before the pending event, beyond OCR1A.
+    /// Ticks still to wait before the pending event, beyond OCR3A.
     wait: u32,
     block: StepBlock,
     counter: PerAxis<u32>,
@@ -172,7 +173,7 @@ pub struct Exec {
 
 #[doc(hidden)]
 pub struct ExecCell(UnsafeCell<Exec>);
-// SAFETY: `Exec` is touched by TIMER1_COMPA, or by task code while that
+// SAFETY: `Exec` is touched by TIMER3_COMPA, or by task code while that
 // interrupt is off (`kick`) or inside a critical section (the readers).
 unsafe impl Sync for ExecCell {}
 
@@ -243,7 +244,7 @@ const _: () = {
     assert!(DRIVERS[3].step == 26 && DRIVERS[3].dir == 28);
 };
 
-/// Owner of the STEP and DIR pins and of Timer1.
+/// Owner of the STEP and DIR pins and of Timer3.
 pub struct Stepper {
     _pins: StepDirPins,
     _timer: StepTimer,
@@ -251,7 +252,7 @@ pub struct Stepper {
 
 impl Stepper {
     /// Takes the pins, and the pulse timing and DIR polarity from
-    /// `config`. Timer1 must run at clk/1 (`StepTimer`).
+    /// `config`. Timer3 must run at clk/1 (`StepTimer`).
     pub fn new(pins: StepDirPins, timer: StepTimer, config: &MachineConfig) -> Stepper {
         let e = exec();
         e.pulse_ticks = config.pulse.step_pulse_us as u16 * 16;
@@ -288,13 +289,13 @@ impl Stepper {
             write_dir(dir, e.dir_high_positive);
         }
         e.frac = 0;
-        // SAFETY: Timer1 registers, owned by the stepper; its interrupt is off.
+        // SAFETY: Timer3 registers, owned by the stepper; its interrupt is off.
         unsafe {
-            write_volatile(OCR1A, read_volatile(TCNT1).wrapping_add(MIN_LEAD));
+            write_volatile(OCR3A, read_volatile(TCNT3).wrapping_add(MIN_LEAD));
             schedule_next(e);
             e.running = true;
-            write_volatile(TIFR1, OCF1A);
-            avr_device::interrupt::free(|_| write_volatile(TIMSK1, read_volatile(TIMSK1) | OCIE1A));
+            write_volatile(TIFR3, OCF3A);
+            avr_device::interrupt::free(|_| write_volatile(TIMSK3, read_volatile(TIMSK3) | OCIE3A));
         }
     }
 
@@ -378,8 +379,8 @@ impl Stepper {
 #[inline(always)]
 pub fn halt() {
     avr_device::interrupt::free(|_| {
-        // SAFETY: a masked read-modify-write of the Timer1 mask register.
-        unsafe { write_volatile(TIMSK1, read_volatile(TIMSK1) & !OCIE1A) }
+        // SAFETY: a masked read-modify-write of the Timer3 mask register.
+        unsafe { write_volatile(TIMSK3, read_volatile(TIMSK3) & !OCIE3A) }
     });
 }
 
@@ -522,7 +523,7 @@ fn dda_partial(e: &mut Exec, m: &mut [u8; SLOTS]) {
 /// Time, DDA and compare register of the next event.
 ///
 /// # Safety
-/// Timer1 registers; called from the interrupt or with it masked.
+/// Timer3 registers; called from the interrupt or with it masked.
 #[inline(always)]
 unsafe fn schedule_next(e: &mut Exec) {
     let t = e.frac as u32 + e.interval;
@@ -541,7 +542,7 @@ unsafe fn schedule_next(e: &mut Exec) {
 /// `WAIT_PART` ticks at a time, flagging an event that can no longer be on time.
 ///
 /// # Safety
-/// Timer1 registers; called from the interrupt or with it masked.
+/// Timer3 registers; called from the interrupt or with it masked.
 #[inline(always)]
 unsafe fn advance_compare(e: &mut Exec) {
     let part = if e.wait > LONG_WAIT {
@@ -551,13 +552,13 @@ unsafe fn advance_compare(e: &mut Exec) {
     };
     e.wait -= part;
     e.waiting = (e.wait != 0) as u8;
-    let at = read_volatile(OCR1A).wrapping_add(part as u16);
-    let now = read_volatile(TCNT1);
+    let at = read_volatile(OCR3A).wrapping_add(part as u16);
+    let now = read_volatile(TCNT3);
     if (at.wrapping_sub(now) as i16) < MIN_LEAD as i16 {
         e.late = e.late.wrapping_add(1);
-        write_volatile(OCR1A, now.wrapping_add(MIN_LEAD));
+        write_volatile(OCR3A, now.wrapping_add(MIN_LEAD));
     } else {
-        write_volatile(OCR1A, at);
+        write_volatile(OCR3A, at);
     }
 }
 
@@ -581,14 +582,14 @@ unsafe fn toggle_steps(m: &[u8; SLOTS]) {
     }
 }
 
-/// The `TIMER1_COMPA` interrupt's general path, entered from the assembly
+/// The `TIMER3_COMPA` interrupt's general path, entered from the assembly
 /// entry in `fast.rs`, which has raised the STEP pins unless this compare
 /// match is part of a split wait (it handles plain events itself). Returns true when the segment queue
 /// wants refilling (the app then spawns the motion task).
 #[inline(always)]
 pub fn on_compare() -> bool {
     let e = exec();
-    // SAFETY: Timer1 and STEP/DIR pin registers, owned by this interrupt.
+    // SAFETY: Timer3 and STEP/DIR pin registers, owned by this interrupt.
     unsafe {
         if e.wait > 0 {
             advance_compare(e);
@@ -598,7 +599,7 @@ pub fn on_compare() -> bool {
         // ends at its set width, before the work below (a new segment, the
         // DDA) that can take longer than the pulse.
         let raised = e.raised;
-        while read_volatile(TCNT1).wrapping_sub(raised) < e.pulse_ticks {}
+        while read_volatile(TCNT3).wrapping_sub(raised) < e.pulse_ticks {}
         toggle_steps(&e.masks);
         e.left -= 1;
         let loaded = e.left == 0 && load_segment_cold(e);
@@ -611,16 +612,16 @@ pub fn on_compare() -> bool {
             if e.block_left > 0 && e.stop == 0 {
                 e.underruns = e.underruns.saturating_add(1);
             }
-            write_volatile(TIMSK1, read_volatile(TIMSK1) & !OCIE1A);
+            write_volatile(TIMSK3, read_volatile(TIMSK3) & !OCIE3A);
         }
         if let Some(dir) = e.new_dir.take() {
             write_dir(dir, e.dir_high_positive);
             // Keep the DIR set-up time before the next STEP edge (only
             // binding above ~200 000 steps/s with the 5 µs default).
-            let earliest = read_volatile(TCNT1).wrapping_add(e.dir_setup_ticks);
-            if e.running && e.wait == 0 && (read_volatile(OCR1A).wrapping_sub(earliest) as i16) < 0
+            let earliest = read_volatile(TCNT3).wrapping_add(e.dir_setup_ticks);
+            if e.running && e.wait == 0 && (read_volatile(OCR3A).wrapping_sub(earliest) as i16) < 0
             {
-                write_volatile(OCR1A, earliest);
+                write_volatile(OCR3A, earliest);
                 e.late = e.late.wrapping_add(1);
             }
         }

@@ -95,5 +95,6 @@ pub fn error(e: ErrorKind) -> FlashStr {
         BadChecksum => BadChecksum,
         JobOwnsMotion => JobOwnsMotion,
         FeedTooLow => FeedTooLow,
+        PenWithMove => PenWithMove,
     ])
 }

@@ -98,7 +98,7 @@ pub fn sample_card_dir() -> PathBuf {
 }
 
 /// The release image with every machine pin probed under its VCD name
-/// (`<axis>_step|dir|en`, `btn_<button>`), booted.
+/// (`<axis>_step|dir|en`, `btn_<button>`, `pen_pwm`), booted.
 pub fn boot_machine() -> sim::Sim {
     use taut_logic::axis::Axis;
     use taut_logic::pinmap::{self, Button};
@@ -108,6 +108,7 @@ pub fn boot_machine() -> sim::Sim {
         sim.probe_step_dir(axis.name(), d.step, d.dir, true);
         sim.probe(d.enable, &format!("{}_en", axis.name()));
     }
+    sim.probe(pinmap::PEN_SERVO, "pen_pwm");
     for b in Button::ALL {
         sim.release(b.pin());
         sim.probe(b.pin(), &format!("btn_{}", b.name()));
@@ -137,8 +138,8 @@ pub fn wait_for(sim: &mut sim::Sim, text: &str, timeout: std::time::Duration) {
     );
 }
 
-/// Timer1 COMPA vector (byte address): the step interrupt.
-pub const STEP_VECTOR: u32 = 0x44;
+/// Timer3 COMPA vector (byte address): the step interrupt.
+pub const STEP_VECTOR: u32 = 0x80;
 /// Documented bound (README): no code masks the step interrupt longer.
 pub const MASKED_BOUND_CYCLES: u64 = 80;
 
@@ -272,4 +273,15 @@ pub fn track(sim: &sim::Sim) -> Vec<(u64, [i64; 3])> {
             (cycle, at)
         })
         .collect()
+}
+
+/// The pen servo's angle at `cycle`, degrees, from the last whole pulse
+/// on `pen_pwm` before it (1–2 ms for 0–180°); `None` before any.
+pub fn pen_deg_at(sim: &sim::Sim, cycle: u64) -> Option<f64> {
+    let edges = sim.probed("pen_pwm").edges();
+    let end = edges.partition_point(|e| e.cycle <= cycle);
+    let fall = edges[..end].iter().rposition(|e| !e.high)?;
+    let rise = edges[..fall].iter().rposition(|e| e.high)?;
+    let us = (edges[fall].cycle - edges[rise].cycle) as f64 / 16.0;
+    Some((us - 1000.0) * 180.0 / 1000.0)
 }

@@ -1,10 +1,11 @@
 //! Issue 11: one image, five machines. Each plotter and the arm is chosen
 //! with `$machine=`, draws over the serial port, and its drawing is rebuilt
-//! from the step and direction pulses alone through its own forward
-//! kinematics, point by point against the toolpath the G-code defines.
+//! from the step, direction and pen pulses alone through its own forward
+//! kinematics, point by point against the toolpath the G-code defines:
+//! drawn while the pen PWM is at the down angle, travel while it is up.
 
 use hil_tests::sim::Sim;
-use hil_tests::{assert_ram_budget, boot_machine, log_tail, send_ok, track};
+use hil_tests::{assert_ram_budget, boot_machine, log_tail, pen_deg_at, send_ok, track};
 use std::time::Duration;
 use taut_logic::config::MachineConfig;
 use taut_logic::kinematics::{AnyKinematics, Kinematics};
@@ -53,15 +54,43 @@ impl Toolpath {
     }
 }
 
-/// A square, a half circle on its top and lines out from its centre in
-/// all eight octants (they catch a sign or octant slip), at `(x, y)` mm.
-fn draw(sim: &mut Sim, x: f64, y: f64) -> Toolpath {
-    let mut path = Toolpath(Vec::new());
+/// How a machine's G-code lifts and lowers its pen.
+#[derive(Clone, Copy)]
+enum PenWords {
+    /// `M3` / `M5` (Grbl's servo forks).
+    Spindle,
+    /// `M300 S30` / `M300 S50` (the Inkscape "unicorn" extension).
+    Unicorn,
+    /// `G1 Z0` / `G0 Z1` (seed 002, gcodetools).
+    Z,
+}
+
+impl PenWords {
+    fn line(self, down: bool) -> &'static str {
+        match (self, down) {
+            (PenWords::Spindle, true) => "M3",
+            (PenWords::Spindle, false) => "M5",
+            (PenWords::Unicorn, true) => "M300 S30",
+            (PenWords::Unicorn, false) => "M300 S50",
+            (PenWords::Z, true) => "G1 Z0 F300",
+            (PenWords::Z, false) => "G0 Z1",
+        }
+    }
+}
+
+/// With the pen up, to `(x, y)` mm; with it down, a square, a half circle
+/// on its top and lines out from its centre in all eight octants (they
+/// catch a sign or octant slip); with it up, back to the start. Returns
+/// what the pen draws and where it travels up.
+fn draw(sim: &mut Sim, pen: PenWords, from: [f64; 2], x: f64, y: f64) -> (Toolpath, Toolpath) {
+    let mut drawn = Toolpath(vec![[x, y]]);
     let mut go = |sim: &mut Sim, line: String, to: [f64; 2]| {
         send(sim, &line);
-        path.line_to(to);
+        drawn.line_to(to);
     };
-    go(sim, format!("G0 X{x} Y{y}"), [x, y]);
+    send(sim, pen.line(false));
+    send(sim, &format!("G0 X{x} Y{y}"));
+    send(sim, pen.line(true));
     go(sim, format!("G1 X{} Y{y} F1200", x + 20.0), [x + 20.0, y]);
     go(
         sim,
@@ -69,11 +98,11 @@ fn draw(sim: &mut Sim, x: f64, y: f64) -> Toolpath {
         [x + 20.0, y + 20.0],
     );
     send(sim, &format!("G3 X{x} Y{} I-10 J0", y + 20.0));
-    path.half_turn_ccw([x + 10.0, y + 20.0]);
+    drawn.half_turn_ccw([x + 10.0, y + 20.0]);
     let c = [x + 10.0, y + 10.0];
     let mut go = |sim: &mut Sim, line: String, to: [f64; 2]| {
         send(sim, &line);
-        path.line_to(to);
+        drawn.line_to(to);
     };
     go(sim, format!("G1 X{} Y{}", c[0], c[1]), c);
     for (dx, dy) in [
@@ -90,48 +119,54 @@ fn draw(sim: &mut Sim, x: f64, y: f64) -> Toolpath {
         go(sim, format!("G1 X{} Y{}", to[0], to[1]), to);
         go(sim, format!("G1 X{} Y{}", c[0], c[1]), c);
     }
+    send(sim, pen.line(false));
+    send(sim, &format!("G0 X{x} Y{y}"));
     send(sim, "M400");
-    path
+    let travel = Toolpath(vec![from, [x, y], c, [x, y]]);
+    (drawn, travel)
 }
 
-/// Draws on `machine` and checks every pulse of the drawing against the
-/// toolpath, within `within` mm (about a step of its coarsest motor).
-fn drawn_from_the_pulses(machine: Machine, at: [f64; 2], within: f64) {
+/// Draws on `machine` and checks every pulse against the toolpath, within
+/// `within` mm (about a step of its coarsest motor): while the pen PWM
+/// says down, on what the G-code draws; while it says up, on the travel.
+fn drawn_from_the_pulses(machine: Machine, pen: PenWords, at: [f64; 2], within: f64) {
     let mut sim = boot_machine();
     send(&mut sim, &format!("$machine={}", machine.name()));
     send(&mut sim, "M17");
     let cfg = MachineConfig::defaults(machine);
     let kin = AnyKinematics::of(&cfg).unwrap();
-    let path = draw(&mut sim, at[0], at[1]);
     let pos = |steps: [i64; 3]| {
         let p = kin.forward(&[steps[0] as i32, steps[1] as i32, steps[2] as i32, 0]);
         [p[0].0 as f64 / 1000.0, p[1].0 as f64 / 1000.0]
     };
+    let home = pos([0; 3]);
+    let (drawn, travel) = draw(&mut sim, pen, home, at[0], at[1]);
     let points = track(&sim);
-    // The first move comes from wherever the machine stood: checked from
-    // the first pulse at the drawing's start.
-    let start = points
-        .iter()
-        .position(|(_, s)| {
-            let p = pos(*s);
-            (p[0] - at[0]).hypot(p[1] - at[1]) < within
-        })
-        .expect("never reached the drawing's start");
-    let mut worst: f64 = 0.0;
-    for (_, s) in &points[start..] {
+    let (mut worst, mut down) = (0.0f64, 0);
+    for (cycle, s) in &points {
         let p = pos(*s);
+        let deg = pen_deg_at(&sim, *cycle).expect("no pen pulses");
+        let is_down = (deg - f64::from(cfg.pen.down_deg)).abs() < 1.0;
+        let is_up = (deg - f64::from(cfg.pen.up_deg)).abs() < 1.0;
+        assert!(
+            is_down || is_up,
+            "{machine:?}: pen at {deg:.1}° while moving"
+        );
+        let path = if is_down { &drawn } else { &travel };
+        down += is_down as usize;
         let d = path.distance(p);
         worst = worst.max(d);
         assert!(
             d <= within,
-            "{machine:?}: ({:.3}, {:.3}) is {d:.3} mm off the toolpath",
+            "{machine:?}: ({:.3}, {:.3}) is {d:.3} mm off the toolpath, pen {}",
             p[0],
-            p[1]
+            p[1],
+            if is_down { "down" } else { "up" }
         );
     }
-    // Every corner and tip is reached, and the drawing ends on its target.
-    for v in [path.0[1], path.0[2], path.0[path.0.len() - 2]] {
-        let near = points[start..].iter().map(|(_, s)| {
+    // Every corner and tip is drawn, and the drawing ends on its target.
+    for v in [drawn.0[1], drawn.0[2], drawn.0[drawn.0.len() - 2]] {
+        let near = points.iter().map(|(_, s)| {
             let p = pos(*s);
             (p[0] - v[0]).hypot(p[1] - v[1])
         });
@@ -141,15 +176,16 @@ fn drawn_from_the_pulses(machine: Machine, at: [f64; 2], within: f64) {
         );
     }
     let end = pos(points.last().unwrap().1);
-    let target = path.0.last().unwrap();
     assert!(
-        (end[0] - target[0]).hypot(end[1] - target[1]) <= within,
+        (end[0] - at[0]).hypot(end[1] - at[1]) <= within,
         "{machine:?} ended at {end:?}\n{}",
         log_tail(&sim)
     );
     eprintln!(
-        "{machine:?}: {} pulses, worst {worst:.3} mm off",
-        points.len() - start
+        "{machine:?}: {} pulses ({down} with the pen down), worst {worst:.3} mm off; stack {} B at {:#x}",
+        points.len(),
+        sim.peak_stack_bytes(),
+        sim.peak_stack_pc()
     );
     assert_ram_budget(&sim);
 }
@@ -157,24 +193,60 @@ fn drawn_from_the_pulses(machine: Machine, at: [f64; 2], within: f64) {
 #[test]
 fn the_drum_plotter_draws_its_toolpath() {
     // Y: 7.24 steps/mm of paper (a step is 0.14 mm).
-    drawn_from_the_pulses(Machine::Drum, [5.0, 5.0], 0.15);
+    drawn_from_the_pulses(Machine::Drum, PenWords::Spindle, [5.0, 5.0], 0.15);
 }
 
 #[test]
 fn the_flatbed_plotter_draws_its_toolpath() {
     // 0.025 mm a step: a step of each axis off, or the chord tolerance.
-    drawn_from_the_pulses(Machine::Flatbed, [5.0, 5.0], 0.046);
+    drawn_from_the_pulses(Machine::Flatbed, PenWords::Z, [5.0, 5.0], 0.046);
 }
 
 #[test]
 fn the_whiteboard_machine_draws_its_toolpath() {
     // 17.5 steps per mm of chain: a step of both moves the pen ~0.08 mm.
-    drawn_from_the_pulses(Machine::Whiteboard, [-10.0, -10.0], 0.1);
+    drawn_from_the_pulses(Machine::Whiteboard, PenWords::Unicorn, [-10.0, -10.0], 0.1);
 }
 
 #[test]
 fn the_scara_arm_draws_its_toolpath() {
-    // 26.7 steps a degree: at 220 mm from the shoulder a shoulder step is
-    // 0.14 mm, an elbow step 0.1 mm at the 150 mm forearm.
-    drawn_from_the_pulses(Machine::Scara, [90.0, 140.0], 0.25);
+    // 26.7 steps a degree: at 300 mm from the shoulder (the arm straight,
+    // where it starts) a shoulder step is 0.2 mm, an elbow step 0.1 mm.
+    drawn_from_the_pulses(Machine::Scara, PenWords::Spindle, [90.0, 140.0], 0.3);
+}
+
+/// `M0` holds once the motion before it is done, until the green button or
+/// `~`; `G20` takes inches, converted once.
+#[test]
+fn a_plotter_pauses_at_m0_and_takes_inches() {
+    use hil_tests::{press, steps_on_pins};
+    use taut_logic::pinmap::Button;
+    let mut sim = boot_machine();
+    send(&mut sim, "$machine=flatbed");
+    send(&mut sim, "M17");
+    // Sent ahead, as a streaming sender does: `M1` is answered only
+    // once the motion before it is done, after the first pause.
+    sim.uart_send(b"G0 X10\nM0\nG0 X20\nM1\nG20 G0 X1\n");
+    let status = |sim: &mut Sim| {
+        let start = sim.uart_bytes().len();
+        sim.uart_send(b"?");
+        sim.run_for(Duration::from_millis(20));
+        String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned()
+    };
+    sim.run_for(Duration::from_secs(2));
+    assert!(status(&mut sim).contains("<Hold:0|"), "{}", log_tail(&sim));
+    assert_eq!(steps_on_pins(&sim)[0], 400, "stopped at X10 (40 steps/mm)");
+    press(&mut sim, Button::Confirm, 100);
+    sim.run_for(Duration::from_secs(2));
+    assert_eq!(
+        steps_on_pins(&sim)[0],
+        800,
+        "the green button went on to X20"
+    );
+    assert!(status(&mut sim).contains("<Hold:0|"));
+    sim.uart_send(b"~");
+    sim.run_for(Duration::from_secs(2));
+    // 1 in = 25.4 mm = 1016 steps.
+    assert_eq!(steps_on_pins(&sim)[0], 1016, "~ went on to X1 in");
+    assert!(status(&mut sim).contains("<Idle|"));
 }

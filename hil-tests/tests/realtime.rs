@@ -162,10 +162,11 @@ fn ctrl_x_stops_at_once_and_locks_motion_until_the_position_is_set() {
 fn status_within_10_ms_behind_a_full_planner_and_during_a_dwell() {
     let mut sim = enabled();
     send(&mut sim, "G91");
-    // Fourteen moves fill the planner; the next line waits for room. Sent
-    // as a sender with flow control does: never more than the 63-byte
-    // receive ring holds unread.
-    for batch in [9, 8] {
+    // The planner's moves fill it; the next line waits for room. Sent as a
+    // sender with flow control does: never more than the 63-byte receive
+    // ring holds unread.
+    let lines = taut_logic::planner::PLANNER_BLOCKS + 1;
+    for batch in [lines / 2, lines - lines / 2] {
         for _ in 0..batch {
             sim.uart_send(b"G0 C5\n");
         }

@@ -50,6 +50,11 @@ pub struct MachineConfig {
     pub arc_tolerance_um: u32,
     /// Which of the five machines this is.
     pub machine: Machine,
+    /// The plotters' pen servo.
+    pub pen: PenConfig,
+    /// `G4 P` in milliseconds (Marlin's reading, what the Inkscape
+    /// "unicorn" extension writes) rather than seconds (Grbl's).
+    pub dwell_p_ms: bool,
     /// Its arms or strings, for the machines that have them.
     pub geometry: Geometry,
 }
@@ -74,6 +79,34 @@ impl Geometry {
         origin: [Milli(0); 2],
         crosstalk: StepsPerUnit::new(0, 1),
     };
+}
+
+/// An SG90-class pen servo on SERVO0 (D11): angles 0–180° are pulses of
+/// 1–2 ms every 20 ms.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PenConfig {
+    /// `M5`, `M300 S50`, a `Z` above 0: degrees.
+    pub up_deg: u8,
+    /// `M3`, `M300 S30`, a `Z` of 0 or below.
+    pub down_deg: u8,
+    /// How long the pen takes to get there, ms: motion waits for it.
+    pub settle_ms: u16,
+}
+
+impl PenConfig {
+    /// The Inkscape "unicorn" extension's angles (`M300 S50` up, `S30`
+    /// down), 150 ms to settle.
+    pub const UNICORN: PenConfig = PenConfig {
+        up_deg: 50,
+        down_deg: 30,
+        settle_ms: 150,
+    };
+
+    /// The servo pulse of `deg` (clamped to 180), µs, rounded.
+    pub const fn pulse_us(deg: u8) -> u16 {
+        let deg = if deg > 180 { 180 } else { deg as u32 };
+        (1000 + (deg * 1000 + 90) / 180) as u16
+    }
 }
 
 /// TB6600 defaults: 5 µs pulse, 5 µs DIR set-up, 5 µs ENABLE set-up.
@@ -240,6 +273,8 @@ const fn plotter(machine: Machine, xy: [AxisConfig; 2]) -> MachineConfig {
         junction_deviation_um: 10,
         arc_tolerance_um: 10,
         machine,
+        pen: PenConfig::UNICORN,
+        dwell_p_ms: !machine.is_string_art(),
         geometry: Geometry::NONE,
     }
 }
@@ -264,6 +299,21 @@ pub(crate) fn square() -> MachineConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_servo_pulse_table() {
+        let table: [(u8, u16); 6] = [
+            (0, 1000),
+            (30, 1167),
+            (50, 1278),
+            (90, 1500),
+            (180, 2000),
+            (255, 2000),
+        ];
+        for (deg, us) in table {
+            assert_eq!(PenConfig::pulse_us(deg), us, "{deg}°");
+        }
+    }
 
     #[test]
     fn defaults_match_the_spec() {

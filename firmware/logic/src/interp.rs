@@ -17,7 +17,7 @@
 
 use crate::arc::{self, Arc, ArcError, Sweep};
 use crate::config::MachineConfig;
-use crate::gcode::{AxisWord, Command, Distance, ErrorKind, Line, Plane, MIN_FEED};
+use crate::gcode::{AxisWord, Command, Distance, ErrorKind, Line, Plane, Units, MIN_FEED};
 use crate::kinematics::{Kinematics, Position, Segmenter, Steps};
 use crate::planner::Feed;
 use crate::units::Milli;
@@ -42,6 +42,14 @@ pub enum Order {
     Dwell {
         ms: u32,
     },
+    /// The pen servo to this angle, degrees, once motion is done; motion
+    /// then waits `ms` for it to get there.
+    Pen {
+        deg: u8,
+        ms: u16,
+    },
+    /// Hold once motion is done, until `~` or the green button (`M0`).
+    Pause,
     /// Take these steps as the position (once motion is done).
     SetPosition {
         steps: Steps,
@@ -100,6 +108,7 @@ enum Motion {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Modal {
     distance: Distance,
+    units: Units,
     motion: Motion,
     plane: Plane,
     feed: Option<Milli>,
@@ -130,6 +139,7 @@ impl Interpreter {
         Interpreter {
             modal: Modal {
                 distance: Distance::Absolute,
+                units: Units::Mm,
                 motion: Motion::Rapid,
                 plane: Plane::Xy,
                 feed: None,
@@ -178,15 +188,20 @@ impl Interpreter {
         if moves && !allowed.motion {
             return Err(ErrorKind::JobOwnsMotion);
         }
-        if line.f.get().is_some_and(|f| f.0 < MIN_FEED) {
+        if let Some(u) = line.units {
+            next.units = u;
+        }
+        let feed = line.f.get().map(|f| mm(f, next.units));
+        if feed.is_some_and(|f| f.0 < MIN_FEED) {
             return Err(ErrorKind::FeedTooLow);
         }
         if let Some(d) = line.distance {
             next.distance = d;
         }
-        if line.f.is_some() {
-            next.feed = line.f.get();
+        if feed.is_some() {
+            next.feed = feed;
         }
+        let pen = !cfg.machine.is_string_art();
         if let Some(p) = line.plane {
             next.plane = p;
         }
@@ -214,6 +229,21 @@ impl Interpreter {
                         next,
                     });
                 }
+                // A plotter's Z lifts (above 0) or lowers its pen and
+                // drives no motor.
+                if let Some(z) = line.axis(AxisWord::Z).filter(|_| pen) {
+                    let alone = AxisWord::ALL
+                        .iter()
+                        .all(|w| *w == AxisWord::Z || line.axis(*w).is_none());
+                    if !alone {
+                        return Err(ErrorKind::PenWithMove);
+                    }
+                    let up = z.0 > 0;
+                    return Ok(Planned {
+                        order: pen_order(cfg, if up { cfg.pen.up_deg } else { cfg.pen.down_deg }),
+                        next,
+                    });
+                }
                 let feed = match (next.motion, next.feed) {
                     (Motion::Rapid, _) => Feed::Rapid,
                     (_, Some(f)) => Feed::PerMinute(f),
@@ -222,22 +252,10 @@ impl Interpreter {
                 if !allowed.position_known {
                     return Err(ErrorKind::Locked);
                 }
-                next.target = self.destination(line, kin, next.distance);
+                next.target = self.destination(line, kin, &next);
                 check_travel(cfg, &next.target, &next.target)?;
                 if arc {
-                    let planned = Planned {
-                        order: Order::Path {
-                            path: Path::Arc(self.arc(line, kin, cfg, &next)?),
-                            feed,
-                        },
-                        next,
-                    };
-                    return match planned.order {
-                        Order::Path { ref path, .. } if !reaches(path, kin) => {
-                            Err(ErrorKind::InvalidTarget)
-                        }
-                        _ => Ok(planned),
-                    };
+                    return self.arc(line, kin, cfg, next, feed);
                 }
                 if !kin.is_linear() {
                     return self.pieces(feed, kin, next);
@@ -249,12 +267,28 @@ impl Interpreter {
                     .map_err(|_| ErrorKind::InvalidTarget)?;
                 Order::Move { steps, feed }
             }
+            // `P` is held in thousandths: of seconds, or of milliseconds.
             Command::Dwell => Order::Dwell {
-                ms: line.p.get().map_or(0, |p| p.0.max(0) as u32),
+                ms: line.p.get().map_or(0, |p| match cfg.dwell_p_ms {
+                    true => (p.0.max(0) as u32 + 500) / 1000,
+                    false => p.0.max(0) as u32,
+                }),
             },
+            Command::PenDown | Command::PenUp | Command::Servo if !pen => {
+                return Err(ErrorKind::UnsupportedCommand)
+            }
+            Command::PenUp => pen_order(cfg, cfg.pen.up_deg),
+            Command::PenDown | Command::Servo => {
+                let deg = match line.s.get() {
+                    Some(s) => (s.0.clamp(0, 180_000) / 1000) as u8,
+                    None => cfg.pen.down_deg,
+                };
+                pen_order(cfg, deg)
+            }
+            Command::Pause => Order::Pause,
             Command::SetPosition => {
                 for (i, w) in kin.words().iter().enumerate() {
-                    if let Some(v) = value(line, *w) {
+                    if let Some(v) = value(line, *w, next.units) {
                         next.target[i] = v;
                     }
                 }
@@ -297,14 +331,18 @@ impl Interpreter {
     }
 
     /// The arc `line` asks for, from the commanded position to
-    /// `next.target` in `next.plane`: checked whole.
+    /// `next.target` in `next.plane`, checked whole. Out of line, and
+    /// returning the whole order: the arc is built once, where the caller
+    /// takes it (the AVR's stack is small).
+    #[inline(never)]
     fn arc(
         &self,
         line: &Line,
         kin: &impl Kinematics,
         cfg: &MachineConfig,
-        next: &Modal,
-    ) -> Result<Arc, ErrorKind> {
+        next: Modal,
+        feed: Feed,
+    ) -> Result<Planned, ErrorKind> {
         let [w0, w1, w2] = next.plane.axes();
         let index = |w: AxisWord| kin.words().iter().position(|l| *l == w.letter());
         let (Some(axis_0), Some(axis_1)) = (index(w0), index(w1)) else {
@@ -326,14 +364,17 @@ impl Interpreter {
             clockwise: next.motion == Motion::ArcCw,
             tolerance: Milli(cfg.arc_tolerance_um.min(i32::MAX as u32) as i32),
         };
-        let arc = match line.r.get() {
+        let arc = match line.r.get().map(|r| mm(r, next.units)) {
             Some(_) if start[axis_0] == end[axis_0] && start[axis_1] == end[axis_1] => {
                 return Err(ErrorKind::InvalidTarget);
             }
             Some(r) => Arc::from_radius(&sweep, r),
             None => {
                 // `I J K` are the offsets along X Y Z.
-                let offset = |w: AxisWord| line.offsets[w.index() - AxisWord::X.index()].get();
+                let offset = |w: AxisWord| {
+                    let o = line.offsets[w.index() - AxisWord::X.index()].get();
+                    o.map(|o| mm(o, next.units))
+                };
                 if offset(w0).is_none() && offset(w1).is_none() {
                     return Err(ErrorKind::ArcNoOffsetInPlane);
                 }
@@ -349,15 +390,22 @@ impl Interpreter {
             ArcError::RadiusTooSmall => ErrorKind::ArcRadiusInvalid,
         })?;
         check_arc(&arc, kin, cfg)?;
-        Ok(arc)
+        let path = Path::Arc(arc);
+        match reaches(&path, kin) {
+            true => Ok(Planned {
+                order: Order::Path { path, feed },
+                next,
+            }),
+            false => Err(ErrorKind::InvalidTarget),
+        }
     }
 
     /// Where the axis words of `line` take the commanded position.
-    fn destination(&self, line: &Line, kin: &impl Kinematics, distance: Distance) -> Position {
+    fn destination(&self, line: &Line, kin: &impl Kinematics, next: &Modal) -> Position {
         let mut target = self.modal.target;
         for (i, w) in kin.words().iter().enumerate() {
-            if let Some(v) = value(line, *w) {
-                target[i] = match distance {
+            if let Some(v) = value(line, *w, next.units) {
+                target[i] = match next.distance {
                     Distance::Absolute => v,
                     Distance::Relative => Milli(target[i].0.saturating_add(v.0)),
                 };
@@ -407,12 +455,33 @@ fn check_travel(cfg: &MachineConfig, lo: &Position, hi: &Position) -> Result<(),
     }
 }
 
-/// The value of the axis word named `letter`, if the line has one.
-fn value(line: &Line, letter: u8) -> Option<Milli> {
-    AxisWord::ALL
+/// The value of the axis word named `letter`, if the line has one, in mm
+/// (or degrees: `C` and `A` are angles in either unit).
+fn value(line: &Line, letter: u8, units: Units) -> Option<Milli> {
+    let v = AxisWord::ALL
         .iter()
         .find(|w| w.letter() == letter)
-        .and_then(|w| line.axis(*w))
+        .and_then(|w| line.axis(*w))?;
+    Some(match letter {
+        b'C' | b'A' => v,
+        _ => mm(v, units),
+    })
+}
+
+/// A length in `units` as mm, rounded once.
+fn mm(v: Milli, units: Units) -> Milli {
+    match units {
+        Units::Mm => v,
+        Units::Inch => Milli(crate::units::div_round(v.0 as i64 * 254, 10) as i32),
+    }
+}
+
+/// The pen to `deg`, then its settle time.
+fn pen_order(cfg: &MachineConfig, deg: u8) -> Order {
+    Order::Pen {
+        deg,
+        ms: cfg.pen.settle_ms,
+    }
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 //! | white `zero_radial` button | Y_MIN | D14 | PJ1 |
 //! | white `zero_drill` button | Z_MIN | D18 | PD3 |
 //! | spare end-stops | Y_MAX, Z_MAX | D15, D19 | PJ0, PD2 |
-//! | servos (pen lift) | SERVO0..3 | D11, D6, D5, D4 | PB5, PH3, PE3, PG5 |
+//! | servos (SERVO0: the plotters' pen, Timer1 OC1A) | SERVO0..3 | D11, D6, D5, D4 | PB5, PH3, PE3, PG5 |
 //! | status LED | "L" | D13 | PB7 |
 //! | SD card MISO / MOSI / SCK / CS | AUX-3 | D50 / D51 / D52 / D53 | PB3 / PB2 / PB1 / PB0 |
 //! | serial console (USART0) RX / TX | | D0 / D1 | PE0 / PE1 |
@@ -89,6 +89,9 @@ pub const fn port_bit(pin: u8) -> (Port, u8) {
 pub const fn analog(n: u8) -> u8 {
     54 + n
 }
+
+/// SERVO0: the plotters' pen servo, on Timer1's OC1A.
+pub const PEN_SERVO: u8 = 11;
 
 /// STEP / DIR / ENABLE pins of one driver.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

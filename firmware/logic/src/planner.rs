@@ -23,7 +23,7 @@ use crate::units::Milli;
 use junction::{Corner, Geometry};
 
 /// Number of moves the planner holds.
-pub const PLANNER_BLOCKS: usize = 14;
+pub const PLANNER_BLOCKS: usize = 13;
 
 /// Requested speed of a move.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

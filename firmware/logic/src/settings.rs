@@ -60,6 +60,12 @@ pub enum GlobalField {
     OriginY,
     /// SCARA: the elbow crosstalk ratio (0: none).
     Crosstalk,
+    /// The pen servo's angles, degrees, and its settle time, ms.
+    PenUp,
+    PenDown,
+    PenSettleMs,
+    /// 1: `G4 P` in milliseconds (Marlin), 0: in seconds (Grbl).
+    DwellPMs,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,7 +95,7 @@ const AXIS_FIELDS: [AxisField; 8] = [
     AxisField::TravelMax,
 ];
 
-const GLOBAL_FIELDS: [GlobalField; 11] = [
+const GLOBAL_FIELDS: [GlobalField; 15] = [
     GlobalField::Machine,
     GlobalField::StepPulseUs,
     GlobalField::DirSetupUs,
@@ -101,6 +107,10 @@ const GLOBAL_FIELDS: [GlobalField; 11] = [
     GlobalField::OriginX,
     GlobalField::OriginY,
     GlobalField::Crosstalk,
+    GlobalField::PenUp,
+    GlobalField::PenDown,
+    GlobalField::PenSettleMs,
+    GlobalField::DwellPMs,
 ];
 
 /// Number of settings; [`Setting::index`] is below it.
@@ -135,6 +145,10 @@ impl GlobalField {
             GlobalField::OriginX => "origin_x",
             GlobalField::OriginY => "origin_y",
             GlobalField::Crosstalk => "crosstalk",
+            GlobalField::PenUp => "pen_up",
+            GlobalField::PenDown => "pen_down",
+            GlobalField::PenSettleMs => "pen_settle_ms",
+            GlobalField::DwellPMs => "dwell_p_ms",
         }
     }
 }
@@ -243,6 +257,10 @@ impl Setting {
             Setting::Global(GlobalField::OriginX) => return Value::Milli(g.origin[0]),
             Setting::Global(GlobalField::OriginY) => return Value::Milli(g.origin[1]),
             Setting::Global(GlobalField::Crosstalk) => return Value::Ratio(g.crosstalk),
+            Setting::Global(GlobalField::PenUp) => cfg.pen.up_deg as u32,
+            Setting::Global(GlobalField::PenDown) => cfg.pen.down_deg as u32,
+            Setting::Global(GlobalField::PenSettleMs) => cfg.pen.settle_ms as u32,
+            Setting::Global(GlobalField::DwellPMs) => cfg.dwell_p_ms as u32,
         })
     }
 
@@ -255,6 +273,9 @@ impl Setting {
             Setting::Global(GlobalField::StepPulseUs) => (1, 255),
             Setting::Global(GlobalField::JunctionDeviationUm) => (0, 100_000),
             Setting::Global(GlobalField::ArcToleranceUm) => (1, 100_000),
+            Setting::Global(GlobalField::PenUp | GlobalField::PenDown) => (0, 180),
+            Setting::Global(GlobalField::PenSettleMs) => (0, 5000),
+            Setting::Global(GlobalField::DwellPMs) => (0, 1),
             Setting::Global(_) => (0, 255),
         }
     }
@@ -391,6 +412,10 @@ impl Setting {
             (Setting::Global(GlobalField::EnableSetupUs), _) => cfg.pulse.enable_setup_us = n as u8,
             (Setting::Global(GlobalField::JunctionDeviationUm), _) => cfg.junction_deviation_um = n,
             (Setting::Global(GlobalField::ArcToleranceUm), _) => cfg.arc_tolerance_um = n,
+            (Setting::Global(GlobalField::PenUp), _) => cfg.pen.up_deg = n as u8,
+            (Setting::Global(GlobalField::PenDown), _) => cfg.pen.down_deg = n as u8,
+            (Setting::Global(GlobalField::PenSettleMs), _) => cfg.pen.settle_ms = n as u16,
+            (Setting::Global(GlobalField::DwellPMs), _) => cfg.dwell_p_ms = n == 1,
             (Setting::Global(_), Value::Number(_)) => {}
         }
     }

@@ -6,6 +6,7 @@ pub mod delay;
 pub mod eeprom;
 pub mod flash;
 pub mod gpio;
+pub mod servo;
 pub mod spi;
 pub mod step_timer;
 pub mod usart;

@@ -82,7 +82,7 @@ pub const PIN1: u16 = pin(1);
 #[doc(hidden)]
 pub const PIN2: u16 = pin(2);
 
-/// Defines `__vector_17` (TIMER1_COMPA): the fast path, falling back to the
+/// Defines `__vector_32` (TIMER3_COMPA): the fast path, falling back to the
 /// `extern "avr-interrupt"` handler `$slow` for any other event.
 #[macro_export]
 macro_rules! step_vector {
@@ -93,7 +93,7 @@ macro_rules! step_vector {
         // `EXEC` and `SEGMENTS` are the step interrupt's, as in `on_compare`.
         #[unsafe(naked)]
         #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn __vector_17() {
+        pub unsafe extern "C" fn __vector_32() {
             core::arch::naked_asm!(
                 "push r24",
                 "in r24, 0x3f",
@@ -107,8 +107,8 @@ macro_rules! step_vector {
                 "lds r24, {e}+{masks}+0", "sts {pin0}, r24",
                 "lds r24, {e}+{masks}+1", "sts {pin1}, r24",
                 "lds r24, {e}+{masks}+2", "sts {pin2}, r24",
-                "lds r24, 0x84", "sts {e}+{raised}, r24",
-                "lds r24, 0x85", "sts {e}+{raised}+1, r24",
+                "lds r24, 0x94", "sts {e}+{raised}, r24",
+                "lds r24, 0x95", "sts {e}+{raised}+1, r24",
                 "lds r24, {e}+{fast_ok}",
                 "cpi r24, 0",
                 "brne 3f",
@@ -182,10 +182,10 @@ macro_rules! step_vector {
                 "adc r20, r26", "adc r21, r27",
                 "sts {e}+{interval}, r18", "sts {e}+{interval}+1, r19",
                 "sts {e}+{interval}+2, r20", "sts {e}+{interval}+3, r21",
-                // at = OCR1A + ticks; late if less than LEAD ahead of TCNT1
-                "lds r26, 0x88", "lds r27, 0x89",
+                // at = OCR3A + ticks; late if less than LEAD ahead of TCNT3
+                "lds r26, 0x98", "lds r27, 0x99",
                 "add r26, r24", "adc r27, r25",
-                "lds r18, 0x84", "lds r19, 0x85",
+                "lds r18, 0x94", "lds r19, 0x95",
                 "movw r20, r26",
                 "sub r20, r18", "sbc r21, r19",
                 "cpi r20, {lead}", "cpc r21, r23",
@@ -197,11 +197,11 @@ macro_rules! step_vector {
                 "adiw r24, 1",
                 "sts {e}+{late}+1, r25", "sts {e}+{late}, r24",
                 "4:",
-                "sts 0x89, r27", "sts 0x88, r26", // OCR1A, high byte first
-                // Hold the pulse: TCNT1 - raised >= pulse_ticks.
+                "sts 0x99, r27", "sts 0x98, r26", // OCR3A, high byte first
+                // Hold the pulse: TCNT3 - raised >= pulse_ticks.
                 "lds r20, {e}+{pulse}", "lds r21, {e}+{pulse}+1",
                 "5:",
-                "lds r18, 0x84", "lds r19, 0x85",
+                "lds r18, 0x94", "lds r19, 0x95",
                 "sub r18, r30", "sbc r19, r31",
                 "cp r18, r20", "cpc r19, r21",
                 "brlo 5b",

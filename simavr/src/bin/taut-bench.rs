@@ -16,8 +16,8 @@ use taut_logic::pinmap::driver;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
-/// Timer1 COMPA vector (byte address): the step interrupt.
-const STEP_VECTOR: u32 = 0x44;
+/// Timer3 COMPA vector (byte address): the step interrupt.
+const STEP_VECTOR: u32 = 0x80;
 const TOLERANCE_US: f64 = 2.0;
 const AXES3: [Axis; 3] = [Axis::Base, Axis::Radial, Axis::Drill];
 

@@ -61,6 +61,8 @@ pub enum ErrorKind {
     JobOwnsMotion = 71,
     /// `F` below [`MIN_FEED`] (taut's: Grbl creeps instead).
     FeedTooLow = 72,
+    /// A plotter's `Z` (its pen) with other axis words (taut's).
+    PenWithMove = 73,
 }
 
 /// The slowest feed rate accepted, thousandths of a unit per minute.
@@ -95,6 +97,7 @@ impl ErrorKind {
             ErrorKind::BadChecksum => "Bad checksum",
             ErrorKind::JobOwnsMotion => "A job is running",
             ErrorKind::FeedTooLow => "Feed rate below 10/min",
+            ErrorKind::PenWithMove => "Pen Z with X/Y: one line each",
         }
     }
 }

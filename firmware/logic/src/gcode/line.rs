@@ -58,6 +58,16 @@ pub enum Distance {
     Relative,
 }
 
+/// `G20`/`G21`: the unit of lengths and feeds, modal like [`Distance`].
+/// Angles (the base's `C`) are degrees either way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Units {
+    /// `G20`.
+    Inch,
+    /// `G21`, the default.
+    Mm,
+}
+
 /// `G17`/`G18`/`G19`: the plane arcs turn in, modal like [`Distance`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Plane {
@@ -107,11 +117,21 @@ pub enum Command {
     ReportPosition,
     /// `M400`: answer `ok` only once motion is done.
     WaitIdle,
+    /// `M0`, `M1`: pause once motion is done, until `~` or the green
+    /// button.
+    Pause,
+    /// `M3` (Grbl's servo forks): the pen down, or to `S` degrees.
+    PenDown,
+    /// `M5`: the pen up.
+    PenUp,
+    /// `M300 S<degrees>` (the Inkscape "unicorn" extension, drawbots):
+    /// the pen servo to that angle.
+    Servo,
 }
 
 impl Command {
     /// Every command.
-    pub const ALL: [Command; 11] = [
+    pub const ALL: [Command; 15] = [
         Command::Empty,
         Command::Rapid,
         Command::Linear,
@@ -123,6 +143,10 @@ impl Command {
         Command::DisableDrivers,
         Command::ReportPosition,
         Command::WaitIdle,
+        Command::Pause,
+        Command::PenDown,
+        Command::PenUp,
+        Command::Servo,
     ];
 
     /// The command a G or M number names. G/M numbers are read as
@@ -140,6 +164,10 @@ impl Command {
             (b'M', 18_000) | (b'M', 84_000) => Command::DisableDrivers,
             (b'M', 114_000) => Command::ReportPosition,
             (b'M', 400_000) => Command::WaitIdle,
+            (b'M', 0) | (b'M', 1000) => Command::Pause,
+            (b'M', 3000) => Command::PenDown,
+            (b'M', 5000) => Command::PenUp,
+            (b'M', 300_000) => Command::Servo,
             _ => return None,
         })
     }
@@ -168,6 +196,7 @@ pub struct Line {
     pub checksum: Option<u8>,
     pub distance: Option<Distance>,
     pub plane: Option<Plane>,
+    pub units: Option<Units>,
     pub command: Command,
     /// Axis words, indexed by [`AxisWord::index`].
     pub axes: [MaybeMilli; AXIS_WORDS],
@@ -179,6 +208,8 @@ pub struct Line {
     pub offsets: [MaybeMilli; 3],
     /// `R`: an arc's radius (negative: the longer way round).
     pub r: MaybeMilli,
+    /// `S`, only with `M3` and `M300`: the pen servo's angle, degrees.
+    pub s: MaybeMilli,
 }
 
 impl Line {
@@ -188,12 +219,14 @@ impl Line {
         checksum: None,
         distance: None,
         plane: None,
+        units: None,
         command: Command::Empty,
         axes: [MaybeMilli::NONE; AXIS_WORDS],
         f: MaybeMilli::NONE,
         p: MaybeMilli::NONE,
         offsets: [MaybeMilli::NONE; 3],
         r: MaybeMilli::NONE,
+        s: MaybeMilli::NONE,
     };
 
     pub fn axis(&self, word: AxisWord) -> Option<Milli> {

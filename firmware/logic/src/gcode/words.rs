@@ -4,7 +4,7 @@
 //! then only skipped.
 
 use super::error::{Error, ErrorKind};
-use super::line::{AxisWord, Command, Distance, Line, Plane};
+use super::line::{AxisWord, Command, Distance, Line, Plane, Units};
 use super::number::Number;
 use crate::units::{MaybeMilli, Milli};
 
@@ -28,8 +28,10 @@ pub(super) struct Words {
     command_column: u8,
     distance_column: u8,
     plane_column: u8,
+    units_column: u8,
     axis_column: u8,
     p_column: u8,
+    s_column: u8,
     /// The first `I J K R`.
     arc_column: u8,
 }
@@ -43,8 +45,10 @@ impl Words {
             command_column: 0,
             distance_column: 0,
             plane_column: 0,
+            units_column: 0,
             axis_column: 0,
             p_column: 0,
+            s_column: 0,
             arc_column: 0,
         }
     }
@@ -157,6 +161,18 @@ impl Words {
                 });
                 Ok(())
             }
+            b'G' if value.0 == 20_000 || value.0 == 21_000 => {
+                if self.units_column != 0 {
+                    return error(ErrorKind::ModalGroupViolation);
+                }
+                self.units_column = column;
+                self.line.units = Some(if value.0 == 20_000 {
+                    Units::Inch
+                } else {
+                    Units::Mm
+                });
+                Ok(())
+            }
             b'I' | b'J' | b'K' | b'R' => {
                 let slot = match letter {
                     b'R' => &mut self.line.r,
@@ -195,12 +211,17 @@ impl Words {
                 self.line.command = command;
                 Ok(())
             }
-            b'F' | b'P' => {
-                let slot = if letter == b'F' {
-                    &mut self.line.f
-                } else {
-                    self.p_column = column;
-                    &mut self.line.p
+            b'F' | b'P' | b'S' => {
+                let slot = match letter {
+                    b'F' => &mut self.line.f,
+                    b'P' => {
+                        self.p_column = column;
+                        &mut self.line.p
+                    }
+                    _ => {
+                        self.s_column = column;
+                        &mut self.line.s
+                    }
                 };
                 if slot.is_some() {
                     return error(ErrorKind::RepeatedWord);
@@ -234,10 +255,17 @@ impl Words {
             Command::SetPosition if !has_axes => {
                 return fail(ErrorKind::NoAxisWords, self.command_column)
             }
+            Command::Servo if line.s.get().is_none() => {
+                return fail(ErrorKind::ValueWordMissing, self.command_column)
+            }
             Command::EnableDrivers
             | Command::DisableDrivers
             | Command::ReportPosition
             | Command::WaitIdle
+            | Command::Pause
+            | Command::PenDown
+            | Command::PenUp
+            | Command::Servo
                 if has_axes =>
             {
                 return fail(ErrorKind::UnusedAxisWords, self.axis_column)
@@ -246,6 +274,9 @@ impl Words {
         }
         if line.p.is_some() && line.command != Command::Dwell {
             return fail(ErrorKind::UnusedValueWords, self.p_column);
+        }
+        if line.s.is_some() && !matches!(line.command, Command::PenDown | Command::Servo) {
+            return fail(ErrorKind::UnusedValueWords, self.s_column);
         }
         // Arc words only with an arc (or axis words in an arc's modal
         // mode: the interpreter decides), and `R` or `I J K`, not both.

@@ -303,3 +303,66 @@ fn straight_moves_of_an_arm_are_cut_into_pieces_that_it_reaches() {
     assert_eq!(plan(&mut i, "G1 X100 Y250"), Err(ErrorKind::InvalidTarget));
     assert_eq!(i.target()[..2], [Milli(130_000), Milli(110_000)]);
 }
+
+#[test]
+fn the_pen_of_a_plotter_answers_m3_m5_m300_and_z() {
+    use crate::machine::Machine;
+    let cfg = MachineConfig::defaults(Machine::Flatbed);
+    let kin = crate::kinematics::AnyKinematics::of(&cfg).unwrap();
+    let mut i = Interpreter::new();
+    let mut plan = |text| {
+        let planned = i.plan(&line(text), &kin, &cfg, FREE)?;
+        i.commit(planned);
+        Ok::<_, ErrorKind>(planned.order)
+    };
+    let pen = |deg| Ok(Order::Pen { deg, ms: 150 });
+    assert_eq!(plan("M3"), pen(30));
+    assert_eq!(plan("M5"), pen(50));
+    assert_eq!(plan("M300 S30"), pen(30));
+    assert_eq!(plan("M300 S50"), pen(50));
+    assert_eq!(plan("M3 S12.7"), pen(12));
+    // Seed 002 and gcodetools: Z above 0 is up, 0 or below is down.
+    assert_eq!(plan("G0 Z1"), pen(50));
+    assert_eq!(plan("G1 Z-0.5 F100"), pen(30));
+    assert_eq!(plan("G0 Z0"), pen(30));
+    assert_eq!(plan("G1 X10 Z1"), Err(ErrorKind::PenWithMove));
+    // Z drives no motor: X alone moves only X.
+    assert_eq!(
+        plan("G0 X1"),
+        Ok(Order::Move {
+            steps: [40, 0, 0, 0],
+            feed: Feed::Rapid
+        })
+    );
+    assert_eq!(plan("M0"), Ok(Order::Pause));
+    // The unicorn's `G4 P150` is 150 ms on a plotter.
+    assert_eq!(plan("G4 P150"), Ok(Order::Dwell { ms: 150 }));
+}
+
+#[test]
+fn the_string_art_machine_has_no_pen_and_dwells_in_seconds() {
+    let mut i = Interpreter::new();
+    assert_eq!(run(&mut i, "M3", FREE), Err(ErrorKind::UnsupportedCommand));
+    assert_eq!(
+        run(&mut i, "M300 S30", FREE),
+        Err(ErrorKind::UnsupportedCommand)
+    );
+    assert_eq!(run(&mut i, "G4 P1.5", FREE), Ok(Order::Dwell { ms: 1500 }));
+    // Z is the drill there.
+    assert_eq!(steps(run(&mut i, "G0 Z1.5", FREE)), [0, 0, 200, 0]);
+}
+
+#[test]
+fn inches_are_converted_once_and_angles_stay_degrees() {
+    let mut i = Interpreter::new();
+    // 1 in = 25.4 mm = 812.8 → 813 radial steps; C stays 90°.
+    assert_eq!(steps(run(&mut i, "G20 G0 X1 C90", FREE)), [2400, 813, 0, 0]);
+    // Modal: the next line is in inches too, from the absolute target.
+    assert_eq!(steps(run(&mut i, "G91 X-0.5", FREE)), [2400, 406, 0, 0]);
+    assert_eq!(steps(run(&mut i, "G21 X-12.7", FREE)), [2400, 0, 0, 0]);
+    // F in inches per minute: 0.3 in/min = 7.62 mm/min, below the least.
+    assert_eq!(
+        run(&mut i, "G20 G1 X1 F0.3", FREE),
+        Err(ErrorKind::FeedTooLow)
+    );
+}

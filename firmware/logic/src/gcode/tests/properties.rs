@@ -41,9 +41,22 @@ fn any_line() -> impl Strategy<Value = Line> {
             milli(),
             any::<bool>(),
         ),
+        (
+            prop::option::of(prop_oneof![Just(Units::Inch), Just(Units::Mm)]),
+            prop::option::of(0..=180_000i32),
+        ),
     )
         .prop_map(
-            |(command, distance, mut axes, f, p, n, (plane, mut offsets, r, radius))| {
+            |(
+                command,
+                distance,
+                mut axes,
+                f,
+                p,
+                n,
+                (plane, mut offsets, r, radius),
+                (units, s),
+            )| {
                 let takes_axes = command.uses_axes() || command == Command::Empty;
                 if !takes_axes {
                     axes = [None; AXIS_WORDS];
@@ -57,17 +70,25 @@ fn any_line() -> impl Strategy<Value = Line> {
                 if !arc || radius {
                     offsets = [None; 3];
                 }
+                // `S` only with `M3` (optional) and `M300` (required).
+                let s = match command {
+                    Command::Servo => Some(Milli(s.unwrap_or(90_000))),
+                    Command::PenDown => s.map(Milli),
+                    _ => None,
+                };
                 Line {
                     n,
                     checksum: None,
                     distance,
                     plane,
+                    units,
                     command,
                     axes: axes.map(MaybeMilli::new),
                     f: f.into(),
                     p: p.into(),
                     offsets: offsets.map(MaybeMilli::new),
                     r: r.into(),
+                    s: s.into(),
                 }
             },
         )

@@ -78,6 +78,10 @@ fn command_words(command: Command) -> Option<(u8, &'static [&'static str])> {
         Command::DisableDrivers => (b'M', &["18", "84"]),
         Command::ReportPosition => (b'M', &["114"]),
         Command::WaitIdle => (b'M', &["400", "0400"]),
+        Command::Pause => (b'M', &["0", "00", "1"]),
+        Command::PenDown => (b'M', &["3", "03"]),
+        Command::PenUp => (b'M', &["5", "05.0"]),
+        Command::Servo => (b'M', &["300"]),
     })
 }
 
@@ -108,6 +112,13 @@ fn words(c: &mut Choices, line: &Line) -> Vec<String> {
             word(c, w.letter(), text);
         }
     }
+    if let Some(u) = line.units {
+        let number = match u {
+            Units::Inch => "20",
+            Units::Mm => "21",
+        };
+        word(c, b'G', number.into());
+    }
     if let Some(p) = line.plane {
         let number = match p {
             Plane::Xy => "17",
@@ -124,6 +135,7 @@ fn words(c: &mut Choices, line: &Line) -> Vec<String> {
         (b'J', j),
         (b'K', k),
         (b'R', line.r),
+        (b'S', line.s),
     ] {
         let value = value.get();
         if let Some(m) = value {
