@@ -26,9 +26,6 @@ pub(super) struct Words {
     error: Option<Error>,
     // Columns of words checked once the line is complete; 0 = absent.
     command_column: u8,
-    distance_column: u8,
-    plane_column: u8,
-    units_column: u8,
     axis_column: u8,
     p_column: u8,
     s_column: u8,
@@ -43,9 +40,6 @@ impl Words {
             word: None,
             error: None,
             command_column: 0,
-            distance_column: 0,
-            plane_column: 0,
-            units_column: 0,
             axis_column: 0,
             p_column: 0,
             s_column: 0,
@@ -138,40 +132,26 @@ impl Words {
         }
         match letter {
             b'G' if value.0 == 90_000 || value.0 == 91_000 => {
-                if self.distance_column != 0 {
-                    return error(ErrorKind::ModalGroupViolation);
-                }
-                self.distance_column = column;
-                self.line.distance = Some(if value.0 == 90_000 {
-                    Distance::Absolute
-                } else {
-                    Distance::Relative
-                });
-                Ok(())
+                let d = match value.0 {
+                    90_000 => Distance::Absolute,
+                    _ => Distance::Relative,
+                };
+                modal(&mut self.line.distance, d, column)
             }
             b'G' if matches!(value.0, 17_000..=19_000) && value.0 % 1000 == 0 => {
-                if self.plane_column != 0 {
-                    return error(ErrorKind::ModalGroupViolation);
-                }
-                self.plane_column = column;
-                self.line.plane = Some(match value.0 {
+                let p = match value.0 {
                     17_000 => Plane::Xy,
                     18_000 => Plane::Zx,
                     _ => Plane::Yz,
-                });
-                Ok(())
+                };
+                modal(&mut self.line.plane, p, column)
             }
             b'G' if value.0 == 20_000 || value.0 == 21_000 => {
-                if self.units_column != 0 {
-                    return error(ErrorKind::ModalGroupViolation);
-                }
-                self.units_column = column;
-                self.line.units = Some(if value.0 == 20_000 {
-                    Units::Inch
-                } else {
-                    Units::Mm
-                });
-                Ok(())
+                let u = match value.0 {
+                    20_000 => Units::Inch,
+                    _ => Units::Mm,
+                };
+                modal(&mut self.line.units, u, column)
             }
             b'I' | b'J' | b'K' | b'R' => {
                 let slot = match letter {
@@ -290,4 +270,14 @@ impl Words {
         }
         Ok(line)
     }
+}
+
+/// A modal word (`G90`, `G17`, `G20`…): one of its group per line (Grbl's
+/// error 21).
+fn modal<T>(slot: &mut Option<T>, value: T, column: u8) -> Result<(), Error> {
+    if slot.is_some() {
+        return Err(Error::new(ErrorKind::ModalGroupViolation, column));
+    }
+    *slot = Some(value);
+    Ok(())
 }
