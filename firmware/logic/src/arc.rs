@@ -197,7 +197,8 @@ impl Arc {
         };
         // Each quarter turn k·π/2 the arc sweeps is an extreme: +axis_0,
         // +axis_1, −axis_0, −axis_1 in turn. Rounded as a chord end is,
-        // with a little slack for the rotation's error.
+        // with just under half a µm of slack for the rotation's error (a chord end
+        // rounded up past a radius a little under its half µm).
         let mut k = (from / FRAC_PI_2) as i32 - 1;
         while k as f32 * FRAC_PI_2 <= to {
             if k as f32 * FRAC_PI_2 >= from {
@@ -212,7 +213,7 @@ impl Arc {
                 } else {
                     self.plane.axis_1
                 };
-                let extreme = Milli(round(self.centre[i] + sign * (self.radius + 0.01)));
+                let extreme = Milli(round(self.centre[i] + sign * (self.radius + 0.49)));
                 lo[axis] = lo[axis].min(extreme);
                 hi[axis] = hi[axis].max(extreme);
             }
