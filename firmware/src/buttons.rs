@@ -56,11 +56,12 @@ pub fn start(pins: ButtonPins) {
 
 /// The tick's millisecond sample: queued while a button is down and until
 /// the levels have been quiet long enough to debounce a release. True when
-/// a sample was queued (spawn the buttons task).
-pub fn sample() -> bool {
+/// a sample was queued (spawn the buttons task); and the inputs read (bit =
+/// button), which are also the homing switches.
+pub fn sample() -> (bool, u8) {
     // SAFETY: see `Sampler`.
     let Some((pins, last, quiet)) = (unsafe { &mut *SAMPLER.0.get() }) else {
-        return false;
+        return (false, 0);
     };
     let raw = pins.raw();
     *quiet = if raw == 0 && raw == *last {
@@ -69,7 +70,7 @@ pub fn sample() -> bool {
         0
     };
     *last = raw;
-    *quiet <= DEBOUNCE_MS && SAMPLES.push(raw).is_ok()
+    (*quiet <= DEBOUNCE_MS && SAMPLES.push(raw).is_ok(), raw)
 }
 
 /// The buttons task's state: the debouncer.

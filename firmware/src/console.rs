@@ -14,18 +14,22 @@
 #![deny(unsafe_code)]
 
 use crate::board::clock;
+use crate::endstop;
 use crate::motion::Motion;
 use crate::queues::{Signal, JOB_CLAIMS_TX, RX};
 use crate::reply::{self, Fixed, REPORTED_AXES};
 use crate::rt::{stack, Poll};
+use crate::{info, warn};
 use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::AXES;
 use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::gcode::{Error, ErrorKind, Input, Line, Parser, SystemLine};
+use taut_logic::homing::{self, Homing, Leg, Next};
 use taut_logic::interp::{Allowed, Interpreter, Order, Path};
 use taut_logic::kinematics::Kinematics;
 use taut_logic::planner::Feed;
 use taut_logic::settings;
+use taut_logic::units::Milli;
 use ufmt::{uWrite, uwrite};
 
 pub struct Console {
@@ -49,6 +53,13 @@ enum Pending {
     Line(Line),
     /// A path whose line was taken, its pieces not all queued yet.
     Path { path: Path, feed: Feed },
+    /// Homing (`G28`, `$H`, at power-on), a leg moving or not; `reply`:
+    /// answer `ok` at the end (a line asked for it).
+    Home {
+        homing: Homing,
+        moving: bool,
+        reply: bool,
+    },
 }
 
 #[derive(Clone, Copy)]
@@ -105,7 +116,7 @@ impl Console {
     ) -> Poll<Signal> {
         if self.epoch != m.epoch() {
             self.epoch = m.epoch();
-            if let Some(Pending::Path { .. }) = self.pending {
+            if let Some(Pending::Path { .. } | Pending::Home { .. }) = self.pending {
                 self.pending = None;
             }
             self.interp.resync(kin.forward(&m.target()));
@@ -121,6 +132,7 @@ impl Console {
             // Copied out by itself: a whole `Pending` is arc-sized.
             let line = match &self.pending {
                 Some(Pending::Path { .. }) => return self.next_piece(m, kin),
+                Some(Pending::Home { .. }) => return self.home(m, cfg),
                 Some(Pending::Line(line)) => Some(*line),
                 None => None,
             };
@@ -194,6 +206,7 @@ impl Console {
             }
             // Held like `!`: `~` or the green button goes on.
             Order::Pause => m.hold(),
+            Order::Home { axes } => self.start_homing(*axes, m, true),
             Order::Path { path, feed } => {
                 self.pending = Some(Pending::Path {
                     path: *path,
@@ -205,6 +218,85 @@ impl Console {
             Order::ReportPosition => report_position(m, kin),
         }
         None
+    }
+
+    /// Home `axes` (bits), their drivers on; `reply`: answer the line
+    /// that asked at the end.
+    pub fn start_homing(&mut self, axes: u8, m: &mut Motion, reply: bool) {
+        m.drivers.set(axes, true);
+        self.pending = Some(Pending::Home {
+            homing: Homing::new(axes),
+            moving: false,
+            reply,
+        });
+    }
+
+    /// One step of homing: wait for the leg to end (done, or stopped at
+    /// its switch), then the next leg, the zero, or the end. Out of line:
+    /// the console's frame stays small.
+    #[inline(never)]
+    fn home(&mut self, m: &mut Motion, cfg: &MachineConfig) -> Poll<Signal> {
+        let Some(Pending::Home {
+            homing,
+            moving,
+            reply,
+        }) = self.pending.as_mut()
+        else {
+            return Poll::Again;
+        };
+        // Looked at every 10 ms while a leg moves (the tick wakes it at
+        // once when the switch stops the steps).
+        if *moving && !endstop::hit() && !m.is_idle() {
+            return Poll::After(LEG_POLL_MS);
+        }
+        let hit = endstop::disarm();
+        if hit {
+            // The steps stopped at the switch: drop the rest of the leg
+            // (a stop of our own: homing goes on).
+            m.stop_now();
+            self.epoch = m.epoch();
+        }
+        *moving = false;
+        match homing.next(cfg, hit, endstop::closed(homing.axis())) {
+            Next::Move(leg) => {
+                if leg.until_closed {
+                    endstop::watch(leg.axis);
+                }
+                let to = homing::target(m.target(), &leg);
+                // The machine stands: the planner has room.
+                let _ = m.push(to, leg_feed(cfg, &leg));
+                *moving = true;
+                return Poll::After(LEG_POLL_MS);
+            }
+            Next::Zero { axis, steps } => {
+                let mut at = m.target();
+                at[axis] = steps;
+                m.set_position(at);
+            }
+            Next::Done => {
+                let reply = *reply;
+                self.pending = None;
+                // Resynced through the kinematics on the next run.
+                self.epoch = m.epoch().wrapping_add(1);
+                match reply {
+                    true => reply::ok(),
+                    false => info!("homed"),
+                }
+            }
+            Next::Failed(_) => {
+                let reply = *reply;
+                self.pending = None;
+                self.epoch = m.epoch().wrapping_add(1);
+                // Not homed: motion waits for G28, G92 or $X.
+                m.lose_position();
+                let e = Error::new(ErrorKind::HomingFailed, 0);
+                match reply {
+                    true => reply::error(&e),
+                    false => warn!("homing failed: switch not found or stuck"),
+                }
+            }
+        }
+        Poll::Again
     }
 
     /// Wait `ms` from the first call (motion done): `Some(wait)` until then.
@@ -274,6 +366,16 @@ impl Console {
                 r.send();
             }
             SystemLine::Unlock => m.unlock(),
+            SystemLine::Home if owner == Owner::Job => {
+                return reply::error(&Error::new(ErrorKind::JobOwnsMotion, 0));
+            }
+            SystemLine::Home if !m.is_idle() => {
+                return reply::error(&Error::new(ErrorKind::NotIdle, 0));
+            }
+            SystemLine::Home if cfg.homing.axes == 0 => {
+                return reply::error(&Error::new(ErrorKind::NoHoming, 0));
+            }
+            SystemLine::Home => return self.start_homing(cfg.homing.axes, m, true),
             SystemLine::Set { .. } if owner == Owner::Job => {
                 return reply::error(&Error::new(ErrorKind::JobOwnsMotion, 0));
             }
@@ -345,4 +447,15 @@ fn report_position(m: &Motion, kin: &impl Kinematics) {
         let _ = uwrite!(r, " {}:{}", words[i] as char, steps[i]);
     }
     r.send();
+}
+
+/// How often homing looks whether a leg has ended, ms.
+const LEG_POLL_MS: u16 = 10;
+
+/// The feed that moves `leg`'s axis at its rate: units per minute.
+fn leg_feed(cfg: &MachineConfig, leg: &Leg) -> Feed {
+    let spu = cfg.axes[leg.axis].steps_per_unit;
+    let milli_per_min =
+        u64::from(leg.rate) * 60_000 * u64::from(spu.den) / u64::from(spu.num.max(1));
+    Feed::PerMinute(Milli(milli_per_min.min(i32::MAX as u64) as i32))
 }

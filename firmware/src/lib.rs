@@ -9,6 +9,7 @@ pub mod buttons;
 pub mod card;
 pub mod console;
 pub mod drivers;
+pub mod endstop;
 pub mod job;
 pub mod log;
 pub mod motion;

@@ -53,7 +53,7 @@ use taut_firmware::{
     board::usart::{RXCIE0, UDRIE0},
     nested_vector, step_vector,
 };
-use taut_firmware::{flash_str, info, reply, warn};
+use taut_firmware::{endstop, flash_str, info, reply, warn};
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::kinematics::AnyKinematics;
@@ -227,21 +227,22 @@ fn init() -> Watchdog {
     let mut store = Store::new(Eeprom::new(dp.EEPROM));
     // CONFIG starts as the defaults (naming the constant here would keep a
     // second copy of it in SRAM).
-    let (config, store_now) = CONFIG.with(|c| {
+    // Read in place from here on: a copy would sit on init's stack.
+    let store_now = CONFIG.with(|c| {
         let (config, store_now) = store.load(c);
         *c = config;
-        (config, store_now)
+        store_now
     });
     STORE.with(|s| *s = Some(store));
     // Settings are only taken whole, kinematics included: never `None`.
-    KIN.with(|k| *k = AnyKinematics::of(&config).ok());
+    KIN.with(|k| *k = CONFIG.with(|c| AnyKinematics::of(c).ok()));
     let enable = EnablePins {
         base: pins.d38.into_output(),
         radial: pins.a2.into_output(),
         drill: pins.a8.into_output(),
         aux: pins.d24.into_output(),
     };
-    let drivers = Drivers::new(enable, &config);
+    let drivers = CONFIG.with(|c| Drivers::new(enable, c));
     let step_dir = StepDirPins {
         base_step: pins.a0.into_output_at(false),
         base_dir: pins.a1.into_output_at(false),
@@ -252,15 +253,15 @@ fn init() -> Watchdog {
         aux_step: pins.d26.into_output_at(false),
         aux_dir: pins.d28.into_output_at(false),
     };
-    let stepper = Stepper::new(step_dir, StepTimer::start(dp.TC3), &config);
+    let stepper = CONFIG.with(|c| Stepper::new(step_dir, StepTimer::start(dp.TC3), c));
     // The pen starts up, whatever the machine (SERVO0 is unused on the
     // string-art machine).
     let pen = PenServo::start(
         dp.TC1,
         pins.d11.into_output(),
-        PenConfig::pulse_us(config.pen.up_deg),
+        PenConfig::pulse_us(CONFIG.with(|c| c.pen.up_deg)),
     );
-    MOTION.with(|m| *m = Some(Motion::new(&config, stepper, drivers, pen)));
+    MOTION.with(|m| *m = Some(CONFIG.with(|c| Motion::new(c, stepper, drivers, pen))));
     let spi = CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53);
     CARD.with(|c| *c = Some(CardReader::new(spi)));
     buttons::start(ButtonPins {
@@ -291,13 +292,21 @@ fn init() -> Watchdog {
         true => spawn(Task::Store),
         false => reschedule(Task::Store, Poll::Wait(Signal::Settings)),
     }
-    LED.with(|l| *l = Some((status_led, clock::millis())));
-    spawn(Task::Led);
     spawn_every(Task::Logger, LOGGER_PERIOD_MS);
     spawn_every(Task::Card, card::CHECK_MS);
     JOB.with(|j| j.power_on(clock::millis()));
     spawn(Task::Job);
     spawn(Task::Card);
+    // A machine that homes at power-on (the flatbed's X) does so first.
+    let homing = CONFIG.with(|c| c.homing);
+    if homing.at_start && homing.axes != 0 {
+        info!("homing");
+        MOTION.with(|m| CONSOLE.with(|c| c.start_homing(homing.axes, m.as_mut().unwrap(), false)));
+        spawn(Task::Console);
+    }
+    // Last: the blinks are timed from here, the dispatcher's start.
+    LED.with(|l| *l = Some((status_led, clock::millis())));
+    spawn(Task::Led);
 
     watchdog
 }
@@ -533,8 +542,12 @@ extern "avr-interrupt" fn timer0_compa() {
     if clock::tick() {
         spawn_from_isr(&SPAWNED, Task::Timers as u8);
     }
-    if buttons::sample() {
+    let (sampled, inputs) = buttons::sample();
+    if sampled {
         spawn_from_isr(&SPAWNED, Task::Buttons as u8);
+    }
+    if endstop::on_tick(inputs) {
+        spawn_from_isr(&SPAWNED, Task::Console as u8);
     }
     // The step interrupt's assembly path cannot spawn; it leaves a flag.
     if stepper::take_refill() {

@@ -262,6 +262,11 @@ impl Motion {
         self.lost = false;
     }
 
+    /// The position can no longer be trusted (homing failed).
+    pub fn lose_position(&mut self) {
+        self.lost = true;
+    }
+
     /// See the `epoch` field.
     pub fn epoch(&self) -> u8 {
         self.epoch

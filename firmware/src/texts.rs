@@ -96,5 +96,7 @@ pub fn error(e: ErrorKind) -> FlashStr {
         JobOwnsMotion => JobOwnsMotion,
         FeedTooLow => FeedTooLow,
         PenWithMove => PenWithMove,
+        NoHoming => NoHoming,
+        HomingFailed => HomingFailed,
     ])
 }

@@ -100,6 +100,15 @@ pub fn sample_card_dir() -> PathBuf {
 /// The release image with every machine pin probed under its VCD name
 /// (`<axis>_step|dir|en`, `btn_<button>`, `pen_pwm`), booted.
 pub fn boot_machine() -> sim::Sim {
+    let mut sim = machine();
+    let booted = sim.run_until_uart_contains("reset:", std::time::Duration::from_millis(50));
+    assert_eq!(booted, sim::Outcome::Done);
+    sim
+}
+
+/// The release image with every machine pin probed, not yet run: fit
+/// end-stops or load an EEPROM first.
+pub fn machine() -> sim::Sim {
     use taut_logic::axis::Axis;
     use taut_logic::pinmap::{self, Button};
     let mut sim = sim::Sim::load(&firmware_elf()).unwrap();
@@ -113,8 +122,6 @@ pub fn boot_machine() -> sim::Sim {
         sim.release(b.pin());
         sim.probe(b.pin(), &format!("btn_{}", b.name()));
     }
-    let booted = sim.run_until_uart_contains("reset:", std::time::Duration::from_millis(50));
-    assert_eq!(booted, sim::Outcome::Done);
     sim
 }
 

@@ -250,3 +250,60 @@ fn a_plotter_pauses_at_m0_and_takes_inches() {
     assert_eq!(steps_on_pins(&sim)[0], 1016, "~ went on to X1 in");
     assert!(status(&mut sim).contains("<Idle|"));
 }
+
+/// The flatbed homes X against its MIN switch (X_MIN, D3) at power-on and
+/// on `G28`: seek, pull off, locate slowly, pull off 1 mm, and X is then
+/// 1.000. The harness closes the switch 3 mm (120 steps) below where X
+/// stood at power-on.
+#[test]
+fn the_flatbed_homes_x_against_its_switch_at_power_on_and_on_g28() {
+    use hil_tests::{machine, steps_on_pins, wait_for};
+    use taut_logic::axis::Axis;
+    use taut_logic::pinmap::{driver, Button};
+    let eeprom = {
+        let mut sim = boot_machine();
+        send(&mut sim, "$machine=flatbed");
+        sim.run_for(Duration::from_secs(2));
+        sim.eeprom()
+    };
+    let mut sim = machine();
+    sim.set_eeprom(&eeprom);
+    let x = driver(Axis::Base);
+    sim.endstop(Button::ZeroBase.pin(), x.step, x.dir, true, -120);
+    wait_for(&mut sim, "homed", Duration::from_secs(20));
+    // Pulled off the switch by 1 mm: 40 steps above it, and that is X1.000.
+    assert_eq!(steps_on_pins(&sim)[0], -80, "{}", log_tail(&sim));
+    assert_eq!(hil_tests::reported_steps(&mut sim)[0], 40);
+    send(&mut sim, "M17");
+    send(&mut sim, "G0 X10");
+    send(&mut sim, "M400");
+    assert_eq!(steps_on_pins(&sim)[0], -120 + 400);
+    // A soft-limit violation is refused before any step.
+    let before = steps_on_pins(&sim);
+    match sim.send_line("G0 X150", Duration::from_secs(2)) {
+        Ok(hil_tests::sim::Reply::Error(e)) => assert!(e.starts_with("error:15 "), "{e}"),
+        other => panic!("{other:?}"),
+    }
+    sim.run_for(Duration::from_millis(300));
+    assert_eq!(steps_on_pins(&sim), before);
+    send(&mut sim, "G28");
+    assert_eq!(steps_on_pins(&sim)[0], -80);
+    assert_ram_budget(&sim);
+}
+
+/// Without its switch, homing fails with an error and motion waits for
+/// `G28`, `G92` or `$X`.
+#[test]
+fn homing_without_a_switch_fails_and_locks_motion() {
+    let mut sim = boot_machine();
+    send(&mut sim, "$machine=flatbed");
+    send(&mut sim, "$homing_seek=4000");
+    match sim.send_line("G28", Duration::from_secs(20)) {
+        Ok(hil_tests::sim::Reply::Error(e)) => assert!(e.starts_with("error:75 "), "{e}"),
+        other => panic!("{other:?}"),
+    }
+    match sim.send_line("G0 X1", Duration::from_secs(2)) {
+        Ok(hil_tests::sim::Reply::Error(e)) => assert!(e.starts_with("error:9 "), "{e}"),
+        other => panic!("{other:?}"),
+    }
+}

@@ -69,10 +69,13 @@ fn settings_survive_a_power_cycle() {
     send_ok(&mut again, "M400", Duration::from_secs(30));
     send(&mut again, "$machine=flatbed");
     send(&mut again, "$x_travel_max=150");
+    // No X switch is fitted here (homing has its own test).
+    send(&mut again, "$homing_at_start=0");
     again.run_for(Duration::from_secs(2));
     let mut third = power_on(&again.eeprom());
     assert_eq!(listed(&mut third, "machine"), "flatbed");
     assert_eq!(listed(&mut third, "x_travel_max"), "150.000");
+    assert_eq!(listed(&mut third, "homing_at_start"), "0");
 }
 
 #[test]

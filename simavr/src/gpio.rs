@@ -56,6 +56,10 @@ impl Sim {
         })
     }
 
+    pub(crate) fn probe_of(&self, pin: u8) -> &Probe {
+        self.probe_on(pin)
+    }
+
     fn probe_on(&self, pin: u8) -> &Probe {
         self.probes()
             .iter()

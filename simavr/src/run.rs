@@ -93,6 +93,7 @@ impl Sim {
         while let Some((pin, high)) = self.schedule.pop_due(now) {
             self.drive(pin, high);
         }
+        self.update_endstops();
         let slot = &mut self.shared_mut().sd;
         slot.apply_due(now);
         let card_due = slot.next_due().unwrap_or(u64::MAX);

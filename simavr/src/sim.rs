@@ -70,6 +70,7 @@ pub struct Sim {
     /// A fatal ending, repeated by every later run.
     pub(crate) ended: Option<Outcome>,
     pub(crate) schedule: PinSchedule,
+    pub(crate) endstops: Vec<crate::endstop::Endstop>,
     /// Externally driven pins per port, in `Port` order: (mask, levels).
     external: [(u8, u8); 11],
     pub(crate) step_dir: Vec<StepDir>,
@@ -178,6 +179,7 @@ impl Sim {
             last_avr_cycle: 0,
             ended: None,
             schedule: PinSchedule::default(),
+            endstops: Vec::new(),
             external: [(0, 0); 11],
             step_dir: Vec::new(),
             last_speed: None,

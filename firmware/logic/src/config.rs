@@ -3,6 +3,7 @@
 //! on the card and `$` settings override them.
 
 use crate::axis::{Axis, PerAxis};
+use crate::homing::HomingConfig;
 use crate::machine::Machine;
 use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
@@ -52,6 +53,8 @@ pub struct MachineConfig {
     pub machine: Machine,
     /// The plotters' pen servo.
     pub pen: PenConfig,
+    /// Which axes home against their MIN switches, and how.
+    pub homing: HomingConfig,
     /// `G4 P` in milliseconds (Marlin's reading, what the Inkscape
     /// "unicorn" extension writes) rather than seconds (Grbl's).
     pub dwell_p_ms: bool,
@@ -161,14 +164,20 @@ impl MachineConfig {
                     axis(StepsPerUnit::new(2_048_000, 282_743), 600, 1500, None),
                 ],
             ),
-            // EasyDriver at 1/8 step: 0.025 mm a step; X 140 mm.
-            Machine::Flatbed => plotter(
-                machine,
-                [
-                    axis(StepsPerUnit::new(40, 1), 2000, 4000, Some((0, 140))),
-                    axis(StepsPerUnit::new(40, 1), 2000, 4000, None),
-                ],
-            ),
+            // EasyDriver at 1/8 step: 0.025 mm a step; X 140 mm, homed
+            // against its switch at power-on.
+            Machine::Flatbed => {
+                let mut cfg = plotter(
+                    machine,
+                    [
+                        axis(StepsPerUnit::new(40, 1), 2000, 4000, Some((0, 140))),
+                        axis(StepsPerUnit::new(40, 1), 2000, 4000, None),
+                    ],
+                );
+                cfg.homing.axes = 1;
+                cfg.homing.at_start = true;
+                cfg
+            }
             // 2000 steps a turn on a 9-tooth sprocket of ½" chain
             // (114.3 mm a turn); the motors 1.2 m apart, the drawing's
             // origin 0.6 m right of and below the left one.
@@ -206,16 +215,18 @@ impl MachineConfig {
     pub fn validate(&self) -> Result<(), ErrorKind> {
         for (a, axis) in Axis::ALL.into_iter().zip(&self.axes) {
             if axis.steps_per_unit.num == 0 || axis.steps_per_unit.den == 0 {
-                return Err(ErrorKind::Invalid("steps_per_unit"));
+                return Err(ErrorKind::Invalid(taut_progmem::text!("steps_per_unit")));
             }
             if axis.max_rate == 0 || axis.max_rate > 200_000 {
-                return Err(ErrorKind::Invalid("max_rate"));
+                return Err(ErrorKind::Invalid(taut_progmem::text!("max_rate")));
             }
             if axis.accel == 0 {
-                return Err(ErrorKind::Invalid("accel"));
+                return Err(ErrorKind::Invalid(taut_progmem::text!("accel")));
             }
             if axis.travel.0 > axis.travel.1 {
-                return Err(ErrorKind::Invalid("travel_min above travel_max"));
+                return Err(ErrorKind::Invalid(taut_progmem::text!(
+                    "travel_min above travel_max"
+                )));
             }
             // The pulse must fit the step period at the highest rate, with
             // as long a low time (the step interrupt holds it high).
@@ -229,7 +240,7 @@ impl MachineConfig {
             }
         }
         if self.pulse.step_pulse_us == 0 {
-            return Err(ErrorKind::Invalid("step_pulse_us"));
+            return Err(ErrorKind::Invalid(taut_progmem::text!("step_pulse_us")));
         }
         Ok(())
     }
@@ -274,6 +285,7 @@ const fn plotter(machine: Machine, xy: [AxisConfig; 2]) -> MachineConfig {
         arc_tolerance_um: 10,
         machine,
         pen: PenConfig::UNICORN,
+        homing: HomingConfig::NONE,
         dwell_p_ms: !machine.is_string_art(),
         geometry: Geometry::NONE,
     }

@@ -50,6 +50,10 @@ pub enum Order {
     },
     /// Hold once motion is done, until `~` or the green button (`M0`).
     Pause,
+    /// Home these axes (bits) once motion is done.
+    Home {
+        axes: u8,
+    },
     /// Take these steps as the position (once motion is done).
     SetPosition {
         steps: Steps,
@@ -183,7 +187,10 @@ impl Interpreter {
         let moves = has_axes
             || matches!(
                 line.command,
-                Command::EnableDrivers | Command::DisableDrivers | Command::SetPosition
+                Command::EnableDrivers
+                    | Command::DisableDrivers
+                    | Command::SetPosition
+                    | Command::Home
             );
         if moves && !allowed.motion {
             return Err(ErrorKind::JobOwnsMotion);
@@ -286,6 +293,10 @@ impl Interpreter {
                 pen_order(cfg, deg)
             }
             Command::Pause => Order::Pause,
+            Command::Home if cfg.homing.axes == 0 => return Err(ErrorKind::NoHoming),
+            Command::Home => Order::Home {
+                axes: cfg.homing.axes,
+            },
             Command::SetPosition => {
                 for (i, w) in kin.words().iter().enumerate() {
                     if let Some(v) = value(line, *w, next.units) {

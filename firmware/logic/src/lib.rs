@@ -21,6 +21,7 @@ pub mod files;
 pub mod fmath;
 pub mod gcode;
 pub mod geometry;
+pub mod homing;
 pub mod interp;
 pub mod kinematics;
 pub mod machine;

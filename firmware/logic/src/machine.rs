@@ -4,6 +4,7 @@
 //! kinematics `AnyKinematics::of`.
 
 use crate::axis::{Axis, AXES};
+use taut_progmem::{text, Text};
 
 /// The string-art machine's words: base `C`, radial `X`, drill `Z`.
 pub const CYLINDRICAL: [u8; AXES] = *b"CXZA";
@@ -35,13 +36,13 @@ impl Machine {
     ];
 
     /// The name `$machine=` takes and `$$` prints.
-    pub const fn name(self) -> &'static str {
+    pub fn name(self) -> Text {
         match self {
-            Machine::StringArt => "string_art",
-            Machine::Drum => "drum",
-            Machine::Flatbed => "flatbed",
-            Machine::Whiteboard => "whiteboard",
-            Machine::Scara => "scara",
+            Machine::StringArt => text!("string_art"),
+            Machine::Drum => text!("drum"),
+            Machine::Flatbed => text!("flatbed"),
+            Machine::Whiteboard => text!("whiteboard"),
+            Machine::Scara => text!("scara"),
         }
     }
 
@@ -49,7 +50,7 @@ impl Machine {
     pub fn parse(name: &[u8]) -> Option<Machine> {
         Machine::ALL
             .into_iter()
-            .find(|m| name.eq_ignore_ascii_case(m.name().as_bytes()))
+            .find(|m| m.name().eq_ignore_ascii_case(name))
     }
 
     pub fn from_index(i: u8) -> Option<Machine> {
@@ -58,14 +59,20 @@ impl Machine {
 
     /// What the machine calls each channel: setting names
     /// (`<channel>_max_rate`), log lines and the VCD's signals.
-    pub const fn channel(self, axis: Axis) -> &'static str {
-        let names = match self {
-            Machine::StringArt => ["base", "radial", "drill", "aux"],
-            Machine::Drum | Machine::Flatbed => ["x", "y", "z", "aux"],
-            Machine::Whiteboard => ["left", "right", "z", "aux"],
-            Machine::Scara => ["shoulder", "elbow", "z", "aux"],
-        };
-        names[axis.index()]
+    pub fn channel(self, axis: Axis) -> Text {
+        match (self, axis) {
+            (_, Axis::Aux) => text!("aux"),
+            (Machine::StringArt, Axis::Base) => text!("base"),
+            (Machine::StringArt, Axis::Radial) => text!("radial"),
+            (Machine::StringArt, Axis::Drill) => text!("drill"),
+            (_, Axis::Drill) => text!("z"),
+            (Machine::Drum | Machine::Flatbed, Axis::Base) => text!("x"),
+            (Machine::Drum | Machine::Flatbed, Axis::Radial) => text!("y"),
+            (Machine::Whiteboard, Axis::Base) => text!("left"),
+            (Machine::Whiteboard, Axis::Radial) => text!("right"),
+            (Machine::Scara, Axis::Base) => text!("shoulder"),
+            (Machine::Scara, Axis::Radial) => text!("elbow"),
+        }
     }
 
     /// The G-code word of each coordinate.

@@ -12,6 +12,7 @@ use crate::machine::Machine;
 use crate::text::num::{parse_milli, parse_ratio, parse_u32, trim, NumError};
 use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
+use taut_progmem::{text, Text};
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
 pub mod image;
@@ -66,6 +67,13 @@ pub enum GlobalField {
     PenSettleMs,
     /// 1: `G4 P` in milliseconds (Marlin), 0: in seconds (Grbl).
     DwellPMs,
+    /// Homing: the axes (bit per channel), at power-on or not, the seek
+    /// and locate rates (steps/s), the pull-off (mm).
+    HomingAxes,
+    HomingAtStart,
+    HomingSeek,
+    HomingLocate,
+    HomingPullOff,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,7 +103,7 @@ const AXIS_FIELDS: [AxisField; 8] = [
     AxisField::TravelMax,
 ];
 
-const GLOBAL_FIELDS: [GlobalField; 15] = [
+const GLOBAL_FIELDS: [GlobalField; 20] = [
     GlobalField::Machine,
     GlobalField::StepPulseUs,
     GlobalField::DirSetupUs,
@@ -111,44 +119,54 @@ const GLOBAL_FIELDS: [GlobalField; 15] = [
     GlobalField::PenDown,
     GlobalField::PenSettleMs,
     GlobalField::DwellPMs,
+    GlobalField::HomingAxes,
+    GlobalField::HomingAtStart,
+    GlobalField::HomingSeek,
+    GlobalField::HomingLocate,
+    GlobalField::HomingPullOff,
 ];
 
 /// Number of settings; [`Setting::index`] is below it.
 pub const COUNT: usize = AXES * AXIS_FIELDS.len() + GLOBAL_FIELDS.len();
 
 impl AxisField {
-    pub const fn name(self) -> &'static str {
+    pub fn name(self) -> Text {
         match self {
-            AxisField::StepsPerUnit => "steps_per_unit",
-            AxisField::MaxRate => "max_rate",
-            AxisField::Accel => "accel",
-            AxisField::DirInvert => "dir_invert",
-            AxisField::EnableActiveHigh => "enable_active_high",
-            AxisField::SoftLimits => "soft_limits",
-            AxisField::TravelMin => "travel_min",
-            AxisField::TravelMax => "travel_max",
+            AxisField::StepsPerUnit => text!("steps_per_unit"),
+            AxisField::MaxRate => text!("max_rate"),
+            AxisField::Accel => text!("accel"),
+            AxisField::DirInvert => text!("dir_invert"),
+            AxisField::EnableActiveHigh => text!("enable_active_high"),
+            AxisField::SoftLimits => text!("soft_limits"),
+            AxisField::TravelMin => text!("travel_min"),
+            AxisField::TravelMax => text!("travel_max"),
         }
     }
 }
 
 impl GlobalField {
-    pub const fn name(self) -> &'static str {
+    pub fn name(self) -> Text {
         match self {
-            GlobalField::StepPulseUs => "step_pulse_us",
-            GlobalField::DirSetupUs => "dir_setup_us",
-            GlobalField::EnableSetupUs => "enable_setup_us",
-            GlobalField::JunctionDeviationUm => "junction_deviation_um",
-            GlobalField::ArcToleranceUm => "arc_tolerance_um",
-            GlobalField::Machine => "machine",
-            GlobalField::Length1 => "length_1",
-            GlobalField::Length2 => "length_2",
-            GlobalField::OriginX => "origin_x",
-            GlobalField::OriginY => "origin_y",
-            GlobalField::Crosstalk => "crosstalk",
-            GlobalField::PenUp => "pen_up",
-            GlobalField::PenDown => "pen_down",
-            GlobalField::PenSettleMs => "pen_settle_ms",
-            GlobalField::DwellPMs => "dwell_p_ms",
+            GlobalField::StepPulseUs => text!("step_pulse_us"),
+            GlobalField::DirSetupUs => text!("dir_setup_us"),
+            GlobalField::EnableSetupUs => text!("enable_setup_us"),
+            GlobalField::JunctionDeviationUm => text!("junction_deviation_um"),
+            GlobalField::ArcToleranceUm => text!("arc_tolerance_um"),
+            GlobalField::Machine => text!("machine"),
+            GlobalField::Length1 => text!("length_1"),
+            GlobalField::Length2 => text!("length_2"),
+            GlobalField::OriginX => text!("origin_x"),
+            GlobalField::OriginY => text!("origin_y"),
+            GlobalField::Crosstalk => text!("crosstalk"),
+            GlobalField::PenUp => text!("pen_up"),
+            GlobalField::PenDown => text!("pen_down"),
+            GlobalField::PenSettleMs => text!("pen_settle_ms"),
+            GlobalField::DwellPMs => text!("dwell_p_ms"),
+            GlobalField::HomingAxes => text!("homing_axes"),
+            GlobalField::HomingAtStart => text!("homing_at_start"),
+            GlobalField::HomingSeek => text!("homing_seek"),
+            GlobalField::HomingLocate => text!("homing_locate"),
+            GlobalField::HomingPullOff => text!("homing_pull_off"),
         }
     }
 }
@@ -188,21 +206,20 @@ impl Setting {
     /// The setting named `key`, in any case, on `machine`.
     pub fn parse(key: &[u8], machine: Machine) -> Option<Setting> {
         for axis in Axis::ALL {
-            let prefix = machine.channel(axis).as_bytes();
-            let named = key.len() > prefix.len()
-                && key[..prefix.len()].eq_ignore_ascii_case(prefix)
-                && key[prefix.len()] == b'_';
+            let prefix = machine.channel(axis);
+            let named =
+                key.len() > prefix.len() && prefix.is_prefix_of(key) && key[prefix.len()] == b'_';
             if named {
                 let rest = &key[prefix.len() + 1..];
                 let field = AXIS_FIELDS
                     .into_iter()
-                    .find(|f| rest.eq_ignore_ascii_case(f.name().as_bytes()))?;
+                    .find(|f| f.name().eq_ignore_ascii_case(rest))?;
                 return Some(Setting::Axis(axis, field));
             }
         }
         GLOBAL_FIELDS
             .into_iter()
-            .find(|f| key.eq_ignore_ascii_case(f.name().as_bytes()))
+            .find(|f| f.name().eq_ignore_ascii_case(key))
             .map(Setting::Global)
     }
 
@@ -261,6 +278,13 @@ impl Setting {
             Setting::Global(GlobalField::PenDown) => cfg.pen.down_deg as u32,
             Setting::Global(GlobalField::PenSettleMs) => cfg.pen.settle_ms as u32,
             Setting::Global(GlobalField::DwellPMs) => cfg.dwell_p_ms as u32,
+            Setting::Global(GlobalField::HomingAxes) => cfg.homing.axes as u32,
+            Setting::Global(GlobalField::HomingAtStart) => cfg.homing.at_start as u32,
+            Setting::Global(GlobalField::HomingSeek) => cfg.homing.seek as u32,
+            Setting::Global(GlobalField::HomingLocate) => cfg.homing.locate as u32,
+            Setting::Global(GlobalField::HomingPullOff) => {
+                return Value::Milli(Milli(i32::from(cfg.homing.pull_off_um)))
+            }
         })
     }
 
@@ -275,7 +299,9 @@ impl Setting {
             Setting::Global(GlobalField::ArcToleranceUm) => (1, 100_000),
             Setting::Global(GlobalField::PenUp | GlobalField::PenDown) => (0, 180),
             Setting::Global(GlobalField::PenSettleMs) => (0, 5000),
-            Setting::Global(GlobalField::DwellPMs) => (0, 1),
+            Setting::Global(GlobalField::DwellPMs | GlobalField::HomingAtStart) => (0, 1),
+            Setting::Global(GlobalField::HomingAxes) => (0, (1 << AXES) - 1),
+            Setting::Global(GlobalField::HomingSeek | GlobalField::HomingLocate) => (1, 65_535),
             Setting::Global(_) => (0, 255),
         }
     }
@@ -305,7 +331,7 @@ impl Setting {
                     })
                 }
             },
-            Setting::Global(Length1 | Length2 | OriginX | OriginY) => {
+            Setting::Global(Length1 | Length2 | OriginX | OriginY | HomingPullOff) => {
                 Value::Milli(parse_milli(text)?)
             }
             Setting::Global(Crosstalk) => Value::Ratio(parse_ratio(text)?),
@@ -342,13 +368,22 @@ impl Setting {
         match (self, value) {
             (Setting::Global(Machine), Value::Machine(_)) => Ok(()),
             (Setting::Global(Length1 | Length2 | OriginX | OriginY), Value::Milli(_)) => Ok(()),
+            (Setting::Global(HomingPullOff), Value::Milli(m)) => {
+                match (0..=65_535).contains(&m.0) {
+                    true => Ok(()),
+                    false => Err(ErrorKind::Invalid(HomingPullOff.name())),
+                }
+            }
             (Setting::Global(Crosstalk), Value::Ratio(r)) => match r.den != 0 {
                 true => Ok(()),
                 false => Err(ErrorKind::Invalid(Crosstalk.name())),
             },
-            (Setting::Global(Machine | Length1 | Length2 | OriginX | OriginY | Crosstalk), _) => {
-                Err(ErrorKind::NotANumber)
-            }
+            (
+                Setting::Global(
+                    Machine | Length1 | Length2 | OriginX | OriginY | Crosstalk | HomingPullOff,
+                ),
+                _,
+            ) => Err(ErrorKind::NotANumber),
             (Setting::Axis(_, AxisField::StepsPerUnit), Value::Ratio(r)) => {
                 match r.num != 0 && r.den != 0 {
                     true => Ok(()),
@@ -405,6 +440,9 @@ impl Setting {
             (Setting::Global(GlobalField::Crosstalk), Value::Ratio(r)) => {
                 cfg.geometry.crosstalk = r
             }
+            (Setting::Global(GlobalField::HomingPullOff), Value::Milli(m)) => {
+                cfg.homing.pull_off_um = m.0 as u16
+            }
             (_, Value::Ratio(_) | Value::Milli(_) | Value::Machine(_)) => {}
             // The ranges keep these within u8.
             (Setting::Global(GlobalField::StepPulseUs), _) => cfg.pulse.step_pulse_us = n as u8,
@@ -416,6 +454,10 @@ impl Setting {
             (Setting::Global(GlobalField::PenDown), _) => cfg.pen.down_deg = n as u8,
             (Setting::Global(GlobalField::PenSettleMs), _) => cfg.pen.settle_ms = n as u16,
             (Setting::Global(GlobalField::DwellPMs), _) => cfg.dwell_p_ms = n == 1,
+            (Setting::Global(GlobalField::HomingAxes), _) => cfg.homing.axes = n as u8,
+            (Setting::Global(GlobalField::HomingAtStart), _) => cfg.homing.at_start = n == 1,
+            (Setting::Global(GlobalField::HomingSeek), _) => cfg.homing.seek = n as u16,
+            (Setting::Global(GlobalField::HomingLocate), _) => cfg.homing.locate = n as u16,
             (Setting::Global(_), Value::Number(_)) => {}
         }
     }
@@ -427,7 +469,7 @@ pub fn check_whole(cfg: &MachineConfig) -> Result<(), ErrorKind> {
     cfg.validate()?;
     match AnyKinematics::of(cfg) {
         Ok(_) => Ok(()),
-        Err(_) => Err(ErrorKind::Invalid("geometry")),
+        Err(_) => Err(ErrorKind::Invalid(text!("geometry"))),
     }
 }
 
@@ -439,7 +481,7 @@ impl uDisplay for Named {
     fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
         match self.0 {
             Setting::Axis(a, field) => uwrite!(f, "{}_{}", self.1.channel(a), field.name()),
-            Setting::Global(g) => f.write_str(g.name()),
+            Setting::Global(g) => uwrite!(f, "{}", g.name()),
         }
     }
 }
@@ -449,7 +491,7 @@ impl uDisplay for Value {
     fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
         match *self {
             Value::Number(n) => uwrite!(f, "{}", n),
-            Value::Machine(m) => f.write_str(m.name()),
+            Value::Machine(m) => uwrite!(f, "{}", m.name()),
             Value::Ratio(r) if r.den == 1 => uwrite!(f, "{}", r.num),
             Value::Ratio(r) => uwrite!(f, "{}/{}", r.num, r.den),
             Value::Milli(m) => {
@@ -570,7 +612,7 @@ mod tests {
         // A geometry its kinematics cannot use is refused.
         set(&mut cfg, "machine", "whiteboard").unwrap();
         let e = set(&mut cfg, "origin_y", "5").unwrap_err();
-        assert_eq!(e.kind, ErrorKind::Invalid("geometry"));
+        assert_eq!(e.kind, ErrorKind::Invalid(text!("geometry")));
         assert_eq!(cfg, MachineConfig::defaults(Machine::Whiteboard));
     }
 
@@ -633,7 +675,7 @@ mod tests {
             );
             let text = match s {
                 _ if ratio => std::format!("{}/{}", n.max(1), den),
-                Setting::Global(GlobalField::Machine) => Machine::ALL[n as usize % 5].name().into(),
+                Setting::Global(GlobalField::Machine) => std::string::ToString::to_string(&Machine::ALL[n as usize % 5].name()),
                 _ => std::format!("{n}"),
             };
             let listed = match s {

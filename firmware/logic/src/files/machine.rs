@@ -67,7 +67,9 @@ fn apply(cfg: &mut MachineConfig, seen: &mut u64, item: Item<'_>) -> Result<(), 
     }
     // The machine loads its defaults whole: it would undo the lines above.
     if setting == Setting::Global(GlobalField::Machine) && *seen != 0 {
-        return Err(at_key(ErrorKind::Invalid("machine: the first key")));
+        return Err(at_key(ErrorKind::Invalid(taut_progmem::text!(
+            "machine: the first key"
+        ))));
     }
     *seen |= bit;
     // Values are trimmed ASCII up to any error, so bytes are columns.

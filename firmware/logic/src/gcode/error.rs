@@ -63,6 +63,11 @@ pub enum ErrorKind {
     FeedTooLow = 72,
     /// A plotter's `Z` (its pen) with other axis words (taut's).
     PenWithMove = 73,
+    /// `G28`/`$H` on a machine with no axis set to home (taut's).
+    NoHoming = 74,
+    /// The homing cycle found no switch, or it stayed closed (Grbl's
+    /// alarms 8 and 9; taut's code).
+    HomingFailed = 75,
 }
 
 /// The slowest feed rate accepted, thousandths of a unit per minute.
@@ -98,6 +103,8 @@ impl ErrorKind {
             ErrorKind::JobOwnsMotion => "A job is running",
             ErrorKind::FeedTooLow => "Feed rate below 10/min",
             ErrorKind::PenWithMove => "Pen Z with X/Y: one line each",
+            ErrorKind::NoHoming => "No axis homes (homing_axes)",
+            ErrorKind::HomingFailed => "Homing failed: switch not found or stuck",
         }
     }
 }

@@ -117,6 +117,8 @@ pub enum Command {
     ReportPosition,
     /// `M400`: answer `ok` only once motion is done.
     WaitIdle,
+    /// `G28`: home the machine's homing axes against their switches.
+    Home,
     /// `M0`, `M1`: pause once motion is done, until `~` or the green
     /// button.
     Pause,
@@ -131,7 +133,7 @@ pub enum Command {
 
 impl Command {
     /// Every command.
-    pub const ALL: [Command; 15] = [
+    pub const ALL: [Command; 16] = [
         Command::Empty,
         Command::Rapid,
         Command::Linear,
@@ -143,6 +145,7 @@ impl Command {
         Command::DisableDrivers,
         Command::ReportPosition,
         Command::WaitIdle,
+        Command::Home,
         Command::Pause,
         Command::PenDown,
         Command::PenUp,
@@ -160,6 +163,7 @@ impl Command {
             (b'G', 3000) => Command::ArcCcw,
             (b'G', 4000) => Command::Dwell,
             (b'G', 92_000) => Command::SetPosition,
+            (b'G', 28_000) => Command::Home,
             (b'M', 17_000) => Command::EnableDrivers,
             (b'M', 18_000) | (b'M', 84_000) => Command::DisableDrivers,
             (b'M', 114_000) => Command::ReportPosition,

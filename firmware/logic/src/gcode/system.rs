@@ -21,6 +21,8 @@ pub enum SystemLine {
     /// `$X`: take the position as known again after a stop at once
     /// (Grbl's alarm unlock).
     Unlock,
+    /// `$H`: home (Grbl's homing cycle).
+    Home,
     /// `$<key>=<value>`, both as typed; the settings module interprets
     /// them (e.g. with [`parse_milli`](super::parse_milli)).
     Set { key: SystemText, value: SystemText },
@@ -94,6 +96,7 @@ impl SystemBuilder {
             "Q" | "q" => Ok(SystemLine::QueueStats),
             "S" | "s" => Ok(SystemLine::Stack),
             "X" | "x" => Ok(SystemLine::Unlock),
+            "H" | "h" => Ok(SystemLine::Home),
             _ => Err(Error::new(ErrorKind::InvalidStatement, self.dollar)),
         }
     }

@@ -242,6 +242,7 @@ impl Words {
             | Command::DisableDrivers
             | Command::ReportPosition
             | Command::WaitIdle
+            | Command::Home
             | Command::Pause
             | Command::PenDown
             | Command::PenUp

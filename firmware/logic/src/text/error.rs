@@ -51,7 +51,7 @@ pub enum ErrorKind {
         found: u32,
     },
     /// The machine configuration as a whole is inconsistent (names the field).
-    Invalid(&'static str),
+    Invalid(taut_progmem::Text),
     /// The file is UTF-16 (starts with its byte-order mark).
     Utf16,
     /// A control byte no text file holds (a binary file, or UTF-16

@@ -78,6 +78,7 @@ fn command_words(command: Command) -> Option<(u8, &'static [&'static str])> {
         Command::DisableDrivers => (b'M', &["18", "84"]),
         Command::ReportPosition => (b'M', &["114"]),
         Command::WaitIdle => (b'M', &["400", "0400"]),
+        Command::Home => (b'G', &["28", "28.0"]),
         Command::Pause => (b'M', &["0", "00", "1"]),
         Command::PenDown => (b'M', &["3", "03"]),
         Command::PenUp => (b'M', &["5", "05.0"]),

@@ -1,0 +1,176 @@
+//! Homing (`G28`, `$H`, the flatbed's start-up), Grbl's cycle, one axis
+//! after the other: seek the MIN switch fast, pull off, locate it slowly,
+//! pull off again; the axis then stands at its travel's start plus the
+//! pull-off. The firmware carries out each [`Leg`]: a move of one axis
+//! that stops at once when its switch closes, if asked to.
+
+use crate::axis::{PerAxis, AXES};
+use crate::config::MachineConfig;
+
+/// Homing's figures (Grbl's `$24`–`$27`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HomingConfig {
+    /// Bit `i`: channel `i` homes against its MIN switch.
+    pub axes: u8,
+    /// Home them at power-on (the flatbed's X).
+    pub at_start: bool,
+    /// Seeking and locating rates, steps/s.
+    pub seek: u16,
+    pub locate: u16,
+    /// How far off the switch the axis ends, µm.
+    pub pull_off_um: u16,
+}
+
+impl HomingConfig {
+    pub const NONE: HomingConfig = HomingConfig {
+        axes: 0,
+        at_start: false,
+        seek: 1000,
+        locate: 100,
+        pull_off_um: 1000,
+    };
+}
+
+/// A move of one axis, `steps` from where it stands, at `rate` steps/s;
+/// with `until_closed` it stops at once when its switch closes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Leg {
+    pub axis: usize,
+    pub steps: i32,
+    pub rate: u16,
+    pub until_closed: bool,
+}
+
+/// Why homing stopped short: the axis is then not homed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HomingError {
+    /// The switch never closed over the whole travel and more.
+    NotFound,
+    /// The switch stayed closed after the pull-off.
+    Stuck,
+}
+
+/// What to do next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Next {
+    Move(Leg),
+    /// Take `steps` as this axis's position (it stands pulled off).
+    Zero {
+        axis: usize,
+        steps: i32,
+    },
+    Done,
+    Failed(HomingError),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    Seek,
+    Release,
+    Locate,
+    PullOff,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Homing {
+    /// Axes still to home (bits).
+    left: u8,
+    axis: usize,
+    phase: Option<Phase>,
+}
+
+impl Homing {
+    pub fn new(axes: u8) -> Homing {
+        Homing {
+            left: axes & ((1 << AXES) - 1),
+            axis: 0,
+            phase: None,
+        }
+    }
+
+    /// The axis being homed.
+    pub fn axis(&self) -> usize {
+        self.axis
+    }
+
+    /// The next step, once the last leg ended: `hit` says whether its
+    /// switch closed and stopped it, `closed` whether the switch is closed
+    /// now.
+    pub fn next(&mut self, cfg: &MachineConfig, hit: bool, closed: bool) -> Next {
+        let h = &cfg.homing;
+        let a = &cfg.axes[self.axis];
+        let mm = |um: i32| a.steps_per_unit.steps(crate::units::Milli(um));
+        let pull_off = mm(i32::from(h.pull_off_um)).max(1);
+        let leg = |steps, rate, until_closed| {
+            Next::Move(Leg {
+                axis: self.axis,
+                steps,
+                rate,
+                until_closed,
+            })
+        };
+        match self.phase {
+            None => {
+                if self.left == 0 {
+                    return Next::Done;
+                }
+                self.axis = self.left.trailing_zeros() as usize;
+                self.phase = Some(Phase::Seek);
+                let a = &cfg.axes[self.axis];
+                // Past the whole travel (or 200 units when it has none).
+                let span = match a.travel.1 .0 - a.travel.0 .0 {
+                    0 => 200_000,
+                    span => span,
+                };
+                let far = a.steps_per_unit.steps(crate::units::Milli(span));
+                Next::Move(Leg {
+                    axis: self.axis,
+                    steps: -(far / 2 * 3),
+                    rate: h.seek,
+                    until_closed: true,
+                })
+            }
+            Some(Phase::Seek) if !hit => self.fail(HomingError::NotFound),
+            Some(Phase::Seek) => {
+                self.phase = Some(Phase::Release);
+                leg(pull_off, h.locate, false)
+            }
+            Some(Phase::Release) if closed => self.fail(HomingError::Stuck),
+            Some(Phase::Release) => {
+                self.phase = Some(Phase::Locate);
+                leg(-2 * pull_off, h.locate, true)
+            }
+            Some(Phase::Locate) if !hit => self.fail(HomingError::NotFound),
+            Some(Phase::Locate) => {
+                self.phase = Some(Phase::PullOff);
+                leg(pull_off, h.locate, false)
+            }
+            Some(Phase::PullOff) if closed => self.fail(HomingError::Stuck),
+            Some(Phase::PullOff) => {
+                let steps = mm(a.travel.0 .0.saturating_add(i32::from(h.pull_off_um)));
+                self.left &= !(1 << self.axis);
+                self.phase = None;
+                Next::Zero {
+                    axis: self.axis,
+                    steps,
+                }
+            }
+        }
+    }
+
+    fn fail(&mut self, e: HomingError) -> Next {
+        self.left = 0;
+        self.phase = None;
+        Next::Failed(e)
+    }
+}
+
+/// `steps` from `from` on `leg`'s axis only.
+pub fn target(from: PerAxis<i32>, leg: &Leg) -> PerAxis<i32> {
+    let mut to = from;
+    to[leg.axis] = to[leg.axis].saturating_add(leg.steps);
+    to
+}
+
+#[cfg(test)]
+mod tests;
