@@ -19,18 +19,15 @@ impl PenServo {
     /// Starts the pulses at `pulse_us` (the pin is already an output).
     pub fn start(tc1: TC1, pin: Pin<11, Output>, pulse_us: u16) -> PenServo {
         // Fast PWM with TOP = ICR1 (mode 14), clk/8; OC1A high from the
-        // period's start until the compare.
+        // period's start until the compare. The mode first: the compare
+        // registers are written in it.
+        tc1.tccr1a()
+            .write(|w| w.com1a().match_clear().wgm1().set(0b10));
+        tc1.tccr1b()
+            .write(|w| w.wgm1().set(0b11).cs1().prescale_8());
         tc1.icr1().write(|w| w.set(PERIOD_US * TICKS_PER_US - 1));
         let mut servo = PenServo { tc1, _pin: pin };
         servo.set_pulse_us(pulse_us);
-        servo
-            .tc1
-            .tccr1a()
-            .write(|w| w.com1a().match_clear().wgm1().set(0b10));
-        servo
-            .tc1
-            .tccr1b()
-            .write(|w| w.wgm1().set(0b11).cs1().prescale_8());
         servo
     }
 

@@ -2,6 +2,7 @@
 //! file, a `machine.txt` override, a `$` setting, or the configuration as a
 //! whole. Printed as the tail of the one-line messages.
 
+use taut_progmem::{text, Text};
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
 /// What went wrong. Messages are short: on the AVR every string lives in SRAM.
@@ -68,45 +69,71 @@ pub enum ErrorKind {
     },
 }
 
+// Every literal through `text!`: kept in flash on the AVR.
 impl uDisplay for ErrorKind {
     fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
+        let t = |f: &mut Formatter<'_, W>, t: Text| t.fmt(f);
         match *self {
-            ErrorKind::NotFound => f.write_str("file not found"),
-            ErrorKind::Empty => f.write_str("empty file"),
-            ErrorKind::LineTooLong => f.write_str("line too long (max 64)"),
-            ErrorKind::ExpectedKeyValue => f.write_str("expected key = value"),
-            ErrorKind::UnknownKey => f.write_str("unknown key"),
-            ErrorKind::UnknownMachine => f.write_str("unknown machine"),
-            ErrorKind::DuplicateKey => f.write_str("duplicate key"),
-            ErrorKind::MissingKey(key) => uwrite!(f, "missing key {}", key),
-            ErrorKind::NotANumber => f.write_str("expected a number"),
-            ErrorKind::TooBig => f.write_str("number too big"),
-            ErrorKind::Range { min, max } => uwrite!(f, "expected {} to {}", min, max),
-            ErrorKind::Shape { max } => uwrite!(f, "expected 0 or 3 to {}", max),
+            ErrorKind::NotFound => t(f, text!("file not found")),
+            ErrorKind::Empty => t(f, text!("empty file")),
+            ErrorKind::LineTooLong => t(f, text!("line too long (max 64)")),
+            ErrorKind::ExpectedKeyValue => t(f, text!("expected key = value")),
+            ErrorKind::UnknownKey => t(f, text!("unknown key")),
+            ErrorKind::UnknownMachine => t(f, text!("unknown machine")),
+            ErrorKind::DuplicateKey => t(f, text!("duplicate key")),
+            ErrorKind::MissingKey(key) => uwrite!(f, "{}{}", text!("missing key "), key),
+            ErrorKind::NotANumber => t(f, text!("expected a number")),
+            ErrorKind::TooBig => t(f, text!("number too big")),
+            ErrorKind::Range { min, max } => {
+                uwrite!(f, "{}{}{}{}", text!("expected "), min, text!(" to "), max)
+            }
+            ErrorKind::Shape { max } => uwrite!(f, "{}{}", text!("expected 0 or 3 to "), max),
             ErrorKind::RadiusTooSmall { above_um } => {
-                f.write_str("expected more than ")?;
+                t(f, text!("expected more than "))?;
                 write_um_as_cm(f, above_um)?;
-                f.write_str(" cm")
+                t(f, text!(" cm"))
             }
-            ErrorKind::ExpectedComma => f.write_str("expected ','"),
-            ErrorKind::Nail { index, nails } => {
-                uwrite!(f, "nail {} out of range (nails: {})", index, nails)
+            ErrorKind::ExpectedComma => t(f, text!("expected ','")),
+            ErrorKind::Nail { index, nails } => uwrite!(
+                f,
+                "{}{}{}{}{}",
+                text!("nail "),
+                index,
+                text!(" out of range (nails: "),
+                nails,
+                text!(")")
+            ),
+            ErrorKind::Count { declared, found } => uwrite!(
+                f,
+                "{}{}{}{}",
+                text!("declared "),
+                declared,
+                text!(" connections, found "),
+                found
+            ),
+            ErrorKind::Invalid(field) => uwrite!(f, "{}{}", text!("invalid "), field),
+            ErrorKind::Utf16 => t(f, text!("UTF-16 text: save it as UTF-8 or ASCII")),
+            ErrorKind::NotText { byte } => {
+                uwrite!(
+                    f,
+                    "{}{}{}",
+                    text!("not a text file (byte "),
+                    byte,
+                    text!(")")
+                )
             }
-            ErrorKind::Count { declared, found } => {
-                uwrite!(f, "declared {} connections, found {}", declared, found)
-            }
-            ErrorKind::Invalid(field) => uwrite!(f, "invalid {}", field),
-            ErrorKind::Utf16 => f.write_str("UTF-16 text: save it as UTF-8 or ASCII"),
-            ErrorKind::NotText { byte } => uwrite!(f, "not a text file (byte {})", byte),
             ErrorKind::PulseTooLong {
                 axis,
                 machine,
                 max_us,
             } => uwrite!(
                 f,
-                "pulse over half a step at {}_max_rate: {} us at most",
+                "{}{}{}{}{}",
+                text!("pulse over half a step at "),
                 machine.channel(axis),
-                max_us
+                text!("_max_rate: "),
+                max_us,
+                text!(" us at most")
             ),
         }
     }
