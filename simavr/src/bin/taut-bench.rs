@@ -346,6 +346,18 @@ fn round(x: f64, digits: i32) -> f64 {
     (x * k).round() / k
 }
 
+/// Cycles per operation of the three batches of `kin_cycles.elf`: a
+/// polargraph inverse, a SCARA inverse, a chord of a 1 mm circle cut,
+/// converted and planned. Each batch of 64 runs while D13 is high.
+fn kinematics_cycles(elf: &Path) -> [u64; 3] {
+    let mut sim = Sim::load(elf).expect("kin_cycles image");
+    sim.probe(13, "batch");
+    sim.run_for(Duration::from_secs(2));
+    let edges = sim.probed("batch").edges().to_vec();
+    assert_eq!(edges.len(), 6, "three batches");
+    [0, 1, 2].map(|i| (edges[2 * i + 1].cycle - edges[2 * i].cycle) / 64)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [fw, busy, out] = &args[..] else {
@@ -402,6 +414,10 @@ fn main() {
         "sd_read_kib_per_s".into(),
         json!(round(sd_read_kib_per_s(&sd_read), 1)),
     );
+    let [polargraph, scara, chord] = kinematics_cycles(&busy.with_file_name("kin_cycles.elf"));
+    f.insert("polargraph_inverse_cycles".into(), json!(polargraph));
+    f.insert("scara_inverse_cycles".into(), json!(scara));
+    f.insert("arc_segments_per_s".into(), json!(16_000_000 / chord));
     f.insert("sim_mhz_idle".into(), json!(round(sim_mhz(fw, 20), 1)));
     f.insert("sim_mhz_busy".into(), json!(round(sim_mhz(busy, 2), 1)));
 
