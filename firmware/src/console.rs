@@ -84,7 +84,9 @@ impl Console {
             dwell_until: None,
             listing: None,
             interp: Interpreter::new(),
-            epoch: 0,
+            // Unlike the motion's: the first run reads the position through
+            // the kinematics (zero steps are not (0, 0) on an arm).
+            epoch: u8::MAX,
             settings_changed: false,
         }
     }
@@ -116,7 +118,9 @@ impl Console {
     ) -> Poll<Signal> {
         if self.epoch != m.epoch() {
             self.epoch = m.epoch();
-            if let Some(Pending::Path { .. } | Pending::Home { .. }) = self.pending {
+            // Queued pieces were dropped with the motion (homing goes on:
+            // its own stops bump the epoch too; Ctrl-X resets it).
+            if let Some(Pending::Path { .. }) = self.pending {
                 self.pending = None;
             }
             self.interp.resync(kin.forward(&m.target()));

@@ -33,8 +33,10 @@
 //!   no red.
 
 mod canvas;
+mod plot;
 
 pub use canvas::Canvas;
+pub use plot::{render_plot, Plot};
 
 use crate::replay::{JobReplay, Trace};
 use crate::vcd::Signal;
@@ -78,6 +80,12 @@ pub fn render_job(
 /// Writes the picture of a replayed job to `path` (PNG).
 pub fn render(job: &JobReplay, path: &Path) -> io::Result<Summary> {
     let (canvas, summary) = draw(job, SIZE);
+    write_png(&canvas, path)?;
+    Ok(summary)
+}
+
+/// `canvas` as a PNG file.
+fn write_png(canvas: &Canvas, path: &Path) -> io::Result<()> {
     let file = io::BufWriter::new(std::fs::File::create(path)?);
     let mut png = png::Encoder::new(file, canvas.size, canvas.size);
     png.set_color(png::ColorType::Rgb);
@@ -86,8 +94,7 @@ pub fn render(job: &JobReplay, path: &Path) -> io::Result<Summary> {
     writer
         .write_image_data(&canvas.rgb)
         .map_err(io::Error::other)?;
-    writer.finish().map_err(io::Error::other)?;
-    Ok(summary)
+    writer.finish().map_err(io::Error::other)
 }
 
 const WOOD: [u8; 3] = [236, 220, 188];

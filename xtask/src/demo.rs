@@ -73,6 +73,44 @@ pub fn run() -> Result<()> {
     Ok(())
 }
 
+/// `cargo xtask demo plotter [MACHINE]`: a plotter (the flatbed unless
+/// named: drum, whiteboard, scara) draws `examples/plotter/star.gcode`,
+/// streamed over its serial port as a sender does; `target/demo/` gets the
+/// trace and the drawing rebuilt from the step and pen pulses.
+pub fn plotter(machine: &str) -> Result<()> {
+    let img = firmware::build_release()?;
+    img.print_size();
+    let out = root().join("target/demo");
+    std::fs::create_dir_all(&out)?;
+    let (vcd, png) = (
+        out.join(format!("{machine}.vcd")),
+        out.join(format!("{machine}.png")),
+    );
+    let gcode = root().join("examples/plotter/star.gcode");
+    println!("== the simulated {machine} draws {}", gcode.display());
+    let path = |p: &std::path::Path| p.display().to_string();
+    run::taut_sim(
+        &img.elf,
+        &[
+            "--machine".into(),
+            machine.into(),
+            "--send".into(),
+            path(&gcode),
+            "--vcd".into(),
+            path(&vcd),
+            "--png".into(),
+            path(&png),
+        ],
+    )?;
+    println!(
+        "written: {}
+         {}",
+        png.display(),
+        vcd.display()
+    );
+    Ok(())
+}
+
 /// Machine time of the card's job on the host (`stringart::machine_time`):
 /// drilling and winding, each axis on its own trapezoid, with the axes of a
 /// move together and one after another.

@@ -55,7 +55,11 @@ fn main() -> ExitCode {
         }
         "sim" => run::setup().and_then(|_| sim(rest)),
         "sdimage" => run::setup().and_then(|_| run::bin("taut-sdimage", rest)),
-        "demo" => run::setup().and_then(|_| demo::run()),
+        "demo" => run::setup().and_then(|_| match rest.first().map(String::as_str) {
+            None => demo::run(),
+            Some("plotter") => demo::plotter(rest.get(1).map_or("flatbed", String::as_str)),
+            Some(other) => Err(format!("demo {other}: `demo` or `demo plotter [MACHINE]`").into()),
+        }),
         "bench" => run::setup().and_then(|_| bench::run()),
         "flash" => run::setup().and_then(|_| firmware::flash()),
         "help" | "--help" | "-h" => {

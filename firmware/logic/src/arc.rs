@@ -177,6 +177,10 @@ impl Arc {
         self.chords
     }
 
+    pub fn start(&self) -> Position {
+        self.start
+    }
+
     /// The smallest box (least and greatest corner) holding every chord
     /// end: both ends, and the circle's extremes the arc passes. Chords
     /// lie inside the circle, so the box holds the whole path: checked

@@ -448,10 +448,23 @@ fn reaches(path: &Path, kin: &impl Kinematics) -> bool {
     kin.is_linear() || every_piece_reached(path, kin)
 }
 
-/// Out of line: its copy of the path stays off the linear machines' stack.
+/// Whether every piece of `path` is within reach, by the kinematics'
+/// geometry ([`Kinematics::reaches_line`]): a line at once, an arc chord
+/// by chord. Out of line: its copy of the path stays off the linear
+/// machines' stack.
 #[inline(never)]
 fn every_piece_reached(path: &Path, kin: &impl Kinematics) -> bool {
-    { *path }.all(|p| kin.inverse(&p).is_ok())
+    match path {
+        Path::Line(line) => kin.reaches_line(&line.start(), &line.end()),
+        Path::Arc(arc) => {
+            let mut from = arc.start();
+            { *arc }.all(|to| {
+                let ok = kin.reaches_line(&from, &to);
+                from = to;
+                ok
+            })
+        }
+    }
 }
 
 /// Refuses a path whose box `lo..=hi` leaves an axis's soft limits.

@@ -10,7 +10,9 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
+use taut_logic::machine::Machine;
 use taut_logic::pinmap::{self, Button};
+use taut_logic::settings::image;
 use taut_simavr::operator::{Operator, Seen};
 use taut_simavr::scenario::{self, FaultSpec, TimedBytes};
 use taut_simavr::sdcard::{SdCard, SdImage};
@@ -23,6 +25,7 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                    [--card-fault SPEC]...] [--auto-confirm] [--send FILE]
                    [--at SECONDS:BYTES]... [--for SECONDS] [--vcd PATH]
                    [--png PATH] [--report PATH] [--eeprom FILE] [--echo]
+                   [--machine NAME [--endstop-mm MM]]
   --sd PATH       put a virtual SD card in the slot: an image file, or a
                   folder, imaged on the fly (FAT16 or FAT32 by size)
   --sd-insert-at SECONDS
@@ -58,9 +61,17 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                   after motion is idle, default 0). Without --for the run
                   also goes on until 1 s after the last planned event
                   (--at, --pull-card-at, --reinsert-at, crc-once-at)
-  --vcd PATH      write a VCD trace of every probed pin
-  --png PATH      draw the string-art job from the step pulses alone (the
-                  board from the card's param.txt; needs --sd)
+  --vcd PATH      write a VCD trace of every probed pin, named by the
+                  machine's channels (base_, radial_, drill_; x_, y_;
+                  left_, right_; shoulder_, elbow_) and pen_pwm
+  --png PATH      draw from the step pulses alone: the string-art job (the
+                  board from the card's param.txt; needs --sd), or a
+                  plotter's drawing (pen down dark, travel faint blue)
+  --machine NAME  power on as this machine (string_art, drum, flatbed,
+                  whiteboard, scara) with its defaults in EEPROM
+  --endstop-mm MM where the MIN switches of the machine's homing axes
+                  close: MM below where each axis stands at power-on
+                  (default 3); homing at power-on and G28 find them there
   --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
   --eeprom FILE   the EEPROM's contents (settings): loaded at power-on if the
                   file exists, saved when the run ends (a power cycle keeps
@@ -85,6 +96,8 @@ struct Args {
     png: Option<PathBuf>,
     report: Option<PathBuf>,
     eeprom: Option<PathBuf>,
+    machine: Option<Machine>,
+    endstop_mm: f64,
     echo: bool,
     auto_confirm: bool,
 }
@@ -105,6 +118,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         png: None,
         report: None,
         eeprom: None,
+        machine: None,
+        endstop_mm: 3.0,
         echo: false,
         auto_confirm: false,
     };
@@ -126,13 +141,23 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--png" => args.png = Some(value()?.into()),
             "--report" => args.report = Some(value()?.into()),
             "--eeprom" => args.eeprom = Some(value()?.into()),
+            "--machine" => {
+                let name = value()?;
+                let m = Machine::parse(name.as_bytes())
+                    .ok_or(format!("--machine {name}: no such machine"))?;
+                args.machine = Some(m);
+            }
+            "--endstop-mm" => args.endstop_mm = value()?.parse().map_err(|_| "--endstop-mm MM")?,
             "--echo" => args.echo = true,
             "--auto-confirm" => args.auto_confirm = true,
             _ => return Err(format!("unknown option {a}")),
         }
     }
+    // A plotter's picture needs no card (the machine may also come from
+    // --eeprom: checked when drawn).
+    let plotter = args.machine.is_some_and(|m| !m.is_string_art());
     let card_options = args.sd_insert_at.is_some()
-        || args.png.is_some()
+        || (args.png.is_some() && !plotter && args.eeprom.is_none())
         || !args.pulls.is_empty()
         || !args.reinserts.is_empty()
         || !args.faults.is_empty();
@@ -158,18 +183,37 @@ impl Args {
     }
 }
 
-/// Probes with the documented signal names: `<axis>_step|dir|en`,
-/// `btn_<button>`, `led`.
-fn probe_machine(sim: &mut Sim) {
+/// Probes with the documented signal names: `<channel>_step|dir|en`
+/// (the machine's channel names), `btn_<button>`, `pen_pwm`, `led`.
+fn probe_machine(sim: &mut Sim, machine: Machine) {
     for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
         let d = pinmap::driver(axis);
-        sim.probe_step_dir(axis.name(), d.step, d.dir, true);
-        sim.probe(d.enable, &format!("{}_en", axis.name()));
+        let name = machine.channel(axis).to_string();
+        sim.probe_step_dir(&name, d.step, d.dir, true);
+        sim.probe(d.enable, &format!("{name}_en"));
     }
     for b in Button::ALL {
         sim.probe(b.pin(), &format!("btn_{}", b.name()));
     }
+    sim.probe(pinmap::PEN_SERVO, "pen_pwm");
     sim.probe(pinmap::STATUS_LED, "led");
+}
+
+/// The MIN switches of `cfg`'s homing axes, `mm` below where each stands
+/// at power-on (a plotter's X_MIN, Y_MIN, Z_MIN inputs).
+fn fit_endstops(sim: &mut Sim, cfg: &MachineConfig, mm: f64) {
+    let min_inputs = [Button::ZeroBase, Button::ZeroRadial, Button::ZeroDrill];
+    for (i, input) in min_inputs.into_iter().enumerate() {
+        if cfg.homing.axes & (1 << i) == 0 {
+            continue;
+        }
+        let axis = Axis::ALL[i];
+        let d = pinmap::driver(axis);
+        let at = cfg.axes[i]
+            .steps_per_unit
+            .steps(taut_logic::units::Milli((-mm * 1000.0) as i32));
+        sim.endstop(input.pin(), d.step, d.dir, true, i64::from(at));
+    }
 }
 
 /// Send every line of `file` as a G-code sender would (next line after the
@@ -183,6 +227,15 @@ fn stream(
     let text = std::fs::read_to_string(file).map_err(|e| format!("{}: {e}", file.display()))?;
     if sim.run_until_uart_contains("reset:", Duration::from_millis(100)) != Outcome::Done {
         return Err("the firmware did not boot".into());
+    }
+    // A machine homing at power-on reads no line until it is done (as a
+    // sender waits for Grbl's homing cycle).
+    sim.run_for(Duration::from_millis(5));
+    if sim.uart_text().contains("] homing") {
+        sim.run_until(
+            |s| s.uart_text().contains("homed") || s.uart_text().contains("homing failed"),
+            Duration::from_secs(600),
+        );
     }
     let lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
     for (n, line) in lines.chain(std::iter::once("M400")).enumerate() {
@@ -236,7 +289,16 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     if let Some(path) = args.eeprom.as_ref().filter(|p| p.exists()) {
         sim.set_eeprom(&std::fs::read(path)?);
     }
-    probe_machine(&mut sim);
+    if let Some(m) = args.machine {
+        let image: Vec<u8> = image::bytes(&MachineConfig::defaults(m)).collect();
+        sim.set_eeprom(&image);
+    }
+    // The machine the EEPROM holds: its channel names and switches.
+    let eeprom = sim.eeprom();
+    let cfg = image::decode(|i| eeprom[i], &MachineConfig::STRING_ART)
+        .unwrap_or(MachineConfig::STRING_ART);
+    probe_machine(&mut sim, cfg.machine);
+    fit_endstops(&mut sim, &cfg, args.endstop_mm);
     let param = match &args.sd {
         Some(path) => put_card(&mut sim, path, &args)?,
         None => None,
@@ -294,7 +356,20 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         sim.write_vcd(path)?;
     }
     let mut picture = None;
-    if let Some(path) = &args.png {
+    if let (Some(path), false) = (&args.png, cfg.machine.is_string_art()) {
+        let p = picture::render_plot(&sim.vcd_signals(), &cfg, path)?;
+        eprintln!(
+            "taut-sim: {}: {} steps, {} with the pen down, drawn over x {:.2}..{:.2}, y {:.2}..{:.2} mm",
+            path.display(),
+            p.steps,
+            p.steps_down,
+            p.min[0],
+            p.max[0],
+            p.min[1],
+            p.max[1]
+        );
+        picture = Some(serde_json::to_value(&p)?);
+    } else if let Some(path) = &args.png {
         let param = param.ok_or("--png: the card has no param.txt")?;
         let board = replay::board_from_param(&param).map_err(|e| format!("param.txt: {e}"))?;
         let s = picture::render_job(&sim.vcd_signals(), board, &MachineConfig::STRING_ART, path)?;

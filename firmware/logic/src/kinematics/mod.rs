@@ -62,6 +62,14 @@ pub trait Kinematics {
     fn is_linear(&self) -> bool;
     /// The G-code word (ASCII letter) naming each coordinate.
     fn words(&self) -> [u8; AXES];
+    /// Whether the whole straight line from `a` to `b` is within reach.
+    /// Its ends are enough where the reach is convex (linear machines,
+    /// the hanging plotter's half-plane); the arm also keeps its distance
+    /// from the shoulder. Geometry only: no inverse per piece, which on
+    /// the AVR would cost ms each.
+    fn reaches_line(&self, a: &Position, b: &Position) -> bool {
+        self.inverse(a).is_ok() && self.inverse(b).is_ok()
+    }
 }
 
 /// Each coordinate scaled onto its own channel: the whole of a linear
@@ -164,6 +172,14 @@ impl Kinematics for AnyKinematics {
             AnyKinematics::Linear(k) => k.forward(steps),
             AnyKinematics::Polargraph(k) => k.forward(steps),
             AnyKinematics::Scara(k) => k.forward(steps),
+        }
+    }
+
+    fn reaches_line(&self, a: &Position, b: &Position) -> bool {
+        match self {
+            AnyKinematics::Linear(k) => k.reaches_line(a, b),
+            AnyKinematics::Polargraph(k) => k.reaches_line(a, b),
+            AnyKinematics::Scara(k) => k.reaches_line(a, b),
         }
     }
 

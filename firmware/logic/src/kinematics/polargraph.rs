@@ -61,6 +61,12 @@ impl Kinematics for Polargraph {
         Ok(steps)
     }
 
+    /// Below the motors is a half-plane: the ends are enough.
+    fn reaches_line(&self, a: &Position, b: &Position) -> bool {
+        let below = |p: &Position| self.origin[1] + mm(p[1]) < 0.0;
+        below(a) && below(b)
+    }
+
     #[inline(never)]
     fn forward(&self, steps: &Steps) -> Position {
         let l = self.home[0] + self.scale.value_f32(0, steps[0]);

@@ -101,6 +101,27 @@ impl Kinematics for Scara {
         false
     }
 
+    /// The ends within L1 + L2 of the shoulder, and the line never closer
+    /// to it than |L1 − L2| (the reach is a ring).
+    fn reaches_line(&self, a: &Position, b: &Position) -> bool {
+        let outer = self.l1 + self.l2 + 0.001;
+        let (ax, ay) = (mm(a[0]) - self.offset[0], mm(a[1]) - self.offset[1]);
+        let (bx, by) = (mm(b[0]) - self.offset[0], mm(b[1]) - self.offset[1]);
+        if ax * ax + ay * ay > outer * outer || bx * bx + by * by > outer * outer {
+            return false;
+        }
+        let (dx, dy) = (bx - ax, by - ay);
+        let len2 = dx * dx + dy * dy;
+        let t = match len2 > 0.0 {
+            true => (-(ax * dx + ay * dy) / len2).clamp(0.0, 1.0),
+            false => 0.0,
+        };
+        let (cx, cy) = (ax + t * dx, ay + t * dy);
+        // The shoulder itself is out of reach even with equal arms.
+        let inner = ((self.l1 - self.l2).abs() - 0.001).max(0.001);
+        cx * cx + cy * cy >= inner * inner
+    }
+
     fn words(&self) -> [u8; AXES] {
         *b"XYZA"
     }
@@ -124,6 +145,16 @@ mod tests {
             crosstalk: StepsPerUnit::new(3, 1),
         };
         Scara::new(&scale, &g).unwrap()
+    }
+
+    #[test]
+    fn a_line_through_the_hole_round_the_shoulder_is_out_of_reach() {
+        // Arms 150 and 120: nothing within 30 mm of the shoulder (10, 20).
+        let k = kin();
+        let at = |x: i32, y: i32| [Milli(x), Milli(y), Milli(0), Milli(0)];
+        assert!(k.reaches_line(&at(-90_000, 20_000), &at(-90_000, 120_000)));
+        assert!(!k.reaches_line(&at(-90_000, 20_000), &at(110_000, 20_000)));
+        assert!(k.reaches_line(&at(-90_000, 60_000), &at(110_000, 60_000)));
     }
 
     #[test]

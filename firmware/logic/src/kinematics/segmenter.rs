@@ -44,6 +44,14 @@ impl Segmenter {
     pub fn pieces(&self) -> u32 {
         self.pieces
     }
+
+    pub fn start(&self) -> Position {
+        self.from
+    }
+
+    pub fn end(&self) -> Position {
+        core::array::from_fn(|i| Milli(self.from[i].0 + self.delta[i] as i32))
+    }
 }
 
 impl Iterator for Segmenter {
