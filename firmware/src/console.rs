@@ -326,6 +326,12 @@ impl Console {
         if !m.has_room() {
             return Poll::Wait(Signal::Motion);
         }
+        // And not while the step queue runs short with pieces planned
+        // ahead: planning one takes a few ms, which the segments' refill
+        // needs first (with none ahead the planner would run dry instead).
+        if crate::motion::urgent() && m.planned() >= 2 {
+            return Poll::After(1);
+        }
         let before = *path;
         match path.next().map(|p| kin.inverse(&p)) {
             Some(Ok(steps)) => {

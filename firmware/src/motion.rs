@@ -108,6 +108,11 @@ impl Motion {
         Ok(())
     }
 
+    /// Moves queued in the planner, not yet taken to be cut.
+    pub fn planned(&self) -> usize {
+        PLANNER.with(|p| p.queued())
+    }
+
     /// Whether the planner has room for a move.
     pub fn has_room(&self) -> bool {
         !PLANNER.with(|p| p.is_full())

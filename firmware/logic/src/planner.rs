@@ -132,6 +132,11 @@ impl Planner {
     }
 
     /// Whether [`Planner::push`] would refuse for want of room.
+    /// Moves queued, not yet taken.
+    pub fn queued(&self) -> usize {
+        self.len
+    }
+
     pub fn is_full(&self) -> bool {
         self.len == PLANNER_BLOCKS
     }
