@@ -27,15 +27,20 @@ use taut_logic::gcode::{Error, ErrorKind, Input, Line, Parser, SystemLine};
 use taut_logic::homing::{self, Homing, Leg, Next};
 use taut_logic::interp::{Allowed, Interpreter, Order, Path};
 use taut_logic::kinematics::Kinematics;
+use taut_logic::patterns;
 use taut_logic::planner::Feed;
 use taut_logic::settings;
 use taut_logic::units::Milli;
+use taut_progmem::Text;
 use ufmt::{uWrite, uwrite};
 
 pub struct Console {
     parser: Parser,
     /// The line being carried out while it waits for room.
     pending: Option<Pending>,
+    /// A test pattern (`$T5`) read in place of the line, and how far: its
+    /// lines are answered once, at its end.
+    pattern: Option<(Text, u16)>,
     dwell_until: Option<u32>,
     /// `$$` or `$Q` in progress: its next line.
     listing: Option<Listing>,
@@ -81,6 +86,7 @@ impl Console {
         Console {
             parser: Parser::new(),
             pending: None,
+            pattern: None,
             dwell_until: None,
             listing: None,
             interp: Interpreter::new(),
@@ -102,6 +108,7 @@ impl Console {
     pub fn reset(&mut self) {
         self.parser = Parser::new();
         self.pending = None;
+        self.pattern = None;
         self.dwell_until = None;
         self.listing = None;
         self.interp.reset();
@@ -147,7 +154,7 @@ impl Console {
                     position_known: m.position_known(),
                 };
                 match self.interp.plan(&line, kin, cfg, allowed) {
-                    Err(kind) => reply::error(&Error::new(kind, 0)),
+                    Err(kind) => self.error(&Error::new(kind, 0)),
                     Ok(planned) => {
                         if let Some(wait) = self.carry_out(&planned.order, m, kin) {
                             self.pending = Some(Pending::Line(line));
@@ -155,19 +162,32 @@ impl Console {
                         }
                         self.interp.commit(planned);
                         if self.pending.is_none() {
-                            reply::ok();
+                            self.ok();
                         }
                     }
                 }
                 // One line per run: the other tasks get their turn.
                 return Poll::Again;
             }
-            let Some(byte) = RX.pop() else {
-                return Poll::Idle;
+            let byte = match self.pattern.as_mut() {
+                Some((text, at)) if usize::from(*at) < text.len() => {
+                    *at += 1;
+                    text.byte(usize::from(*at) - 1)
+                }
+                // The pattern is drawn: its one answer.
+                Some(_) => {
+                    self.pattern = None;
+                    reply::ok();
+                    continue;
+                }
+                None => match RX.pop() {
+                    Some(byte) => byte,
+                    None => return Poll::Idle,
+                },
             };
             match self.parser.push(byte) {
                 None | Some(Ok(Input::Realtime(_))) => {}
-                Some(Err(e)) => reply::error(&e),
+                Some(Err(e)) => self.error(&e),
                 Some(Ok(Input::Line(line))) => self.pending = Some(Pending::Line(line)),
                 Some(Ok(Input::System(s))) => self.system(s, m, cfg, owner),
             }
@@ -303,6 +323,19 @@ impl Console {
         Poll::Again
     }
 
+    /// `ok` to a line, unless it is a pattern's (answered at its end).
+    fn ok(&self) {
+        if self.pattern.is_none() {
+            reply::ok();
+        }
+    }
+
+    /// An error: the answer to the line, or to the pattern, which stops.
+    fn error(&mut self, e: &Error) {
+        self.pattern = None;
+        reply::error(e);
+    }
+
     /// Wait `ms` from the first call (motion done): `Some(wait)` until then.
     fn dwell(&mut self, ms: u32) -> Option<Poll<Signal>> {
         let now = clock::millis();
@@ -342,7 +375,7 @@ impl Console {
             }
             None => {
                 self.pending = None;
-                reply::ok();
+                self.ok();
             }
             // The interpreter checked every chord: not reached.
             Some(Err(_)) => {
@@ -386,6 +419,14 @@ impl Console {
                 return reply::error(&Error::new(ErrorKind::NoHoming, 0));
             }
             SystemLine::Home => return self.start_homing(cfg.homing.axes, m, true),
+            SystemLine::Pattern(_) if owner == Owner::Job => {
+                return reply::error(&Error::new(ErrorKind::JobOwnsMotion, 0));
+            }
+            // Answered at its end.
+            SystemLine::Pattern(n) => {
+                self.pattern = patterns::pattern(n).map(|t| (t, 0));
+                return;
+            }
             SystemLine::Set { .. } if owner == Owner::Job => {
                 return reply::error(&Error::new(ErrorKind::JobOwnsMotion, 0));
             }

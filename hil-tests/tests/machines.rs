@@ -365,3 +365,53 @@ fn a_full_speed_1_mm_circle_never_starves_the_step_queue() {
     sim.run_for(Duration::from_millis(1500));
     assert!(!sim.uart_text().contains("underruns"), "{}", log_tail(&sim));
 }
+
+/// Seed 001's test patterns run on any plotter, answered once: `$T7`'s
+/// lines reach their eight tips (a sign or octant slip would miss one),
+/// and each pattern ends where it began.
+#[test]
+fn seed_001_test_patterns_draw_and_end_where_they_began() {
+    let mut sim = boot_machine();
+    send(&mut sim, "$machine=flatbed");
+    send(&mut sim, "$homing_at_start=0");
+    send(&mut sim, "M17");
+    send(&mut sim, "G0 X40 Y40");
+    send(&mut sim, "M400");
+    let from = track(&sim).len();
+    let start = sim.uart_bytes().len();
+    send(&mut sim, "$T7");
+    send(&mut sim, "M400");
+    let replies = String::from_utf8_lossy(&sim.uart_bytes()[start..])
+        .matches("ok\n")
+        .count();
+    assert_eq!(replies, 2, "one ok for the pattern, one for M400");
+    let path = &track(&sim)[from..];
+    let at = |x: f64, y: f64| [(x * 40.0).round() as i64, (y * 40.0).round() as i64];
+    for (dx, dy) in [
+        (20.0, 8.0),
+        (8.0, 20.0),
+        (-8.0, 20.0),
+        (-20.0, 8.0),
+        (-20.0, -8.0),
+        (-8.0, -20.0),
+        (8.0, -20.0),
+        (20.0, -8.0),
+    ] {
+        let tip = at(40.0 + dx, 40.0 + dy);
+        assert!(
+            path.iter().any(|(_, s)| [s[0], s[1]] == tip),
+            "never at the tip {dx},{dy}"
+        );
+    }
+    assert_eq!(
+        [path.last().unwrap().1[0], path.last().unwrap().1[1]],
+        at(40.0, 40.0)
+    );
+    for t in ["$T5", "$T6"] {
+        send(&mut sim, t);
+    }
+    send(&mut sim, "M400");
+    send(&mut sim, "$T1");
+    send(&mut sim, "M400");
+    assert_eq!(hil_tests::steps_on_pins(&sim)[..2], [0, 0], "$T1: over 0,0");
+}

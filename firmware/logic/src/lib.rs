@@ -25,6 +25,7 @@ pub mod homing;
 pub mod interp;
 pub mod kinematics;
 pub mod machine;
+pub mod patterns;
 pub mod pinmap;
 pub mod planner;
 pub mod prep;

@@ -23,6 +23,8 @@ pub enum SystemLine {
     Unlock,
     /// `$H`: home (Grbl's homing cycle).
     Home,
+    /// `$T<n>`: seed 001's test pattern `n`.
+    Pattern(u8),
     /// `$<key>=<value>`, both as typed; the settings module interprets
     /// them (e.g. with [`parse_milli`](super::parse_milli)).
     Set { key: SystemText, value: SystemText },
@@ -97,6 +99,10 @@ impl SystemBuilder {
             "S" | "s" => Ok(SystemLine::Stack),
             "X" | "x" => Ok(SystemLine::Unlock),
             "H" | "h" => Ok(SystemLine::Home),
+            "T1" | "t1" => Ok(SystemLine::Pattern(1)),
+            "T5" | "t5" => Ok(SystemLine::Pattern(5)),
+            "T6" | "t6" => Ok(SystemLine::Pattern(6)),
+            "T7" | "t7" => Ok(SystemLine::Pattern(7)),
             _ => Err(Error::new(ErrorKind::InvalidStatement, self.dollar)),
         }
     }
