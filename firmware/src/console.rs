@@ -244,6 +244,11 @@ impl Console {
         None
     }
 
+    /// A homing cycle is running.
+    pub fn is_homing(&self) -> bool {
+        matches!(self.pending, Some(Pending::Home { .. }))
+    }
+
     /// Home `axes` (bits), their drivers on; `reply`: answer the line
     /// that asked at the end.
     pub fn start_homing(&mut self, axes: u8, m: &mut Motion, reply: bool) {

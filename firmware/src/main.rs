@@ -404,7 +404,8 @@ fn realtime() {
         }
         if r.status() {
             if reply::room() {
-                KIN.with(|kin| realtime::status(m, kin.as_ref().unwrap()));
+                let homing = CONSOLE.with(|c| c.is_homing());
+                KIN.with(|kin| realtime::status(m, kin.as_ref().unwrap(), homing));
             } else {
                 realtime::status_later();
                 spawn_after(Task::Realtime, 1);

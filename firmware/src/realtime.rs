@@ -74,10 +74,12 @@ pub fn status_later() {
 }
 
 /// `<Idle|MPos:0.000,12.500,-3.000>`: the state and the position as the
-/// pulses left it, in the machine's units (Grbl's status report).
-pub fn status(m: &Motion, kin: &impl Kinematics) {
+/// pulses left it, in the machine's units (Grbl's status report);
+/// `homing`: the console runs a homing cycle (`Home`).
+pub fn status(m: &Motion, kin: &impl Kinematics, homing: bool) {
     let mut r = reply::line();
     let state = match m.state() {
+        _ if homing => flash_str!("Home"),
         _ if !m.position_known() => flash_str!("Alarm"),
         State::Idle => flash_str!("Idle"),
         State::Run => flash_str!("Run"),

@@ -270,6 +270,9 @@ fn the_flatbed_homes_x_against_its_switch_at_power_on_and_on_g28() {
     sim.set_eeprom(&eeprom);
     let x = driver(Axis::Base);
     sim.endstop(Button::ZeroBase.pin(), x.step, x.dir, true, -120);
+    wait_for(&mut sim, "homing", Duration::from_secs(1));
+    sim.uart_send(b"?");
+    wait_for(&mut sim, "<Home|", Duration::from_millis(50));
     wait_for(&mut sim, "homed", Duration::from_secs(20));
     // Pulled off the switch by 1 mm: 40 steps above it, and that is X1.000.
     assert_eq!(steps_on_pins(&sim)[0], -80, "{}", log_tail(&sim));
@@ -336,6 +339,18 @@ fn unknown_but_harmless_codes_are_refused_and_the_stream_goes_on() {
     assert_eq!(steps_on_pins(&sim), [51, 0, 0]);
 }
 
+/// A flatbed (not homing: no switch here), drivers on, standing at
+/// `(x, y)` mm.
+fn flatbed_at(x: f64, y: f64) -> Sim {
+    let mut sim = boot_machine();
+    send(&mut sim, "$machine=flatbed");
+    send(&mut sim, "$homing_at_start=0");
+    send(&mut sim, "M17");
+    send(&mut sim, &format!("G0 X{x} Y{y}"));
+    send(&mut sim, "M400");
+    sim
+}
+
 /// A 1 mm-radius circle asked at the flatbed's full speed (50 mm/s, 12
 /// chords a turn) streams without starving the step queue: a chord is cut
 /// and planned only while the queue holds enough motion (the corners
@@ -343,12 +358,7 @@ fn unknown_but_harmless_codes_are_refused_and_the_stream_goes_on() {
 /// physics, as in Grbl).
 #[test]
 fn a_full_speed_1_mm_circle_never_starves_the_step_queue() {
-    let mut sim = boot_machine();
-    send(&mut sim, "$machine=flatbed");
-    send(&mut sim, "$homing_at_start=0");
-    send(&mut sim, "M17");
-    send(&mut sim, "G0 X11 Y10");
-    send(&mut sim, "M400");
+    let mut sim = flatbed_at(11.0, 10.0);
     let from = track(&sim).len();
     for _ in 0..5 {
         send(&mut sim, "G2 X11 Y10 I-1 J0 F3000");
@@ -371,12 +381,7 @@ fn a_full_speed_1_mm_circle_never_starves_the_step_queue() {
 /// and each pattern ends where it began.
 #[test]
 fn seed_001_test_patterns_draw_and_end_where_they_began() {
-    let mut sim = boot_machine();
-    send(&mut sim, "$machine=flatbed");
-    send(&mut sim, "$homing_at_start=0");
-    send(&mut sim, "M17");
-    send(&mut sim, "G0 X40 Y40");
-    send(&mut sim, "M400");
+    let mut sim = flatbed_at(40.0, 40.0);
     let from = track(&sim).len();
     let start = sim.uart_bytes().len();
     send(&mut sim, "$T7");
