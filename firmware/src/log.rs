@@ -130,7 +130,7 @@ macro_rules! __log_module {
         static S: [u8; LEN] = $crate::board::flash::bytes::<LEN>(FULL, SKIP);
         #[allow(unsafe_code)]
         // SAFETY: S is a progmem static of LEN bytes.
-        let s = unsafe { $crate::board::flash::FlashStr::from_progmem(S.as_ptr(), LEN) };
+        let s = unsafe { $crate::board::flash::FlashStr::from_static(&S) };
         s
     }};
 }

@@ -123,14 +123,14 @@ impl ufmt::uDisplay for Text {
     }
 }
 
-/// The bytes of `s` as an array, at compile time.
+/// The bytes of `s` from `skip` on, as an array, at compile time.
 #[doc(hidden)]
-pub const fn bytes<const N: usize>(s: &str) -> [u8; N] {
+pub const fn bytes<const N: usize>(s: &str, skip: usize) -> [u8; N] {
     let b = s.as_bytes();
     let mut out = [0u8; N];
     let mut i = 0;
     while i < N {
-        out[i] = b[i];
+        out[i] = b[skip + i];
         i += 1;
     }
     out
@@ -142,7 +142,7 @@ macro_rules! text {
     ($s:expr) => {{
         const S: &str = $s;
         #[cfg_attr(target_arch = "avr", link_section = ".progmem.data")]
-        static T: [u8; S.len()] = $crate::bytes(S);
+        static T: [u8; S.len()] = $crate::bytes(S, 0);
         // SAFETY: `T` is a static holding the whole of `S`, in flash on
         // the AVR.
         unsafe { $crate::Text::from_static(&T) }
