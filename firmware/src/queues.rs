@@ -12,9 +12,11 @@ use taut_logic::files::FileName;
 use taut_logic::segment::{Segment, StepBlock};
 
 /// UART receive interrupt → console: line bytes (real-time commands are
-/// taken out before). Full: the byte is lost and counted (the sender
-/// ignored flow control).
-pub static RX: Ring<u8, 64> = Ring::new();
+/// taken out before). 127 bytes, Grbl's 128-byte buffer less one: what
+/// senders count characters against (CNCjs 120, UGS and grbl-streamer 128
+/// with the line in flight). Full: the byte is lost and counted (the
+/// sender ignored flow control).
+pub static RX: Ring<u8, 128> = Ring::new();
 /// Console, job, logger → UART transmit interrupt. Replies wait for room;
 /// a log line without room is dropped whole and counted.
 pub static TX: Ring<u8, 128> = Ring::new();

@@ -163,7 +163,7 @@ fn status_within_10_ms_behind_a_full_planner_and_during_a_dwell() {
     let mut sim = enabled();
     send(&mut sim, "G91");
     // The planner's moves fill it; the next line waits for room. Sent as a
-    // sender with flow control does: never more than the 63-byte receive
+    // sender with flow control does: never more than the receive
     // ring holds unread.
     let lines = taut_logic::planner::PLANNER_BLOCKS + 1;
     for batch in [lines / 2, lines - lines / 2] {
