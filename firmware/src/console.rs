@@ -305,8 +305,7 @@ impl Console {
             Next::Done => {
                 let reply = *reply;
                 self.pending = None;
-                // Resynced through the kinematics on the next run.
-                self.epoch = m.epoch().wrapping_add(1);
+                self.resync_next_run(m);
                 match reply {
                     true => reply::ok(),
                     false => info!("homed"),
@@ -315,7 +314,7 @@ impl Console {
             Next::Failed(_) => {
                 let reply = *reply;
                 self.pending = None;
-                self.epoch = m.epoch().wrapping_add(1);
+                self.resync_next_run(m);
                 // Not homed: motion waits for G28, G92 or $X.
                 m.lose_position();
                 let e = Error::new(ErrorKind::HomingFailed, 0);
@@ -339,6 +338,12 @@ impl Console {
     fn error(&mut self, e: &Error) {
         self.pattern = None;
         reply::error(e);
+    }
+
+    /// Read the commanded position back through the kinematics on the
+    /// next run (the machine moved, or is another one), as after a stop.
+    fn resync_next_run(&mut self, m: &Motion) {
+        self.epoch = m.epoch().wrapping_add(1);
     }
 
     /// Wait `ms` from the first call (motion done): `Some(wait)` until then.
@@ -452,8 +457,7 @@ impl Console {
                     // modal state starts afresh.
                     m.set_position([0; AXES]);
                     self.interp = Interpreter::new();
-                    // Resynced on the next run, through the new kinematics.
-                    self.epoch = m.epoch().wrapping_add(1);
+                    self.resync_next_run(m);
                 }
                 self.settings_changed = true;
             }

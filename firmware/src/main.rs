@@ -525,9 +525,9 @@ fn led() {
 
 // The step timer: the one handler that is never interrupted. Plain events
 // take the assembly fast path (`stepper::fast`), all others this handler.
-step_vector!(timer1_compa);
+step_vector!(timer3_compa);
 
-extern "avr-interrupt" fn timer1_compa() {
+extern "avr-interrupt" fn timer3_compa() {
     if stepper::on_compare() {
         spawn_from_isr(&SPAWNED, refill_task() as u8);
     }
