@@ -98,5 +98,10 @@ pub fn error(e: ErrorKind) -> FlashStr {
         PenWithMove => PenWithMove,
         NoHoming => NoHoming,
         HomingFailed => HomingFailed,
+        NoCard => NoCard,
+        CardFailed => CardFailed,
+        FileNotFound => FileNotFound,
+        Printing => Printing,
+        NoFileSelected => NoFileSelected,
     ])
 }

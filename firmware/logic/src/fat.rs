@@ -1,6 +1,7 @@
 //! A read-only FAT16/FAT32 file reader over a device of 512-byte blocks: one
 //! partition (MBR entry 0, or a partition-less "superfloppy"), files in the
-//! root directory by 8.3 name, read sequentially a block at a time.
+//! root directory by 8.3 or long name ([`dir`]), read sequentially a block
+//! at a time.
 //!
 //! Written for the AVR: the caller owns the one block buffer, nothing is
 //! allocated, and the only divisions are shifts (sectors per cluster is a
@@ -60,9 +61,9 @@ pub struct File {
 
 const ATTR_VOLUME: u8 = 0x08;
 const ATTR_DIR: u8 = 0x10;
-/// A directory holds at most 65536 entries of 32 bytes, so a longer one
-/// (a FAT32 root chain in a loop) is corrupt.
-const MAX_DIR_BLOCKS: u16 = 4096;
+
+mod dir;
+pub use dir::{short_display, Dir, Entry, Name, Scan, Slot, LONG};
 
 fn le16(b: &[u8], at: usize) -> u16 {
     u16::from_le_bytes([b[at], b[at + 1]])
@@ -158,70 +159,6 @@ impl Volume {
 
     pub fn is_fat32(&self) -> bool {
         self.fat32
-    }
-
-    /// Looks a file up in the root directory by its 8.3 name, case-insensitively
-    /// (b"param.txt" matches PARAM.TXT; b"EMPTY" matches a name without extension).
-    /// Skips deleted entries, long-file-name entries, the volume label and directories.
-    /// Reads directory blocks one at a time into `buf`; FAT16's fixed root directory and
-    /// FAT32's cluster-chained root directory.
-    pub fn open<D: BlockRead>(
-        &self,
-        dev: &mut D,
-        buf: &mut [u8; BLOCK],
-        name: &[u8],
-    ) -> Result<File, FatError<D::Error>> {
-        let want = short_name(name).ok_or(FatError::NotFound)?;
-        // A run of consecutive blocks: FAT16's whole root, or one FAT32 cluster.
-        let mut cluster = self.root_cluster;
-        let (mut lba, mut left) = if self.fat32 {
-            (self.cluster_lba(cluster), 1u16 << self.cluster_shift)
-        } else {
-            (self.root_start, self.root_blocks)
-        };
-        for _ in 0..MAX_DIR_BLOCKS {
-            if left == 0 {
-                if !self.fat32 {
-                    return Err(FatError::NotFound);
-                }
-                cluster = match self.next_cluster(dev, buf, cluster)? {
-                    Some((next, _)) => next,
-                    None => return Err(FatError::NotFound),
-                };
-                lba = self.cluster_lba(cluster);
-                left = 1 << self.cluster_shift;
-            }
-            dev.read_block(lba, buf).map_err(FatError::Device)?;
-            for entry in buf.chunks_exact(32) {
-                match entry[0] {
-                    0x00 => return Err(FatError::NotFound), // no entries beyond
-                    0xE5 => continue,                       // deleted
-                    _ => {}
-                }
-                // Long-name entries (attributes 0x0F) carry the volume bit too.
-                if entry[11] & (ATTR_VOLUME | ATTR_DIR) != 0
-                    || !entry[..11].eq_ignore_ascii_case(&want)
-                {
-                    continue;
-                }
-                let high = if self.fat32 { le16(entry, 20) } else { 0 };
-                let first = u32::from(high) << 16 | u32::from(le16(entry, 26));
-                let size = le32(entry, 28);
-                if size > 0 && first.wrapping_sub(2) >= self.clusters {
-                    return Err(FatError::BadChain);
-                }
-                return Ok(File {
-                    first,
-                    cluster: first,
-                    size,
-                    pos: 0,
-                    run_end: first,
-                });
-            }
-            lba += 1;
-            left -= 1;
-        }
-        Err(FatError::BadChain)
     }
 
     fn cluster_lba(&self, cluster: u32) -> u32 {

@@ -55,6 +55,17 @@ pub enum ErrorKind {
     ArcRadiusInvalid = 34,
     /// An arc with neither `R` nor an offset of its plane (interpreter).
     ArcNoOffsetInPlane = 35,
+    /// `M20`, `M23`…: no card in the slot, or none with a FAT volume
+    /// (numbered as FluidNC's SD errors).
+    NoCard = 60,
+    /// The card failed while a file was read.
+    CardFailed = 61,
+    /// `M23`: no such file (or a name longer than any kept).
+    FileNotFound = 65,
+    /// A card print is running: `M25` pauses it, `M524` aborts it.
+    Printing = 67,
+    /// `M24` with no file selected by `M23` (taut's).
+    NoFileSelected = 76,
     /// `*` checksum wrong, malformed, or followed by more words.
     BadChecksum = 70,
     /// Motion, drivers or settings while a string-art job runs (taut's).
@@ -99,6 +110,11 @@ impl ErrorKind {
             ErrorKind::ArcNoAxisInPlane => "Arc without an axis of its plane",
             ErrorKind::ArcRadiusInvalid => "Arc radius invalid",
             ErrorKind::ArcNoOffsetInPlane => "Arc without R or an offset of its plane",
+            ErrorKind::NoCard => "No card",
+            ErrorKind::CardFailed => "Card read failed",
+            ErrorKind::FileNotFound => "File not found",
+            ErrorKind::Printing => "Printing from the card (M25, M524)",
+            ErrorKind::NoFileSelected => "No file selected (M23)",
             ErrorKind::BadChecksum => "Bad checksum",
             ErrorKind::JobOwnsMotion => "A job is running",
             ErrorKind::FeedTooLow => "Feed rate below 10/min",

@@ -2,6 +2,7 @@
 //! or a realtime byte.
 
 use super::system::SystemLine;
+use crate::fat::Name;
 use crate::units::{MaybeMilli, Milli};
 
 /// Axis letters the command line accepts. Which channel each drives is the
@@ -273,6 +274,40 @@ impl Realtime {
     }
 }
 
+/// Marlin's card commands, run by the console (not the interpreter).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CardLine {
+    /// `M20`: list the card's files.
+    List,
+    /// `M21`: mount the card (mounted when inserted: answered at once).
+    Mount,
+    /// `M23 <name>`: select a file by its 8.3 or long name.
+    Select(Name),
+    /// `M24`: start the selected file, or go on after `M25`.
+    Start,
+    /// `M25`: pause the print (a feed hold).
+    Pause,
+    /// `M27`: how far the print is.
+    Progress,
+    /// `M524`: abort the print.
+    Abort,
+}
+
+impl CardLine {
+    pub(super) fn from_number(number: Milli) -> Option<CardLine> {
+        Some(match number.0 {
+            20_000 => CardLine::List,
+            21_000 => CardLine::Mount,
+            23_000 => CardLine::Select(Name::EMPTY),
+            24_000 => CardLine::Start,
+            25_000 => CardLine::Pause,
+            27_000 => CardLine::Progress,
+            524_000 => CardLine::Abort,
+            _ => return None,
+        })
+    }
+}
+
 /// What a byte pushed into the parser completed.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Input {
@@ -280,6 +315,8 @@ pub enum Input {
     Line(Line),
     /// A `$` line.
     System(SystemLine),
+    /// `M20`, `M23 <name>`, `M24`…
+    Card(CardLine),
     /// A realtime byte (no `ok`).
     Realtime(Realtime),
 }

@@ -209,10 +209,10 @@ impl Parser {
                 checksum,
                 ..Line::EMPTY
             })),
-            Statement::GCode(words) => {
-                let line = words.finish(end)?;
-                Ok(Input::Line(Line { checksum, ..line }))
-            }
+            Statement::GCode(words) => match words.finish(end)? {
+                Input::Line(line) => Ok(Input::Line(Line { checksum, ..line })),
+                other => Ok(other),
+            },
             Statement::System(system) => system.finish(end).map(Input::System),
         }
     }

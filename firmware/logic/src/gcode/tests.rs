@@ -7,6 +7,7 @@ mod properties;
 mod render;
 
 use super::*;
+use crate::fat::Name;
 use crate::units::Milli;
 use std::format;
 use std::vec::Vec;

@@ -4,7 +4,7 @@
 //! then only skipped.
 
 use super::error::{Error, ErrorKind};
-use super::line::{AxisWord, Command, Distance, Line, Plane, Units};
+use super::line::{AxisWord, CardLine, Command, Distance, Input, Line, Plane, Units};
 use super::number::Number;
 use crate::units::{MaybeMilli, Milli};
 
@@ -31,6 +31,9 @@ pub(super) struct Words {
     s_column: u8,
     /// The first `I J K R`.
     arc_column: u8,
+    /// A card command (`M20`…) in place of the line's command; `M23`
+    /// collects the rest of the line as its file name.
+    card: Option<CardLine>,
 }
 
 impl Words {
@@ -44,6 +47,7 @@ impl Words {
             p_column: 0,
             s_column: 0,
             arc_column: 0,
+            card: None,
         }
     }
 
@@ -61,6 +65,9 @@ impl Words {
     }
 
     fn take(&mut self, c: u8, column: u8) -> Result<(), Error> {
+        if self.naming() {
+            return self.name_char(c, column);
+        }
         match c {
             // A space ends a number but may sit between letter and number.
             b' ' | b'\t' => match self.word {
@@ -69,6 +76,9 @@ impl Words {
             },
             b'a'..=b'z' | b'A'..=b'Z' => {
                 self.close(column)?;
+                if self.naming() {
+                    return self.name_char(c, column);
+                }
                 let letter = c.to_ascii_uppercase();
                 let number = match letter {
                     b'N' => Number::integer(MAX_LINE_NUMBER),
@@ -92,6 +102,23 @@ impl Words {
                 None => Err(Error::new(ErrorKind::ExpectedCommandLetter, column)),
             },
         }
+    }
+
+    /// After `M23`: the characters are its file name.
+    fn naming(&self) -> bool {
+        matches!(self.card, Some(CardLine::Select(_))) && self.word.is_none()
+    }
+
+    fn name_char(&mut self, c: u8, column: u8) -> Result<(), Error> {
+        let Some(CardLine::Select(name)) = &mut self.card else {
+            return Ok(());
+        };
+        if c == b' ' && name.is_empty() {
+            return Ok(());
+        }
+        // No file on the card has a longer name that can be selected.
+        name.push(c)
+            .map_err(|()| Error::new(ErrorKind::FileNotFound, column))
     }
 
     /// Ends the word being read at the character in `column`.
@@ -169,7 +196,18 @@ impl Words {
                 }
                 Ok(())
             }
+            b'M' if CardLine::from_number(value).is_some() => {
+                if self.command_column != 0 {
+                    return error(ErrorKind::ModalGroupViolation);
+                }
+                self.command_column = column;
+                self.card = CardLine::from_number(value);
+                Ok(())
+            }
             b'G' | b'M' => {
+                if self.card.is_some() {
+                    return error(ErrorKind::ModalGroupViolation);
+                }
                 let Some(command) = Command::from_word(letter, value) else {
                     return error(ErrorKind::UnsupportedCommand);
                 };
@@ -217,7 +255,7 @@ impl Words {
     }
 
     /// The line, once its last character (before `column`) has been read.
-    pub(super) fn finish(mut self, column: u8) -> Result<Line, Error> {
+    pub(super) fn finish(mut self, column: u8) -> Result<Input, Error> {
         if let Some(e) = self.error {
             return Err(e);
         }
@@ -225,6 +263,23 @@ impl Words {
         let line = self.line;
         let fail = |kind, column| Err(Error::new(kind, column));
         let has_axes = self.axis_column != 0;
+        if let Some(card) = self.card {
+            let value_column = [self.p_column, self.s_column, self.arc_column]
+                .into_iter()
+                .find(|&c| c != 0);
+            return match card {
+                _ if has_axes => fail(ErrorKind::UnusedAxisWords, self.axis_column),
+                _ if value_column.is_some() || line.f.is_some() => fail(
+                    ErrorKind::UnusedValueWords,
+                    value_column.unwrap_or(self.command_column),
+                ),
+                CardLine::Select(name) if name.is_empty() => {
+                    fail(ErrorKind::ValueWordMissing, self.command_column)
+                }
+                CardLine::Select(name) => Ok(Input::Card(CardLine::Select(name.trimmed()))),
+                _ => Ok(Input::Card(card)),
+            };
+        }
         match line.command {
             Command::Dwell if has_axes => {
                 return fail(ErrorKind::UnusedAxisWords, self.axis_column)
@@ -269,7 +324,7 @@ impl Words {
         if self.arc_column != 0 && (!arc || (offsets && line.r.is_some())) {
             return fail(ErrorKind::UnusedValueWords, self.arc_column);
         }
-        Ok(line)
+        Ok(Input::Line(line))
     }
 }
 

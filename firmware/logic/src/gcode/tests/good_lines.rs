@@ -157,3 +157,19 @@ fn parse_milli_reads_setting_values() {
     assert_eq!(parse_milli("1e3"), None);
     assert_eq!(parse_milli("2147483.648"), None);
 }
+
+#[test]
+fn card_lines() {
+    let select = |name: &str| Ok(Input::Card(CardLine::Select(Name::new(name.as_bytes()).unwrap())));
+    assert_eq!(parse("M20"), Ok(Input::Card(CardLine::List)));
+    assert_eq!(parse("m21"), Ok(Input::Card(CardLine::Mount)));
+    assert_eq!(parse("N5 M24*16"), Ok(Input::Card(CardLine::Start)));
+    assert_eq!(parse("M25 ; pause"), Ok(Input::Card(CardLine::Pause)));
+    assert_eq!(parse("M27"), Ok(Input::Card(CardLine::Progress)));
+    assert_eq!(parse("M524"), Ok(Input::Card(CardLine::Abort)));
+    // The rest of the line is the name, in its case, the comment apart.
+    assert_eq!(parse("M23 star.gcode"), select("star.gcode"));
+    assert_eq!(parse("M23STAR.GCO ; the star"), select("STAR.GCO"));
+    assert_eq!(parse("M23   My Drawing.nc  "), select("My Drawing.nc"));
+    assert_eq!(parse("N7 M23 A1.NC*102"), select("A1.NC"));
+}
