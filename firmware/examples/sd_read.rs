@@ -13,7 +13,7 @@ use taut_firmware::card::CardReader;
 use taut_firmware::info;
 use taut_firmware::queues::{Request, Signal, What, CARD_IN, CARD_OUT};
 use taut_firmware::rt::Poll;
-use taut_logic::files::FileName;
+use taut_logic::fat::Name;
 
 #[avr_device::entry]
 fn main() -> ! {
@@ -36,7 +36,8 @@ fn main() -> ! {
             }
         }
     }
-    let _ = CARD_IN.push(Request::Open(FileName::Poradi, 1));
+    let poradi = Name::new(b"poradi.txt").unwrap_or(Name::EMPTY);
+    let _ = CARD_IN.push(Request::Open(poradi, 1));
     let start = clock::micros();
     let mut bytes: u32 = 0;
     loop {
@@ -48,6 +49,7 @@ fn main() -> ! {
         match CARD_OUT.pop().map(|m| m.what) {
             Some(What::Data { len, .. }) => bytes += len as u32,
             Some(What::End) => break,
+            Some(What::Opened { .. }) => {}
             Some(_) => break,
             None => {}
         }

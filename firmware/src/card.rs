@@ -22,8 +22,10 @@ use core::mem::{offset_of, size_of};
 use embedded_hal::spi::SpiDevice;
 use embedded_sdmmc::sdcard::spi::AcquireOpts;
 use embedded_sdmmc::{Block, BlockDevice, BlockIdx, SdCard, SdCardError};
-use taut_logic::fat::{BlockRead, FatError, File, Volume, BLOCK};
-use taut_logic::files::FileName;
+use taut_logic::fat::{
+    BlockRead, Dir, Entry, FatError, File, Scan, Slot as DirSlot, Volume, BLOCK,
+};
+use ufmt::uwrite;
 
 /// Free slots the reader waits for before a step of work: the most one
 /// step sends (the last chunk of a block and `End`, or `Failed` and
@@ -66,7 +68,22 @@ pub struct CardReader {
     faulty: Option<(u32, FlashStr, u8)>,
     /// When the card is next looked for or checked.
     check_at: u32,
+    /// `M20` in progress.
+    listing: Option<Listing>,
 }
+
+/// A directory listing written line by line as the TX ring has room.
+#[derive(Clone, Copy)]
+struct Listing {
+    dir: Dir,
+    scan: Scan,
+    /// The next entry of the block in `block`; `ENTRIES`: read the next block.
+    at: u8,
+    ticket: u8,
+}
+
+/// Directory entries per block.
+const ENTRIES: u8 = (BLOCK / 32) as u8;
 
 // The FAT reader fills `Block::contents` through a `[u8; 512]` view.
 const _: () = assert!(size_of::<Block>() == BLOCK && offset_of!(Block, contents) == 0);
@@ -119,6 +136,7 @@ impl CardReader {
             failures: 0,
             faulty: None,
             check_at: 0,
+            listing: None,
         }
     }
 
@@ -148,17 +166,37 @@ impl CardReader {
             }
         }
         let Slot::Mounted(volume) = self.slot else {
+            // Asked of an empty or failed slot: no such file.
+            if let Some(Request::Open(_, t) | Request::OpenFirst(t) | Request::List(t)) =
+                CARD_IN.peek()
+            {
+                if CARD_OUT.free() < ROOM {
+                    return Poll::Wait(Signal::CardRoom);
+                }
+                let _ = CARD_IN.pop();
+                Self::send(What::Failed, t);
+                return Poll::Again;
+            }
+            let _ = CARD_IN.pop();
             return Poll::Idle;
         };
-        if let Some(Request::Open(name, ticket)) = CARD_IN.peek() {
+        if let Some(request) = CARD_IN.peek() {
             if CARD_OUT.free() < ROOM {
                 return Poll::Wait(Signal::CardRoom);
             }
             let _ = CARD_IN.pop();
-            self.open(volume, name, ticket);
+            match request {
+                Request::Open(name, ticket) => {
+                    self.open(volume, ticket, |e| e.matches(name.as_bytes()))
+                }
+                Request::OpenFirst(ticket) => self.open(volume, ticket, Entry::is_gcode),
+                Request::List(ticket) => self.list_from_start(volume, ticket),
+                Request::Close => self.file = None,
+            }
             return Poll::Again;
         }
         match volume {
+            Some(v) if self.listing.is_some() => self.list(v),
             Some(v) if self.file.is_some() => self.stream(v),
             _ => Poll::Idle,
         }
@@ -169,6 +207,7 @@ impl CardReader {
         let _ = CARD_OUT.push(CardMsg { ticket, what });
     }
 
+    #[inline(never)]
     fn look_for_card(&mut self) -> Poll<Signal> {
         let present = self.sd.spi(|spi| {
             spi.bus.slow_speed();
@@ -223,8 +262,11 @@ impl CardReader {
         Poll::Idle
     }
 
-    fn open(&mut self, volume: Option<Volume>, name: FileName, ticket: u8) {
+    /// Open the first file `pick` wants; `Opened` and its bytes follow.
+    #[inline(never)]
+    fn open(&mut self, volume: Option<Volume>, ticket: u8, pick: impl FnMut(&Entry) -> bool) {
         self.file = None;
+        self.listing = None;
         self.at = 0;
         self.len = 0;
         let Some(v) = volume else {
@@ -234,8 +276,15 @@ impl CardReader {
             sd: &self.sd,
             lba: 0,
         };
-        match v.open(&mut dev, &mut self.block.contents, name.name().as_bytes()) {
-            Ok(f) => self.file = Some((f, ticket)),
+        let found = v
+            .find(&mut dev, &mut self.block.contents, pick)
+            .and_then(|e| v.file(&e).map(|f| (e, f)));
+        match found {
+            Ok((e, f)) => {
+                self.file = Some((f, ticket));
+                let (name, size) = (e.name(), e.size);
+                Self::send(What::Opened { name, size }, ticket);
+            }
             Err(FatError::NotFound) => Self::send(What::Missing, ticket),
             Err(FatError::Device(e)) => {
                 let lba = dev.lba;
@@ -251,7 +300,83 @@ impl CardReader {
         }
     }
 
+    fn list_from_start(&mut self, volume: Option<Volume>, ticket: u8) {
+        match volume {
+            Some(v) => {
+                self.listing = Some(Listing {
+                    dir: v.root(),
+                    scan: Scan::new(),
+                    at: ENTRIES,
+                    ticket,
+                })
+            }
+            None => Self::send(What::Failed, ticket),
+        }
+    }
+
+    /// Lines of the listing while the TX ring has room, `NAME.EXT size
+    /// long name` as Marlin's `M20 L`; the next directory block when
+    /// this one is done.
+    #[inline(never)]
+    fn list(&mut self, volume: Volume) -> Poll<Signal> {
+        let Some(mut l) = self.listing else {
+            return Poll::Idle;
+        };
+        if l.at == ENTRIES {
+            let mut dev = Device {
+                sd: &self.sd,
+                lba: 0,
+            };
+            match volume.read_dir(&mut l.dir, &mut dev, &mut self.block.contents) {
+                Ok(true) => l.at = 0,
+                Ok(false) => return self.listed(l.ticket),
+                Err(FatError::Device(e)) => {
+                    let lba = dev.lba;
+                    return match failure(&e) {
+                        // Read again: the walk moved on only past good blocks.
+                        Failure::Block(what) => self.bad_block(lba, what, l.ticket),
+                        Failure::Gone => {
+                            self.removed(l.ticket);
+                            Poll::Idle
+                        }
+                    };
+                }
+                Err(_) => return self.listed(l.ticket),
+            }
+        }
+        while l.at < ENTRIES {
+            if !crate::reply::room() {
+                self.listing = Some(l);
+                return Poll::After(2);
+            }
+            let at = usize::from(l.at) * 32;
+            let slot = l.scan.take(&self.block.contents[at..at + 32]);
+            l.at += 1;
+            match slot {
+                DirSlot::End => return self.listed(l.ticket),
+                DirSlot::Skip => {}
+                DirSlot::File(e) => {
+                    let mut r = crate::reply::line();
+                    let _ = uwrite!(r, "{} {}", e.short_name(), e.size);
+                    if !e.long.is_empty() && e.long != e.short_name() {
+                        let _ = uwrite!(r, " {}", e.long);
+                    }
+                    r.send();
+                }
+            }
+        }
+        self.listing = Some(l);
+        Poll::Again
+    }
+
+    fn listed(&mut self, ticket: u8) -> Poll<Signal> {
+        self.listing = None;
+        Self::send(What::Listed, ticket);
+        Poll::Idle
+    }
+
     /// Sends what is left of the block, then reads the next one.
+    #[inline(never)]
     fn stream(&mut self, volume: Volume) -> Poll<Signal> {
         let Some((mut file, ticket)) = self.file else {
             return Poll::Idle;
@@ -329,6 +454,7 @@ impl CardReader {
     /// Say once that the card is failing (waiting for room for the line),
     /// and fail the file (or the directory it was looked up in); a card
     /// that failed while mounted was never announced to the job.
+    #[inline(never)]
     fn report_faulty(&mut self, lba: u32, what: FlashStr, ticket: u8) -> Poll<Signal> {
         if TX.free() < crate::log::LINE || CARD_OUT.free() < ROOM {
             return Poll::After(2);
@@ -338,7 +464,8 @@ impl CardReader {
             "card: block ",
             lba, " ", what, " ", TRIES, " times: the card is failing, replace it"
         );
-        if self.file.take().is_some() || ticket != 0 {
+        let reading = self.file.take().is_some() || self.listing.take().is_some();
+        if reading || ticket != 0 {
             Self::send(What::Failed, ticket);
         }
         Poll::Idle
@@ -357,7 +484,7 @@ impl CardReader {
     /// The card stopped answering: pulled out (or dead, which the user
     /// treats the same way). A file being read fails first.
     fn removed(&mut self, ticket: u8) {
-        if self.file.take().is_some() {
+        if self.file.take().is_some() || self.listing.take().is_some() {
             Self::send(What::Failed, ticket);
         }
         self.failures = 0;

@@ -16,23 +16,26 @@
 use crate::board::clock;
 use crate::endstop;
 use crate::motion::Motion;
-use crate::queues::{Signal, JOB_CLAIMS_TX, RX};
+use crate::print::Print;
+use crate::queues::{Signal, BUTTONS, JOB_CLAIMS_TX, RX};
 use crate::reply::{self, Fixed, REPORTED_AXES};
 use crate::rt::{stack, Poll};
-use crate::{info, warn};
+use crate::{flash_str, info, warn};
 use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::AXES;
+use taut_logic::buttons::ButtonEvent;
 use taut_logic::config::{MachineConfig, PenConfig};
-use taut_logic::gcode::{Error, ErrorKind, Input, Line, Parser, SystemLine};
+use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Line, Parser, SystemLine};
 use taut_logic::homing::{self, Homing, Leg, Next};
 use taut_logic::interp::{Allowed, Interpreter, Order, Path};
 use taut_logic::kinematics::Kinematics;
 use taut_logic::patterns;
+use taut_logic::pinmap::Button;
 use taut_logic::planner::Feed;
 use taut_logic::settings;
 use taut_logic::units::Milli;
 use taut_progmem::Text;
-use ufmt::{uWrite, uwrite};
+use ufmt::uwrite;
 
 pub struct Console {
     parser: Parser,
@@ -51,6 +54,17 @@ pub struct Console {
     epoch: u8,
     /// A `$` setting changed since the app last asked.
     settings_changed: bool,
+    /// A plotter's print from the card.
+    print: Print,
+    /// Where the line being read comes from, `None` between lines: while
+    /// a print runs, a serial line is read whenever one has arrived whole.
+    source: Option<Source>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Source {
+    Serial,
+    Card,
 }
 
 enum Pending {
@@ -94,6 +108,8 @@ impl Console {
             // the kinematics (zero steps are not (0, 0) on an arm).
             epoch: u8::MAX,
             settings_changed: false,
+            print: Print::new(),
+            source: None,
         }
     }
 
@@ -112,6 +128,8 @@ impl Console {
         self.dwell_until = None;
         self.listing = None;
         self.interp.reset();
+        self.print.abort();
+        self.source = None;
         RX.clear();
     }
 
@@ -139,6 +157,22 @@ impl Console {
             if let Some(listing) = self.listing {
                 self.list(listing, cfg);
                 return Poll::Again;
+            }
+            // A card command waits for the reader.
+            if !cfg.machine.is_string_art() && self.card_news(m) {
+                return Poll::Idle;
+            }
+            // A serial line (`M25`, `M27`, `?`-like reads) goes by while
+            // the card's line waits for the planner: a held print must
+            // still hear `M24`.
+            if self.pending.is_some() && self.source == Some(Source::Card) && serial_line_waits() {
+                self.source = Some(Source::Serial);
+                let read = self.read(m, cfg, owner);
+                self.source = Some(Source::Card);
+                if let Err(wait) = read {
+                    return wait;
+                }
+                continue;
             }
             // Copied out by itself: a whole `Pending` is arc-sized.
             let line = match &self.pending {
@@ -169,6 +203,24 @@ impl Console {
                 // One line per run: the other tasks get their turn.
                 return Poll::Again;
             }
+            if let Err(wait) = self.read(m, cfg, owner) {
+                return wait;
+            }
+        }
+    }
+
+    /// Read bytes until an input is complete, and take it: a G-code line
+    /// waits in `pending`, the others are carried out. `Err` when the
+    /// bytes ran out. Out of line: the parser's copies of a line stay off
+    /// the frame that plans and cuts moves.
+    #[inline(never)]
+    fn read(
+        &mut self,
+        m: &mut Motion,
+        cfg: &mut MachineConfig,
+        owner: Owner,
+    ) -> Result<(), Poll<Signal>> {
+        loop {
             let byte = match self.pattern.as_mut() {
                 Some((text, at)) if usize::from(*at) < text.len() => {
                     *at += 1;
@@ -178,19 +230,130 @@ impl Console {
                 Some(_) => {
                     self.pattern = None;
                     reply::ok();
-                    continue;
+                    return Ok(());
                 }
-                None => match RX.pop() {
+                None => match self.next_byte() {
                     Some(byte) => byte,
-                    None => return Poll::Idle,
+                    None => return Err(Poll::Idle),
                 },
             };
-            match self.parser.push(byte) {
-                None | Some(Ok(Input::Realtime(_))) => {}
-                Some(Err(e)) => self.error(&e),
-                Some(Ok(Input::Line(line))) => self.pending = Some(Pending::Line(line)),
-                Some(Ok(Input::System(s))) => self.system(s, m, cfg, owner),
+            let input = match parse(&mut self.parser, byte) {
+                None | Some(Ok(Input::Realtime(_))) => continue,
+                Some(input) => input,
+            };
+            if self.source == Some(Source::Card) {
+                self.print.line_done();
             }
+            match input {
+                Ok(Input::Realtime(_)) => {}
+                Err(e) => self.error(&e),
+                // While a print runs, the serial line may only look.
+                Ok(Input::Line(_)) if self.printing_from_serial() => {
+                    self.error(&Error::new(ErrorKind::Printing, 0))
+                }
+                Ok(Input::Line(line)) => self.pending = Some(Pending::Line(line)),
+                Ok(Input::System(s)) => self.system(s, m, cfg, owner),
+                Ok(Input::Card(c)) => self.card_line(c, m, cfg),
+            }
+            return Ok(());
+        }
+    }
+
+    /// The next byte of the line being read: a line from the card, or
+    /// from the serial line once it has arrived whole while a print runs
+    /// (its lines are not cut into by the card's).
+    #[inline(never)]
+    fn next_byte(&mut self) -> Option<u8> {
+        if self.source == Some(Source::Card) && !self.print.running() {
+            // The print stopped mid-line: the part read is dropped (a lost
+            // print reads the line again).
+            self.parser = Parser::new();
+            self.source = None;
+        }
+        if !self.parser.mid_line() {
+            self.source = Some(match self.print.running() && !serial_line_waits() {
+                true => Source::Card,
+                false => Source::Serial,
+            });
+        }
+        let byte = match self.source {
+            Some(Source::Card) => self.print.next_byte(),
+            _ => RX.pop(),
+        };
+        if byte.is_none() {
+            self.print.finished();
+        }
+        byte
+    }
+
+    /// A serial line while a print runs.
+    fn printing_from_serial(&self) -> bool {
+        self.print.busy() && self.source != Some(Source::Card)
+    }
+
+    /// A plotter's buttons and card messages; `true` while a card command
+    /// still waits for the reader.
+    #[inline(never)]
+    fn card_news(&mut self, m: &mut Motion) -> bool {
+        self.green_button(m);
+        let waited = self.print.waiting();
+        match self.print.take_messages() {
+            Some(Ok(())) => self.ok(),
+            Some(Err(kind)) => self.error(&Error::new(kind, 0)),
+            None => return waited,
+        }
+        false
+    }
+
+    /// The green button on a plotter: go on after a hold or `M0`, else
+    /// start the selected file, go on with a lost one, or start the
+    /// card's first G-code file.
+    #[inline(never)]
+    fn green_button(&mut self, m: &mut Motion) {
+        while let Some(event) = BUTTONS.pop() {
+            if event == ButtonEvent::Pressed(Button::Confirm)
+                && !m.resume()
+                && self.print.start(false).is_err()
+            {
+                self.print.start_first();
+            }
+        }
+    }
+
+    /// `M20`, `M23`…: a plotter's card print (the string-art job owns the
+    /// card on its machine; a file cannot run card commands).
+    #[inline(never)]
+    #[optimize(size)]
+    fn card_line(&mut self, c: CardLine, m: &mut Motion, cfg: &MachineConfig) {
+        if cfg.machine.is_string_art() || self.source == Some(Source::Card) {
+            return self.error(&Error::new(ErrorKind::UnsupportedCommand, 1));
+        }
+        let done = match c {
+            CardLine::List => self.print.list(),
+            CardLine::Mount => Ok(()),
+            CardLine::Select(name) => self.print.select(name),
+            CardLine::Start if m.resume() => Ok(()),
+            CardLine::Start => self.print.start(true),
+            CardLine::Pause => {
+                if self.print.running() {
+                    m.hold();
+                }
+                Ok(())
+            }
+            CardLine::Progress => {
+                self.print.progress();
+                Ok(())
+            }
+            CardLine::Abort => {
+                self.print.abort();
+                Ok(())
+            }
+        };
+        match done {
+            Err(kind) => self.error(&Error::new(kind, 0)),
+            // Answered when the reader has.
+            Ok(()) if self.print.waiting() => {}
+            Ok(()) => self.ok(),
         }
     }
 
@@ -307,7 +470,7 @@ impl Console {
                 self.pending = None;
                 self.resync_next_run(m);
                 match reply {
-                    true => reply::ok(),
+                    true => self.ok(),
                     false => info!("homed"),
                 }
             }
@@ -319,7 +482,7 @@ impl Console {
                 m.lose_position();
                 let e = Error::new(ErrorKind::HomingFailed, 0);
                 match reply {
-                    true => reply::error(&e),
+                    true => self.error(&e),
                     false => warn!("homing failed: switch not found or stuck"),
                 }
             }
@@ -327,17 +490,26 @@ impl Console {
         Poll::Again
     }
 
-    /// `ok` to a line, unless it is a pattern's (answered at its end).
+    /// `ok` to a line, unless it is a pattern's (answered at its end) or
+    /// the card's.
     fn ok(&self) {
-        if self.pattern.is_none() {
+        if self.pattern.is_none() && self.source != Some(Source::Card) {
             reply::ok();
         }
     }
 
-    /// An error: the answer to the line, or to the pattern, which stops.
+    /// An error: the answer to the line, or to the pattern, which stops,
+    /// or in the log with the card's file and line.
     fn error(&mut self, e: &Error) {
+        self.error_because(e, None);
+    }
+
+    fn error_because(&mut self, e: &Error, why: Option<taut_logic::text::ErrorKind>) {
         self.pattern = None;
-        reply::error(e);
+        match self.source {
+            Some(Source::Card) => self.print.line_failed(e, why),
+            _ => reply::error_because(e, why),
+        }
     }
 
     /// Read the commanded position back through the kinematics on the
@@ -391,13 +563,14 @@ impl Console {
             Some(Err(_)) => {
                 self.pending = None;
                 self.interp.resync(kin.forward(&m.target()));
-                reply::error(&Error::new(ErrorKind::InvalidTarget, 0));
+                self.error(&Error::new(ErrorKind::InvalidTarget, 0));
             }
         }
         Poll::Again
     }
 
     #[inline(never)]
+    #[optimize(size)]
     fn system(&mut self, s: SystemLine, m: &mut Motion, cfg: &mut MachineConfig, owner: Owner) {
         match s {
             SystemLine::PrintSettings => {
@@ -412,25 +585,36 @@ impl Console {
                 let mut r = reply::line();
                 let _ = uwrite!(
                     r,
-                    "[stack peak {} B, headroom {} B]",
+                    "{}{}{}{}{}",
+                    flash_str!("[stack peak "),
                     stack::peak(),
-                    stack::headroom()
+                    flash_str!(" B, headroom "),
+                    stack::headroom(),
+                    flash_str!(" B]")
                 );
                 r.send();
             }
+            SystemLine::Unlock
+            | SystemLine::Home
+            | SystemLine::Pattern(_)
+            | SystemLine::Set { .. }
+                if self.printing_from_serial() =>
+            {
+                return self.error(&Error::new(ErrorKind::Printing, 0));
+            }
             SystemLine::Unlock => m.unlock(),
             SystemLine::Home if owner == Owner::Job => {
-                return reply::error(&Error::new(ErrorKind::JobOwnsMotion, 0));
+                return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
             }
             SystemLine::Home if !m.is_idle() => {
-                return reply::error(&Error::new(ErrorKind::NotIdle, 0));
+                return self.error(&Error::new(ErrorKind::NotIdle, 0));
             }
             SystemLine::Home if cfg.homing.axes == 0 => {
-                return reply::error(&Error::new(ErrorKind::NoHoming, 0));
+                return self.error(&Error::new(ErrorKind::NoHoming, 0));
             }
             SystemLine::Home => return self.start_homing(cfg.homing.axes, m, true),
             SystemLine::Pattern(_) if owner == Owner::Job => {
-                return reply::error(&Error::new(ErrorKind::JobOwnsMotion, 0));
+                return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
             }
             // Answered at its end.
             SystemLine::Pattern(n) => {
@@ -438,10 +622,10 @@ impl Console {
                 return;
             }
             SystemLine::Set { .. } if owner == Owner::Job => {
-                return reply::error(&Error::new(ErrorKind::JobOwnsMotion, 0));
+                return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
             }
             SystemLine::Set { .. } if !m.is_idle() => {
-                return reply::error(&Error::new(ErrorKind::NotIdle, 0));
+                return self.error(&Error::new(ErrorKind::NotIdle, 0));
             }
             SystemLine::Set { key, value } => {
                 let machine = cfg.machine;
@@ -449,7 +633,7 @@ impl Console {
                     // `$key=value`: the value starts after `$`, the key, `=`.
                     let col = (key.len() + 3 + e.at).min(u8::MAX as usize) as u8;
                     let invalid = Error::new(ErrorKind::InvalidStatement, col);
-                    return reply::error_because(&invalid, Some(e.kind));
+                    return self.error_because(&invalid, Some(e.kind));
                 }
                 m.configure(cfg);
                 if cfg.machine != machine {
@@ -462,7 +646,7 @@ impl Console {
                 self.settings_changed = true;
             }
         }
-        reply::ok();
+        self.ok();
     }
 
     /// One line of a listing per call: the TX ring never overflows.
@@ -491,6 +675,18 @@ impl Default for Console {
     }
 }
 
+/// A whole line has arrived on the serial line.
+fn serial_line_waits() -> bool {
+    RX.any(|&b| b == b'\n' || b == b'\r')
+}
+
+/// One byte into the parser. Out of line: its copies of the line being
+/// finished are gone before the line is carried out.
+#[inline(never)]
+fn parse(parser: &mut Parser, byte: u8) -> Option<Result<Input, Error>> {
+    parser.push(byte)
+}
+
 /// `M114`: `C:1.000 X:0.000 Z:0.000 Count C:27 X:0 Z:0` (the executed
 /// position).
 #[inline(never)]
@@ -502,7 +698,7 @@ fn report_position(m: &Motion, kin: &impl Kinematics) {
     for i in 0..REPORTED_AXES {
         let _ = uwrite!(r, "{}:{} ", words[i] as char, Fixed(pos[i]));
     }
-    let _ = r.write_str("Count");
+    let _ = uwrite!(r, "{}", flash_str!("Count"));
     for i in 0..REPORTED_AXES {
         let _ = uwrite!(r, " {}:{}", words[i] as char, steps[i]);
     }

@@ -18,6 +18,7 @@ use core::sync::atomic::Ordering::Relaxed;
 use heapless::Deque;
 use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
+use taut_logic::fat::Name;
 use taut_logic::files::check::{Files, Next};
 use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
@@ -199,6 +200,8 @@ impl JobTask {
                 return self.event(Event::CardRemoved, now);
             }
             _ if msg.ticket != self.ticket => return,
+            // Its bytes follow.
+            What::Opened { .. } | What::Listed => return,
             _ => {}
         }
         let files = match &mut self.stream {
@@ -261,6 +264,7 @@ impl JobTask {
         self.ticket = self.ticket.wrapping_add(1).max(1);
         // The reader takes requests before anything else: one slot will do,
         // and a full one means the last request is being replaced anyway.
+        let name = Name::new(name.name().as_bytes()).unwrap_or(Name::EMPTY);
         while CARD_IN.push(Request::Open(name, self.ticket)).is_err() {
             let _ = CARD_IN.pop();
         }

@@ -2,6 +2,7 @@
 //! tasks' state, which the `app` (src/main.rs) wires together. The special
 //! images in examples/ are built on the same pieces.
 #![no_std]
+#![feature(optimize_attribute)]
 #![feature(asm_experimental_arch)]
 
 pub mod board;
@@ -13,6 +14,7 @@ pub mod endstop;
 pub mod job;
 pub mod log;
 pub mod motion;
+pub mod print;
 pub mod queues;
 pub mod realtime;
 pub mod reply;

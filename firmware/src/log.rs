@@ -61,8 +61,15 @@ impl Line {
             cut: false,
         };
         let tag = [b'E', b'W', b'I', b'D'][level as usize];
-        let _ = ufmt::uwrite!(l, "[{} {} ", tag as char, clock::millis());
-        let _ = ufmt::uwrite!(l, "{}] ", module);
+        // Pushed byte by byte: format strings' pieces would sit in SRAM.
+        let _ = l.buf.push(b'[');
+        let _ = l.buf.push(tag);
+        let _ = l.buf.push(b' ');
+        let _ = ufmt::uwrite!(l, "{}", clock::millis());
+        let _ = l.buf.push(b' ');
+        let _ = ufmt::uwrite!(l, "{}", module);
+        let _ = l.buf.push(b']');
+        let _ = l.buf.push(b' ');
         l
     }
 

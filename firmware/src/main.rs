@@ -16,7 +16,7 @@
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
 //! | `Realtime` status, hold, resume, reset | software | 4 | `REALTIME` | `TX`, `JOB_CONTROL` |
 //! | `Refill` planner → segments while the queue holds < 30 ms of motion | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
-//! | `Console` one G-code line per run | software | 2 | `RX` | planner, `TX` |
+//! | `Console` one G-code line per run; a plotter's card print | software | 2 | `RX`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `CARD_IN`; signals `CardRoom` |
 //! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` |
 //! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `JOB_CONTROL` | planner, `CARD_IN`, `TX`; signals `CardRoom` |
 //! | `Led` status LED pattern (timed edges: runs before the long tasks) | software | 2 | its timer | |
@@ -26,7 +26,7 @@
 //! | `Store` settings → EEPROM, a changed byte per run | software | 0 | signal `Settings` | EEPROM |
 #![no_std]
 #![no_main]
-#![feature(abi_avr_interrupt, asm_experimental_arch)]
+#![feature(abi_avr_interrupt, asm_experimental_arch, optimize_attribute)]
 
 use embedded_hal::digital::OutputPin;
 use panic_halt as _;
@@ -43,7 +43,7 @@ use taut_firmware::console::{Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
-use taut_firmware::queues::{Control, Signal, BUTTONS, CARD_IN, CARD_OUT, JOB_CONTROL, SIGNALS};
+use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL, SIGNALS};
 use taut_firmware::realtime::{self, Requests};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{stack, Poll, TaskCell};
@@ -54,10 +54,8 @@ use taut_firmware::{
     nested_vector, step_vector,
 };
 use taut_firmware::{endstop, flash_str, info, reply, warn};
-use taut_logic::buttons::ButtonEvent;
 use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::kinematics::AnyKinematics;
-use taut_logic::pinmap::Button;
 use taut_logic::sched::{Ready, TaskId, Timers};
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -213,6 +211,7 @@ fn main() -> ! {
 /// The board, the tasks' state, the first tasks. Its own frame: the
 /// set-up's locals are gone from the stack before the dispatcher starts.
 #[inline(never)]
+#[optimize(size)]
 fn init() -> Watchdog {
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
     let reset = ResetCause::take(&dp.CPU);
@@ -371,6 +370,13 @@ fn console() {
     // New moves may be queued: the motion task feeds them to the stepper.
     spawn(Task::Motion);
     reschedule(Task::Console, poll);
+    // A plotter's card print asks the reader and takes its messages.
+    if !CARD_IN.is_empty() {
+        spawn(Task::Card);
+    }
+    if CARD_OUT.free() >= card::ROOM {
+        signal(Signal::CardRoom);
+    }
     if CONSOLE.with(|c| c.take_settings_changed()) {
         CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
         signal(Signal::Settings);
@@ -425,24 +431,26 @@ fn control_job(c: Control) {
     spawn(Task::Job);
 }
 
-/// Debounce the tick's samples; presses go to the job.
+/// Who takes the buttons' presses and the card's messages: the job on
+/// the string-art machine, the console (its card print) on a plotter.
+fn card_owner() -> Task {
+    match CONFIG.with(|cfg| cfg.machine.is_string_art()) {
+        true => Task::Job,
+        false => Task::Console,
+    }
+}
+
+/// Debounce the tick's samples; presses go to the card's owner.
 #[inline(never)]
 fn buttons() {
     if BUTTONS_TASK.with(|d| d.poll()) {
-        spawn(Task::Job);
+        spawn(card_owner());
     }
 }
 
 #[inline(never)]
 fn job() {
-    if !CONFIG.with(|cfg| cfg.machine.is_string_art()) {
-        // A plotter: the green button goes on after `M0`, as `~` does.
-        while let Some(event) = BUTTONS.pop() {
-            if event == ButtonEvent::Pressed(Button::Confirm) {
-                MOTION.with(|m| m.as_mut().unwrap().resume());
-                spawn(Task::Refill);
-            }
-        }
+    if card_owner() != Task::Job {
         return;
     }
     let now = clock::millis();
@@ -467,12 +475,13 @@ fn card() {
     let poll = CARD.with(|c| c.as_mut().unwrap().poll(now, moving));
     reschedule(Task::Card, poll);
     if !CARD_OUT.is_empty() {
-        spawn(Task::Job);
+        spawn(card_owner());
     }
 }
 
 /// Settings into EEPROM, a changed byte per run.
 #[inline(never)]
+#[optimize(size)]
 fn store() {
     let poll = CONFIG.with(|cfg| STORE.with(|s| s.as_mut().unwrap().poll(cfg)));
     reschedule(Task::Store, poll);

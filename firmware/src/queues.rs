@@ -8,7 +8,7 @@
 use crate::rt::{Flags, Ring};
 use core::sync::atomic::AtomicBool;
 use taut_logic::buttons::ButtonEvent;
-use taut_logic::files::FileName;
+use taut_logic::fat::Name;
 use taut_logic::segment::{Segment, StepBlock};
 
 /// UART receive interrupt → console: line bytes (real-time commands are
@@ -52,12 +52,19 @@ pub static JOB_CONTROL: Ring<Control, 4> = Ring::new();
 /// or a stream of replies would keep the ring full for as long as it lasts.
 pub static JOB_CLAIMS_TX: AtomicBool = AtomicBool::new(false);
 
-/// What the job asks of the card reader.
+/// What the job (string art) or the console (a plotter's card print)
+/// asks of the card reader.
 #[derive(Clone, Copy)]
 pub enum Request {
-    /// Stream this file from its start (dropping the one being read); the
-    /// number is the ticket its messages carry.
-    Open(FileName, u8),
+    /// Stream this file (8.3 or long name) from its start, dropping the
+    /// one being read; the number is the ticket its messages carry.
+    Open(Name, u8),
+    /// The same for the first G-code file of the root directory.
+    OpenFirst(u8),
+    /// Write the root directory's files to the serial line, then `Listed`.
+    List(u8),
+    /// Stop streaming the file.
+    Close,
 }
 
 /// What the card reader tells the job. `ticket` numbers the `Open` request
@@ -72,6 +79,14 @@ pub struct CardMsg {
 pub enum What {
     Inserted,
     Removed,
+    /// The file asked for is open (its name as the user gave it); its
+    /// bytes follow.
+    Opened {
+        name: Name,
+        size: u32,
+    },
+    /// The listing asked for is written.
+    Listed,
     /// The next bytes of the file.
     Data {
         len: u8,

@@ -86,7 +86,7 @@ pub fn status(m: &Motion, kin: &impl Kinematics, homing: bool) {
         State::Hold { standing: true } => flash_str!("Hold:0"),
         State::Hold { standing: false } => flash_str!("Hold:1"),
     };
-    let _ = uwrite!(r, "<{}|MPos:", state);
+    let _ = uwrite!(r, "<{}{}", state, flash_str!("|MPos:"));
     let pos = kin.forward(&m.stepper.position());
     for (i, p) in pos.iter().take(REPORTED_AXES).enumerate() {
         let _ = uwrite!(r, "{}{}", if i > 0 { "," } else { "" }, Fixed(*p));

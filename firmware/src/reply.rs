@@ -5,7 +5,7 @@
 
 use crate::board::usart;
 use crate::log::Line;
-use crate::texts;
+use crate::{flash_str, texts};
 use taut_logic::gcode::Error;
 use taut_logic::text::ErrorKind;
 use taut_logic::units::Milli;
@@ -45,12 +45,18 @@ pub fn error(e: &Error) {
 #[inline(never)]
 pub fn error_because(e: &Error, why: Option<ErrorKind>) {
     let mut r = line();
-    let _ = uwrite!(r, "error:{} {}", e.code(), texts::error(e.kind()));
+    let _ = uwrite!(
+        r,
+        "{}{} {}",
+        flash_str!("error:"),
+        e.code(),
+        texts::error(e.kind())
+    );
     if let Some(why) = why {
         let _ = uwrite!(r, ": {}", why);
     }
     if let Some(c) = e.column() {
-        let _ = uwrite!(r, " (col {})", c);
+        let _ = uwrite!(r, "{}{})", flash_str!(" (col "), c);
     }
     r.send();
 }

@@ -8,6 +8,8 @@ use std::sync::Once;
 
 pub use taut_simavr as sim;
 
+pub mod drawing;
+
 fn firmware_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware")
 }

@@ -4,190 +4,27 @@
 //! kinematics, point by point against the toolpath the G-code defines:
 //! drawn while the pen PWM is at the down angle, travel while it is up.
 
+use hil_tests::drawing::{assert_drawn_from_the_pulses, drawing, home, PenWords};
 use hil_tests::sim::Sim;
-use hil_tests::{assert_ram_budget, boot_machine, log_tail, pen_deg_at, send_ok, track};
+use hil_tests::{assert_ram_budget, boot_machine, log_tail, send_ok, track};
 use std::time::Duration;
-use taut_logic::config::MachineConfig;
-use taut_logic::kinematics::{AnyKinematics, Kinematics};
 use taut_logic::machine::Machine;
 
 fn send(sim: &mut Sim, line: &str) {
     send_ok(sim, line, Duration::from_secs(60));
 }
 
-/// The toolpath as a polyline, mm: straight moves as they are, arcs
-/// sampled far finer than the chord tolerance.
-struct Toolpath(Vec<[f64; 2]>);
-
-impl Toolpath {
-    fn line_to(&mut self, p: [f64; 2]) {
-        self.0.push(p);
-    }
-
-    /// Counter-clockwise half turn round `c` from the last point.
-    fn half_turn_ccw(&mut self, c: [f64; 2]) {
-        let p = *self.0.last().unwrap();
-        let (r, a0) = (
-            (p[0] - c[0]).hypot(p[1] - c[1]),
-            (p[1] - c[1]).atan2(p[0] - c[0]),
-        );
-        for k in 1..=2000 {
-            let a = a0 + std::f64::consts::PI * k as f64 / 2000.0;
-            self.0.push([c[0] + r * a.cos(), c[1] + r * a.sin()]);
-        }
-    }
-
-    fn distance(&self, p: [f64; 2]) -> f64 {
-        self.0
-            .windows(2)
-            .map(|w| {
-                let (a, b) = (w[0], w[1]);
-                let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-                let len2 = dx * dx + dy * dy;
-                let t = match len2 {
-                    0.0 => 0.0,
-                    _ => (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0),
-                };
-                (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
-            })
-            .fold(f64::MAX, f64::min)
-    }
-}
-
-/// How a machine's G-code lifts and lowers its pen.
-#[derive(Clone, Copy)]
-enum PenWords {
-    /// `M3` / `M5` (Grbl's servo forks).
-    Spindle,
-    /// `M300 S30` / `M300 S50` (the Inkscape "unicorn" extension).
-    Unicorn,
-    /// `G1 Z0` / `G0 Z1` (seed 002, gcodetools).
-    Z,
-}
-
-impl PenWords {
-    fn line(self, down: bool) -> &'static str {
-        match (self, down) {
-            (PenWords::Spindle, true) => "M3",
-            (PenWords::Spindle, false) => "M5",
-            (PenWords::Unicorn, true) => "M300 S30",
-            (PenWords::Unicorn, false) => "M300 S50",
-            (PenWords::Z, true) => "G1 Z0 F300",
-            (PenWords::Z, false) => "G0 Z1",
-        }
-    }
-}
-
-/// With the pen up, to `(x, y)` mm; with it down, a square, a half circle
-/// on its top and lines out from its centre in all eight octants (they
-/// catch a sign or octant slip); with it up, back to the start. Returns
-/// what the pen draws and where it travels up.
-fn draw(sim: &mut Sim, pen: PenWords, from: [f64; 2], x: f64, y: f64) -> (Toolpath, Toolpath) {
-    let mut drawn = Toolpath(vec![[x, y]]);
-    let mut go = |sim: &mut Sim, line: String, to: [f64; 2]| {
-        send(sim, &line);
-        drawn.line_to(to);
-    };
-    send(sim, pen.line(false));
-    send(sim, &format!("G0 X{x} Y{y}"));
-    send(sim, pen.line(true));
-    go(sim, format!("G1 X{} Y{y} F1200", x + 20.0), [x + 20.0, y]);
-    go(
-        sim,
-        format!("G1 X{} Y{}", x + 20.0, y + 20.0),
-        [x + 20.0, y + 20.0],
-    );
-    send(sim, &format!("G3 X{x} Y{} I-10 J0", y + 20.0));
-    drawn.half_turn_ccw([x + 10.0, y + 20.0]);
-    let c = [x + 10.0, y + 10.0];
-    let mut go = |sim: &mut Sim, line: String, to: [f64; 2]| {
-        send(sim, &line);
-        drawn.line_to(to);
-    };
-    go(sim, format!("G1 X{} Y{}", c[0], c[1]), c);
-    for (dx, dy) in [
-        (6, 2),
-        (2, 6),
-        (-2, 6),
-        (-6, 2),
-        (-6, -2),
-        (-2, -6),
-        (2, -6),
-        (6, -2),
-    ] {
-        let to = [c[0] + dx as f64, c[1] + dy as f64];
-        go(sim, format!("G1 X{} Y{}", to[0], to[1]), to);
-        go(sim, format!("G1 X{} Y{}", c[0], c[1]), c);
-    }
-    send(sim, pen.line(false));
-    send(sim, &format!("G0 X{x} Y{y}"));
-    send(sim, "M400");
-    let travel = Toolpath(vec![from, [x, y], c, [x, y]]);
-    (drawn, travel)
-}
-
-/// Draws on `machine` and checks every pulse against the toolpath, within
-/// `within` mm (about a step of its coarsest motor): while the pen PWM
-/// says down, on what the G-code draws; while it says up, on the travel.
+/// Draws on `machine` over the serial line and checks every pulse against
+/// the toolpath, within `within` mm.
 fn drawn_from_the_pulses(machine: Machine, pen: PenWords, at: [f64; 2], within: f64) {
     let mut sim = boot_machine();
     send(&mut sim, &format!("$machine={}", machine.name()));
     send(&mut sim, "M17");
-    let cfg = MachineConfig::defaults(machine);
-    let kin = AnyKinematics::of(&cfg).unwrap();
-    let pos = |steps: [i64; 3]| {
-        let p = kin.forward(&[steps[0] as i32, steps[1] as i32, steps[2] as i32, 0]);
-        [p[0].0 as f64 / 1000.0, p[1].0 as f64 / 1000.0]
-    };
-    let home = pos([0; 3]);
-    let (drawn, travel) = draw(&mut sim, pen, home, at[0], at[1]);
-    let points = track(&sim);
-    let (mut worst, mut down) = (0.0f64, 0);
-    for (cycle, s) in &points {
-        let p = pos(*s);
-        let deg = pen_deg_at(&sim, *cycle).expect("no pen pulses");
-        let is_down = (deg - f64::from(cfg.pen.down_deg)).abs() < 1.0;
-        let is_up = (deg - f64::from(cfg.pen.up_deg)).abs() < 1.0;
-        assert!(
-            is_down || is_up,
-            "{machine:?}: pen at {deg:.1}° while moving"
-        );
-        let path = if is_down { &drawn } else { &travel };
-        down += is_down as usize;
-        let d = path.distance(p);
-        worst = worst.max(d);
-        assert!(
-            d <= within,
-            "{machine:?}: ({:.3}, {:.3}) is {d:.3} mm off the toolpath, pen {}",
-            p[0],
-            p[1],
-            if is_down { "down" } else { "up" }
-        );
+    let d = drawing(pen, home(machine), at[0], at[1]);
+    for line in &d.lines {
+        send(&mut sim, line);
     }
-    // Every corner and tip is drawn, and the drawing ends on its target.
-    for v in [drawn.0[1], drawn.0[2], drawn.0[drawn.0.len() - 2]] {
-        let near = points.iter().map(|(_, s)| {
-            let p = pos(*s);
-            (p[0] - v[0]).hypot(p[1] - v[1])
-        });
-        assert!(
-            near.fold(f64::MAX, f64::min) <= within,
-            "{machine:?}: never at {v:?}"
-        );
-    }
-    let end = pos(points.last().unwrap().1);
-    assert!(
-        (end[0] - at[0]).hypot(end[1] - at[1]) <= within,
-        "{machine:?} ended at {end:?}\n{}",
-        log_tail(&sim)
-    );
-    eprintln!(
-        "{machine:?}: {} pulses ({down} with the pen down), worst {worst:.3} mm off; stack {} B at {:#x}",
-        points.len(),
-        sim.peak_stack_bytes(),
-        sim.peak_stack_pc()
-    );
-    assert_ram_budget(&sim);
+    assert_drawn_from_the_pulses(&sim, machine, &d, within);
 }
 
 #[test]

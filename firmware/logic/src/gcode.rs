@@ -38,7 +38,9 @@ mod words;
 mod tests;
 
 pub use error::{Error, ErrorKind, MIN_FEED};
-pub use line::{AxisWord, CardLine, Command, Distance, Input, Line, Plane, Realtime, Units, AXIS_WORDS};
+pub use line::{
+    AxisWord, CardLine, Command, Distance, Input, Line, Plane, Realtime, Units, AXIS_WORDS,
+};
 pub use number::parse_milli;
 pub use parser::{Parser, MAX_LINE};
 pub use system::{SystemLine, SystemText, SYSTEM_TEXT};

@@ -115,6 +115,33 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         Some(unsafe { (*self.buf.get())[t as usize].assume_init() })
     }
 
+    /// Consumer: `f` of the oldest message, read in place.
+    pub fn peek_with<R>(&self, f: impl FnOnce(&T) -> R) -> Option<R> {
+        let t = self.tail.load(Relaxed);
+        if t == self.head.load(Relaxed) {
+            return None;
+        }
+        compiler_fence(Acquire);
+        // SAFETY: as in `pop`.
+        Some(f(unsafe {
+            (*self.buf.get())[t as usize].assume_init_ref()
+        }))
+    }
+
+    /// Consumer: whether any waiting message is `f`'s.
+    pub fn any(&self, f: impl Fn(&T) -> bool) -> bool {
+        let (mut t, h) = (self.tail.load(Relaxed), self.head.load(Relaxed));
+        compiler_fence(Acquire);
+        while t != h {
+            // SAFETY: slots from tail to head are published and not consumed.
+            if f(unsafe { (*self.buf.get())[t as usize].assume_init_ref() }) {
+                return true;
+            }
+            t = t.wrapping_add(1) & Self::MASK;
+        }
+        false
+    }
+
     /// Byte offsets of the indices, for the step interrupt's assembly
     /// consumer (`stepper::fast`); the slots start at offset 0.
     #[doc(hidden)]

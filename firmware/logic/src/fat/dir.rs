@@ -18,6 +18,10 @@ const ATTR_LONG: u8 = 0x0F;
 /// (a FAT32 root chain in a loop) is corrupt.
 const MAX_DIR_BLOCKS: u16 = 4096;
 
+/// A name has [`LONG`] characters already.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Full;
+
 /// A file name of up to [`LONG`] ASCII characters.
 #[derive(Clone, Copy, Debug, Eq)]
 pub struct Name {
@@ -40,8 +44,8 @@ impl Name {
         Some(n)
     }
 
-    pub fn push(&mut self, c: u8) -> Result<(), ()> {
-        let slot = self.bytes.get_mut(usize::from(self.len)).ok_or(())?;
+    pub fn push(&mut self, c: u8) -> Result<(), Full> {
+        let slot = self.bytes.get_mut(usize::from(self.len)).ok_or(Full)?;
         *slot = c;
         self.len += 1;
         Ok(())
@@ -71,9 +75,17 @@ impl PartialEq for Name {
 }
 
 impl ufmt::uDisplay for Name {
-    fn fmt<W: ufmt::uWrite + ?Sized>(&self, f: &mut ufmt::Formatter<'_, W>) -> Result<(), W::Error> {
-        // Only ASCII is ever pushed by the card reader and the parser.
-        f.write_str(core::str::from_utf8(self.as_bytes()).unwrap_or("?"))
+    fn fmt<W: ufmt::uWrite + ?Sized>(
+        &self,
+        f: &mut ufmt::Formatter<'_, W>,
+    ) -> Result<(), W::Error> {
+        // Byte by byte: `from_utf8` would bring its 256-byte table into
+        // the AVR's SRAM. Only ASCII is pushed by the card reader and the
+        // parser.
+        for &c in self.as_bytes() {
+            f.write_char(c as char)?;
+        }
+        Ok(())
     }
 }
 
@@ -119,9 +131,21 @@ impl Entry {
 }
 
 fn is_gcode_ext(ext: &[u8]) -> bool {
-    [&b"gcode"[..], b"gco", b"g", b"nc"]
-        .iter()
-        .any(|e| e.eq_ignore_ascii_case(ext))
+    // Matched as array patterns: a table of strings would sit in the
+    // AVR's SRAM.
+    let mut lower = [0u8; 5];
+    if ext.len() > lower.len() {
+        return false;
+    }
+    lower[..ext.len()].copy_from_slice(ext);
+    lower.make_ascii_lowercase();
+    matches!(
+        (ext.len(), lower),
+        (5, [b'g', b'c', b'o', b'd', b'e'])
+            | (3, [b'g', b'c', b'o', 0, 0])
+            | (1, [b'g', 0, 0, 0, 0])
+            | (2, [b'n', b'c', 0, 0, 0])
+    )
 }
 
 fn trim(part: &[u8]) -> &[u8] {
@@ -243,7 +267,10 @@ impl Scan {
             return;
         }
         let at = (usize::from(order) - 1) * PER_ENTRY;
-        let chars = (1..11).step_by(2).chain((14..26).step_by(2)).chain((28..32).step_by(2));
+        let chars = (1..11)
+            .step_by(2)
+            .chain((14..26).step_by(2))
+            .chain((28..32).step_by(2));
         for (i, o) in chars.enumerate() {
             let c = le16(raw, o);
             match c {
@@ -393,7 +420,10 @@ mod tests {
             e[0] = k as u8 | if k == parts { 0x40 } else { 0 };
             e[11] = ATTR_LONG;
             e[13] = sum;
-            let offsets = (1..11).step_by(2).chain((14..26).step_by(2)).chain((28..32).step_by(2));
+            let offsets = (1..11)
+                .step_by(2)
+                .chain((14..26).step_by(2))
+                .chain((28..32).step_by(2));
             for (i, o) in offsets.enumerate() {
                 let at = (k - 1) * PER_ENTRY + i;
                 let c = match at.cmp(&units.len()) {
@@ -426,7 +456,12 @@ mod tests {
 
     #[test]
     fn long_names_join_their_short_entry() {
-        for long in ["star.gcode", "a.nc", "exactly_thirteen", "twenty_six_characters_.gco"] {
+        for long in [
+            "star.gcode",
+            "a.nc",
+            "exactly_thirteen",
+            "twenty_six_characters_.gco",
+        ] {
             let e = scan_all(&entries(long, b"STAR~1  GCO"));
             assert_eq!(e.len(), 1);
             assert_eq!(e[0].long.as_bytes(), long.as_bytes(), "{long}");

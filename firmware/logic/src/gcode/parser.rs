@@ -80,6 +80,11 @@ impl Parser {
         }
     }
 
+    /// Some of a line has been read, not yet its end.
+    pub fn mid_line(&self) -> bool {
+        self.column != 0
+    }
+
     /// Takes one received byte; returns what it completed, if anything.
     pub fn push(&mut self, byte: u8) -> Option<Result<Input, Error>> {
         if let Some(realtime) = Realtime::from_byte(byte) {

@@ -118,7 +118,7 @@ impl Words {
         }
         // No file on the card has a longer name that can be selected.
         name.push(c)
-            .map_err(|()| Error::new(ErrorKind::FileNotFound, column))
+            .map_err(|_| Error::new(ErrorKind::FileNotFound, column))
     }
 
     /// Ends the word being read at the character in `column`.

@@ -160,7 +160,11 @@ fn parse_milli_reads_setting_values() {
 
 #[test]
 fn card_lines() {
-    let select = |name: &str| Ok(Input::Card(CardLine::Select(Name::new(name.as_bytes()).unwrap())));
+    let select = |name: &str| {
+        Ok(Input::Card(CardLine::Select(
+            Name::new(name.as_bytes()).unwrap(),
+        )))
+    };
     assert_eq!(parse("M20"), Ok(Input::Card(CardLine::List)));
     assert_eq!(parse("m21"), Ok(Input::Card(CardLine::Mount)));
     assert_eq!(parse("N5 M24*16"), Ok(Input::Card(CardLine::Start)));

@@ -1,0 +1,488 @@
+//! A plotter's print from the SD card, as Marlin's: `M20` lists the card,
+//! `M23 <name>` selects a file, `M24` starts it (or the green button the
+//! first G-code file), `M25` pauses, `M27` tells how far, `M524` aborts.
+//! Its lines go through the console's parser and interpreter like the
+//! serial line's, without `ok`s; an error names the file, line and column.
+//!
+//! The file's bytes are taken from `CARD_OUT` in place, as the console
+//! wants them. A card pulled (or failing) mid-print stops the reading at
+//! the end of the last whole line: the moves already queued finish, and
+//! once the card is back, `M24` or the green button opens the file again
+//! and goes on from the next line.
+#![deny(unsafe_code)]
+
+use crate::board::flash::FlashStr;
+use crate::log::{Level, Line};
+use crate::queues::{Request, What, CARD_IN, CARD_OUT};
+use crate::reply;
+use crate::{flash_str, info, warn};
+use taut_logic::fat::Name;
+use taut_logic::gcode::{Error, ErrorKind};
+use ufmt::uwrite;
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum State {
+    Idle,
+    /// `M20` asked: the reader writes the list, then `Listed`.
+    Listing,
+    /// `M23` asked (`start`: the green button, which starts at once; or a
+    /// lost print opening again).
+    Opening {
+        start: bool,
+    },
+    /// Open, not started.
+    Selected,
+    Running,
+    /// The card went away mid-print: `M24` or the green button goes on.
+    Lost,
+}
+
+/// Where in the file: bytes taken and line ends seen.
+#[derive(Clone, Copy)]
+struct Mark {
+    pos: u32,
+    lines: u32,
+}
+
+pub struct Print {
+    state: State,
+    /// Numbers the card requests; messages of older ones are dropped.
+    ticket: u8,
+    name: Name,
+    size: u32,
+    at: Mark,
+    /// The start of the line being read: where a lost print goes on.
+    line_start: Mark,
+    /// After opening again: bytes up to here are passed over.
+    skip: u32,
+    /// Bytes of the oldest `Data` message already taken.
+    taken: u8,
+    /// The card sent the file's end.
+    ended: bool,
+    /// The last byte taken (a `\r` ends a line before its `\n`).
+    last: u8,
+    /// A console line waits for the reader's answer (`M20`, `M23`, `M24`
+    /// opening a lost print again).
+    line_waits: bool,
+}
+
+/// The answer to the console line that waited: `ok`, or the error.
+pub type Answer = Option<Result<(), ErrorKind>>;
+
+impl Print {
+    pub const fn new() -> Print {
+        Print {
+            state: State::Idle,
+            ticket: 0,
+            name: Name::EMPTY,
+            size: 0,
+            at: Mark { pos: 0, lines: 0 },
+            line_start: Mark { pos: 0, lines: 0 },
+            skip: 0,
+            taken: 0,
+            ended: false,
+            last: 0,
+            line_waits: false,
+        }
+    }
+
+    /// Lines come from the card now.
+    pub fn running(&self) -> bool {
+        self.state == State::Running
+    }
+
+    /// A print is under way (running, or lost with its card).
+    pub fn busy(&self) -> bool {
+        matches!(self.state, State::Running | State::Lost)
+    }
+
+    /// A console line waits for the reader's answer.
+    pub fn waiting(&self) -> bool {
+        self.line_waits
+    }
+
+    fn ask(&mut self, request: impl FnOnce(u8) -> Request) {
+        self.ticket = self.ticket.wrapping_add(1).max(1);
+        // The reader takes requests before anything else: one slot will do,
+        // and a full one means the last request is being replaced anyway.
+        let r = request(self.ticket);
+        while CARD_IN.push(r).is_err() {
+            let _ = CARD_IN.pop();
+        }
+    }
+
+    /// `M20`: `Begin file list`, the files, `End file list` once `Listed`.
+    #[inline(never)]
+    #[optimize(size)]
+    pub fn list(&mut self) -> Result<(), ErrorKind> {
+        self.not_busy()?;
+        self.close();
+        send_line(flash_str!("Begin file list"));
+        self.ask(Request::List);
+        self.state = State::Listing;
+        self.line_waits = true;
+        Ok(())
+    }
+
+    /// `M23`: open `name`; answered when the reader has.
+    pub fn select(&mut self, name: Name) -> Result<(), ErrorKind> {
+        self.not_busy()?;
+        self.open(name, false);
+        self.line_waits = true;
+        Ok(())
+    }
+
+    /// The green button with no print: the card's first G-code file.
+    pub fn start_first(&mut self) {
+        if self.state == State::Idle {
+            self.ask(Request::OpenFirst);
+            self.state = State::Opening { start: true };
+            self.skip = 0;
+        }
+    }
+
+    /// `M24` (`line`) or the green button: start the selected file, or
+    /// go on with a lost one (the line is answered once it is open again).
+    pub fn start(&mut self, line: bool) -> Result<(), ErrorKind> {
+        match self.state {
+            State::Selected => self.state = State::Running,
+            State::Lost => {
+                self.skip = self.line_start.pos;
+                let name = self.name;
+                self.open(name, true);
+                self.line_waits = line;
+            }
+            State::Running => {}
+            _ => return Err(ErrorKind::NoFileSelected),
+        }
+        Ok(())
+    }
+
+    /// `M524`, Ctrl-X: no more lines from the file.
+    #[inline(never)]
+    #[optimize(size)]
+    pub fn abort(&mut self) {
+        if self.busy() || self.state == State::Selected {
+            info!("print aborted at line ", self.line_start.lines + 1);
+        }
+        self.close();
+    }
+
+    /// `M27`: `SD printing byte 1234/5678`, Marlin's words.
+    #[inline(never)]
+    #[optimize(size)]
+    pub fn progress(&self) {
+        let mut r = reply::line();
+        let _ = match self.state {
+            State::Running | State::Lost | State::Selected => uwrite!(
+                r,
+                "{}{}/{}",
+                flash_str!("SD printing byte "),
+                self.line_start.pos,
+                self.size
+            ),
+            _ => uwrite!(r, "{}", flash_str!("Not SD printing")),
+        };
+        r.send();
+    }
+
+    fn not_busy(&self) -> Result<(), ErrorKind> {
+        match self.busy() {
+            true => Err(ErrorKind::Printing),
+            false => Ok(()),
+        }
+    }
+
+    fn open(&mut self, name: Name, start: bool) {
+        self.ask(|t| Request::Open(name, t));
+        self.state = State::Opening { start };
+    }
+
+    fn close(&mut self) {
+        if self.state != State::Idle {
+            let _ = CARD_IN.push(Request::Close);
+        }
+        self.state = State::Idle;
+        self.line_waits = false;
+        self.ticket = self.ticket.wrapping_add(1).max(1);
+    }
+
+    /// Take the card's messages up to the next of the file's bytes; the
+    /// answer to the waiting line, once there is one.
+    #[inline(never)]
+    #[optimize(size)]
+    pub fn take_messages(&mut self) -> Answer {
+        let answer = self.messages();
+        match answer {
+            Some(_) if core::mem::take(&mut self.line_waits) => answer,
+            _ => None,
+        }
+    }
+
+    fn messages(&mut self) -> Answer {
+        while let Some(msg) = CARD_OUT.peek_with(|m| (m.ticket, message(&m.what))) {
+            let (ticket, what) = msg;
+            let ours = ticket == self.ticket;
+            match what {
+                // Bytes wait in the queue until a line wants them.
+                Kind::Data if ours && self.state != State::Idle => return None,
+                Kind::Opened(name, size) if ours => {
+                    let _ = CARD_OUT.pop();
+                    return self.opened(name, size);
+                }
+                Kind::Listed if ours => {
+                    let _ = CARD_OUT.pop();
+                    self.state = State::Idle;
+                    send_line(flash_str!("End file list"));
+                    return Some(Ok(()));
+                }
+                Kind::End if ours => {
+                    let _ = CARD_OUT.pop();
+                    self.ended = true;
+                    return None;
+                }
+                Kind::Missing | Kind::Failed if ours => {
+                    let _ = CARD_OUT.pop();
+                    return self.failed(what == Kind::Missing);
+                }
+                Kind::Removed => {
+                    let _ = CARD_OUT.pop();
+                    self.lost();
+                }
+                Kind::Inserted if self.state == State::Lost => {
+                    let _ = CARD_OUT.pop();
+                    info!("card back: M24 or the green button goes on");
+                }
+                // Older requests', and the slot's news when they change nothing.
+                _ => {
+                    let _ = CARD_OUT.pop();
+                }
+            }
+        }
+        None
+    }
+
+    #[inline(never)]
+    #[optimize(size)]
+    fn opened(&mut self, name: Name, size: u32) -> Answer {
+        let State::Opening { start } = self.state else {
+            return None;
+        };
+        self.taken = 0;
+        self.ended = false;
+        self.at = Mark { pos: 0, lines: 0 };
+        if self.skip > 0 {
+            // Going on after a lost card: the same lines are counted again.
+            self.at.lines = self.line_start.lines;
+            info!("print goes on at line ", self.line_start.lines + 1);
+            self.state = State::Running;
+            return Some(Ok(()));
+        }
+        self.name = name;
+        self.size = size;
+        self.line_start = self.at;
+        let mut r = reply::line();
+        let _ = uwrite!(
+            r,
+            "{}{}{}{}",
+            flash_str!("File opened: "),
+            name,
+            flash_str!(" Size: "),
+            size
+        );
+        r.send();
+        send_line(flash_str!("File selected"));
+        self.state = match start {
+            true => {
+                info!("printing ", name);
+                State::Running
+            }
+            false => State::Selected,
+        };
+        Some(Ok(()))
+    }
+
+    #[inline(never)]
+    #[optimize(size)]
+    fn failed(&mut self, missing: bool) -> Answer {
+        match self.state {
+            State::Opening { .. } | State::Listing => {
+                let green = !self.line_waits && self.skip == 0;
+                self.state = match self.skip > 0 {
+                    true => State::Lost,
+                    false => State::Idle,
+                };
+                if green {
+                    warn!("no G-code file on the card");
+                }
+                Some(Err(match missing {
+                    true => ErrorKind::FileNotFound,
+                    false => ErrorKind::NoCard,
+                }))
+            }
+            State::Running => {
+                self.lost();
+                None
+            }
+            _ => None,
+        }
+    }
+
+    /// The card went away: a running print stops at its last whole line.
+    #[inline(never)]
+    #[optimize(size)]
+    fn lost(&mut self) {
+        if self.state != State::Running {
+            if self.state == State::Selected {
+                self.state = State::Idle;
+            }
+            return;
+        }
+        self.state = State::Lost;
+        self.ticket = self.ticket.wrapping_add(1).max(1);
+        warn!(
+            "card out: print stopped before line ",
+            self.line_start.lines + 1,
+            ": put it back, then M24 or green"
+        );
+    }
+
+    /// The file's next byte for the parser; `None` when the card has not
+    /// sent it yet (or the print does not run). At the file's end, a last
+    /// line without its newline gets one.
+    #[inline(never)]
+    pub fn next_byte(&mut self) -> Option<u8> {
+        if self.state != State::Running {
+            return None;
+        }
+        loop {
+            let head = CARD_OUT.peek_with(|m| match m.what {
+                What::Data { len, bytes } if m.ticket == self.ticket => {
+                    Some((len, bytes[usize::from(self.taken).min(bytes.len() - 1)]))
+                }
+                _ => None,
+            });
+            let Some(Some((len, byte))) = head else {
+                // Nothing waits while the print runs.
+                let _ = self.messages();
+                if !self.ended || self.state != State::Running {
+                    return None;
+                }
+                return match self.last {
+                    b'\n' | b'\r' | 0 => None,
+                    _ => Some(self.took(b'\n')),
+                };
+            };
+            self.taken += 1;
+            if self.taken >= len {
+                self.taken = 0;
+                let _ = CARD_OUT.pop();
+            }
+            if self.at.pos < self.skip {
+                self.at.pos += 1;
+                continue;
+            }
+            self.at.pos += 1;
+            return Some(self.took(byte));
+        }
+    }
+
+    fn took(&mut self, byte: u8) -> u8 {
+        if byte == b'\n' {
+            self.at.lines += 1;
+        }
+        self.last = byte;
+        byte
+    }
+
+    /// The parser finished a line: the next one starts here.
+    pub fn line_done(&mut self) {
+        self.line_start = self.at;
+    }
+
+    /// The file is read to its end and its last line carried out.
+    #[inline(never)]
+    #[optimize(size)]
+    pub fn finished(&mut self) -> bool {
+        let done = self.state == State::Running
+            && self.ended
+            && matches!(self.last, b'\n' | b'\r' | 0)
+            && !CARD_OUT.any(|m| m.ticket == self.ticket);
+        if done {
+            self.state = State::Idle;
+            send_line(flash_str!("Done printing file"));
+        }
+        done
+    }
+
+    /// A line of the file failed: `NAME:line:col: error:…`. Harmless
+    /// unknown codes (`M117`, tool changes) are passed over, as senders
+    /// do; any other error stops the print (its next moves would start
+    /// from the wrong place).
+    #[inline(never)]
+    #[optimize(size)]
+    pub fn line_failed(&mut self, e: &Error, why: Option<taut_logic::text::ErrorKind>) {
+        // A `\r` ended the line before its `\n` was counted.
+        let line = self.at.lines + u32::from(self.last != b'\n');
+        let mut r = Line::new(Level::Error, crate::__log_module!());
+        let _ = uwrite!(r, "{}:{}:", self.name, line);
+        if let Some(c) = e.column() {
+            let _ = uwrite!(r, "{}:", c);
+        }
+        let _ = uwrite!(
+            r,
+            "{}{} {}",
+            flash_str!(" error:"),
+            e.code(),
+            crate::texts::error(e.kind())
+        );
+        if let Some(why) = why {
+            let _ = uwrite!(r, ": {}", why);
+        }
+        r.emit();
+        if e.kind() != ErrorKind::UnsupportedCommand {
+            warn!("print stopped");
+            self.close();
+        }
+    }
+}
+
+impl Default for Print {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// A card message without its bytes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Inserted,
+    Removed,
+    Opened(Name, u32),
+    Listed,
+    Data,
+    End,
+    Missing,
+    Failed,
+}
+
+fn message(w: &What) -> Kind {
+    match *w {
+        What::Inserted => Kind::Inserted,
+        What::Removed => Kind::Removed,
+        What::Opened { name, size } => Kind::Opened(name, size),
+        What::Listed => Kind::Listed,
+        What::Data { .. } => Kind::Data,
+        What::End => Kind::End,
+        What::Missing => Kind::Missing,
+        What::Failed => Kind::Failed,
+    }
+}
+
+#[inline(never)]
+#[optimize(size)]
+fn send_line(s: FlashStr) {
+    let mut r = reply::line();
+    let _ = uwrite!(r, "{}", s);
+    r.send();
+}

@@ -1,0 +1,211 @@
+//! Issue 11: a plotter prints G-code from the SD card without a PC, as
+//! Marlin does (`M20`, `M23`, `M24`, `M25`, `M27`, `M524`, the green
+//! button), through the same interpreter as the serial line; the drawing
+//! is rebuilt from the pulses alone. Files are named as PCs save them
+//! (long names, CRLF line ends, comments, codes taut does not do), and a
+//! card pulled mid-print loses no line and doubles none.
+
+use hil_tests::drawing::{assert_drawn_from_the_pulses, drawing, home, Drawing, PenWords};
+use hil_tests::sim::{Reply, Sim};
+use hil_tests::{boot_machine, card, log_tail, press, send_ok, settle, steps_on_pins, wait_for};
+use std::time::Duration;
+use taut_logic::machine::Machine;
+use taut_logic::pinmap::Button;
+
+const FLATBED: Machine = Machine::Flatbed;
+/// A step of its 40 steps/mm, diagonally, and a little.
+const WITHIN: f64 = 0.046;
+
+fn send(sim: &mut Sim, line: &str) {
+    send_ok(sim, line, Duration::from_secs(10));
+}
+
+fn error(sim: &mut Sim, line: &str) -> String {
+    match sim.send_line(line, Duration::from_secs(5)) {
+        Ok(Reply::Error(e)) => e,
+        other => panic!("{line}: {other:?}\n{}", log_tail(sim)),
+    }
+}
+
+/// The drawing as a PC's tool saves it: a header comment, CRLF line ends,
+/// an `M117` message taut does not do, a comment line after every line
+/// (files far longer than the reader's look-ahead: a card pulled
+/// mid-print is pulled mid-file), no newline after the last line.
+fn file_of(d: &Drawing) -> Vec<u8> {
+    let mut text = String::from(
+        "; drawing.gcode, made by a tool\r\nG21 G90 (mm, absolute)\r\nM117 Drawing...\r\n",
+    );
+    let comment = format!("; {}", "-".repeat(70));
+    let lines: Vec<String> = d
+        .lines
+        .iter()
+        .map(|l| format!("{l}\r\n{comment}"))
+        .collect();
+    text.push_str(&lines.join("\r\n"));
+    text.into_bytes()
+}
+
+/// A flatbed standing at zero (no switch here: no homing), drivers on,
+/// with `files` on its card.
+fn flatbed_with(files: &[(&str, &[u8])]) -> Sim {
+    let mut sim = boot_machine();
+    sim.insert_sd(card(files));
+    send(&mut sim, "$machine=flatbed");
+    send(&mut sim, "$homing_at_start=0");
+    send(&mut sim, "M17");
+    wait_for(&mut sim, "MiB FAT", Duration::from_secs(3));
+    sim
+}
+
+fn since(sim: &Sim, from: usize) -> String {
+    String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned()
+}
+
+#[test]
+fn m20_lists_m23_selects_by_long_name_and_m24_prints_the_drawing() {
+    let d = drawing(PenWords::Unicorn, home(FLATBED), 10.0, 10.0);
+    let bytes = file_of(&d);
+    let mut sim = flatbed_with(&[("star drawing.gcode", &bytes), ("NOTES.TXT", b"hello")]);
+    let from = sim.uart_bytes().len();
+    send(&mut sim, "M20");
+    let list = since(&sim, from);
+    // `NAME.EXT size long name`, the long name only where it differs.
+    let star = format!("\nSTARDR~1.GCO {} star drawing.gcode\n", bytes.len());
+    for line in [
+        "Begin file list\n",
+        &star,
+        "\nNOTES.TXT 5\n",
+        "End file list\nok\n",
+    ] {
+        assert!(list.contains(line), "{line:?} in\n{list}");
+    }
+    assert_eq!(
+        error(&mut sim, "M23 nothere.nc").split(' ').next(),
+        Some("error:65")
+    );
+    assert_eq!(error(&mut sim, "M24").split(' ').next(), Some("error:76"));
+    let from = sim.uart_bytes().len();
+    send(&mut sim, "M23 STAR DRAWING.GCODE");
+    assert!(since(&sim, from).contains(&format!(
+        "File opened: star drawing.gcode Size: {}\nFile selected\n",
+        bytes.len()
+    )));
+    assert_eq!(steps_on_pins(&sim), [0, 0, 0], "selecting moves nothing");
+    send(&mut sim, "M24");
+    // While it prints, the serial line may look but not move.
+    sim.run_for(Duration::from_millis(300));
+    assert_eq!(
+        error(&mut sim, "G0 X50").split(' ').next(),
+        Some("error:67")
+    );
+    assert_eq!(
+        error(&mut sim, "$machine=drum").split(' ').next(),
+        Some("error:67")
+    );
+    assert_eq!(
+        error(&mut sim, "M23 notes.txt").split(' ').next(),
+        Some("error:67")
+    );
+    let from = sim.uart_bytes().len();
+    send(&mut sim, "M27");
+    assert!(
+        since(&sim, from).contains("SD printing byte "),
+        "{}",
+        since(&sim, from)
+    );
+    wait_for(&mut sim, "Done printing file", Duration::from_secs(60));
+    send(&mut sim, "M400");
+    let log = sim.uart_text();
+    // The message taut does not do is named with its file and line, and
+    // the print went on.
+    assert!(
+        log.contains("star drawing.gcode:3:1: error:20 "),
+        "{}",
+        log_tail(&sim)
+    );
+    assert_eq!(log.matches("error:").count(), 6, "{}", log_tail(&sim));
+    assert_drawn_from_the_pulses(&sim, FLATBED, &d, WITHIN);
+    let from = sim.uart_bytes().len();
+    send(&mut sim, "M27");
+    assert!(since(&sim, from).contains("Not SD printing"));
+}
+
+#[test]
+fn the_green_button_prints_the_first_gcode_file_and_a_pulled_card_loses_no_line() {
+    let d = drawing(PenWords::Spindle, home(FLATBED), 30.0, 20.0);
+    let bytes = file_of(&d);
+    let mut sim = flatbed_with(&[("README.TXT", b"not g-code"), ("PLOT.NC", &bytes)]);
+    press(&mut sim, Button::Confirm, 100);
+    wait_for(&mut sim, "printing PLOT.NC", Duration::from_secs(2));
+    // Pulled in the middle of the drawing, put back a second later.
+    sim.run_for(Duration::from_millis(2500));
+    let image = sim.remove_sd().unwrap();
+    wait_for(
+        &mut sim,
+        "card out: print stopped before line",
+        Duration::from_secs(3),
+    );
+    settle(&mut sim);
+    let standing = steps_on_pins(&sim);
+    sim.run_for(Duration::from_secs(1));
+    assert_eq!(
+        steps_on_pins(&sim),
+        standing,
+        "the queued moves ended; nothing more"
+    );
+    sim.insert_sd(image);
+    wait_for(&mut sim, "card back", Duration::from_secs(3));
+    send(&mut sim, "M24");
+    wait_for(&mut sim, "Done printing file", Duration::from_secs(60));
+    send(&mut sim, "M400");
+    let log = sim.uart_text();
+    for l in log
+        .lines()
+        .filter(|l| l.contains("print") || l.contains("card"))
+    {
+        eprintln!("{l}");
+    }
+    assert!(log.contains("print goes on at line "));
+    // Every pulse on the toolpath and the end on target: a line lost or
+    // done twice would leave the path or end elsewhere (relative moves
+    // are not needed: the octant lines go out and back to the centre, so
+    // a doubled line would pass the centre twice, harmless, but a lost
+    // one leaves a tip undrawn).
+    assert_drawn_from_the_pulses(&sim, FLATBED, &d, WITHIN);
+}
+
+#[test]
+fn a_file_line_out_of_reach_stops_the_print_with_its_line_and_moves_nothing_more() {
+    let text = b"G21\nG0 X10 Y10\nM400\nG1 X500 Y10 F600 ; beyond X's 140 mm\nG1 X20 Y20 F600\n";
+    let mut sim = flatbed_with(&[("FAR.GCO", text)]);
+    send(&mut sim, "M23 far.gco");
+    send(&mut sim, "M24");
+    wait_for(&mut sim, "print stopped", Duration::from_secs(10));
+    sim.run_for(Duration::from_secs(2));
+    let log = sim.uart_text();
+    assert!(log.contains("FAR.GCO:4: error:15 "), "{}", log_tail(&sim));
+    assert!(!log.contains("Done printing file"));
+    // 40 steps/mm: at (10, 10), never further.
+    assert_eq!(steps_on_pins(&sim)[..2], [400, 400]);
+    // The stream is free again.
+    send(&mut sim, "G0 X0 Y0");
+}
+
+#[test]
+fn m25_holds_the_print_and_m24_goes_on() {
+    let d = drawing(PenWords::Z, home(FLATBED), 15.0, 15.0);
+    let bytes = file_of(&d);
+    let mut sim = flatbed_with(&[("Z.GCO", &bytes)]);
+    send(&mut sim, "M23 z.gco");
+    send(&mut sim, "M24");
+    sim.run_for(Duration::from_millis(1500));
+    send(&mut sim, "M25");
+    sim.run_for(Duration::from_millis(800));
+    let held = steps_on_pins(&sim);
+    sim.run_for(Duration::from_secs(2));
+    assert_eq!(steps_on_pins(&sim), held, "held");
+    send(&mut sim, "M24");
+    wait_for(&mut sim, "Done printing file", Duration::from_secs(60));
+    send(&mut sim, "M400");
+    assert_drawn_from_the_pulses(&sim, FLATBED, &d, WITHIN);
+}
