@@ -257,3 +257,52 @@ fn seed_001_test_patterns_draw_and_end_where_they_began() {
     send(&mut sim, "M400");
     assert_eq!(hil_tests::steps_on_pins(&sim)[..2], [0, 0], "$T1: over 0,0");
 }
+
+/// `taut-sim --png` pictures a plotter in its own coordinates: the flatbed
+/// homes X against its switch at power-on (3 mm below where it stood),
+/// and the drawing is where the G-code put it, not 3 mm off.
+#[test]
+fn the_picture_counts_from_the_homed_zero_not_from_power_on() {
+    use hil_tests::sim::picture::render_plot;
+    use hil_tests::wait_for;
+    use taut_logic::config::MachineConfig;
+    use taut_logic::pinmap::Button;
+    use taut_logic::settings::image;
+    let cfg = MachineConfig::defaults(Machine::Flatbed);
+    let mut sim = Sim::load(&hil_tests::firmware_elf()).unwrap();
+    sim.set_eeprom(&image::bytes(&cfg).collect::<Vec<u8>>());
+    sim.probe_machine(Machine::Flatbed);
+    for b in Button::ALL {
+        sim.release(b.pin());
+    }
+    let endstops = sim.fit_machine_endstops(&cfg, 3.0);
+    wait_for(&mut sim, "homed", Duration::from_secs(20));
+    for line in [
+        "M17",
+        "M5",
+        "G0 X10 Y10",
+        "M3",
+        "G1 X30 Y10 F1200",
+        "G1 X30 Y20",
+        "M5",
+        "M400",
+    ] {
+        send(&mut sim, line);
+    }
+    let png = std::env::temp_dir().join(format!("taut-hil-origin-{}.png", std::process::id()));
+    let origin = endstops.power_on_origin(&sim, &cfg);
+    let plot = render_plot(&sim.vcd_signals(), &cfg, origin, &png).unwrap();
+    std::fs::remove_file(&png).unwrap();
+    let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 0.03 && (a[1] - b[1]).abs() < 0.03;
+    assert!(
+        near(plot.min, [10.0, 10.0]) && near(plot.max, [30.0, 20.0]),
+        "drawn over {:?}..{:?}, origin {origin:?}",
+        plot.min,
+        plot.max
+    );
+    assert_eq!(
+        origin[0],
+        -(-120),
+        "X stood 3 mm (120 steps) above its switch"
+    );
+}

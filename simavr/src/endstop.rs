@@ -4,6 +4,11 @@
 //! carriage reaches it.
 
 use crate::sim::Sim;
+use taut_logic::axis::Axis;
+use taut_logic::config::MachineConfig;
+use taut_logic::machine::Machine;
+use taut_logic::pinmap::{self, Button};
+use taut_logic::units::Milli;
 
 pub(crate) struct Endstop {
     switch: u8,
@@ -17,6 +22,8 @@ pub(crate) struct Endstop {
     seen: usize,
     position: i64,
     closed: bool,
+    /// The switch has closed at least once: the firmware homed against it.
+    tripped: bool,
 }
 
 impl Sim {
@@ -35,8 +42,17 @@ impl Sim {
             seen: 0,
             position: 0,
             closed,
+            tripped: closed,
         });
         self.update_endstops();
+    }
+
+    /// Whether the end-stop on `switch` has ever closed (the axis was
+    /// homed against it, or stood on it).
+    pub fn endstop_tripped(&self, switch: u8) -> bool {
+        self.endstops
+            .iter()
+            .any(|e| e.switch == switch && e.tripped)
     }
 
     /// Moves every end-stop's axis by the STEP edges since the last look,
@@ -66,9 +82,73 @@ impl Sim {
             let closed = e.position <= e.at;
             if closed != e.closed {
                 e.closed = closed;
+                e.tripped |= closed;
                 let pin = e.switch;
                 self.drive(pin, !closed);
             }
         }
+    }
+}
+
+/// The MIN switches fitted for a machine's homing axes: per drawing motor,
+/// its switch pin and where it closes (steps from power-on).
+pub struct MachineEndstops([Option<(u8, i32)>; 2]);
+
+impl Sim {
+    /// Probes with the documented signal names: `<channel>_step|dir|en`
+    /// (the machine's channel names), `btn_<button>`, `pen_pwm`, `led`.
+    pub fn probe_machine(&mut self, machine: Machine) {
+        for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
+            let d = pinmap::driver(axis);
+            let name = machine.channel(axis).to_string();
+            self.probe_step_dir(&name, d.step, d.dir, true);
+            self.probe(d.enable, &format!("{name}_en"));
+        }
+        for b in Button::ALL {
+            self.probe(b.pin(), &format!("btn_{}", b.name()));
+        }
+        self.probe(pinmap::PEN_SERVO, "pen_pwm");
+        self.probe(pinmap::STATUS_LED, "led");
+    }
+
+    /// The MIN switches of `cfg`'s homing axes, `mm` below where each
+    /// stands at power-on (a plotter's X_MIN, Y_MIN, Z_MIN inputs); its
+    /// pins probed first.
+    pub fn fit_machine_endstops(&mut self, cfg: &MachineConfig, mm: f64) -> MachineEndstops {
+        let min_inputs = [Button::ZeroBase, Button::ZeroRadial, Button::ZeroDrill];
+        let mut fitted = [None; 2];
+        for (i, input) in min_inputs.into_iter().enumerate() {
+            if cfg.homing.axes & (1 << i) == 0 {
+                continue;
+            }
+            let d = pinmap::driver(Axis::ALL[i]);
+            let at = cfg.axes[i]
+                .steps_per_unit
+                .steps(Milli((-mm * 1000.0) as i32));
+            self.endstop(input.pin(), d.step, d.dir, true, i64::from(at));
+            if let Some(f) = fitted.get_mut(i) {
+                *f = Some((input.pin(), at));
+            }
+        }
+        MachineEndstops(fitted)
+    }
+}
+
+impl MachineEndstops {
+    /// Where the drawing motors stood at power-on in the machine's own
+    /// coordinates: a motor homed against its switch counts from the end
+    /// of its travel there (as the firmware does once homed), the others
+    /// from zero.
+    pub fn power_on_origin(&self, sim: &Sim, cfg: &MachineConfig) -> [i32; 2] {
+        let mut origin = [0; 2];
+        for (i, f) in self.0.iter().enumerate() {
+            if let Some((switch, at)) = *f {
+                if sim.endstop_tripped(switch) {
+                    let a = &cfg.axes[i];
+                    origin[i] = a.steps_per_unit.steps(a.travel.0) - at;
+                }
+            }
+        }
+        origin
     }
 }

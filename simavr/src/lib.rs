@@ -9,7 +9,7 @@ mod card_slot;
 pub mod clock;
 pub mod console;
 pub mod elf;
-mod endstop;
+pub mod endstop;
 mod error;
 mod gpio;
 mod hooks;

@@ -8,10 +8,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
-use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
-use taut_logic::pinmap::{self, Button};
 use taut_logic::settings::image;
 use taut_simavr::operator::{Operator, Seen};
 use taut_simavr::scenario::{self, FaultSpec, TimedBytes};
@@ -183,39 +181,6 @@ impl Args {
     }
 }
 
-/// Probes with the documented signal names: `<channel>_step|dir|en`
-/// (the machine's channel names), `btn_<button>`, `pen_pwm`, `led`.
-fn probe_machine(sim: &mut Sim, machine: Machine) {
-    for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
-        let d = pinmap::driver(axis);
-        let name = machine.channel(axis).to_string();
-        sim.probe_step_dir(&name, d.step, d.dir, true);
-        sim.probe(d.enable, &format!("{name}_en"));
-    }
-    for b in Button::ALL {
-        sim.probe(b.pin(), &format!("btn_{}", b.name()));
-    }
-    sim.probe(pinmap::PEN_SERVO, "pen_pwm");
-    sim.probe(pinmap::STATUS_LED, "led");
-}
-
-/// The MIN switches of `cfg`'s homing axes, `mm` below where each stands
-/// at power-on (a plotter's X_MIN, Y_MIN, Z_MIN inputs).
-fn fit_endstops(sim: &mut Sim, cfg: &MachineConfig, mm: f64) {
-    let min_inputs = [Button::ZeroBase, Button::ZeroRadial, Button::ZeroDrill];
-    for (i, input) in min_inputs.into_iter().enumerate() {
-        if cfg.homing.axes & (1 << i) == 0 {
-            continue;
-        }
-        let axis = Axis::ALL[i];
-        let d = pinmap::driver(axis);
-        let at = cfg.axes[i]
-            .steps_per_unit
-            .steps(taut_logic::units::Milli((-mm * 1000.0) as i32));
-        sim.endstop(input.pin(), d.step, d.dir, true, i64::from(at));
-    }
-}
-
 /// Send every line of `file` as a G-code sender would (next line after the
 /// reply), then wait until motion is idle (`M400`).
 fn stream(
@@ -297,8 +262,8 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     let eeprom = sim.eeprom();
     let cfg = image::decode(|i| eeprom[i], &MachineConfig::STRING_ART)
         .unwrap_or(MachineConfig::STRING_ART);
-    probe_machine(&mut sim, cfg.machine);
-    fit_endstops(&mut sim, &cfg, args.endstop_mm);
+    sim.probe_machine(cfg.machine);
+    let endstops = sim.fit_machine_endstops(&cfg, args.endstop_mm);
     let param = match &args.sd {
         Some(path) => put_card(&mut sim, path, &args)?,
         None => None,
@@ -357,7 +322,8 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     }
     let mut picture = None;
     if let (Some(path), false) = (&args.png, cfg.machine.is_string_art()) {
-        let p = picture::render_plot(&sim.vcd_signals(), &cfg, path)?;
+        let origin = endstops.power_on_origin(&sim, &cfg);
+        let p = picture::render_plot(&sim.vcd_signals(), &cfg, origin, path)?;
         eprintln!(
             "taut-sim: {}: {} steps, {} with the pen down, drawn over x {:.2}..{:.2}, y {:.2}..{:.2} mm",
             path.display(),

@@ -33,8 +33,15 @@ fn degrees(high_ns: u64) -> f64 {
 }
 
 /// Replays `signals` (named by `cfg`'s machine: `x_step`, `left_step`…,
-/// and `pen_pwm`) and writes the drawing to `path` (PNG).
-pub fn render_plot(signals: &[Signal], cfg: &MachineConfig, path: &Path) -> io::Result<Plot> {
+/// and `pen_pwm`) and writes the drawing to `path` (PNG). `origin`: the
+/// two drawing motors' step counts in the machine's own coordinates where
+/// they stood at power-on (found by homing; zero when it did not home).
+pub fn render_plot(
+    signals: &[Signal],
+    cfg: &MachineConfig,
+    origin: [i32; 2],
+    path: &Path,
+) -> io::Result<Plot> {
     let kin = AnyKinematics::of(cfg).map_err(|e| io::Error::other(e.message()))?;
     let find = |name: &str| signals.iter().find(|s| s.name == name);
     let missing = |name: &str| io::Error::other(format!("no signal {name}"));
@@ -70,7 +77,7 @@ pub fn render_plot(signals: &[Signal], cfg: &MachineConfig, path: &Path) -> io::
         let i = widths.partition_point(|w| w.0 <= t);
         i > 0 && (widths[i - 1].1 - f64::from(cfg.pen.down_deg)).abs() < 1.0
     };
-    let mut steps = [0i32; 4];
+    let mut steps = [origin[0], origin[1], 0, 0];
     let mut points = Vec::with_capacity(events.len() + 1);
     let at = |s: &[i32; 4]| {
         let p = kin.forward(s);
