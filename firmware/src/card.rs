@@ -16,10 +16,11 @@ use crate::board::delay::Delay;
 use crate::board::flash::FlashStr;
 use crate::board::spi::CardSpi;
 use crate::queues::{CardMsg, Request, Signal, What, CARD_IN, CARD_OUT, CHUNK, TX};
-use crate::rt::Poll;
+use crate::rt::{Poll, TaskCell};
 use crate::{error, flash_str, info, warn};
 use core::mem::{offset_of, size_of};
-use embedded_hal::spi::SpiDevice;
+use embedded_hal::delay::DelayNs;
+use embedded_hal::spi::{Operation, SpiDevice};
 use embedded_sdmmc::sdcard::spi::AcquireOpts;
 use embedded_sdmmc::{Block, BlockDevice, BlockIdx, SdCard, SdCardError};
 use taut_logic::fat::{
@@ -40,7 +41,55 @@ pub const CHECK_MS: u32 = 1000;
 /// How much earlier than a second after the last check the next may come.
 const CHECK_SLACK_MS: u32 = 100;
 
-type Sd = SdCard<CardSpi, Delay>;
+type Sd = SdCard<TimedSpi, TimedDelay>;
+
+/// Waiting the SD driver may do in one run of the reader, in its 10 µs
+/// steps: 8 ms. A card that stopped answering (pulled mid-read) would
+/// otherwise keep it polling 10 000 times per command, 120 ms with the
+/// other tasks shut out and the step queue (30 ms of motion) running dry;
+/// real cards answer a read within a millisecond or two. Starting a card
+/// (its `ACMD41` loop can take a second) is done only while the machine
+/// stands, and may wait as long as the driver likes.
+const WAIT_STEPS: u16 = 800;
+/// The driver's waits so far in this run, and how many it may do.
+static WAITED: TaskCell<(u16, u16)> = TaskCell::new((0, WAIT_STEPS));
+
+/// The driver's delay, counting its waits.
+pub struct TimedDelay;
+
+impl DelayNs for TimedDelay {
+    fn delay_ns(&mut self, ns: u32) {
+        WAITED.with(|w| w.0 = w.0.saturating_add(1));
+        Delay.delay_ns(ns);
+    }
+}
+
+/// The card's SPI device, failing once the run has waited its budget: the
+/// driver then gives up at once (a transport error, taken as a removal).
+pub struct TimedSpi(pub CardSpi);
+
+#[derive(Debug)]
+pub struct OutOfTime;
+
+impl embedded_hal::spi::Error for OutOfTime {
+    fn kind(&self) -> embedded_hal::spi::ErrorKind {
+        embedded_hal::spi::ErrorKind::Other
+    }
+}
+
+impl embedded_hal::spi::ErrorType for TimedSpi {
+    type Error = OutOfTime;
+}
+
+impl SpiDevice for TimedSpi {
+    fn transaction(&mut self, ops: &mut [Operation<'_, u8>]) -> Result<(), OutOfTime> {
+        if WAITED.with(|w| w.0 > w.1) {
+            return Err(OutOfTime);
+        }
+        let _ = self.0.transaction(ops);
+        Ok(())
+    }
+}
 
 enum Slot {
     Empty,
@@ -127,7 +176,7 @@ impl CardReader {
             acquire_retries: 4,
         };
         CardReader {
-            sd: SdCard::new_with_options(spi, Delay, options),
+            sd: SdCard::new_with_options(TimedSpi(spi), TimedDelay, options),
             slot: Slot::Empty,
             file: None,
             block: Block::new(),
@@ -145,6 +194,7 @@ impl CardReader {
     /// is `moving`, an empty slot is not probed (the probe holds the bus at
     /// the slow init clock).
     pub fn poll(&mut self, now: u32, moving: bool) -> Poll<Signal> {
+        WAITED.with(|w| *w = (0, WAIT_STEPS));
         if let Some((lba, what, ticket)) = self.faulty {
             return self.report_faulty(lba, what, ticket);
         }
@@ -209,10 +259,11 @@ impl CardReader {
 
     #[inline(never)]
     fn look_for_card(&mut self) -> Poll<Signal> {
+        WAITED.with(|w| w.1 = u16::MAX);
         let present = self.sd.spi(|spi| {
-            spi.bus.slow_speed();
-            spi.idle_clocks(10);
-            answers_cmd0(spi)
+            spi.0.bus.slow_speed();
+            spi.0.idle_clocks(10);
+            answers_cmd0(&mut spi.0)
         });
         if !present {
             return Poll::Idle;
@@ -225,7 +276,7 @@ impl CardReader {
                 return Poll::Idle;
             }
         };
-        self.sd.spi(|spi| spi.bus.full_speed());
+        self.sd.spi(|spi| spi.0.bus.full_speed());
         let mut dev = Device {
             sd: &self.sd,
             lba: 0,

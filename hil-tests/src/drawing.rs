@@ -12,8 +12,28 @@ use taut_logic::machine::Machine;
 pub struct Toolpath(pub Vec<[f64; 2]>);
 
 impl Toolpath {
-    fn line_to(&mut self, p: [f64; 2]) {
+    pub fn line_to(&mut self, p: [f64; 2]) {
         self.0.push(p);
+    }
+
+    /// From the last point round `c` to `to` (on the same circle),
+    /// counter-clockwise or not, a full turn when `to` is the start.
+    pub fn arc_to(&mut self, c: [f64; 2], to: [f64; 2], ccw: bool) {
+        let p = *self.0.last().unwrap();
+        let r = (p[0] - c[0]).hypot(p[1] - c[1]);
+        let a0 = (p[1] - c[1]).atan2(p[0] - c[0]);
+        let a1 = (to[1] - c[1]).atan2(to[0] - c[0]);
+        let tau = std::f64::consts::TAU;
+        let mut sweep = if ccw { a1 - a0 } else { a0 - a1 }.rem_euclid(tau);
+        if sweep < 1e-9 {
+            sweep = tau;
+        }
+        let n = ((sweep * r / 0.01).ceil() as usize).max(8);
+        for k in 1..n {
+            let a = a0 + if ccw { 1.0 } else { -1.0 } * sweep * k as f64 / n as f64;
+            self.0.push([c[0] + r * a.cos(), c[1] + r * a.sin()]);
+        }
+        self.0.push(to);
     }
 
     /// Counter-clockwise half turn round `c` from the last point.

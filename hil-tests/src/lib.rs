@@ -10,6 +10,39 @@ pub use taut_simavr as sim;
 
 pub mod drawing;
 
+/// A tiny seeded generator (xorshift): the same draws on every run.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+
+    pub fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+
+    /// Uniform in `lo..hi`.
+    pub fn between(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// `full` under `cargo xtask soak` (`TAUT_SOAK=1`), `everyday` otherwise.
+pub fn soak_or<T>(full: T, everyday: T) -> T {
+    match std::env::var_os("TAUT_SOAK") {
+        Some(_) => full,
+        None => everyday,
+    }
+}
+
 fn firmware_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware")
 }

@@ -209,3 +209,77 @@ fn m25_holds_the_print_and_m24_goes_on() {
     send(&mut sim, "M400");
     assert_drawn_from_the_pulses(&sim, FLATBED, &d, WITHIN);
 }
+
+/// From a list of seeds: files of random line lengths and line ends, the
+/// card pulled at a random moment and put back after a random while, a
+/// feed hold (`!`, then `~`) at another; every print ends with the whole
+/// drawing, rebuilt from the pulses.
+#[test]
+fn seeded_pulls_and_holds_mid_print_still_draw_the_whole_drawing() {
+    use hil_tests::{soak_or, Rng};
+    for seed in soak_or(vec![1u64, 2, 3, 4, 5, 6, 7, 8, 9, 10], vec![41, 42, 43]) {
+        let mut rng = Rng::new(seed);
+        let at = [rng.between(5.0, 60.0), rng.between(5.0, 60.0)];
+        let d = drawing(
+            PenWords::Unicorn,
+            home(FLATBED),
+            at[0].round(),
+            at[1].round(),
+        );
+        let mut text = String::new();
+        for line in &d.lines {
+            let end = if rng.below(2) == 0 { "\n" } else { "\r\n" };
+            let pad = "-".repeat(rng.below(76) as usize);
+            text.push_str(&format!("{line}{end};{pad}{end}"));
+        }
+        let mut sim = flatbed_with(&[("SEED.GCO", text.as_bytes())]);
+        send(&mut sim, "M23 seed.gco");
+        send(&mut sim, "M24");
+        let (pull, hold) = (rng.between(0.2, 6.0), rng.between(0.2, 6.0));
+        let (back, resume) = (rng.between(0.1, 2.0), rng.between(0.1, 1.0));
+        let start = sim.time_s();
+        sim.run_for(Duration::from_secs_f64(pull.min(hold)));
+        let first_pull = pull <= hold;
+        let mut act = |sim: &mut Sim, pulling: bool| {
+            if pulling {
+                let mounts = sim.uart_text().matches("MiB FAT").count();
+                let image = sim.remove_sd().unwrap();
+                sim.run_for(Duration::from_secs_f64(back));
+                sim.insert_sd(image);
+                // Mounted again (it is looked for once a second).
+                let again = sim.run_until(
+                    |s| s.uart_text().matches("MiB FAT").count() > mounts,
+                    Duration::from_secs(5),
+                );
+                assert_eq!(again, hil_tests::sim::Outcome::Done, "{}", log_tail(sim));
+                // Lost only if it noticed while lines were left to read.
+                if sim.uart_text().contains("card out: print stopped") {
+                    send(sim, "M24");
+                }
+            } else {
+                sim.uart_send(b"!");
+                sim.run_for(Duration::from_secs_f64(resume));
+                sim.uart_send(b"~");
+            }
+        };
+        act(&mut sim, first_pull);
+        let elapsed = sim.time_s() - start;
+        let second = if first_pull { hold } else { pull };
+        if second > elapsed {
+            sim.run_for(Duration::from_secs_f64(second - elapsed));
+        }
+        act(&mut sim, !first_pull);
+        wait_for(&mut sim, "Done printing file", Duration::from_secs(60));
+        send(&mut sim, "M400");
+        eprintln!(
+            "seed {seed}: pulled at {pull:.2} s for {back:.2} s, held at {hold:.2} s for {resume:.2} s; {}",
+            match sim.uart_text().contains("print goes on at line") {
+                true => "went on after the pull",
+                false => "the pull came after the last line was read",
+            }
+        );
+        assert_drawn_from_the_pulses(&sim, FLATBED, &d, WITHIN);
+        // Nothing starved the steps, the pull included.
+        assert!(!sim.uart_text().contains("underruns"), "{}", log_tail(&sim));
+    }
+}

@@ -5,35 +5,17 @@
 //! the sum of the moves and to the pulses counted on the pins.
 
 use hil_tests::{
-    boot_machine, log_tail, reported_steps, send_ok, sim::Outcome, sim::Sim, steps_on_pins,
+    boot_machine, log_tail, reported_steps, send_ok, sim::Outcome, sim::Sim, soak_or,
+    steps_on_pins, Rng,
 };
 use std::time::Duration;
 use taut_logic::config::MachineConfig;
-
-/// A tiny seeded generator (xorshift): the same moves on every run.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
 
 /// How many random moves a seed streams: the full campaign under
 /// `cargo xtask soak` (`TAUT_SOAK=1`), a tenth in the everyday run (slow
 /// feeds make it long). The fixed-length streams always run whole.
 fn moves(full: usize) -> usize {
-    if std::env::var_os("TAUT_SOAK").is_some() {
-        full
-    } else {
-        full / 10
-    }
+    soak_or(full, full / 10)
 }
 
 /// Stream `lines`, each after the previous reply, optionally with a `?`
@@ -176,7 +158,7 @@ fn a_circle_of_2000_pieces() {
 #[test]
 fn random_moves_and_feeds_from_seeds() {
     for (seed, status) in [(1u64, false), (7, false), (1234, true)] {
-        let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+        let mut rng = Rng::new(seed);
         let (mut c, mut x, mut z) = (0.0f64, -100.0f64, -10.0f64);
         let mut lines = vec!["G90".to_string()];
         for _ in 0..moves(3000) {
