@@ -240,7 +240,7 @@ fn seeded_pulls_and_holds_mid_print_still_draw_the_whole_drawing() {
         let start = sim.time_s();
         sim.run_for(Duration::from_secs_f64(pull.min(hold)));
         let first_pull = pull <= hold;
-        let mut act = |sim: &mut Sim, pulling: bool| {
+        let act = |sim: &mut Sim, pulling: bool| {
             if pulling {
                 let mounts = sim.uart_text().matches("MiB FAT").count();
                 let image = sim.remove_sd().unwrap();
