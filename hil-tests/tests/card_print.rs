@@ -283,3 +283,26 @@ fn seeded_pulls_and_holds_mid_print_still_draw_the_whole_drawing() {
         assert!(!sim.uart_text().contains("underruns"), "{}", log_tail(&sim));
     }
 }
+
+/// Every plotter prints from the card what it draws over the serial line
+/// (`machines.rs`), checked the same way from its pulses.
+#[test]
+fn every_plotter_prints_its_drawing_from_the_card() {
+    for (machine, pen, at, within) in [
+        (Machine::Drum, PenWords::Spindle, [5.0, 5.0], 0.15),
+        (Machine::Whiteboard, PenWords::Unicorn, [-10.0, -10.0], 0.1),
+        (Machine::Scara, PenWords::Z, [90.0, 140.0], 0.3),
+    ] {
+        let d = drawing(pen, home(machine), at[0], at[1]);
+        let mut sim = boot_machine();
+        sim.insert_sd(card(&[("DRAWING.NC", &file_of(&d))]));
+        send(&mut sim, &format!("$machine={}", machine.name()));
+        send(&mut sim, "M17");
+        wait_for(&mut sim, "MiB FAT", Duration::from_secs(3));
+        send(&mut sim, "M23 drawing.nc");
+        send(&mut sim, "M24");
+        wait_for(&mut sim, "Done printing file", Duration::from_secs(120));
+        send(&mut sim, "M400");
+        assert_drawn_from_the_pulses(&sim, machine, &d, within);
+    }
+}
