@@ -224,6 +224,17 @@ impl JobTask {
         };
         match next {
             Ok(Next::Open(name)) => self.open(name),
+            Ok(Next::Machine(c)) => {
+                // A plotter's card: that machine from here on, standing
+                // where it is as its zero (as `$machine=` does).
+                self.stream = Stream::None;
+                *config = c;
+                m.configure(config);
+                m.set_position([0; AXES]);
+                m.renew();
+                info!("machine.txt: the card is for the ", c.machine.name());
+                self.event(Event::OtherMachine, now);
+            }
             Ok(Next::Done(c)) => {
                 self.stream = Stream::None;
                 info!(

@@ -454,8 +454,15 @@ fn job() {
         return;
     }
     let now = clock::millis();
+    let machine = CONFIG.with(|cfg| cfg.machine);
     let poll =
         MOTION.with(|m| CONFIG.with(|cfg| JOB.with(|j| j.poll(m.as_mut().unwrap(), cfg, now))));
+    // A plotter's card switched the machine: its kinematics, kept in EEPROM.
+    if CONFIG.with(|cfg| cfg.machine) != machine {
+        CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
+        signal(Signal::Settings);
+        spawn(Task::Console);
+    }
     spawn(Task::Motion);
     reschedule(Task::Job, poll);
     if !CARD_IN.is_empty() {

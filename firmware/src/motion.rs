@@ -272,6 +272,12 @@ impl Motion {
         self.lost = true;
     }
 
+    /// Another machine took over where it stands: whoever keeps a
+    /// position reads it back (a new epoch, as after a stop).
+    pub fn renew(&mut self) {
+        self.epoch = self.epoch.wrapping_add(1);
+    }
+
     /// See the `epoch` field.
     pub fn epoch(&self) -> u8 {
         self.epoch

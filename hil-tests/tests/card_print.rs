@@ -306,3 +306,47 @@ fn every_plotter_prints_its_drawing_from_the_card() {
         assert_drawn_from_the_pulses(&sim, machine, &d, within);
     }
 }
+
+/// A card with no job (`param.txt`) whose `machine.txt` names a plotter
+/// makes the machine that plotter, with the file's settings, kept in
+/// EEPROM across a power cycle; its drawing then prints.
+#[test]
+fn a_plotter_card_s_machine_txt_switches_the_machine_and_keeps_it() {
+    use hil_tests::machine;
+    let d = drawing(PenWords::Unicorn, home(Machine::Whiteboard), -10.0, -10.0);
+    let files: &[(&str, &[u8])] = &[
+        (
+            "machine.txt",
+            b"machine = whiteboard  # seed 003\npen_settle_ms = 200\n",
+        ),
+        ("PLOT.GCO", &file_of(&d)),
+    ];
+    let mut sim = boot_machine();
+    sim.insert_sd(card(files));
+    wait_for(
+        &mut sim,
+        "machine.txt: the card is for the whiteboard",
+        Duration::from_secs(3),
+    );
+    send(&mut sim, "M17");
+    send(&mut sim, "M23 plot.gco");
+    send(&mut sim, "M24");
+    wait_for(&mut sim, "Done printing file", Duration::from_secs(120));
+    send(&mut sim, "M400");
+    assert_drawn_from_the_pulses(&sim, Machine::Whiteboard, &d, 0.1);
+    sim.run_for(Duration::from_secs(3));
+    let eeprom = sim.eeprom();
+    let mut sim = machine();
+    sim.set_eeprom(&eeprom);
+    wait_for(&mut sim, "reset:", Duration::from_millis(50));
+    let from = sim.uart_bytes().len();
+    send(&mut sim, "$$");
+    let settings = since(&sim, from);
+    for s in [
+        "$machine=whiteboard\n",
+        "$pen_settle_ms=200\n",
+        "$left_max_rate=",
+    ] {
+        assert!(settings.contains(s), "{s} in\n{settings}");
+    }
+}

@@ -1,7 +1,9 @@
 //! Checking a card's job files in one pass each, in the order the card
 //! reader opens them: `param.txt`, then the optional `machine.txt`, then
 //! `poradi.txt` (its count and every index checked against the nails).
-//! Nothing is kept of `poradi.txt`: winding streams it again.
+//! Nothing is kept of `poradi.txt`: winding streams it again. A card
+//! without `param.txt` whose `machine.txt` names a plotter is that
+//! plotter's card: the machine switches to it ([`Next::Machine`]).
 //!
 //! The firmware opens [`Files::file`], feeds its bytes to [`Files::push`]
 //! and answers its end with [`Files::end`] (or [`Files::missing`] when the
@@ -63,10 +65,14 @@ pub struct CardId {
 pub enum Next {
     Open(FileName),
     Done(Checked),
+    /// A plotter's card: `machine.txt` names it, with its settings.
+    Machine(MachineConfig),
 }
 
 enum Stage {
     Param(ParamFile),
+    /// No `param.txt`: a plotter's `machine.txt`, or a bad card.
+    Plotter(MachineFile),
     Machine(Params, MachineFile),
     Poradi(Params, MachineConfig, PoradiCheck),
 }
@@ -94,7 +100,7 @@ impl Files {
     pub fn file(&self) -> FileName {
         match self.stage {
             Stage::Param(_) => FileName::Param,
-            Stage::Machine(..) => FileName::Machine,
+            Stage::Plotter(_) | Stage::Machine(..) => FileName::Machine,
             Stage::Poradi(..) => FileName::Poradi,
         }
     }
@@ -105,7 +111,7 @@ impl Files {
                 self.id.param.add(chunk);
                 p.push(chunk)
             }
-            Stage::Machine(_, m) => m.push(chunk),
+            Stage::Plotter(m) | Stage::Machine(_, m) => m.push(chunk),
             Stage::Poradi(_, _, c) => {
                 self.id.poradi.add(chunk);
                 c.push(chunk)
@@ -122,6 +128,13 @@ impl Files {
             Stage::Param(p) => {
                 let params = p.finish()?;
                 self.stage = Stage::Machine(params, MachineFile::new(*base));
+            }
+            Stage::Plotter(m) => {
+                let config = m.finish()?;
+                return match config.machine.is_string_art() {
+                    true => Err(FileError::whole(FileName::Param, ErrorKind::NotFound)),
+                    false => Ok(Next::Machine(config)),
+                };
             }
             Stage::Machine(params, m) => {
                 let params = *params;
@@ -140,9 +153,15 @@ impl Files {
         Ok(Next::Open(self.file()))
     }
 
-    /// The card has no such file: only `machine.txt` may be left out.
+    /// The card has no such file: only `machine.txt` may be left out, or
+    /// `param.txt` on a plotter's card.
     pub fn missing(&mut self, base: &MachineConfig) -> Result<Next, FileError> {
         match self.stage {
+            Stage::Param(_) => {
+                self.stage = Stage::Plotter(MachineFile::new(*base));
+                Ok(Next::Open(FileName::Machine))
+            }
+            Stage::Plotter(_) => Err(FileError::whole(FileName::Param, ErrorKind::NotFound)),
             Stage::Machine(params, _) => {
                 self.stage = Stage::Poradi(params, *base, PoradiCheck::new(params.nails));
                 Ok(Next::Open(FileName::Poradi))
@@ -161,6 +180,14 @@ mod tests {
 
     /// Reads a card given as (file, contents or None when missing).
     fn read(card: &[(FileName, Option<&[u8]>)]) -> Result<Checked, FileError> {
+        match read_any(card)? {
+            Next::Done(c) => Ok(c),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// Reads a card to its end: a job's files, or a plotter's.
+    fn read_any(card: &[(FileName, Option<&[u8]>)]) -> Result<Next, FileError> {
         let base = MachineConfig::STRING_ART;
         let mut files = Files::new();
         loop {
@@ -176,10 +203,30 @@ mod tests {
                     files.end(&base)?
                 }
             };
-            if let Next::Done(c) = next {
-                return Ok(c);
+            if !matches!(next, Next::Open(_)) {
+                return Ok(next);
             }
         }
+    }
+
+    #[test]
+    fn a_card_with_only_a_plotters_machine_txt_switches_to_it() {
+        let card: &[(FileName, Option<&[u8]>)] = &[(
+            FileName::Machine,
+            Some(b"machine = flatbed\nx_max_rate = 1500\n"),
+        )];
+        let Ok(Next::Machine(cfg)) = read_any(card) else {
+            panic!("{:?}", read_any(card));
+        };
+        assert_eq!(cfg.machine, crate::machine::Machine::Flatbed);
+        assert_eq!(cfg.axes[0].max_rate, 1500);
+        // Without param.txt, a string-art machine.txt is a bad job card.
+        let string_art: &[(FileName, Option<&[u8]>)] =
+            &[(FileName::Machine, Some(b"base_max_rate = 1500\n"))];
+        assert_eq!(
+            show(&read_any(string_art).unwrap_err()),
+            "param.txt: file not found"
+        );
     }
 
     #[test]

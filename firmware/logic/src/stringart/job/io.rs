@@ -83,6 +83,9 @@ pub enum Event<'c> {
     Nail(u16),
     /// The card could not deliver the next index while winding.
     PatternLost,
+    /// The card switched the machine to a plotter (its `machine.txt`): the
+    /// job is dropped, quietly; back on this machine it waits for a card.
+    OtherMachine,
 }
 
 /// Something the firmware logs.

@@ -181,6 +181,7 @@ impl Job {
             Event::Resume => self.resume(o, now_ms),
             Event::Abort => self.abort(o),
             Event::Nail(j) => self.nail(j, o, now_ms),
+            Event::OtherMachine => *self = Job::new(),
             Event::PatternLost => {
                 if self.phase() == Some(Phase::Winding) {
                     self.card = Card::Absent;
