@@ -87,7 +87,9 @@ const fn step_map() -> StepMap {
 
 pub(crate) const MAP: StepMap = step_map();
 
-/// PINx register of a slot (null for an unused slot).
+/// PINx register of a slot (null for an unused slot). Always inlined: the
+/// step interrupt calls it with constant slots, folded to addresses.
+#[inline(always)]
 const fn slot_pin(s: usize) -> *mut u8 {
     match MAP.ports[s] {
         Some(p) => p.pin_register() as *mut u8,
@@ -102,6 +104,7 @@ struct PinReg {
     mask: u8,
 }
 
+#[inline(always)]
 const fn reg(n: u8) -> PinReg {
     let (pin, _ddr, port, mask) = regs(n);
     PinReg { pin, port, mask }
