@@ -85,6 +85,7 @@ enum Pending {
 enum Listing {
     Settings(usize),
     Queues(u8),
+    Offsets(u8),
 }
 
 /// Who may move the machine now.
@@ -603,6 +604,17 @@ impl Console {
                 return self.error(&Error::new(ErrorKind::Printing, 0));
             }
             SystemLine::Unlock => m.unlock(),
+            SystemLine::BuildInfo => build_info(cfg),
+            SystemLine::ParserState => {
+                let pen_down = m.pen.pulse_us() == PenConfig::pulse_us(cfg.pen.down_deg);
+                let mut r = reply::line();
+                let _ = uwrite!(r, "[GC:{}]", self.interp.parser_state(pen_down));
+                r.send();
+            }
+            SystemLine::Offsets => {
+                self.listing = Some(Listing::Offsets(0));
+                return;
+            }
             SystemLine::Home if owner == Owner::Job => {
                 return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
             }
@@ -662,6 +674,7 @@ impl Console {
             Listing::Queues(line) => {
                 crate::report::queue_line(line).then_some(Listing::Queues(line + 1))
             }
+            Listing::Offsets(line) => offsets_line(line).then_some(Listing::Offsets(line + 1)),
         };
         if self.listing.is_none() {
             reply::ok();
@@ -673,6 +686,59 @@ impl Default for Console {
     fn default() -> Self {
         Self::new()
     }
+}
+
+/// `$I`: `[VER:1.1h.taut-0.1.0:flatbed]` (UGS wants `[VER:1.1`) and
+/// `[OPT:,<planner blocks>,<receive bytes>]`.
+#[inline(never)]
+fn build_info(cfg: &MachineConfig) {
+    let mut r = reply::line();
+    let _ = uwrite!(
+        r,
+        "{}{}]",
+        flash_str!(concat!("[VER:1.1h.taut-", env!("CARGO_PKG_VERSION"), ":")),
+        cfg.machine.name()
+    );
+    r.send();
+    let mut r = reply::line();
+    let _ = uwrite!(
+        r,
+        "{}{},{}]",
+        flash_str!("[OPT:,"),
+        taut_logic::planner::PLANNER_BLOCKS,
+        RX.capacity()
+    );
+    r.send();
+}
+
+/// Line `line` of `$#`; `false` past the last. taut keeps no work
+/// offsets, tool length or probe: every one is zero, in Grbl's format.
+fn offsets_line(line: u8) -> bool {
+    use taut_progmem::text;
+    // A match, not a table: a table of texts would sit in SRAM.
+    let name = match line {
+        0 => text!("G54"),
+        1 => text!("G55"),
+        2 => text!("G56"),
+        3 => text!("G57"),
+        4 => text!("G58"),
+        5 => text!("G59"),
+        6 => text!("G28"),
+        7 => text!("G30"),
+        8 => text!("G92"),
+        9 => text!("TLO"),
+        10 => text!("PRB"),
+        _ => return false,
+    };
+    let zeros = match line {
+        9 => flash_str!(":0.000]"),
+        10 => flash_str!(":0.000,0.000,0.000:0]"),
+        _ => flash_str!(":0.000,0.000,0.000]"),
+    };
+    let mut r = reply::line();
+    let _ = uwrite!(r, "[{}{}", name, zeros);
+    r.send();
+    true
 }
 
 /// A whole line has arrived on the serial line.

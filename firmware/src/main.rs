@@ -271,6 +271,7 @@ fn init() -> Watchdog {
     });
     // SAFETY: every interrupt handler and the state it touches is ready.
     unsafe { avr_device::interrupt::enable() };
+    reply::banner();
 
     info!(
         flash_str!(concat!(
@@ -396,6 +397,7 @@ fn realtime() {
             m.stop_now();
             CONSOLE.with(|c| c.reset());
             control_job(Control::Abort);
+            reply::banner();
             if m.position_known() {
                 info!("reset");
             } else {

@@ -12,11 +12,11 @@ use taut_logic::fat::Name;
 use taut_logic::segment::{Segment, StepBlock};
 
 /// UART receive interrupt → console: line bytes (real-time commands are
-/// taken out before). 127 bytes, Grbl's 128-byte buffer less one: what
-/// senders count characters against (CNCjs 120, UGS and grbl-streamer 128
-/// with the line in flight). Full: the byte is lost and counted (the
-/// sender ignored flow control).
-pub static RX: Ring<u8, 128> = Ring::new();
+/// taken out before). 128 bytes, Grbl's buffer, every one usable: what
+/// senders count characters against (CNCjs 120, UGS and grbl-streamer
+/// 128, all of it unread when the console has not begun the next line).
+/// Full: the byte is lost and counted (the sender ignored flow control).
+pub static RX: Ring<u8, 128, true> = Ring::new();
 /// Console, job, logger → UART transmit interrupt. Replies wait for room;
 /// a log line without room is dropped whole and counted.
 pub static TX: Ring<u8, 128> = Ring::new();

@@ -7,12 +7,13 @@
 
 use crate::flash_str;
 use crate::motion::{Motion, State};
-use crate::queues::REALTIME;
+use crate::queues::{REALTIME, RX};
 use crate::reply::{self, Fixed, REPORTED_AXES};
 use crate::stepper;
 use taut_logic::gcode::Realtime;
 use taut_logic::kinematics::Kinematics;
-use ufmt::{uWrite, uwrite};
+use taut_logic::planner::PLANNER_BLOCKS;
+use ufmt::uwrite;
 
 const STATUS: u8 = 0;
 const HOLD: u8 = 1;
@@ -73,8 +74,9 @@ pub fn status_later() {
     REALTIME.set(STATUS);
 }
 
-/// `<Idle|MPos:0.000,12.500,-3.000>`: the state and the position as the
-/// pulses left it, in the machine's units (Grbl's status report);
+/// `<Idle|MPos:0.000,12.500,-3.000|Bf:13,127>`: the state and the
+/// position as the pulses left it, in the machine's units, and the free
+/// planner blocks and receive bytes (Grbl 1.1's status report);
 /// `homing`: the console runs a homing cycle (`Home`).
 pub fn status(m: &Motion, kin: &impl Kinematics, homing: bool) {
     let mut r = reply::line();
@@ -91,6 +93,9 @@ pub fn status(m: &Motion, kin: &impl Kinematics, homing: bool) {
     for (i, p) in pos.iter().take(REPORTED_AXES).enumerate() {
         let _ = uwrite!(r, "{}{}", if i > 0 { "," } else { "" }, Fixed(*p));
     }
-    let _ = r.write_str(">");
+    // Grbl 1.1's buffer state (its `$10=1` default): free planner blocks,
+    // free bytes of the receive ring (CNCjs sizes its character count by it).
+    let planner_free = PLANNER_BLOCKS - m.planned();
+    let _ = uwrite!(r, "{}{},{}>", flash_str!("|Bf:"), planner_free, RX.free());
     r.send();
 }

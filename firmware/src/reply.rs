@@ -31,6 +31,14 @@ pub fn room() -> bool {
     crate::queues::TX.free() >= ROOM
 }
 
+/// Grbl 1.1's greeting, at power-on and after Ctrl-X: what senders wait
+/// for (grbl-streamer looks for `Grbl `, UGS and CNCjs for the version).
+pub fn banner() {
+    let mut r = line();
+    let _ = uwrite!(r, "{}", flash_str!("Grbl 1.1h ['$' for help]"));
+    r.send();
+}
+
 pub fn ok() {
     usart::send(b"ok\n");
 }

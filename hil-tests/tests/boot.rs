@@ -16,8 +16,18 @@ fn banner_within_50_ms_with_version_and_reset_cause() {
         sim.uart_text()
     );
     // The line is complete once its newline is out.
-    sim.run_until_uart_contains("\n", Duration::from_millis(50));
+    sim.run_until(
+        |s| {
+            s.uart_text()
+                .split("reset:")
+                .nth(1)
+                .is_some_and(|t| t.contains('\n'))
+        },
+        Duration::from_millis(50),
+    );
     let text = sim.uart_text();
+    // Grbl 1.1's greeting first: what senders wait for.
+    assert!(text.starts_with("Grbl 1.1h ['$' for help]\n"), "{text}");
     let banner = text
         .lines()
         .find(|l| l.contains("taut "))

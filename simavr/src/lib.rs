@@ -19,6 +19,7 @@ pub mod operator;
 mod outcome;
 pub mod picture;
 pub mod probe;
+pub mod pty;
 pub mod replay;
 pub mod report;
 mod run;

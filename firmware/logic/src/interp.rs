@@ -120,6 +120,43 @@ struct Modal {
     target: Position,
 }
 
+/// The modal state as `$G` reports it: `[GC:` this `]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ParserState {
+    motion: u8,
+    plane: u8,
+    units: u8,
+    distance: u8,
+    spindle: u8,
+    /// Whole units per minute.
+    feed: i32,
+}
+
+impl ufmt::uDisplay for ParserState {
+    fn fmt<W: ufmt::uWrite + ?Sized>(
+        &self,
+        f: &mut ufmt::Formatter<'_, W>,
+    ) -> Result<(), W::Error> {
+        // The fixed words as flash text: literals would sit in the AVR's SRAM.
+        ufmt::uwrite!(
+            f,
+            "G{}{}{}{}{}{}{}{}{}{}{}",
+            self.motion,
+            taut_progmem::text!(" G54 G"),
+            self.plane,
+            taut_progmem::text!(" G"),
+            self.units,
+            taut_progmem::text!(" G"),
+            self.distance,
+            taut_progmem::text!(" G94 M"),
+            self.spindle,
+            taut_progmem::text!(" M9 T0 F"),
+            self.feed
+        )?;
+        ufmt::uwrite!(f, "{}", taut_progmem::text!(" S0"))
+    }
+}
+
 /// A line checked and ready to carry out, with the modal state it leaves.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Planned {
@@ -149,6 +186,40 @@ impl Interpreter {
                 feed: None,
                 target: [Milli::ZERO; crate::axis::AXES],
             },
+        }
+    }
+
+    /// Grbl's `$G` report of the modal state, `pen_down` standing for the
+    /// spindle: `G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0` (no work offsets,
+    /// feed per minute, in the line's units).
+    pub fn parser_state(&self, pen_down: bool) -> ParserState {
+        let m = &self.modal;
+        ParserState {
+            motion: match m.motion {
+                Motion::Rapid => 0,
+                Motion::Linear => 1,
+                Motion::ArcCw => 2,
+                Motion::ArcCcw => 3,
+            },
+            plane: match m.plane {
+                Plane::Xy => 17,
+                Plane::Zx => 18,
+                Plane::Yz => 19,
+            },
+            units: match m.units {
+                Units::Inch => 20,
+                Units::Mm => 21,
+            },
+            distance: match m.distance {
+                Distance::Absolute => 90,
+                Distance::Relative => 91,
+            },
+            spindle: if pen_down { 3 } else { 5 },
+            // Kept in mm: whole units per minute of the line's unit.
+            feed: m.feed.map_or(0, |f| match m.units {
+                Units::Mm => f.0 / 1000,
+                Units::Inch => f.0 / 25_400,
+            }),
         }
     }
 

@@ -36,4 +36,9 @@ impl PenServo {
     pub fn set_pulse_us(&mut self, us: u16) {
         self.tc1.ocr1a().write(|w| w.set(us * TICKS_PER_US - 1));
     }
+
+    /// The pulse width now set, µs.
+    pub fn pulse_us(&self) -> u16 {
+        (self.tc1.ocr1a().read().bits() + 1) / TICKS_PER_US
+    }
 }

@@ -10,8 +10,12 @@ use core::mem::MaybeUninit;
 use core::sync::atomic::{compiler_fence, AtomicU8, Ordering::*};
 use taut_logic::sched::QueueStats;
 
+/// `WHOLE`: all `N` slots usable (indices run free and are masked when
+/// used, so full and empty differ by the count: `N` ≤ 128). Otherwise one
+/// slot stays empty and the indices are kept masked, as the step
+/// interrupt's assembly consumer of the segment ring expects.
 #[repr(C)]
-pub struct Ring<T: Copy, const N: usize> {
+pub struct Ring<T: Copy, const N: usize, const WHOLE: bool = false> {
     buf: UnsafeCell<[MaybeUninit<T>; N]>,
     head: AtomicU8,
     tail: AtomicU8,
@@ -23,13 +27,21 @@ pub struct Ring<T: Copy, const N: usize> {
 // consumer reads only `buf[tail]` before publishing `tail`: their slots never
 // overlap. `stats` is written by the producer only; readers take a copy
 // inside a critical section (see `stats`).
-unsafe impl<T: Copy + Send, const N: usize> Sync for Ring<T, N> {}
+unsafe impl<T: Copy + Send, const N: usize, const WHOLE: bool> Sync for Ring<T, N, WHOLE> {}
 
-impl<T: Copy, const N: usize> Ring<T, N> {
+impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
     const MASK: u8 = (N - 1) as u8;
 
+    /// The index after `i`.
+    fn next(i: u8) -> u8 {
+        match WHOLE {
+            true => i.wrapping_add(1),
+            false => i.wrapping_add(1) & Self::MASK,
+        }
+    }
+
     pub const fn new() -> Self {
-        assert!(N.is_power_of_two() && N <= 256);
+        assert!(N.is_power_of_two() && N <= 256 && (!WHOLE || N <= 128));
         Ring {
             buf: UnsafeCell::new([MaybeUninit::uninit(); N]),
             head: AtomicU8::new(0),
@@ -40,11 +52,14 @@ impl<T: Copy, const N: usize> Ring<T, N> {
 
     /// Messages waiting.
     pub fn len(&self) -> usize {
-        (self
+        let n = self
             .head
             .load(Relaxed)
-            .wrapping_sub(self.tail.load(Relaxed))
-            & Self::MASK) as usize
+            .wrapping_sub(self.tail.load(Relaxed));
+        match WHOLE {
+            true => n as usize,
+            false => (n & Self::MASK) as usize,
+        }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -57,9 +72,9 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         self.tail.store(self.head.load(Relaxed), Relaxed);
     }
 
-    /// Free slots (one stays empty to tell full from empty).
+    /// Free slots (unless `WHOLE`, one stays empty to tell full from empty).
     pub fn free(&self) -> usize {
-        N - 1 - self.len()
+        self.capacity() - self.len()
     }
 
     /// Producer: append all of `items` or none (refusal is counted once).
@@ -73,8 +88,8 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         let mut h = self.head.load(Relaxed);
         for &item in items {
             // SAFETY: slot `h` is free (checked above) and the producer's.
-            unsafe { (*self.buf.get())[h as usize] = MaybeUninit::new(item) };
-            h = h.wrapping_add(1) & Self::MASK;
+            unsafe { (*self.buf.get())[(h & Self::MASK) as usize] = MaybeUninit::new(item) };
+            h = Self::next(h);
         }
         compiler_fence(Release);
         self.head.store(h, Relaxed);
@@ -98,9 +113,9 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         }
         compiler_fence(Acquire);
         // SAFETY: slot `t` was published by the producer and not yet consumed.
-        let item = unsafe { (*self.buf.get())[t as usize].assume_init() };
+        let item = unsafe { (*self.buf.get())[(t & Self::MASK) as usize].assume_init() };
         compiler_fence(Release);
-        self.tail.store(t.wrapping_add(1) & Self::MASK, Relaxed);
+        self.tail.store(Self::next(t), Relaxed);
         Some(item)
     }
 
@@ -112,7 +127,7 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         }
         compiler_fence(Acquire);
         // SAFETY: as in `pop`.
-        Some(unsafe { (*self.buf.get())[t as usize].assume_init() })
+        Some(unsafe { (*self.buf.get())[(t & Self::MASK) as usize].assume_init() })
     }
 
     /// Consumer: `f` of the oldest message, read in place.
@@ -124,7 +139,7 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         compiler_fence(Acquire);
         // SAFETY: as in `pop`.
         Some(f(unsafe {
-            (*self.buf.get())[t as usize].assume_init_ref()
+            (*self.buf.get())[(t & Self::MASK) as usize].assume_init_ref()
         }))
     }
 
@@ -134,10 +149,10 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         compiler_fence(Acquire);
         while t != h {
             // SAFETY: slots from tail to head are published and not consumed.
-            if f(unsafe { (*self.buf.get())[t as usize].assume_init_ref() }) {
+            if f(unsafe { (*self.buf.get())[(t & Self::MASK) as usize].assume_init_ref() }) {
                 return true;
             }
-            t = t.wrapping_add(1) & Self::MASK;
+            t = Self::next(t);
         }
         false
     }
@@ -151,7 +166,10 @@ impl<T: Copy, const N: usize> Ring<T, N> {
 
     /// Usable capacity.
     pub const fn capacity(&self) -> usize {
-        N - 1
+        match WHOLE {
+            true => N,
+            false => N - 1,
+        }
     }
 
     /// A consistent copy of the counters (the producer may be an interrupt).

@@ -7,11 +7,13 @@ use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
 use taut_logic::settings::image;
 use taut_simavr::operator::{Operator, Seen};
+use taut_simavr::pty::Pty;
 use taut_simavr::scenario::{self, FaultSpec, TimedBytes};
 use taut_simavr::sdcard::{SdCard, SdImage};
 use taut_simavr::{picture, replay};
@@ -23,7 +25,7 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                    [--card-fault SPEC]...] [--auto-confirm] [--send FILE]
                    [--at SECONDS:BYTES]... [--for SECONDS] [--vcd PATH]
                    [--png PATH] [--report PATH] [--eeprom FILE] [--echo]
-                   [--machine NAME [--endstop-mm MM]]
+                   [--machine NAME [--endstop-mm MM]] [--pty [PATH]]
   --sd PATH       put a virtual SD card in the slot: an image file, or a
                   folder, imaged on the fly (FAT16 or FAT32 by size)
   --sd-insert-at SECONDS
@@ -70,6 +72,11 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
   --endstop-mm MM where the MIN switches of the machine's homing axes
                   close: MM below where each axis stands at power-on
                   (default 3); homing at power-on and G28 find them there
+  --pty [PATH]    serve the serial port as a pseudo-terminal (its path is
+                  printed; PATH, if given, becomes a symbolic link to it)
+                  for senders and terminals, in real time; runs until
+                  --for SECONDS, or SIGINT / SIGTERM, then writes the VCD,
+                  the picture and the report as any run does
   --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
   --eeprom FILE   the EEPROM's contents (settings): loaded at power-on if the
                   file exists, saved when the run ends (a power cycle keeps
@@ -98,6 +105,8 @@ struct Args {
     endstop_mm: f64,
     echo: bool,
     auto_confirm: bool,
+    /// `--pty`, and the link to make, if any.
+    pty: Option<Option<PathBuf>>,
 }
 
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
@@ -120,7 +129,9 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         endstop_mm: 3.0,
         echo: false,
         auto_confirm: false,
+        pty: None,
     };
+    let mut it = it.peekable();
     while let Some(a) = it.next() {
         let mut value = || it.next().ok_or(format!("{a} needs a value"));
         let time = |text: String| scenario::seconds(&text).map_err(|e| format!("{a}: {e}"));
@@ -147,6 +158,10 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
             }
             "--endstop-mm" => args.endstop_mm = value()?.parse().map_err(|_| "--endstop-mm MM")?,
             "--echo" => args.echo = true,
+            "--pty" => {
+                let link = it.next_if(|v| !v.starts_with("--")).map(PathBuf::from);
+                args.pty = Some(link);
+            }
             "--auto-confirm" => args.auto_confirm = true,
             _ => return Err(format!("unknown option {a}")),
         }
@@ -276,10 +291,26 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     if let Some(file) = &args.send {
         stream(&mut sim, file, args.echo, &mut printed)?;
     }
-    let default = match (args.auto_confirm, args.send.is_some()) {
-        (true, _) => 7200.0,
-        (false, true) => 0.0,
-        (false, false) => 5.0,
+    let default = match (args.auto_confirm, args.send.is_some(), args.pty.is_some()) {
+        // Until SIGINT or SIGTERM.
+        (_, _, true) => f64::from(u32::MAX),
+        (true, _, _) => 7200.0,
+        (false, true, _) => 0.0,
+        (false, false, _) => 5.0,
+    };
+    let mut pty = match &args.pty {
+        Some(link) => {
+            let pty = Pty::open(link.as_deref())?;
+            eprintln!(
+                "taut-sim: serial port on {}{}",
+                pty.path().display(),
+                link.as_ref()
+                    .map_or(String::new(), |l| format!(" (link {})", l.display()))
+            );
+            stop_on_signals();
+            Some(pty)
+        }
+        None => None,
     };
     let mut operator = if args.auto_confirm {
         Operator::confirming()
@@ -295,9 +326,15 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     let slice = Duration::from_millis(10);
     let mut outcome = Outcome::Running;
     let mut elapsed = Duration::ZERO;
-    while elapsed < total {
+    while elapsed < total && !STOP.load(Ordering::Relaxed) {
         let step = slice.min(total - elapsed);
-        outcome = sim.run_for(step);
+        match pty.as_mut() {
+            Some(pty) => {
+                pty.serve(&mut sim, step)?;
+                outcome = Outcome::Running;
+            }
+            None => outcome = sim.run_for(step),
+        }
         elapsed += step;
         if args.echo {
             let text = &sim.uart_bytes()[printed..];
@@ -426,6 +463,21 @@ impl Bar {
         if let Some((_, bar)) = self.phase.take() {
             bar.finish();
         }
+    }
+}
+
+/// SIGINT or SIGTERM came: the run ends, its files are written.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: libc::c_int) {
+    STOP.store(true, Ordering::Relaxed);
+}
+
+fn stop_on_signals() {
+    // SAFETY: the handler only stores to an atomic.
+    unsafe {
+        libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
+        libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
     }
 }
 

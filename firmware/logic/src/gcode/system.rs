@@ -25,6 +25,12 @@ pub enum SystemLine {
     Home,
     /// `$T<n>`: seed 001's test pattern `n`.
     Pattern(u8),
+    /// `$I`: the build (`[VER:…]`, `[OPT:…]`), as Grbl 1.1.
+    BuildInfo,
+    /// `$G`: the parser's modal state (`[GC:…]`).
+    ParserState,
+    /// `$#`: the coordinate offsets (`[G54:…]` … `[PRB:…]`).
+    Offsets,
     /// `$<key>=<value>`, both as typed; the settings module interprets
     /// them (e.g. with [`parse_milli`](super::parse_milli)).
     Set { key: SystemText, value: SystemText },
@@ -66,7 +72,9 @@ impl SystemBuilder {
                 Err(())
             };
         }
-        let key_char = c.is_ascii_alphanumeric() || c == b'_' || (c == b'$' && self.key.is_empty());
+        let key_char = c.is_ascii_alphanumeric()
+            || c == b'_'
+            || (matches!(c, b'$' | b'#') && self.key.is_empty());
         if self.key == "$" {
             Err(()) // nothing may follow `$$`
         } else if c == b'=' && !self.key.is_empty() {
@@ -99,6 +107,9 @@ impl SystemBuilder {
             "S" | "s" => Ok(SystemLine::Stack),
             "X" | "x" => Ok(SystemLine::Unlock),
             "H" | "h" => Ok(SystemLine::Home),
+            "I" | "i" => Ok(SystemLine::BuildInfo),
+            "G" | "g" => Ok(SystemLine::ParserState),
+            "#" => Ok(SystemLine::Offsets),
             "T1" | "t1" => Ok(SystemLine::Pattern(1)),
             "T5" | "t5" => Ok(SystemLine::Pattern(5)),
             "T6" | "t6" => Ok(SystemLine::Pattern(6)),

@@ -366,3 +366,18 @@ fn inches_are_converted_once_and_angles_stay_degrees() {
         Err(ErrorKind::FeedTooLow)
     );
 }
+
+/// `$G` in Grbl 1.1's words, after the lines that set each mode; a line
+/// that fails changes none of it.
+#[test]
+fn parser_state_reports_the_modal_state_as_grbl() {
+    let show = |i: &Interpreter, pen| crate::text::error::tests::show(&i.parser_state(pen));
+    let mut i = Interpreter::new();
+    assert_eq!(show(&i, false), "G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0");
+    run(&mut i, "G91 G18 G1 X1 F500", FREE).unwrap();
+    assert_eq!(show(&i, true), "G1 G54 G18 G21 G91 G94 M3 M9 T0 F500 S0");
+    assert!(run(&mut i, "G90 G2 X5 I1", FREE).is_err());
+    run(&mut i, "G20 G90", FREE).unwrap();
+    // 500 mm/min is 19.7 inches a minute.
+    assert_eq!(show(&i, false), "G1 G54 G18 G20 G90 G94 M5 M9 T0 F19 S0");
+}

@@ -98,6 +98,9 @@ fn system_lines() {
     assert_eq!(parse(" $Q"), Ok(Input::System(SystemLine::QueueStats)));
     assert_eq!(parse("$s ; stack"), Ok(Input::System(SystemLine::Stack)));
     assert_eq!(parse("$X"), Ok(Input::System(SystemLine::Unlock)));
+    assert_eq!(parse("$I"), Ok(Input::System(SystemLine::BuildInfo)));
+    assert_eq!(parse("$g"), Ok(Input::System(SystemLine::ParserState)));
+    assert_eq!(parse("$#"), Ok(Input::System(SystemLine::Offsets)));
     assert_eq!(parse("$ steps_c = 26.667"), set("steps_c", "26.667"));
     assert_eq!(parse("$100=80"), set("100", "80"));
     assert_eq!(parse("$Q=-1"), set("Q", "-1"));

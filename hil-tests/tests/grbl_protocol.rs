@@ -1,0 +1,86 @@
+//! Issue 12: Grbl 1.1 on the wire, in the formats its interface document
+//! gives (the lines quoted there are checked byte for byte): the banner at
+//! power-on and after Ctrl-X, `$I`, `$G`, `$#` and the status report's
+//! buffer state, which senders size their streams by.
+
+use hil_tests::sim::Sim;
+use hil_tests::{boot_machine, log_tail, send_ok, wait_for};
+use std::time::Duration;
+
+fn send(sim: &mut Sim, line: &str) -> String {
+    let from = sim.uart_bytes().len();
+    send_ok(sim, line, Duration::from_secs(2));
+    String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned()
+}
+
+/// The reply lines of a command, its `ok` included: no log lines, nor the
+/// end of one under way when the command was sent.
+fn replies(text: &str) -> Vec<&str> {
+    let log = |l: &str| ["[I ", "[W ", "[E "].iter().any(|p| l.starts_with(p));
+    text.lines()
+        .filter(|l| (l.starts_with('[') && !log(l)) || *l == "ok")
+        .collect()
+}
+
+#[test]
+fn banner_build_info_parser_state_offsets_and_status_in_grbl_formats() {
+    let mut sim = boot_machine();
+    wait_for(
+        &mut sim,
+        "Grbl 1.1h ['$' for help]\n",
+        Duration::from_millis(50),
+    );
+    let version = env!("CARGO_PKG_VERSION");
+    assert_eq!(
+        replies(&send(&mut sim, "$I")),
+        [
+            format!("[VER:1.1h.taut-{version}:string_art]").as_str(),
+            "[OPT:,13,128]",
+            "ok"
+        ]
+    );
+    // Quoted from Grbl's interface document: the power-on state.
+    assert_eq!(
+        replies(&send(&mut sim, "$G")),
+        ["[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0]", "ok"]
+    );
+    send(&mut sim, "G91 G18 G1 F600");
+    assert_eq!(
+        replies(&send(&mut sim, "$G")),
+        ["[GC:G1 G54 G18 G21 G91 G94 M5 M9 T0 F600 S0]", "ok"]
+    );
+    // taut keeps no work offsets: every one zero, in Grbl's format.
+    let offsets = send(&mut sim, "$#");
+    let expected = [
+        "[G54:0.000,0.000,0.000]",
+        "[G55:0.000,0.000,0.000]",
+        "[G56:0.000,0.000,0.000]",
+        "[G57:0.000,0.000,0.000]",
+        "[G58:0.000,0.000,0.000]",
+        "[G59:0.000,0.000,0.000]",
+        "[G28:0.000,0.000,0.000]",
+        "[G30:0.000,0.000,0.000]",
+        "[G92:0.000,0.000,0.000]",
+        "[TLO:0.000]",
+        "[PRB:0.000,0.000,0.000:0]",
+        "ok",
+    ];
+    assert_eq!(replies(&offsets), expected);
+    // The buffer state: every planner block and receive byte free.
+    let from = sim.uart_bytes().len();
+    sim.uart_send(b"?");
+    sim.run_for(Duration::from_millis(20));
+    let report = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
+    assert_eq!(
+        report,
+        "<Idle|MPos:0.000,0.000,0.000|Bf:13,128>\n",
+        "{}",
+        log_tail(&sim)
+    );
+    // Ctrl-X: the banner again, as after a power-on.
+    let from = sim.uart_bytes().len();
+    sim.uart_send(&[0x18]);
+    sim.run_for(Duration::from_millis(20));
+    let after = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
+    assert!(after.contains("Grbl 1.1h ['$' for help]\n"), "{after}");
+}
