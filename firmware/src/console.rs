@@ -603,7 +603,12 @@ impl Console {
             {
                 return self.error(&Error::new(ErrorKind::Printing, 0));
             }
-            SystemLine::Unlock => m.unlock(),
+            SystemLine::Unlock => {
+                m.unlock();
+                let mut r = reply::line();
+                let _ = uwrite!(r, "{}", flash_str!("[MSG:Caution: Unlocked]"));
+                r.send();
+            }
             SystemLine::BuildInfo => build_info(cfg),
             SystemLine::ParserState => {
                 let pen_down = m.pen.pulse_us() == PenConfig::pulse_us(cfg.pen.down_deg);

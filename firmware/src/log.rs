@@ -2,9 +2,10 @@
 //!
 //! `info!("nail ", i, " of ", n)`: string literals are stored in flash (they
 //! would otherwise cost SRAM for the firmware's whole life), other arguments
-//! are printed with `ufmt`. Each line reads `[I 1234 module] text`: level,
-//! milliseconds since boot, module. Brackets make Grbl-style senders treat it
-//! as a message, not a reply. A line is formatted on the stack and queued
+//! are printed with `ufmt`. Each line reads `[MSG:I 1234 module: text]`:
+//! level, milliseconds since boot, module, in Grbl 1.1's message brackets,
+//! which every sender shows and none takes for a reply, an error or an
+//! alarm (grbl-streamer aborts a stream on a bare line holding "error"). A line is formatted on the stack and queued
 //! whole; when the TX ring has no room it is dropped and counted, and the
 //! count is reported on the next line that fits. Levels below `MAX_LEVEL`
 //! (cargo feature `log-debug` lowers it) compile to nothing.
@@ -40,6 +41,8 @@ pub fn dropped() -> u16 {
 pub struct Line {
     buf: heapless::Vec<u8, LINE>,
     cut: bool,
+    /// A log line: closed by `]`.
+    msg: bool,
 }
 
 impl ufmt::uWrite for Line {
@@ -59,16 +62,19 @@ impl Line {
         let mut l = Line {
             buf: heapless::Vec::new(),
             cut: false,
+            msg: true,
         };
         let tag = [b'E', b'W', b'I', b'D'][level as usize];
         // Pushed byte by byte: format strings' pieces would sit in SRAM.
-        let _ = l.buf.push(b'[');
+        for c in [b'[', b'M', b'S', b'G', b':'] {
+            let _ = l.buf.push(c);
+        }
         let _ = l.buf.push(tag);
         let _ = l.buf.push(b' ');
         let _ = ufmt::uwrite!(l, "{}", clock::millis());
         let _ = l.buf.push(b' ');
         let _ = ufmt::uwrite!(l, "{}", module);
-        let _ = l.buf.push(b']');
+        let _ = l.buf.push(b':');
         let _ = l.buf.push(b' ');
         l
     }
@@ -79,6 +85,7 @@ impl Line {
         Line {
             buf: heapless::Vec::new(),
             cut: false,
+            msg: false,
         }
     }
 
@@ -88,11 +95,16 @@ impl Line {
         usart::send(&self.buf);
     }
 
-    /// The newline, always: a line that did not fit ends in `~` first.
+    /// The newline, always, after a log line's `]`: a line that did not
+    /// fit ends in `~` first.
     fn end(&mut self) {
-        if self.cut || self.buf.is_full() {
-            self.buf.truncate(LINE - 2);
+        let close = usize::from(self.msg);
+        if self.cut || self.buf.len() + close + 1 > LINE {
+            self.buf.truncate(LINE - 2 - close);
             let _ = self.buf.push(b'~');
+        }
+        if self.msg {
+            let _ = self.buf.push(b']');
         }
         let _ = self.buf.push(b'\n');
     }
@@ -103,7 +115,8 @@ impl Line {
         let dropped = dropped();
         if dropped > 0 {
             let mut note = Line::new(Level::Warn, crate::flash_str!("log"));
-            let _ = ufmt::uwrite!(note, "{}{}\n", dropped, crate::flash_str!(" lines dropped"));
+            let _ = ufmt::uwrite!(note, "{}{}", dropped, crate::flash_str!(" lines dropped"));
+            note.end();
             if note.buf.len() + self.buf.len() > crate::queues::TX.free() {
                 return count_drop();
             }

@@ -397,11 +397,16 @@ fn realtime() {
             m.stop_now();
             CONSOLE.with(|c| c.reset());
             control_job(Control::Abort);
+            // Grbl's words: alarm 3 (reset while in motion), the greeting.
+            let lost = !m.position_known();
+            if lost {
+                reply::alarm(3);
+            }
             reply::banner();
-            if m.position_known() {
-                info!("reset");
-            } else {
+            if lost {
                 warn!("reset during motion: position unknown until G92, $X or zeroing");
+            } else {
+                info!("reset");
             }
         }
         if r.hold() {

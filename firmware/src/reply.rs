@@ -39,6 +39,13 @@ pub fn banner() {
     r.send();
 }
 
+/// `ALARM:<n>`, Grbl's alarm numbers (3: reset while in motion).
+pub fn alarm(n: u8) {
+    let mut r = line();
+    let _ = uwrite!(r, "{}{}", flash_str!("ALARM:"), n);
+    r.send();
+}
+
 pub fn ok() {
     usart::send(b"ok\n");
 }

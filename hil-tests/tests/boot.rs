@@ -32,13 +32,13 @@ fn banner_within_50_ms_with_version_and_reset_cause() {
         .lines()
         .find(|l| l.contains("taut "))
         .expect("banner line");
-    assert!(banner.starts_with("[I "), "log line format: {banner}");
+    assert!(banner.starts_with("[MSG:I "), "log line format: {banner}");
     assert!(
         banner.contains(&format!("taut {} git ", firmware_version())),
         "{banner}"
     );
     assert!(banner.contains("atmega2560 16MHz"), "{banner}");
-    assert!(banner.ends_with("reset:power-on"), "{banner}");
+    assert!(banner.ends_with("reset:power-on]"), "{banner}");
     assert!(sim.time_s() < 0.050);
 }
 

@@ -278,7 +278,7 @@ fn every_bad_file_gets_its_message_and_nothing_moves() {
         let errors: Vec<String> = sim
             .uart_text()
             .lines()
-            .filter(|l| l.starts_with("[E"))
+            .filter(|l| l.starts_with("[MSG:E"))
             .filter_map(|l| message(l).map(str::to_string))
             .collect();
         if errors != [expected.to_string()] {
@@ -383,5 +383,5 @@ fn a_card_pulled_while_winding_pauses_the_job_until_it_is_back() {
 }
 
 fn no_errors(sim: &Sim) {
-    assert!(!sim.uart_text().contains("[E "), "{}", sim.uart_text());
+    assert!(!sim.uart_text().contains("[MSG:E "), "{}", sim.uart_text());
 }

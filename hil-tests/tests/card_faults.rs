@@ -283,7 +283,7 @@ fn an_oversized_pattern_is_refused_once_then_quiet() {
     assert_eq!(count(&sim, refusal), 1, "{}", log_tail(&sim));
     assert_eq!(sim.watchdog_resets(), 0);
     assert!(
-        log_tail(&sim).ends_with(">>> bad files: replace card\n"),
+        log_tail(&sim).ends_with(">>> bad files: replace card]\n"),
         "{}",
         log_tail(&sim)
     );

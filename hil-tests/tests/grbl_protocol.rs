@@ -16,7 +16,13 @@ fn send(sim: &mut Sim, line: &str) -> String {
 /// The reply lines of a command, its `ok` included: no log lines, nor the
 /// end of one under way when the command was sent.
 fn replies(text: &str) -> Vec<&str> {
-    let log = |l: &str| ["[I ", "[W ", "[E "].iter().any(|p| l.starts_with(p));
+    // Ours read `[MSG:I 1234 module: …]`; Grbl's own (`[MSG:Caution: …]`) stay.
+    let log = |l: &str| {
+        let b = l.as_bytes();
+        l.starts_with("[MSG:")
+            && b.get(6) == Some(&b' ')
+            && b.get(7).is_some_and(u8::is_ascii_digit)
+    };
     text.lines()
         .filter(|l| (l.starts_with('[') && !log(l)) || *l == "ok")
         .collect()
@@ -83,4 +89,37 @@ fn banner_build_info_parser_state_offsets_and_status_in_grbl_formats() {
     sim.run_for(Duration::from_millis(20));
     let after = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
     assert!(after.contains("Grbl 1.1h ['$' for help]\n"), "{after}");
+}
+
+/// Ctrl-X during motion: Grbl's alarm 3 (reset while in motion), the
+/// greeting, and how to unlock; `?` says `Alarm` until `$X`, which
+/// answers Grbl's caution.
+#[test]
+fn a_reset_in_motion_is_grbl_s_alarm_3_and_x_unlocks_it() {
+    let mut sim = boot_machine();
+    send(&mut sim, "M17");
+    sim.uart_send(b"G0 C90\n");
+    sim.run_for(Duration::from_millis(300));
+    let from = sim.uart_bytes().len();
+    sim.uart_send(&[0x18]);
+    sim.run_for(Duration::from_millis(30));
+    let after = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
+    let lines: Vec<&str> = after.lines().collect();
+    assert_eq!(
+        lines[..2],
+        ["ALARM:3", "Grbl 1.1h ['$' for help]"],
+        "{after}"
+    );
+    assert!(
+        lines[2].ends_with("position unknown until G92, $X or zeroing]"),
+        "{after}"
+    );
+    let from = sim.uart_bytes().len();
+    sim.uart_send(b"?");
+    sim.run_for(Duration::from_millis(20));
+    assert!(String::from_utf8_lossy(&sim.uart_bytes()[from..]).starts_with("<Alarm|"));
+    assert_eq!(
+        replies(&send(&mut sim, "$X")),
+        ["[MSG:Caution: Unlocked]", "ok"]
+    );
 }

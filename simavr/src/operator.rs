@@ -20,7 +20,7 @@ pub enum Seen {
     Prompt(String),
     /// `drill 3/24` or `wind 1234/3000 left 12s`: phase, done, total.
     Progress(String, u32, u32),
-    /// An error line (`[E …]`).
+    /// An error line (`[MSG:E …]`).
     Error(String),
 }
 
@@ -38,10 +38,10 @@ pub struct Operator {
     pub finished: bool,
 }
 
-/// The message text of a log line `[I 123 module] text`.
+/// The message text of a log line `[MSG:I 123 module: text]`.
 pub fn message(line: &str) -> Option<&str> {
-    let rest = line.strip_prefix('[')?;
-    let (_, text) = rest.split_once("] ")?;
+    let rest = line.strip_prefix("[MSG:")?.strip_suffix(']')?;
+    let (_, text) = rest.split_once(": ")?;
     Some(text)
 }
 
@@ -71,7 +71,7 @@ impl Operator {
         let mut seen = Vec::new();
         for line in text.lines() {
             let Some(msg) = message(line) else { continue };
-            if line.starts_with("[E") {
+            if line.starts_with("[MSG:E") {
                 seen.push(Seen::Error(msg.to_string()));
             } else if let Some(state) = msg.strip_prefix("state: ") {
                 self.state = Some(state.to_string());
@@ -118,7 +118,12 @@ mod tests {
 
     #[test]
     fn log_lines_are_read_as_the_firmware_writes_them() {
-        assert_eq!(message("[I 12 job] state: reading"), Some("state: reading"));
+        assert_eq!(
+            message("[MSG:I 12 job: state: reading]"),
+            Some("state: reading")
+        );
+        assert_eq!(message("[MSG:Caution: Unlocked]"), Some("Unlocked"));
+        assert_eq!(message("ok"), None);
         assert_eq!(
             progress("wind 1234/3000 left 12s"),
             Some(Seen::Progress("wind".into(), 1234, 3000))

@@ -324,11 +324,11 @@ fn sd_read_kib_per_s(elf: &Path) -> f64 {
     let mut sim = Sim::load(elf).expect("sd_read image");
     sim.insert_sd(SdImage::from_path(&dir).unwrap());
     std::fs::remove_dir_all(&dir).unwrap();
-    let end = sim.run_until_uart_contains(" us\n", Duration::from_secs(30));
+    let end = sim.run_until_uart_contains(" us]\n", Duration::from_secs(30));
     assert_eq!(end, Outcome::Done, "{}", sim.uart_text());
     let text = sim.uart_text();
     let words: Vec<&str> = text.lines().last().unwrap().split(' ').collect();
-    // `[I ms sd_read] read <bytes> B in <us> us`
+    // `[MSG:I ms sd_read: read <bytes> B in <us> us]`
     let bytes: f64 = words[4].parse().unwrap();
     let us: f64 = words[7].parse().unwrap();
     bytes / 1024.0 / (us / 1e6)
