@@ -57,6 +57,13 @@ fn flatbed_with(files: &[(&str, &[u8])]) -> Sim {
     sim
 }
 
+/// The print runs to its end and the machine stands; its pulses drew `d`.
+fn print_ends_drawn(sim: &mut Sim, machine: Machine, d: &Drawing, within: f64) {
+    wait_for(sim, "Done printing file", Duration::from_secs(120));
+    send(sim, "M400");
+    assert_drawn_from_the_pulses(sim, machine, d, within);
+}
+
 fn since(sim: &Sim, from: usize) -> String {
     String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned()
 }
@@ -205,9 +212,7 @@ fn m25_holds_the_print_and_m24_goes_on() {
     sim.run_for(Duration::from_secs(2));
     assert_eq!(steps_on_pins(&sim), held, "held");
     send(&mut sim, "M24");
-    wait_for(&mut sim, "Done printing file", Duration::from_secs(60));
-    send(&mut sim, "M400");
-    assert_drawn_from_the_pulses(&sim, FLATBED, &d, WITHIN);
+    print_ends_drawn(&mut sim, FLATBED, &d, WITHIN);
 }
 
 /// From a list of seeds: files of random line lengths and line ends, the
@@ -301,9 +306,7 @@ fn every_plotter_prints_its_drawing_from_the_card() {
         wait_for(&mut sim, "MiB FAT", Duration::from_secs(3));
         send(&mut sim, "M23 drawing.nc");
         send(&mut sim, "M24");
-        wait_for(&mut sim, "Done printing file", Duration::from_secs(120));
-        send(&mut sim, "M400");
-        assert_drawn_from_the_pulses(&sim, machine, &d, within);
+        print_ends_drawn(&mut sim, machine, &d, within);
     }
 }
 
@@ -331,9 +334,7 @@ fn a_plotter_card_s_machine_txt_switches_the_machine_and_keeps_it() {
     send(&mut sim, "M17");
     send(&mut sim, "M23 plot.gco");
     send(&mut sim, "M24");
-    wait_for(&mut sim, "Done printing file", Duration::from_secs(120));
-    send(&mut sim, "M400");
-    assert_drawn_from_the_pulses(&sim, Machine::Whiteboard, &d, 0.1);
+    print_ends_drawn(&mut sim, Machine::Whiteboard, &d, 0.1);
     sim.run_for(Duration::from_secs(3));
     let eeprom = sim.eeprom();
     let mut sim = machine();
