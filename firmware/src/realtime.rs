@@ -20,11 +20,21 @@ const HOLD: u8 = 1;
 const RESUME: u8 = 2;
 const RESET: u8 = 3;
 
+/// Grbl's safety-door byte.
+const SAFETY_DOOR: u8 = 0x84;
+
 /// The receive interrupt's part: true when `byte` was a real-time command
-/// (flagged: spawn the task), which is then not line input.
+/// (flagged: spawn the task), which is then not line input. Grbl 1.1
+/// makes every byte from 0x80 up a real-time command: the safety door
+/// (0x84) holds as `!` does; jog cancel (0x85), the overrides (0x90–0x9D)
+/// and the coolant toggles are taken out of the stream and do nothing
+/// here (taut has no jog mode, overrides or coolant), so a sender that
+/// sends them never spoils a line.
 #[inline(always)]
 pub fn on_receive(byte: u8) -> bool {
     let bit = match Realtime::from_byte(byte) {
+        None if byte == SAFETY_DOOR => HOLD,
+        None if byte >= 0x80 => return true,
         None => return false,
         Some(Realtime::Status) => STATUS,
         Some(Realtime::FeedHold) => HOLD,

@@ -123,3 +123,30 @@ fn a_reset_in_motion_is_grbl_s_alarm_3_and_x_unlocks_it() {
         ["[MSG:Caution: Unlocked]", "ok"]
     );
 }
+
+/// Grbl 1.1's extended real-time bytes (CNCjs and UGS send overrides and
+/// jog cancels): taken out of the stream wherever they fall, so the line
+/// around them stays whole; the safety door holds as `!` does.
+#[test]
+fn override_and_door_bytes_never_spoil_a_line() {
+    let mut sim = boot_machine();
+    send(&mut sim, "M17");
+    sim.uart_send(b"G0 \x90C\x91\x9a9\x85\xa0\n");
+    sim.run_for(Duration::from_millis(100));
+    assert!(sim.uart_text().ends_with("ok\n"), "{}", log_tail(&sim));
+    send(&mut sim, "M400");
+    // 9° of the base at 9600 steps a turn.
+    assert_eq!(hil_tests::steps_on_pins(&sim)[0], 240);
+    send(&mut sim, "G0 C0");
+    sim.run_for(Duration::from_millis(200));
+    sim.uart_send(&[0x84]);
+    sim.run_for(Duration::from_millis(1500));
+    let from = sim.uart_bytes().len();
+    sim.uart_send(b"?");
+    sim.run_for(Duration::from_millis(20));
+    let report = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
+    assert!(report.starts_with("<Hold:0|"), "{report}");
+    sim.uart_send(b"~");
+    send(&mut sim, "M400");
+    assert_eq!(hil_tests::steps_on_pins(&sim)[0], 0);
+}
