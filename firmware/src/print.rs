@@ -147,9 +147,9 @@ impl Print {
         match self.state {
             State::Selected => self.state = State::Running,
             State::Lost => {
-                self.skip = self.line_start.pos;
                 let name = self.name;
                 self.open(name, true);
+                self.skip = self.line_start.pos;
                 self.line_waits = line;
             }
             State::Running => {}
@@ -193,9 +193,11 @@ impl Print {
         }
     }
 
+    /// Open `name` from its start (a lost print then sets what to pass over).
     fn open(&mut self, name: Name, start: bool) {
         self.ask(|t| Request::Open(name, t));
         self.state = State::Opening { start };
+        self.skip = 0;
     }
 
     fn close(&mut self) {

@@ -57,9 +57,13 @@ fn flatbed_with(files: &[(&str, &[u8])]) -> Sim {
     sim
 }
 
-/// The print runs to its end and the machine stands; its pulses drew `d`.
+/// The print under way runs to its end and the machine stands; its
+/// pulses drew `d`.
 fn print_ends_drawn(sim: &mut Sim, machine: Machine, d: &Drawing, within: f64) {
-    wait_for(sim, "Done printing file", Duration::from_secs(120));
+    let done = |s: &Sim| s.uart_text().matches("Done printing file").count();
+    let before = done(sim);
+    let ended = sim.run_until(|s| done(s) > before, Duration::from_secs(120));
+    assert_eq!(ended, hil_tests::sim::Outcome::Done, "{}", log_tail(sim));
     send(sim, "M400");
     assert_drawn_from_the_pulses(sim, machine, d, within);
 }
@@ -179,6 +183,16 @@ fn the_green_button_prints_the_first_gcode_file_and_a_pulled_card_loses_no_line(
     // a doubled line would pass the centre twice, harmless, but a lost
     // one leaves a tip undrawn).
     assert_drawn_from_the_pulses(&sim, FLATBED, &d, WITHIN);
+    // The next print of the file reads it whole, from its first line: the
+    // lost print's place is not kept.
+    let from = sim.uart_bytes().len();
+    send(&mut sim, "M23 plot.nc");
+    send(&mut sim, "M24");
+    print_ends_drawn(&mut sim, FLATBED, &d, WITHIN);
+    let again = since(&sim, from);
+    assert!(!again.contains("print goes on"), "{again}");
+    // Its M117 line (line 3) is met again: the file was read from the top.
+    assert!(again.contains("PLOT.NC:3:1: error:20 "), "{again}");
 }
 
 #[test]
