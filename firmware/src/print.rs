@@ -13,7 +13,7 @@
 
 use crate::board::flash::FlashStr;
 use crate::log::{Level, Line};
-use crate::queues::{Request, What, CARD_IN, CARD_OUT};
+use crate::queues::{CardMsg, Request, What, CARD_IN, CARD_OUT};
 use crate::reply;
 use crate::{flash_str, info, warn};
 use taut_logic::fat::Name;
@@ -222,43 +222,35 @@ impl Print {
     }
 
     fn messages(&mut self) -> Answer {
-        while let Some(msg) = CARD_OUT.peek_with(|m| (m.ticket, message(&m.what))) {
-            let (ticket, what) = msg;
+        let is_data = |m: &CardMsg| (m.ticket, matches!(m.what, What::Data { .. }));
+        while let Some((ticket, data)) = CARD_OUT.peek_with(is_data) {
             let ours = ticket == self.ticket;
-            match what {
-                // Bytes wait in the queue until a line wants them.
-                Kind::Data if ours && self.state != State::Idle => return None,
-                Kind::Opened(name, size) if ours => {
-                    let _ = CARD_OUT.pop();
-                    return self.opened(name, size);
-                }
-                Kind::Listed if ours => {
-                    let _ = CARD_OUT.pop();
+            // Bytes wait in the queue until a line wants them.
+            if data && ours && self.state != State::Idle {
+                return None;
+            }
+            let Some(msg) = CARD_OUT.pop() else {
+                return None;
+            };
+            match msg.what {
+                What::Opened { name, size } if ours => return self.opened(name, size),
+                What::Listed if ours => {
                     self.state = State::Idle;
                     send_line(flash_str!("End file list"));
                     return Some(Ok(()));
                 }
-                Kind::End if ours => {
-                    let _ = CARD_OUT.pop();
+                What::End if ours => {
                     self.ended = true;
                     return None;
                 }
-                Kind::Missing | Kind::Failed if ours => {
-                    let _ = CARD_OUT.pop();
-                    return self.failed(what == Kind::Missing);
-                }
-                Kind::Removed => {
-                    let _ = CARD_OUT.pop();
-                    self.lost();
-                }
-                Kind::Inserted if self.state == State::Lost => {
-                    let _ = CARD_OUT.pop();
+                What::Missing if ours => return self.failed(true),
+                What::Failed if ours => return self.failed(false),
+                What::Removed => self.lost(),
+                What::Inserted if self.state == State::Lost => {
                     info!("card back: M24 or the green button goes on");
                 }
                 // Older requests', and the slot's news when they change nothing.
-                _ => {
-                    let _ = CARD_OUT.pop();
-                }
+                _ => {}
             }
         }
         None
@@ -431,16 +423,7 @@ impl Print {
         if let Some(c) = e.column() {
             let _ = uwrite!(r, "{}:", c);
         }
-        let _ = uwrite!(
-            r,
-            "{}{} {}",
-            flash_str!(" error:"),
-            e.code(),
-            crate::texts::error(e.kind())
-        );
-        if let Some(why) = why {
-            let _ = uwrite!(r, ": {}", why);
-        }
+        let _ = uwrite!(r, " {}", reply::Because(e, why));
         r.emit();
         if e.kind() != ErrorKind::UnsupportedCommand {
             warn!("print stopped");
@@ -452,32 +435,6 @@ impl Print {
 impl Default for Print {
     fn default() -> Self {
         Self::new()
-    }
-}
-
-/// A card message without its bytes.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Kind {
-    Inserted,
-    Removed,
-    Opened(Name, u32),
-    Listed,
-    Data,
-    End,
-    Missing,
-    Failed,
-}
-
-fn message(w: &What) -> Kind {
-    match *w {
-        What::Inserted => Kind::Inserted,
-        What::Removed => Kind::Removed,
-        What::Opened { name, size } => Kind::Opened(name, size),
-        What::Listed => Kind::Listed,
-        What::Data { .. } => Kind::Data,
-        What::End => Kind::End,
-        What::Missing => Kind::Missing,
-        What::Failed => Kind::Failed,
     }
 }
 

@@ -60,20 +60,32 @@ pub fn error(e: &Error) {
 #[inline(never)]
 pub fn error_because(e: &Error, why: Option<ErrorKind>) {
     let mut r = line();
-    let _ = uwrite!(
-        r,
-        "{}{} {}",
-        flash_str!("error:"),
-        e.code(),
-        texts::error(e.kind())
-    );
-    if let Some(why) = why {
-        let _ = uwrite!(r, ": {}", why);
-    }
+    let _ = uwrite!(r, "{}", Because(e, why));
     if let Some(c) = e.column() {
         let _ = uwrite!(r, "{}{})", flash_str!(" (col "), c);
     }
     r.send();
+}
+
+/// `error:<code> <text>[: <why>]`: an error as the console and a card
+/// print's log both word it.
+pub struct Because<'a>(pub &'a Error, pub Option<ErrorKind>);
+
+impl ufmt::uDisplay for Because<'_> {
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut ufmt::Formatter<'_, W>) -> Result<(), W::Error> {
+        let Because(e, why) = self;
+        uwrite!(
+            f,
+            "{}{} {}",
+            flash_str!("error:"),
+            e.code(),
+            texts::error(e.kind())
+        )?;
+        match why {
+            Some(why) => uwrite!(f, ": {}", why),
+            None => Ok(()),
+        }
+    }
 }
 
 /// A fixed-point value as `-12.345`.
