@@ -209,7 +209,7 @@ pub fn steps_on_pins(sim: &sim::Sim) -> [i64; 3] {
 pub fn reported_steps(sim: &mut sim::Sim) -> [i64; 3] {
     let start = sim.uart_bytes().len();
     send_ok(sim, "M114", std::time::Duration::from_secs(1));
-    let text = String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned();
+    let text = sim.uart_text_from(start);
     let count = text
         .lines()
         .find_map(|l| l.split_once("Count "))

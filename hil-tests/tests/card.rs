@@ -153,7 +153,7 @@ fn a_bad_crc_once_and_a_card_pulled_and_put_back_end_in_a_good_read() {
     sim.sd_reinsert_at(now + Duration::from_millis(2500));
     let seen = sim.uart_bytes().len();
     let wait_for_new = |sim: &mut Sim, text: &str, timeout: Duration| {
-        let new = |s: &Sim| String::from_utf8_lossy(&s.uart_bytes()[seen..]).contains(text);
+        let new = |s: &Sim| s.uart_text_from(seen).contains(text);
         let end = sim.run_until(new, timeout);
         assert_eq!(end, Outcome::Done, "{text:?}:\n{}", sim.uart_text());
     };
@@ -161,7 +161,7 @@ fn a_bad_crc_once_and_a_card_pulled_and_put_back_end_in_a_good_read() {
     assert!(!sim.sd_present());
     wait_for_new(&mut sim, "files ok:", Duration::from_millis(3000));
     assert!(sim.time_s() > (now + Duration::from_millis(2500)).as_secs_f64());
-    let after = String::from_utf8_lossy(&sim.uart_bytes()[seen..]).into_owned();
+    let after = sim.uart_text_from(seen);
     assert!(!after.contains("read failed"), "{after}");
     no_motion(&sim);
     assert_ram_budget(&sim);

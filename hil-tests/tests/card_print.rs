@@ -68,10 +68,6 @@ fn print_ends_drawn(sim: &mut Sim, machine: Machine, d: &Drawing, within: f64) {
     assert_drawn_from_the_pulses(sim, machine, d, within);
 }
 
-fn since(sim: &Sim, from: usize) -> String {
-    String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned()
-}
-
 #[test]
 fn m20_lists_m23_selects_by_long_name_and_m24_prints_the_drawing() {
     let d = drawing(PenWords::Unicorn, home(FLATBED), 10.0, 10.0);
@@ -79,7 +75,7 @@ fn m20_lists_m23_selects_by_long_name_and_m24_prints_the_drawing() {
     let mut sim = flatbed_with(&[("star drawing.gcode", &bytes), ("NOTES.TXT", b"hello")]);
     let from = sim.uart_bytes().len();
     send(&mut sim, "M20");
-    let list = since(&sim, from);
+    let list = sim.uart_text_from(from);
     // `NAME.EXT size long name`, the long name only where it differs.
     let star = format!("\nSTARDR~1.GCO {} star drawing.gcode\n", bytes.len());
     for line in [
@@ -97,7 +93,7 @@ fn m20_lists_m23_selects_by_long_name_and_m24_prints_the_drawing() {
     assert_eq!(error(&mut sim, "M24").split(' ').next(), Some("error:76"));
     let from = sim.uart_bytes().len();
     send(&mut sim, "M23 STAR DRAWING.GCODE");
-    assert!(since(&sim, from).contains(&format!(
+    assert!(sim.uart_text_from(from).contains(&format!(
         "File opened: star drawing.gcode Size: {}\nFile selected\n",
         bytes.len()
     )));
@@ -120,9 +116,9 @@ fn m20_lists_m23_selects_by_long_name_and_m24_prints_the_drawing() {
     let from = sim.uart_bytes().len();
     send(&mut sim, "M27");
     assert!(
-        since(&sim, from).contains("SD printing byte "),
+        sim.uart_text_from(from).contains("SD printing byte "),
         "{}",
-        since(&sim, from)
+        sim.uart_text_from(from)
     );
     wait_for(&mut sim, "Done printing file", Duration::from_secs(60));
     send(&mut sim, "M400");
@@ -138,7 +134,7 @@ fn m20_lists_m23_selects_by_long_name_and_m24_prints_the_drawing() {
     assert_drawn_from_the_pulses(&sim, FLATBED, &d, WITHIN);
     let from = sim.uart_bytes().len();
     send(&mut sim, "M27");
-    assert!(since(&sim, from).contains("Not SD printing"));
+    assert!(sim.uart_text_from(from).contains("Not SD printing"));
 }
 
 #[test]
@@ -189,7 +185,7 @@ fn the_green_button_prints_the_first_gcode_file_and_a_pulled_card_loses_no_line(
     send(&mut sim, "M23 plot.nc");
     send(&mut sim, "M24");
     print_ends_drawn(&mut sim, FLATBED, &d, WITHIN);
-    let again = since(&sim, from);
+    let again = sim.uart_text_from(from);
     assert!(!again.contains("print goes on"), "{again}");
     // Its M117 line (line 3) is met again: the file was read from the top.
     assert!(again.contains("PLOT.NC:3:1: error:20 "), "{again}");
@@ -356,7 +352,7 @@ fn a_plotter_card_s_machine_txt_switches_the_machine_and_keeps_it() {
     wait_for(&mut sim, "reset:", Duration::from_millis(50));
     let from = sim.uart_bytes().len();
     send(&mut sim, "$$");
-    let settings = since(&sim, from);
+    let settings = sim.uart_text_from(from);
     for s in [
         "$machine=whiteboard\n",
         "$pen_settle_ms=200\n",

@@ -10,7 +10,16 @@ use std::time::Duration;
 fn send(sim: &mut Sim, line: &str) -> String {
     let from = sim.uart_bytes().len();
     send_ok(sim, line, Duration::from_secs(2));
-    String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned()
+    sim.uart_text_from(from)
+}
+
+/// What the firmware sends in the `ms` after `bytes` (real-time bytes,
+/// not lines: nothing waits for an `ok`).
+fn bytes_then(sim: &mut Sim, bytes: &[u8], ms: u64) -> String {
+    let from = sim.uart_bytes().len();
+    sim.uart_send(bytes);
+    sim.run_for(Duration::from_millis(ms));
+    sim.uart_text_from(from)
 }
 
 /// The reply lines of a command, its `ok` included: no log lines, nor the
@@ -73,10 +82,7 @@ fn banner_build_info_parser_state_offsets_and_status_in_grbl_formats() {
     ];
     assert_eq!(replies(&offsets), expected);
     // The buffer state: every planner block and receive byte free.
-    let from = sim.uart_bytes().len();
-    sim.uart_send(b"?");
-    sim.run_for(Duration::from_millis(20));
-    let report = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
+    let report = bytes_then(&mut sim, b"?", 20);
     assert_eq!(
         report,
         "<Idle|MPos:0.000,0.000,0.000|Bf:13,128>\n",
@@ -84,10 +90,7 @@ fn banner_build_info_parser_state_offsets_and_status_in_grbl_formats() {
         log_tail(&sim)
     );
     // Ctrl-X: the banner again, as after a power-on.
-    let from = sim.uart_bytes().len();
-    sim.uart_send(&[0x18]);
-    sim.run_for(Duration::from_millis(20));
-    let after = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
+    let after = bytes_then(&mut sim, &[0x18], 20);
     assert!(after.contains("Grbl 1.1h ['$' for help]\n"), "{after}");
 }
 
@@ -100,10 +103,7 @@ fn a_reset_in_motion_is_grbl_s_alarm_3_and_x_unlocks_it() {
     send(&mut sim, "M17");
     sim.uart_send(b"G0 C90\n");
     sim.run_for(Duration::from_millis(300));
-    let from = sim.uart_bytes().len();
-    sim.uart_send(&[0x18]);
-    sim.run_for(Duration::from_millis(30));
-    let after = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
+    let after = bytes_then(&mut sim, &[0x18], 30);
     let lines: Vec<&str> = after.lines().collect();
     assert_eq!(
         lines[..2],
@@ -114,10 +114,7 @@ fn a_reset_in_motion_is_grbl_s_alarm_3_and_x_unlocks_it() {
         lines[2].ends_with("position unknown until G92, $X or zeroing]"),
         "{after}"
     );
-    let from = sim.uart_bytes().len();
-    sim.uart_send(b"?");
-    sim.run_for(Duration::from_millis(20));
-    assert!(String::from_utf8_lossy(&sim.uart_bytes()[from..]).starts_with("<Alarm|"));
+    assert!(bytes_then(&mut sim, b"?", 20).starts_with("<Alarm|"));
     assert_eq!(
         replies(&send(&mut sim, "$X")),
         ["[MSG:Caution: Unlocked]", "ok"]
@@ -141,10 +138,7 @@ fn override_and_door_bytes_never_spoil_a_line() {
     sim.run_for(Duration::from_millis(200));
     sim.uart_send(&[0x84]);
     sim.run_for(Duration::from_millis(1500));
-    let from = sim.uart_bytes().len();
-    sim.uart_send(b"?");
-    sim.run_for(Duration::from_millis(20));
-    let report = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
+    let report = bytes_then(&mut sim, b"?", 20);
     assert!(report.starts_with("<Hold:0|"), "{report}");
     sim.uart_send(b"~");
     send(&mut sim, "M400");

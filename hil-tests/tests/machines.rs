@@ -68,7 +68,7 @@ fn a_plotter_pauses_at_m0_and_takes_inches() {
         let start = sim.uart_bytes().len();
         sim.uart_send(b"?");
         sim.run_for(Duration::from_millis(20));
-        String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned()
+        sim.uart_text_from(start)
     };
     sim.run_for(Duration::from_secs(2));
     assert!(status(&mut sim).contains("<Hold:0|"), "{}", log_tail(&sim));
@@ -223,9 +223,7 @@ fn seed_001_test_patterns_draw_and_end_where_they_began() {
     let start = sim.uart_bytes().len();
     send(&mut sim, "$T7");
     send(&mut sim, "M400");
-    let replies = String::from_utf8_lossy(&sim.uart_bytes()[start..])
-        .matches("ok\n")
-        .count();
+    let replies = sim.uart_text_from(start).matches("ok\n").count();
     assert_eq!(replies, 2, "one ok for the pattern, one for M400");
     let path = &track(&sim)[from..];
     let at = |x: f64, y: f64| [(x * 40.0).round() as i64, (y * 40.0).round() as i64];

@@ -43,7 +43,7 @@ fn status(sim: &mut Sim) -> (String, f64) {
     let mut first = None;
     let done = sim.run_until(
         |s| {
-            let text = String::from_utf8_lossy(&s.uart_bytes()[start..]).into_owned();
+            let text = s.uart_text_from(start);
             if first.is_none() && text.contains('<') {
                 first = Some(s.time_s());
             }
@@ -52,7 +52,7 @@ fn status(sim: &mut Sim) -> (String, f64) {
         Duration::from_millis(100),
     );
     assert_eq!(done, hil_tests::sim::Outcome::Done, "{}", log_tail(sim));
-    let text = String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned();
+    let text = sim.uart_text_from(start);
     let report = text
         .lines()
         .find(|l| l.starts_with('<'))
@@ -307,7 +307,7 @@ fn refused_settings_say_why_and_long_replies_are_whole() {
     send(&mut sim, "G92 C-999999 X-999999 Z-999999");
     let start = sim.uart_bytes().len();
     send(&mut sim, "M114");
-    let text = String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned();
+    let text = sim.uart_text_from(start);
     assert!(
         text.starts_with("C:-999999.000 X:-999999.000 Z:-999999.000 Count C:-26666640 X:-31999968 Z:-133333200\nok\n"),
         "{text:?}"

@@ -127,7 +127,7 @@ fn grbl_streamer_streams_2000_lines_counting_characters_and_the_pulses_follow() 
     if !out.status.success() {
         let from = sim.uart_bytes().len();
         let _ = sim.send_line("$Q", Duration::from_secs(1));
-        let queues = String::from_utf8_lossy(&sim.uart_bytes()[from..]).into_owned();
+        let queues = sim.uart_text_from(from);
         panic!("{said}\n{queues}");
     }
     eprintln!("{}", said.trim());

@@ -28,7 +28,7 @@ fn power_on(eeprom: &[u8]) -> Sim {
 fn listed(sim: &mut Sim, name: &str) -> String {
     let start = sim.uart_bytes().len();
     send(sim, "$$");
-    let text = String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned();
+    let text = sim.uart_text_from(start);
     let prefix = format!("${name}=");
     text.lines()
         .find_map(|l| l.strip_prefix(&prefix))

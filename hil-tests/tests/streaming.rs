@@ -51,7 +51,7 @@ fn stream(sim: &mut Sim, lines: &[String], status_every: Option<Duration>) -> f6
                     next_status = sim.time_s() + every.as_secs_f64();
                 }
             }
-            let text = String::from_utf8_lossy(&sim.uart_bytes()[start..]).into_owned();
+            let text = sim.uart_text_from(start);
             let mut complete = text
                 .split_inclusive('\n')
                 .filter_map(|l| l.strip_suffix('\n'));

@@ -18,6 +18,11 @@ impl Sim {
         String::from_utf8_lossy(self.uart_bytes()).into_owned()
     }
 
+    /// The bytes transmitted from byte `from` on, as text.
+    pub fn uart_text_from(&self, from: usize) -> String {
+        String::from_utf8_lossy(&self.uart_bytes()[from..]).into_owned()
+    }
+
     /// The transmitted text, clearing the capture.
     pub fn take_uart(&mut self) -> String {
         let bytes = std::mem::take(&mut self.shared_mut().uart.tx);
