@@ -17,6 +17,7 @@ mod input;
 mod masked;
 pub mod operator;
 mod outcome;
+pub mod profile;
 pub mod picture;
 pub mod probe;
 pub mod pty;

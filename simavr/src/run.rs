@@ -134,6 +134,9 @@ impl Sim {
             self.resets += 1;
             return Some(Outcome::WatchdogReset { count: self.resets });
         }
+        if let Some(profile) = &mut self.profile {
+            profile.add(pc_before, cycle - self.last_avr_cycle);
+        }
         self.last_avr_cycle = cycle;
         let now = self.shared().cycle_base + cycle;
         self.masked.observe(now, pc, interrupts_on);

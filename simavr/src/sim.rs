@@ -78,6 +78,8 @@ pub struct Sim {
     pub(crate) last_speed: Option<(u64, Duration)>,
     /// Interrupts-masked spans: the open one, and the longest so far.
     pub(crate) masked: MaskedSpans,
+    /// Cycles per program word, when asked for ([`Sim::enable_profile`]).
+    pub(crate) profile: Option<crate::profile::Profile>,
 }
 
 impl Sim {
@@ -184,6 +186,7 @@ impl Sim {
             step_dir: Vec::new(),
             last_speed: None,
             masked: MaskedSpans::default(),
+            profile: None,
         }
     }
 
@@ -195,6 +198,16 @@ impl Sim {
     pub(crate) fn shared_mut(&mut self) -> &mut Shared {
         // SAFETY: as `shared`; `&mut self` makes this the only reference.
         unsafe { self.shared.as_mut() }
+    }
+
+    /// Counts from now on the cycles spent at each program address.
+    pub fn enable_profile(&mut self) {
+        self.profile.get_or_insert_with(Default::default);
+    }
+
+    /// The cycle counts, if [`Sim::enable_profile`] was called.
+    pub fn profile(&self) -> Option<&crate::profile::Profile> {
+        self.profile.as_ref()
     }
 
     /// Section sizes and end of statics, when loaded from an ELF.

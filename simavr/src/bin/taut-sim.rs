@@ -77,6 +77,7 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                   for senders and terminals, in real time; runs until
                   --for SECONDS, or SIGINT / SIGTERM, then writes the VCD,
                   the picture and the report as any run does
+  --profile N     print the N functions the MCU spent the most cycles in
   --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
   --eeprom FILE   the EEPROM's contents (settings): loaded at power-on if the
                   file exists, saved when the run ends (a power cycle keeps
@@ -107,6 +108,8 @@ struct Args {
     auto_confirm: bool,
     /// `--pty`, and the link to make, if any.
     pty: Option<Option<PathBuf>>,
+    /// `--profile N`: the top N functions by cycles.
+    profile: Option<usize>,
 }
 
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
@@ -130,6 +133,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         echo: false,
         auto_confirm: false,
         pty: None,
+        profile: None,
     };
     let mut it = it.peekable();
     while let Some(a) = it.next() {
@@ -163,6 +167,9 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                 args.pty = Some(link);
             }
             "--auto-confirm" => args.auto_confirm = true,
+            "--profile" => {
+                args.profile = Some(value()?.parse().map_err(|_| "--profile N")?);
+            }
             _ => return Err(format!("unknown option {a}")),
         }
     }
@@ -266,6 +273,9 @@ fn put_card(sim: &mut Sim, path: &Path, args: &Args) -> Result<Option<Vec<u8>>, 
 
 fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     let mut sim = Sim::load(&args.elf)?;
+    if args.profile.is_some() {
+        sim.enable_profile();
+    }
     if let Some(path) = args.eeprom.as_ref().filter(|p| p.exists()) {
         sim.set_eeprom(&std::fs::read(path)?);
     }
@@ -385,6 +395,15 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
             s.moves_while_plunged
         );
         picture = Some(serde_json::to_value(&s)?);
+    }
+    if let (Some(n), Some(profile)) = (args.profile, sim.profile()) {
+        let by_function = profile.by_function(&args.elf)?;
+        let total: u64 = by_function.iter().map(|(c, _)| c).sum();
+        eprintln!("taut-sim: cycles by function ({total} in all)");
+        for (cycles, name) in by_function.iter().take(n) {
+            let share = 100.0 * *cycles as f64 / total.max(1) as f64;
+            eprintln!("{share:6.2} % {cycles:>12} {name}");
+        }
     }
     if let Some(path) = &args.report {
         let mut report = serde_json::to_value(sim.report(outcome))?;
