@@ -135,6 +135,7 @@ impl Console {
     }
 
     /// Read and carry out input until it runs out or must wait.
+    #[optimize(speed)]
     pub fn poll(
         &mut self,
         m: &mut Motion,
@@ -215,6 +216,7 @@ impl Console {
     /// bytes ran out. Out of line: the parser's copies of a line stay off
     /// the frame that plans and cuts moves.
     #[inline(never)]
+    #[optimize(speed)]
     fn read(
         &mut self,
         m: &mut Motion,
@@ -359,6 +361,7 @@ impl Console {
     }
 
     /// Carry out an order; `Some(wait)` when it cannot run yet.
+    #[optimize(speed)]
     fn carry_out(
         &mut self,
         order: &Order,
@@ -534,6 +537,7 @@ impl Console {
     /// Queue the path's next piece; `ok` once the last one is queued. Out
     /// of line: its copy of the path stays off the console's frame.
     #[inline(never)]
+    #[optimize(speed)]
     fn next_piece(&mut self, m: &mut Motion, kin: &impl Kinematics) -> Poll<Signal> {
         let Some(Pending::Path { path, feed }) = self.pending.as_mut() else {
             return Poll::Again;
@@ -754,6 +758,7 @@ fn serial_line_waits() -> bool {
 /// One byte into the parser. Out of line: its copies of the line being
 /// finished are gone before the line is carried out.
 #[inline(never)]
+#[optimize(speed)]
 fn parse(parser: &mut Parser, byte: u8) -> Option<Result<Input, Error>> {
     parser.push(byte)
 }

@@ -327,6 +327,7 @@ fn timers() {
 }
 
 #[inline(never)]
+#[optimize(speed)]
 fn motion() {
     /// Pieces of work per run (a block's profile or a segment, up to ~4 ms
     /// each): one keeps `?` answered in 10 ms.
@@ -355,6 +356,7 @@ fn refill_task() -> Task {
 }
 
 #[inline(never)]
+#[optimize(speed)]
 fn console() {
     let owner = match JOB.with(|j| j.owns_motion()) {
         true => Owner::Job,
@@ -389,6 +391,7 @@ fn console() {
 /// Real-time commands, in the order that makes sense when several came
 /// together: reset, hold, resume, status.
 #[inline(never)]
+#[optimize(speed)]
 fn realtime() {
     let r = Requests::take();
     MOTION.with(|m| {
@@ -550,6 +553,7 @@ fn led() {
 // take the assembly fast path (`stepper::fast`), all others this handler.
 step_vector!(timer3_compa);
 
+#[optimize(speed)]
 extern "avr-interrupt" fn timer3_compa() {
     if stepper::on_compare() {
         spawn_from_isr(&SPAWNED, refill_task() as u8);
@@ -562,6 +566,7 @@ nested_vector!(__vector_25, usart0_rx, reg = "0xC1", keep = "0x7F"); // USART0_R
 nested_vector!(__vector_26, usart0_udre, reg = "0xC1", keep = "0xDF"); // USART0_UDRE: UDRIE0
 const _: () = assert!(usart::UCSR0B == 0xC1 && !0x7Fu8 == 1 << RXCIE0 && !0xDFu8 == 1 << UDRIE0);
 
+#[optimize(speed)]
 extern "avr-interrupt" fn timer0_compa() {
     if clock::tick() {
         spawn_from_isr(&SPAWNED, Task::Timers as u8);
@@ -579,6 +584,7 @@ extern "avr-interrupt" fn timer0_compa() {
     }
 }
 
+#[optimize(speed)]
 extern "avr-interrupt" fn usart0_rx() {
     let task = match usart::on_receive(realtime::on_receive) {
         true => Task::Realtime,
@@ -587,6 +593,7 @@ extern "avr-interrupt" fn usart0_rx() {
     spawn_from_isr(&SPAWNED, task as u8);
 }
 
+#[optimize(speed)]
 extern "avr-interrupt" fn usart0_udre() {
     usart::on_data_register_empty();
 }

@@ -99,6 +99,7 @@ impl Motion {
     }
 
     /// Queue a move to the absolute step `target`; `Full` is back-pressure.
+    #[optimize(speed)]
     pub fn push(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
         let from = self.target();
         PLANNER.with(|p| p.push(target, feed))?;

@@ -88,6 +88,7 @@ pub fn status_later() {
 /// position as the pulses left it, in the machine's units, and the free
 /// planner blocks and receive bytes (Grbl 1.1's status report);
 /// `homing`: the console runs a homing cycle (`Home`).
+#[optimize(speed)]
 pub fn status(m: &Motion, kin: &impl Kinematics, homing: bool) {
     let mut r = reply::line();
     let state = match m.state() {

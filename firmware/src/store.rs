@@ -65,10 +65,7 @@ impl Store {
         if self.eeprom.busy() {
             return Poll::After(4);
         }
-        let differs = image::bytes(cfg)
-            .enumerate()
-            .find(|&(i, b)| self.eeprom.read(i as u16) != b);
-        match differs {
+        match image::first_difference(cfg, |i| self.eeprom.read(i as u16)) {
             Some((i, b)) => {
                 self.eeprom.start_write(i as u16, b);
                 Poll::After(4)

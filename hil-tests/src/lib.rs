@@ -108,7 +108,8 @@ pub fn assert_ram_budget(sim: &sim::Sim) {
     let stack = sim.peak_stack_bytes() as u32;
     assert!(
         statics + stack < RAM_BUDGET,
-        "static {statics} B + stack {stack} B"
+        "static {statics} B + stack {stack} B (deepest at {:#x})",
+        sim.peak_stack_pc()
     );
 }
 

@@ -183,8 +183,13 @@ fn random_moves_and_feeds_from_seeds() {
 #[test]
 fn tiny_moves_with_status_reports() {
     let (lines, expected) = radial_pieces(0.1, 5000);
+    let mut sim = boot_enabled();
+    // The greeting and the start-up log (≈ 250 bytes, 22 ms at 115200 baud)
+    // go out first: a report can only follow bytes already queued, and
+    // this measures the stream, not the boot.
+    sim.run_for(Duration::from_millis(100));
     check_stream(
-        &mut boot_enabled(),
+        &mut sim,
         &lines,
         Some(Duration::from_millis(50)),
         expected,

@@ -12,6 +12,7 @@ use crate::files::error::{FileError, FileName};
 use crate::files::kv::{Item, KvReader};
 use crate::text::num::{parse_fixed, parse_u32, NumError};
 use crate::text::ErrorKind;
+use taut_progmem::{text, Text};
 
 /// Most corners of a polygonal board.
 pub const MAX_SHAPE: u16 = 1000;
@@ -48,16 +49,27 @@ pub fn radius_limit_um(shape: u16) -> u32 {
     NAIL_MARGIN_UM + (INNER_CLEARANCE_UM as f32 / apothem_ratio) as u32
 }
 
-/// Names a key may have: the original's first, as `missing key` prints them.
-const KEYS: [(&str, &str, &str); 3] = [
-    ("tvar", "shape", "tvar (shape)"),
-    ("pocet_hrebiku", "nails", "pocet_hrebiku (nails)"),
-    (
-        "polomer_matrice",
-        "radius_cm",
-        "polomer_matrice (radius_cm)",
-    ),
-];
+/// Names key `i` may have: the original's, its English alias, and both as
+/// `missing key` prints them. Built by code from texts in flash: a table
+/// would sit in the AVR's SRAM (130 bytes as strings).
+fn key_names(i: usize) -> [Text; 3] {
+    match i {
+        0 => [text!("tvar"), text!("shape"), text!("tvar (shape)")],
+        1 => [
+            text!("pocet_hrebiku"),
+            text!("nails"),
+            text!("pocet_hrebiku (nails)"),
+        ],
+        _ => [
+            text!("polomer_matrice"),
+            text!("radius_cm"),
+            text!("polomer_matrice (radius_cm)"),
+        ],
+    }
+}
+
+/// Number of keys.
+const KEYS: usize = 3;
 
 /// Values seen so far, by the index of their key in [`KEYS`].
 #[derive(Default)]
@@ -108,7 +120,7 @@ impl ParamFile {
         if !seen.lines {
             return Err(FileError::whole(FILE, ErrorKind::Empty));
         }
-        let missing = |key: usize| FileError::whole(FILE, ErrorKind::MissingKey(KEYS[key].2));
+        let missing = |key: usize| FileError::whole(FILE, ErrorKind::MissingKey(key_names(key)[2]));
         let shape = seen.shape.ok_or(missing(0))?;
         let nails = seen.nails.ok_or(missing(1))?;
         let (radius_um, line, col) = seen.radius.ok_or(missing(2))?;
@@ -129,11 +141,10 @@ impl Seen {
     fn take(&mut self, item: Item<'_>) -> Result<(), FileError> {
         self.lines = true;
         let at = |col, kind| FileError::at(FILE, item.line, col, kind);
-        let key = KEYS
-            .iter()
-            .position(|k| {
-                item.key.eq_ignore_ascii_case(k.0.as_bytes())
-                    || item.key.eq_ignore_ascii_case(k.1.as_bytes())
+        let key = (0..KEYS)
+            .find(|&k| {
+                let [name, alias, _] = key_names(k);
+                name.eq_ignore_ascii_case(item.key) || alias.eq_ignore_ascii_case(item.key)
             })
             .ok_or(at(item.key_col, ErrorKind::UnknownKey))?;
         let already = match key {
@@ -358,7 +369,7 @@ mod tests {
             ];
             let mut text = String::new();
             for k in order {
-                let key = if english { KEYS[k].1 } else { KEYS[k].0 };
+                let key = key_names(k)[usize::from(english)];
                 text += &std::format!("{key} = {}{}", values[k], if crlf { "\r\n" } else { "\n" });
             }
             let result = parse_in_chunks(text.as_bytes(), chunk);

@@ -232,23 +232,21 @@ impl Trapezoid {
 
 /// Integer square root, rounded down. Written for the AVR, where `u64`
 /// arithmetic is a library call: a 32-bit digit-by-digit root of the top
-/// half gives 16 good bits, one Newton step (one `u64 / u32` division)
-/// doubles them, and a final check fixes the last unit.
+/// half gives 16 good bits, one Newton step (one `u64` division) doubles
+/// them. Newton from above never lands below the floor root, so at most a
+/// step down is left to check, with one plain square: the root is below
+/// 2^32, so it cannot overflow (checked squares cost a 128-bit product).
 pub fn isqrt(x: u64) -> u64 {
     if x <= u32::MAX as u64 {
         return isqrt32(x as u32) as u64;
     }
     // x ≥ 2^32: shift right by the even amount that leaves 31–32 bits.
     let shift = (33 - x.leading_zeros()) & !1;
-    let r0 = (isqrt32((x >> shift) as u32) as u64) << (shift / 2);
-    // r0 ≤ √x < r0 + 2^(shift/2): Newton from above converges downwards.
-    let r0 = r0 + (1u64 << (shift / 2));
+    // r0 ≤ √x < r0 + 2^(shift/2): start from the upper end, ≤ 2^32.
+    let r0 = ((isqrt32((x >> shift) as u32) as u64) + 1) << (shift / 2);
     let mut r = (r0 + x / r0) / 2;
-    while r.checked_mul(r).is_none_or(|sq| sq > x) {
+    while r * r > x {
         r -= 1;
-    }
-    while (r + 1).checked_mul(r + 1).is_some_and(|sq| sq <= x) {
-        r += 1;
     }
     r
 }

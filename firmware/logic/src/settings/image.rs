@@ -66,9 +66,50 @@ pub fn bytes(cfg: &MachineConfig) -> impl Iterator<Item = u8> + '_ {
     })
 }
 
+/// The first byte of `cfg`'s image that differs from what `read(i)` holds
+/// at byte `i`, and its new value; `None` when they agree. What [`bytes`]
+/// gives, in plain loops: the settings task looks for one byte to write
+/// per run, and the iterator chain took ~11 ms a run on the AVR.
+pub fn first_difference(cfg: &MachineConfig, read: impl Fn(usize) -> u8) -> Option<(usize, u8)> {
+    let mut sum = Fletcher::new();
+    let mut at = 0;
+    let mut differs = |b: u8, sum: &mut Fletcher| {
+        let i = at;
+        at += 1;
+        sum.add(b);
+        (read(i) != b).then_some((i, b))
+    };
+    for b in MAGIC.into_iter().chain([VERSION]) {
+        if let Some(d) = differs(b, &mut sum) {
+            return Some(d);
+        }
+    }
+    for s in all() {
+        let (buf, n) = value_array(s.get(cfg));
+        for &b in &buf[..n] {
+            if let Some(d) = differs(b, &mut sum) {
+                return Some(d);
+            }
+        }
+    }
+    let mut tail = Fletcher::new();
+    for b in sum.value().to_le_bytes() {
+        if let Some(d) = differs(b, &mut tail) {
+            return Some(d);
+        }
+    }
+    None
+}
+
 /// Value bytes: up to 8, the unused ones skipped.
 fn value_bytes(v: Value) -> impl Iterator<Item = u8> {
-    let (buf, n) = match v {
+    let (buf, n) = value_array(v);
+    buf.into_iter().take(n)
+}
+
+/// A value's bytes and how many of them count.
+fn value_array(v: Value) -> ([u8; 8], usize) {
+    match v {
         Value::Number(n) => (widen(n.to_le_bytes()), 4),
         Value::Milli(m) => (widen(m.0.to_le_bytes()), 4),
         Value::Machine(m) => (widen((m as u32).to_le_bytes()), 4),
@@ -78,8 +119,7 @@ fn value_bytes(v: Value) -> impl Iterator<Item = u8> {
             b[4..].copy_from_slice(&r.den.to_le_bytes());
             (b, 8)
         }
-    };
-    buf.into_iter().take(n)
+    }
 }
 
 fn widen(b: [u8; 4]) -> [u8; 8] {
@@ -138,9 +178,17 @@ impl Fletcher {
         Fletcher { a: 0, b: 0 }
     }
 
+    /// Both sums stay below 255, so one subtraction reduces them (a `%`
+    /// is a 16-bit division on the AVR, twice a byte).
     fn add(&mut self, x: u8) {
-        self.a = (self.a + x as u16) % 255;
-        self.b = (self.b + self.a) % 255;
+        self.a += x as u16;
+        if self.a >= 255 {
+            self.a -= 255;
+        }
+        self.b += self.a;
+        if self.b >= 255 {
+            self.b -= 255;
+        }
     }
 
     fn value(&self) -> u16 {

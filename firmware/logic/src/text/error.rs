@@ -21,7 +21,7 @@ pub enum ErrorKind {
     UnknownMachine,
     DuplicateKey,
     /// A required key never appeared; carries its names as `name/alias`.
-    MissingKey(&'static str),
+    MissingKey(taut_progmem::Text),
     NotANumber,
     /// More digits than the value's type holds.
     TooBig,

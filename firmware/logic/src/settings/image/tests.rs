@@ -1,5 +1,6 @@
 use super::*;
 use crate::settings::set;
+use std::vec;
 use std::vec::Vec;
 
 const BASE: MachineConfig = MachineConfig::STRING_ART;
@@ -81,4 +82,44 @@ fn the_machine_and_its_geometry_are_kept() {
     img[..n - 2].iter().for_each(|&b| sum.add(b));
     img[n - 2..].copy_from_slice(&sum.value().to_le_bytes());
     assert!(matches!(read(&img), Err(Unusable::Refused(_))));
+}
+
+/// What `bytes` says differs first, the slow way.
+fn first_difference_by_bytes(cfg: &MachineConfig, eeprom: &[u8]) -> Option<(usize, u8)> {
+    bytes(cfg).enumerate().find(|&(i, b)| eeprom[i] != b)
+}
+
+#[test]
+fn the_first_difference_is_the_image_s_and_writing_it_converges() {
+    use crate::machine::Machine;
+    let mut tuned = BASE;
+    set(&mut tuned, "base_max_rate", "1500").unwrap();
+    set(&mut tuned, "step_pulse_us", "7").unwrap();
+    let configs: Vec<MachineConfig> = Machine::ALL
+        .into_iter()
+        .map(MachineConfig::defaults)
+        .chain([tuned])
+        .collect();
+    for cfg in &configs {
+        let mut eeproms = vec![vec![0xFF; len()], image(&BASE), image(cfg)];
+        for i in 0..len() {
+            let mut flipped = image(cfg);
+            flipped[i] ^= 0x41;
+            eeproms.push(flipped);
+        }
+        for mut eeprom in eeproms {
+            assert_eq!(
+                first_difference(cfg, |i| eeprom[i]),
+                first_difference_by_bytes(cfg, &eeprom)
+            );
+            // The settings task: one byte a run until they agree.
+            let mut writes = 0;
+            while let Some((i, b)) = first_difference(cfg, |i| eeprom[i]) {
+                eeprom[i] = b;
+                writes += 1;
+                assert!(writes <= len(), "never converges");
+            }
+            assert_eq!(eeprom, image(cfg));
+        }
+    }
 }
