@@ -59,7 +59,7 @@ let serverLog = '';
 const server = spawn(
   process.execPath,
   [path.join(modules, 'cncjs/bin/cncjs'), '--host', '127.0.0.1', '--port', '0', '--config', config, '--controller', 'Grbl'],
-  { stdio: ['ignore', 'pipe', 'pipe'], env: { ...process.env, FORCE_COLOR: '0', NO_COLOR: '1' } },
+  { stdio: ['ignore', 'pipe', 'pipe'] },
 );
 let socket = null;
 let finished = false;

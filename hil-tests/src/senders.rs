@@ -17,7 +17,9 @@ pub fn clients_dir() -> PathBuf {
 
 /// A client script of `hil-tests/clients/`.
 pub fn client_script(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("clients").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("clients")
+        .join(name)
 }
 
 /// A flatbed's random walk of `n` short moves (0.2–1 mm, 40 steps/mm)

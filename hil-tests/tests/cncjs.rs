@@ -20,15 +20,13 @@ use std::time::{Duration, Instant};
 const CNCJS_VERSION: &str = "1.11.5";
 
 /// CNCjs installed under `target/clients/cncjs` (npm, the pinned
-/// version), the first time (said on stderr); its prefix.
+/// version), the first time (said on stderr); its prefix. A marker written
+/// after npm succeeded tells a whole install from an interrupted one.
+/// `--prefer-offline`: what npm's cache holds is not asked for again.
 fn cncjs_prefix() -> PathBuf {
     let prefix = clients_dir().join("cncjs");
-    let manifest = prefix.join("node_modules/cncjs/package.json");
-    let installed = || {
-        std::fs::read_to_string(&manifest)
-            .is_ok_and(|m| m.contains(&format!("\"version\": \"{CNCJS_VERSION}\"")))
-    };
-    if !installed() {
+    let marker = prefix.join(format!("installed-{CNCJS_VERSION}"));
+    if !marker.exists() {
         let spec = format!("cncjs@{CNCJS_VERSION}");
         eprintln!("installing {spec} into {}", prefix.display());
         let started = Instant::now();
@@ -37,6 +35,7 @@ fn cncjs_prefix() -> PathBuf {
             .arg(&prefix)
             .args([
                 "--save-exact",
+                "--prefer-offline",
                 "--no-audit",
                 "--no-fund",
                 "--loglevel=error",
@@ -44,8 +43,17 @@ fn cncjs_prefix() -> PathBuf {
             ])
             .status()
             .is_ok_and(|s| s.success());
-        assert!(ok && installed(), "could not install {spec} (npm, node)");
-        eprintln!("installed {spec} in {:.0?}", started.elapsed());
+        let manifest = prefix.join("node_modules/cncjs/package.json");
+        let version = std::fs::read_to_string(manifest).unwrap_or_default();
+        assert!(
+            ok && version.contains(&format!("\"version\": \"{CNCJS_VERSION}\"")),
+            "could not install {spec} (npm)"
+        );
+        std::fs::write(&marker, "").unwrap();
+        eprintln!(
+            "installed {spec} in {:.1} s",
+            started.elapsed().as_secs_f64()
+        );
     }
     prefix
 }
@@ -71,6 +79,9 @@ struct InFlight {
     line: usize,
     bytes: usize,
     max: usize,
+    /// The sum and count of the figures seen while lines were in flight.
+    sum: usize,
+    samples: usize,
     answers: Vec<u8>,
 }
 
@@ -93,6 +104,10 @@ impl InFlight {
             }
         }
         self.max = self.max.max(self.bytes + self.line);
+        if self.bytes > 0 {
+            self.sum += self.bytes;
+            self.samples += 1;
+        }
     }
 
     fn read(&mut self, out: &[u8]) {
@@ -141,7 +156,10 @@ fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
         if seen.hold_sent.is_none() && wrote.contains(&b'!') {
             seen.hold_sent = Some(at);
             uart_seen = sim.uart_bytes().len();
-        } else if seen.hold_reported.is_some() && seen.resume_sent.is_none() && wrote.contains(&b'~') {
+        } else if seen.hold_reported.is_some()
+            && seen.resume_sent.is_none()
+            && wrote.contains(&b'~')
+        {
             seen.resume_sent = Some(at);
         }
         if seen.hold_sent.is_some() && seen.hold_reported.is_none() {
@@ -154,7 +172,11 @@ fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
     std::fs::remove_file(&file).unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     let said = stdout.clone() + &String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{said}\n{}", hil_tests::log_tail(&sim));
+    assert!(
+        out.status.success(),
+        "{said}\n{}",
+        hil_tests::log_tail(&sim)
+    );
     if std::env::var_os("TAUT_CNCJS_LOG").is_some() {
         eprintln!("{said}");
     }
@@ -214,7 +236,7 @@ fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
     let cycles: Vec<u64> = track(&sim).iter().map(|(c, _)| *c).collect();
     let between = |from: u64, to: u64| cycles.iter().filter(|&&c| from <= c && c < to).count();
     let ms = |c: u64| c as f64 / 16e3;
-    let before = between(hold_sent.saturating_sub(16_000_000 / 10), hold_sent);
+    let before = between(hold_sent.saturating_sub(16_000_000 / 2), hold_sent);
     let slowing = between(hold_sent, hold_reported);
     let held = between(hold_reported, resume_sent);
     let after = between(resume_sent, resume_sent + 16_000_000 / 10);
@@ -225,7 +247,7 @@ fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
         ms(hold_reported - hold_sent),
         ms(resume_sent - hold_reported),
     );
-    assert!(before > 0, "no pulses in the 100 ms before the hold");
+    assert!(before > 0, "no pulses in the 500 ms before the hold");
     assert!(
         resume_sent - hold_reported > 16_000_000 / 2,
         "held for {:.0} ms only",
@@ -239,7 +261,9 @@ fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
 
     // What CNCjs wrote besides the job: on connecting, then its polls.
     let rx = String::from_utf8_lossy(&rx);
-    let job_at = rx.find(&format!("{}\n", lines[0])).expect("the job's first line");
+    let job_at = rx
+        .find(&format!("{}\n", lines[0]))
+        .expect("the job's first line");
     let count = |what: &str| rx.matches(what).count();
     eprintln!(
         "CNCjs wrote before the job {:?}; in all {} `?`, {} `$G`, {} `$$`",
@@ -260,7 +284,11 @@ fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
     // Its Reset at the end: the banner, from which it took the version.
     assert_eq!(of("version"), ["1.1h"], "{said}");
     // Character counting, against the receive buffer.
-    eprintln!("CNCjs had at most {} bytes of lines unanswered", in_flight.max);
+    eprintln!(
+        "CNCjs had at most {} bytes of lines unanswered ({} on average)",
+        in_flight.max,
+        in_flight.sum / in_flight.samples.max(1)
+    );
     assert!(
         (64..=128).contains(&in_flight.max),
         "at most {} bytes in flight",
