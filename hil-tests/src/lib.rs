@@ -9,6 +9,7 @@ use std::sync::Once;
 pub use taut_simavr as sim;
 
 pub mod drawing;
+pub mod senders;
 
 /// A tiny seeded generator (xorshift): the same draws on every run.
 pub struct Rng(u64);

@@ -1,0 +1,305 @@
+//! Issue 12: the real CNCjs (npm, pinned, installed under `target/`)
+//! drives the simulated Mega through a pseudo-terminal, as it would drive
+//! `/dev/ttyACM0`. Its server opens the terminal as a Grbl controller,
+//! loads a job from its watch directory and streams it; a feed hold from
+//! it stops the pulses until its cycle start; its Grbl state goes
+//! Idle → Run → Hold → Run → Idle; the job ends with no error, and the path
+//! rebuilt from the step pulses passes through every line's end, in order.
+//! `hil-tests/clients/cncjs_client.js` plays CNCjs's web UI (sign in,
+//! socket.io, the same commands its buttons send).
+
+use hil_tests::senders::{
+    assert_path_through, client_script, clients_dir, random_walk, serve, underruns,
+};
+use hil_tests::{boot_machine, send_ok, settle, track};
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+const CNCJS_VERSION: &str = "1.11.5";
+
+/// CNCjs installed under `target/clients/cncjs` (npm, the pinned
+/// version), the first time (said on stderr); its prefix. A marker written
+/// after npm succeeded tells a whole install from an interrupted one.
+/// `--prefer-offline`: what npm's cache holds is not asked for again.
+fn cncjs_prefix() -> PathBuf {
+    let prefix = clients_dir().join("cncjs");
+    let marker = prefix.join(format!("installed-{CNCJS_VERSION}"));
+    if !marker.exists() {
+        let spec = format!("cncjs@{CNCJS_VERSION}");
+        eprintln!("installing {spec} into {}", prefix.display());
+        let started = Instant::now();
+        let ok = Command::new("npm")
+            .args(["install", "--prefix"])
+            .arg(&prefix)
+            .args([
+                "--save-exact",
+                "--prefer-offline",
+                "--no-audit",
+                "--no-fund",
+                "--loglevel=error",
+                &spec,
+            ])
+            .status()
+            .is_ok_and(|s| s.success());
+        let manifest = prefix.join("node_modules/cncjs/package.json");
+        let version = std::fs::read_to_string(manifest).unwrap_or_default();
+        assert!(
+            ok && version.contains(&format!("\"version\": \"{CNCJS_VERSION}\"")),
+            "could not install {spec} (npm)"
+        );
+        std::fs::write(&marker, "").unwrap();
+        eprintln!(
+            "installed {spec} in {:.1} s",
+            started.elapsed().as_secs_f64()
+        );
+    }
+    prefix
+}
+
+/// When things happened, in simulated cycles.
+#[derive(Default, Debug)]
+struct Seen {
+    /// CNCjs's feed hold `!` reached the UART.
+    hold_sent: Option<u64>,
+    /// The firmware first answered a `?` with `<Hold:0|…>` (hold
+    /// complete) after it.
+    hold_reported: Option<u64>,
+    /// CNCjs's cycle start `~` reached the UART.
+    resume_sent: Option<u64>,
+}
+
+/// The bytes of the lines a sender has written and the firmware not yet
+/// answered (`ok` / `error:`): what character counting keeps under the
+/// 128-byte receive buffer. Real-time bytes take no room.
+#[derive(Default)]
+struct InFlight {
+    lines: VecDeque<usize>,
+    line: usize,
+    bytes: usize,
+    max: usize,
+    /// The sum and count of the figures seen while lines were in flight.
+    sum: usize,
+    samples: usize,
+    answers: Vec<u8>,
+}
+
+impl InFlight {
+    fn wrote(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            match b {
+                b'?' | b'!' | b'~' | 0x80.. => {}
+                // Ctrl-X empties the receive buffer.
+                0x18 => {
+                    self.lines.clear();
+                    (self.line, self.bytes) = (0, 0);
+                }
+                b'\n' => {
+                    self.lines.push_back(self.line + 1);
+                    self.bytes += self.line + 1;
+                    self.line = 0;
+                }
+                _ => self.line += 1,
+            }
+        }
+        self.max = self.max.max(self.bytes + self.line);
+        if self.bytes > 0 {
+            self.sum += self.bytes;
+            self.samples += 1;
+        }
+    }
+
+    fn read(&mut self, out: &[u8]) {
+        self.answers.extend_from_slice(out);
+        while let Some(end) = self.answers.iter().position(|&b| b == b'\n') {
+            let line: Vec<u8> = self.answers.drain(..=end).collect();
+            if line.trim_ascii_end() == b"ok" || line.starts_with(b"error:") {
+                self.bytes -= self.lines.pop_front().unwrap_or(0);
+            }
+        }
+    }
+}
+
+#[test]
+fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
+    let started = Instant::now();
+    let prefix = cncjs_prefix();
+    let installed = started.elapsed();
+    let (lines, ends) = random_walk(12, 300);
+    let file = clients_dir().join(format!("cncjs-walk-{}.gcode", std::process::id()));
+    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
+    let mut sim = boot_machine();
+    // The job starts where the machine stands (its first move is there).
+    for line in ["$machine=flatbed", "$homing_at_start=0", "M17", &lines[1]] {
+        send_ok(&mut sim, line, Duration::from_secs(2));
+    }
+    settle(&mut sim);
+    let mut client = Command::new("node");
+    client.arg(client_script("cncjs_client.js"));
+    let limit = Duration::from_secs(60);
+    let (timeout, hold_s) = (limit.as_secs().to_string(), "1".to_string());
+    let args = [
+        prefix.to_str().unwrap(),
+        file.to_str().unwrap(),
+        &timeout,
+        &hold_s,
+    ];
+    let mut seen = Seen::default();
+    let mut uart_seen = sim.uart_bytes().len();
+    let (mut rx, mut in_flight, mut answered) = (Vec::new(), InFlight::default(), uart_seen);
+    let out = serve(&mut sim, &mut client, &args, limit, |sim, wrote, at| {
+        rx.extend_from_slice(wrote);
+        in_flight.wrote(wrote);
+        in_flight.read(&sim.uart_bytes()[answered..]);
+        answered = sim.uart_bytes().len();
+        if seen.hold_sent.is_none() && wrote.contains(&b'!') {
+            seen.hold_sent = Some(at);
+            uart_seen = sim.uart_bytes().len();
+        } else if seen.hold_reported.is_some()
+            && seen.resume_sent.is_none()
+            && wrote.contains(&b'~')
+        {
+            seen.resume_sent = Some(at);
+        }
+        if seen.hold_sent.is_some() && seen.hold_reported.is_none() {
+            let text = &sim.uart_bytes()[uart_seen..];
+            if text.windows(7).any(|w| w == b"<Hold:0") {
+                seen.hold_reported = Some(sim.cycles());
+            }
+        }
+    });
+    std::fs::remove_file(&file).unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let said = stdout.clone() + &String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success(),
+        "{said}\n{}",
+        hil_tests::log_tail(&sim)
+    );
+    if std::env::var_os("TAUT_CNCJS_LOG").is_some() {
+        eprintln!("{said}");
+    }
+    let events: Vec<(&str, &str)> = stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("cncjs: ")?.split_once(' '))
+        .map(|(_, l)| l.split_once(' ').unwrap_or((l, "")))
+        .collect();
+    let of = |kind: &str| -> Vec<&str> {
+        events
+            .iter()
+            .filter(|(k, _)| *k == kind)
+            .map(|(_, v)| *v)
+            .collect()
+    };
+
+    // CNCjs's Grbl state, as its UI shows it, until its Reset at the end:
+    // Idle, Run, one Hold, Run again, Idle (a stream that falls behind the
+    // planner may show Idle between Runs: Grbl does too).
+    let states: Vec<&str> = events
+        .iter()
+        .take_while(|e| *e != &("command", "reset"))
+        .filter(|(k, _)| *k == "state")
+        .map(|(_, v)| *v)
+        .collect();
+    let hold = states.iter().position(|&s| s == "Hold");
+    let ok = states.first() == Some(&"Idle")
+        && states.last() == Some(&"Idle")
+        && states.iter().all(|s| ["Idle", "Run", "Hold"].contains(s))
+        && states.iter().filter(|&&s| s == "Hold").count() == 1
+        && hold.is_some_and(|h| states[..h].contains(&"Run") && states[h..].contains(&"Run"));
+    assert!(ok, "CNCjs's states {states:?}\n{said}");
+    let workflow = of("workflow");
+    assert_eq!(workflow, ["running", "idle"], "CNCjs's workflow\n{said}");
+    // The whole file acknowledged (and CNCjs's own `%wait` line after it).
+    let total = lines.len() + 1;
+    assert!(
+        of("sender").contains(&format!("{total}/{total}").as_str()),
+        "the job was not acknowledged whole\n{said}"
+    );
+    let bad: Vec<&str> = of("read")
+        .into_iter()
+        .filter(|l| l.starts_with("error") || l.starts_with("ALARM"))
+        .collect();
+    assert!(bad.is_empty(), "{bad:?}\n{said}");
+
+    // The pulses: under way when the hold is sent, none from the hold
+    // being reported until the cycle start, and on again after it.
+    let (hold_sent, hold_reported, resume_sent) = match seen {
+        Seen {
+            hold_sent: Some(a),
+            hold_reported: Some(b),
+            resume_sent: Some(c),
+        } => (a, b, c),
+        _ => panic!("hold and resume not seen: {seen:?}\n{said}"),
+    };
+    let cycles: Vec<u64> = track(&sim).iter().map(|(c, _)| *c).collect();
+    let between = |from: u64, to: u64| cycles.iter().filter(|&&c| from <= c && c < to).count();
+    let ms = |c: u64| c as f64 / 16e3;
+    let before = between(hold_sent.saturating_sub(16_000_000 / 2), hold_sent);
+    let slowing = between(hold_sent, hold_reported);
+    let held = between(hold_reported, resume_sent);
+    let after = between(resume_sent, resume_sent + 16_000_000 / 10);
+    eprintln!(
+        "hold sent at {:.0} ms, reported {:.0} ms later ({slowing} pulses), \
+         held {:.0} ms ({held} pulses), resumed: {after} pulses in 100 ms",
+        ms(hold_sent),
+        ms(hold_reported - hold_sent),
+        ms(resume_sent - hold_reported),
+    );
+    assert!(before > 0, "no pulses in the 500 ms before the hold");
+    assert!(
+        resume_sent - hold_reported > 16_000_000 / 2,
+        "held for {:.0} ms only",
+        ms(resume_sent - hold_reported)
+    );
+    assert_eq!(held, 0, "pulses during the hold");
+    assert!(after > 0, "no pulses in the 100 ms after the cycle start");
+
+    // Every line's end, in order, on the path the pulses made.
+    let path = assert_path_through(&sim, &ends);
+
+    // What CNCjs wrote besides the job: on connecting, then its polls.
+    let rx = String::from_utf8_lossy(&rx);
+    let job_at = rx
+        .find(&format!("{}\n", lines[0]))
+        .expect("the job's first line");
+    let count = |what: &str| rx.matches(what).count();
+    eprintln!(
+        "CNCjs wrote before the job {:?}; in all {} `?`, {} `$G`, {} `$$`",
+        &rx[..job_at],
+        count("?"),
+        count("$G\n"),
+        count("$$\n")
+    );
+    assert!(count("?") >= 10, "CNCjs polls `?`");
+    assert!(count("$G\n") >= 1, "CNCjs polls `$G`");
+    // It opened the port after the banner (serialport flushes what came
+    // before), so it asked `?` and was ready on the report: then `$$`.
+    assert!(
+        rx.starts_with("?$$\n"),
+        "CNCjs began with {:?}",
+        &rx[..job_at]
+    );
+    // Its Reset at the end: the banner, from which it took the version.
+    assert_eq!(of("version"), ["1.1h"], "{said}");
+    // Character counting, against the receive buffer.
+    eprintln!(
+        "CNCjs had at most {} bytes of lines unanswered ({} on average)",
+        in_flight.max,
+        in_flight.sum / in_flight.samples.max(1)
+    );
+    assert!(
+        (64..=128).contains(&in_flight.max),
+        "at most {} bytes in flight",
+        in_flight.max
+    );
+    eprintln!(
+        "{}; {} pulses; {}; {:.1} s (install {:.1} s)",
+        of("done").join(" "),
+        path.len(),
+        underruns(&sim),
+        started.elapsed().as_secs_f64(),
+        installed.as_secs_f64()
+    );
+}
