@@ -138,4 +138,53 @@ fn the_sample_job_drills_and_winds_as_its_pulses_show() {
     // interrupt off.
     assert_step_interrupt_never_masked_long(&sim);
     assert_ram_budget(&sim);
+    machine_time_is_the_estimate(&sim, &card);
+}
+
+/// The firmware's log stamp (ms) of `state: <name>`.
+fn entered(sim: &hil_tests::sim::Sim, state: &str) -> f64 {
+    let needle = format!("job: state: {state}]");
+    let line = sim
+        .uart_text()
+        .lines()
+        .find(|l| l.ends_with(&needle))
+        .map(str::to_string);
+    let line = line.unwrap_or_else(|| panic!("{needle} in the log"));
+    line.split(' ')
+        .nth(1)
+        .and_then(|ms| ms.parse().ok())
+        .expect("[MSG:I ms …]")
+}
+
+/// Each phase lasts what `cargo xtask estimate` works out on the host from
+/// the same files (`taut_logic::stringart::estimate`), within 1 %.
+fn machine_time_is_the_estimate(sim: &hil_tests::sim::Sim, card: &Path) {
+    use taut_logic::files::FileName;
+    let read = |f: FileName| std::fs::read(card.join(f.name())).ok();
+    let files = [FileName::Param, FileName::Machine, FileName::Poradi].map(|f| (f, read(f)));
+    let file = |name| {
+        files
+            .iter()
+            .find(|(f, _)| *f == name)
+            .and_then(|(_, b)| b.as_deref())
+    };
+    let estimate = taut_logic::stringart::estimate::card(file).unwrap();
+    let simulated = [
+        (
+            "drilling",
+            (entered(sim, "waiting for nails") - entered(sim, "drilling")) / 1000.0,
+        ),
+        (
+            "winding",
+            (entered(sim, "end") - entered(sim, "winding")) / 1000.0,
+        ),
+    ];
+    let estimated = [estimate.firmware.drilling_s, estimate.firmware.winding_s];
+    for ((phase, sim_s), est_s) in simulated.into_iter().zip(estimated) {
+        eprintln!("{phase}: {sim_s:.2} s simulated, {est_s:.2} s estimated");
+        assert!(
+            (sim_s - est_s).abs() <= sim_s / 100.0,
+            "{phase}: {sim_s:.2} s simulated, {est_s:.2} s estimated"
+        );
+    }
 }

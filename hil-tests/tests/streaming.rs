@@ -188,10 +188,5 @@ fn tiny_moves_with_status_reports() {
     // go out first: a report can only follow bytes already queued, and
     // this measures the stream, not the boot.
     sim.run_for(Duration::from_millis(100));
-    check_stream(
-        &mut sim,
-        &lines,
-        Some(Duration::from_millis(50)),
-        expected,
-    );
+    check_stream(&mut sim, &lines, Some(Duration::from_millis(50)), expected);
 }

@@ -59,10 +59,12 @@ pub fn run() -> Result<()> {
     if job["finished"] != true {
         return Err("the job did not finish".into());
     }
-    let (together, sequential) = estimate(&folder)?;
+    let e = crate::estimate::estimate(&folder)?;
     println!(
-        "host estimate from the same files: {together:.1} s with the axes of a move together \
-         (this firmware), {sequential:.1} s one axis after another (the original's blocking moves)"
+        "host estimate from the same files (cargo xtask estimate): {:.1} s of motion with this \
+         firmware's planner, {:.1} s one axis after another (the original's blocking moves)",
+        e.firmware.total_s(),
+        e.sequential_s
     );
     println!(
         "written: {}\n         {}\n         {}",
@@ -109,41 +111,4 @@ pub fn plotter(machine: &str) -> Result<()> {
         vcd.display()
     );
     Ok(())
-}
-
-/// Machine time of the card's job on the host (`stringart::machine_time`):
-/// drilling and winding, each axis on its own trapezoid, with the axes of a
-/// move together and one after another.
-fn estimate(folder: &std::path::Path) -> Result<(f64, f64)> {
-    use taut_logic::config::MachineConfig;
-    use taut_logic::files::param::ParamFile;
-    use taut_logic::files::poradi::PoradiReader;
-    use taut_logic::geometry::Board;
-    use taut_logic::stringart::{machine_time, Drilling, MachineStep, Overlap, Winder, Winding};
-    use taut_logic::units::Milli;
-    let bad = |e: taut_logic::files::FileError| format!("{e:?}");
-    let mut param = ParamFile::new();
-    param
-        .push(&std::fs::read(folder.join("param.txt"))?)
-        .map_err(bad)?;
-    let p = param.finish().map_err(bad)?;
-    let mut reader = PoradiReader::new(p.nails);
-    let text = std::fs::read(folder.join("poradi.txt"))?;
-    let (mut at, mut nails) = (0, Vec::new());
-    while at < text.len() {
-        let (used, nail) = reader.next(&text[at..]).map_err(bad)?;
-        at += used;
-        nails.extend(nail);
-    }
-    nails.extend(reader.finish().map_err(bad)?);
-    let c = MachineConfig::STRING_ART;
-    let board = Board::new(p.shape, p.nails, Milli(p.radius_um as i32)).map_err(|e| e.message())?;
-    let winder = Winder::new(board, &c).map_err(|e| format!("{e:?}"))?;
-    let steps: Vec<MachineStep> = Drilling::new(board, &c)
-        .chain(Winding::new(winder, nails.into_iter()).map_while(|s| s.ok()))
-        .collect();
-    Ok((
-        machine_time(steps.iter().copied(), &c, Overlap::Together),
-        machine_time(steps.iter().copied(), &c, Overlap::Sequential),
-    ))
 }

@@ -4,6 +4,7 @@
 
 mod bench;
 mod demo;
+mod estimate;
 mod firmware;
 mod fuzz;
 mod run;
@@ -26,6 +27,8 @@ usage: cargo xtask <command> [args]
   build             release ELF + Intel HEX + size report
   sim [args]        run the firmware in simavr (see `cargo xtask sim --help`)
   sdimage DIR -o IMG  build a FAT card image from a folder (dd it to a real card)
+  estimate DIR      the machine time of a card folder's job: this firmware's (its
+                    own job, planner and trapezoids, on the host) and the original's
   bench             measure, write target/bench.json, print a table
   flash             flash a Mega 2560 through ravedude
   setup             install what is missing (apt packages, the pinned nightly)
@@ -61,6 +64,7 @@ fn main() -> ExitCode {
             Some(other) => Err(format!("demo {other}: `demo` or `demo plotter [MACHINE]`").into()),
         }),
         "bench" => run::setup().and_then(|_| bench::run()),
+        "estimate" => estimate::run(rest),
         "flash" => run::setup().and_then(|_| firmware::flash()),
         "help" | "--help" | "-h" => {
             print!("{HELP}");

@@ -1,9 +1,12 @@
 //! Move planning of the string-art job: pure iterators that turn the board's
 //! geometry into the machine's sequence of absolute step targets and events.
 //! `drilling` drills every nail's hole, `winding` wraps the pattern's nails,
-//! `timing` estimates machine time on the host (for the closing report).
+//! `estimate` works out a job's machine time on the host with the
+//! firmware's own job, planner and trapezoids; `timing` the same for the
+//! original firmware's moves, one axis after another.
 
 mod drilling;
+pub mod estimate;
 pub mod job;
 mod timing;
 mod winding;
