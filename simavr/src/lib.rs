@@ -5,6 +5,7 @@
 //! stack. Every `unsafe` call into simavr, and every raw pointer to its
 //! objects, stays in `sim` and `hooks`.
 
+mod calls;
 mod card_slot;
 pub mod clock;
 pub mod console;

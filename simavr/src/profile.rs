@@ -20,6 +20,22 @@ impl Profile {
         self.cycles[word] += cycles;
     }
 
+    /// The `n` program words (byte addresses) with the most cycles.
+    pub fn hottest(&self, n: usize) -> Vec<(u32, u64)> {
+        let mut words: Vec<(u32, u64)> = (self.cycles.iter().enumerate())
+            .filter(|(_, c)| **c > 0)
+            .map(|(w, c)| (w as u32 * 2, *c))
+            .collect();
+        words.sort_by(|a, b| b.1.cmp(&a.1));
+        words.truncate(n);
+        words
+    }
+
+    /// Cycles counted so far.
+    pub fn total(&self) -> u64 {
+        self.cycles.iter().sum()
+    }
+
     /// Cycles per function of `elf`, most first: (cycles, demangled name).
     pub fn by_function(&self, elf: &Path) -> Result<Vec<(u64, String)>, Error> {
         use object::{Object, ObjectSymbol};

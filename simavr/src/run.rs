@@ -122,6 +122,7 @@ impl Sim {
             avr_cycle: cycle,
             interrupts_on,
             core,
+            was_asleep,
         } = self.execute();
         if cycle < self.last_avr_cycle {
             // Only a reset sets simavr's counter back, and in a run only the
@@ -137,6 +138,14 @@ impl Sim {
         if let Some(profile) = &mut self.profile {
             profile.add(pc_before, cycle - self.last_avr_cycle);
         }
+        // simavr sleeps in the same call that runs `sleep` (1 cycle), and in
+        // every call after until an interrupt wakes the core.
+        let spent = cycle - self.last_avr_cycle;
+        self.asleep += match (was_asleep, core) {
+            (true, _) => spent,
+            (false, Core::Sleeping) => spent.saturating_sub(1),
+            _ => 0,
+        };
         self.last_avr_cycle = cycle;
         let now = self.shared().cycle_base + cycle;
         self.masked.observe(now, pc, interrupts_on);
@@ -148,7 +157,7 @@ impl Sim {
         match core {
             Core::Crashed => return Some(Outcome::Crashed { pc: pc_before }),
             Core::Hung => return Some(Outcome::Hung { pc: pc_before }),
-            Core::Running => {}
+            Core::Running | Core::Sleeping => {}
         }
         if let Some(pc) = self.shared().bad_opcode_pc {
             return Some(Outcome::Crashed { pc });
@@ -157,6 +166,9 @@ impl Sim {
             return Some(Outcome::Crashed { pc: pc_before });
         }
         let sp = self.sp();
+        for w in &mut self.call_watches {
+            w.observe(pc, sp, now);
+        }
         if sp < self.min_sp {
             self.min_sp = sp;
             self.min_sp_pc = pc;

@@ -78,6 +78,10 @@ pub struct Sim {
     pub(crate) last_speed: Option<(u64, Duration)>,
     /// Interrupts-masked spans: the open one, and the longest so far.
     pub(crate) masked: MaskedSpans,
+    /// Cycles the core has slept.
+    pub(crate) asleep: u64,
+    /// Functions whose runs are timed ([`Sim::watch_calls`]).
+    pub(crate) call_watches: Vec<crate::calls::CallWatch>,
     /// Cycles per program word, when asked for ([`Sim::enable_profile`]).
     pub(crate) profile: Option<crate::profile::Profile>,
 }
@@ -186,6 +190,8 @@ impl Sim {
             step_dir: Vec::new(),
             last_speed: None,
             masked: MaskedSpans::default(),
+            asleep: 0,
+            call_watches: Vec::new(),
             profile: None,
         }
     }
@@ -269,6 +275,27 @@ impl Sim {
             .map_or(&[], |w| &w.1)
     }
 
+    /// Cycles the MCU has spent asleep (waiting for an interrupt) since
+    /// power-on: the rest of [`Sim::cycles`] it was awake.
+    pub fn asleep_cycles(&self) -> u64 {
+        self.asleep
+    }
+
+    /// Time every run of the function at byte address `pc` from now on (a
+    /// task: how long it keeps the others waiting).
+    pub fn watch_calls(&mut self, pc: u32) {
+        self.call_watches.push(crate::calls::CallWatch::new(pc));
+    }
+
+    /// The finished runs of a function given to [`Sim::watch_calls`]:
+    /// (first cycle, cycles), in order.
+    pub fn call_runs(&self, pc: u32) -> &[(u64, u64)] {
+        self.call_watches
+            .iter()
+            .find(|w| w.entry == pc)
+            .map_or(&[], |w| &w.runs)
+    }
+
     /// Lowest stack pointer seen, an address (checked after every
     /// instruction); `peak_stack_bytes` says how deep that is.
     pub fn lowest_sp(&self) -> u16 {
@@ -328,12 +355,16 @@ pub(crate) struct Executed {
     /// The I flag afterwards.
     pub interrupts_on: bool,
     pub core: Core,
+    /// The core was asleep when the step began: its cycles were slept.
+    pub was_asleep: bool,
 }
 
 /// The core's state as simavr left it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Core {
     Running,
+    /// Asleep until an interrupt.
+    Sleeping,
     Crashed,
     /// Asleep with interrupts masked: nothing can wake it.
     Hung,
@@ -348,10 +379,12 @@ impl Sim {
         // SAFETY: `avr` is live (invariants); callbacks it triggers only
         // touch `Shared`, and no reference into it is held here. `sreg` is
         // simavr's unpacked status register.
-        let (pc_before, state, pc, avr_cycle, interrupts_on) = unsafe {
+        let (was_asleep, pc_before, state, pc, avr_cycle, interrupts_on) = unsafe {
+            let was_asleep = (*avr).state == ffi::cpu_Sleeping as std::os::raw::c_int;
             let pc_before = (*avr).pc;
             let state = ffi::avr_run(avr) as u32;
             (
+                was_asleep,
                 pc_before,
                 state,
                 (*avr).pc,
@@ -362,9 +395,11 @@ impl Sim {
         let core = match state {
             ffi::cpu_Crashed => Core::Crashed,
             ffi::cpu_Done => Core::Hung,
+            ffi::cpu_Sleeping => Core::Sleeping,
             _ => Core::Running,
         };
         Executed {
+            was_asleep,
             pc_before,
             pc,
             avr_cycle,

@@ -219,3 +219,44 @@ fn uart_echoes_bytes_sent_before_the_receiver_is_on() {
     assert_eq!(sim.take_uart(), "IBM");
     assert_eq!(sim.uart_text(), "");
 }
+
+/// Calls a function three times; it counts r16 down from 10 and returns.
+const CALL_3: [u16; 10] = [
+    0xE013, // ldi r17, 3
+    0xD004, // loop: rcall f
+    0x951A, // dec r17
+    0xF7E9, // brne loop
+    CLI, SLEEP, 0xE00A, // f: ldi r16, 10
+    0x950A, // l: dec r16
+    0xF7F1, // brne l
+    0x9508, // ret
+];
+
+#[test]
+fn each_run_of_a_watched_function_is_timed_to_its_return() {
+    let mut sim = Sim::from_program(&CALL_3).unwrap();
+    sim.watch_calls(12);
+    sim.run_for(ms(1));
+    // ldi 1, ten dec 10, nine brne taken 18 and one not 1, ret 5 (22-bit PC).
+    let runs = sim.call_runs(12);
+    assert_eq!(runs.len(), 3, "{runs:?}");
+    assert!(runs.iter().all(|&(_, cycles)| cycles == 35), "{runs:?}");
+    // rcall 4, then dec 1, brne 2 between a return and the next entry.
+    assert_eq!(runs[1].0 - runs[0].0, 35 + 3 + 4);
+    assert!(sim.call_runs(14).is_empty());
+}
+
+#[test]
+fn cycles_asleep_are_counted_apart() {
+    const SEI: u16 = 0x9478;
+    // Awake for 3 cycles of ldi/ldi/ldi, then asleep with nothing to wake it.
+    let mut sim = Sim::from_program(&[0xE000, 0xE000, 0xE000, SEI, SLEEP, 0xCFFF]).unwrap();
+    sim.run_for(ms(1));
+    let awake = sim.cycles() - sim.asleep_cycles();
+    assert!(sim.cycles() >= 16_000, "{}", sim.cycles());
+    assert!(
+        (4..=8).contains(&awake),
+        "awake {awake} of {}",
+        sim.cycles()
+    );
+}

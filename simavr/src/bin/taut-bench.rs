@@ -343,6 +343,47 @@ fn sim_mhz(elf: &Path, seconds: u64) -> f64 {
     sim.cycles() as f64 / wall.elapsed().as_secs_f64() / 1e6
 }
 
+/// The sample job's drilling and its first 30 s of winding, the operator
+/// pressing green at once: the share of cycles the MCU is awake in each
+/// (percent), and the longest run of the motion task, which prepares the
+/// segments (cycles).
+fn job_figures(elf: &Path, card: &Path) -> (f64, f64, u64) {
+    let motion = taut_simavr::elf::function_address(elf, "4taut6motion")
+        .expect("ELF symbols")
+        .expect("the motion task");
+    let mut sim = boot(elf);
+    sim.insert_sd(SdImage::from_path(card).expect("sample card"));
+    sim.watch_calls(motion);
+    let mut op = taut_simavr::operator::Operator::confirming();
+    // (awake, all) cycles so far.
+    let mark = |sim: &Sim| (sim.cycles() - sim.asleep_cycles(), sim.cycles());
+    let mut until = |sim: &mut Sim, state: &str| {
+        let from = sim.uart_text().len();
+        while !sim.uart_text()[from..].contains(state) {
+            assert_eq!(sim.run_for(Duration::from_millis(10)), Outcome::Running);
+            op.step(sim);
+            assert!(sim.time_s() < 1000.0, "{}", sim.uart_text());
+        }
+    };
+    let mut marks = Vec::new();
+    for state in [
+        "state: drilling",
+        "state: waiting for nails",
+        "state: winding",
+    ] {
+        until(&mut sim, state);
+        marks.push(mark(&sim));
+    }
+    sim.run_for(Duration::from_secs(30));
+    marks.push(mark(&sim));
+    let busy = |a: usize| {
+        let ((w0, t0), (w1, t1)) = (marks[a], marks[a + 1]);
+        100.0 * (w1 - w0) as f64 / (t1 - t0) as f64
+    };
+    let longest = sim.call_runs(motion).iter().map(|r| r.1).max().unwrap_or(0);
+    (busy(0), busy(2), longest)
+}
+
 fn round(x: f64, digits: i32) -> f64 {
     let k = 10f64.powi(digits);
     (x * k).round() / k
@@ -420,6 +461,13 @@ fn main() {
     f.insert("polargraph_inverse_cycles".into(), json!(polargraph));
     f.insert("scara_inverse_cycles".into(), json!(scara));
     f.insert("arc_segments_per_s".into(), json!(16_000_000 / chord));
+    let (drilling, winding, prep) = job_figures(fw, &card);
+    f.insert(
+        "cpu_busy_percent_drilling".into(),
+        json!(round(drilling, 1)),
+    );
+    f.insert("cpu_busy_percent_winding".into(), json!(round(winding, 1)));
+    f.insert("segment_prep_max_cycles".into(), json!(prep));
     f.insert("sim_mhz_idle".into(), json!(round(sim_mhz(fw, 20), 1)));
     f.insert("sim_mhz_busy".into(), json!(round(sim_mhz(busy, 2), 1)));
 

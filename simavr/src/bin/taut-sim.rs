@@ -400,6 +400,11 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         let by_function = profile.by_function(&args.elf)?;
         let total: u64 = by_function.iter().map(|(c, _)| c).sum();
         eprintln!("taut-sim: cycles by function ({total} in all)");
+        if std::env::var_os("TAUT_PROFILE_PCS").is_some() {
+            for (pc, cycles) in profile.hottest(n) {
+                eprintln!("{pc:#07x} {cycles:>12}");
+            }
+        }
         for (cycles, name) in by_function.iter().take(n) {
             let share = 100.0 * *cycles as f64 / total.max(1) as f64;
             eprintln!("{share:6.2} % {cycles:>12} {name}");
