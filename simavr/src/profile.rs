@@ -26,7 +26,7 @@ impl Profile {
             .filter(|(_, c)| **c > 0)
             .map(|(w, c)| (w as u32 * 2, *c))
             .collect();
-        words.sort_by(|a, b| b.1.cmp(&a.1));
+        words.sort_by_key(|w| std::cmp::Reverse(w.1));
         words.truncate(n);
         words
     }
