@@ -6,7 +6,14 @@
 //! runs the step interrupt executes). `sched` is the task dispatcher's logic;
 //! `stringart` the string-art job; `fat` reads its files from the SD card.
 #![no_std]
-#![forbid(unsafe_code)]
+// The AVR build (nightly) compiles the hot arithmetic for speed.
+#![cfg_attr(
+    target_arch = "avr",
+    feature(optimize_attribute, asm_experimental_arch)
+)]
+// No unsafe code, but for the AVR assembly of `segment`'s 64-by-32-bit
+// division (allowed there alone).
+#![deny(unsafe_code)]
 
 #[cfg(test)]
 extern crate std;

@@ -401,6 +401,28 @@ fn kinematics_cycles(elf: &Path) -> [u64; 3] {
     [0, 1, 2].map(|i| (edges[2 * i + 1].cycle - edges[2 * i].cycle) / 64)
 }
 
+/// Cycles of `segment_cycles.elf`'s batches: one 64-bit square root, one
+/// trapezoid made, one event time read off it, and one segment of a
+/// default-speed move cut (mean), with the move's segment count.
+fn segment_cycles(elf: &Path) -> ([u64; 4], u64) {
+    let mut sim = Sim::load(elf).expect("segment_cycles image");
+    sim.probe(13, "batch");
+    sim.probe(12, "segment");
+    sim.run_for(Duration::from_secs(5));
+    assert!(
+        sim.pin_level(11),
+        "the assembly division disagrees with u64 division"
+    );
+    let edges = sim.probed("batch").edges().to_vec();
+    assert_eq!(edges.len(), 8, "four batches");
+    let segments = sim.probed("segment").edge_count() as u64;
+    let per = [64, 64, 64, segments];
+    (
+        [0, 1, 2, 3].map(|i| (edges[2 * i + 1].cycle - edges[2 * i].cycle) / per[i]),
+        segments,
+    )
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [fw, busy, out] = &args[..] else {
@@ -461,6 +483,13 @@ fn main() {
     f.insert("polargraph_inverse_cycles".into(), json!(polargraph));
     f.insert("scara_inverse_cycles".into(), json!(scara));
     f.insert("arc_segments_per_s".into(), json!(16_000_000 / chord));
+    let ([root, new, time, segment], segments) =
+        segment_cycles(&busy.with_file_name("segment_cycles.elf"));
+    f.insert("isqrt64_cycles".into(), json!(root));
+    f.insert("trapezoid_new_cycles".into(), json!(new));
+    f.insert("trapezoid_time_cycles".into(), json!(time));
+    f.insert("segment_cycles_mean".into(), json!(segment));
+    f.insert("segments_per_default_move".into(), json!(segments));
     let (drilling, winding, prep) = job_figures(fw, &card);
     f.insert(
         "cpu_busy_percent_drilling".into(),

@@ -1,4 +1,4 @@
-use super::trapezoid::{cbrt_floor_approx, isqrt};
+use super::trapezoid::{cbrt_floor_approx, isqrt, per_speed};
 use super::*;
 use proptest::prelude::*;
 use std::vec::Vec;
@@ -236,6 +236,28 @@ proptest! {
         let k = (f * r.events as f64) as u32;
         let exact = r.ideal(k) * SUBTICKS_PER_S as f64;
         prop_assert!((t.time(k) as f64 - exact).abs() < 64.0 + exact * 1e-9);
+    }
+
+    #[test]
+    fn narrow_division_is_exact(d in 1u32.., q in any::<u32>(), r in any::<u32>()) {
+        let n = q as u64 * d as u64 + (r % d) as u64;
+        prop_assert_eq!(div_to_u32(n, d), q);
+    }
+
+    /// A ramp's time by the reciprocal is the exact quotient, or up to
+    /// 2 sub-ticks below it.
+    #[test]
+    fn ramp_time_by_reciprocal_is_within_two_subticks(
+        accel in 1u32..=MAX_ACCEL,
+        shift in 0u32..=32,
+        ds in any::<u32>(),
+    ) {
+        let (m, p) = per_speed(accel, shift);
+        prop_assert!(m >> 62 != 0, "{m:#x}");
+        let ds = ds as u128;
+        let exact = ds * SUBTICKS_PER_S as u128 / ((accel as u128) << shift);
+        let by_reciprocal = ds * m as u128 >> p;
+        prop_assert!(by_reciprocal <= exact && exact - by_reciprocal <= 2);
     }
 
     #[test]

@@ -26,6 +26,11 @@ pub struct Trapezoid {
     cruise_sqr: u64,
     /// Fixed-point shift: speeds are `isqrt(v² << 2·shift)`, i.e. `v·2^shift`.
     shift: u32,
+    /// `Q / (accel·2^shift)` as `per_speed / 2^per_speed_shift`: sub-ticks
+    /// per unit of scaled speed, so a ramp's time is a multiplication (a
+    /// `u64` division costs ~3 000 cycles on the AVR).
+    per_speed: u64,
+    per_speed_shift: u32,
     s0: u64,
     s1: u64,
     /// Length of the ramps in units of `1 / (2a)` events.
@@ -55,6 +60,8 @@ impl Trapezoid {
             v1_sqr: 0,
             cruise_sqr: 0,
             shift: 0,
+            per_speed: 0,
+            per_speed_shift: 32,
             s0: 0,
             s1: 0,
             acc2: 0,
@@ -108,6 +115,7 @@ impl Trapezoid {
             .max(v0_sqr)
             .max(v1_sqr);
         let shift = (64 - (64 - peak.leading_zeros())) / 2;
+        let (per_speed, per_speed_shift) = per_speed(a as u32, shift);
         let mut t = Trapezoid {
             events,
             accel: a,
@@ -116,6 +124,8 @@ impl Trapezoid {
             v1_sqr,
             cruise_sqr,
             shift,
+            per_speed,
+            per_speed_shift,
             acc2: peak - v0_sqr,
             dec2: peak - v1_sqr,
             ..Self::idle()
@@ -171,6 +181,7 @@ impl Trapezoid {
     }
 
     /// Ideal time of event `k` (0..=events), sub-ticks after event 0.
+    #[cfg_attr(target_arch = "avr", optimize(speed))]
     pub fn time(&self, k: u32) -> u64 {
         let x = self.two_a * k as u64;
         let y = self.two_a * (self.events - k) as u64;
@@ -218,9 +229,15 @@ impl Trapezoid {
         isqrt(v_sqr << (2 * self.shift))
     }
 
-    /// Time to change speed between two scaled speeds at `accel`.
+    /// Time to change speed between two scaled speeds at `accel`: the
+    /// difference (below 2^32: the scale keeps the peak's below 2^64) times
+    /// `per_speed`, a 96-bit product cut to its top bits.
+    #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn ramp_time(&self, s_hi: u64, s_lo: u64) -> u64 {
-        (s_hi - s_lo) * Q / (self.accel << self.shift)
+        let ds = s_hi - s_lo;
+        let low = ds * (self.per_speed & 0xFFFF_FFFF);
+        let high = ds * (self.per_speed >> 32);
+        (high + (low >> 32)) >> (self.per_speed_shift - 32)
     }
 
     /// Time to cruise `w / (2a)` events.
@@ -230,28 +247,110 @@ impl Trapezoid {
     }
 }
 
+/// `Q / (accel·2^shift)` as `(m, p)` with `m / 2^p` (floor) and `m` in
+/// [2^62, 2^64): 62 good bits, so a ramp's time is within 2 sub-ticks of
+/// the exact quotient. `Q = 125 000·2^15`: one `u64 / u32` division and
+/// one of the remainder, once per trapezoid.
+pub(super) fn per_speed(accel: u32, shift: u32) -> (u64, u32) {
+    let n = 125_000u64 << 46;
+    let (q, r) = (n / accel as u64, n % accel as u64);
+    // q < 2^63 and r < accel ≤ 2^24: r's next z bits fit.
+    let z = q.leading_zeros();
+    let m = q << z | (r << z) / accel as u64;
+    // m / 2^p = 125 000·2^(46+z) / (accel·2^(15+p-shift)) = Q / (accel·2^shift)
+    (m, 31 + z + shift)
+}
+
 /// Integer square root, rounded down. Written for the AVR, where `u64`
 /// arithmetic is a library call: a 32-bit digit-by-digit root of the top
-/// half gives 16 good bits, one Newton step (one `u64` division) doubles
-/// them. Newton from above never lands below the floor root, so at most a
-/// step down is left to check, with one plain square: the root is below
-/// 2^32, so it cannot overflow (checked squares cost a 128-bit product).
+/// half gives 16 good bits, one Newton step doubles them. Newton from
+/// above never lands below the floor root, so at most a step down is
+/// left to check. The step's division has a 32-bit quotient: done 32 bits
+/// wide ([`div_to_u32`]), a fifth of a general `u64` division.
+#[cfg_attr(target_arch = "avr", optimize(speed))]
 pub fn isqrt(x: u64) -> u64 {
     if x <= u32::MAX as u64 {
         return isqrt32(x as u32) as u64;
     }
+    // The largest root there is: its square and above.
+    const TOP: u64 = u32::MAX as u64;
+    if x >= TOP * TOP {
+        return TOP;
+    }
     // x ≥ 2^32: shift right by the even amount that leaves 31–32 bits.
     let shift = (33 - x.leading_zeros()) & !1;
-    // r0 ≤ √x < r0 + 2^(shift/2): start from the upper end, ≤ 2^32.
-    let r0 = ((isqrt32((x >> shift) as u32) as u64) + 1) << (shift / 2);
-    let mut r = (r0 + x / r0) / 2;
+    // r0 ≤ √x < r0 + 2^(shift/2): start from the upper end, below 2^32
+    // (a root of 2^32 would need x ≥ TOP²).
+    let r0 = (((isqrt32((x >> shift) as u32) as u64) + 1) << (shift / 2)).min(TOP) as u32;
+    // x / r0 ≤ √x < 2^32: the quotient fits.
+    let mut r = (r0 as u64 + div_to_u32(x, r0) as u64) / 2;
     while r * r > x {
         r -= 1;
     }
     r
 }
 
+/// `n / d`, for a quotient known to fit 32 bits (`n >> 32 < d`): restoring
+/// division a bit at a time, on 32-bit halves.
+#[cfg(not(target_arch = "avr"))]
+pub fn div_to_u32(n: u64, d: u32) -> u32 {
+    let mut rem = (n >> 32) as u32;
+    let mut low = n as u32;
+    let mut q = 0u32;
+    for _ in 0..32 {
+        // rem < d: shifted in, it may need a 33rd bit (`carry`).
+        let carry = rem >> 31;
+        rem = rem << 1 | low >> 31;
+        low <<= 1;
+        q <<= 1;
+        if carry != 0 || rem >= d {
+            rem = rem.wrapping_sub(d);
+            q |= 1;
+        }
+    }
+    q
+}
+
+/// The same on the AVR, in assembly (the compiled loop spilled to the
+/// stack: 2 300 cycles): the dividend's low half shifts into the
+/// remainder while the quotient's bits fill it from the right, ~20 cycles
+/// a bit. Checked against the division above by `segment_cycles.elf`.
+#[cfg(target_arch = "avr")]
+#[allow(unsafe_code)]
+pub fn div_to_u32(n: u64, d: u32) -> u32 {
+    let [mut l0, mut l1, mut l2, mut l3, mut r0, mut r1, mut r2, mut r3] = n.to_le_bytes();
+    let [d0, d1, d2, d3] = d.to_le_bytes();
+    // SAFETY: registers only; no memory, no stack.
+    unsafe {
+        core::arch::asm!(
+            "ldi {count}, 32",
+            "1:",
+            "lsl {l0}", "rol {l1}", "rol {l2}", "rol {l3}",
+            "rol {r0}", "rol {r1}", "rol {r2}", "rol {r3}",
+            // A 33rd bit: above any divisor.
+            "brcs 2f",
+            "cp {r0}, {d0}", "cpc {r1}, {d1}", "cpc {r2}, {d2}", "cpc {r3}, {d3}",
+            "brcs 3f",
+            "2:",
+            "sub {r0}, {d0}", "sbc {r1}, {d1}", "sbc {r2}, {d2}", "sbc {r3}, {d3}",
+            // The shift left bit 0 clear: this sets the quotient's bit.
+            "inc {l0}",
+            "3:",
+            "dec {count}",
+            "brne 1b",
+            count = out(reg_upper) _,
+            l0 = inout(reg) l0, l1 = inout(reg) l1, l2 = inout(reg) l2, l3 = inout(reg) l3,
+            r0 = inout(reg) r0, r1 = inout(reg) r1, r2 = inout(reg) r2, r3 = inout(reg) r3,
+            d0 = in(reg) d0, d1 = in(reg) d1, d2 = in(reg) d2, d3 = in(reg) d3,
+            options(pure, nomem, nostack),
+        );
+    }
+    let _ = (r0, r1, r2, r3);
+    u32::from_le_bytes([l0, l1, l2, l3])
+}
+
 /// 32-bit integer square root, rounded down (digit by digit).
+#[cfg_attr(target_arch = "avr", optimize(speed))]
 fn isqrt32(x: u32) -> u32 {
     let mut rem = x;
     let mut root = 0u32;
