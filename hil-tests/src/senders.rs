@@ -15,6 +15,20 @@ pub fn clients_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/clients")
 }
 
+/// The real senders installed (`hil-tests/clients/install.sh`: pinned,
+/// idempotent, says what it installs): grbl-streamer's venv and CNCjs's
+/// npm prefix, under [`clients_dir`]. Several tests may ask at once: one
+/// installs, the others wait for it.
+pub fn install_clients() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let ok = Command::new(client_script("install.sh"))
+            .status()
+            .is_ok_and(|s| s.success());
+        assert!(ok, "hil-tests/clients/install.sh failed");
+    });
+}
+
 /// A client script of `hil-tests/clients/`.
 pub fn client_script(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

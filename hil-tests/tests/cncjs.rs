@@ -9,7 +9,7 @@
 //! socket.io, the same commands its buttons send).
 
 use hil_tests::senders::{
-    assert_path_through, client_script, clients_dir, random_walk, serve, underruns,
+    assert_path_through, client_script, clients_dir, install_clients, random_walk, serve, underruns,
 };
 use hil_tests::{boot_machine, send_ok, settle, track};
 use std::collections::VecDeque;
@@ -17,45 +17,10 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-const CNCJS_VERSION: &str = "1.11.5";
-
-/// CNCjs installed under `target/clients/cncjs` (npm, the pinned
-/// version), the first time (said on stderr); its prefix. A marker written
-/// after npm succeeded tells a whole install from an interrupted one.
-/// `--prefer-offline`: what npm's cache holds is not asked for again.
+/// CNCjs's npm prefix (installed by `install_clients`).
 fn cncjs_prefix() -> PathBuf {
-    let prefix = clients_dir().join("cncjs");
-    let marker = prefix.join(format!("installed-{CNCJS_VERSION}"));
-    if !marker.exists() {
-        let spec = format!("cncjs@{CNCJS_VERSION}");
-        eprintln!("installing {spec} into {}", prefix.display());
-        let started = Instant::now();
-        let ok = Command::new("npm")
-            .args(["install", "--prefix"])
-            .arg(&prefix)
-            .args([
-                "--save-exact",
-                "--prefer-offline",
-                "--no-audit",
-                "--no-fund",
-                "--loglevel=error",
-                &spec,
-            ])
-            .status()
-            .is_ok_and(|s| s.success());
-        let manifest = prefix.join("node_modules/cncjs/package.json");
-        let version = std::fs::read_to_string(manifest).unwrap_or_default();
-        assert!(
-            ok && version.contains(&format!("\"version\": \"{CNCJS_VERSION}\"")),
-            "could not install {spec} (npm)"
-        );
-        std::fs::write(&marker, "").unwrap();
-        eprintln!(
-            "installed {spec} in {:.1} s",
-            started.elapsed().as_secs_f64()
-        );
-    }
-    prefix
+    install_clients();
+    clients_dir().join("cncjs")
 }
 
 /// When things happened, in simulated cycles.

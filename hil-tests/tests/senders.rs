@@ -6,41 +6,17 @@
 //! every line's end point, in order.
 
 use hil_tests::senders::{
-    assert_path_through, client_script, clients_dir, random_walk, serve, underruns,
+    assert_path_through, client_script, clients_dir, install_clients, random_walk, serve, underruns,
 };
 use hil_tests::{boot_machine, send_ok};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::path::PathBuf;
+use std::process::Command;
 use std::time::Duration;
 
-const GRBL_STREAMER: &str = "grbl-streamer==2.0.2";
-
-/// The venv's Python with grbl-streamer, installed the first time (said
-/// on stderr).
+/// The venv's Python with grbl-streamer (installed by `install_clients`).
 fn grbl_streamer_python() -> PathBuf {
-    let venv = clients_dir().join("venv");
-    let python = venv.join("bin/python");
-    let has = |p: &Path| {
-        Command::new(p)
-            .args(["-c", "import grbl_streamer"])
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success())
-    };
-    if !has(&python) {
-        eprintln!("installing {GRBL_STREAMER} into {}", venv.display());
-        let ok = Command::new("python3")
-            .args(["-m", "venv"])
-            .arg(&venv)
-            .status()
-            .is_ok_and(|s| s.success())
-            && Command::new(venv.join("bin/pip"))
-                .args(["install", "--quiet", GRBL_STREAMER])
-                .status()
-                .is_ok_and(|s| s.success());
-        assert!(ok && has(&python), "could not install {GRBL_STREAMER}");
-    }
-    python
+    install_clients();
+    clients_dir().join("venv/bin/python")
 }
 
 #[test]

@@ -84,11 +84,18 @@ fn main() -> ExitCode {
 fn test() -> Result<()> {
     let start = Instant::now();
     run::setup()?;
+    // The real senders' downloads overlap the host tests and the fuzzing.
+    let clients = run::Background::start(
+        "installing the HIL tests' senders (grbl-streamer, CNCjs)",
+        &root().join("hil-tests/clients/install.sh"),
+        &root().join("target/clients/install.log"),
+    )?;
     println!("== host unit tests");
     cargo(&["test", "--workspace", "--exclude", "hil-tests"], &root())?;
     let host = start.elapsed().as_secs();
     fuzz::run(&fuzz::Plan::test())?;
     let fuzz = start.elapsed().as_secs() - host;
+    clients.finish()?;
     simtest()?;
     let total = start.elapsed().as_secs();
     println!(

@@ -68,3 +68,46 @@ pub fn bin(name: &str, args: &[String]) -> Result<()> {
     c.args(args);
     status(&mut c)
 }
+
+/// A script running beside the build, its output kept in a log file.
+pub struct Background {
+    child: std::process::Child,
+    what: String,
+    log: std::path::PathBuf,
+}
+
+impl Background {
+    pub fn start(what: &str, script: &Path, log: &Path) -> Result<Background> {
+        if let Some(dir) = log.parent() {
+            std::fs::create_dir_all(dir)?;
+        }
+        let out = std::fs::File::create(log)?;
+        let child = Command::new(script)
+            .stdout(out.try_clone()?)
+            .stderr(out)
+            .spawn()
+            .map_err(|e| format!("{}: {e}", script.display()))?;
+        println!("== {what}, in the background (log: {})", log.display());
+        Ok(Background {
+            child,
+            what: what.to_string(),
+            log: log.to_owned(),
+        })
+    }
+
+    /// Waits for the script; prints its log.
+    pub fn finish(mut self) -> Result<()> {
+        let ok = self.child.wait()?.success();
+        let log = std::fs::read_to_string(&self.log).unwrap_or_default();
+        println!(
+            "== {}: {}\n{}",
+            self.what,
+            if ok { "done" } else { "FAILED" },
+            log.trim_end()
+        );
+        match ok {
+            true => Ok(()),
+            false => Err(format!("{} failed", self.what).into()),
+        }
+    }
+}
