@@ -579,5 +579,7 @@ fn pen_order(cfg: &MachineConfig, deg: u8) -> Order {
     }
 }
 
+pub mod estimate;
+
 #[cfg(test)]
 mod tests;

@@ -256,7 +256,7 @@ proptest! {
         prop_assert!(m >> 62 != 0, "{m:#x}");
         let ds = ds as u128;
         let exact = ds * SUBTICKS_PER_S as u128 / ((accel as u128) << shift);
-        let by_reciprocal = ds * m as u128 >> p;
+        let by_reciprocal = (ds * m as u128) >> p;
         prop_assert!(by_reciprocal <= exact && exact - by_reciprocal <= 2);
     }
 

@@ -256,7 +256,7 @@ pub(super) fn per_speed(accel: u32, shift: u32) -> (u64, u32) {
     let (q, r) = (n / accel as u64, n % accel as u64);
     // q < 2^63 and r < accel ≤ 2^24: r's next z bits fit.
     let z = q.leading_zeros();
-    let m = q << z | (r << z) / accel as u64;
+    let m = (q << z) | ((r << z) / accel as u64);
     // m / 2^p = 125 000·2^(46+z) / (accel·2^(15+p-shift)) = Q / (accel·2^shift)
     (m, 31 + z + shift)
 }
