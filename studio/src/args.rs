@@ -70,14 +70,14 @@ impl Args {
         }
     }
 
-    /// `--name X,Y`, or `default` when absent.
-    pub fn pair(&mut self, name: &str, default: [f64; 2]) -> Result<[f64; 2], String> {
+    /// `--name X,Y`, if given.
+    pub fn pair(&mut self, name: &str) -> Result<Option<[f64; 2]>, String> {
         let Some(v) = self.value(name) else {
-            return Ok(default);
+            return Ok(None);
         };
         let bad = || format!("{} {v}: expected two numbers, X,Y", dashed(name));
         let (a, b) = v.split_once(',').ok_or_else(bad)?;
-        Ok([a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?])
+        Ok(Some([a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?]))
     }
 
     fn take(&mut self, name: &str) -> Option<Option<String>> {
@@ -121,7 +121,8 @@ mod tests {
         assert_eq!(a.number("lines", 7usize), Ok(7));
         assert_eq!(a.required("o").unwrap(), "card");
         assert!(a.flag("quiet"));
-        assert_eq!(a.pair("at", [0.0; 2]), Ok([1.0, -2.5]));
+        assert_eq!(a.pair("at"), Ok(Some([1.0, -2.5])));
+        assert_eq!(a.pair("canny"), Ok(None));
         assert!(a.finish().is_ok());
         let mut a = args(&["--nails", "x", "--what", "1", "extra"]);
         assert_eq!(a.number("nails", 0u16), Err("--nails x: not a number".into()));

@@ -9,9 +9,14 @@
 pub mod args;
 pub mod board;
 pub mod gray;
+pub mod hershey;
+pub mod plot;
+pub mod preview;
 pub mod progress;
 pub mod raster;
 pub mod stringart;
 pub mod svg;
 pub mod template;
+pub mod text;
 pub mod toolpath;
+pub mod vectorize;

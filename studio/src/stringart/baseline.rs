@@ -7,8 +7,7 @@
 //!   pixels (one sample a pixel along it, not anti-aliased) hold the most
 //!   residual wins; a fixed weight is taken off the residual along it; the
 //!   last nails visited are skipped (kmmeerts keeps 20) so the thread does
-//!   not ping-pong. The weight here is the thread's share of a pixel, the
-//!   same thread as ours.
+//!   not ping-pong. The weight is [`PLAIN_WEIGHT`].
 //! - [`random`]: a random walk of chords, the floor any method must clear.
 
 use super::greedy::Rng;
@@ -16,11 +15,16 @@ use super::target::{far_enough, Target};
 use indicatif::ProgressBar;
 use std::collections::VecDeque;
 
+/// What a chord takes off the residual darkness: 20/255, the usual
+/// setting of the ports. (On `camera.jpg`, 250 nails, 3000 lines, 0.3 mm
+/// thread, weights of 8, 13, 20, 31, 51 and 77/255 give RMSEs of 0.241,
+/// 0.229, 0.231, 0.239, 0.249 and 0.272: 20 is within 1 % of the best.)
+pub const PLAIN_WEIGHT: f32 = 20.0 / 255.0;
+
 /// The plain greedy winding of `lines` chords.
 pub fn plain(target: &Target, lines: usize, min: u16, progress: &ProgressBar) -> Vec<u16> {
     let n = target.nails();
     let mut residual = target.darkness.clone();
-    let weight = target.thread_px.min(1.0);
     let recent_len = usize::from(n / 8).min(20);
     let mut recent: VecDeque<u16> = VecDeque::with_capacity(recent_len + 1);
     let mut pixels = Vec::new();
@@ -42,7 +46,7 @@ pub fn plain(target: &Target, lines: usize, min: u16, progress: &ProgressBar) ->
         };
         samples(target, at, b, &mut pixels);
         for &i in &pixels {
-            residual[i] = (residual[i] - weight).max(0.0);
+            residual[i] = (residual[i] - PLAIN_WEIGHT).max(0.0);
         }
         pattern.push(b);
         recent.push_back(b);

@@ -24,6 +24,7 @@
 use super::target::{far_enough, Target};
 use crate::raster::blur;
 use indicatif::ProgressBar;
+use rayon::prelude::*;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Settings {
@@ -103,9 +104,7 @@ impl<'a> Loom<'a> {
             bare[i] = if on { before * (1.0 - w) } else { before / (1.0 - w) };
             touched.push((i, before - bare[i]));
         });
-        for &(i, dark) in &touched {
-            self.splat(i, dark);
-        }
+        self.splat(&touched);
         self.touched = touched;
     }
 
@@ -117,20 +116,32 @@ impl<'a> Loom<'a> {
         self.apply(a, b, false);
     }
 
-    /// F += K₂ centred on pixel `i`, times `dark`.
-    fn splat(&mut self, i: usize, dark: f32) {
-        if dark == 0.0 {
-            return;
-        }
+    /// F += K₂∗δ for the darkening δ of each touched pixel. The rows of F
+    /// are split between the two cores.
+    fn splat(&mut self, touched: &[(usize, f32)]) {
         let size = self.target.frame.size;
-        let (x, y, r) = (i % size, i / size, self.reach);
-        let side = 2 * r + 1;
-        let (x0, x1) = (x.saturating_sub(r), (x + r).min(size - 1));
-        for yy in y.saturating_sub(r)..=(y + r).min(size - 1) {
-            let krow = &self.kernel[(yy + r - y) * side..][..side];
-            let frow = &mut self.field[yy * size..][..size];
+        let (kernel, reach) = (&self.kernel[..], self.reach);
+        let mid = size / 2;
+        let (top, bottom) = self.field.split_at_mut(mid * size);
+        rayon::join(
+            || splat_rows(top, 0, touched, kernel, reach, size),
+            || splat_rows(bottom, mid, touched, kernel, reach, size),
+        );
+    }
+}
+
+/// [`Loom::splat`] into `rows`, the rows of F from `first` on.
+fn splat_rows(rows: &mut [f32], first: usize, touched: &[(usize, f32)], kernel: &[f32], reach: usize, size: usize) {
+    let (side, last) = (2 * reach + 1, first + rows.len() / size);
+    for &(i, dark) in touched {
+        let (x, y) = (i % size, i / size);
+        let (y0, y1) = (y.saturating_sub(reach).max(first), (y + reach + 1).min(last));
+        let (x0, x1) = (x.saturating_sub(reach), (x + reach).min(size - 1));
+        for yy in y0..y1 {
+            let krow = &kernel[(yy + reach - y) * side..][..side];
+            let frow = &mut rows[(yy - first) * size..][..size];
             for xx in x0..=x1 {
-                frow[xx] += dark * krow[xx + r - x];
+                frow[xx] += dark * krow[xx + reach - x];
             }
         }
     }
@@ -170,29 +181,17 @@ pub fn wind(target: &Target, settings: &Settings, progress: &ProgressBar) -> Res
 }
 
 /// The nail the chord from `at` should go to: least gain, the lowest
-/// index among equals. The candidates are split between the two cores.
+/// index among equals (so the answer does not depend on how the two cores
+/// shared the candidates).
 fn best_from(loom: &Loom<'_>, at: u16, min: u16) -> u16 {
     let n = loom.target.nails();
-    let candidates: Vec<u16> = (0..n).filter(|&b| far_enough(at, b, n, min)).collect();
-    let best_of = |part: &[u16]| {
-        part.iter()
-            .map(|&b| (loom.gain(at, b), b))
-            .fold((f32::INFINITY, u16::MAX), |best, c| if c.0 < best.0 { c } else { best })
-    };
-    if candidates.len() < 64 {
-        return best_of(&candidates).1;
-    }
-    let (left, right) = candidates.split_at(candidates.len() / 2);
-    let (l, r) = std::thread::scope(|s| {
-        let other = s.spawn(|| best_of(right));
-        (best_of(left), other.join().expect("chord search"))
-    });
-    // Left holds the lower indices: it wins ties.
-    if r.0 < l.0 {
-        r.1
-    } else {
-        l.1
-    }
+    (0..n)
+        .into_par_iter()
+        .filter(|&b| far_enough(at, b, n, min))
+        .map(|b| (loom.gain(at, b), b))
+        .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
+        .expect("a nail far enough")
+        .1
 }
 
 /// One pass of single-nail moves; returns how many nails moved.
@@ -216,22 +215,20 @@ fn improve(
         let fits = |c: u16| far_enough(prev, c, n, min) && next.is_none_or(|x| far_enough(c, x, n, min));
         let cost = |loom: &Loom<'_>, c: u16| loom.gain(prev, c) + next.map_or(0.0, |x| loom.gain(c, x));
         // Screening on the present state: who would do better than here?
-        let mut best = (cost(loom, here), here);
-        for d in 1..=settings.window.min(n / 2) {
-            for c in [(here + d) % n, (here + n - d) % n] {
-                if fits(c) {
-                    let g = cost(loom, c);
-                    if g < best.0 {
-                        best = (g, c);
-                    }
-                }
-            }
-        }
-        if best.1 == here {
+        // (The present nail comes first and wins ties.)
+        let near = (1..=settings.window.min(n / 2)).flat_map(|d| [(here + d) % n, (here + n - d) % n]);
+        let candidates: Vec<u16> = std::iter::once(here).chain(near.filter(|&c| fits(c))).collect();
+        let best = candidates
+            .par_iter()
+            .enumerate()
+            .map(|(order, &c)| (cost(loom, c), order, c))
+            .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
+            .expect("the present nail");
+        if best.2 == here {
             continue;
         }
         // The check: without the chords through nail k, here or there.
-        let c = best.1;
+        let c = best.2;
         loom.remove(prev, here);
         if let Some(x) = next {
             loom.remove(here, x);

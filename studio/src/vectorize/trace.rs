@@ -26,7 +26,7 @@ pub fn chains(edge: &[bool], w: usize, h: usize) -> Vec<Polyline> {
     let mut used = vec![false; edge.len()];
     let mut out = Vec::new();
     let centre = |i: usize| [(i % w) as f64 + 0.5, (i / w) as f64 + 0.5];
-    let mut follow = |start: usize, used: &mut Vec<bool>| {
+    let follow = |start: usize, used: &mut Vec<bool>| {
         let mut chain = vec![centre(start)];
         used[start] = true;
         let mut at = start;
