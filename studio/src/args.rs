@@ -59,14 +59,17 @@ impl Args {
     }
 
     pub fn required(&mut self, name: &str) -> Result<String, String> {
-        self.value(name).ok_or_else(|| format!("missing {}", dashed(name)))
+        self.value(name)
+            .ok_or_else(|| format!("missing {}", dashed(name)))
     }
 
     /// `--name` read as a `T`, or `default` when absent.
     pub fn number<T: FromStr>(&mut self, name: &str, default: T) -> Result<T, String> {
         match self.value(name) {
             None => Ok(default),
-            Some(v) => v.parse().map_err(|_| format!("{} {v}: not a number", dashed(name))),
+            Some(v) => v
+                .parse()
+                .map_err(|_| format!("{} {v}: not a number", dashed(name))),
         }
     }
 
@@ -77,7 +80,10 @@ impl Args {
         };
         let bad = || format!("{} {v}: expected two numbers, X,Y", dashed(name));
         let (a, b) = v.split_once(',').ok_or_else(bad)?;
-        Ok(Some([a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?]))
+        Ok(Some([
+            a.trim().parse().map_err(|_| bad())?,
+            b.trim().parse().map_err(|_| bad())?,
+        ]))
     }
 
     fn take(&mut self, name: &str) -> Option<Option<String>> {
@@ -115,7 +121,15 @@ mod tests {
 
     #[test]
     fn options_flags_and_leftovers() {
-        let mut a = args(&["pic.png", "--nails=250", "-o", "card", "--quiet", "--at", "1, -2.5"]);
+        let mut a = args(&[
+            "pic.png",
+            "--nails=250",
+            "-o",
+            "card",
+            "--quiet",
+            "--at",
+            "1, -2.5",
+        ]);
         assert_eq!(a.positional("IMAGE").unwrap(), "pic.png");
         assert_eq!(a.number("nails", 0u16), Ok(250));
         assert_eq!(a.number("lines", 7usize), Ok(7));
@@ -125,10 +139,16 @@ mod tests {
         assert_eq!(a.pair("canny"), Ok(None));
         assert!(a.finish().is_ok());
         let mut a = args(&["--nails", "x", "--what", "1", "extra"]);
-        assert_eq!(a.number("nails", 0u16), Err("--nails x: not a number".into()));
+        assert_eq!(
+            a.number("nails", 0u16),
+            Err("--nails x: not a number".into())
+        );
         assert_eq!(a.required("o"), Err("missing -o".into()));
         assert_eq!(a.finish().unwrap_err(), "unknown option --what");
         let raw = vec!["--nails".to_string()];
-        assert_eq!(Args::parse(&raw, &[]).err(), Some("--nails needs a value".into()));
+        assert_eq!(
+            Args::parse(&raw, &[]).err(),
+            Some("--nails needs a value".into())
+        );
     }
 }

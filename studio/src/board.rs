@@ -116,7 +116,10 @@ mod tests {
         // A square board's nails lie on a square at 45°: half the raster.
         let square = Frame::new(Board::new(4, 40, Milli(115_000)).unwrap(), 64);
         let inside = square.mask.iter().filter(|&&m| m).count() as f32;
-        assert!((inside / (64.0 * 64.0 / 2.0) - 1.0).abs() < 0.03, "{inside}");
+        assert!(
+            (inside / (64.0 * 64.0 / 2.0) - 1.0).abs() < 0.03,
+            "{inside}"
+        );
         assert!(square.mask[32 * 64 + 32] && !square.mask[2 * 64 + 2]);
     }
 }

@@ -116,7 +116,9 @@ fn decode_png(bytes: &[u8]) -> Result<Gray, String> {
     decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
     let mut reader = decoder.read_info().map_err(|e| format!("PNG: {e}"))?;
     let mut buf = vec![0; reader.output_buffer_size()];
-    let frame = reader.next_frame(&mut buf).map_err(|e| format!("PNG: {e}"))?;
+    let frame = reader
+        .next_frame(&mut buf)
+        .map_err(|e| format!("PNG: {e}"))?;
     let data = &buf[..frame.buffer_size()];
     let pixels = match frame.color_type {
         png::ColorType::Grayscale => data.iter().map(|&v| f32::from(v) / 255.0).collect(),
@@ -124,7 +126,10 @@ fn decode_png(bytes: &[u8]) -> Result<Gray, String> {
             .chunks_exact(2)
             .map(|p| over_white(f32::from(p[0]) / 255.0, p[1]))
             .collect(),
-        png::ColorType::Rgb => data.chunks_exact(3).map(|p| luma(p[0], p[1], p[2])).collect(),
+        png::ColorType::Rgb => data
+            .chunks_exact(3)
+            .map(|p| luma(p[0], p[1], p[2]))
+            .collect(),
         png::ColorType::Rgba => data
             .chunks_exact(4)
             .map(|p| over_white(luma(p[0], p[1], p[2]), p[3]))
@@ -149,7 +154,10 @@ fn decode_jpeg(bytes: &[u8]) -> Result<Gray, String> {
             .chunks_exact(2)
             .map(|p| f32::from(u16::from_be_bytes([p[0], p[1]])) / 65535.0)
             .collect(),
-        PixelFormat::RGB24 => data.chunks_exact(3).map(|p| luma(p[0], p[1], p[2])).collect(),
+        PixelFormat::RGB24 => data
+            .chunks_exact(3)
+            .map(|p| luma(p[0], p[1], p[2]))
+            .collect(),
         PixelFormat::CMYK32 => data
             .chunks_exact(4)
             .map(|p| {
@@ -193,7 +201,10 @@ mod tests {
     fn unreadable_files_say_why() {
         let missing = Gray::open(Path::new("/nonexistent/x.png")).unwrap_err();
         assert!(missing.starts_with("/nonexistent/x.png: "), "{missing}");
-        assert_eq!(Gray::decode(b"GIF89a").unwrap_err(), "not a PNG or JPEG image");
+        assert_eq!(
+            Gray::decode(b"GIF89a").unwrap_err(),
+            "not a PNG or JPEG image"
+        );
         let broken = Gray::decode(b"\x89PNG\r\n\x1a\n\0\0").unwrap_err();
         assert!(broken.starts_with("PNG: "), "{broken}");
         let broken = Gray::decode(&[0xFF, 0xD8, 0xFF, 0x00]).unwrap_err();

@@ -44,7 +44,9 @@ impl Font {
             let names: Vec<&str> = FONTS.iter().map(|f| f.0).collect();
             format!("--font {name}: one of {}", names.join(", "))
         })?;
-        Ok(Font { glyphs: parse(data)? })
+        Ok(Font {
+            glyphs: parse(data)?,
+        })
     }
 
     /// The glyph of a printable ASCII character.
@@ -66,14 +68,24 @@ pub fn parse(text: &str) -> Result<Vec<Glyph>, String> {
             continue;
         }
         let bad = |what: &str| format!("font line {}: {what}", no + 1);
-        let count: usize = line.get(5..8).ok_or(bad("too short"))?.trim().parse().map_err(|_| bad("vertex count"))?;
+        let count: usize = line
+            .get(5..8)
+            .ok_or(bad("too short"))?
+            .trim()
+            .parse()
+            .map_err(|_| bad("vertex count"))?;
         let mut pairs: String = line.get(8..).unwrap_or("").to_string();
         while pairs.len() < 2 * count {
             let (_, more) = lines.next().ok_or(bad("glyph cut short"))?;
             pairs.push_str(more);
         }
         let b = pairs.as_bytes();
-        let at = |k: usize| [i32::from(b[2 * k]) - i32::from(b'R'), i32::from(b[2 * k + 1]) - i32::from(b'R')];
+        let at = |k: usize| {
+            [
+                i32::from(b[2 * k]) - i32::from(b'R'),
+                i32::from(b[2 * k + 1]) - i32::from(b'R'),
+            ]
+        };
         let [left, right] = at(0);
         let mut strokes: Vec<Vec<[i32; 2]>> = vec![Vec::new()];
         for k in 1..count {
@@ -84,7 +96,11 @@ pub fn parse(text: &str) -> Result<Vec<Glyph>, String> {
             }
         }
         strokes.retain(|s| !s.is_empty());
-        glyphs.push(Glyph { left, right, strokes });
+        glyphs.push(Glyph {
+            left,
+            right,
+            strokes,
+        });
     }
     Ok(glyphs)
 }
@@ -99,7 +115,10 @@ mod tests {
             let f = Font::named(name).unwrap();
             assert!(f.glyphs.len() >= 95, "{name}: {}", f.glyphs.len());
             let space = f.glyph(' ').unwrap();
-            assert!(space.strokes.is_empty() && space.right > space.left, "{name}");
+            assert!(
+                space.strokes.is_empty() && space.right > space.left,
+                "{name}"
+            );
             for c in '!'..='~' {
                 let g = f.glyph(c).unwrap();
                 assert!(!g.strokes.is_empty(), "{name} {c:?}");
@@ -108,9 +127,16 @@ mod tests {
             // Capitals stand on the base line and reach the cap line.
             let h = f.glyph('H').unwrap();
             let ys: Vec<i32> = h.strokes.iter().flatten().map(|p| p[1]).collect();
-            assert_eq!((*ys.iter().min().unwrap(), *ys.iter().max().unwrap()), (CAP_LINE, BASE_LINE), "{name}");
+            assert_eq!(
+                (*ys.iter().min().unwrap(), *ys.iter().max().unwrap()),
+                (CAP_LINE, BASE_LINE),
+                "{name}"
+            );
         }
-        assert!(Font::named("comic").err().unwrap().starts_with("--font comic: one of futural"));
+        assert!(Font::named("comic")
+            .err()
+            .unwrap()
+            .starts_with("--font comic: one of futural"));
     }
 
     #[test]
@@ -118,9 +144,17 @@ mod tests {
         // futural's `!`: edges −5/5, a stroke down, pen up, the dot.
         let g = parse("12345  9MWRFRT RRYQZR[SZRY\n").unwrap();
         assert_eq!((g[0].left, g[0].right), (-5, 5));
-        assert_eq!(g[0].strokes, vec![vec![[0, -12], [0, 2]], vec![[0, 7], [-1, 8], [0, 9], [1, 8], [0, 7]]]);
+        assert_eq!(
+            g[0].strokes,
+            vec![
+                vec![[0, -12], [0, 2]],
+                vec![[0, 7], [-1, 8], [0, 9], [1, 8], [0, 7]]
+            ]
+        );
         let wrapped = parse("12345  9MWRFRT RRYQZ\nR[SZRY\n").unwrap();
         assert_eq!(wrapped, g);
-        assert!(parse("12345 40MW\n").unwrap_err().ends_with("glyph cut short"));
+        assert!(parse("12345 40MW\n")
+            .unwrap_err()
+            .ends_with("glyph cut short"));
     }
 }

@@ -7,6 +7,7 @@
 //! the tools predict is what the machine does.
 
 pub mod args;
+pub mod bench;
 pub mod board;
 pub mod gray;
 pub mod hershey;

@@ -2,12 +2,20 @@
 
 use std::process::ExitCode;
 use taut_studio::args::Args;
-use taut_studio::{preview, stringart, template, text, vectorize};
+use taut_studio::{bench, preview, stringart, template, text, vectorize};
 
 const HELP: &str = "usage: taut <command> [args]   (cargo run --release --bin taut -- <command> …)";
 
 fn usage() -> String {
-    [stringart::USAGE, template::USAGE, vectorize::USAGE, text::USAGE, preview::USAGE].join("\n\n")
+    [
+        stringart::USAGE,
+        template::USAGE,
+        vectorize::USAGE,
+        text::USAGE,
+        preview::USAGE,
+        bench::USAGE,
+    ]
+    .join("\n\n")
 }
 
 fn main() -> ExitCode {
@@ -23,6 +31,7 @@ fn main() -> ExitCode {
         "vectorize" => run(vectorize::run),
         "text" => run(text::run),
         "preview" => run(preview::run),
+        "bench" => run(bench::run),
         "help" | "--help" | "-h" => {
             println!("{HELP}\n\n{}", usage());
             Ok(())

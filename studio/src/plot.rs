@@ -11,7 +11,9 @@ use taut_logic::machine::Machine;
 /// The plotters and the arm (`$machine=` names).
 pub fn machine(name: &str) -> Result<Machine, String> {
     match Machine::parse(name.as_bytes()) {
-        Some(Machine::StringArt) | None => Err(format!("--machine {name}: flatbed, drum, whiteboard or scara")),
+        Some(Machine::StringArt) | None => Err(format!(
+            "--machine {name}: flatbed, drum, whiteboard or scara"
+        )),
         Some(m) => Ok(m),
     }
 }
@@ -41,13 +43,17 @@ fn n(v: f64) -> String {
     crate::svg::num(v)
 }
 
-/// The program: units and mode, each stroke drawn pen down at `feed`
-/// mm/min after a pen-up rapid to its start, then pen up and home.
+/// The program: units, mode and drivers on, each stroke drawn pen down at
+/// `feed` mm/min after a pen-up rapid to its start, then pen up and home.
 pub fn gcode(strokes: &[Polyline], machine: Machine, feed: f64, title: &str) -> String {
     let (down, up) = pen_words(machine);
     // `?`, `!` and `~` are real-time bytes even inside a comment.
-    let title: String = title.chars().filter(|c| c.is_ascii() && !"?!~()\n\r".contains(*c)).collect();
-    let mut g = format!("; {title}\nG21\nG90\n{up}\n");
+    let title: String = title
+        .chars()
+        .filter(|c| c.is_ascii() && !"?!~()\n\r".contains(*c))
+        .collect();
+    // The drivers start off at power-on: M17 switches them on.
+    let mut g = format!("; {title}\nG21\nG90\nM17\n{up}\n");
     let mut feed_set = false;
     for s in strokes.iter().filter(|s| s.len() >= 2) {
         g += &format!("G0 X{} Y{}\n{down}\n", n(s[0][0]), n(s[0][1]));
@@ -67,7 +73,12 @@ pub fn gcode(strokes: &[Polyline], machine: Machine, feed: f64, title: &str) -> 
 }
 
 /// The G-code of `strokes` and its toolpath as the firmware reads it.
-pub fn plot(strokes: &[Polyline], machine: Machine, feed: f64, title: &str) -> Result<(String, Toolpath), String> {
+pub fn plot(
+    strokes: &[Polyline],
+    machine: Machine,
+    feed: f64,
+    title: &str,
+) -> Result<(String, Toolpath), String> {
     if !(feed >= 10.0) {
         return Err("--feed must be at least 10 mm/min".into());
     }
@@ -85,8 +96,16 @@ mod tests {
 
     #[test]
     fn each_machine_gets_its_pen_words_and_the_path_reads_back() {
-        let strokes = vec![vec![[1.0, 1.0], [5.0, 1.0], [5.0, 4.0]], vec![[8.0, 8.0], [9.0, 9.5]]];
-        for m in [Machine::Drum, Machine::Flatbed, Machine::Whiteboard, Machine::Scara] {
+        let strokes = vec![
+            vec![[1.0, 1.0], [5.0, 1.0], [5.0, 4.0]],
+            vec![[8.0, 8.0], [9.0, 9.5]],
+        ];
+        for m in [
+            Machine::Drum,
+            Machine::Flatbed,
+            Machine::Whiteboard,
+            Machine::Scara,
+        ] {
             let (g, path) = plot(&strokes, m, 1200.0, "test? drawing").unwrap();
             let (down, up) = pen_words(m);
             assert_eq!(g.matches(&format!("{down}\n")).count(), 2, "{m:?}");
@@ -94,16 +113,25 @@ mod tests {
             assert!(g.starts_with("; test drawing\n") && g.contains("G1 X5 Y1 F1200\n"));
             let (drawn, _) = path.lengths();
             // To a step of the coarsest motor (the drum's 0.14 mm).
-            assert!((drawn - 7.0 - 1.0f64.hypot(1.5)).abs() < 0.15, "{m:?}: {drawn}");
+            assert!(
+                (drawn - 7.0 - 1.0f64.hypot(1.5)).abs() < 0.15,
+                "{m:?}: {drawn}"
+            );
         }
-        assert_eq!(machine("string_art").unwrap_err(), "--machine string_art: flatbed, drum, whiteboard or scara");
+        assert_eq!(
+            machine("string_art").unwrap_err(),
+            "--machine string_art: flatbed, drum, whiteboard or scara"
+        );
     }
 
     #[test]
     fn a_drawing_past_the_flatbeds_travel_is_refused() {
         let wide = vec![vec![[0.0, 0.0], [150.0, 0.0]]];
         let e = plot(&wide, Machine::Flatbed, 1200.0, "").unwrap_err();
-        assert!(e.starts_with("the drawing does not fit the flatbed (G-code line 7: error:15"), "{e}");
+        assert!(
+            e.starts_with("the drawing does not fit the flatbed (G-code line 8: error:15"),
+            "{e}"
+        );
         assert!(plot(&wide, Machine::Drum, 1200.0, "").is_ok());
     }
 }

@@ -40,7 +40,12 @@ fn view(path: &Toolpath) -> ([f64; 2], f64) {
 pub fn png(path: &Toolpath, px: usize) -> Canvas {
     let (corner, span) = view(path);
     let scale = px as f64 / span;
-    let at = |p: [f64; 2]| [((p[0] - corner[0]) * scale) as f32, (px as f64 - (p[1] - corner[1]) * scale) as f32];
+    let at = |p: [f64; 2]| {
+        [
+            ((p[0] - corner[0]) * scale) as f32,
+            (px as f64 - (p[1] - corner[1]) * scale) as f32,
+        ]
+    };
     let mut c = Canvas::new(px, px, [255; 3]);
     for m in path.moves.iter().filter(|m| !m.down) {
         c.dashed(at(m.from), at(m.to), 1.0, TRAVEL, 4.0);
@@ -60,7 +65,9 @@ pub fn svg(path: &Toolpath) -> String {
     let mut runs: Vec<(bool, Vec<[f64; 2]>)> = Vec::new();
     for m in &path.moves {
         match runs.last_mut() {
-            Some((down, pts)) if *down == m.down && pts.last() == Some(&flip(m.from)) => pts.push(flip(m.to)),
+            Some((down, pts)) if *down == m.down && pts.last() == Some(&flip(m.from)) => {
+                pts.push(flip(m.to))
+            }
             _ => runs.push((m.down, vec![flip(m.from), flip(m.to)])),
         }
     }
@@ -68,9 +75,16 @@ pub fn svg(path: &Toolpath) -> String {
     for (down, pts) in runs {
         let style = match down {
             true => format!("stroke=\"#141428\" stroke-width=\"{width}\""),
-            false => format!("stroke=\"#4682e6\" stroke-width=\"{width}\" stroke-dasharray=\"{} {}\"", num(span / 150.0), num(span / 150.0)),
+            false => format!(
+                "stroke=\"#4682e6\" stroke-width=\"{width}\" stroke-dasharray=\"{} {}\"",
+                num(span / 150.0),
+                num(span / 150.0)
+            ),
         };
-        s.push(&format!("<polyline points=\"{}\" fill=\"none\" {style}/>", points(pts)));
+        s.push(&format!(
+            "<polyline points=\"{}\" fill=\"none\" {style}/>",
+            points(pts)
+        ));
     }
     s.finish()
 }
@@ -84,15 +98,25 @@ pub fn save(path: &Toolpath, out: &Path, px: usize) -> Result<(), String> {
 }
 
 fn extension(out: &Path) -> Result<String, String> {
-    let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     match ext.as_str() {
         "png" | "svg" => Ok(ext),
-        _ => Err(format!("{}: the picture must be .png or .svg", out.display())),
+        _ => Err(format!(
+            "{}: the picture must be .png or .svg",
+            out.display()
+        )),
     }
 }
 
 /// The nails the string-art job wrapped, from its trace.
-pub fn wrapped_nails(signals: &[vcd::Signal], param_txt: &[u8]) -> Result<(taut_logic::geometry::Board, Vec<u16>), String> {
+pub fn wrapped_nails(
+    signals: &[vcd::Signal],
+    param_txt: &[u8],
+) -> Result<(taut_logic::geometry::Board, Vec<u16>), String> {
     let board = board_from_param(param_txt)?;
     let job = JobReplay::from_signals(signals, board, &MachineConfig::STRING_ART)?;
     Ok((board, job.wrapped_nails()))
@@ -102,7 +126,8 @@ pub fn wrapped_nails(signals: &[vcd::Signal], param_txt: &[u8]) -> Result<(taut_
 pub fn run(mut args: Args) -> Result<(), String> {
     let input = PathBuf::from(args.positional("FILE.gcode or TRACE.vcd")?);
     let name = args.required("machine")?;
-    let machine = Machine::parse(name.as_bytes()).ok_or(format!("--machine {name}: not a machine"))?;
+    let machine =
+        Machine::parse(name.as_bytes()).ok_or(format!("--machine {name}: not a machine"))?;
     let out = PathBuf::from(args.required("o")?);
     let px = args.number("px", 1000usize)?;
     let card = args.value("card").map(PathBuf::from);
@@ -110,7 +135,9 @@ pub fn run(mut args: Args) -> Result<(), String> {
     args.finish()?;
     extension(&out)?;
     let text = std::fs::read_to_string(&input).map_err(|e| format!("{}: {e}", input.display()))?;
-    let is_vcd = input.extension().is_some_and(|e| e.eq_ignore_ascii_case("vcd"));
+    let is_vcd = input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("vcd"));
     if machine == Machine::StringArt {
         if !is_vcd {
             return Err("a string-art job is previewed from its trace (.vcd) with --card".into());
@@ -121,19 +148,31 @@ pub fn run(mut args: Args) -> Result<(), String> {
         let signals = vcd::parse(&text)?;
         let (board, nails) = wrapped_nails(&signals, &param)?;
         match extension(&out)?.as_str() {
-            "svg" => std::fs::write(&out, picture::svg(&board, &nails, thread_mm)).map_err(|e| e.to_string())?,
+            "svg" => std::fs::write(&out, picture::svg(&board, &nails, thread_mm))
+                .map_err(|e| e.to_string())?,
             _ => picture::png(&board, &nails, thread_mm, px).save_png(&out)?,
         }
-        println!("{}: {} nails wrapped; written {}", input.display(), nails.len(), out.display());
+        println!(
+            "{}: {} nails wrapped; written {}",
+            input.display(),
+            nails.len(),
+            out.display()
+        );
         return Ok(());
     }
     let path = match is_vcd {
         true => toolpath::from_vcd(&vcd::parse(&text)?, machine)?,
-        false => toolpath::from_gcode(&text, machine).map_err(|e| format!("{}: {e}", input.display()))?,
+        false => {
+            toolpath::from_gcode(&text, machine).map_err(|e| format!("{}: {e}", input.display()))?
+        }
     };
     save(&path, &out, px)?;
     let (down, up) = path.lengths();
-    println!("{}: pen down {down:.0} mm, up {up:.0} mm; written {}", input.display(), out.display());
+    println!(
+        "{}: pen down {down:.0} mm, up {up:.0} mm; written {}",
+        input.display(),
+        out.display()
+    );
     Ok(())
 }
 
@@ -162,7 +201,9 @@ mod tests {
         let at = |x: usize, y: usize| &c.rgb[(y * 330 + x) * 3..][..3];
         assert!(at(215, 215)[0] < 100, "{:?}", at(215, 215));
         // The diagonal travel: some of it drawn, some of it gap.
-        let travel: Vec<bool> = (40..300).map(|k| at(k, 330 - k)[2] > 200 && at(k, 330 - k)[0] < 200).collect();
+        let travel: Vec<bool> = (40..300)
+            .map(|k| at(k, 330 - k)[2] > 200 && at(k, 330 - k)[0] < 200)
+            .collect();
         assert!(travel.iter().any(|&b| b) && travel.iter().any(|&b| !b));
         let doc = svg(&square());
         assert_eq!(doc.matches("<polyline").count(), 3);
@@ -172,6 +213,8 @@ mod tests {
 
     #[test]
     fn only_png_or_svg() {
-        assert!(save(&square(), Path::new("/tmp/x.jpg"), 10).unwrap_err().ends_with("must be .png or .svg"));
+        assert!(save(&square(), Path::new("/tmp/x.jpg"), 10)
+            .unwrap_err()
+            .ends_with("must be .png or .svg"));
     }
 }

@@ -9,7 +9,14 @@ pub fn bar(message: &str, len: u64) -> ProgressBar {
     let style = ProgressStyle::with_template("{msg:>12} [{bar:32}] {pos}/{len} {elapsed}")
         .expect("a valid template")
         .progress_chars("=> ");
-    ProgressBar::new(len).with_style(style).with_message(message.to_string())
+    ProgressBar::new(len)
+        .with_style(style)
+        .with_message(message.to_string())
+}
+
+/// No bar at all (tests, library callers).
+pub fn quiet() -> ProgressBar {
+    ProgressBar::hidden()
 }
 
 /// A step that cannot count: a spinner with its name.

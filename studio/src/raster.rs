@@ -116,7 +116,12 @@ impl Canvas {
         let mut at = 0.0;
         while at < len {
             let end = (at + dash).min(len);
-            let point = |s: f32| [p[0] + (q[0] - p[0]) * s / len, p[1] + (q[1] - p[1]) * s / len];
+            let point = |s: f32| {
+                [
+                    p[0] + (q[0] - p[0]) * s / len,
+                    p[1] + (q[1] - p[1]) * s / len,
+                ]
+            };
             self.line(point(at), point(end), width, color, 1.0);
             at += 2.0 * dash;
         }
@@ -124,8 +129,14 @@ impl Canvas {
 
     /// A filled disc, its edge anti-aliased.
     pub fn disc(&mut self, c: [f32; 2], radius: f32, color: Rgb) {
-        let (x0, x1) = ((c[0] - radius - 1.0).max(0.0), (c[0] + radius + 1.0).min(self.cols as f32));
-        let (y0, y1) = ((c[1] - radius - 1.0).max(0.0), (c[1] + radius + 1.0).min(self.rows as f32));
+        let (x0, x1) = (
+            (c[0] - radius - 1.0).max(0.0),
+            (c[0] + radius + 1.0).min(self.cols as f32),
+        );
+        let (y0, y1) = (
+            (c[1] - radius - 1.0).max(0.0),
+            (c[1] + radius + 1.0).min(self.rows as f32),
+        );
         for y in y0 as usize..y1.max(0.0) as usize {
             for x in x0 as usize..x1.max(0.0) as usize {
                 let d = (x as f32 + 0.5 - c[0]).hypot(y as f32 + 0.5 - c[1]);
@@ -215,10 +226,16 @@ mod tests {
         for k in 0..24 {
             let a = k as f32 * std::f32::consts::TAU / 24.0 + 0.1;
             let (c, s) = (a.cos(), a.sin());
-            let (p, q) = ([32.0 - 20.0 * c, 32.0 - 20.0 * s], [32.0 + 20.0 * c, 32.0 + 20.0 * s]);
+            let (p, q) = (
+                [32.0 - 20.0 * c, 32.0 - 20.0 * s],
+                [32.0 + 20.0 * c, 32.0 + 20.0 * s],
+            );
             for t in [0.15f32, 0.7, 2.5] {
                 let area: f32 = covered(p, q, t, 64).iter().sum();
-                assert!((area - 40.0 * t).abs() < 1.5 * t, "angle {a} width {t}: {area}");
+                assert!(
+                    (area - 40.0 * t).abs() < 1.5 * t,
+                    "angle {a} width {t}: {area}"
+                );
             }
         }
     }
@@ -229,8 +246,12 @@ mod tests {
         assert!((c[4 * 10 + 3] - 0.2).abs() < 1e-6 && (c[5 * 10 + 3] - 0.2).abs() < 1e-6);
         assert_eq!(c.iter().filter(|&&w| w > 0.0).count(), 20);
         // Off the raster, nothing; no length, nothing.
-        assert!(covered([-5.0, -5.0], [-1.0, -3.0], 1.0, 10).iter().all(|&w| w == 0.0));
-        assert!(covered([3.0, 3.0], [3.0, 3.0], 1.0, 10).iter().all(|&w| w == 0.0));
+        assert!(covered([-5.0, -5.0], [-1.0, -3.0], 1.0, 10)
+            .iter()
+            .all(|&w| w == 0.0));
+        assert!(covered([3.0, 3.0], [3.0, 3.0], 1.0, 10)
+            .iter()
+            .all(|&w| w == 0.0));
     }
 
     #[test]
@@ -240,7 +261,9 @@ mod tests {
         assert!((b[16 * 32 + 16] - 0.5).abs() < 1e-5);
         assert!(b[0] < 0.5); // zero beyond the edge
         let mask: Vec<bool> = (0..32 * 32).map(|i| i % 2 == 0).collect();
-        let other: Vec<f32> = (0..32 * 32).map(|i| if i % 2 == 0 { 0.7 } else { 9.0 }).collect();
+        let other: Vec<f32> = (0..32 * 32)
+            .map(|i| if i % 2 == 0 { 0.7 } else { 9.0 })
+            .collect();
         assert!((rmse(&flat, &other, &mask) - 0.2).abs() < 1e-6);
     }
 }

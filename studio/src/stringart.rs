@@ -83,7 +83,11 @@ pub struct Winding {
 }
 
 /// Generates the winding of `image` on the board of `options`.
-pub fn generate(image: &Gray, options: &Options, progress: &ProgressBar) -> Result<Winding, String> {
+pub fn generate(
+    image: &Gray,
+    options: &Options,
+    progress: &ProgressBar,
+) -> Result<Winding, String> {
     if options.lines == 0 {
         return Err("--lines must be at least 1".into());
     }
@@ -111,7 +115,12 @@ pub fn generate(image: &Gray, options: &Options, progress: &ProgressBar) -> Resu
             greedy::wind(&target, &settings, progress)?
         }
         Method::Plain => baseline::plain(&target, options.lines, options.min_separation, progress),
-        Method::Random => baseline::random(board.nails(), options.lines, options.min_separation, options.seed),
+        Method::Random => baseline::random(
+            board.nails(),
+            options.lines,
+            options.min_separation,
+            options.seed,
+        ),
     };
     let seconds = start.elapsed().as_secs_f64();
     Ok(Winding {
@@ -152,7 +161,10 @@ pub fn write_card(
     write("poradi.txt", poradi.as_bytes())?;
     let thread = f64::from(options.thread_mm);
     picture::png(&board, pattern, thread, preview_px).save_png(&dir.join("preview.png"))?;
-    write("preview.svg", picture::svg(&board, pattern, thread).as_bytes())?;
+    write(
+        "preview.svg",
+        picture::svg(&board, pattern, thread).as_bytes(),
+    )?;
     let (drilling_s, winding_s) = card::machine_seconds(board, pattern)?;
     Ok(Card {
         thread_m: card::thread_mm(&board, pattern) / 1000.0,
@@ -189,8 +201,12 @@ pub fn run(mut args: Args) -> Result<(), String> {
     let w = generate(&image, &o, &bar)?;
     bar.finish_and_clear();
     let card = write_card(&dir, &o, &w.pattern, preview_px)?;
-    let random = Target::new(&image, board, o.resolution, o.thread_mm)
-        .rmse(&baseline::random(spec.nails, o.lines, o.min_separation, o.seed));
+    let random = Target::new(&image, board, o.resolution, o.thread_mm).rmse(&baseline::random(
+        spec.nails,
+        o.lines,
+        o.min_separation,
+        o.seed,
+    ));
     let shape = match spec.shape {
         0 => "a circle".to_string(),
         n => format!("a {n}-gon"),
@@ -202,7 +218,10 @@ pub fn run(mut args: Args) -> Result<(), String> {
         o.lines,
         o.thread_mm
     );
-    println!("  generated in {:.1} s ({:?}, {} px across the ring)", w.seconds, o.method, o.resolution);
+    println!(
+        "  generated in {:.1} s ({:?}, {} px across the ring)",
+        w.seconds, o.method, o.resolution
+    );
     println!(
         "  RMSE {:.4} against the picture (darkness 0–1, both blurred σ = {} px); random chords: {random:.4}",
         w.rmse,
@@ -214,7 +233,10 @@ pub fn run(mut args: Args) -> Result<(), String> {
         hours(card.drilling_s),
         hours(card.winding_s)
     );
-    println!("  written: {}/{{param.txt,poradi.txt,preview.png,preview.svg}}", dir.display());
+    println!(
+        "  written: {}/{{param.txt,poradi.txt,preview.png,preview.svg}}",
+        dir.display()
+    );
     Ok(())
 }
 
@@ -222,7 +244,9 @@ pub fn run(mut args: Args) -> Result<(), String> {
 pub fn spec_from(args: &mut Args) -> Result<Spec, String> {
     let shape = match args.required("shape")?.as_str() {
         "circle" => 0,
-        n => n.parse().map_err(|_| format!("--shape {n}: circle or a number of sides"))?,
+        n => n
+            .parse()
+            .map_err(|_| format!("--shape {n}: circle or a number of sides"))?,
     };
     let radius_cm: f64 = args.number("radius-cm", f64::NAN)?;
     if !(radius_cm > 0.0 && radius_cm <= 1000.0) {

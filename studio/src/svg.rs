@@ -18,7 +18,10 @@ impl Svg {
             w = num(width),
             h = num(height),
         );
-        Svg { head, body: String::new() }
+        Svg {
+            head,
+            body: String::new(),
+        }
     }
 
     pub fn push(&mut self, element: &str) {
@@ -43,13 +46,18 @@ pub fn num(v: f64) -> String {
 
 /// Points as an SVG `points` attribute.
 pub fn points(pts: impl IntoIterator<Item = [f64; 2]>) -> String {
-    let all: Vec<String> = pts.into_iter().map(|p| format!("{},{}", num(p[0]), num(p[1]))).collect();
+    let all: Vec<String> = pts
+        .into_iter()
+        .map(|p| format!("{},{}", num(p[0]), num(p[1])))
+        .collect();
     all.join(" ")
 }
 
 /// Text made safe for XML.
 pub fn escape(text: &str) -> String {
-    text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 #[cfg(test)]

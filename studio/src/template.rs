@@ -42,12 +42,22 @@ pub fn template(spec: &Spec) -> Result<String, String> {
     let mut crosses = String::new();
     for i in 0..board.nails() {
         let [x, y] = flip(nail_mm(&board, i));
-        crosses += &format!("M {} {} h {} M {} {} v {} ", num(x - cross), num(y), num(2.0 * cross), num(x), num(y - cross), num(2.0 * cross));
+        crosses += &format!(
+            "M {} {} h {} M {} {} v {} ",
+            num(x - cross),
+            num(y),
+            num(2.0 * cross),
+            num(x),
+            num(y - cross),
+            num(2.0 * cross)
+        );
         if i % every == 0 {
             s.push(&label(&board, i, font, cross));
         }
     }
-    s.push(&format!("<path d=\"{crosses}\" stroke=\"#000\" stroke-width=\"0.15\"/>"));
+    s.push(&format!(
+        "<path d=\"{crosses}\" stroke=\"#000\" stroke-width=\"0.15\"/>"
+    ));
     let zero = flip(nail_mm(&board, 0));
     s.push(&format!(
         "<line x1=\"0\" y1=\"0\" x2=\"{}\" y2=\"0\" stroke=\"#c03020\" stroke-width=\"0.25\" stroke-dasharray=\"3 2\"/>",
@@ -146,9 +156,15 @@ fn numbering_arrow(board: &Board, font: f64) -> String {
     // The head points along the arc (counter-clockwise: up the page at 0°).
     let (t, n) = ([-sweep.sin(), -sweep.cos()], [sweep.cos(), -sweep.sin()]);
     let head = [
-        [end[0] - 3.0 * t[0] + 1.5 * n[0], end[1] - 3.0 * t[1] + 1.5 * n[1]],
+        [
+            end[0] - 3.0 * t[0] + 1.5 * n[0],
+            end[1] - 3.0 * t[1] + 1.5 * n[1],
+        ],
         end,
-        [end[0] - 3.0 * t[0] - 1.5 * n[0], end[1] - 3.0 * t[1] - 1.5 * n[1]],
+        [
+            end[0] - 3.0 * t[0] - 1.5 * n[0],
+            end[1] - 3.0 * t[1] - 1.5 * n[1],
+        ],
     ];
     format!(
         "<polyline points=\"{}\" fill=\"none\" stroke=\"#c03020\" stroke-width=\"0.4\"/>\n\
@@ -168,7 +184,10 @@ pub fn run(mut args: Args) -> Result<(), String> {
     args.finish()?;
     let doc = template(&spec)?;
     std::fs::write(&out, doc).map_err(|e| format!("{}: {e}", out.display()))?;
-    println!("written: {} (print at 100 %, no fitting to the page)", out.display());
+    println!(
+        "written: {} (print at 100 %, no fitting to the page)",
+        out.display()
+    );
     Ok(())
 }
 
@@ -178,7 +197,11 @@ mod tests {
 
     #[test]
     fn every_nail_is_a_cross_at_the_machines_position() {
-        let spec = Spec { shape: 6, nails: 24, radius_um: 200_000 };
+        let spec = Spec {
+            shape: 6,
+            nails: 24,
+            radius_um: 200_000,
+        };
         let doc = template(&spec).unwrap();
         // 1:1: the page is in millimetres.
         assert!(doc.contains("width=\"444mm\""), "{}", &doc[..200]);
@@ -198,13 +221,23 @@ mod tests {
     fn crowded_numbers_thin_out() {
         assert_eq!(labels(9.7), (5.0, 1));
         assert_eq!(labels(0.24), (1.5, 10));
-        let doc = template(&Spec { shape: 0, nails: 10_000, radius_um: 402_000 }).unwrap();
+        let doc = template(&Spec {
+            shape: 0,
+            nails: 10_000,
+            radius_um: 402_000,
+        })
+        .unwrap();
         assert!(doc.contains(">9990</text>") && !doc.contains(">9991</text>"));
     }
 
     #[test]
     fn impossible_boards_are_refused() {
-        let e = template(&Spec { shape: 0, nails: 2, radius_um: 200_000 }).unwrap_err();
+        let e = template(&Spec {
+            shape: 0,
+            nails: 2,
+            radius_um: 200_000,
+        })
+        .unwrap_err();
         assert_eq!(e, "param.txt:2:17: expected 3 to 10000");
     }
 }

@@ -26,7 +26,13 @@ const LINE_PITCH: i32 = 32;
 /// `text` laid out in `font`: strokes in mm, the lower left corner of all
 /// their ink at `at` (a glyph may reach past its left edge, a descender
 /// below the base line). Errors name a character the font lacks.
-pub fn strokes(font: &Font, text: &str, height_mm: f64, wrap_mm: Option<f64>, at: [f64; 2]) -> Result<Vec<Polyline>, String> {
+pub fn strokes(
+    font: &Font,
+    text: &str,
+    height_mm: f64,
+    wrap_mm: Option<f64>,
+    at: [f64; 2],
+) -> Result<Vec<Polyline>, String> {
     if !(height_mm > 0.0) {
         return Err("--height-mm must be above 0".into());
     }
@@ -35,7 +41,9 @@ pub fn strokes(font: &Font, text: &str, height_mm: f64, wrap_mm: Option<f64>, at
     if let Some(c) = text.chars().find(|&c| c != '\n' && advance(c).is_none()) {
         return Err(format!("{c:?} is not in the font (printable ASCII only)"));
     }
-    let lines = layout(&text.replace("\\n", "\n"), wrap_mm, |c| advance(c).unwrap_or(0.0));
+    let lines = layout(&text.replace("\\n", "\n"), wrap_mm, |c| {
+        advance(c).unwrap_or(0.0)
+    });
     let pitch = f64::from(LINE_PITCH) * scale;
     let mut out: Vec<Polyline> = Vec::new();
     for (k, line) in lines.iter().enumerate() {
@@ -44,7 +52,12 @@ pub fn strokes(font: &Font, text: &str, height_mm: f64, wrap_mm: Option<f64>, at
         for c in line.chars() {
             let g = font.glyph(c).expect("checked above");
             for s in &g.strokes {
-                let pts = s.iter().map(|p| [x + f64::from(p[0] - g.left) * scale, base - f64::from(p[1] - BASE_LINE) * scale]);
+                let pts = s.iter().map(|p| {
+                    [
+                        x + f64::from(p[0] - g.left) * scale,
+                        base - f64::from(p[1] - BASE_LINE) * scale,
+                    ]
+                });
                 out.push(pts.collect());
             }
             x += f64::from(g.right - g.left) * scale;
@@ -93,11 +106,20 @@ pub fn run(mut args: Args) -> Result<(), String> {
         Some(m) => plot::machine(&m)?,
         None => Machine::Flatbed,
     };
-    let wrap = args.value("wrap-mm").map(|w| w.parse::<f64>().map_err(|_| format!("--wrap-mm {w}: not a number"))).transpose()?;
+    let wrap = args
+        .value("wrap-mm")
+        .map(|w| {
+            w.parse::<f64>()
+                .map_err(|_| format!("--wrap-mm {w}: not a number"))
+        })
+        .transpose()?;
     let at = args.pair("at")?;
     let feed = args.number("feed", 1500.0)?;
     let out = PathBuf::from(args.required("o")?);
-    let preview_path = args.value("preview").map(PathBuf::from).unwrap_or_else(|| out.with_extension("png"));
+    let preview_path = args
+        .value("preview")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| out.with_extension("png"));
     args.finish()?;
     let placed = strokes(&font, &text, height, wrap, [0.0, 0.0])?;
     let (_, size) = extent(&placed);
@@ -111,9 +133,15 @@ pub fn run(mut args: Args) -> Result<(), String> {
 }
 
 fn extent(strokes: &[Polyline]) -> ([f64; 2], [f64; 2]) {
-    strokes.iter().flatten().fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
-        ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])])
-    })
+    strokes
+        .iter()
+        .flatten()
+        .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1])],
+                [hi[0].max(p[0]), hi[1].max(p[1])],
+            )
+        })
 }
 
 fn report(path: &Toolpath, out: &std::path::Path, preview: &std::path::Path) {
@@ -145,7 +173,9 @@ mod tests {
             let font = Font::named(name).unwrap();
             let s = strokes(&font, &all, 5.0, None, [0.0, 0.0]).unwrap();
             // Every glyph but the space draws at least one stroke.
-            let drawn: usize = ('!'..='~').map(|c| font.glyph(c).unwrap().strokes.len()).sum();
+            let drawn: usize = ('!'..='~')
+                .map(|c| font.glyph(c).unwrap().strokes.len())
+                .sum();
             assert_eq!(s.len(), drawn, "{name}");
             let (g, path) = plot::plot(&s, Machine::Flatbed, 1500.0, name).unwrap();
             assert!(path.lengths().0 > 0.0 && g.lines().count() > 95, "{name}");
@@ -163,7 +193,11 @@ mod tests {
         // The second H starts one H's advance (22 units) after the first.
         let h = font.glyph('H').unwrap();
         assert_eq!(h.right - h.left, 22);
-        assert!((s[3][0][0] - s[0][0][0] - 22.0 * unit).abs() < 1e-9, "{:?}", s[3]);
+        assert!(
+            (s[3][0][0] - s[0][0][0] - 22.0 * unit).abs() < 1e-9,
+            "{:?}",
+            s[3]
+        );
         // From the first H's left bar to the second's right bar: one
         // advance and the 14 units between an H's bars.
         assert!((hi[0] - lo[0] - (22.0 + 14.0) * unit).abs() < 1e-9);
@@ -180,6 +214,8 @@ mod tests {
         let adv = |c: char| if c == ' ' { 1.0 } else { 2.0 };
         assert_eq!(layout("ab cd ef", Some(9.0), adv), ["ab cd", "ef"]);
         assert_eq!(layout("abcdefgh ij", Some(5.0), adv), ["abcdefgh", "ij"]);
-        assert!(strokes(&font, "é", 10.0, None, [0.0; 2]).unwrap_err().starts_with("'é' is not in the font"));
+        assert!(strokes(&font, "é", 10.0, None, [0.0; 2])
+            .unwrap_err()
+            .starts_with("'é' is not in the font"));
     }
 }

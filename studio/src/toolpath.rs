@@ -33,10 +33,12 @@ pub struct Toolpath {
 impl Toolpath {
     /// Length with the pen down, and up, mm.
     pub fn lengths(&self) -> (f64, f64) {
-        self.moves.iter().fold((0.0, 0.0), |(d, u), m| match m.down {
-            true => (d + m.len(), u),
-            false => (d, u + m.len()),
-        })
+        self.moves
+            .iter()
+            .fold((0.0, 0.0), |(d, u), m| match m.down {
+                true => (d + m.len(), u),
+                false => (d, u + m.len()),
+            })
     }
 
     /// Least and greatest x and y of every move.
@@ -89,7 +91,9 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
         let fail = |code: u8, message: &str| format!("line {here}: error:{code} {message}");
         let line = match result {
             Ok(Input::Line(line)) => line,
-            Ok(Input::Realtime(r)) => return Err(format!("line {here}: a real-time byte ({r:?}) in the file")),
+            Ok(Input::Realtime(r)) => {
+                return Err(format!("line {here}: a real-time byte ({r:?}) in the file"))
+            }
             Ok(_) => return Err(format!("line {here}: a $ or card command is not a drawing")),
             Err(e) => return Err(fail(e.code(), e.message())),
         };
@@ -126,7 +130,8 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
 /// motors stood at power-on.
 pub fn from_vcd(signals: &[Signal], machine: Machine) -> Result<Toolpath, String> {
     let cfg = MachineConfig::defaults(machine);
-    let points = taut_simavr::picture::plot_points(signals, &cfg, [0, 0]).map_err(|e| e.to_string())?;
+    let points =
+        taut_simavr::picture::plot_points(signals, &cfg, [0, 0]).map_err(|e| e.to_string())?;
     let mut path = Toolpath::default();
     for w in points.windows(2) {
         path.push([w[0].0 .0, w[0].0 .1], [w[1].0 .0, w[1].0 .1], w[1].1);
@@ -144,11 +149,17 @@ mod tests {
         let p = from_gcode(g, Machine::Scara).unwrap();
         let (down, up) = p.lengths();
         // 10 mm straight, a half circle of radius 5 drawn; 10 + 10 mm up.
-        assert!((down - 10.0 - 5.0 * std::f64::consts::PI).abs() < 0.05, "{down}");
+        assert!(
+            (down - 10.0 - 5.0 * std::f64::consts::PI).abs() < 0.05,
+            "{down}"
+        );
         assert!((up - 20.0).abs() < 0.01, "{up}");
         // Z lifts and lowers the flatbed's pen.
         let p = from_gcode("G0 Z1\nG0 X5\nG0 Z0\nG1 X6 F100\n", Machine::Flatbed).unwrap();
-        assert_eq!(p.moves.iter().map(|m| m.down).collect::<Vec<_>>(), [false, true]);
+        assert_eq!(
+            p.moves.iter().map(|m| m.down).collect::<Vec<_>>(),
+            [false, true]
+        );
     }
 
     #[test]

@@ -34,7 +34,11 @@ pub enum Mode {
     /// Canny edges, thresholds on the 0–255 gradient (OpenCV's scale).
     Edges { low: f32, high: f32 },
     /// Outlines and hatching of the regions darker than `threshold` (0–1).
-    Hatch { threshold: f32, spacing_mm: f64, angle: f64 },
+    Hatch {
+        threshold: f32,
+        spacing_mm: f64,
+        angle: f64,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -56,7 +60,10 @@ impl Options {
         Options {
             machine,
             width_mm,
-            mode: Mode::Edges { low: 50.0, high: 150.0 },
+            mode: Mode::Edges {
+                low: 50.0,
+                high: 150.0,
+            },
             blur: 1.4,
             tolerance_mm: 0.1,
             min_length_mm: 0.5,
@@ -95,7 +102,8 @@ pub fn vectorize(image: &Gray, o: &Options, title: &str) -> Result<Vectorized, S
     let (w, h) = (image.width, image.height);
     let mm_per_px = o.width_mm / w as f64;
     let size = [o.width_mm, h as f64 * mm_per_px];
-    let at = o.at.unwrap_or_else(|| plot::default_corner(o.machine, size));
+    let at =
+        o.at.unwrap_or_else(|| plot::default_corner(o.machine, size));
     let spin = progress::spinner("tracing");
     let traced: Vec<Polyline> = match o.mode {
         Mode::Edges { low, high } => {
@@ -105,7 +113,11 @@ pub fn vectorize(image: &Gray, o: &Options, title: &str) -> Result<Vectorized, S
             let edge = canny::edges(&image, o.blur, low, high);
             trace::chains(&edge, w, h)
         }
-        Mode::Hatch { threshold, spacing_mm, angle } => {
+        Mode::Hatch {
+            threshold,
+            spacing_mm,
+            angle,
+        } => {
             if !(spacing_mm > 0.0) {
                 return Err("--hatch-mm must be above 0".into());
             }
@@ -120,7 +132,12 @@ pub fn vectorize(image: &Gray, o: &Options, title: &str) -> Result<Vectorized, S
         }
     };
     // Pixels (y down) to the G-code's millimetres (y up).
-    let to_mm = |p: &[f64; 2]| [at[0] + p[0] * mm_per_px, at[1] + (h as f64 - p[1]) * mm_per_px];
+    let to_mm = |p: &[f64; 2]| {
+        [
+            at[0] + p[0] * mm_per_px,
+            at[1] + (h as f64 - p[1]) * mm_per_px,
+        ]
+    };
     let strokes: Vec<Polyline> = traced
         .iter()
         .map(|line| simplify::simplify(&line.iter().map(to_mm).collect::<Vec<_>>(), o.tolerance_mm))
@@ -150,7 +167,9 @@ pub fn vectorize(image: &Gray, o: &Options, title: &str) -> Result<Vectorized, S
 }
 
 fn length(s: &[[f64; 2]]) -> f64 {
-    s.windows(2).map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1])).sum()
+    s.windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum()
 }
 
 /// `taut vectorize …` from the command line.
@@ -163,8 +182,15 @@ pub fn run(mut args: Args) -> Result<(), String> {
     let spacing_mm = args.number("hatch-mm", 1.0)?;
     let angle = args.number("angle", 45.0)?;
     o.mode = match args.value("mode").as_deref() {
-        None | Some("edges") => Mode::Edges { low: low as f32, high: high as f32 },
-        Some("hatch") => Mode::Hatch { threshold, spacing_mm, angle },
+        None | Some("edges") => Mode::Edges {
+            low: low as f32,
+            high: high as f32,
+        },
+        Some("hatch") => Mode::Hatch {
+            threshold,
+            spacing_mm,
+            angle,
+        },
         Some(m) => return Err(format!("--mode {m}: edges or hatch")),
     };
     o.blur = args.number("blur", o.blur)?;
@@ -173,7 +199,10 @@ pub fn run(mut args: Args) -> Result<(), String> {
     o.at = args.pair("at")?;
     o.feed = args.number("feed", o.feed)?;
     let out = PathBuf::from(args.required("o")?);
-    let preview_path = args.value("preview").map(PathBuf::from).unwrap_or_else(|| out.with_extension("png"));
+    let preview_path = args
+        .value("preview")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| out.with_extension("png"));
     args.finish()?;
 
     let image = Gray::open(&image_path)?;

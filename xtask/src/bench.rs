@@ -1,5 +1,6 @@
 //! `cargo xtask bench`: figures from simavr's cycle counter (`taut-bench`
-//! in simavr/), written to target/bench.json and printed as a table.
+//! in simavr/), written to target/bench.json and printed as a table; then
+//! the host tools' string-art figures (`taut bench`) added to it.
 
 use crate::firmware;
 use crate::run::{self, root, Result};
@@ -15,5 +16,7 @@ pub fn run() -> Result<()> {
         busy.display().to_string(),
         out.display().to_string(),
     ];
-    run::bin("taut-bench", &args)
+    run::bin("taut-bench", &args)?;
+    println!("\n== string art on the host (taut bench)");
+    run::studio(&["bench".into(), "--json".into(), out.display().to_string()])
 }

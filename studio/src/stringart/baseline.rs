@@ -63,7 +63,10 @@ pub fn plain(target: &Target, lines: usize, min: u16, progress: &ProgressBar) ->
 /// truncated to the pixel (numpy's `linspace(…, dtype=int)`), repeats
 /// dropped.
 fn samples(target: &Target, a: u16, b: u16, out: &mut Vec<usize>) {
-    let (p, q) = (target.frame.nails[a as usize], target.frame.nails[b as usize]);
+    let (p, q) = (
+        target.frame.nails[a as usize],
+        target.frame.nails[b as usize],
+    );
     let size = target.frame.size;
     let count = ((q[0] - p[0]).hypot(q[1] - p[1]) as usize).max(2);
     out.clear();
@@ -85,7 +88,9 @@ pub fn random(nails: u16, lines: usize, min: u16, seed: u64) -> Vec<u16> {
     let mut at = 0u16;
     (0..lines)
         .map(|_| {
-            let choices: Vec<u16> = (0..nails).filter(|&b| far_enough(at, b, nails, min.max(1))).collect();
+            let choices: Vec<u16> = (0..nails)
+                .filter(|&b| far_enough(at, b, nails, min.max(1)))
+                .collect();
             at = choices[rng.below(choices.len() as u64) as usize];
             at
         })

@@ -39,7 +39,8 @@ impl Spec {
         files.push(self.param_txt().as_bytes()).map_err(show)?;
         files.end(&base).map_err(show)?;
         let radius = taut_logic::units::Milli(self.radius_um as i32);
-        let board = Board::new(self.shape, self.nails, radius).map_err(|e| e.message().to_string())?;
+        let board =
+            Board::new(self.shape, self.nails, radius).map_err(|e| e.message().to_string())?;
         Winder::new(board, &base).map_err(|_| "the board is too small to wind".to_string())?;
         Ok(board)
     }
@@ -82,7 +83,11 @@ pub fn check(param: &[u8], poradi: &[u8]) -> Result<Vec<u16>, String> {
     }
     nails.extend(reader.finish().map_err(show)?);
     if nails.len() != checked.count as usize {
-        return Err(format!("{} nails read, {} declared", nails.len(), checked.count));
+        return Err(format!(
+            "{} nails read, {} declared",
+            nails.len(),
+            checked.count
+        ));
     }
     Ok(nails)
 }
@@ -135,33 +140,68 @@ pub fn machine_seconds(board: Board, pattern: &[u16]) -> Result<(f64, f64), Stri
 mod tests {
     use super::*;
 
-    const SPEC: Spec = Spec { shape: 0, nails: 250, radius_um: 402_000 };
+    const SPEC: Spec = Spec {
+        shape: 0,
+        nails: 250,
+        radius_um: 402_000,
+    };
 
     #[test]
     fn the_files_read_back_through_the_firmware() {
-        assert_eq!(SPEC.param_txt(), "tvar = 0\npocet_hrebiku = 250\npolomer_matrice = 40.2\n");
+        assert_eq!(
+            SPEC.param_txt(),
+            "tvar = 0\npocet_hrebiku = 250\npolomer_matrice = 40.2\n"
+        );
         let pattern: Vec<u16> = (0..45).map(|k| (k * 37 % 250) as u16).collect();
         let text = poradi_txt(&pattern);
         assert!(text.starts_with("45,\n0,37,74,"));
-        assert_eq!(check(SPEC.param_txt().as_bytes(), text.as_bytes()), Ok(pattern));
+        assert_eq!(
+            check(SPEC.param_txt().as_bytes(), text.as_bytes()),
+            Ok(pattern)
+        );
         let bad = check(SPEC.param_txt().as_bytes(), b"2,4,250\n").unwrap_err();
         assert_eq!(bad, "poradi.txt:1:5: nail 250 out of range (nails: 250)");
     }
 
     #[test]
     fn impossible_boards_get_the_firmwares_words() {
-        let spec = |shape, nails, radius_um| Spec { shape, nails, radius_um };
-        assert_eq!(spec(2, 250, 402_000).board().unwrap_err(), "param.txt:1:8: expected 0 or 3 to 1000");
-        assert_eq!(spec(0, 2, 402_000).board().unwrap_err(), "param.txt:2:17: expected 3 to 10000");
-        assert_eq!(spec(0, 10_001, 402_000).board().unwrap_err(), "param.txt:2:17: expected 3 to 10000");
-        assert_eq!(spec(4, 50, 40_000).board().unwrap_err(), "param.txt:3:19: expected more than 4.3284 cm");
-        assert_eq!(spec(0, 50, 352_500).param_txt().lines().last(), Some("polomer_matrice = 35.25"));
+        let spec = |shape, nails, radius_um| Spec {
+            shape,
+            nails,
+            radius_um,
+        };
+        assert_eq!(
+            spec(2, 250, 402_000).board().unwrap_err(),
+            "param.txt:1:8: expected 0 or 3 to 1000"
+        );
+        assert_eq!(
+            spec(0, 2, 402_000).board().unwrap_err(),
+            "param.txt:2:17: expected 3 to 10000"
+        );
+        assert_eq!(
+            spec(0, 10_001, 402_000).board().unwrap_err(),
+            "param.txt:2:17: expected 3 to 10000"
+        );
+        assert_eq!(
+            spec(4, 50, 40_000).board().unwrap_err(),
+            "param.txt:3:19: expected more than 4.3284 cm"
+        );
+        assert_eq!(
+            spec(0, 50, 352_500).param_txt().lines().last(),
+            Some("polomer_matrice = 35.25")
+        );
         assert!(spec(1000, 3, 10_000_000).board().is_ok());
     }
 
     #[test]
     fn thread_and_time_of_a_small_job() {
-        let board = Spec { shape: 0, nails: 4, radius_um: 115_000 }.board().unwrap();
+        let board = Spec {
+            shape: 0,
+            nails: 4,
+            radius_um: 115_000,
+        }
+        .board()
+        .unwrap();
         // Nail 0 → 2 → 1: a diameter (200 mm) and a side (100·√2).
         let mm = thread_mm(&board, &[2, 1]);
         assert!((mm - 200.0 - 100.0 * 2f64.sqrt()).abs() < 0.01, "{mm}");

@@ -63,7 +63,10 @@ impl<'a> Loom<'a> {
         let side = 2 * reach + 1;
         let kernel: Vec<f32> = (0..side * side)
             .map(|k| {
-                let (dx, dy) = ((k % side) as f32 - reach as f32, (k / side) as f32 - reach as f32);
+                let (dx, dy) = (
+                    (k % side) as f32 - reach as f32,
+                    (k / side) as f32 - reach as f32,
+                );
                 (-(dx * dx + dy * dy) / (2.0 * sigma2 * sigma2)).exp()
             })
             .collect();
@@ -72,7 +75,12 @@ impl<'a> Loom<'a> {
         let kernel = kernel.iter().map(|k| k / sum).collect();
         let want = blur(&target.darkness, size, sigma2);
         Loom {
-            bare: target.frame.mask.iter().map(|&m| if m { 1.0 } else { 0.0 }).collect(),
+            bare: target
+                .frame
+                .mask
+                .iter()
+                .map(|&m| if m { 1.0 } else { 0.0 })
+                .collect(),
             field: want.iter().map(|w| -w).collect(),
             kernel,
             reach,
@@ -101,7 +109,11 @@ impl<'a> Loom<'a> {
         let bare = &mut self.bare;
         self.target.chord(a, b, |i, w| {
             let before = bare[i];
-            bare[i] = if on { before * (1.0 - w) } else { before / (1.0 - w) };
+            bare[i] = if on {
+                before * (1.0 - w)
+            } else {
+                before / (1.0 - w)
+            };
             touched.push((i, before - bare[i]));
         });
         self.splat(&touched);
@@ -131,11 +143,21 @@ impl<'a> Loom<'a> {
 }
 
 /// [`Loom::splat`] into `rows`, the rows of F from `first` on.
-fn splat_rows(rows: &mut [f32], first: usize, touched: &[(usize, f32)], kernel: &[f32], reach: usize, size: usize) {
+fn splat_rows(
+    rows: &mut [f32],
+    first: usize,
+    touched: &[(usize, f32)],
+    kernel: &[f32],
+    reach: usize,
+    size: usize,
+) {
     let (side, last) = (2 * reach + 1, first + rows.len() / size);
     for &(i, dark) in touched {
         let (x, y) = (i % size, i / size);
-        let (y0, y1) = (y.saturating_sub(reach).max(first), (y + reach + 1).min(last));
+        let (y0, y1) = (
+            y.saturating_sub(reach).max(first),
+            (y + reach + 1).min(last),
+        );
         let (x0, x1) = (x.saturating_sub(reach), (x + reach).min(size - 1));
         for yy in y0..y1 {
             let krow = &kernel[(yy + reach - y) * side..][..side];
@@ -149,7 +171,11 @@ fn splat_rows(rows: &mut [f32], first: usize, touched: &[(usize, f32)], kernel: 
 
 /// The winding: `settings.lines` nails after nail 0, where the thread is
 /// tied. `progress` counts lines, then pass visits.
-pub fn wind(target: &Target, settings: &Settings, progress: &ProgressBar) -> Result<Vec<u16>, String> {
+pub fn wind(
+    target: &Target,
+    settings: &Settings,
+    progress: &ProgressBar,
+) -> Result<Vec<u16>, String> {
     let n = target.nails();
     let min = settings.min_separation.max(1);
     if n / 2 < min {
@@ -212,12 +238,17 @@ fn improve(
         let prev = if k == 0 { 0 } else { pattern[k - 1] };
         let next = pattern.get(k + 1).copied();
         let here = pattern[k];
-        let fits = |c: u16| far_enough(prev, c, n, min) && next.is_none_or(|x| far_enough(c, x, n, min));
-        let cost = |loom: &Loom<'_>, c: u16| loom.gain(prev, c) + next.map_or(0.0, |x| loom.gain(c, x));
+        let fits =
+            |c: u16| far_enough(prev, c, n, min) && next.is_none_or(|x| far_enough(c, x, n, min));
+        let cost =
+            |loom: &Loom<'_>, c: u16| loom.gain(prev, c) + next.map_or(0.0, |x| loom.gain(c, x));
         // Screening on the present state: who would do better than here?
         // (The present nail comes first and wins ties.)
-        let near = (1..=settings.window.min(n / 2)).flat_map(|d| [(here + d) % n, (here + n - d) % n]);
-        let candidates: Vec<u16> = std::iter::once(here).chain(near.filter(|&c| fits(c))).collect();
+        let near =
+            (1..=settings.window.min(n / 2)).flat_map(|d| [(here + d) % n, (here + n - d) % n]);
+        let candidates: Vec<u16> = std::iter::once(here)
+            .chain(near.filter(|&c| fits(c)))
+            .collect();
         let best = candidates
             .par_iter()
             .enumerate()
@@ -233,7 +264,11 @@ fn improve(
         if let Some(x) = next {
             loom.remove(here, x);
         }
-        let winner = if cost(loom, c) < cost(loom, here) { c } else { here };
+        let winner = if cost(loom, c) < cost(loom, here) {
+            c
+        } else {
+            here
+        };
         loom.add(prev, winner);
         if let Some(x) = next {
             loom.add(winner, x);
@@ -306,7 +341,13 @@ mod tests {
     }
 
     fn settings(lines: usize, passes: usize) -> Settings {
-        Settings { lines, min_separation: 3, passes, window: 4, seed: 7 }
+        Settings {
+            lines,
+            min_separation: 3,
+            passes,
+            window: 4,
+            seed: 7,
+        }
     }
 
     #[test]
@@ -326,18 +367,35 @@ mod tests {
         for (a, b) in chords(&better) {
             assert!(far_enough(a, b, 40, 3), "{a}–{b}");
         }
-        assert!(t.rmse(&better) <= t.rmse(&greedy) + 1e-6, "{} > {}", t.rmse(&better), t.rmse(&greedy));
+        assert!(
+            t.rmse(&better) <= t.rmse(&greedy) + 1e-6,
+            "{} > {}",
+            t.rmse(&better),
+            t.rmse(&greedy)
+        );
         // The loom's running state is the rendering inside the ring, and
         // its field the blurred difference, up to rounding.
         let loom = loom_of(&t, &better);
         let dark = t.render(&better);
         let inside = |i: &usize| t.frame.mask[*i];
-        let worst = (0..dark.len()).filter(inside).map(|i| (1.0 - loom.bare[i] - dark[i]).abs());
+        let worst = (0..dark.len())
+            .filter(inside)
+            .map(|i| (1.0 - loom.bare[i] - dark[i]).abs());
         assert!(worst.fold(0.0, f32::max) < 1e-4);
         // Threads off the ring (beside the nails) are not in the field.
-        let diff: Vec<f32> = (0..dark.len()).map(|i| if inside(&i) { dark[i] - t.darkness[i] } else { 0.0 }).collect();
+        let diff: Vec<f32> = (0..dark.len())
+            .map(|i| {
+                if inside(&i) {
+                    dark[i] - t.darkness[i]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
         let field = blur(&diff, 64, t.blur_sigma() * std::f32::consts::SQRT_2);
-        let worst = (0..dark.len()).map(|i| (loom.field[i] - field[i]).abs()).fold(0.0, f32::max);
+        let worst = (0..dark.len())
+            .map(|i| (loom.field[i] - field[i]).abs())
+            .fold(0.0, f32::max);
         assert!(worst < 1e-4, "{worst}");
     }
 

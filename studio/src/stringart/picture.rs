@@ -44,7 +44,11 @@ pub fn png(board: &Board, pattern: &[u16], thread_mm: f64, px: usize) -> Canvas 
         [(c + p[0] / mm_per_px) as f32, (c - p[1] / mm_per_px) as f32]
     };
     let mut c = Canvas::new(px, px, GROUND);
-    fill_polygon(&mut c, &outline(board).iter().map(|&p| at(p)).collect::<Vec<_>>(), FACE);
+    fill_polygon(
+        &mut c,
+        &outline(board).iter().map(|&p| at(p)).collect::<Vec<_>>(),
+        FACE,
+    );
     let edge = outline(board);
     for w in edge.windows(2) {
         c.line(at(w[0]), at(w[1]), 1.5, EDGE, 1.0);
@@ -66,7 +70,9 @@ pub fn png(board: &Board, pattern: &[u16], thread_mm: f64, px: usize) -> Canvas 
 /// Fills a convex polygon given in pixels (anti-aliasing left to its edge
 /// line).
 fn fill_polygon(c: &mut Canvas, poly: &[[f32; 2]], color: Rgb) {
-    let (lo, hi) = poly.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| (lo.min(p[1]), hi.max(p[1])));
+    let (lo, hi) = poly.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| {
+        (lo.min(p[1]), hi.max(p[1]))
+    });
     for y in lo.max(0.0) as usize..(hi.ceil() as usize).min(c.rows) {
         let yc = y as f32 + 0.5;
         let mut xs: Vec<f32> = poly
@@ -123,7 +129,10 @@ mod tests {
         let o = outline(&hex);
         assert_eq!(o.len(), 7);
         assert!((o[1][0] - 100.0).abs() < 1e-9);
-        assert_eq!(outline(&Board::new(0, 30, Milli(200_000)).unwrap()).len(), 361);
+        assert_eq!(
+            outline(&Board::new(0, 30, Milli(200_000)).unwrap()).len(),
+            361
+        );
     }
 
     #[test]

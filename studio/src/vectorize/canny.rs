@@ -9,8 +9,14 @@ use crate::gray::Gray;
 pub fn edges(image: &Gray, sigma: f32, low: f32, high: f32) -> Vec<bool> {
     let (w, h) = (image.width, image.height);
     let levels: Vec<f32> = image.pixels.iter().map(|v| v * 255.0).collect();
-    let smooth = if sigma > 0.0 { gaussian(&levels, w, h, sigma) } else { levels };
-    let at = |x: isize, y: isize| smooth[y.clamp(0, h as isize - 1) as usize * w + x.clamp(0, w as isize - 1) as usize];
+    let smooth = if sigma > 0.0 {
+        gaussian(&levels, w, h, sigma)
+    } else {
+        levels
+    };
+    let at = |x: isize, y: isize| {
+        smooth[y.clamp(0, h as isize - 1) as usize * w + x.clamp(0, w as isize - 1) as usize]
+    };
     let mut magnitude = vec![0.0f32; w * h];
     let mut sector = vec![0u8; w * h];
     for y in 0..h as isize {
@@ -72,12 +78,23 @@ pub fn edges(image: &Gray, sigma: f32, low: f32, high: f32) -> Vec<bool> {
 }
 
 /// The eight neighbours, the four sides first.
-pub const NEIGHBOURS: [(isize, isize); 8] = [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, 1), (-1, -1), (1, -1)];
+pub const NEIGHBOURS: [(isize, isize); 8] = [
+    (1, 0),
+    (0, 1),
+    (-1, 0),
+    (0, -1),
+    (1, 1),
+    (-1, 1),
+    (-1, -1),
+    (1, -1),
+];
 
 /// Separable Gaussian blur, edges clamped.
 pub fn gaussian(data: &[f32], w: usize, h: usize, sigma: f32) -> Vec<f32> {
     let reach = (3.0 * sigma).ceil() as isize;
-    let kernel: Vec<f32> = (-reach..=reach).map(|k| (-(k * k) as f32 / (2.0 * sigma * sigma)).exp()).collect();
+    let kernel: Vec<f32> = (-reach..=reach)
+        .map(|k| (-(k * k) as f32 / (2.0 * sigma * sigma)).exp())
+        .collect();
     let sum: f32 = kernel.iter().sum();
     let blur = |src: &[f32], along_x: bool| {
         let mut out = vec![0.0; src.len()];
@@ -116,7 +133,10 @@ mod tests {
         // Along the left side, one pixel wide, at the step.
         let row: Vec<usize> = (0..40).filter(|&x| e[20 * 40 + x]).collect();
         assert_eq!(row.len(), 2, "{row:?}");
-        assert!((9..=10).contains(&row[0]) && (29..=30).contains(&row[1]), "{row:?}");
+        assert!(
+            (9..=10).contains(&row[0]) && (29..=30).contains(&row[1]),
+            "{row:?}"
+        );
         // Nothing in the flat parts.
         assert!(!e[20 * 40 + 20] && !e[2 * 40 + 2]);
         // Thresholds above every gradient: no edges at all.

@@ -123,7 +123,13 @@ mod tests {
                 // A closed square, or an open two- or three-point stroke.
                 0 => {
                     let (x, y) = (r(), r());
-                    vec![[x, y], [x + 2.0, y], [x + 2.0, y + 2.0], [x, y + 2.0], [x, y]]
+                    vec![
+                        [x, y],
+                        [x + 2.0, y],
+                        [x + 2.0, y + 2.0],
+                        [x, y + 2.0],
+                        [x, y],
+                    ]
                 }
                 1 => vec![[r(), r()], [r(), r()]],
                 _ => vec![[r(), r()], [r(), r()], [r(), r()]],
@@ -134,7 +140,10 @@ mod tests {
     /// Every stroke drawn once, the same points, either way round.
     fn same_strokes(a: &[Polyline], b: &[Polyline]) -> bool {
         let key = |s: &Polyline| {
-            let mut pts: Vec<(i64, i64)> = s.iter().map(|p| ((p[0] * 1e6) as i64, (p[1] * 1e6) as i64)).collect();
+            let mut pts: Vec<(i64, i64)> = s
+                .iter()
+                .map(|p| ((p[0] * 1e6) as i64, (p[1] * 1e6) as i64))
+                .collect();
             if closed(s) {
                 pts.pop();
             }
@@ -159,7 +168,10 @@ mod tests {
             assert!(after <= before + 1e-9, "trial {trial}: {after} > {before}");
             assert!(same_strokes(&strokes, &ordered), "trial {trial}");
             if trial > 5 {
-                assert!(after < 0.6 * before, "trial {trial}: only {before} → {after}");
+                assert!(
+                    after < 0.6 * before,
+                    "trial {trial}: only {before} → {after}"
+                );
             }
         }
     }
@@ -167,7 +179,10 @@ mod tests {
     #[test]
     fn a_row_of_dashes_is_drawn_left_to_right_in_turn() {
         // Given right to left, each pointing left.
-        let strokes: Vec<Polyline> = (0..5).rev().map(|k| vec![[k as f64 * 10.0 + 5.0, 0.0], [k as f64 * 10.0, 0.0]]).collect();
+        let strokes: Vec<Polyline> = (0..5)
+            .rev()
+            .map(|k| vec![[k as f64 * 10.0 + 5.0, 0.0], [k as f64 * 10.0, 0.0]])
+            .collect();
         let ordered = order(strokes, [0.0; 2]);
         let starts: Vec<f64> = ordered.iter().map(|s| s[0][0]).collect();
         assert_eq!(starts, [0.0, 10.0, 20.0, 30.0, 40.0]);

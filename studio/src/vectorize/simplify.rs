@@ -22,7 +22,11 @@ pub fn simplify(line: &[[f64; 2]], tolerance: f64) -> Polyline {
             spans.push((far, b));
         }
     }
-    line.iter().zip(keep).filter(|(_, k)| *k).map(|(p, _)| *p).collect()
+    line.iter()
+        .zip(keep)
+        .filter(|(_, k)| *k)
+        .map(|(p, _)| *p)
+        .collect()
 }
 
 /// Distance from `p` to the segment `a`–`b`.
@@ -45,15 +49,29 @@ mod tests {
         let line: Vec<[f64; 2]> = (0..50).map(|i| [i as f64, 0.0]).collect();
         assert_eq!(simplify(&line, 0.1), [[0.0, 0.0], [49.0, 0.0]]);
         // A staircase within half a pixel of a diagonal.
-        let stairs: Vec<[f64; 2]> = (0..40).map(|i| [(i / 2 + i % 2) as f64, (i / 2) as f64]).collect();
+        let stairs: Vec<[f64; 2]> = (0..40)
+            .map(|i| [(i / 2 + i % 2) as f64, (i / 2) as f64])
+            .collect();
         let s = simplify(&stairs, 0.75);
         assert!(s.len() <= 3, "{s:?}");
         for p in &stairs {
-            let d = s.windows(2).map(|w| distance(*p, w[0], w[1])).fold(f64::MAX, f64::min);
+            let d = s
+                .windows(2)
+                .map(|w| distance(*p, w[0], w[1]))
+                .fold(f64::MAX, f64::min);
             assert!(d <= 0.75 + 1e-12);
         }
         // A corner stays.
-        let corner = [[0.0, 0.0], [5.0, 0.0], [10.0, 0.0], [10.0, 5.0], [10.0, 10.0]];
-        assert_eq!(simplify(&corner, 0.5), [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]]);
+        let corner = [
+            [0.0, 0.0],
+            [5.0, 0.0],
+            [10.0, 0.0],
+            [10.0, 5.0],
+            [10.0, 10.0],
+        ];
+        assert_eq!(
+            simplify(&corner, 0.5),
+            [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]]
+        );
     }
 }

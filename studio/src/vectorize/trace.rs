@@ -58,13 +58,18 @@ pub fn chains(edge: &[bool], w: usize, h: usize) -> Vec<Polyline> {
 /// round, so every boundary closes).
 pub fn outlines(dark: &[bool], w: usize, h: usize) -> Vec<Polyline> {
     // Corner (x, y) of the padded grid is pixel (x − 1, y − 1).
-    let at = |x: usize, y: usize| x >= 1 && y >= 1 && x <= w && y <= h && dark[(y - 1) * w + (x - 1)];
+    let at =
+        |x: usize, y: usize| x >= 1 && y >= 1 && x <= w && y <= h && dark[(y - 1) * w + (x - 1)];
     // Each cell's crossing segments, as edges between midpoints of cell
     // sides, joined into loops through a map of where each starts.
-    let mut next: std::collections::HashMap<(usize, usize, u8), (usize, usize, u8)> = Default::default();
+    let mut next: std::collections::HashMap<(usize, usize, u8), (usize, usize, u8)> =
+        Default::default();
     for y in 0..=h {
         for x in 0..=w {
-            let case = (at(x, y) as u8) | (at(x + 1, y) as u8) << 1 | (at(x + 1, y + 1) as u8) << 2 | (at(x, y + 1) as u8) << 3;
+            let case = (at(x, y) as u8)
+                | (at(x + 1, y) as u8) << 1
+                | (at(x + 1, y + 1) as u8) << 2
+                | (at(x, y + 1) as u8) << 3;
             // Sides: 0 top, 1 right, 2 bottom, 3 left. Dark on the left of
             // each directed segment.
             let segments: &[(u8, u8)] = match case {
@@ -136,7 +141,16 @@ mod tests {
         for x in 2..12 {
             e[3 * w + x] = true;
         }
-        for (x, y) in [(10, 10), (11, 10), (12, 11), (12, 12), (11, 13), (10, 13), (9, 12), (9, 11)] {
+        for (x, y) in [
+            (10, 10),
+            (11, 10),
+            (12, 11),
+            (12, 12),
+            (11, 13),
+            (10, 13),
+            (9, 12),
+            (9, 11),
+        ] {
             e[y * w + x] = true;
         }
         let c = chains(&e, w, h);
@@ -163,7 +177,10 @@ mod tests {
         assert_eq!(ring.first(), ring.last());
         // Halfway between the dark and the light pixel centres.
         let xs: Vec<f64> = ring.iter().map(|p| p[0]).collect();
-        let (lo, hi) = (xs.iter().cloned().fold(f64::MAX, f64::min), xs.iter().cloned().fold(f64::MIN, f64::max));
+        let (lo, hi) = (
+            xs.iter().cloned().fold(f64::MAX, f64::min),
+            xs.iter().cloned().fold(f64::MIN, f64::max),
+        );
         assert_eq!((lo, hi), (3.0, 7.0));
         // A block with a hole: two loops.
         d[3 * w + 4] = false;
