@@ -14,6 +14,7 @@ pub mod baseline;
 pub mod card;
 pub mod greedy;
 pub mod picture;
+mod spread;
 pub mod target;
 
 use crate::args::Args;
