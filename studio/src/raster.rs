@@ -10,11 +10,18 @@ use std::path::Path;
 /// under the band (0–1). Exact for each column the centre of which lies
 /// between the ends (rows, for a steep segment); the ends themselves are
 /// left square. A segment of no length covers nothing.
-pub fn band(
+pub fn band(p: [f32; 2], q: [f32; 2], width: f32, dims: (usize, usize), f: impl FnMut(usize, f32)) {
+    band_every(p, q, width, dims, 1, f)
+}
+
+/// [`band`] over every `stride`-th column (row, for a steep segment) only:
+/// a sample of its pixels, for a quick estimate.
+pub fn band_every(
     p: [f32; 2],
     q: [f32; 2],
     width: f32,
     (cols, rows): (usize, usize),
+    stride: usize,
     mut f: impl FnMut(usize, f32),
 ) {
     let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
@@ -22,18 +29,33 @@ pub fn band(
         if dx == 0.0 {
             return;
         }
-        across(p[0], p[1], q[0], dy / dx, width, cols, rows, |u, v, w| {
-            f(v * cols + u, w)
-        });
+        across(
+            p[0],
+            p[1],
+            q[0],
+            dy / dx,
+            width,
+            (cols, rows),
+            stride,
+            |u, v, w| f(v * cols + u, w),
+        );
     } else {
-        across(p[1], p[0], q[1], dx / dy, width, rows, cols, |v, u, w| {
-            f(v * cols + u, w)
-        });
+        across(
+            p[1],
+            p[0],
+            q[1],
+            dx / dy,
+            width,
+            (rows, cols),
+            stride,
+            |v, u, w| f(v * cols + u, w),
+        );
     }
 }
 
 /// One axis of [`band`]: the major coordinate runs from `a0` to `a1`
-/// over `major` cells, the minor one starts at `b0` with `slope`.
+/// over `major` cells (every `stride`-th), the minor one starts at `b0`
+/// with `slope`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn across(
@@ -42,8 +64,8 @@ fn across(
     a1: f32,
     slope: f32,
     width: f32,
-    major: usize,
-    minor: usize,
+    (major, minor): (usize, usize),
+    stride: usize,
     mut f: impl FnMut(usize, usize, f32),
 ) {
     let (lo_a, hi_a) = if a0 <= a1 { (a0, a1) } else { (a1, a0) };
@@ -55,7 +77,7 @@ fn across(
     // The band's extent across one cell of the major axis.
     let half = 0.5 * width * (1.0 + slope * slope).sqrt();
     let top = minor as f32;
-    for u in first..=last as usize {
+    for u in (first..=last as usize).step_by(stride) {
         let b = b0 + (u as f32 + 0.5 - a0) * slope;
         let (lo, hi) = ((b - half).max(0.0), (b + half).min(top));
         if hi <= lo {

@@ -13,7 +13,9 @@
 //! chord's pixels ([`super::spread`]).
 //!
 //! Greedy: from the nail the thread is on, the chord to the nail (at least
-//! `min_separation` away) that lowers the error most, `lines` times.
+//! `min_separation` away) that lowers the error most, `lines` times (each
+//! candidate weighed on a third of its columns first, the best sixteen
+//! then in full).
 //! Then each pass visits the nails of the winding in a seeded order and
 //! tries moving nail k to its neighbours within `window`: a candidate that
 //! scores better than the present nail on the present state is checked
@@ -78,6 +80,17 @@ impl<'a> Loom<'a> {
     #[inline]
     fn gain(&self, a: u16, b: u16) -> f32 {
         self.weigh(a, b, 1.0)
+    }
+
+    /// [`Loom::gain`] estimated from every [`SAMPLE`]-th column.
+    fn rough_gain(&self, a: u16, b: u16) -> f32 {
+        let (bare, field, k) = (&self.bare[..], &self.field[..], self.self_weight);
+        let mut sum = 0.0;
+        self.target.chord_sample(a, b, SAMPLE, |i, w| {
+            let t = bare[i];
+            sum += t * w * (2.0 * field[i] + t * k);
+        });
+        sum * SAMPLE as f32
     }
 
     /// The same for a chord that is on already, to compare with moving it:
@@ -166,16 +179,30 @@ pub fn wind(
     Ok(pattern)
 }
 
-/// The nail the chord from `at` should go to: least gain, the lowest
-/// index among equals (so the answer does not depend on how the two cores
-/// shared the candidates).
+/// Every candidate is first weighed on every [`SAMPLE`]-th column of its
+/// chord; the [`SHORTLIST`] best are then weighed whole. (On the README's
+/// figure: the same RMSE to ±0.0005 as weighing all whole, a third less
+/// time.)
+const SAMPLE: usize = 3;
+const SHORTLIST: usize = 16;
+
+/// The nail the chord from `at` should go to: least gain among the
+/// shortlist, the lowest index among equals (so the answer does not
+/// depend on how the two cores shared the candidates).
 fn best_from(loom: &Loom<'_>, at: u16, min: u16) -> u16 {
     let n = loom.target.nails();
-    (0..n)
+    let order = |x: &(f32, u16), y: &(f32, u16)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
+    let mut rough: Vec<(f32, u16)> = (0..n)
         .into_par_iter()
         .filter(|&b| far_enough(at, b, n, min))
-        .map(|b| (loom.gain(at, b), b))
-        .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
+        .map(|b| (loom.rough_gain(at, b), b))
+        .collect();
+    rough.sort_by(order);
+    rough.truncate(SHORTLIST);
+    rough
+        .par_iter()
+        .map(|&(_, b)| (loom.gain(at, b), b))
+        .min_by(order)
         .expect("a nail far enough")
         .1
 }

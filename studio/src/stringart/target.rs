@@ -10,7 +10,7 @@
 
 use crate::board::Frame;
 use crate::gray::Gray;
-use crate::raster::{band, blur, rmse};
+use crate::raster::{band, band_every, blur, rmse};
 use taut_logic::geometry::Board;
 
 /// No thread covers more of a pixel than this: bare area never reaches
@@ -57,6 +57,16 @@ impl Target {
         let (p, q) = (self.frame.nails[a as usize], self.frame.nails[b as usize]);
         let size = self.frame.size;
         band(p, q, self.thread_px, (size, size), |i, w| {
+            f(i, w.min(MAX_COVER))
+        });
+    }
+
+    /// [`Target::chord`] over every `stride`-th column (or row) only.
+    #[inline]
+    pub fn chord_sample(&self, a: u16, b: u16, stride: usize, mut f: impl FnMut(usize, f32)) {
+        let (p, q) = (self.frame.nails[a as usize], self.frame.nails[b as usize]);
+        let size = self.frame.size;
+        band_every(p, q, self.thread_px, (size, size), stride, |i, w| {
             f(i, w.min(MAX_COVER))
         });
     }
