@@ -36,7 +36,7 @@ mod canvas;
 mod plot;
 
 pub use canvas::Canvas;
-pub use plot::{render_plot, Plot};
+pub use plot::{plot_points, render_plot, Plot};
 
 use crate::replay::{JobReplay, Trace};
 use crate::vcd::Signal;

@@ -1,7 +1,7 @@
 //! `cargo xtask bench`: figures from simavr's cycle counter (`taut-bench`
-//! in simavr/), written to target/bench.json and printed as a table, and
-//! the string-art job's machine time worked out on the host
-//! (`cargo xtask estimate`).
+//! in simavr/), written to target/bench.json and printed as a table, the
+//! string-art job's machine time worked out on the host (`cargo xtask
+//! estimate`), then the host tools' string-art figures (`taut bench`).
 
 use crate::firmware;
 use crate::run::{self, root, Result};
@@ -37,8 +37,8 @@ pub fn run() -> Result<()> {
         }
     }
     std::fs::write(&out, serde_json::to_string_pretty(&figures)?)?;
-    println!("\nwritten: {}", out.display());
-    Ok(())
+    println!("\n== string art on the host (taut bench)");
+    run::studio(&["bench".into(), "--json".into(), out.display().to_string()])
 }
 
 /// The seed's example size: a 250-nail circle of 40.2 cm and 3 000

@@ -50,6 +50,25 @@ pub fn taut_sim(elf: &Path, args: &[String]) -> Result<()> {
     bin("taut-sim", &all)
 }
 
+/// `taut ARGS…`, the host tools (studio/), built optimised.
+pub fn studio(args: &[String]) -> Result<()> {
+    let mut c = cargo_cmd(
+        &[
+            "run",
+            "--quiet",
+            "--release",
+            "-p",
+            "taut-studio",
+            "--bin",
+            "taut",
+            "--",
+        ],
+        &root(),
+    );
+    c.args(args);
+    status(&mut c)
+}
+
 /// One of the harness crate's binaries (simavr/src/bin), built optimised.
 pub fn bin(name: &str, args: &[String]) -> Result<()> {
     let mut c = cargo_cmd(

@@ -42,6 +42,18 @@ pub fn render_plot(
     origin: [i32; 2],
     path: &Path,
 ) -> io::Result<Plot> {
+    let points = plot_points(signals, cfg, origin)?;
+    draw_plot(&points, path)
+}
+
+/// The pen's point (mm) after power-on and after every step of the two
+/// drawing motors, in time order, each with whether the pen was down
+/// (see [`render_plot`] for `origin`).
+pub fn plot_points(
+    signals: &[Signal],
+    cfg: &MachineConfig,
+    origin: [i32; 2],
+) -> io::Result<Vec<((f64, f64), bool)>> {
     let kin = AnyKinematics::of(cfg).map_err(|e| io::Error::other(e.message()))?;
     let find = |name: &str| signals.iter().find(|s| s.name == name);
     let missing = |name: &str| io::Error::other(format!("no signal {name}"));
@@ -88,13 +100,18 @@ pub fn render_plot(
         steps[i] += d;
         points.push((at(&steps), down_at(t)));
     }
+    Ok(points)
+}
+
+/// The drawing of [`plot_points`], written to `path` (PNG).
+fn draw_plot(points: &[((f64, f64), bool)], path: &Path) -> io::Result<Plot> {
     let mut plot = Plot {
-        steps: events.len(),
+        steps: points.len() - 1,
         min: [f64::MAX; 2],
         max: [f64::MIN; 2],
         ..Plot::default()
     };
-    for (p, down) in &points {
+    for (p, down) in points {
         if *down {
             plot.steps_down += 1;
             plot.min = [plot.min[0].min(p.0), plot.min[1].min(p.1)];

@@ -1,0 +1,23 @@
+//! taut's host tools, one command a module: `stringart` (a picture to a
+//! string-art card), `template` (a 1:1 drilling template), `vectorize` (a
+//! picture to plotter G-code), `text` (Hershey text to G-code), `preview`
+//! (G-code or a simulator trace to a picture). They share the firmware's
+//! logic crate (`taut_logic`): its nail geometry, card parsers, G-code
+//! parser and interpreter, kinematics and machine-time estimate, so what
+//! the tools predict is what the machine does.
+
+pub mod args;
+pub mod bench;
+pub mod board;
+pub mod gray;
+pub mod hershey;
+pub mod plot;
+pub mod preview;
+pub mod progress;
+pub mod raster;
+pub mod stringart;
+pub mod svg;
+pub mod template;
+pub mod text;
+pub mod toolpath;
+pub mod vectorize;
