@@ -670,9 +670,9 @@ impl Console {
     #[inline(never)]
     fn list(&mut self, listing: Listing, cfg: &MachineConfig) {
         self.listing = match listing {
-            Listing::Settings(next) => settings::Setting::at(next).map(|s| {
+            Listing::Settings(next) => settings::listed(next, cfg).map(|line| {
                 let mut r = reply::line();
-                let _ = uwrite!(r, "${}={}", settings::Named(s, cfg.machine), s.get(cfg));
+                let _ = uwrite!(r, "{}", line);
                 r.send();
                 Listing::Settings(next + 1)
             }),

@@ -144,3 +144,54 @@ fn override_and_door_bytes_never_spoil_a_line() {
     send(&mut sim, "M400");
     assert_eq!(hil_tests::steps_on_pins(&sim)[0], 0);
 }
+
+/// `$$` as Grbl 1.1 lists it (`$0=10` … `$132=200.000`: whole numbers for
+/// switches and masks, three decimals for the rest), then taut's named
+/// settings; `$110=` writes Grbl's units into the named setting behind it
+/// (the string-art machine's X place is its radial carriage), and a value
+/// taut cannot take is refused with Grbl's error 3 and the reason.
+#[test]
+fn numbered_settings_list_and_write_through_to_the_named_ones() {
+    let mut sim = boot_machine();
+    let listing = replies_all(&send(&mut sim, "$$"));
+    assert_eq!(
+        listing[..4],
+        ["$0=5", "$1=255", "$3=0", "$10=3"],
+        "{listing:?}"
+    );
+    for line in [
+        "$11=0.010",
+        "$100=32.000",
+        "$110=3750.000",
+        "$132=42.000",
+        "$machine=string_art",
+    ] {
+        assert!(listing.contains(&line.to_string()), "{line} in {listing:?}");
+    }
+    assert_eq!(listing.last().map(String::as_str), Some("ok"));
+    // 1875 mm/min at 32 steps/mm: 1000 steps/s.
+    send(&mut sim, "$110=1875");
+    let listing = replies_all(&send(&mut sim, "$$"));
+    assert!(
+        listing.contains(&"$110=1875.000".to_string()),
+        "{listing:?}"
+    );
+    assert!(
+        listing.contains(&"$radial_max_rate=1000".to_string()),
+        "{listing:?}"
+    );
+    match sim.send_line("$21=1", Duration::from_secs(2)) {
+        Ok(hil_tests::sim::Reply::Error(e)) => {
+            assert_eq!(e, "error:3 Invalid statement: expected 0 to 0 (col 5)")
+        }
+        other => panic!("{other:?}\n{}", log_tail(&sim)),
+    }
+}
+
+/// The setting lines of a reply and its `ok`.
+fn replies_all(text: &str) -> Vec<String> {
+    text.lines()
+        .filter(|l| l.starts_with('$') || *l == "ok")
+        .map(str::to_string)
+        .collect()
+}
