@@ -11,7 +11,7 @@ use crate::kinematics::AnyKinematics;
 use crate::machine::Machine;
 use crate::text::num::{parse_milli, parse_ratio, parse_u32, trim, NumError};
 use crate::text::ErrorKind;
-use crate::units::{Milli, StepsPerUnit};
+use crate::units::{Decimal, Milli, StepsPerUnit};
 use taut_progmem::{text, Text};
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
@@ -399,18 +399,16 @@ impl Setting {
     /// an error.
     pub fn put(self, cfg: &mut MachineConfig, value: Value) -> Result<(), ErrorKind> {
         self.check(value)?;
-        let new = match value {
-            // Another machine: its defaults, whole.
-            Value::Machine(m) => MachineConfig::defaults(m),
-            _ => {
-                let mut new = *cfg;
-                self.force(&mut new, value);
-                new
-            }
-        };
-        check_whole(&new)?;
-        *cfg = new;
-        Ok(())
+        // Another machine: its defaults, whole (they always hold).
+        if let Value::Machine(m) = value {
+            *cfg = MachineConfig::defaults(m);
+            return Ok(());
+        }
+        // Changed in place and put back on an error: no copy of the whole
+        // configuration on the AVR's small stack.
+        let old = self.get(cfg);
+        self.force(cfg, value);
+        check_whole(cfg).inspect_err(|_| self.force(cfg, old))
     }
 
     /// Whether `value` is of this setting's kind and in its range.
@@ -547,19 +545,7 @@ impl uDisplay for Value {
             Value::Machine(m) => uwrite!(f, "{}", m.name()),
             Value::Ratio(r) if r.den == 1 => uwrite!(f, "{}", r.num),
             Value::Ratio(r) => uwrite!(f, "{}/{}", r.num, r.den),
-            Value::Milli(m) => {
-                let (sign, a) = (if m.0 < 0 { "-" } else { "" }, m.0.unsigned_abs());
-                uwrite!(f, "{}{}.", sign, a / 1000)?;
-                let frac = a % 1000;
-                let pad = if frac < 10 {
-                    "00"
-                } else if frac < 100 {
-                    "0"
-                } else {
-                    ""
-                };
-                uwrite!(f, "{}{}", pad, frac)
-            }
+            Value::Milli(m) => uwrite!(f, "{}", Decimal(m.0, 3)),
         }
     }
 }

@@ -64,6 +64,15 @@ pub const fn report_axes(machine: Machine) -> [Axis; 3] {
     }
 }
 
+/// The report places (bits) whose position is an angle, never in inches:
+/// the string-art machine's base.
+pub const fn report_angles(machine: Machine) -> u8 {
+    match machine {
+        Machine::StringArt => 0b010,
+        _ => 0,
+    }
+}
+
 impl Numbered {
     /// The setting at `index` in `$$` order: `$0 $1 $3 $10 $11 $12 $13
     /// $20 $21 $22 $27`, then `$100…$132`.
