@@ -18,23 +18,23 @@ use crate::endstop;
 use crate::motion::Motion;
 use crate::print::Print;
 use crate::queues::{Signal, BUTTONS, JOB_CLAIMS_TX, RX};
-use crate::reply::{self, Fixed, REPORTED_AXES};
+use crate::reply::{self, REPORTED_AXES};
 use crate::rt::{stack, Poll};
-use crate::{flash_str, info, warn};
+use crate::{flash_str, info};
 use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::AXES;
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::config::{MachineConfig, PenConfig};
-use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Line, Parser, SystemLine};
-use taut_logic::homing::{self, Homing, Leg, Next};
+use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Line, Parser, Restore, SystemLine};
+use taut_logic::homing::{self, Homing, HomingError, Leg, Next};
 use taut_logic::interp::{Allowed, Interpreter, Order, Path};
 use taut_logic::kinematics::Kinematics;
 use taut_logic::patterns;
 use taut_logic::pinmap::Button;
 use taut_logic::planner::Feed;
 use taut_logic::settings;
-use taut_logic::units::Milli;
-use taut_progmem::Text;
+use taut_logic::units::{Decimal, Milli};
+use taut_progmem::{text, Text};
 use ufmt::uwrite;
 
 pub struct Console {
@@ -59,6 +59,21 @@ pub struct Console {
     /// Where the line being read comes from, `None` between lines: while
     /// a print runs, a serial line is read whenever one has arrived whole.
     source: Option<Source>,
+    /// The motion queued is jogs (`$J=`): a jog cancel stops it, other
+    /// lines wait for it to end.
+    jogging: bool,
+    /// `$C`: lines are checked and answered, nothing moves.
+    checking: bool,
+    sleep: Sleep,
+}
+
+/// `$SLP`: until a reset.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Sleep {
+    Awake,
+    /// Stopping: the drivers go off once the machine stands.
+    Falling,
+    Asleep,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -70,6 +85,8 @@ enum Source {
 enum Pending {
     /// Read but not yet carried out (back-pressure).
     Line(Line),
+    /// A jog (`$J=`) the same way.
+    Jog(Line),
     /// A path whose line was taken, its pieces not all queued yet.
     Path { path: Path, feed: Feed },
     /// Homing (`G28`, `$H`, at power-on), a leg moving or not; `reply`:
@@ -86,6 +103,19 @@ enum Listing {
     Settings(usize),
     Queues(u8),
     Offsets(u8),
+}
+
+/// What the console is doing, for the status report.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Activity {
+    /// Reading and carrying out lines.
+    Lines,
+    Homing,
+    Jogging,
+    /// `$C`: checking lines without moving.
+    Checking,
+    /// `$SLP`: the drivers off until a reset.
+    Sleeping,
 }
 
 /// Who may move the machine now.
@@ -111,6 +141,9 @@ impl Console {
             settings_changed: false,
             print: Print::new(),
             source: None,
+            jogging: false,
+            checking: false,
+            sleep: Sleep::Awake,
         }
     }
 
@@ -131,7 +164,48 @@ impl Console {
         self.interp.reset();
         self.print.abort();
         self.source = None;
+        self.jogging = false;
+        self.checking = false;
+        self.sleep = Sleep::Awake;
         RX.clear();
+    }
+
+    /// A jog cancel (0x85, or `!` or the safety door while jogging): brake
+    /// to a stop and drop the jogs queued; the jogs read and not yet
+    /// queued are answered `ok` and dropped on the next run (Grbl answered
+    /// them when it took them). False when no jog moves.
+    pub fn cancel_jog(&mut self, m: &mut Motion) -> bool {
+        if !self.jogging || m.is_idle() {
+            return false;
+        }
+        m.cancel();
+        true
+    }
+
+    /// The safety door while homing: stop at once, not homed (Grbl's alarm
+    /// 7); the line that asked is answered `ok`, as Grbl's.
+    pub fn abort_homing(&mut self, m: &mut Motion) {
+        let Some(Pending::Home { reply, .. }) = self.pending else {
+            return;
+        };
+        endstop::disarm();
+        m.stop_now();
+        m.lose_position();
+        self.pending = None;
+        self.resync_next_run(m);
+        reply::alarm(7);
+        if reply {
+            self.ok();
+        }
+    }
+
+    /// Drop a jog that waited to be queued or was being queued piece by
+    /// piece (a jog cancel), answering it.
+    fn drop_jog(&mut self) {
+        if self.jogging && matches!(self.pending, Some(Pending::Jog(_) | Pending::Path { .. })) {
+            self.pending = None;
+            self.ok();
+        }
     }
 
     /// Read and carry out input until it runs out or must wait.
@@ -146,7 +220,11 @@ impl Console {
         if self.epoch != m.epoch() {
             self.epoch = m.epoch();
             // Queued pieces were dropped with the motion (homing goes on:
-            // its own stops bump the epoch too; Ctrl-X resets it).
+            // its own stops bump the epoch too; Ctrl-X resets it); a
+            // cancelled jog's are answered.
+            if reply::room() {
+                self.drop_jog();
+            }
             if let Some(Pending::Path { .. }) = self.pending {
                 self.pending = None;
             }
@@ -155,6 +233,25 @@ impl Console {
         loop {
             if !reply::room() || JOB_CLAIMS_TX.load(Relaxed) {
                 return Poll::After(2);
+            }
+            // A jog cancel or `$SLP` is braking: nothing new until it stands.
+            if m.is_cancelling() {
+                self.drop_jog();
+                return Poll::Wait(Signal::Motion);
+            }
+            match self.sleep {
+                Sleep::Awake => {}
+                Sleep::Falling if !m.is_idle() => return Poll::Wait(Signal::Motion),
+                // Only a reset wakes it: lines wait unread.
+                Sleep::Asleep => return Poll::Idle,
+                Sleep::Falling => {
+                    self.sleep = Sleep::Asleep;
+                    m.drivers.set(0xFF, false);
+                    // The motors may be turned by hand now.
+                    m.lose_position();
+                    message(text!("Sleeping"));
+                    return Poll::Idle;
+                }
             }
             if let Some(listing) = self.listing {
                 self.list(listing, cfg);
@@ -180,27 +277,21 @@ impl Console {
             let line = match &self.pending {
                 Some(Pending::Path { .. }) => return self.next_piece(m, kin),
                 Some(Pending::Home { .. }) => return self.home(m, cfg),
-                Some(Pending::Line(line)) => Some(*line),
+                Some(Pending::Line(line)) => Some((*line, false)),
+                Some(Pending::Jog(line)) => Some((*line, true)),
                 None => None,
             };
-            if let Some(line) = line {
-                self.pending = None;
-                let allowed = Allowed {
-                    motion: owner == Owner::Console,
-                    position_known: m.position_known(),
-                };
-                match self.interp.plan(&line, kin, cfg, allowed) {
-                    Err(kind) => self.error(&Error::new(kind, 0)),
-                    Ok(planned) => {
-                        if let Some(wait) = self.carry_out(&planned.order, m, kin) {
-                            self.pending = Some(Pending::Line(line));
-                            return wait;
-                        }
-                        self.interp.commit(planned);
-                        if self.pending.is_none() {
-                            self.ok();
-                        }
+            if let Some((line, jog)) = line {
+                // Other lines wait for the jogs to end.
+                if !jog && self.jogging {
+                    if !m.is_idle() {
+                        return Poll::Wait(Signal::Motion);
                     }
+                    self.jogging = false;
+                }
+                self.pending = None;
+                if let Some(wait) = self.run_line(&line, jog, m, kin, cfg, owner) {
+                    return wait;
                 }
                 // One line per run: the other tasks get their turn.
                 return Poll::Again;
@@ -209,6 +300,56 @@ impl Console {
                 return wait;
             }
         }
+    }
+
+    /// Plan a line (or a jog) read whole, then carry it out and commit it,
+    /// or in check mode only commit it; `Some(wait)` when it must wait
+    /// (kept in `pending`). Out of line: its plan (arc-sized) stays off
+    /// the frame that reads lines and runs `$` commands.
+    #[inline(never)]
+    fn run_line(
+        &mut self,
+        line: &Line,
+        jog: bool,
+        m: &mut Motion,
+        kin: &impl Kinematics,
+        cfg: &MachineConfig,
+        owner: Owner,
+    ) -> Option<Poll<Signal>> {
+        let allowed = Allowed {
+            motion: owner == Owner::Console,
+            position_known: m.position_known(),
+        };
+        match self.interp.plan(line, kin, cfg, allowed) {
+            Err(kind) => self.error(&Error::new(kind, 0)),
+            // Checked, not carried out; reads are still answered.
+            Ok(planned) if self.checking => {
+                if matches!(planned.order, Order::ReportPosition) {
+                    report_position(m, kin);
+                }
+                self.interp.commit(&planned);
+                self.ok();
+            }
+            Ok(planned) => {
+                if let Some(wait) = self.carry_out(&planned.order, m, kin) {
+                    // Each in place: a `Pending` is arc-sized.
+                    match jog {
+                        true => self.pending = Some(Pending::Jog(*line)),
+                        false => self.pending = Some(Pending::Line(*line)),
+                    }
+                    return Some(wait);
+                }
+                match jog {
+                    true => self.interp.commit_jog(&planned),
+                    false => self.interp.commit(&planned),
+                }
+                self.jogging |= jog;
+                if self.pending.is_none() {
+                    self.ok();
+                }
+            }
+        }
+        None
     }
 
     /// Read bytes until an input is complete, and take it: a G-code line
@@ -255,6 +396,11 @@ impl Console {
                     self.error(&Error::new(ErrorKind::Printing, 0))
                 }
                 Ok(Input::Line(line)) => self.pending = Some(Pending::Line(line)),
+                // Grbl jogs from `Idle` or `Jog` only.
+                Ok(Input::Jog(_)) if self.checking || !(m.is_idle() || self.jogging) => {
+                    self.error(&Error::new(ErrorKind::NotIdle, 0))
+                }
+                Ok(Input::Jog(line)) => self.pending = Some(Pending::Jog(line)),
                 Ok(Input::System(s)) => self.system(s, m, cfg, owner),
                 Ok(Input::Card(c)) => self.card_line(c, m, cfg),
             }
@@ -411,9 +557,15 @@ impl Console {
         None
     }
 
-    /// A homing cycle is running.
-    pub fn is_homing(&self) -> bool {
-        matches!(self.pending, Some(Pending::Home { .. }))
+    /// What the console is doing.
+    pub fn activity(&self) -> Activity {
+        match self.pending {
+            _ if self.sleep != Sleep::Awake => Activity::Sleeping,
+            Some(Pending::Home { .. }) => Activity::Homing,
+            _ if self.checking => Activity::Checking,
+            _ if self.jogging => Activity::Jogging,
+            _ => Activity::Lines,
+        }
     }
 
     /// Home `axes` (bits), their drivers on; `reply`: answer the line
@@ -478,16 +630,21 @@ impl Console {
                     false => info!("homed"),
                 }
             }
-            Next::Failed(_) => {
+            // Grbl's alarms 8 (the switch stayed closed after the pull-off)
+            // and 9 (no switch within the travel); the line that asked is
+            // then answered `ok`, as Grbl's. Motion waits for `$H`, `G92`
+            // or `$X`.
+            Next::Failed(e) => {
                 let reply = *reply;
                 self.pending = None;
                 self.resync_next_run(m);
-                // Not homed: motion waits for G28, G92 or $X.
                 m.lose_position();
-                let e = Error::new(ErrorKind::HomingFailed, 0);
-                match reply {
-                    true => self.error(&e),
-                    false => warn!("homing failed: switch not found or stuck"),
+                reply::alarm(match e {
+                    HomingError::Stuck => 8,
+                    HomingError::NotFound => 9,
+                });
+                if reply {
+                    self.ok();
                 }
             }
         }
@@ -603,15 +760,39 @@ impl Console {
             | SystemLine::Home
             | SystemLine::Pattern(_)
             | SystemLine::Set { .. }
+            | SystemLine::Restore(_)
+            | SystemLine::Sleep
                 if self.printing_from_serial() =>
             {
                 return self.error(&Error::new(ErrorKind::Printing, 0));
             }
+            // What moves the machine or changes its settings: not while a
+            // job owns it; in check mode Grbl's "not idle".
+            SystemLine::Home
+            | SystemLine::Pattern(_)
+            | SystemLine::Set { .. }
+            | SystemLine::Restore(_)
+            | SystemLine::Sleep
+                if owner == Owner::Job =>
+            {
+                return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
+            }
+            SystemLine::Home
+            | SystemLine::Pattern(_)
+            | SystemLine::Set { .. }
+            | SystemLine::Restore(_)
+            | SystemLine::Sleep
+                if self.checking =>
+            {
+                return self.error(&Error::new(ErrorKind::NotIdle, 0));
+            }
+            // Settings are written with the planner empty, as Grbl's.
+            SystemLine::Home | SystemLine::Set { .. } | SystemLine::Restore(_) if !m.is_idle() => {
+                return self.error(&Error::new(ErrorKind::NotIdle, 0));
+            }
             SystemLine::Unlock => {
                 m.unlock();
-                let mut r = reply::line();
-                let _ = uwrite!(r, "{}", flash_str!("[MSG:Caution: Unlocked]"));
-                r.send();
+                message(text!("Caution: Unlocked"));
             }
             SystemLine::BuildInfo => build_info(cfg),
             SystemLine::ParserState => {
@@ -624,29 +805,14 @@ impl Console {
                 self.listing = Some(Listing::Offsets(0));
                 return;
             }
-            SystemLine::Home if owner == Owner::Job => {
-                return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
-            }
-            SystemLine::Home if !m.is_idle() => {
-                return self.error(&Error::new(ErrorKind::NotIdle, 0));
-            }
             SystemLine::Home if cfg.homing.axes == 0 => {
                 return self.error(&Error::new(ErrorKind::NoHoming, 0));
             }
             SystemLine::Home => return self.start_homing(cfg.homing.axes, m, true),
-            SystemLine::Pattern(_) if owner == Owner::Job => {
-                return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
-            }
             // Answered at its end.
             SystemLine::Pattern(n) => {
                 self.pattern = patterns::pattern(n).map(|t| (t, 0));
                 return;
-            }
-            SystemLine::Set { .. } if owner == Owner::Job => {
-                return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
-            }
-            SystemLine::Set { .. } if !m.is_idle() => {
-                return self.error(&Error::new(ErrorKind::NotIdle, 0));
             }
             SystemLine::Set { key, value } => {
                 let machine = cfg.machine;
@@ -666,6 +832,45 @@ impl Console {
                 }
                 self.settings_changed = true;
             }
+            // The machine's defaults; taut keeps no offsets to clear.
+            SystemLine::Restore(what) => {
+                if what != Restore::Offsets {
+                    restore_defaults(cfg);
+                    m.configure(cfg);
+                    self.settings_changed = true;
+                }
+                message(text!("Restoring defaults"));
+            }
+            // Asleep once it stands (`poll`).
+            SystemLine::Sleep => {
+                m.cancel();
+                self.sleep = Sleep::Falling;
+            }
+            // taut keeps no startup lines: both empty, as a fresh Grbl's.
+            SystemLine::StartupLines => {
+                for n in 0..2 {
+                    let mut r = reply::line();
+                    let _ = uwrite!(r, "{}{}=", flash_str!("$N"), n);
+                    r.send();
+                }
+            }
+            // Grbl leaves check mode with a soft reset: the modal state
+            // afresh, the position read back, the greeting.
+            SystemLine::CheckMode if self.checking => {
+                self.checking = false;
+                message(text!("Disabled"));
+                self.ok();
+                self.interp.reset();
+                self.resync_next_run(m);
+                return reply::banner();
+            }
+            SystemLine::CheckMode if owner == Owner::Job || !m.is_idle() || !m.position_known() => {
+                return self.error(&Error::new(ErrorKind::NotIdle, 0));
+            }
+            SystemLine::CheckMode => {
+                self.checking = true;
+                message(text!("Enabled"));
+            }
         }
         self.ok();
     }
@@ -674,9 +879,9 @@ impl Console {
     #[inline(never)]
     fn list(&mut self, listing: Listing, cfg: &MachineConfig) {
         self.listing = match listing {
-            Listing::Settings(next) => settings::Setting::at(next).map(|s| {
+            Listing::Settings(next) => settings::listed(next, cfg).map(|line| {
                 let mut r = reply::line();
-                let _ = uwrite!(r, "${}={}", settings::Named(s, cfg.machine), s.get(cfg));
+                let _ = uwrite!(r, "{}", line);
                 r.send();
                 Listing::Settings(next + 1)
             }),
@@ -750,6 +955,20 @@ fn offsets_line(line: u8) -> bool {
     true
 }
 
+/// The machine's defaults in place of `cfg`. Out of line: the copy they
+/// are made in stays off the console's frame.
+#[inline(never)]
+fn restore_defaults(cfg: &mut MachineConfig) {
+    *cfg = MachineConfig::defaults(cfg.machine);
+}
+
+/// Grbl's feedback message: `[MSG:<text>]`.
+fn message(text: Text) {
+    let mut r = reply::line();
+    let _ = uwrite!(r, "{}{}]", flash_str!("[MSG:"), text);
+    r.send();
+}
+
 /// A whole line has arrived on the serial line.
 fn serial_line_waits() -> bool {
     RX.any(|&b| b == b'\n' || b == b'\r')
@@ -772,7 +991,7 @@ fn report_position(m: &Motion, kin: &impl Kinematics) {
     let words = kin.words();
     let mut r = reply::line();
     for i in 0..REPORTED_AXES {
-        let _ = uwrite!(r, "{}:{} ", words[i] as char, Fixed(pos[i]));
+        let _ = uwrite!(r, "{}:{} ", words[i] as char, Decimal(pos[i].0, 3));
     }
     let _ = uwrite!(r, "{}", flash_str!("Count"));
     for i in 0..REPORTED_AXES {

@@ -39,12 +39,12 @@ use taut_firmware::board::{
 };
 use taut_firmware::buttons::{self, ButtonPins, ButtonsTask};
 use taut_firmware::card::{self, CardReader};
-use taut_firmware::console::{Console, Owner};
+use taut_firmware::console::{Activity, Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
 use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL, SIGNALS};
-use taut_firmware::realtime::{self, Requests};
+use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{stack, Poll, TaskCell};
 use taut_firmware::stepper::{self, StepDirPins, Stepper};
@@ -56,6 +56,7 @@ use taut_firmware::{
 use taut_firmware::{endstop, flash_str, info, reply, warn};
 use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::kinematics::AnyKinematics;
+use taut_logic::planner::Overrides;
 use taut_logic::sched::{Ready, TaskId, Timers};
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -396,32 +397,50 @@ fn realtime() {
     let r = Requests::take();
     MOTION.with(|m| {
         let m = m.as_mut().unwrap();
+        let activity = CONSOLE.with(|c| c.activity());
         if r.reset() {
-            m.stop_now();
+            let moving = m.stop_now();
             CONSOLE.with(|c| c.reset());
+            STANDING.with(|rt| rt.reset());
+            m.set_overrides(Overrides::NONE);
             control_job(Control::Abort);
-            // Grbl's words: alarm 3 (reset while in motion), the greeting.
-            let lost = !m.position_known();
-            if lost {
-                reply::alarm(3);
-            }
-            reply::banner();
-            if lost {
-                warn!("reset during motion: position unknown until G92, $X or zeroing");
-            } else {
-                info!("reset");
+            realtime::after_reset(m, activity == Activity::Homing, moving);
+        }
+        // `!` while jogging cancels the jog; while homing only the door
+        // stops (Grbl's alarm 7).
+        if r.hold() && !CONSOLE.with(|c| c.cancel_jog(m)) {
+            match activity {
+                Activity::Homing if r.door() => CONSOLE.with(|c| c.abort_homing(m)),
+                Activity::Homing => {}
+                _ => {
+                    m.hold();
+                    STANDING.with(|rt| rt.door |= r.door());
+                }
             }
         }
-        if r.hold() {
-            m.hold();
+        if r.jog_cancel() {
+            CONSOLE.with(|c| c.cancel_jog(m));
         }
-        if r.resume() && !m.resume() {
-            control_job(Control::Resume);
+        if r.resume() {
+            match m.resume() {
+                true => STANDING.with(|rt| rt.door = false),
+                false => control_job(Control::Resume),
+            }
+        }
+        if r.overrides() != 0 {
+            if let Some(o) = STANDING.with(|rt| rt.apply(r.overrides()).then_some(rt.overrides)) {
+                m.set_overrides(o);
+            }
         }
         if r.status() {
             if reply::room() {
-                let homing = CONSOLE.with(|c| c.is_homing());
-                KIN.with(|kin| realtime::status(m, kin.as_ref().unwrap(), homing));
+                KIN.with(|kin| {
+                    CONFIG.with(|cfg| {
+                        STANDING.with(|rt| {
+                            realtime::status(m, kin.as_ref().unwrap(), cfg, activity, rt)
+                        })
+                    })
+                });
             } else {
                 realtime::status_later();
                 spawn_after(Task::Realtime, 1);

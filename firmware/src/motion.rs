@@ -12,9 +12,10 @@ use crate::stepper::{fast_segment, Stepper, FAST};
 use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
-use taut_logic::planner::{Feed, Full, Planner};
+use taut_logic::planner::{Feed, Full, Overrides, Planner};
 use taut_logic::prep::{Hold, Prep};
 use taut_logic::segment::{Buffered, StepBlock};
+use taut_logic::units::Milli;
 
 /// Preparing segments is urgent (the app runs it at the highest software
 /// priority) while the queue holds less motion than this; otherwise it is
@@ -203,6 +204,19 @@ impl Motion {
         }
     }
 
+    /// The feed and rapid overrides, for the moves not yet cut.
+    pub fn set_overrides(&mut self, overrides: Overrides) {
+        PLANNER.with(|p| p.set_overrides(overrides));
+    }
+
+    /// The speed along the path, milli-units per minute (0 standing).
+    pub fn feed(&self) -> Milli {
+        if self.is_idle() || matches!(self.state(), State::Hold { standing: true }) {
+            return Milli::ZERO;
+        }
+        Milli((taut_logic::fmath::sqrt(self.prep.path_speed_sqr()) * 60.0) as i32)
+    }
+
     /// Feed hold: brake to a stop on the path (after the queued motion).
     pub fn hold(&mut self) {
         self.prep.hold();
@@ -222,14 +236,19 @@ impl Motion {
         }
     }
 
+    /// A cancel is braking (the queued motion goes once it stands).
+    pub fn is_cancelling(&self) -> bool {
+        self.cancel
+    }
+
     /// Stop at once (Ctrl-X): no more steps, the queued motion dropped, the
     /// position as the pulses left it. If the motors were moving, steps
-    /// may have been lost: the position is unknown until set again.
-    pub fn stop_now(&mut self) {
-        if self.stepper.is_running() {
-            self.lost = true;
-        }
+    /// may have been lost: the position is unknown until set again (true).
+    pub fn stop_now(&mut self) -> bool {
+        let moving = self.stepper.is_running();
+        self.lost |= moving;
         self.abort();
+        moving
     }
 
     /// Drop the queued motion with the machine at rest (or stopped at once).

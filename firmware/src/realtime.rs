@@ -1,41 +1,49 @@
 //! Grbl's real-time commands, acted on in the receive path: the receive
-//! interrupt takes `?`, `!`, `~` and Ctrl-X out of the byte stream, so
-//! they never wait behind a line. Ctrl-X stops the steps there and then;
-//! the rest is flagged for the `Realtime` task (the highest software
-//! priority), which also writes the status report.
+//! interrupt takes `?`, `!`, `~`, Ctrl-X and the bytes from 0x80 up out
+//! of the byte stream, so they never wait behind a line. Ctrl-X stops the
+//! steps there and then; the rest is flagged for the `Realtime` task (the
+//! highest software priority), which also writes the status report
+//! (formatted by `taut_logic::gcode::Status`).
 #![deny(unsafe_code)]
 
-use crate::flash_str;
-use crate::motion::{Motion, State};
+use crate::console::Activity;
+use crate::endstop;
+use crate::motion::{self, Motion};
 use crate::queues::{REALTIME, RX};
-use crate::reply::{self, Fixed, REPORTED_AXES};
+use crate::reply;
+use crate::rt::TaskCell;
 use crate::stepper;
-use taut_logic::gcode::Realtime;
+use crate::{flash_str, info, warn};
+use taut_logic::config::MachineConfig;
+use taut_logic::gcode::{Overrides, Realtime, Refresh, State, Status, OVERRIDE_BYTES};
 use taut_logic::kinematics::Kinematics;
 use taut_logic::planner::PLANNER_BLOCKS;
+use taut_logic::settings::grbl::{report_angles, report_axes};
 use ufmt::uwrite;
 
 const STATUS: u8 = 0;
 const HOLD: u8 = 1;
 const RESUME: u8 = 2;
 const RESET: u8 = 3;
+const DOOR: u8 = 4;
+const JOG_CANCEL: u8 = 5;
+/// The override bytes 0x90–0x97, a bit each from here.
+const OVERRIDES: u8 = 6;
 
-/// Grbl's safety-door byte.
-const SAFETY_DOOR: u8 = 0x84;
+/// Grbl's safety-door and jog-cancel bytes.
+const SAFETY_DOOR_BYTE: u8 = 0x84;
+const JOG_CANCEL_BYTE: u8 = 0x85;
 
 /// The receive interrupt's part: true when `byte` was a real-time command
 /// (flagged: spawn the task), which is then not line input. Grbl 1.1
 /// makes every byte from 0x80 up a real-time command: the safety door
-/// (0x84) holds as `!` does; jog cancel (0x85), the overrides (0x90–0x9D)
-/// and the coolant toggles are taken out of the stream and do nothing
-/// here (taut has no jog mode, overrides or coolant), so a sender that
-/// sends them never spoils a line.
+/// (0x84), jog cancel (0x85) and the feed and rapid overrides (0x90–0x97)
+/// are flagged; the spindle overrides and coolant toggles are taken out
+/// of the stream and do nothing (taut has no spindle or coolant), so a
+/// sender that sends them never spoils a line.
 #[inline(always)]
 pub fn on_receive(byte: u8) -> bool {
     let bit = match Realtime::from_byte(byte) {
-        None if byte == SAFETY_DOOR => HOLD,
-        None if byte >= 0x80 => return true,
-        None => return false,
         Some(Realtime::Status) => STATUS,
         Some(Realtime::FeedHold) => HOLD,
         Some(Realtime::CycleStart) => RESUME,
@@ -43,13 +51,20 @@ pub fn on_receive(byte: u8) -> bool {
             stepper::halt();
             RESET
         }
+        None => match byte {
+            SAFETY_DOOR_BYTE => DOOR,
+            JOG_CANCEL_BYTE => JOG_CANCEL,
+            0x90..=0x97 => OVERRIDES + (byte - OVERRIDE_BYTES),
+            0x80.. => return true,
+            _ => return false,
+        },
     };
     REALTIME.set(bit);
     true
 }
 
 /// The commands taken for one run of the task, in the order they act:
-/// reset, hold, resume, status.
+/// reset, jog cancel, hold, resume, overrides, status.
 #[derive(Clone, Copy)]
 pub struct Requests(u16);
 
@@ -66,12 +81,26 @@ impl Requests {
         self.has(RESET)
     }
 
+    pub fn jog_cancel(self) -> bool {
+        self.has(JOG_CANCEL)
+    }
+
+    /// `!` or the safety door.
     pub fn hold(self) -> bool {
-        self.has(HOLD)
+        self.has(HOLD) || self.door()
+    }
+
+    pub fn door(self) -> bool {
+        self.has(DOOR)
     }
 
     pub fn resume(self) -> bool {
         self.has(RESUME)
+    }
+
+    /// The override bytes that came: bit `i` for 0x90 + `i`.
+    pub fn overrides(self) -> u8 {
+        (self.0 >> OVERRIDES) as u8
     }
 
     pub fn status(self) -> bool {
@@ -84,29 +113,116 @@ pub fn status_later() {
     REALTIME.set(STATUS);
 }
 
-/// `<Idle|MPos:0.000,12.500,-3.000|Bf:13,127>`: the state and the
-/// position as the pulses left it, in the machine's units, and the free
-/// planner blocks and receive bytes (Grbl 1.1's status report);
-/// `homing`: the console runs a homing cycle (`Home`).
-#[optimize(speed)]
-pub fn status(m: &Motion, kin: &impl Kinematics, homing: bool) {
-    let mut r = reply::line();
-    let state = match m.state() {
-        _ if homing => flash_str!("Home"),
-        _ if !m.position_known() => flash_str!("Alarm"),
-        State::Idle => flash_str!("Idle"),
-        State::Run => flash_str!("Run"),
-        State::Hold { standing: true } => flash_str!("Hold:0"),
-        State::Hold { standing: false } => flash_str!("Hold:1"),
-    };
-    let _ = uwrite!(r, "<{}{}", state, flash_str!("|MPos:"));
-    let pos = kin.forward(&m.stepper.position());
-    for (i, p) in pos.iter().take(REPORTED_AXES).enumerate() {
-        let _ = uwrite!(r, "{}{}", if i > 0 { "," } else { "" }, Fixed(*p));
+/// Ctrl-X done: in Grbl's words, alarm 6 (reset while homing) or 3 (while
+/// moving: steps may be lost), the greeting, and while motion is locked
+/// how to unlock it.
+#[inline(never)]
+pub fn after_reset(m: &mut Motion, homing: bool, moving: bool) {
+    if homing {
+        m.lose_position();
+        reply::alarm(6);
+    } else if moving {
+        reply::alarm(3);
     }
-    // Grbl 1.1's buffer state (its `$10=1` default): free planner blocks,
-    // free bytes of the receive ring (CNCjs sizes its character count by it).
-    let planner_free = PLANNER_BLOCKS - m.planned();
-    let _ = uwrite!(r, "{}{},{}>", flash_str!("|Bf:"), planner_free, RX.free());
+    reply::banner();
+    match m.position_known() {
+        true => info!("reset"),
+        false => {
+            let mut r = reply::line();
+            let _ = uwrite!(r, "{}", flash_str!("[MSG:'$H'|'$X' to unlock]"));
+            r.send();
+            warn!("position unknown until $H, G92, $X or zeroing");
+        }
+    }
+}
+
+/// What the real-time commands leave behind them.
+pub struct Standing {
+    pub overrides: Overrides,
+    refresh: Refresh,
+    /// The hold came from the safety door.
+    pub door: bool,
+}
+
+/// The `Realtime` task's.
+pub static STANDING: TaskCell<Standing> = TaskCell::new(Standing::new());
+
+impl Standing {
+    const fn new() -> Standing {
+        Standing {
+            overrides: Overrides::NONE,
+            refresh: Refresh::new(),
+            door: false,
+        }
+    }
+
+    /// Ctrl-X: Grbl's defaults again.
+    pub fn reset(&mut self) {
+        *self = Standing::new();
+    }
+
+    /// Override bytes (bit `i`: 0x90 + `i`); true if the overrides changed
+    /// (the next report carries them).
+    pub fn apply(&mut self, bits: u8) -> bool {
+        let changed = self.overrides.apply(bits);
+        if changed {
+            self.refresh.overrides_changed();
+        }
+        changed
+    }
+}
+
+/// Grbl 1.1's status report: `<Run|MPos:0.000,12.500,-3.000|Bf:12,100|FS:600,0>`,
+/// the position as the pulses left it in the report's X, Y, Z places,
+/// the fields `$10` chooses, in `$13`'s unit. Out of line: the task's
+/// frame stays small when no report is asked for.
+#[inline(never)]
+#[optimize(speed)]
+pub fn status(
+    m: &Motion,
+    kin: &impl Kinematics,
+    cfg: &MachineConfig,
+    activity: Activity,
+    rt: &mut Standing,
+) {
+    let state = match (activity, m.state()) {
+        (Activity::Sleeping, _) => State::Sleep,
+        (Activity::Homing, _) => State::Home,
+        _ if !m.position_known() => State::Alarm,
+        (Activity::Checking, _) => State::Check,
+        (_, motion::State::Hold { standing }) if rt.door => State::Door { standing },
+        (_, motion::State::Hold { standing }) => State::Hold { standing },
+        (Activity::Jogging, motion::State::Run) => State::Jog,
+        (_, motion::State::Run) => State::Run,
+        (_, motion::State::Idle) => State::Idle,
+    };
+    let busy = !matches!(
+        state,
+        State::Idle | State::Alarm | State::Check | State::Sleep
+    );
+    let places = report_axes(cfg.machine);
+    let at = kin.forward(&m.stepper.position());
+    // A plotter's MIN inputs are its limit switches (the string-art
+    // machine's are buttons).
+    let mut pins = 0;
+    if !cfg.machine.is_string_art() {
+        for (p, axis) in places.iter().enumerate() {
+            pins |= (endstop::closed(axis.index()) as u8) << p;
+        }
+    }
+    let report = Status {
+        state,
+        position: places.map(|a| at[a.index()]),
+        angles: report_angles(cfg.machine),
+        feed: m.feed(),
+        buffer: ((PLANNER_BLOCKS - m.planned()) as u8, RX.free() as u8),
+        pins,
+        overrides: rt.overrides,
+        extra: rt.refresh.next(busy),
+        fields: cfg.status_report,
+        inches: cfg.report_inches,
+    };
+    let mut r = reply::line();
+    let _ = uwrite!(r, "{}", report);
     r.send();
 }

@@ -8,7 +8,6 @@ use crate::log::Line;
 use crate::{flash_str, texts};
 use taut_logic::gcode::Error;
 use taut_logic::text::ErrorKind;
-use taut_logic::units::Milli;
 use ufmt::{uWrite, uwrite};
 
 /// Longest reply line, its newline included: `M114` at the extremes of
@@ -85,27 +84,5 @@ impl ufmt::uDisplay for Because<'_> {
             Some(why) => uwrite!(f, ": {}", why),
             None => Ok(()),
         }
-    }
-}
-
-/// A fixed-point value as `-12.345`.
-pub struct Fixed(pub Milli);
-
-impl ufmt::uDisplay for Fixed {
-    fn fmt<W: uWrite + ?Sized>(&self, f: &mut ufmt::Formatter<'_, W>) -> Result<(), W::Error> {
-        let v = self.0 .0;
-        if v < 0 {
-            f.write_str("-")?;
-        }
-        let a = v.unsigned_abs();
-        let frac = a % 1000;
-        uwrite!(f, "{}.", a / 1000)?;
-        if frac < 100 {
-            f.write_str("0")?;
-        }
-        if frac < 10 {
-            f.write_str("0")?;
-        }
-        uwrite!(f, "{}", frac)
     }
 }

@@ -97,7 +97,7 @@ pub fn error(e: ErrorKind) -> FlashStr {
         FeedTooLow => FeedTooLow,
         PenWithMove => PenWithMove,
         NoHoming => NoHoming,
-        HomingFailed => HomingFailed,
+        InvalidJogCommand => InvalidJogCommand,
         NoCard => NoCard,
         CardFailed => CardFailed,
         FileNotFound => FileNotFound,

@@ -109,7 +109,7 @@ pub fn assert_ram_budget(sim: &sim::Sim) {
     let stack = sim.peak_stack_bytes() as u32;
     assert!(
         statics + stack < RAM_BUDGET,
-        "static {statics} B + stack {stack} B (deepest at {:#x})",
+        "static {statics} B + stack {stack} B, deepest at {:#x} (avr-addr2line -fe taut.elf)",
         sim.peak_stack_pc()
     );
 }

@@ -131,17 +131,23 @@ fn the_flatbed_homes_x_against_its_switch_at_power_on_and_on_g28() {
     assert_ram_budget(&sim);
 }
 
-/// Without its switch, homing fails with an error and motion waits for
-/// `G28`, `G92` or `$X`.
+/// Without its switch, homing fails with Grbl's alarm 9 ("could not find
+/// limit switch"), the line answered `ok` as Grbl's, and motion waits for
+/// `G28`, `G92` or `$X`; a machine with no homing axes answers Grbl's
+/// error 5 (setting disabled).
 #[test]
 fn homing_without_a_switch_fails_and_locks_motion() {
     let mut sim = boot_machine();
-    send(&mut sim, "$machine=flatbed");
-    send(&mut sim, "$homing_seek=4000");
-    match sim.send_line("G28", Duration::from_secs(20)) {
-        Ok(hil_tests::sim::Reply::Error(e)) => assert!(e.starts_with("error:75 "), "{e}"),
+    match sim.send_line("$H", Duration::from_secs(2)) {
+        Ok(hil_tests::sim::Reply::Error(e)) => assert!(e.starts_with("error:5 "), "{e}"),
         other => panic!("{other:?}"),
     }
+    send(&mut sim, "$machine=flatbed");
+    send(&mut sim, "$homing_seek=4000");
+    let from = sim.uart_bytes().len();
+    send_ok(&mut sim, "G28", Duration::from_secs(20));
+    let text = sim.uart_text_from(from);
+    assert!(text.ends_with("ALARM:9\nok\n"), "{text}");
     match sim.send_line("G0 X1", Duration::from_secs(2)) {
         Ok(hil_tests::sim::Reply::Error(e)) => assert!(e.starts_with("error:9 "), "{e}"),
         other => panic!("{other:?}"),

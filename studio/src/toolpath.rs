@@ -119,7 +119,7 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
             Order::Home { .. } => return Err(fail(0, "homing (G28) cannot be previewed")),
             _ => {}
         }
-        interp.commit(planned);
+        interp.commit(&planned);
     }
     Ok(path)
 }

@@ -60,6 +60,11 @@ pub struct MachineConfig {
     pub dwell_p_ms: bool,
     /// Its arms or strings, for the machines that have them.
     pub geometry: Geometry,
+    /// Grbl's `$10`: what status reports carry (bit 0: `MPos` rather than
+    /// `WPos`, bit 1: the buffer state `Bf:`).
+    pub status_report: u8,
+    /// Grbl's `$13`: positions and feeds in reports in inches.
+    pub report_inches: bool,
 }
 
 /// The arm or string geometry of the non-linear machines, mm.
@@ -288,6 +293,10 @@ const fn plotter(machine: Machine, xy: [AxisConfig; 2]) -> MachineConfig {
         homing: HomingConfig::NONE,
         dwell_p_ms: !machine.is_string_art(),
         geometry: Geometry::NONE,
+        // Machine positions and the buffer state: CNCjs sizes its
+        // character count from `Bf:`.
+        status_report: 3,
+        report_inches: false,
     }
 }
 

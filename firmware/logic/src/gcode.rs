@@ -31,6 +31,7 @@ mod error;
 mod line;
 mod number;
 mod parser;
+mod status;
 mod system;
 mod words;
 
@@ -43,4 +44,5 @@ pub use line::{
 };
 pub use number::parse_milli;
 pub use parser::{Parser, MAX_LINE};
-pub use system::{SystemLine, SystemText, SYSTEM_TEXT};
+pub use status::{Extra, Overrides, Refresh, State, Status, OVERRIDE_BYTES};
+pub use system::{Restore, SystemLine, SystemText, SYSTEM_TEXT};

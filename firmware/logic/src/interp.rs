@@ -408,8 +408,15 @@ impl Interpreter {
 
     /// The order of `planned` was carried out: take the modal state it
     /// leaves.
-    pub fn commit(&mut self, planned: Planned) {
+    pub fn commit(&mut self, planned: &Planned) {
         self.modal = planned.next;
+    }
+
+    /// A jog's (`$J=`, planned as the `G1` the parser made of it) was
+    /// carried out: its `G20`/`G21`, `G90`/`G91` and feed were its own, so
+    /// only the position is taken (Grbl's jogging.md).
+    pub fn commit_jog(&mut self, planned: &Planned) {
+        self.modal.target = planned.next.target;
     }
 
     /// The arc `line` asks for, from the commanded position to

@@ -54,12 +54,17 @@ struct Block {
     step: StepBlock,
     /// Events/s², the tightest of the axes' limits.
     accel: u32,
-    /// Cruise speed², events²/s².
-    nominal_ev_sqr: u64,
+    /// The speed asked for, events/s, before the overrides and the axes'
+    /// limits; 0: a rapid.
+    feed_ev: f32,
+    /// Cruise speed along the path with the overrides, milli-units/s in
+    /// 24.8 fixed point.
+    nominal: u32,
     /// (events per path milli-unit)²: converts path speeds² to events²/s².
     ev_per_milli_sqr: f32,
-    /// Path speeds², (milli-units/s)².
-    max_entry_sqr: u64,
+    /// Path speeds², (milli-units/s)²: what the junction with the block
+    /// before allows, and the entry planned.
+    junction_sqr: u64,
     entry_sqr: u64,
     /// Largest change of speed² over the block: 2·accel·length.
     delta_sqr: u64,
@@ -73,12 +78,44 @@ impl Block {
             dir: 0,
         },
         accel: 0,
-        nominal_ev_sqr: 0,
+        feed_ev: 0.0,
+        nominal: 0,
         ev_per_milli_sqr: 0.0,
-        max_entry_sqr: 0,
+        junction_sqr: 0,
         entry_sqr: 0,
         delta_sqr: 0,
     };
+
+    /// Cruise speed², path units.
+    fn nominal_sqr(&self) -> u64 {
+        (self.nominal as u64 * self.nominal as u64) >> 16
+    }
+}
+
+/// The feed and rapid overrides, percent (Grbl's 10–200 and 25/50/100).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Overrides {
+    pub feed: u8,
+    pub rapid: u8,
+}
+
+impl Overrides {
+    pub const NONE: Overrides = Overrides {
+        feed: 100,
+        rapid: 100,
+    };
+
+    /// The cruise speed along the path of a move asking `feed_ev` events/s
+    /// (0: rapid) whose axes allow `rate`, with `ev_per_milli` events per
+    /// path milli-unit: milli-units/s in 24.8 fixed point.
+    fn nominal(self, feed_ev: f32, rate: u32, ev_per_milli: f32) -> u32 {
+        let (asked, percent) = match feed_ev == 0.0 {
+            true => (rate as f32, self.rapid),
+            false => (feed_ev, self.feed),
+        };
+        let ev = (asked * percent as f32 / 100.0).clamp(1.0, rate as f32);
+        (ev * 256.0 / ev_per_milli) as u32
+    }
 }
 
 pub struct Planner {
@@ -92,8 +129,11 @@ pub struct Planner {
     /// Target of the last move, steps.
     position: PerAxis<i32>,
     geometry: Geometry,
-    /// Direction and cruise speed² of the last move, for the next junction.
-    last: Option<([f32; AXES], u64)>,
+    /// Direction of the last move, for the next junction.
+    last: Option<[f32; AXES]>,
+    /// `None`: none (100 %). An `Option`, so that `EMPTY` is all zeros: a
+    /// static of it then costs no initial image in flash.
+    overrides: Option<Overrides>,
 }
 
 impl Planner {
@@ -107,6 +147,7 @@ impl Planner {
         position: [0; AXES],
         geometry: Geometry::EMPTY,
         last: None,
+        overrides: None,
     };
 
     /// Take the machine's figures, in place; drops queued moves and keeps
@@ -128,6 +169,7 @@ impl Planner {
             position: [0; AXES],
             geometry: Geometry::new(config),
             last: None,
+            overrides: None,
         }
     }
 
@@ -163,35 +205,31 @@ impl Planner {
         let (accel, rate) = self.geometry.limits(&step);
         let path = self.geometry.path(&delta);
         let feed_ev = match feed {
-            Feed::Rapid => rate,
-            Feed::PerMinute(f) => (f.0.max(0) as f32 / 60.0 * path.ev_per_milli) as u32,
+            Feed::Rapid => 0.0,
+            // Never 0, which means a rapid.
+            Feed::PerMinute(f) => f.0.max(1) as f32 / 60.0 * path.ev_per_milli,
         };
-        let nominal_ev = feed_ev.clamp(1, rate) as u64;
         let k2 = path.ev_per_milli * path.ev_per_milli;
-        let nominal_ev_sqr = nominal_ev * nominal_ev;
-        let nominal_sqr = (nominal_ev_sqr as f32 / k2) as u64;
-        let mut max_entry_sqr = 0;
-        if let Some((prev_unit, prev_nominal_sqr)) = self.last {
-            let corner = Corner::new(&prev_unit, &path.unit);
-            max_entry_sqr = self
+        let junction_sqr = match self.last {
+            Some(prev_unit) => self
                 .geometry
-                .junction_sqr(&corner)
-                .min(nominal_sqr)
-                .min(prev_nominal_sqr);
-        }
+                .junction_sqr(&Corner::new(&prev_unit, &path.unit)),
+            None => 0,
+        };
         let slot = (self.head + self.len) % PLANNER_BLOCKS;
         self.blocks[slot] = Block {
             step,
             accel,
-            nominal_ev_sqr,
+            feed_ev,
+            nominal: self.overrides().nominal(feed_ev, rate, path.ev_per_milli),
             ev_per_milli_sqr: k2,
-            max_entry_sqr,
+            junction_sqr,
             entry_sqr: 0,
             delta_sqr: ((2 * accel as u64 * step.events as u64) as f32 / k2) as u64,
         };
         self.len += 1;
         self.position = target;
-        self.last = Some((path.unit, nominal_sqr));
+        self.last = Some(path.unit);
         self.recalculate();
         Ok(())
     }
@@ -237,7 +275,7 @@ impl Planner {
                 b.accel,
                 &Speeds {
                     entry_sqr: to_events(b.entry_sqr),
-                    cruise_sqr: b.nominal_ev_sqr,
+                    cruise_sqr: to_events(b.nominal_sqr()),
                     exit_sqr: to_events(exit_sqr),
                 },
             ),
@@ -262,15 +300,37 @@ impl Planner {
         self.set_position(position);
     }
 
-    /// Grbl's passes: backwards, each entry is at most what still stops at
-    /// the end of the queue; forwards, at most what the previous block can
-    /// reach from its entry. Additions and comparisons only.
+    /// New overrides: the cruise speeds of the moves not yet taken, as
+    /// Grbl's (the block being cut keeps its profile).
+    pub fn set_overrides(&mut self, overrides: Overrides) {
+        self.overrides = Some(overrides);
+        for i in 0..self.len {
+            let b = &mut self.blocks[(self.head + i) % PLANNER_BLOCKS];
+            let (_, rate) = self.geometry.limits(&b.step);
+            let ev_per_milli = crate::fmath::sqrt(b.ev_per_milli_sqr);
+            b.nominal = overrides.nominal(b.feed_ev, rate, ev_per_milli);
+        }
+        if self.len > 0 {
+            self.recalculate();
+        }
+    }
+
+    fn overrides(&self) -> Overrides {
+        self.overrides.unwrap_or(Overrides::NONE)
+    }
+
+    /// Grbl's passes: backwards, each entry is at most what the junction
+    /// and both cruise speeds allow and what still stops at the end of the
+    /// queue; forwards, at most what the previous block can reach from its
+    /// entry. Integer only.
     fn recalculate(&mut self) {
         let at = |i: usize| (self.head + i) % PLANNER_BLOCKS;
         let mut next_entry = 0u64;
         for i in (1..self.len).rev() {
+            let prev_nominal_sqr = self.blocks[at(i - 1)].nominal_sqr();
             let b = &mut self.blocks[at(i)];
-            b.entry_sqr = b.max_entry_sqr.min(next_entry.saturating_add(b.delta_sqr));
+            let max_entry_sqr = b.junction_sqr.min(b.nominal_sqr()).min(prev_nominal_sqr);
+            b.entry_sqr = max_entry_sqr.min(next_entry.saturating_add(b.delta_sqr));
             next_entry = b.entry_sqr;
         }
         self.blocks[self.head].entry_sqr = self.carry_sqr;

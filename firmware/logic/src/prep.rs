@@ -65,6 +65,12 @@ impl Prep {
         self.hold
     }
 
+    /// Speed² along the path of the last segment cut, (milli-units/s)²:
+    /// Grbl's real-time feed rate (`FS:`), a segment ahead of the steps.
+    pub fn path_speed_sqr(&self) -> f32 {
+        self.cut.speed_sqr() as f32 / self.ev_per_milli_sqr
+    }
+
     /// Every block taken has been cut whole (no hold stopped one short).
     pub fn is_idle(&self) -> bool {
         self.cut.is_idle()

@@ -11,10 +11,11 @@ use crate::kinematics::AnyKinematics;
 use crate::machine::Machine;
 use crate::text::num::{parse_milli, parse_ratio, parse_u32, trim, NumError};
 use crate::text::ErrorKind;
-use crate::units::{Milli, StepsPerUnit};
+use crate::units::{Decimal, Milli, StepsPerUnit};
 use taut_progmem::{text, Text};
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
+pub mod grbl;
 pub mod image;
 
 /// A setting value that did not fit: what, and at which byte of the value.
@@ -74,6 +75,9 @@ pub enum GlobalField {
     HomingSeek,
     HomingLocate,
     HomingPullOff,
+    /// Grbl's `$10` and `$13`: the status report's fields, and inches.
+    StatusReport,
+    ReportInches,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -103,7 +107,7 @@ const AXIS_FIELDS: [AxisField; 8] = [
     AxisField::TravelMax,
 ];
 
-const GLOBAL_FIELDS: [GlobalField; 20] = [
+const GLOBAL_FIELDS: [GlobalField; 22] = [
     GlobalField::Machine,
     GlobalField::StepPulseUs,
     GlobalField::DirSetupUs,
@@ -124,7 +128,13 @@ const GLOBAL_FIELDS: [GlobalField; 20] = [
     GlobalField::HomingSeek,
     GlobalField::HomingLocate,
     GlobalField::HomingPullOff,
+    GlobalField::StatusReport,
+    GlobalField::ReportInches,
 ];
+
+/// Largest denominator of steps per unit (nine decimals): Grbl's units
+/// of `$110` and `$120` are then worked out in 64 bits.
+pub const MAX_DEN: u32 = 1_000_000_000;
 
 /// Number of settings; [`Setting::index`] is below it.
 pub const COUNT: usize = AXES * AXIS_FIELDS.len() + GLOBAL_FIELDS.len();
@@ -167,6 +177,8 @@ impl GlobalField {
             GlobalField::HomingSeek => text!("homing_seek"),
             GlobalField::HomingLocate => text!("homing_locate"),
             GlobalField::HomingPullOff => text!("homing_pull_off"),
+            GlobalField::StatusReport => text!("status_report"),
+            GlobalField::ReportInches => text!("report_inches"),
         }
     }
 }
@@ -192,9 +204,43 @@ pub fn for_each(cfg: &MachineConfig, mut f: impl FnMut(Setting, Value)) {
     }
 }
 
-/// Sets the named setting (name in any case, axes named as `cfg`'s
-/// machine names them) from its text.
+/// Line `index` of `$$`: Grbl's numbered settings, then ours by name.
+pub fn listed(index: usize, cfg: &MachineConfig) -> Option<Listed> {
+    Some(match index.checked_sub(grbl::COUNT) {
+        None => {
+            let n = grbl::Numbered::at(index)?;
+            Listed(Key::Number(n.number()), n.get(cfg))
+        }
+        Some(i) => {
+            let s = Setting::at(i)?;
+            Listed(Key::Named(Named(s, cfg.machine)), s.get(cfg))
+        }
+    })
+}
+
+/// A line of `$$`: `$110=3750.000`, `$radial_max_rate=2000`.
+pub struct Listed(Key, Value);
+
+enum Key {
+    Number(u8),
+    Named(Named),
+}
+
+impl uDisplay for Listed {
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
+        match &self.0 {
+            Key::Number(n) => uwrite!(f, "${}={}", n, self.1),
+            Key::Named(name) => uwrite!(f, "${}={}", name, self.1),
+        }
+    }
+}
+
+/// Sets a setting from its text: by Grbl's number (`110`) or by name (in
+/// any case, axes named as `cfg`'s machine names them).
 pub fn set(cfg: &mut MachineConfig, key: &str, value: &str) -> Result<(), SettingError> {
+    if let Some(n) = grbl::Numbered::parse(key.as_bytes()) {
+        return n.set(cfg, value.as_bytes());
+    }
     let setting = Setting::parse(key.as_bytes(), cfg.machine).ok_or(NumError {
         at: 0,
         kind: ErrorKind::UnknownKey,
@@ -285,6 +331,8 @@ impl Setting {
             Setting::Global(GlobalField::HomingPullOff) => {
                 return Value::Milli(Milli(i32::from(cfg.homing.pull_off_um)))
             }
+            Setting::Global(GlobalField::StatusReport) => cfg.status_report as u32,
+            Setting::Global(GlobalField::ReportInches) => cfg.report_inches as u32,
         })
     }
 
@@ -299,7 +347,10 @@ impl Setting {
             Setting::Global(GlobalField::ArcToleranceUm) => (1, 100_000),
             Setting::Global(GlobalField::PenUp | GlobalField::PenDown) => (0, 180),
             Setting::Global(GlobalField::PenSettleMs) => (0, 5000),
-            Setting::Global(GlobalField::DwellPMs | GlobalField::HomingAtStart) => (0, 1),
+            Setting::Global(
+                GlobalField::DwellPMs | GlobalField::HomingAtStart | GlobalField::ReportInches,
+            ) => (0, 1),
+            Setting::Global(GlobalField::StatusReport) => (0, 3),
             Setting::Global(GlobalField::HomingAxes) => (0, (1 << AXES) - 1),
             Setting::Global(GlobalField::HomingSeek | GlobalField::HomingLocate) => (1, 65_535),
             Setting::Global(_) => (0, 255),
@@ -348,18 +399,16 @@ impl Setting {
     /// an error.
     pub fn put(self, cfg: &mut MachineConfig, value: Value) -> Result<(), ErrorKind> {
         self.check(value)?;
-        let new = match value {
-            // Another machine: its defaults, whole.
-            Value::Machine(m) => MachineConfig::defaults(m),
-            _ => {
-                let mut new = *cfg;
-                self.force(&mut new, value);
-                new
-            }
-        };
-        check_whole(&new)?;
-        *cfg = new;
-        Ok(())
+        // Another machine: its defaults, whole (they always hold).
+        if let Value::Machine(m) = value {
+            *cfg = MachineConfig::defaults(m);
+            return Ok(());
+        }
+        // Changed in place and put back on an error: no copy of the whole
+        // configuration on the AVR's small stack.
+        let old = self.get(cfg);
+        self.force(cfg, value);
+        check_whole(cfg).inspect_err(|_| self.force(cfg, old))
     }
 
     /// Whether `value` is of this setting's kind and in its range.
@@ -385,7 +434,7 @@ impl Setting {
                 _,
             ) => Err(ErrorKind::NotANumber),
             (Setting::Axis(_, AxisField::StepsPerUnit), Value::Ratio(r)) => {
-                match r.num != 0 && r.den != 0 {
+                match r.num != 0 && r.den != 0 && r.den <= MAX_DEN {
                     true => Ok(()),
                     false => Err(ErrorKind::Invalid(AxisField::StepsPerUnit.name())),
                 }
@@ -458,6 +507,8 @@ impl Setting {
             (Setting::Global(GlobalField::HomingAtStart), _) => cfg.homing.at_start = n == 1,
             (Setting::Global(GlobalField::HomingSeek), _) => cfg.homing.seek = n as u16,
             (Setting::Global(GlobalField::HomingLocate), _) => cfg.homing.locate = n as u16,
+            (Setting::Global(GlobalField::StatusReport), _) => cfg.status_report = n as u8,
+            (Setting::Global(GlobalField::ReportInches), _) => cfg.report_inches = n == 1,
             (Setting::Global(_), Value::Number(_)) => {}
         }
     }
@@ -494,19 +545,7 @@ impl uDisplay for Value {
             Value::Machine(m) => uwrite!(f, "{}", m.name()),
             Value::Ratio(r) if r.den == 1 => uwrite!(f, "{}", r.num),
             Value::Ratio(r) => uwrite!(f, "{}/{}", r.num, r.den),
-            Value::Milli(m) => {
-                let (sign, a) = (if m.0 < 0 { "-" } else { "" }, m.0.unsigned_abs());
-                uwrite!(f, "{}{}.", sign, a / 1000)?;
-                let frac = a % 1000;
-                let pad = if frac < 10 {
-                    "00"
-                } else if frac < 100 {
-                    "0"
-                } else {
-                    ""
-                };
-                uwrite!(f, "{}{}", pad, frac)
-            }
+            Value::Milli(m) => uwrite!(f, "{}", Decimal(m.0, 3)),
         }
     }
 }

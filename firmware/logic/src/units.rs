@@ -93,6 +93,35 @@ impl StepsPerUnit {
     }
 }
 
+/// `value / 10^places` with `places` decimals: `Decimal(-12_345, 3)` is
+/// `-12.345`, `Decimal(7, 0)` is `7`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Decimal(pub i32, pub u8);
+
+impl ufmt::uDisplay for Decimal {
+    fn fmt<W: ufmt::uWrite + ?Sized>(
+        &self,
+        f: &mut ufmt::Formatter<'_, W>,
+    ) -> Result<(), W::Error> {
+        let Decimal(v, places) = *self;
+        if v < 0 {
+            f.write_char('-')?;
+        }
+        let scale = 10u32.pow(places as u32);
+        let a = v.unsigned_abs();
+        ufmt::uwrite!(f, "{}", a / scale)?;
+        if places > 0 {
+            f.write_char('.')?;
+        }
+        let mut digit = scale / 10;
+        while digit > 0 {
+            f.write_char((b'0' + (a / digit % 10) as u8) as char)?;
+            digit /= 10;
+        }
+        Ok(())
+    }
+}
+
 /// `n / d` rounded half away from zero; `d > 0`.
 pub fn div_round(n: i64, d: i64) -> i64 {
     if n >= 0 {

@@ -31,6 +31,8 @@ pub enum ErrorKind {
     RepeatedWord = 25,
     /// `G92` without an axis word.
     NoAxisWords = 26,
+    /// `$J=` with a command or word a jog cannot take.
+    InvalidJogCommand = 16,
     /// `N` negative, fractional or above 9 999 999.
     InvalidLineNumber = 27,
     /// `G4` without `P`.
@@ -74,11 +76,9 @@ pub enum ErrorKind {
     FeedTooLow = 72,
     /// A plotter's `Z` (its pen) with other axis words (taut's).
     PenWithMove = 73,
-    /// `G28`/`$H` on a machine with no axis set to home (taut's).
-    NoHoming = 74,
-    /// The homing cycle found no switch, or it stayed closed (Grbl's
-    /// alarms 8 and 9; taut's code).
-    HomingFailed = 75,
+    /// `G28`/`$H` on a machine with no axis set to home (Grbl's "setting
+    /// disabled").
+    NoHoming = 5,
 }
 
 /// The slowest feed rate accepted, thousandths of a unit per minute.
@@ -119,8 +119,8 @@ impl ErrorKind {
             ErrorKind::JobOwnsMotion => "A job is running",
             ErrorKind::FeedTooLow => "Feed rate below 10/min",
             ErrorKind::PenWithMove => "Pen Z with X/Y: one line each",
-            ErrorKind::NoHoming => "No axis homes (homing_axes)",
-            ErrorKind::HomingFailed => "Homing failed: switch not found or stuck",
+            ErrorKind::NoHoming => "Homing not enabled (homing_axes)",
+            ErrorKind::InvalidJogCommand => "Invalid jog command",
         }
     }
 }

@@ -315,6 +315,9 @@ pub enum Input {
     Line(Line),
     /// A `$` line.
     System(SystemLine),
+    /// `$J=`: a jog (Grbl 1.1), read as the `G1` it moves: axis words and
+    /// `F`, with `G20`/`G21`, `G90`/`G91` and `G53` for this line only.
+    Jog(Line),
     /// `M20`, `M23 <name>`, `M24`…
     Card(CardLine),
     /// A realtime byte (no `ok`).

@@ -7,7 +7,7 @@ use super::error::{Error, ErrorKind};
 use super::line::{Input, Line, Realtime};
 use super::number::Number;
 use super::system::SystemBuilder;
-use super::words::Words;
+use super::words::{jog_line, Words};
 
 /// Longest line, characters (without its line end and realtime bytes).
 pub const MAX_LINE: u8 = 80;
@@ -41,6 +41,7 @@ struct Checksum {
 enum Statement {
     /// Only spaces and comments so far.
     Start,
+    /// G-code words, or a jog's after `$J=`.
     GCode(Words),
     System(SystemBuilder),
 }
@@ -119,8 +120,10 @@ impl Parser {
 
     fn take(&mut self, c: u8) {
         let column = self.column;
-        // Marlin's checksum covers every byte before the `*`.
-        let star = self.lexeme == Lexeme::Code && c == b'*';
+        // Marlin's checksum covers every byte before the `*` (not the one
+        // of `$RST=*`).
+        let restore_all = matches!(&self.statement, Statement::System(s) if s.restores());
+        let star = self.lexeme == Lexeme::Code && c == b'*' && !restore_all;
         if self.checksum.is_none() && !star {
             self.xor ^= c;
         }
@@ -134,7 +137,7 @@ impl Parser {
                 self.feed(b' ', column);
             }
             (Lexeme::Checksum | Lexeme::AfterChecksum, b';') => self.lexeme = Lexeme::LineComment,
-            (Lexeme::Code, b'*') => {
+            (Lexeme::Code, b'*') if star => {
                 self.lexeme = Lexeme::Checksum;
                 self.checksum = Some(Checksum {
                     column,
@@ -167,14 +170,27 @@ impl Parser {
                 b' ' | b'\t' => {}
                 b'$' => self.statement = Statement::System(SystemBuilder::new(column)),
                 _ => {
-                    let mut words = Words::new();
-                    words.feed(c, column);
-                    self.statement = Statement::GCode(words);
+                    self.start_words(false);
+                    if let Statement::GCode(words) = &mut self.statement {
+                        words.feed(c, column);
+                    }
                 }
             },
             Statement::GCode(words) => words.feed(c, column),
-            Statement::System(system) => system.feed(c, column),
+            Statement::System(system) => {
+                system.feed(c, column);
+                if system.jog_starts() {
+                    self.start_words(true);
+                }
+            }
         }
+    }
+
+    /// A G-code line's words begin, or a jog's after `$J=`. Out of line:
+    /// the words it makes stay off the frame that reads every byte.
+    #[inline(never)]
+    fn start_words(&mut self, jog: bool) {
+        self.statement = Statement::GCode(Words::new(jog));
     }
 
     /// The result of a complete line. Errors rank: overflow (the line was
@@ -214,10 +230,18 @@ impl Parser {
                 checksum,
                 ..Line::EMPTY
             })),
-            Statement::GCode(words) => match words.finish(end)? {
-                Input::Line(line) => Ok(Input::Line(Line { checksum, ..line })),
-                other => Ok(other),
-            },
+            Statement::GCode(words) => {
+                let jog = words.is_jog();
+                if let Some(e) = words.jog_error() {
+                    return Err(e);
+                }
+                match words.finish(end)? {
+                    Input::Line(line) if jog => jog_line(line, end).map(Input::Jog),
+                    _ if jog => Err(Error::new(ErrorKind::InvalidJogCommand, end)),
+                    Input::Line(line) => Ok(Input::Line(Line { checksum, ..line })),
+                    other => Ok(other),
+                }
+            }
             Statement::System(system) => system.finish(end).map(Input::System),
         }
     }

@@ -34,6 +34,25 @@ pub enum SystemLine {
     /// `$<key>=<value>`, both as typed; the settings module interprets
     /// them (e.g. with [`parse_milli`](super::parse_milli)).
     Set { key: SystemText, value: SystemText },
+    /// `$N`: the startup lines (taut keeps none: `$N0=` `$N1=`).
+    StartupLines,
+    /// `$C`: check mode on, or off (with a soft reset).
+    CheckMode,
+    /// `$SLP`: the drivers off until a reset.
+    Sleep,
+    /// `$RST=$`, `$RST=#`, `$RST=*`: Grbl's defaults back.
+    Restore(Restore),
+}
+
+/// What `$RST=` restores.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Restore {
+    /// `$`: the settings (the machine's defaults).
+    Settings,
+    /// `#`: the offsets (taut keeps none).
+    Offsets,
+    /// `*`: both.
+    All,
 }
 
 /// A `$` line being read.
@@ -87,9 +106,27 @@ impl SystemBuilder {
         }
     }
 
+    /// `$RST=` has just been read: its `*` is no checksum.
+    pub(super) fn restores(&self) -> bool {
+        self.equals && self.value.is_empty() && self.key.eq_ignore_ascii_case("RST")
+    }
+
+    /// `$J=` has just been read: the rest is a jog's G-code.
+    pub(super) fn jog_starts(&self) -> bool {
+        self.equals && self.value.is_empty() && self.key.eq_ignore_ascii_case("J")
+    }
+
     pub(super) fn finish(self, end: u8) -> Result<SystemLine, Error> {
         if let Some(e) = self.error {
             return Err(e);
+        }
+        if self.equals && self.key.eq_ignore_ascii_case("RST") {
+            return match self.value.as_str() {
+                "$" => Ok(SystemLine::Restore(Restore::Settings)),
+                "#" => Ok(SystemLine::Restore(Restore::Offsets)),
+                "*" => Ok(SystemLine::Restore(Restore::All)),
+                _ => Err(Error::new(ErrorKind::InvalidStatement, self.dollar + 5)),
+            };
         }
         if self.equals {
             return if self.value.is_empty() {
@@ -110,6 +147,9 @@ impl SystemBuilder {
             "I" | "i" => Ok(SystemLine::BuildInfo),
             "G" | "g" => Ok(SystemLine::ParserState),
             "#" => Ok(SystemLine::Offsets),
+            "N" | "n" => Ok(SystemLine::StartupLines),
+            "C" | "c" => Ok(SystemLine::CheckMode),
+            "SLP" | "slp" => Ok(SystemLine::Sleep),
             "T1" | "t1" => Ok(SystemLine::Pattern(1)),
             "T5" | "t5" => Ok(SystemLine::Pattern(5)),
             "T6" | "t6" => Ok(SystemLine::Pattern(6)),

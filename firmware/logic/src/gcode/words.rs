@@ -34,10 +34,12 @@ pub(super) struct Words {
     /// A card command (`M20`…) in place of the line's command; `M23`
     /// collects the rest of the line as its file name.
     card: Option<CardLine>,
+    /// A jog's words (after `$J=`).
+    jog: bool,
 }
 
 impl Words {
-    pub(super) const fn new() -> Words {
+    pub(super) const fn new(jog: bool) -> Words {
         Words {
             line: Line::EMPTY,
             word: None,
@@ -48,7 +50,12 @@ impl Words {
             s_column: 0,
             arc_column: 0,
             card: None,
+            jog,
         }
+    }
+
+    pub(super) fn is_jog(&self) -> bool {
+        self.jog
     }
 
     pub(super) fn line_number(&self) -> Option<u32> {
@@ -165,6 +172,9 @@ impl Words {
                 };
                 modal(&mut self.line.distance, d, column)
             }
+            // Machine coordinates: taut keeps no work offsets, so every
+            // position is one already.
+            b'G' if value.0 == 53_000 => Ok(()),
             b'G' if matches!(value.0, 17_000..=19_000) && value.0 % 1000 == 0 => {
                 let p = match value.0 {
                     17_000 => Plane::Xy,
@@ -326,6 +336,49 @@ impl Words {
         }
         Ok(Input::Line(line))
     }
+}
+
+impl Words {
+    /// Why a jog's words (after `$J=`) are no jog, before the line ends:
+    /// a command, a plane or a value word other than `F` and `N` (Grbl's
+    /// error 16). Its own errors come first.
+    pub(super) fn jog_error(&self) -> Option<Error> {
+        if !self.jog || self.error.is_some() {
+            return None;
+        }
+        let open = self.word.map_or(0, |w| match w.letter {
+            b'M' | b'P' | b'S' | b'I' | b'J' | b'K' | b'R' => w.column,
+            _ => 0,
+        });
+        let commands = self.line.command != Command::Empty || self.card.is_some();
+        let column = match commands || self.line.plane.is_some() {
+            true => self.command_column.max(1),
+            false => [self.p_column, self.s_column, self.arc_column, open]
+                .into_iter()
+                .find(|&c| c != 0)?,
+        };
+        Some(Error::new(ErrorKind::InvalidJogCommand, column))
+    }
+}
+
+/// A jog's line once read whole: a `G1` to its axis words at its `F`
+/// (Grbl's error 16 for a command or plane its last word brought, 26
+/// without an axis word, 22 without `F`); `end` is the line's end.
+pub(super) fn jog_line(line: Line, end: u8) -> Result<Line, Error> {
+    let fail = |kind| Err(Error::new(kind, end));
+    if line.command != Command::Empty || line.plane.is_some() || line.has_arc_words() {
+        return fail(ErrorKind::InvalidJogCommand);
+    }
+    if !line.has_axes() {
+        return fail(ErrorKind::NoAxisWords);
+    }
+    if line.f.get().is_none() {
+        return fail(ErrorKind::UndefinedFeedRate);
+    }
+    Ok(Line {
+        command: Command::Linear,
+        ..line
+    })
 }
 
 /// A modal word (`G90`, `G17`, `G20`…): one of its group per line (Grbl's

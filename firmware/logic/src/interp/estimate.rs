@@ -56,8 +56,8 @@ impl GcodeTime {
                     };
                     match self.interp.plan(&line, &self.kin, &self.config, allowed) {
                         Ok(planned) => {
+                            self.interp.commit(&planned);
                             self.carry_out(planned.order);
-                            self.interp.commit(planned);
                         }
                         Err(_) => self.refused += 1,
                     }

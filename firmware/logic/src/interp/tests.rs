@@ -26,7 +26,7 @@ fn line(text: &str) -> Line {
 fn run(i: &mut Interpreter, text: &str, allowed: Allowed) -> Result<Order, ErrorKind> {
     let kin = Linear::cylindrical(&CFG);
     let planned = i.plan(&line(text), &kin, &CFG, allowed)?;
-    i.commit(planned);
+    i.commit(&planned);
     Ok(planned.order)
 }
 
@@ -81,7 +81,7 @@ fn planned_twice_committed_once_is_one_move() {
     let first = i.plan(&l, &kin, &CFG, FREE).unwrap();
     let again = i.plan(&l, &kin, &CFG, FREE).unwrap();
     assert_eq!(first, again);
-    i.commit(again);
+    i.commit(&again);
     assert_eq!(i.target()[0], Milli(10_000));
 }
 
@@ -283,7 +283,7 @@ fn straight_moves_of_an_arm_are_cut_into_pieces_that_it_reaches() {
     i.resync(kin.forward(&[0; crate::axis::AXES]));
     let plan = |i: &mut Interpreter, text| {
         let planned = i.plan(&line(text), &kin, &cfg, FREE)?;
-        i.commit(planned);
+        i.commit(&planned);
         Ok::<_, ErrorKind>(planned.order)
     };
     plan(&mut i, "G0 X100 Y150").unwrap();
@@ -312,7 +312,7 @@ fn the_pen_of_a_plotter_answers_m3_m5_m300_and_z() {
     let mut i = Interpreter::new();
     let mut plan = |text| {
         let planned = i.plan(&line(text), &kin, &cfg, FREE)?;
-        i.commit(planned);
+        i.commit(&planned);
         Ok::<_, ErrorKind>(planned.order)
     };
     let pen = |deg| Ok(Order::Pen { deg, ms: 150 });
@@ -380,4 +380,57 @@ fn parser_state_reports_the_modal_state_as_grbl() {
     run(&mut i, "G20 G90", FREE).unwrap();
     // 500 mm/min is 19.7 inches a minute.
     assert_eq!(show(&i, false), "G1 G54 G18 G20 G90 G94 M5 M9 T0 F19 S0");
+}
+
+fn jog(text: &str) -> Line {
+    let mut p = Parser::new();
+    let out: Vec<_> = text
+        .bytes()
+        .chain([b'\n'])
+        .filter_map(|b| p.push(b))
+        .collect();
+    match out.as_slice() {
+        [Ok(Input::Jog(l))] => *l,
+        other => panic!("{text:?}: {other:?}"),
+    }
+}
+
+/// jogging.md: "The jog command ... G20, G21, G90, G91 ... only apply to
+/// the jog and do not alter the g-code parser state"; "if soft limits
+/// are enabled, jog commands beyond the travel are rejected with an
+/// error" (15).
+#[test]
+fn a_jog_moves_and_keeps_the_modal_state_but_the_position() {
+    let kin = Linear::cylindrical(&CFG);
+    let mut i = Interpreter::new();
+    run(&mut i, "G1 X-10 F300", FREE).unwrap();
+    let before = i.parser_state(false);
+    let planned = i
+        .plan(&jog("$J=G91 G20 X-1 F10"), &kin, &CFG, FREE)
+        .unwrap();
+    // One inch further out at 10 in/min: 254 mm/min.
+    assert_eq!(
+        planned.order,
+        Order::Move {
+            // 35.4 mm at 32 steps/mm: 1132.8 steps, rounded once.
+            steps: [0, -1133, 0, 0],
+            feed: Feed::PerMinute(Milli(254_000)),
+        }
+    );
+    i.commit_jog(&planned);
+    assert_eq!(i.parser_state(false), before, "G90 G21 G1 F300 stay");
+    assert_eq!(i.target()[1], Milli(-35_400));
+    // Beyond the radial travel (−450 mm): refused, nothing changes.
+    assert_eq!(
+        i.plan(&jog("$J=X-451 F100"), &kin, &CFG, FREE),
+        Err(ErrorKind::TravelExceeded)
+    );
+    let locked = Allowed {
+        position_known: false,
+        ..FREE
+    };
+    assert_eq!(
+        i.plan(&jog("$J=X-1 F100"), &kin, &CFG, locked),
+        Err(ErrorKind::Locked)
+    );
 }

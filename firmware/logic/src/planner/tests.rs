@@ -189,3 +189,60 @@ proptest! {
         prop_assert!(a <= 500.0 * 1.02, "accel {}", a);
     }
 }
+
+/// The cruise speed of a move taken from the planner, events/s.
+fn cruise(p: &mut Planner) -> f64 {
+    (p.take().unwrap().profile.cruise_sqr() as f64).sqrt()
+}
+
+/// Grbl's overrides act on the moves not yet taken: the feed's from 10
+/// to 200 % of `F`, never above the axes' rates; the rapid's 25, 50 or
+/// 100 % of the rapid rate, on rapids only.
+#[test]
+fn overrides_scale_the_moves_not_yet_taken() {
+    let mut p = Planner::new(&square());
+    // F1200 on an axis of 100 steps/unit: 2000 steps/s; rapids 4000.
+    for k in 1..=4 {
+        p.push([k * 20_000, 0, 0, 0], Feed::PerMinute(Milli(1_200_000)))
+            .unwrap();
+    }
+    p.push([100_000, 0, 0, 0], Feed::Rapid).unwrap();
+    assert!((cruise(&mut p) - 2000.0).abs() < 1.0);
+    p.set_overrides(Overrides {
+        feed: 50,
+        rapid: 25,
+    });
+    assert!((cruise(&mut p) - 1000.0).abs() < 1.0);
+    p.set_overrides(Overrides {
+        feed: 150,
+        rapid: 25,
+    });
+    assert!((cruise(&mut p) - 3000.0).abs() < 1.0);
+    // 200 % of 2000 would be 4000: the axis's rate.
+    p.set_overrides(Overrides {
+        feed: 200,
+        rapid: 25,
+    });
+    assert!((cruise(&mut p) - 4000.0).abs() < 1.0);
+    assert!((cruise(&mut p) - 1000.0).abs() < 1.0, "the rapid at 25 %");
+    // A move queued later gets them too, and the entries follow the new
+    // cruise speeds (a junction never faster than either side).
+    p.set_overrides(Overrides {
+        feed: 10,
+        rapid: 100,
+    });
+    for k in 6..=8 {
+        p.push([k * 20_000, 0, 0, 0], Feed::PerMinute(Milli(1_200_000)))
+            .unwrap();
+    }
+    // 200 steps/s at 100 steps a unit: 2 000 milli-units/s.
+    let slow = 2000.0 * 2000.0;
+    assert!(
+        entries(&p)[1..]
+            .iter()
+            .all(|&e| (e as f64 - slow).abs() < slow * 1e-3),
+        "{:?}",
+        entries(&p)
+    );
+    assert!((cruise(&mut p) - 200.0).abs() < 1.0);
+}

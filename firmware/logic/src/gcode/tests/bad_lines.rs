@@ -38,6 +38,17 @@ const BAD: &[(&str, u8, u8)] = &[
     ("G1 M24", 21, 4),
     ("M25 G1", 21, 5),
     ("G1 Q5", 20, 4),
+    // Grbl's jogging.md: "Only the following G-codes are valid ... G20,
+    // G21 ... G90, G91 ... G53"; "F - Feed rate value" and at least one
+    // axis word are required.
+    ("$J=G1 X1 F100", 16, 4),
+    ("$J=G91 X1 P1 F100", 16, 11),
+    ("$J=G17 X1 F100", 16, 1),
+    ("$J=M20", 16, 4),
+    ("$J=G91 X1", 22, 10),
+    ("$J=G91 F100", 26, 12),
+    ("$J=", 26, 4),
+    ("$RST=x", 3, 6),
     ("G0 G1 X1", 21, 4),
     ("G1 G1 X1", 21, 4),
     ("G90 G91", 21, 5),

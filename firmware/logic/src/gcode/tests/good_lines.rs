@@ -86,6 +86,54 @@ fn checksummed_lines_report_number_and_checksum() {
     );
 }
 
+/// Jogs as senders write them (jogging.md's `$J=G91 X10 F100`; CNCjs
+/// `$J=G91 G21 X-10 F1000`; UGS `$J=G21G91X1F100`; bCNC's feed far above
+/// any rate; machine coordinates `G53`, which are taut's own), each read
+/// as the `G1` it moves.
+#[test]
+fn jogs() {
+    use Command::Linear;
+    let jog = |text| match parse(text) {
+        Ok(Input::Jog(line)) => line,
+        other => panic!("{text}: {other:?}"),
+    };
+    let relative = |l: Line| l.distance(Distance::Relative);
+    assert_eq!(
+        jog("$J=G91 X10 F100"),
+        relative(line(Linear).at(X, 10_000).f(100_000))
+    );
+    assert_eq!(
+        jog("$j=x-1 z2 f60"),
+        line(Linear).at(X, -1_000).at(Z, 2_000).f(60_000)
+    );
+    let cncjs = jog("$J=G91 G21 X-10 F1000");
+    assert_eq!(cncjs.units, Some(Units::Mm));
+    assert_eq!(
+        cncjs,
+        Line {
+            units: Some(Units::Mm),
+            ..relative(line(Linear).at(X, -10_000).f(1_000_000))
+        }
+    );
+    let ugs = jog("$J=G21G91X1F100");
+    assert_eq!(
+        ugs,
+        Line {
+            units: Some(Units::Mm),
+            ..relative(line(Linear).at(X, 1_000).f(100_000))
+        }
+    );
+    assert_eq!(
+        jog("$J=G91 Y1 F100000"),
+        relative(line(Linear).at(Y, 1_000).f(100_000_000))
+    );
+    assert_eq!(jog("$J=G53 X0 F100"), line(Linear).at(X, 0).f(100_000));
+    assert_eq!(
+        parse("G53 G0 X0"),
+        Ok(Input::Line(line(Command::Rapid).at(X, 0)))
+    );
+}
+
 #[test]
 fn system_lines() {
     let set = |key: &str, value: &str| {
@@ -101,6 +149,21 @@ fn system_lines() {
     assert_eq!(parse("$I"), Ok(Input::System(SystemLine::BuildInfo)));
     assert_eq!(parse("$g"), Ok(Input::System(SystemLine::ParserState)));
     assert_eq!(parse("$#"), Ok(Input::System(SystemLine::Offsets)));
+    // Grbl's commands.md: `$N` "View startup blocks", `$C` "Check gcode
+    // mode", `$SLP` "Enable Sleep Mode", `$RST=$`, `$RST=#`, `$RST=*`
+    // "Restore Grbl settings and data to defaults".
+    assert_eq!(parse("$N"), Ok(Input::System(SystemLine::StartupLines)));
+    assert_eq!(parse("$C"), Ok(Input::System(SystemLine::CheckMode)));
+    assert_eq!(parse("$SLP"), Ok(Input::System(SystemLine::Sleep)));
+    for (text, what) in [
+        ("$", Restore::Settings),
+        ("#", Restore::Offsets),
+        ("*", Restore::All),
+    ] {
+        let line = format!("$RST={text}");
+        assert_eq!(parse(&line), Ok(Input::System(SystemLine::Restore(what))));
+    }
+    assert_eq!(parse("$N0=G20"), set("N0", "G20"));
     assert_eq!(parse("$ steps_c = 26.667"), set("steps_c", "26.667"));
     assert_eq!(parse("$100=80"), set("100", "80"));
     assert_eq!(parse("$Q=-1"), set("Q", "-1"));

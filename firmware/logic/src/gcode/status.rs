@@ -1,0 +1,244 @@
+//! Grbl 1.1's status report, the answer to `?`:
+//! `<Idle|MPos:0.000,0.000,0.000|Bf:15,128|FS:0,0|WCO:0.000,0.000,0.000>`,
+//! with `$10` choosing machine or work position and the buffer state,
+//! `$13` inches, and the work offset and overrides carried every so
+//! often, as Grbl's refresh counters do. The feed and speed overrides
+//! (Grbl's real-time bytes 0x90–0x97) are kept here too.
+
+pub use crate::planner::Overrides;
+use crate::units::{div_round, Decimal, Milli};
+use taut_progmem::text;
+use ufmt::{uDisplay, uWrite, uwrite, Formatter};
+
+/// The machine state, in Grbl's words.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum State {
+    Idle,
+    Run,
+    /// A feed hold braking (`Hold:1`) or standing (`Hold:0`).
+    Hold {
+        standing: bool,
+    },
+    Jog,
+    /// Motion locked until `$X` or homing (the position may be lost).
+    Alarm,
+    /// The safety door (0x84): stopping (`Door:2`), or stopped with the
+    /// door closed, ready to resume (`Door:0`; taut has no door switch).
+    Door {
+        standing: bool,
+    },
+    /// `$C`: lines are checked, nothing moves.
+    Check,
+    Home,
+    /// `$SLP`: the drivers off until a reset.
+    Sleep,
+}
+
+impl uDisplay for State {
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
+        let word = match self {
+            State::Idle => text!("Idle"),
+            State::Run => text!("Run"),
+            State::Hold { standing: true } => text!("Hold:0"),
+            State::Hold { standing: false } => text!("Hold:1"),
+            State::Jog => text!("Jog"),
+            State::Alarm => text!("Alarm"),
+            State::Door { standing: true } => text!("Door:0"),
+            State::Door { standing: false } => text!("Door:2"),
+            State::Check => text!("Check"),
+            State::Home => text!("Home"),
+            State::Sleep => text!("Sleep"),
+        };
+        word.fmt(f)
+    }
+}
+
+/// Grbl's first override byte: 0x90 feed 100 %, 0x91 +10, 0x92 −10,
+/// 0x93 +1, 0x94 −1, 0x95 rapid 100 %, 0x96 50 %, 0x97 25 %.
+pub const OVERRIDE_BYTES: u8 = 0x90;
+
+/// The override bytes (the planner applies the percentages).
+impl Overrides {
+    /// Applies the override bytes that came (bit `i`: byte 0x90 + `i`) in
+    /// Grbl's order — reset, coarse, fine — the feed kept within 10–200 %;
+    /// true if anything changed.
+    pub fn apply(&mut self, bits: u8) -> bool {
+        let before = *self;
+        let has = |i: u8| bits >> i & 1 != 0;
+        let mut feed = self.feed as i16;
+        if has(0) {
+            feed = 100;
+        }
+        for (i, step) in [(1, 10), (2, -10), (3, 1), (4, -1)] {
+            if has(i) {
+                feed += step;
+            }
+        }
+        self.feed = feed.clamp(10, 200) as u8;
+        for (i, rapid) in [(5, 100), (6, 50), (7, 25)] {
+            if has(i) {
+                self.rapid = rapid;
+            }
+        }
+        *self != before
+    }
+}
+
+/// What a report carries besides the state, the position, the buffer and
+/// the feed: the work offset or the overrides, never both.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Extra {
+    None,
+    Wco,
+    Ov,
+}
+
+/// Grbl's refresh counters: the work offset every 10th report (30th
+/// while busy), the overrides every 10th (20th) and in the report after
+/// they change; both soon after a reset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Refresh {
+    wco: u8,
+    ov: u8,
+}
+
+impl Default for Refresh {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Refresh {
+    pub const fn new() -> Refresh {
+        Refresh { wco: 0, ov: 0 }
+    }
+
+    /// The overrides changed: in the next report.
+    pub fn overrides_changed(&mut self) {
+        self.ov = 0;
+    }
+
+    /// What the next report carries; `busy`: the machine moves or holds.
+    pub fn next(&mut self, busy: bool) -> Extra {
+        let mut extra = Extra::None;
+        match self.wco {
+            0 => {
+                self.wco = if busy { 29 } else { 9 };
+                // Not both in one report: the overrides in the next one.
+                self.ov = self.ov.max(1);
+                extra = Extra::Wco;
+            }
+            _ => self.wco -= 1,
+        }
+        match self.ov {
+            0 => {
+                self.ov = if busy { 19 } else { 9 };
+                Extra::Ov
+            }
+            _ => {
+                self.ov -= 1;
+                extra
+            }
+        }
+    }
+}
+
+/// A status report. Positions are in the report's places X, Y, Z, in
+/// thousandths of mm (or degrees).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Status {
+    pub state: State,
+    pub position: [Milli; 3],
+    /// Places (bits) whose position is an angle: never in inches.
+    pub angles: u8,
+    /// Along the path, thousandths of a unit per minute.
+    pub feed: Milli,
+    /// Free planner blocks and receive bytes.
+    pub buffer: (u8, u8),
+    /// Places (bits) whose limit switch is closed.
+    pub pins: u8,
+    pub overrides: Overrides,
+    pub extra: Extra,
+    /// `$10`: bit 0 machine position (else work position), bit 1 buffer.
+    pub fields: u8,
+    /// `$13`.
+    pub inches: bool,
+}
+
+impl Status {
+    /// `v` thousandths of mm in the report's unit: mm with three
+    /// decimals, or inches with four.
+    fn length(&self, v: Milli, angle: bool) -> Decimal {
+        match self.inches && !angle {
+            true => Decimal(div_round(v.0 as i64 * 100, 254) as i32, 4),
+            false => Decimal(v.0, 3),
+        }
+    }
+
+    /// The three places of `values`, comma-separated.
+    fn axes<W: uWrite + ?Sized>(
+        &self,
+        f: &mut Formatter<'_, W>,
+        values: &[Milli; 3],
+    ) -> Result<(), W::Error> {
+        for (p, v) in values.iter().enumerate() {
+            if p > 0 {
+                f.write_char(',')?;
+            }
+            uwrite!(f, "{}", self.length(*v, self.angles >> p & 1 != 0))?;
+        }
+        Ok(())
+    }
+}
+
+impl uDisplay for Status {
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
+        // No work offsets: the work position is the machine position.
+        let position = match self.fields & 1 {
+            1 => text!("|MPos:"),
+            _ => text!("|WPos:"),
+        };
+        uwrite!(f, "<{}{}", self.state, position)?;
+        self.axes(f, &self.position)?;
+        if self.fields & 2 != 0 {
+            uwrite!(f, "{}{},{}", text!("|Bf:"), self.buffer.0, self.buffer.1)?;
+        }
+        // Whole mm per minute, or inches with one decimal; no spindle.
+        let (feed, places) = match self.inches {
+            true => (div_round(self.feed.0 as i64, 2540), 1),
+            false => (div_round(self.feed.0 as i64, 1000), 0),
+        };
+        let feed = Decimal(feed as i32, places);
+        uwrite!(f, "{}{}{}", text!("|FS:"), feed, text!(",0"))?;
+        if self.pins != 0 {
+            text!("|Pn:").fmt(f)?;
+            for p in 0..3 {
+                if self.pins >> p & 1 != 0 {
+                    f.write_char((b'X' + p) as char)?;
+                }
+            }
+        }
+        match self.extra {
+            Extra::None => {}
+            Extra::Wco => {
+                text!("|WCO:").fmt(f)?;
+                self.axes(f, &[Milli::ZERO; 3])?;
+            }
+            Extra::Ov => {
+                let o = self.overrides;
+                uwrite!(
+                    f,
+                    "{}{},{}{}",
+                    text!("|Ov:"),
+                    o.feed,
+                    o.rapid,
+                    text!(",100")
+                )?;
+            }
+        }
+        f.write_char('>')
+    }
+}
+
+#[cfg(test)]
+mod tests;
