@@ -52,7 +52,7 @@ fn crc16_is_ccitt_false() {
 fn layout_fits_above_the_settings_and_in_the_eeprom() {
     assert!(crate::settings::image::len() <= START as usize);
     assert_eq!(SLOTS, 440);
-    assert!(RING + SLOTS * RECORD_BYTES <= END);
+    const { assert!(RING + SLOTS * RECORD_BYTES <= END) };
 }
 
 #[test]

@@ -36,6 +36,22 @@ pub struct Winder {
 pub struct Wrap {
     targets: [i32; 4],
     next: u8,
+    /// The gaps the needle goes out and comes back in through, as the
+    /// nail each follows (`gap_after`).
+    gaps: [u16; 2],
+}
+
+impl Wrap {
+    /// Moves handed out so far (0 to 4).
+    pub fn handed(&self) -> u8 {
+        self.next
+    }
+
+    /// The gap the needle goes out through, and the one it comes back
+    /// in through, each named by the nail before it.
+    pub fn gaps(&self) -> [u16; 2] {
+        self.gaps
+    }
 }
 
 impl Iterator for Wrap {
@@ -85,6 +101,24 @@ impl Winder {
         ]
     }
 
+    /// After a power cut, from the zero pose again (needle outside the
+    /// ring at the board's edge): the drill's driver off, the base to the
+    /// gap after nail `gap`, the needle in through it. The wraps go on
+    /// from there as they would have.
+    pub fn resume_entry(&mut self, gap: u16) -> [MachineStep; 3] {
+        self.base = self
+            .scale
+            .shorter_rotation(self.base, self.board.gap_after(gap));
+        [
+            MachineStep::Drivers {
+                mask: bit(Axis::Drill),
+                on: false,
+            },
+            MachineStep::to(Axis::Base, self.base),
+            MachineStep::to(Axis::Radial, self.inner),
+        ]
+    }
+
     /// The moves that wrap nail `j`.
     pub fn wrap(&mut self, j: u16) -> Result<Wrap, WindError> {
         let nails = self.board.nails();
@@ -96,16 +130,18 @@ impl Winder {
         let after = s.shorter_rotation(self.base, self.board.gap_after(j));
         // Steps across nail j, from its gap before to its gap after.
         let span = (after - before).rem_euclid(s.steps_per_turn);
-        let (first, second) = if (before - self.base).abs() <= (after - self.base).abs() {
-            (before, before + span)
+        let (g_before, g_after) = ((j + nails - 1) % nails, j);
+        let (first, second, gaps) = if (before - self.base).abs() <= (after - self.base).abs() {
+            (before, before + span, [g_before, g_after])
         } else {
-            (after, after - span)
+            (after, after - span, [g_after, g_before])
         };
         let outer = s.radial_steps(&self.board, self.board.nail(j).radius + OUTER_MARGIN_MM);
         self.base = second;
         Ok(Wrap {
             targets: [first, outer, second, self.inner],
             next: 0,
+            gaps,
         })
     }
 
