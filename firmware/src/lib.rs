@@ -8,6 +8,7 @@
 pub mod board;
 pub mod buttons;
 pub mod card;
+pub mod checkpoint;
 pub mod console;
 pub mod drivers;
 pub mod endstop;

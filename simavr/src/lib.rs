@@ -20,6 +20,7 @@ mod outcome;
 pub mod profile;
 pub mod picture;
 pub mod probe;
+pub mod power;
 pub mod pty;
 pub mod replay;
 pub mod report;
