@@ -86,37 +86,33 @@ impl Winder {
     /// The drill's driver off (the needle holds its height unpowered),
     /// then the entry move.
     pub fn entry(&mut self) -> [MachineStep; 4] {
-        let gap = self
-            .scale
-            .shorter_rotation(self.base, self.board.gap_after(0));
-        self.base = self.scale.shorter_rotation(gap, self.board.nail(0).angle);
-        [
-            MachineStep::Drivers {
-                mask: bit(Axis::Drill),
-                on: false,
-            },
-            MachineStep::to(Axis::Base, gap),
-            MachineStep::to(Axis::Radial, self.inner),
-            MachineStep::to(Axis::Base, self.base),
-        ]
+        [0, 1, 2, 3].map(|i| self.entry_step(None, i).expect("four steps"))
     }
 
-    /// After a power cut, from the zero pose again (needle outside the
-    /// ring at the board's edge): the drill's driver off, the base to the
-    /// gap after nail `gap`, the needle in through it. The wraps go on
-    /// from there as they would have.
-    pub fn resume_entry(&mut self, gap: u16) -> [MachineStep; 3] {
-        self.base = self
-            .scale
-            .shorter_rotation(self.base, self.board.gap_after(gap));
-        [
-            MachineStep::Drivers {
+    /// Step `i` of the entry from the zero pose (needle outside the ring
+    /// at the board's edge), made when needed rather than kept: a new
+    /// job's (`resume: None`: half a nail round to the gap after nail 0,
+    /// needle in, back to nail 0's angle), or after a power cut (`Some(g)`:
+    /// to the gap after nail `g`, needle in through it; the wraps go on
+    /// from there as they would have). The drill's driver goes off first.
+    pub fn entry_step(&mut self, resume: Option<u16>, i: u8) -> Option<MachineStep> {
+        let s = &self.scale;
+        let gap = s.shorter_rotation(0, self.board.gap_after(resume.unwrap_or(0)));
+        let last = match resume {
+            Some(_) => gap,
+            None => s.shorter_rotation(gap, self.board.nail(0).angle),
+        };
+        self.base = last;
+        Some(match (i, resume) {
+            (0, _) => MachineStep::Drivers {
                 mask: bit(Axis::Drill),
                 on: false,
             },
-            MachineStep::to(Axis::Base, self.base),
-            MachineStep::to(Axis::Radial, self.inner),
-        ]
+            (1, _) => MachineStep::to(Axis::Base, gap),
+            (2, _) => MachineStep::to(Axis::Radial, self.inner),
+            (3, None) => MachineStep::to(Axis::Base, last),
+            _ => return None,
+        })
     }
 
     /// The moves that wrap nail `j`.

@@ -487,26 +487,26 @@ impl Job {
             (Phase::Drilling, Some(d)) => {
                 let hole = s.n().min(plan.board.nails() as u32);
                 let d = d.from_hole(hole as u16);
-                let steps = PhaseSteps::drill(d, plan.board.nails(), Some(hole), now_ms);
-                self.go(State::Drilling, steps, MACHINE_DRIVERS, o, now_ms);
+                self.steps = Some(PhaseSteps::drill(d, plan.board.nails(), Some(hole), now_ms));
+                self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
             }
             _ => {
                 let Some(winder) = plan.winder.take() else {
                     return;
                 };
-                let steps = PhaseSteps::wind(winder, plan.count, Some(s.last), now_ms);
-                let skip = steps.done;
-                o.push(Action::OpenPattern { skip });
+                self.steps = Some(PhaseSteps::wind(winder, plan.count, Some(s.last), now_ms));
+                o.push(Action::OpenPattern { skip: s.done() });
                 // The resume entry switches the drill's driver off itself.
-                self.go(State::Winding, steps, MACHINE_DRIVERS, o, now_ms);
+                self.go(State::Winding, MACHINE_DRIVERS, o, now_ms);
             }
         }
     }
 
-    /// A phase starts: its steps, its state, its drivers, its first line.
-    fn go(&mut self, state: State, mut steps: PhaseSteps, drivers: u8, o: &mut Out, now_ms: u32) {
+    /// A phase starts (its steps in place): its state, its drivers, its
+    /// first line.
+    fn go(&mut self, state: State, drivers: u8, o: &mut Out, now_ms: u32) {
+        let Some(steps) = &mut self.steps else { return };
         let first = steps.reporter.first(now_ms);
-        self.steps = Some(steps);
         self.enter(state, o);
         o.push(Action::DriversOn(drivers));
         o.push(Action::Progress(first));
@@ -518,8 +518,8 @@ impl Job {
         let Some(drilling) = plan.drilling.take() else {
             return;
         };
-        let steps = PhaseSteps::drill(drilling, plan.board.nails(), None, now_ms);
-        self.go(State::Drilling, steps, MACHINE_DRIVERS, o, now_ms);
+        self.steps = Some(PhaseSteps::drill(drilling, plan.board.nails(), None, now_ms));
+        self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
     }
 
     fn start_winding(&mut self, o: &mut Out, now_ms: u32) {

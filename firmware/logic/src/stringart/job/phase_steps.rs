@@ -26,8 +26,11 @@ enum Work {
     },
     Wind {
         winder: Winder,
-        /// The entry move, until it has been handed out.
-        entry: Option<heapless::Deque<MachineStep, 5>>,
+        /// The entry's next step, until it has been handed out.
+        entry: Option<u8>,
+        /// The entry after a power cut goes in through the gap after
+        /// this nail.
+        resume_gap: Option<u16>,
         wrap: Option<Wrap>,
         /// The wrap's move count at its last record (1 or 3), 0 if none.
         saved_at: u8,
@@ -81,38 +84,23 @@ impl PhaseSteps {
 
     /// Winding a new job's pattern (`resume: None`), or on from a
     /// checkpoint's record (`Some(None)`: none written yet).
-    pub fn wind(
-        mut winder: Winder,
-        count: u32,
-        resume: Option<Option<Record>>,
-        now_ms: u32,
-    ) -> Self {
-        let mut entry = heapless::Deque::new();
-        let mut push = |s| {
-            let _ = entry.push_back(s);
-        };
-        let done = match resume {
-            Some(Some(r)) => {
-                winder.resume_entry(r.gap).into_iter().for_each(&mut push);
-                r.n / 2
-            }
-            _ => {
-                if resume.is_none() {
-                    push(MachineStep::Save(Save::Begin(Phase::Winding)));
-                }
-                winder.entry().into_iter().for_each(&mut push);
-                0
-            }
-        };
+    pub fn wind(winder: Winder, count: u32, resume: Option<Option<Record>>, now_ms: u32) -> Self {
+        let last = resume.flatten();
+        let done = last.map_or(0, |r| r.n / 2);
         let work = Work::Wind {
             winder,
-            entry: Some(entry),
+            entry: Some(0),
+            resume_gap: last.map(|r| r.gap),
             wrap: None,
             saved_at: 0,
             feed: heapless::Deque::new(),
             fed: done,
         };
-        Self::new(work, Phase::Winding, (count, done), now_ms)
+        let mut steps = Self::new(work, Phase::Winding, (count, done), now_ms);
+        if resume.is_none() {
+            steps.then = Some(MachineStep::Save(Save::Begin(Phase::Winding)));
+        }
+        steps
     }
 
     fn new(work: Work, phase: Phase, (total, done): (u32, u32), now_ms: u32) -> Self {
@@ -179,13 +167,15 @@ impl PhaseSteps {
             Work::Wind {
                 winder,
                 entry,
+                resume_gap,
                 wrap,
                 feed,
                 saved_at,
                 ..
             } => {
-                if let Some(steps) = entry {
-                    if let Some(step) = steps.pop_front() {
+                if let Some(i) = entry {
+                    if let Some(step) = winder.entry_step(*resume_gap, *i) {
+                        *i += 1;
                         return Some(step);
                     }
                     *entry = None;
