@@ -52,6 +52,11 @@ impl Wrap {
     pub fn gaps(&self) -> [u16; 2] {
         self.gaps
     }
+
+    /// The base's position once the wrap is done.
+    pub fn end_base(&self) -> i32 {
+        self.targets[2]
+    }
 }
 
 impl Iterator for Wrap {
@@ -139,6 +144,11 @@ impl Winder {
             next: 0,
             gaps,
         })
+    }
+
+    /// The base's position after the moves handed out so far.
+    pub fn base(&self) -> i32 {
+        self.base
     }
 
     /// All drivers off at the end of the job.

@@ -98,6 +98,8 @@ pub enum Event<'c> {
     /// After `PowerOn`: the checkpoint of a job under way at the last
     /// power-off, found in EEPROM.
     Saved(Saved),
+    /// An operator's tool from the console ([`super::tools`]).
+    Tool(super::tools::Tool),
 }
 
 /// Something the firmware logs.
@@ -129,6 +131,15 @@ pub enum Msg {
     SavedDiscarded,
     /// Green refused before a resume: an axis is not zeroed yet.
     ZeroAll,
+    /// A tool refused: the machine moves.
+    ToolMoving,
+    /// A tool refused: not in this state.
+    ToolNotNow,
+    /// A tool refused: no such nail or wrap.
+    ToolRange,
+    WrapTested,
+    DriftChecked,
+    Jumped,
 }
 
 impl Msg {
@@ -152,6 +163,12 @@ impl Msg {
             Msg::SavedOtherCard => "checkpoint: another card, discarded",
             Msg::SavedDiscarded => "checkpoint discarded",
             Msg::ZeroAll => "zero base, radial and drill first (white buttons)",
+            Msg::ToolMoving => "tool refused: the machine moves (pause first)",
+            Msg::ToolNotNow => "tool refused: not in this state",
+            Msg::ToolRange => "tool refused: no such nail or wrap",
+            Msg::WrapTested => "wrap test done",
+            Msg::DriftChecked => "drift check done",
+            Msg::Jumped => "jumped: green resumes there",
         }
     }
 }
@@ -234,6 +251,12 @@ pub enum Action {
     /// The job's checkpoint is done with (the job ended, or it was
     /// discarded): write an idle header.
     Forget,
+    /// Log the drift check: the base's step count (the firmware's) against
+    /// where `nail` is expected (`expected`, steps).
+    Drift {
+        nail: u16,
+        expected: i32,
+    },
 }
 
 /// The actions of one event; never more than this many.

@@ -45,6 +45,7 @@ mod io;
 mod phase;
 mod phase_steps;
 mod progress;
+pub mod tools;
 
 pub use io::{Action, Actions, Event, Msg, Prompt, State, PROMPT_MARK};
 pub use phase::Phase;
@@ -58,7 +59,7 @@ use crate::checkpoint::Saved;
 use crate::config::MachineConfig;
 use crate::files::check::CardId;
 use crate::files::param::Params;
-use crate::geometry::Board;
+use crate::geometry::{Board, StepScale};
 use crate::pinmap::Button;
 use crate::units::Milli;
 use phase_steps::PhaseSteps;
@@ -81,6 +82,7 @@ struct Plan {
     count: u32,
     id: CardId,
     board: Board,
+    scale: StepScale,
     drilling: Option<Drilling>,
     winder: Option<Winder>,
 }
@@ -101,6 +103,10 @@ pub struct Job {
     saved: Option<Saved>,
     /// Axes zeroed since the resume offer was taken.
     zeroed: u8,
+    /// An operator's tool under way.
+    run: Option<tools::Run>,
+    /// `$wrap_step`: 1 asked, 2 its wrap handed out (pause after it).
+    step_once: u8,
 }
 
 impl Default for Job {
@@ -132,6 +138,8 @@ impl Job {
             lost: false,
             saved: None,
             zeroed: 0,
+            run: None,
+            step_once: 0,
         }
     }
 
@@ -151,6 +159,9 @@ impl Job {
     /// the batch: its remaining steps still come (drill raised, needle
     /// inside the ring before the machine stands).
     pub fn next_step(&mut self) -> Option<MachineStep> {
+        if self.run.is_some() {
+            return self.tool_step();
+        }
         let finishing = matches!(self.state, State::Paused(_))
             && self.steps.as_ref().is_some_and(PhaseSteps::mid_batch);
         if !self.state.is_running() && !finishing {
@@ -162,7 +173,7 @@ impl Job {
     /// Drilling or winding, or paused inside them: the job owns the
     /// machine's motion, and nothing else may move it.
     pub fn owns_motion(&self) -> bool {
-        self.phase().is_some()
+        self.phase().is_some() || self.run.is_some()
     }
 
     /// Winding wants the next index of the pattern ([`Event::Nail`]).
@@ -191,6 +202,10 @@ impl Job {
             } => self.files_valid(params, count, id, config, o),
             Event::FilesInvalid => self.files_invalid(o),
             Event::Button(b) => self.button(b, o, now_ms),
+            Event::MotionDone if self.run.is_some() => {
+                self.moving = false;
+                self.tool_done(o);
+            }
             Event::MotionDone => {
                 self.moving = false;
                 if let Some(m) = &mut self.steps {
@@ -205,6 +220,7 @@ impl Job {
             Event::Nail(j) => self.nail(j, o, now_ms),
             Event::OtherMachine => *self = Job::new(),
             Event::Saved(s) => self.saved = Some(s),
+            Event::Tool(t) => self.tool(t, o, now_ms),
             Event::PatternLost => {
                 if self.phase() == Some(Phase::Winding) {
                     self.card = Card::Absent;
@@ -384,6 +400,7 @@ impl Job {
             count,
             id,
             board,
+            scale: StepScale::from_config(config),
             drilling: Some(Drilling::new(board, config)),
             winder: Some(Winder::new(board, config).ok()?),
         })
@@ -400,6 +417,10 @@ impl Job {
     }
 
     fn button(&mut self, event: ButtonEvent, o: &mut Out, now_ms: u32) {
+        if self.run.is_some() {
+            // A tool is moving the machine: buttons wait.
+            return;
+        }
         let axis = |b| match b {
             Button::ZeroBase => Some(Axis::Base),
             Button::ZeroRadial => Some(Axis::Radial),
@@ -568,7 +589,14 @@ impl Job {
                 }
             };
             self.enter(next, o);
+        } else if self.step_once == 2 {
+            // `$wrap_step`: that wrap was the one.
+            self.step_once = 0;
+            self.pause(o, now_ms);
         } else if !m.starved() {
+            if self.step_once == 1 {
+                self.step_once = 2;
+            }
             self.next_moves(o);
         }
     }

@@ -55,6 +55,8 @@ pub(super) struct PhaseSteps {
     pub reporter: Reporter,
     /// A step to hand out before anything else: a new phase's header.
     then: Option<MachineStep>,
+    /// Winding: the gap the needle last went in through (its record's).
+    gap: u16,
 }
 
 fn save(n: u32, gap: u16) -> MachineStep {
@@ -97,6 +99,7 @@ impl PhaseSteps {
             fed: done,
         };
         let mut steps = Self::new(work, Phase::Winding, (count, done), now_ms);
+        steps.gap = last.map_or(0, |r| r.gap);
         if resume.is_none() {
             steps.then = Some(MachineStep::Save(Save::Begin(Phase::Winding)));
         }
@@ -113,6 +116,7 @@ impl PhaseSteps {
             exhausted: false,
             reporter: Reporter::start_at(phase, total, done, now_ms),
             then: None,
+            gap: 0,
         }
     }
 
@@ -191,6 +195,7 @@ impl PhaseSteps {
                             1 => (1, w.gaps()[0]),
                             _ => (2, w.gaps()[1]),
                         };
+                        self.gap = gap;
                         return Some(save(2 * self.done + half, gap));
                     }
                     if let Some(step) = w.next() {
@@ -212,6 +217,36 @@ impl PhaseSteps {
                 wrap.as_mut().and_then(Iterator::next)
             }
         }
+    }
+
+    /// The base's position after the steps handed out (0 while drilling).
+    pub fn base(&self) -> i32 {
+        match &self.work {
+            Work::Wind { winder, .. } => winder.base(),
+            Work::Drill { .. } => 0,
+        }
+    }
+
+    /// Paused between wraps, winding goes on at wrap `k + 1` (`k` counted
+    /// done, the pattern to be read on from there): the record that says
+    /// so, the needle inside the ring at its last gap.
+    pub fn jump(&mut self, k: u32) -> Option<Record> {
+        let Work::Wind {
+            wrap, feed, fed, saved_at, ..
+        } = &mut self.work
+        else {
+            return None;
+        };
+        *wrap = None;
+        *saved_at = 0;
+        feed.clear();
+        *fed = k;
+        self.done = k;
+        self.exhausted = false;
+        Some(Record {
+            n: 2 * k,
+            gap: self.gap,
+        })
     }
 
     /// Winding, with room in the buffer for another index of the pattern.

@@ -7,6 +7,7 @@ use std::vec::Vec;
 
 mod props;
 mod resume;
+mod tools;
 
 const HEX: Params = Params {
     shape: 6,
