@@ -642,6 +642,12 @@ impl Console {
                 self.pattern = patterns::pattern(n).map(|t| (t, 0));
                 return;
             }
+            // The job's tools: it answers them itself, in its log.
+            SystemLine::Set { ref key, ref value } if crate::tools::is_tool(key) => {
+                if let Err(col) = crate::tools::send(key, value) {
+                    return self.error(&Error::new(ErrorKind::InvalidStatement, col));
+                }
+            }
             SystemLine::Set { .. } if owner == Owner::Job => {
                 return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
             }

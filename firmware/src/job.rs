@@ -193,6 +193,7 @@ impl JobTask {
                     }
                     Event::Abort
                 }
+                Control::Tool(t) => Event::Tool(t),
             };
             self.event(e, now);
             return true;
@@ -352,6 +353,7 @@ impl JobTask {
                     | Action::Prompt(_)
                     | Action::Progress(_)
                     | Action::Offer { .. }
+                    | Action::Drift { .. }
             );
             if logs && !room_for_a_line() {
                 return Some(Poll::After(5));
@@ -406,6 +408,18 @@ impl JobTask {
                 Action::NextMoves => self.pulling = true,
                 Action::Progress(p) => info!(p),
                 Action::Offer { phase, next, total } => offer(phase, next, total),
+                Action::Drift { nail, expected } => {
+                    let base = m.target()[0];
+                    info!(
+                        "drift check: nail ",
+                        nail,
+                        ": base at ",
+                        base,
+                        " steps, expected ",
+                        expected,
+                        ": is the nail under the needle?"
+                    );
+                }
                 // After a write under way (the last record): the header
                 // goes in the other slot, but one write at a time.
                 Action::Forget if store.saving() => {

@@ -24,3 +24,4 @@ pub mod rt;
 pub mod stepper;
 pub mod store;
 pub mod texts;
+pub mod tools;

@@ -376,6 +376,10 @@ fn console() {
     // New moves may be queued: the motion task feeds them to the stepper.
     spawn(Task::Motion);
     reschedule(Task::Console, poll);
+    // An operator's tool for the job.
+    if !JOB_CONTROL.is_empty() {
+        spawn(Task::Job);
+    }
     // A plotter's card print asks the reader and takes its messages.
     if !CARD_IN.is_empty() {
         spawn(Task::Card);

@@ -69,6 +69,12 @@ pub fn msg(m: Msg) -> FlashStr {
         SavedOtherCard => SavedOtherCard,
         SavedDiscarded => SavedDiscarded,
         ZeroAll => ZeroAll,
+        ToolMoving => ToolMoving,
+        ToolNotNow => ToolNotNow,
+        ToolRange => ToolRange,
+        WrapTested => WrapTested,
+        DriftChecked => DriftChecked,
+        Jumped => Jumped,
     ])
 }
 
