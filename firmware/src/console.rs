@@ -766,6 +766,13 @@ impl Console {
             {
                 return self.error(&Error::new(ErrorKind::Printing, 0));
             }
+            // The job's tools: it answers them itself, in its log (and
+            // refuses them while it moves).
+            SystemLine::Set { ref key, ref value } if crate::tools::is_tool(key) => {
+                if let Err(col) = crate::tools::send(key, value) {
+                    return self.error(&Error::new(ErrorKind::InvalidStatement, col));
+                }
+            }
             // What moves the machine or changes its settings: not while a
             // job owns it; in check mode Grbl's "not idle".
             SystemLine::Home

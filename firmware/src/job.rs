@@ -12,7 +12,9 @@ use crate::queues::{
     CardMsg, Control, Request, Signal, What, BUTTONS, CARD_IN, CARD_OUT, CHUNK, JOB_CLAIMS_TX,
     JOB_CONTROL, TX,
 };
+use crate::checkpoint::BootNote;
 use crate::rt::Poll;
+use crate::store::Store;
 use crate::{error, info, report, texts};
 use core::sync::atomic::Ordering::Relaxed;
 use heapless::Deque;
@@ -23,8 +25,9 @@ use taut_logic::files::check::{Files, Next};
 use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::planner::Feed;
-use taut_logic::stringart::job::{Action, Event, Job, State};
-use taut_logic::stringart::MachineStep;
+use taut_logic::checkpoint::Saved;
+use taut_logic::stringart::job::{Action, Event, Job, Phase, State};
+use taut_logic::stringart::{MachineStep, Save};
 
 /// Room for a whole log line, claimed from the console while there is none.
 fn room_for_a_line() -> bool {
@@ -75,6 +78,8 @@ pub struct JobTask {
     dwell_until: Option<u32>,
     /// Queue figures are logged line by line after a job ends.
     report_line: Option<u8>,
+    /// What the boot found of a checkpoint, to say once there is room.
+    boot_note: Option<BootNote>,
 }
 
 impl Default for JobTask {
@@ -96,6 +101,7 @@ impl JobTask {
             pending: None,
             dwell_until: None,
             report_line: None,
+            boot_note: None,
         }
     }
 
@@ -105,18 +111,36 @@ impl JobTask {
         self.job.owns_motion()
     }
 
-    /// Once at boot: drivers off, waiting for a card.
-    pub fn power_on(&mut self, now: u32) {
+    /// Once at boot: drivers off, waiting for a card; the checkpoint of a
+    /// job a power cut stopped, if any.
+    pub fn power_on(&mut self, saved: Option<Saved>, note: Option<BootNote>, now: u32) {
+        self.boot_note = note;
         self.event(Event::PowerOn, now);
+        if let Some(s) = saved {
+            self.event(Event::Saved(s), now);
+        }
     }
 
     /// One run: carry out the pending actions and then each input in turn
     /// (while their log lines fit), feed winding its nails, then move.
-    pub fn poll(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> Poll<Signal> {
+    pub fn poll(
+        &mut self,
+        m: &mut Motion,
+        config: &mut MachineConfig,
+        store: &mut Store,
+        now: u32,
+    ) -> Poll<Signal> {
         // Claimed again below if still needed.
         JOB_CLAIMS_TX.store(false, Relaxed);
+        if let Some(note) = self.boot_note {
+            if !room_for_a_line() {
+                return Poll::After(5);
+            }
+            self.boot_note = None;
+            note.log();
+        }
         loop {
-            if let Some(p) = self.carry_out(m) {
+            if let Some(p) = self.carry_out(m, store) {
                 return p;
             }
             if let Some(line) = self.report_line {
@@ -138,7 +162,7 @@ impl JobTask {
         if !self.todo.is_empty() {
             return Poll::Again;
         }
-        self.run_steps(m, now)
+        self.run_steps(m, store, now)
     }
 
     fn event(&mut self, e: Event<'_>, now: u32) {
@@ -169,6 +193,7 @@ impl JobTask {
                     }
                     Event::Abort
                 }
+                Control::Tool(t) => Event::Tool(t),
             };
             self.event(e, now);
             return true;
@@ -319,11 +344,16 @@ impl JobTask {
     }
 
     /// Carry out actions while their log lines fit; `Some` to stop the run.
-    fn carry_out(&mut self, m: &mut Motion) -> Option<Poll<Signal>> {
+    fn carry_out(&mut self, m: &mut Motion, store: &mut Store) -> Option<Poll<Signal>> {
         while let Some(&a) = self.todo.front() {
             let logs = matches!(
                 a,
-                Action::Enter(_) | Action::Log(_) | Action::Prompt(_) | Action::Progress(_)
+                Action::Enter(_)
+                    | Action::Log(_)
+                    | Action::Prompt(_)
+                    | Action::Progress(_)
+                    | Action::Offer { .. }
+                    | Action::Drift { .. }
             );
             if logs && !room_for_a_line() {
                 return Some(Poll::After(5));
@@ -377,6 +407,26 @@ impl JobTask {
                 }
                 Action::NextMoves => self.pulling = true,
                 Action::Progress(p) => info!(p),
+                Action::Offer { phase, next, total } => offer(phase, next, total),
+                Action::Drift { nail, expected } => {
+                    let base = m.target()[0];
+                    info!(
+                        "drift check: nail ",
+                        nail,
+                        ": base at ",
+                        base,
+                        " steps, expected ",
+                        expected,
+                        ": is the nail under the needle?"
+                    );
+                }
+                // After a write under way (the last record): the header
+                // goes in the other slot, but one write at a time.
+                Action::Forget if store.saving() => {
+                    let _ = self.todo.push_front(a);
+                    return Some(Poll::After(4));
+                }
+                Action::Forget => store.forget(),
             }
         }
         None
@@ -384,7 +434,11 @@ impl JobTask {
 
     /// Hand the job's steps to the planner; report `MotionDone` when the
     /// machine stands after the last one.
-    fn run_steps(&mut self, m: &mut Motion, now: u32) -> Poll<Signal> {
+    fn run_steps(&mut self, m: &mut Motion, store: &mut Store, now: u32) -> Poll<Signal> {
+        // A checkpoint is durable before the next step.
+        if store.saving() {
+            return Poll::After(4);
+        }
         if let Some(until) = self.dwell_until {
             let left = until.wrapping_sub(now) as i32;
             if left > 0 {
@@ -426,6 +480,16 @@ impl JobTask {
                     return Poll::After(ms);
                 }
                 MachineStep::Drivers { mask, on } => m.drivers.set(mask, on),
+                MachineStep::Save(save) => {
+                    match save {
+                        Save::Begin(phase) => match self.job.card() {
+                            Some(card) => store.begin(phase, card),
+                            None => continue,
+                        },
+                        Save::Record(r) => store.record(r),
+                    }
+                    return Poll::After(4);
+                }
             }
         }
         if self.settling {
@@ -438,6 +502,23 @@ impl JobTask {
         }
         Poll::Idle
     }
+}
+
+/// `>>> resume winding at wrap 1234/3000? green: resume, hold green 2 s:
+/// discard`: what a power cut left, offered on the job's card.
+fn offer(phase: Phase, next: u32, total: u32) {
+    let what = match phase {
+        Phase::Drilling => crate::flash_str!("drilling at hole "),
+        Phase::Winding => crate::flash_str!("winding at wrap "),
+    };
+    info!(
+        ">>> resume ",
+        what,
+        next,
+        "/",
+        total,
+        "? green: resume, hold green 2 s: discard"
+    );
 }
 
 impl Pattern {

@@ -8,6 +8,7 @@
 pub mod board;
 pub mod buttons;
 pub mod card;
+pub mod checkpoint;
 pub mod console;
 pub mod drivers;
 pub mod endstop;
@@ -23,3 +24,4 @@ pub mod rt;
 pub mod stepper;
 pub mod store;
 pub mod texts;
+pub mod tools;

@@ -23,7 +23,7 @@
 //! | `Card` SD reader: one block per run | software | 1 | `CARD_IN`, every 1 s | `CARD_OUT` |
 //! | `Motion` planner → segments, background | software | 1 | planner | as `Refill` |
 //! | `Logger` deferred reports | software | 0 | every 1 s | `TX` |
-//! | `Store` settings → EEPROM, a changed byte per run | software | 0 | signal `Settings` | EEPROM |
+//! | `Store` checkpoint, settings → EEPROM, a changed byte per run | software | 0 | the job's checkpoint, signal `Settings` | EEPROM |
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt, asm_experimental_arch, optimize_attribute)]
@@ -38,6 +38,7 @@ use taut_firmware::board::{
     self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
 };
 use taut_firmware::buttons::{self, ButtonPins, ButtonsTask};
+use taut_firmware::checkpoint;
 use taut_firmware::card::{self, CardReader};
 use taut_firmware::console::{Activity, Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
@@ -233,6 +234,7 @@ fn init() -> Watchdog {
         *c = config;
         store_now
     });
+    let found = store.load_checkpoint();
     STORE.with(|s| *s = Some(store));
     // Settings are only taken whole, kinematics included: never `None`.
     KIN.with(|k| *k = CONFIG.with(|c| AnyKinematics::of(c).ok()));
@@ -289,13 +291,14 @@ fn init() -> Watchdog {
     if reset == ResetCause::Watchdog {
         warn!("watchdog reset: a task did not return");
     }
-    match store_now {
+    let (saved, note) = checkpoint::found(found, reset);
+    match store_now || STORE.with(|s| s.as_ref().unwrap().saving()) {
         true => spawn(Task::Store),
         false => reschedule(Task::Store, Poll::Wait(Signal::Settings)),
     }
     spawn_every(Task::Logger, LOGGER_PERIOD_MS);
     spawn_every(Task::Card, card::CHECK_MS);
-    JOB.with(|j| j.power_on(clock::millis()));
+    JOB.with(|j| j.power_on(saved, note, clock::millis()));
     spawn(Task::Job);
     spawn(Task::Card);
     // A machine that homes at power-on (the flatbed's X) does so first.
@@ -374,6 +377,10 @@ fn console() {
     // New moves may be queued: the motion task feeds them to the stepper.
     spawn(Task::Motion);
     reschedule(Task::Console, poll);
+    // An operator's tool for the job.
+    if !JOB_CONTROL.is_empty() {
+        spawn(Task::Job);
+    }
     // A plotter's card print asks the reader and takes its messages.
     if !CARD_IN.is_empty() {
         spawn(Task::Card);
@@ -383,7 +390,7 @@ fn console() {
     }
     if CONSOLE.with(|c| c.take_settings_changed()) {
         CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
-        signal(Signal::Settings);
+        settings_changed();
         // The string-art job runs only on its machine.
         spawn(Task::Job);
     }
@@ -484,12 +491,23 @@ fn job() {
     }
     let now = clock::millis();
     let machine = CONFIG.with(|cfg| cfg.machine);
-    let poll =
-        MOTION.with(|m| CONFIG.with(|cfg| JOB.with(|j| j.poll(m.as_mut().unwrap(), cfg, now))));
+    let (poll, saving) = MOTION.with(|m| {
+        CONFIG.with(|cfg| {
+            STORE.with(|s| {
+                let s = s.as_mut().unwrap();
+                let poll = JOB.with(|j| j.poll(m.as_mut().unwrap(), cfg, s, now));
+                (poll, s.saving())
+            })
+        })
+    });
+    // The job's checkpoint goes to EEPROM.
+    if saving {
+        spawn(Task::Store);
+    }
     // A plotter's card switched the machine: its kinematics, kept in EEPROM.
     if CONFIG.with(|cfg| cfg.machine) != machine {
         CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
-        signal(Signal::Settings);
+        settings_changed();
         spawn(Task::Console);
     }
     spawn(Task::Motion);
@@ -515,7 +533,13 @@ fn card() {
     }
 }
 
-/// Settings into EEPROM, a changed byte per run.
+/// Settings changed: their image goes to EEPROM.
+fn settings_changed() {
+    STORE.with(|s| s.as_mut().unwrap().settings_changed());
+    signal(Signal::Settings);
+}
+
+/// Checkpoint and settings into EEPROM, a changed byte per run.
 #[inline(never)]
 #[optimize(size)]
 fn store() {

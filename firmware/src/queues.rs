@@ -106,6 +106,8 @@ pub enum Control {
     Resume,
     /// Ctrl-X: the machine was stopped at once; end the job.
     Abort,
+    /// Console → job: an operator's tool (`crate::tools`).
+    Tool(taut_logic::stringart::job::tools::Tool),
 }
 
 /// Conditions a task can wait for ([`crate::rt::Poll::Wait`]): the app

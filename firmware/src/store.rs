@@ -1,15 +1,21 @@
-//! The machine's settings kept in EEPROM (`taut_logic::settings::image`):
-//! read at power-on, and written back after a `$` change by the `Store`
-//! task, one changed byte per run (a byte takes 3.4 ms to write: the task
-//! comes back rather than wait). Only bytes that differ are written.
+//! The EEPROM's one writer: the machine's settings
+//! (`taut_logic::settings::image`), read at power-on and written back after
+//! a `$` change, and the string-art job's checkpoint
+//! (`taut_logic::checkpoint`), scanned at power-on and written as the job
+//! goes. One byte per run (a byte takes 3.4 ms: the task comes back rather
+//! than wait); only bytes that differ are written. A checkpoint write goes
+//! before the settings: the job waits for it ([`Store::saving`]).
 #![deny(unsafe_code)]
 
 use crate::board::eeprom::Eeprom;
 use crate::queues::{Signal, TX};
 use crate::rt::Poll;
 use crate::{flash_str, warn};
+use taut_logic::checkpoint::{self, Found, Header, Record, HEADER_BYTES};
 use taut_logic::config::MachineConfig;
+use taut_logic::files::check::CardId;
 use taut_logic::settings::image::{self, Unusable};
+use taut_logic::stringart::job::Phase;
 
 pub struct Store {
     eeprom: Eeprom,
@@ -17,6 +23,17 @@ pub struct Store {
     /// for the line (it must not be dropped, and the boot fills the TX
     /// ring).
     unusable: Option<Unusable>,
+    /// A `$` change (or the defaults after an unusable image) is still to
+    /// be written. Only then are the settings compared: a card's
+    /// `machine.txt` figures are the job's, not kept.
+    settings_due: bool,
+    /// The checkpoint header in force (its number mixes into records).
+    seq: u16,
+    /// The checkpoint bytes being written: where, how many, how far.
+    buf: [u8; HEADER_BYTES as usize],
+    at: u16,
+    len: u8,
+    done: u8,
 }
 
 impl Store {
@@ -24,6 +41,12 @@ impl Store {
         Store {
             eeprom,
             unusable: None,
+            settings_due: false,
+            seq: 0,
+            buf: [0; HEADER_BYTES as usize],
+            at: 0,
+            len: 0,
+            done: 0,
         }
     }
 
@@ -35,9 +58,62 @@ impl Store {
             Ok(cfg) => (cfg, false),
             Err(why) => {
                 self.unusable = Some(why);
+                self.settings_due = true;
                 (*defaults, true)
             }
         }
+    }
+
+    /// The job's checkpoint as the last power-off left it. A corrupt one
+    /// is retired at once (an idle header after it): it is never used.
+    pub fn load_checkpoint(&mut self) -> Found {
+        let found = checkpoint::scan(|a| self.eeprom.read(a));
+        self.seq = found.next_seq().wrapping_sub(1);
+        if let Found::Corrupt { .. } = found {
+            self.forget();
+        }
+        found
+    }
+
+    /// A `$` change came: write the settings' image back.
+    pub fn settings_changed(&mut self) {
+        self.settings_due = true;
+    }
+
+    /// A checkpoint write is under way (its last byte included): the job
+    /// waits before moving on.
+    pub fn saving(&self) -> bool {
+        self.done < self.len || self.eeprom.busy()
+    }
+
+    fn start(&mut self, at: u16, bytes: &[u8]) {
+        self.buf[..bytes.len()].copy_from_slice(bytes);
+        self.at = at;
+        self.len = bytes.len() as u8;
+        self.done = 0;
+    }
+
+    /// A phase of the job starts: a new header, its records after it.
+    pub fn begin(&mut self, phase: Phase, (nails, count, id): (u16, u32, CardId)) {
+        self.seq = self.seq.wrapping_add(1);
+        let h = Header {
+            seq: self.seq,
+            phase: Some(phase),
+            nails,
+            count,
+            id,
+        };
+        self.start(Header::address(self.seq), &h.encode());
+    }
+
+    pub fn record(&mut self, r: Record) {
+        self.start(Record::address(r.n), &r.encode(self.seq));
+    }
+
+    /// No job under way any more: an idle header.
+    pub fn forget(&mut self) {
+        self.seq = self.seq.wrapping_add(1);
+        self.start(Header::address(self.seq), &Header::idle(self.seq).encode());
     }
 
     fn warn(why: Unusable) {
@@ -52,8 +128,8 @@ impl Store {
         warn!("settings: EEPROM ", text, ": defaults");
     }
 
-    /// Write the next byte of `cfg`'s image that differs from the EEPROM;
-    /// `Wait(Settings)` once they all agree.
+    /// Write the next checkpoint byte, else the next byte of `cfg`'s image
+    /// that differs from the EEPROM; `Wait(Settings)` once all agree.
     pub fn poll(&mut self, cfg: &MachineConfig) -> Poll<Signal> {
         if let Some(why) = self.unusable {
             if TX.free() < crate::log::LINE {
@@ -65,12 +141,26 @@ impl Store {
         if self.eeprom.busy() {
             return Poll::After(4);
         }
+        while self.saving() {
+            let (at, b) = (self.at + self.done as u16, self.buf[self.done as usize]);
+            self.done += 1;
+            if self.eeprom.read(at) != b {
+                self.eeprom.start_write(at, b);
+                return Poll::After(4);
+            }
+        }
+        if !self.settings_due {
+            return Poll::Wait(Signal::Settings);
+        }
         match image::first_difference(cfg, |i| self.eeprom.read(i as u16)) {
             Some((i, b)) => {
                 self.eeprom.start_write(i as u16, b);
                 Poll::After(4)
             }
-            None => Poll::Wait(Signal::Settings),
+            None => {
+                self.settings_due = false;
+                Poll::Wait(Signal::Settings)
+            }
         }
     }
 }

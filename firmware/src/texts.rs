@@ -30,6 +30,8 @@ pub fn state(s: State) -> FlashStr {
         Winding => Winding,
         Paused(_) => Paused(Phase::Drilling),
         End => End,
+        Offer => Offer,
+        PrepResume(_) => PrepResume(Phase::Drilling),
     ])
 }
 
@@ -42,6 +44,7 @@ pub fn prompt(p: Prompt) -> FlashStr {
         StartWinding => StartWinding,
         Resume => Resume,
         Finished => Finished,
+        ZeroToResume => ZeroToResume,
     ])
 }
 
@@ -63,6 +66,15 @@ pub fn msg(m: Msg) -> FlashStr {
         PatternLost => PatternLost,
         Resumed => Resumed,
         Aborted => Aborted,
+        SavedOtherCard => SavedOtherCard,
+        SavedDiscarded => SavedDiscarded,
+        ZeroAll => ZeroAll,
+        ToolMoving => ToolMoving,
+        ToolNotNow => ToolNotNow,
+        ToolRange => ToolRange,
+        WrapTested => WrapTested,
+        DriftChecked => DriftChecked,
+        Jumped => Jumped,
     ])
 }
 

@@ -20,6 +20,7 @@ pub mod operator;
 mod outcome;
 pub mod picture;
 pub mod probe;
+pub mod power;
 pub mod profile;
 pub mod pty;
 pub mod replay;

@@ -1,15 +1,22 @@
 //! The person at the machine, simulated: reads the string-art job's log
 //! lines as they arrive, follows its state and progress, and presses the
 //! green button whenever a prompt asks for it (`taut-sim --auto-confirm`,
-//! the demo and the HIL job tests).
+//! the demo and the HIL job tests). After a power cut it takes the resume
+//! offer (green) and zeroes again: the axes, unpowered, are put back at
+//! the zero pose by hand — in the simulator they never left it, since each
+//! run's trace starts there — and each white button is pressed twice.
 
 use crate::Sim;
+use std::collections::VecDeque;
 use std::time::Duration;
 use taut_logic::pinmap::Button;
 use taut_logic::stringart::job::{Prompt, PROMPT_MARK};
 
 /// How long a confirming press is held (well below a long press).
 pub const PRESS: Duration = Duration::from_millis(150);
+
+/// Between two scripted presses, s (debouncing takes 20 ms).
+const GAP_S: f64 = 0.1;
 
 /// Something the operator read in the log.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -30,9 +37,12 @@ pub struct Operator {
     pub confirm: bool,
     /// UART bytes already read.
     read: usize,
-    release_at: Option<f64>,
-    /// Presses made so far.
+    /// Button changes to make: when (simulated s), which pin, pressed.
+    script: VecDeque<(f64, u8, bool)>,
+    /// Presses of green made so far.
     pub presses: u32,
+    /// Resume offers taken (green at `>>> resume …`).
+    pub resumes: u32,
     pub state: Option<String>,
     /// The job reached its end (`done: press green`).
     pub finished: bool,
@@ -56,10 +66,14 @@ impl Operator {
     /// Reads the complete lines that arrived since the last call and acts
     /// on them; returns what was seen.
     pub fn step(&mut self, sim: &mut Sim) -> Vec<Seen> {
-        if let Some(at) = self.release_at {
-            if sim.time_s() >= at {
-                sim.release(Button::Confirm.pin());
-                self.release_at = None;
+        while let Some(&(at, pin, pressed)) = self.script.front() {
+            if sim.time_s() < at {
+                break;
+            }
+            self.script.pop_front();
+            match pressed {
+                true => sim.press(pin),
+                false => sim.release(pin),
             }
         }
         let bytes = sim.uart_bytes();
@@ -89,11 +103,33 @@ impl Operator {
     fn prompt(&mut self, sim: &mut Sim, line: &str) {
         if line == Prompt::Finished.as_str() {
             self.finished = true;
-        } else if self.confirm && line.contains("press green") {
-            sim.press(Button::Confirm.pin());
-            self.release_at = Some(sim.time_s() + PRESS.as_secs_f64());
-            self.presses += 1;
+        } else if !self.confirm {
+        } else if line == Prompt::ZeroToResume.as_str() {
+            // Each axis: driver off (turned to the zero pose by hand),
+            // then taken as zero; then green.
+            for b in [Button::ZeroBase, Button::ZeroRadial, Button::ZeroDrill] {
+                self.click(sim, b.pin());
+                self.click(sim, b.pin());
+            }
+            self.green(sim);
+        } else if line.starts_with(">>> resume ") {
+            self.resumes += 1;
+            self.green(sim);
+        } else if line.contains("press green") {
+            self.green(sim);
         }
+    }
+
+    fn green(&mut self, sim: &Sim) {
+        self.click(sim, Button::Confirm.pin());
+        self.presses += 1;
+    }
+
+    /// A short press after the scripted ones, a gap after it.
+    fn click(&mut self, sim: &Sim, pin: u8) {
+        let from = self.script.back().map_or(sim.time_s(), |s| s.0 + GAP_S);
+        self.script.push_back((from, pin, true));
+        self.script.push_back((from + PRESS.as_secs_f64(), pin, false));
     }
 }
 

@@ -84,6 +84,8 @@ pub struct Sim {
     pub(crate) call_watches: Vec<crate::calls::CallWatch>,
     /// Cycles per program word, when asked for ([`Sim::enable_profile`]).
     pub(crate) profile: Option<crate::profile::Profile>,
+    /// EEPROM byte writes, when watched (`power`).
+    pub(crate) eeprom_watch: Option<Box<crate::power::EepromWatch>>,
 }
 
 impl Sim {
@@ -193,7 +195,19 @@ impl Sim {
             asleep: 0,
             call_watches: Vec::new(),
             profile: None,
+            eeprom_watch: None,
         }
+    }
+
+    /// The avr_t, for a module's own callbacks (`power`).
+    pub(crate) fn avr_raw(&self) -> *mut ffi::avr_t {
+        self.avr.as_ptr()
+    }
+
+    /// simavr's own cycle counter (it drops on a reset).
+    pub(crate) fn avr_cycle(&self) -> u64 {
+        // SAFETY: `avr` is valid for the life of `self`.
+        unsafe { (*self.avr.as_ptr()).cycle }
     }
 
     pub(crate) fn shared(&self) -> &Shared {

@@ -21,6 +21,7 @@ extern crate std;
 pub mod arc;
 pub mod axis;
 pub mod buttons;
+pub mod checkpoint;
 pub mod config;
 pub mod fat;
 pub mod files;

@@ -25,6 +25,8 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                    [--card-fault SPEC]...] [--auto-confirm] [--send FILE]
                    [--at SECONDS:BYTES]... [--for SECONDS] [--vcd PATH]
                    [--png PATH] [--report PATH] [--eeprom FILE] [--echo]
+                   [--power-cut-at SECONDS | --power-cut-on TEXT
+                   [--power-cut-delay SECONDS]]
                    [--machine NAME [--endstop-mm MM]] [--pty [PATH]]
   --sd PATH       put a virtual SD card in the slot: an image file, or a
                   folder, imaged on the fly (FAT16 or FAT32 by size)
@@ -82,7 +84,20 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
   --eeprom FILE   the EEPROM's contents (settings): loaded at power-on if the
                   file exists, saved when the run ends (a power cycle keeps
                   only the EEPROM: run again with the same file)
-  --auto-confirm  press the green button whenever the job asks for it, and
+  --power-cut-at SECONDS
+                  cut the power at that simulated time: the run ends where
+                  it is, the VCD and the report are written (\"ended\":
+                  \"power cut\") and --eeprom saves the EEPROM as the cut
+                  leaves it (a byte still being written, within its 3.4 ms,
+                  left erased); run again with the same --eeprom to resume
+  --power-cut-on TEXT
+                  cut the power when the firmware's serial output first
+                  holds TEXT (seen within 1 ms), plus --power-cut-delay
+  --power-cut-delay SECONDS
+                  simulated seconds from TEXT to the cut (default 0)
+  --auto-confirm  press the green button whenever the job asks for it, take
+                  a resume offer and zero the axes again after a power cut
+                  (in the simulator they are still at the zero pose), and
                   run until the job is done (or --for SECONDS, default 7200)
   --echo          print the firmware's serial output as it runs
   --help, -h      this text
@@ -110,6 +125,14 @@ struct Args {
     pty: Option<Option<PathBuf>>,
     /// `--profile N`: the top N functions by cycles.
     profile: Option<usize>,
+    cut: Option<Cut>,
+    cut_delay: Duration,
+}
+
+/// When the power goes.
+enum Cut {
+    At(Duration),
+    On(String),
 }
 
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
@@ -134,6 +157,8 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         auto_confirm: false,
         pty: None,
         profile: None,
+        cut: None,
+        cut_delay: Duration::ZERO,
     };
     let mut it = it.peekable();
     while let Some(a) = it.next() {
@@ -167,6 +192,9 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
                 args.pty = Some(link);
             }
             "--auto-confirm" => args.auto_confirm = true,
+            "--power-cut-at" => args.cut = Some(Cut::At(time(value()?)?)),
+            "--power-cut-on" => args.cut = Some(Cut::On(value()?)),
+            "--power-cut-delay" => args.cut_delay = time(value()?)?,
             "--profile" => {
                 args.profile = Some(value()?.parse().map_err(|_| "--profile N")?);
             }
@@ -188,13 +216,20 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         );
     }
     scenario::check_card_plan(args.sd_insert_at, &args.pulls, &args.reinserts)?;
+    if args.cut_delay > Duration::ZERO && !matches!(args.cut, Some(Cut::On(_))) {
+        return Err("--power-cut-delay needs --power-cut-on".into());
+    }
     Ok(args)
 }
 
 impl Args {
     /// The simulated time of the last planned event.
     fn last_planned(&self) -> Option<Duration> {
-        let times = self.at.iter().map(|t| t.at);
+        let cut = match self.cut {
+            Some(Cut::At(at)) => Some(at),
+            _ => None,
+        };
+        let times = self.at.iter().map(|t| t.at).chain(cut);
         let faults = self.faults.iter().filter_map(FaultSpec::at);
         (times.chain(self.pulls.iter().copied()))
             .chain(self.reinserts.iter().copied())
@@ -279,6 +314,8 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     if let Some(path) = args.eeprom.as_ref().filter(|p| p.exists()) {
         sim.set_eeprom(&std::fs::read(path)?);
     }
+    // A cut may fall in the middle of an EEPROM write.
+    sim.watch_eeprom();
     if let Some(m) = args.machine {
         let image: Vec<u8> = image::bytes(&MachineConfig::defaults(m)).collect();
         sim.set_eeprom(&image);
@@ -336,8 +373,29 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     let slice = Duration::from_millis(10);
     let mut outcome = Outcome::Running;
     let mut elapsed = Duration::ZERO;
+    // The simulated time of the cut, once known; set when it happened.
+    let mut cut_at = match args.cut {
+        Some(Cut::At(at)) => Some(at),
+        _ => None,
+    };
+    let mut cut = None;
     while elapsed < total && !STOP.load(Ordering::Relaxed) {
-        let step = slice.min(total - elapsed);
+        let now = Duration::from_secs_f64(sim.time_s());
+        if let (None, Some(Cut::On(text))) = (cut_at, &args.cut) {
+            if sim.uart_text().contains(text.as_str()) {
+                cut_at = Some(now + args.cut_delay);
+            }
+        }
+        if cut_at.is_some_and(|at| now >= at) {
+            cut = Some(now);
+            break;
+        }
+        let mut step = slice.min(total - elapsed);
+        match (cut_at, &args.cut) {
+            (Some(at), _) => step = step.min(at - now),
+            (None, Some(Cut::On(_))) => step = step.min(Duration::from_millis(1)),
+            _ => {}
+        }
         match pty.as_mut() {
             Some(pty) => {
                 pty.serve(&mut sim, step)?;
@@ -361,8 +419,21 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     }
     bar.finish();
     let wall_s = wall.elapsed().as_secs_f64();
+    let (eeprom, torn) = match cut {
+        Some(_) => sim.eeprom_after_cut(0xFF),
+        None => (sim.eeprom(), None),
+    };
     if let Some(path) = &args.eeprom {
-        std::fs::write(path, sim.eeprom())?;
+        std::fs::write(path, eeprom)?;
+    }
+    if let Some(at) = cut {
+        eprintln!(
+            "taut-sim: power cut at {:.3} s{}",
+            at.as_secs_f64(),
+            torn.map_or(String::new(), |a| format!(
+                " during the write of EEPROM byte {a}: left erased"
+            ))
+        );
     }
     if let Some(path) = &args.vcd {
         sim.write_vcd(path)?;
@@ -413,12 +484,18 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     if let Some(path) = &args.report {
         let mut report = serde_json::to_value(sim.report(outcome))?;
         let extra = json!({
+            "ended": if cut.is_some() { "power cut".to_string() } else { format!("{outcome:?}") },
+            "power_cut": cut.map(|at| json!({
+                "at_s": at.as_secs_f64(),
+                "eeprom_byte_torn": torn,
+            })),
             "wall_seconds": wall_s,
             "sim_mhz": sim.cycles() as f64 / wall_s / 1e6,
             "job": {
                 "state": operator.state,
                 "finished": operator.finished,
                 "green_presses": operator.presses,
+                "resumes": operator.resumes,
                 "picture": picture,
             },
         });
@@ -429,11 +506,14 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         std::fs::write(path, serde_json::to_string_pretty(&report)?)?;
     }
     eprintln!(
-        "taut-sim: {:.3} s of machine time in {:.2} s ({:.0} simulated MHz), ended: {:?}",
+        "taut-sim: {:.3} s of machine time in {:.2} s ({:.0} simulated MHz), ended: {}",
         sim.time_s(),
         wall_s,
         sim.cycles() as f64 / wall_s / 1e6,
-        outcome
+        match cut {
+            Some(_) => "power cut".to_string(),
+            None => format!("{outcome:?}"),
+        }
     );
     Ok(outcome)
 }
@@ -588,6 +668,8 @@ mod tests {
             "fw.elf --sd c --card-fault crc-twice:3",
             "fw.elf --at 2",
             "fw.elf --for -1",
+            "fw.elf --power-cut-at 3 --power-cut-delay 1",
+            "fw.elf --power-cut-on",
         ] {
             assert!(args(line).is_err(), "{line}");
         }

@@ -50,6 +50,21 @@ impl FileSum {
         }
         self.len = self.len.wrapping_add(bytes.len() as u32);
     }
+
+    /// Length and sums, little-endian: kept with a job's checkpoint.
+    pub fn to_bytes(self) -> [u8; 8] {
+        let l = self.len.to_le_bytes();
+        let (a, b) = (self.a.to_le_bytes(), self.b.to_le_bytes());
+        [l[0], l[1], l[2], l[3], a[0], a[1], b[0], b[1]]
+    }
+
+    pub fn from_bytes(x: [u8; 8]) -> Self {
+        FileSum {
+            len: u32::from_le_bytes([x[0], x[1], x[2], x[3]]),
+            a: u16::from_le_bytes([x[4], x[5]]),
+            b: u16::from_le_bytes([x[6], x[7]]),
+        }
+    }
 }
 
 /// The job's files as the card holds them: another card with the same

@@ -57,6 +57,13 @@ impl Drilling {
         }
     }
 
+    /// After a power cut: the drill raised first, then on from hole
+    /// `hole` (the one being drilled, or the next).
+    pub fn from_hole(mut self, hole: u16) -> Self {
+        self.nail = hole.min(self.board.nails());
+        self
+    }
+
     /// Base and carriage together over nail `i`, the shorter way round.
     fn over_nail(&mut self, i: u16) -> MachineStep {
         let nail = self.board.nail(i);
@@ -87,7 +94,15 @@ impl Iterator for Drilling {
 
     fn next(&mut self) -> Option<MachineStep> {
         let (step, next) = match self.stage {
-            Stage::Raise => (MachineStep::to(Axis::Drill, self.raised), Stage::Approach),
+            Stage::Raise => {
+                // A resumed drilling may have no hole left: home at once.
+                let next = if self.nail < self.board.nails() {
+                    Stage::Approach
+                } else {
+                    Stage::Home
+                };
+                (MachineStep::to(Axis::Drill, self.raised), next)
+            }
             Stage::Approach => (self.over_nail(self.nail), Stage::Plunge),
             Stage::Plunge => (MachineStep::to(Axis::Drill, self.plunged), Stage::Dwell),
             Stage::Dwell => (MachineStep::Dwell(DWELL_MS), Stage::Retract),

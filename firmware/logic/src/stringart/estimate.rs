@@ -8,10 +8,12 @@
 //! How the firmware carries the steps out (`firmware/src/job.rs`): the
 //! moves of a batch go into the planner together, so it blends them; a
 //! dwell or a driver switch waits until the machine stands, and so does
-//! the end of every batch.
+//! the end of every batch and every checkpoint write (`firmware/src/store.rs`:
+//! one differing EEPROM byte per 4 ms run, the job back 4 ms after).
 
 use super::job::{Action, Actions, Event, Job, State};
-use super::{machine_time, Drilling, MachineStep, Overlap, Winder, Winding};
+use super::{machine_time, Drilling, MachineStep, Overlap, Save, Winder, Winding};
+use crate::checkpoint::{self, Header, Record};
 use crate::axis::PerAxis;
 use crate::buttons::ButtonEvent;
 use crate::config::MachineConfig;
@@ -52,7 +54,14 @@ struct Machine {
     planner: Planner,
     /// Sub-ticks of motion and dwell so far.
     subticks: u64,
+    /// The EEPROM as the checkpoint writes leave it (blank at first), and
+    /// the header in force: only differing bytes take time.
+    eeprom: [u8; checkpoint::END as usize],
+    seq: u16,
 }
+
+/// A run of the Store task, and the job's wait between its looks.
+const SAVE_RUN_MS: u64 = 4;
 
 impl Machine {
     /// Every planned block run to its end: the machine stands.
@@ -66,7 +75,21 @@ impl Machine {
         (self.subticks * 1000 / SUBTICKS_PER_S) as u32
     }
 
-    fn carry_out(&mut self, step: MachineStep) {
+    /// The checkpoint bytes `bytes` written at `at`, the machine standing.
+    fn save(&mut self, at: u16, bytes: &[u8]) {
+        self.settle();
+        let mut ms = SAVE_RUN_MS;
+        for (cell, &b) in self.eeprom[at as usize..].iter_mut().zip(bytes) {
+            if *cell != b {
+                *cell = b;
+                ms += SAVE_RUN_MS;
+            }
+        }
+        self.subticks += ms * SUBTICKS_PER_S / 1000;
+    }
+
+    /// `card`: the job's ([`Job::card`]), named by a phase's header.
+    fn carry_out(&mut self, step: MachineStep, card: Option<(u16, u32, CardId)>) {
         match step {
             MachineStep::Move(targets) => {
                 let mut at = self.planner.position();
@@ -86,6 +109,23 @@ impl Machine {
                 self.subticks += ms as u64 * SUBTICKS_PER_S / 1000;
             }
             MachineStep::Drivers { .. } => self.settle(),
+            MachineStep::Save(Save::Begin(phase)) => {
+                let Some((nails, count, id)) = card else {
+                    return;
+                };
+                self.seq = self.seq.wrapping_add(1);
+                let header = Header {
+                    seq: self.seq,
+                    phase: Some(phase),
+                    nails,
+                    count,
+                    id,
+                };
+                self.save(Header::address(self.seq), &header.encode());
+            }
+            MachineStep::Save(Save::Record(r)) => {
+                self.save(Record::address(r.n), &r.encode(self.seq));
+            }
         }
     }
 }
@@ -111,6 +151,8 @@ pub fn job_time(
     let mut m = Machine {
         planner: Planner::new(config),
         subticks: 0,
+        eeprom: [0xFF; checkpoint::END as usize],
+        seq: 0,
     };
     let mut job = Job::new();
     let mut time = JobTime::default();
@@ -177,7 +219,7 @@ pub fn job_time(
         }
         pulling = false;
         while let Some(step) = job.next_step() {
-            m.carry_out(step);
+            m.carry_out(step, job.card());
         }
         m.settle();
         queue(&mut pending, job.on(Event::MotionDone, m.ms()));

@@ -40,6 +40,18 @@ pub enum MachineStep {
     Dwell(u16),
     /// Switch the drivers of the axes in `mask` (bit = axis index) on or off.
     Drivers { mask: u8, on: bool },
+    /// Make the job's progress durable (EEPROM) with the machine standing,
+    /// before any later step: the checkpoint a power cut resumes from.
+    Save(Save),
+}
+
+/// What a [`MachineStep::Save`] writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Save {
+    /// A phase starts: a new checkpoint header ([`job::Job::card`] names
+    /// the job).
+    Begin(job::Phase),
+    Record(crate::checkpoint::Record),
 }
 
 impl MachineStep {

@@ -52,7 +52,7 @@ pub fn machine_time(
                 total += longest;
             }
             MachineStep::Dwell(ms) => total += ms as f64 / 1000.0,
-            MachineStep::Drivers { .. } => {}
+            MachineStep::Drivers { .. } | MachineStep::Save(_) => {}
         }
     }
     total

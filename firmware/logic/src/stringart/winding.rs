@@ -36,6 +36,27 @@ pub struct Winder {
 pub struct Wrap {
     targets: [i32; 4],
     next: u8,
+    /// The gaps the needle goes out and comes back in through, as the
+    /// nail each follows (`gap_after`).
+    gaps: [u16; 2],
+}
+
+impl Wrap {
+    /// Moves handed out so far (0 to 4).
+    pub fn handed(&self) -> u8 {
+        self.next
+    }
+
+    /// The gap the needle goes out through, and the one it comes back
+    /// in through, each named by the nail before it.
+    pub fn gaps(&self) -> [u16; 2] {
+        self.gaps
+    }
+
+    /// The base's position once the wrap is done.
+    pub fn end_base(&self) -> i32 {
+        self.targets[2]
+    }
 }
 
 impl Iterator for Wrap {
@@ -70,19 +91,33 @@ impl Winder {
     /// The drill's driver off (the needle holds its height unpowered),
     /// then the entry move.
     pub fn entry(&mut self) -> [MachineStep; 4] {
-        let gap = self
-            .scale
-            .shorter_rotation(self.base, self.board.gap_after(0));
-        self.base = self.scale.shorter_rotation(gap, self.board.nail(0).angle);
-        [
-            MachineStep::Drivers {
+        [0, 1, 2, 3].map(|i| self.entry_step(None, i).expect("four steps"))
+    }
+
+    /// Step `i` of the entry from the zero pose (needle outside the ring
+    /// at the board's edge), made when needed rather than kept: a new
+    /// job's (`resume: None`: half a nail round to the gap after nail 0,
+    /// needle in, back to nail 0's angle), or after a power cut (`Some(g)`:
+    /// to the gap after nail `g`, needle in through it; the wraps go on
+    /// from there as they would have). The drill's driver goes off first.
+    pub fn entry_step(&mut self, resume: Option<u16>, i: u8) -> Option<MachineStep> {
+        let s = &self.scale;
+        let gap = s.shorter_rotation(0, self.board.gap_after(resume.unwrap_or(0)));
+        let last = match resume {
+            Some(_) => gap,
+            None => s.shorter_rotation(gap, self.board.nail(0).angle),
+        };
+        self.base = last;
+        Some(match (i, resume) {
+            (0, _) => MachineStep::Drivers {
                 mask: bit(Axis::Drill),
                 on: false,
             },
-            MachineStep::to(Axis::Base, gap),
-            MachineStep::to(Axis::Radial, self.inner),
-            MachineStep::to(Axis::Base, self.base),
-        ]
+            (1, _) => MachineStep::to(Axis::Base, gap),
+            (2, _) => MachineStep::to(Axis::Radial, self.inner),
+            (3, None) => MachineStep::to(Axis::Base, last),
+            _ => return None,
+        })
     }
 
     /// The moves that wrap nail `j`.
@@ -96,17 +131,24 @@ impl Winder {
         let after = s.shorter_rotation(self.base, self.board.gap_after(j));
         // Steps across nail j, from its gap before to its gap after.
         let span = (after - before).rem_euclid(s.steps_per_turn);
-        let (first, second) = if (before - self.base).abs() <= (after - self.base).abs() {
-            (before, before + span)
+        let (g_before, g_after) = ((j + nails - 1) % nails, j);
+        let (first, second, gaps) = if (before - self.base).abs() <= (after - self.base).abs() {
+            (before, before + span, [g_before, g_after])
         } else {
-            (after, after - span)
+            (after, after - span, [g_after, g_before])
         };
         let outer = s.radial_steps(&self.board, self.board.nail(j).radius + OUTER_MARGIN_MM);
         self.base = second;
         Ok(Wrap {
             targets: [first, outer, second, self.inner],
             next: 0,
+            gaps,
         })
+    }
+
+    /// The base's position after the moves handed out so far.
+    pub fn base(&self) -> i32 {
+        self.base
     }
 
     /// All drivers off at the end of the job.

@@ -5,6 +5,7 @@ use super::phase::Phase;
 use super::progress::Progress;
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;
+use crate::checkpoint::Saved;
 use crate::config::MachineConfig;
 use crate::files::check::CardId;
 use crate::files::param::Params;
@@ -25,6 +26,12 @@ pub enum State {
     /// Drilling or winding, stopped after the current move; drivers hold.
     Paused(Phase),
     End,
+    /// The card of a job a power cut stopped: go on with it (green) or
+    /// discard it (green held 2 s)?
+    Offer,
+    /// Going on with it: the axes were unpowered, every one must be zeroed
+    /// again at the zero pose before green.
+    PrepResume(Phase),
 }
 
 impl State {
@@ -40,6 +47,8 @@ impl State {
             State::Winding => "winding",
             State::Paused(_) => "paused",
             State::End => "end",
+            State::Offer => "resume offer",
+            State::PrepResume(_) => "prep resume",
         }
     }
 
@@ -86,6 +95,11 @@ pub enum Event<'c> {
     /// The card switched the machine to a plotter (its `machine.txt`): the
     /// job is dropped, quietly; back on this machine it waits for a card.
     OtherMachine,
+    /// After `PowerOn`: the checkpoint of a job under way at the last
+    /// power-off, found in EEPROM.
+    Saved(Saved),
+    /// An operator's tool from the console ([`super::tools`]).
+    Tool(super::tools::Tool),
 }
 
 /// Something the firmware logs.
@@ -111,6 +125,21 @@ pub enum Msg {
     Resumed,
     /// Ended by Ctrl-X.
     Aborted,
+    /// The card is not the checkpoint's job's.
+    SavedOtherCard,
+    /// Green held at the offer.
+    SavedDiscarded,
+    /// Green refused before a resume: an axis is not zeroed yet.
+    ZeroAll,
+    /// A tool refused: the machine moves.
+    ToolMoving,
+    /// A tool refused: not in this state.
+    ToolNotNow,
+    /// A tool refused: no such nail or wrap.
+    ToolRange,
+    WrapTested,
+    DriftChecked,
+    Jumped,
 }
 
 impl Msg {
@@ -131,6 +160,15 @@ impl Msg {
             Msg::PatternLost => "pattern lost",
             Msg::Resumed => "resumed",
             Msg::Aborted => "job stopped by Ctrl-X",
+            Msg::SavedOtherCard => "checkpoint: another card, discarded",
+            Msg::SavedDiscarded => "checkpoint discarded",
+            Msg::ZeroAll => "zero base, radial and drill first (white buttons)",
+            Msg::ToolMoving => "tool refused: the machine moves (pause first)",
+            Msg::ToolNotNow => "tool refused: not in this state",
+            Msg::ToolRange => "tool refused: no such nail or wrap",
+            Msg::WrapTested => "wrap test done",
+            Msg::DriftChecked => "drift check done",
+            Msg::Jumped => "jumped: green resumes there",
         }
     }
 }
@@ -147,6 +185,7 @@ pub enum Prompt {
     StartWinding,
     Resume,
     Finished,
+    ZeroToResume,
 }
 
 /// Every prompt starts with this.
@@ -161,6 +200,9 @@ impl Prompt {
             Prompt::StartWinding => ">>> nails, thread on 0, zero, press green to wind",
             Prompt::Resume => ">>> paused: press green to resume",
             Prompt::Finished => ">>> done: press green",
+            Prompt::ZeroToResume => {
+                ">>> axes were unpowered: zero each at the zero pose, press green to resume"
+            }
         }
     }
 
@@ -199,6 +241,22 @@ pub enum Action {
     NextMoves,
     /// Log the progress line.
     Progress(Progress),
+    /// Log the resume offer: `>>> resume winding at wrap 1234/3000?
+    /// green: resume, hold green 2 s: discard` (the next unit, of `total`).
+    Offer {
+        phase: Phase,
+        next: u32,
+        total: u32,
+    },
+    /// The job's checkpoint is done with (the job ended, or it was
+    /// discarded): write an idle header.
+    Forget,
+    /// Log the drift check: the base's step count (the firmware's) against
+    /// where `nail` is expected (`expected`, steps).
+    Drift {
+        nail: u16,
+        expected: i32,
+    },
 }
 
 /// The actions of one event; never more than this many.

@@ -16,6 +16,14 @@
 //! needle inside the ring — with the drivers holding. (The console's `!` is
 //! a feed hold of the motion, not a pause of the job.)
 //!
+//! Power cuts: each phase keeps a checkpoint ([`crate::checkpoint`]) through
+//! [`MachineStep::Save`] steps. After [`Event::PowerOn`] the firmware
+//! hands the one it found over as [`Event::Saved`]; once the card is read,
+//! the job's own card gets an offer (`resume offer`: green goes on, green
+//! held 2 s discards), the axes are zeroed again (`prep resume`: all three,
+//! they were unpowered), and the phase goes on from its last record.
+//! Another card discards the checkpoint.
+//!
 //! Buttons: green confirms on a short press (released before 2 s) and
 //! pauses drilling or winding on a long press; the white zeroing buttons
 //! act on their press, in prep drill and waiting for nails only.
@@ -37,6 +45,7 @@ mod io;
 mod phase;
 mod phase_steps;
 mod progress;
+pub mod tools;
 
 pub use io::{Action, Actions, Event, Msg, Prompt, State, PROMPT_MARK};
 pub use phase::Phase;
@@ -46,10 +55,11 @@ pub use progress::{left_s, Progress};
 use super::{bit, Drilling, MachineStep, Winder, MACHINE_DRIVERS};
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;
+use crate::checkpoint::Saved;
 use crate::config::MachineConfig;
 use crate::files::check::CardId;
 use crate::files::param::Params;
-use crate::geometry::Board;
+use crate::geometry::{Board, StepScale};
 use crate::pinmap::Button;
 use crate::units::Milli;
 use phase_steps::PhaseSteps;
@@ -72,6 +82,7 @@ struct Plan {
     count: u32,
     id: CardId,
     board: Board,
+    scale: StepScale,
     drilling: Option<Drilling>,
     winder: Option<Winder>,
 }
@@ -88,6 +99,14 @@ pub struct Job {
     moving: bool,
     /// Winding lost its pattern stream (card removed or unreadable).
     lost: bool,
+    /// A power cut's checkpoint, until resumed or discarded.
+    saved: Option<Saved>,
+    /// Axes zeroed since the resume offer was taken.
+    zeroed: u8,
+    /// An operator's tool under way.
+    run: Option<tools::Run>,
+    /// `$wrap_step`: 1 asked, 2 its wrap handed out (pause after it).
+    step_once: u8,
 }
 
 impl Default for Job {
@@ -117,7 +136,18 @@ impl Job {
             loose: 0,
             moving: false,
             lost: false,
+            saved: None,
+            zeroed: 0,
+            run: None,
+            step_once: 0,
         }
+    }
+
+    /// The job's board and files, for its checkpoint's header: nails,
+    /// connections, the card's identity.
+    pub fn card(&self) -> Option<(u16, u32, CardId)> {
+        let p = self.plan.as_ref()?;
+        Some((p.board.nails(), p.count, p.id))
     }
 
     pub fn state(&self) -> State {
@@ -129,6 +159,9 @@ impl Job {
     /// the batch: its remaining steps still come (drill raised, needle
     /// inside the ring before the machine stands).
     pub fn next_step(&mut self) -> Option<MachineStep> {
+        if self.run.is_some() {
+            return self.tool_step();
+        }
         let finishing = matches!(self.state, State::Paused(_))
             && self.steps.as_ref().is_some_and(PhaseSteps::mid_batch);
         if !self.state.is_running() && !finishing {
@@ -140,7 +173,7 @@ impl Job {
     /// Drilling or winding, or paused inside them: the job owns the
     /// machine's motion, and nothing else may move it.
     pub fn owns_motion(&self) -> bool {
-        self.phase().is_some()
+        self.phase().is_some() || self.run.is_some()
     }
 
     /// Winding wants the next index of the pattern ([`Event::Nail`]).
@@ -169,6 +202,10 @@ impl Job {
             } => self.files_valid(params, count, id, config, o),
             Event::FilesInvalid => self.files_invalid(o),
             Event::Button(b) => self.button(b, o, now_ms),
+            Event::MotionDone if self.run.is_some() => {
+                self.moving = false;
+                self.tool_done(o);
+            }
             Event::MotionDone => {
                 self.moving = false;
                 if let Some(m) = &mut self.steps {
@@ -182,6 +219,8 @@ impl Job {
             Event::Abort => self.abort(o),
             Event::Nail(j) => self.nail(j, o, now_ms),
             Event::OtherMachine => *self = Job::new(),
+            Event::Saved(s) => self.saved = Some(s),
+            Event::Tool(t) => self.tool(t, o, now_ms),
             Event::PatternLost => {
                 if self.phase() == Some(Phase::Winding) {
                     self.card = Card::Absent;
@@ -213,6 +252,21 @@ impl Job {
             State::Paused(_) if self.lost => Prompt::InsertCard,
             State::Paused(_) => Prompt::Resume,
             State::End => Prompt::Finished,
+            State::PrepResume(_) => Prompt::ZeroToResume,
+            State::Offer => {
+                if let (Some(s), Some(p)) = (self.saved, &self.plan) {
+                    let total = match s.phase() {
+                        Phase::Drilling => p.board.nails() as u32,
+                        Phase::Winding => p.count,
+                    };
+                    o.push(Action::Offer {
+                        phase: s.phase(),
+                        next: (s.done() + 1).min(total),
+                        total,
+                    });
+                }
+                return;
+            }
             State::Reading | State::Drilling | State::Winding => return,
         };
         o.push(Action::Prompt(prompt));
@@ -257,8 +311,8 @@ impl Job {
                 o.push(Action::Log(Msg::CardRemoved));
                 self.restart(o);
             }
-            State::PrepDrill => {
-                // Nothing done yet: start over, with the drivers off as
+            State::PrepDrill | State::Offer | State::PrepResume(_) => {
+                // Nothing done yet (a checkpoint is kept): start over, with the drivers off as
                 // whenever the job waits for a card.
                 o.push(Action::Log(Msg::CardRemoved));
                 o.push(Action::StopMotion);
@@ -295,6 +349,16 @@ impl Job {
                 Some(plan) => {
                     self.plan = Some(plan);
                     self.card = Card::Present;
+                    if let Some(s) = self.saved {
+                        let h = s.header;
+                        if (h.id, h.count, h.nails) == (id, count, params.nails) {
+                            self.enter(State::Offer, o);
+                            return;
+                        }
+                        self.saved = None;
+                        o.push(Action::Log(Msg::SavedOtherCard));
+                        o.push(Action::Forget);
+                    }
                     o.push(Action::DriversOn(MACHINE_DRIVERS));
                     self.enter(State::PrepDrill, o);
                 }
@@ -336,6 +400,7 @@ impl Job {
             count,
             id,
             board,
+            scale: StepScale::from_config(config),
             drilling: Some(Drilling::new(board, config)),
             winder: Some(Winder::new(board, config).ok()?),
         })
@@ -352,6 +417,10 @@ impl Job {
     }
 
     fn button(&mut self, event: ButtonEvent, o: &mut Out, now_ms: u32) {
+        if self.run.is_some() {
+            // A tool is moving the machine: buttons wait.
+            return;
+        }
         let axis = |b| match b {
             Button::ZeroBase => Some(Axis::Base),
             Button::ZeroRadial => Some(Axis::Radial),
@@ -361,10 +430,20 @@ impl Job {
         match event {
             ButtonEvent::Pressed(b) => {
                 if let Some(axis) = axis(b) {
-                    if matches!(self.state, State::PrepDrill | State::WaitingForNails) {
+                    if matches!(
+                        self.state,
+                        State::PrepDrill | State::WaitingForNails | State::PrepResume(_)
+                    ) {
                         self.zero(axis, o);
                     }
                 }
+            }
+            ButtonEvent::LongPress(Button::Confirm) if self.state == State::Offer => {
+                self.saved = None;
+                o.push(Action::Forget);
+                o.push(Action::Log(Msg::SavedDiscarded));
+                o.push(Action::DriversOn(MACHINE_DRIVERS));
+                self.enter(State::PrepDrill, o);
             }
             ButtonEvent::LongPress(Button::Confirm) => self.pause(o, now_ms),
             e if e.is_short_press(Button::Confirm) => self.confirm(o, now_ms),
@@ -382,6 +461,7 @@ impl Job {
             o.push(Action::Log(Msg::Loose(axis)));
         } else {
             self.loose &= !b;
+            self.zeroed |= b;
             o.push(Action::SetZero(axis));
             o.push(Action::DriversOn(b));
             o.push(Action::Log(Msg::Zeroed(axis)));
@@ -402,8 +482,56 @@ impl Job {
             State::WaitingForNails => self.start_winding(o, now_ms),
             State::Paused(_) => self.resume(o, now_ms),
             State::End => self.restart(o),
+            State::Offer => {
+                self.loose = 0;
+                self.zeroed = 0;
+                o.push(Action::DriversOn(MACHINE_DRIVERS));
+                let phase = self.saved.map_or(Phase::Drilling, |s| s.phase());
+                self.enter(State::PrepResume(phase), o);
+            }
+            State::PrepResume(_) if self.loose != 0 => o.push(Action::Log(Msg::ZeroPending)),
+            State::PrepResume(_) if self.zeroed != MACHINE_DRIVERS => {
+                o.push(Action::Log(Msg::ZeroAll));
+            }
+            State::PrepResume(_) => self.start_resumed(o, now_ms),
             _ => {}
         }
+    }
+
+    /// Zeroed again after a power cut: the checkpoint's phase goes on.
+    fn start_resumed(&mut self, o: &mut Out, now_ms: u32) {
+        let (Some(s), Some(plan)) = (self.saved.take(), &mut self.plan) else {
+            return;
+        };
+        let drilling = plan.drilling.take();
+        match (s.phase(), drilling) {
+            (Phase::Drilling, Some(d)) => {
+                let hole = s.n().min(plan.board.nails() as u32);
+                let d = d.from_hole(hole as u16);
+                self.steps = Some(PhaseSteps::drill(d, plan.board.nails(), Some(hole), now_ms));
+                self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
+            }
+            _ => {
+                let Some(winder) = plan.winder.take() else {
+                    return;
+                };
+                self.steps = Some(PhaseSteps::wind(winder, plan.count, Some(s.last), now_ms));
+                o.push(Action::OpenPattern { skip: s.done() });
+                // The resume entry switches the drill's driver off itself.
+                self.go(State::Winding, MACHINE_DRIVERS, o, now_ms);
+            }
+        }
+    }
+
+    /// A phase starts (its steps in place): its state, its drivers, its
+    /// first line.
+    fn go(&mut self, state: State, drivers: u8, o: &mut Out, now_ms: u32) {
+        let Some(steps) = &mut self.steps else { return };
+        let first = steps.reporter.first(now_ms);
+        self.enter(state, o);
+        o.push(Action::DriversOn(drivers));
+        o.push(Action::Progress(first));
+        self.next_moves(o);
     }
 
     fn start_drilling(&mut self, o: &mut Out, now_ms: u32) {
@@ -411,13 +539,8 @@ impl Job {
         let Some(drilling) = plan.drilling.take() else {
             return;
         };
-        let mut steps = PhaseSteps::drill(drilling, plan.board.nails(), now_ms);
-        let first = steps.reporter.first(now_ms);
-        self.steps = Some(steps);
-        self.enter(State::Drilling, o);
-        o.push(Action::DriversOn(MACHINE_DRIVERS));
-        o.push(Action::Progress(first));
-        self.next_moves(o);
+        self.steps = Some(PhaseSteps::drill(drilling, plan.board.nails(), None, now_ms));
+        self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
     }
 
     fn start_winding(&mut self, o: &mut Out, now_ms: u32) {
@@ -425,7 +548,7 @@ impl Job {
         let Some(winder) = plan.winder.take() else {
             return;
         };
-        let mut steps = PhaseSteps::wind(winder, plan.count, now_ms);
+        let mut steps = PhaseSteps::wind(winder, plan.count, None, now_ms);
         let first = steps.reporter.first(now_ms);
         self.steps = Some(steps);
         self.enter(State::Winding, o);
@@ -460,10 +583,20 @@ impl Job {
             // The phase's last step switched the drivers off.
             let next = match self.state {
                 State::Drilling => State::WaitingForNails,
-                _ => State::End,
+                _ => {
+                    o.push(Action::Forget);
+                    State::End
+                }
             };
             self.enter(next, o);
+        } else if self.step_once == 2 {
+            // `$wrap_step`: that wrap was the one.
+            self.step_once = 0;
+            self.pause(o, now_ms);
         } else if !m.starved() {
+            if self.step_once == 1 {
+                self.step_once = 2;
+            }
             self.next_moves(o);
         }
     }
@@ -516,6 +649,7 @@ impl Job {
         self.moving = false;
         self.lost = false;
         o.push(Action::Log(Msg::Aborted));
+        o.push(Action::Forget);
         self.enter(State::End, o);
     }
 

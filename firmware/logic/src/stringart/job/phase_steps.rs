@@ -5,7 +5,8 @@
 
 use super::phase::Phase;
 use super::progress::Reporter;
-use crate::stringart::{Drilling, MachineStep, Winder, Wrap};
+use crate::checkpoint::Record;
+use crate::stringart::{Drilling, MachineStep, Save, Winder, Wrap};
 
 /// Nail indices buffered ahead of the winder: the card is read while the
 /// machine moves.
@@ -20,12 +21,19 @@ enum Work {
         /// The last step handed out was the dwell: the next is the retract
         /// that ends the hole.
         after_dwell: bool,
+        /// The retract, held back behind the hole's record.
+        retract: Option<MachineStep>,
     },
     Wind {
         winder: Winder,
-        /// The entry move, until it has been handed out.
-        entry: Option<core::array::IntoIter<MachineStep, 4>>,
+        /// The entry's next step, until it has been handed out.
+        entry: Option<u8>,
+        /// The entry after a power cut goes in through the gap after
+        /// this nail.
+        resume_gap: Option<u16>,
         wrap: Option<Wrap>,
+        /// The wrap's move count at its last record (1 or 3), 0 if none.
+        saved_at: u8,
         feed: heapless::Deque<u16, FEED>,
         /// Indices received so far (the buffered ones included).
         fed: u32,
@@ -45,42 +53,70 @@ pub(super) struct PhaseSteps {
     /// Every step has been handed out.
     pub exhausted: bool,
     pub reporter: Reporter,
+    /// A step to hand out before anything else: a new phase's header.
+    then: Option<MachineStep>,
+    /// Winding: the gap the needle last went in through (its record's).
+    gap: u16,
+}
+
+fn save(n: u32, gap: u16) -> MachineStep {
+    MachineStep::Save(Save::Record(Record { n, gap }))
 }
 
 impl PhaseSteps {
-    pub fn drill(drilling: Drilling, nails: u16, now_ms: u32) -> Self {
-        Self::new(
+    /// Drilling a new job (`resume: None`: its header comes first) or on
+    /// from hole `resume` after a power cut.
+    pub fn drill(drilling: Drilling, nails: u16, resume: Option<u32>, now_ms: u32) -> Self {
+        let from = resume.unwrap_or(0);
+        let mut steps = Self::new(
             Work::Drill {
                 drilling,
                 after_dwell: false,
+                retract: None,
             },
             Phase::Drilling,
-            nails as u32,
+            (nails as u32, from),
             now_ms,
-        )
+        );
+        if resume.is_none() {
+            steps.then = Some(MachineStep::Save(Save::Begin(Phase::Drilling)));
+        }
+        steps
     }
 
-    pub fn wind(mut winder: Winder, count: u32, now_ms: u32) -> Self {
-        let entry = Some(winder.entry().into_iter());
+    /// Winding a new job's pattern (`resume: None`), or on from a
+    /// checkpoint's record (`Some(None)`: none written yet).
+    pub fn wind(winder: Winder, count: u32, resume: Option<Option<Record>>, now_ms: u32) -> Self {
+        let last = resume.flatten();
+        let done = last.map_or(0, |r| r.n / 2);
         let work = Work::Wind {
             winder,
-            entry,
+            entry: Some(0),
+            resume_gap: last.map(|r| r.gap),
             wrap: None,
+            saved_at: 0,
             feed: heapless::Deque::new(),
-            fed: 0,
+            fed: done,
         };
-        Self::new(work, Phase::Winding, count, now_ms)
+        let mut steps = Self::new(work, Phase::Winding, (count, done), now_ms);
+        steps.gap = last.map_or(0, |r| r.gap);
+        if resume.is_none() {
+            steps.then = Some(MachineStep::Save(Save::Begin(Phase::Winding)));
+        }
+        steps
     }
 
-    fn new(work: Work, phase: Phase, total: u32, now_ms: u32) -> Self {
+    fn new(work: Work, phase: Phase, (total, done): (u32, u32), now_ms: u32) -> Self {
         PhaseSteps {
             work,
-            done: 0,
+            done,
             total,
             hold: false,
             started: false,
             exhausted: false,
-            reporter: Reporter::start(phase, total, now_ms),
+            reporter: Reporter::start_at(phase, total, done, now_ms),
+            then: None,
+            gap: 0,
         }
     }
 
@@ -105,18 +141,29 @@ impl PhaseSteps {
         if self.hold || self.exhausted {
             return None;
         }
+        if let Some(step) = self.then.take() {
+            return Some(step);
+        }
         match &mut self.work {
             Work::Drill {
                 drilling,
                 after_dwell,
+                retract,
             } => {
+                if let Some(step) = retract.take() {
+                    self.hold = true;
+                    return Some(step);
+                }
                 let Some(step) = drilling.next() else {
                     self.exhausted = true;
                     return None;
                 };
                 if *after_dwell {
+                    // The hole is drilled: its record, then the retract.
+                    *after_dwell = false;
                     self.done += 1;
-                    self.hold = true;
+                    *retract = Some(step);
+                    return Some(save(self.done, 0));
                 }
                 *after_dwell = matches!(step, MachineStep::Dwell(_));
                 Some(step)
@@ -124,12 +171,15 @@ impl PhaseSteps {
             Work::Wind {
                 winder,
                 entry,
+                resume_gap,
                 wrap,
                 feed,
+                saved_at,
                 ..
             } => {
-                if let Some(steps) = entry {
-                    if let Some(step) = steps.next() {
+                if let Some(i) = entry {
+                    if let Some(step) = winder.entry_step(*resume_gap, *i) {
+                        *i += 1;
                         return Some(step);
                     }
                     *entry = None;
@@ -137,6 +187,17 @@ impl PhaseSteps {
                     return None;
                 }
                 if let Some(w) = wrap {
+                    let handed = w.handed();
+                    if (handed == 1 || handed == 3) && *saved_at != handed {
+                        // At the gap the needle goes out / comes back in.
+                        *saved_at = handed;
+                        let (half, gap) = match handed {
+                            1 => (1, w.gaps()[0]),
+                            _ => (2, w.gaps()[1]),
+                        };
+                        self.gap = gap;
+                        return Some(save(2 * self.done + half, gap));
+                    }
                     if let Some(step) = w.next() {
                         return Some(step);
                     }
@@ -151,10 +212,41 @@ impl PhaseSteps {
                 }
                 // Indices are range-checked when fed, so `wrap` succeeds.
                 let j = feed.pop_front()?;
+                *saved_at = 0;
                 *wrap = winder.wrap(j).ok();
                 wrap.as_mut().and_then(Iterator::next)
             }
         }
+    }
+
+    /// The base's position after the steps handed out (0 while drilling).
+    pub fn base(&self) -> i32 {
+        match &self.work {
+            Work::Wind { winder, .. } => winder.base(),
+            Work::Drill { .. } => 0,
+        }
+    }
+
+    /// Paused between wraps, winding goes on at wrap `k + 1` (`k` counted
+    /// done, the pattern to be read on from there): the record that says
+    /// so, the needle inside the ring at its last gap.
+    pub fn jump(&mut self, k: u32) -> Option<Record> {
+        let Work::Wind {
+            wrap, feed, fed, saved_at, ..
+        } = &mut self.work
+        else {
+            return None;
+        };
+        *wrap = None;
+        *saved_at = 0;
+        feed.clear();
+        *fed = k;
+        self.done = k;
+        self.exhausted = false;
+        Some(Record {
+            n: 2 * k,
+            gap: self.gap,
+        })
     }
 
     /// Winding, with room in the buffer for another index of the pattern.

@@ -40,6 +40,8 @@ pub fn left_s(done: u32, total: u32, elapsed_ms: u32) -> Option<u32> {
 pub(super) struct Reporter {
     phase: Phase,
     total: u32,
+    /// Units already done when the clock started (a resumed phase).
+    from: u32,
     started_ms: u32,
     /// Time spent paused so far, and the start of the current pause.
     paused_ms: u32,
@@ -52,16 +54,18 @@ pub(super) struct Reporter {
 }
 
 impl Reporter {
-    pub fn start(phase: Phase, total: u32, now_ms: u32) -> Self {
+    /// A phase started with `from` units done (0, or a resumed phase's).
+    pub fn start_at(phase: Phase, total: u32, from: u32, now_ms: u32) -> Self {
         let every = (total / 20).max(1);
         Reporter {
             phase,
             total,
+            from,
             started_ms: now_ms,
             paused_ms: 0,
             pause_from: None,
             every,
-            next: every,
+            next: (from / every + 1) * every,
             last: None,
         }
     }
@@ -85,13 +89,13 @@ impl Reporter {
             phase: self.phase,
             done,
             total: self.total,
-            left_s: left_s(done, self.total, elapsed),
+            left_s: left_s(done.saturating_sub(self.from), self.total.saturating_sub(self.from), elapsed),
         }
     }
 
     /// The line for the phase's start.
     pub fn first(&mut self, now_ms: u32) -> Progress {
-        self.line(0, now_ms)
+        self.line(self.from, now_ms)
     }
 
     /// A line if another 5 % is done.
@@ -146,7 +150,7 @@ mod tests {
 
     #[test]
     fn pauses_do_not_count_as_work() {
-        let mut r = Reporter::start(Phase::Drilling, 100, 1000);
+        let mut r = Reporter::start_at(Phase::Drilling, 100, 0, 1000);
         r.pause(11_000);
         r.pause(12_000); // a second `!` changes nothing
         r.resume(51_000);
@@ -157,7 +161,7 @@ mod tests {
 
     #[test]
     fn a_line_every_5_percent_and_one_at_the_end() {
-        let mut r = Reporter::start(Phase::Winding, 3000, 0);
+        let mut r = Reporter::start_at(Phase::Winding, 3000, 0, 0);
         let lines: std::vec::Vec<u32> = (1..=3000)
             .filter_map(|d| r.update(d, d))
             .map(|p| p.done)
@@ -167,10 +171,21 @@ mod tests {
         assert!(lines.windows(2).all(|w| w[1] - w[0] == 150));
         assert_eq!(r.finish(3000), None, "3000/3000 was the last line");
         // Small totals: a line per unit; jumps of several units report once.
-        let mut r = Reporter::start(Phase::Drilling, 7, 0);
+        let mut r = Reporter::start_at(Phase::Drilling, 7, 0, 0);
         assert!(r.update(1, 0).is_some());
         assert_eq!(r.update(5, 0).map(|p| p.done), Some(5));
         assert!(r.update(5, 0).is_none());
         assert_eq!(r.finish(0).map(|p| p.done), Some(7));
+    }
+
+    #[test]
+    fn a_resumed_phase_counts_from_where_it_went_on() {
+        let mut r = Reporter::start_at(Phase::Winding, 3000, 1234, 0);
+        assert_eq!(r.first(0).done, 1234);
+        // The next line at the next multiple of 150, estimated from the
+        // units done since the resume only: 116 in 116 s, 1650 left.
+        assert!(r.update(1349, 115_000).is_none());
+        let p = r.update(1350, 116_000).unwrap();
+        assert_eq!(p.left_s, Some(1650));
     }
 }

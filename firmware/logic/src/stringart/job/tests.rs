@@ -2,10 +2,12 @@
 //! actions the way the firmware does.
 
 use super::*;
-use crate::stringart::Winding;
+use crate::stringart::{Save, Winding};
 use std::vec::Vec;
 
 mod props;
+mod resume;
+mod tools;
 
 const HEX: Params = Params {
     shape: 6,
@@ -72,8 +74,10 @@ struct Bench {
     pattern: Vec<u16>,
     /// Next index of the pattern the card reader delivers.
     at: usize,
-    /// Steps carried out, and every action seen.
+    /// Steps carried out (checkpoints apart), and every action seen.
     steps: Vec<MachineStep>,
+    /// Checkpoints written, in order.
+    saves: Vec<Save>,
     actions: Vec<Action>,
     pulling: bool,
     drivers: u8,
@@ -89,6 +93,7 @@ impl Bench {
             pattern: pattern.to_vec(),
             at: 0,
             steps: Vec::new(),
+            saves: Vec::new(),
             actions: Vec::new(),
             pulling: false,
             drivers: 0,
@@ -158,6 +163,10 @@ impl Bench {
                 MachineStep::Dwell(ms) => self.now += ms as u32,
                 MachineStep::Drivers { mask, on: true } => self.drivers |= mask,
                 MachineStep::Drivers { mask, on: false } => self.drivers &= !mask,
+                MachineStep::Save(save) => {
+                    self.saves.push(save);
+                    continue;
+                }
             }
             self.steps.push(step);
             self.feed();
@@ -419,11 +428,21 @@ fn long_press_pauses_after_the_batch_and_a_short_press_resumes() {
     );
     // The hole is finished first: its dwell and retract still come (the
     // machine stands with the drill raised), then nothing.
-    let rest: std::vec::Vec<MachineStep> = core::iter::from_fn(|| b.job.next_step()).collect();
+    // The hole's record comes between them.
+    let mut rest: std::vec::Vec<MachineStep> =
+        core::iter::from_fn(|| b.job.next_step()).collect();
     assert!(
-        matches!(rest[..], [MachineStep::Dwell(_), MachineStep::Move(_)]),
+        matches!(
+            rest[..],
+            [
+                MachineStep::Dwell(_),
+                MachineStep::Save(Save::Record(_)),
+                MachineStep::Move(_)
+            ]
+        ),
         "{rest:?}"
     );
+    rest.remove(1);
     b.steps.extend(rest);
     assert_eq!(b.job.next_step(), None, "paused after the hole");
     assert_eq!(b.send(Event::MotionDone), []);
@@ -499,6 +518,7 @@ fn ctrl_x_ends_the_job_where_it_is_with_the_drivers_holding() {
         b.send(Event::Abort),
         [
             Action::Log(Msg::Aborted),
+            Action::Forget,
             Action::Enter(State::End),
             Action::Prompt(Prompt::Finished)
         ]
@@ -516,6 +536,8 @@ fn pause_and_resume_before_the_batch_has_finished() {
     b.ready();
     b.green();
     b.pulling = false;
+    let header = b.job.next_step().unwrap();
+    assert_eq!(header, MachineStep::Save(Save::Begin(Phase::Drilling)));
     let step = b.job.next_step().unwrap();
     b.steps.push(step);
     b.send(LONG_GREEN);
@@ -752,7 +774,8 @@ fn winding_waits_for_the_card_reader() {
     b.green();
     // The reader is slow: nothing fed yet. The entry needs no index.
     b.pulling = false;
-    let entry: Vec<MachineStep> = core::iter::from_fn(|| b.job.next_step()).collect();
+    let mut entry: Vec<MachineStep> = core::iter::from_fn(|| b.job.next_step()).collect();
+    assert_eq!(entry.remove(0), MachineStep::Save(Save::Begin(Phase::Winding)));
     assert_eq!(entry.len(), 4);
     assert_eq!(b.send(Event::MotionDone), [], "no index yet: it waits");
     assert!(b.job.wants_nail());

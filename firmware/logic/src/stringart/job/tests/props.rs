@@ -34,6 +34,7 @@ fn event(k: usize, nail: u16) -> Event<'static> {
         9 => Event::Nail(nail),
         10 => Event::PatternLost,
         27 => Event::Abort,
+        28 => Event::Saved(super::resume::saved(SMALL, 3, Phase::Winding, nail as u32 % 8, nail % 4)),
         11..=14 => Event::Button(ButtonEvent::Pressed(button)),
         15..=18 => Event::Button(ButtonEvent::Released {
             button,
@@ -51,7 +52,7 @@ fn event(k: usize, nail: u16) -> Event<'static> {
 /// resets are rare, green and the motion loop common.
 fn ops() -> impl Strategy<Value = Vec<(Op, u16)>> {
     let op = prop_oneof![
-        1 => (0usize..28).prop_map(Op::Send),
+        1 => (0usize..29).prop_map(Op::Send),
         2 => Just(Op::Send(1)),
         2 => Just(Op::Send(3)),
         4 => Just(Op::Send(15)),
@@ -71,7 +72,10 @@ fn send(job: &mut Job, e: Event) -> Result<(), TestCaseError> {
         match a {
             Action::NextMoves => prop_assert!(after.is_running(), "{:?} -> {:?}", before, after),
             Action::SetZero(_) => prop_assert!(
-                matches!(before, State::PrepDrill | State::WaitingForNails),
+                matches!(
+                    before,
+                    State::PrepDrill | State::WaitingForNails | State::PrepResume(_)
+                ),
                 "zero in {:?}",
                 before
             ),
