@@ -43,7 +43,10 @@ fn poradi(pattern: &[u16]) -> String {
 
 fn job_card(pattern: &[u16]) -> SdImage {
     card(&[
-        ("param.txt", b"tvar = 0\npocet_hrebiku = 12\npolomer_matrice = 20.0\n"),
+        (
+            "param.txt",
+            b"tvar = 0\npocet_hrebiku = 12\npolomer_matrice = 20.0\n",
+        ),
         ("poradi.txt", poradi(pattern).as_bytes()),
         ("machine.txt", MACHINE_TXT.as_bytes()),
     ])
@@ -140,9 +143,7 @@ fn power_on(eeprom: Option<&[u8]>, image: SdImage, cut: Option<Cut>) -> (Run, Ve
                 break;
             }
             None if sim.eeprom_writes() > writes
-                && sim
-                    .eeprom_writing()
-                    .is_some_and(|a| a >= checkpoint::START) =>
+                && sim.eeprom_writing().is_some_and(|a| a >= checkpoint::START) =>
             {
                 armed = Some(sim.time_s() + c.mid_write.unwrap());
                 mid_record = true;
@@ -204,17 +205,26 @@ fn check_union(runs: &[Run], pattern: &[u16]) -> (usize, usize) {
     for (r, run) in runs.iter().enumerate() {
         let mut job = JobReplay::from_signals(&run.signals, board, &cfg).unwrap();
         let stray = job.moves_while_plunged();
-        assert!(stray.is_empty(), "run {r}: moved with the drill down: {stray:?}");
+        assert!(
+            stray.is_empty(),
+            "run {r}: moved with the drill down: {stray:?}"
+        );
         for p in job.plunges() {
             let at = p.base.rem_euclid(turn) as f64 / per_nail;
             let nail = at.round() as u16 % NAILS;
-            assert!((at - at.round()).abs() < 0.05, "run {r}: plunge off a nail: {p:?}");
+            assert!(
+                (at - at.round()).abs() < 0.05,
+                "run {r}: plunge off a nail: {p:?}"
+            );
             holes.push((r, nail));
         }
         let Some(from) = run.winding_ns else { continue };
         job.set_winding(from, u64::MAX);
         let bad = job.crossings_outside_gaps();
-        assert!(bad.is_empty(), "run {r}: crossed the ring at a nail: {bad:#?}");
+        assert!(
+            bad.is_empty(),
+            "run {r}: crossed the ring at a nail: {bad:#?}"
+        );
         let mut first = true;
         for c in job.crossings() {
             match (c.direction, pending.take()) {
@@ -289,7 +299,10 @@ fn twenty_power_cuts_lose_no_hole_and_no_wrap() {
     assert!(last.finished, "{}", last.uart);
     // The job's end forgot the checkpoint.
     let e = eeprom.unwrap();
-    assert!(matches!(checkpoint::scan(|a| e[a as usize]), Found::Idle { .. }));
+    assert!(matches!(
+        checkpoint::scan(|a| e[a as usize]),
+        Found::Idle { .. }
+    ));
 
     let cuts: Vec<&Run> = runs.iter().filter(|r| r.cut_at_s.is_some()).collect();
     let in_state = |s: &str| {
@@ -320,7 +333,10 @@ fn twenty_power_cuts_lose_no_hole_and_no_wrap() {
         (wall.elapsed() - simulated).as_secs_f64()
     );
     assert!(cuts.len() >= 20, "only {} cuts", cuts.len());
-    assert!(drilling >= 3 && winding >= 10, "{drilling} drilling, {winding} winding");
+    assert!(
+        drilling >= 3 && winding >= 10,
+        "{drilling} drilling, {winding} winding"
+    );
     assert!(mid >= 5, "{mid} cuts in a checkpoint write");
     assert_ram_budget(&last.sim);
 }
@@ -353,7 +369,11 @@ fn another_card_or_a_corrupt_checkpoint_is_never_resumed() {
     // Another pattern on the same board: not this job.
     let mut other = PATTERN;
     other.swap(3, 4);
-    let (run, after) = power_on(Some(&eeprom), job_card(&other), Some(Cut { at_s: 3.0, ..cut }));
+    let (run, after) = power_on(
+        Some(&eeprom),
+        job_card(&other),
+        Some(Cut { at_s: 3.0, ..cut }),
+    );
     assert!(
         run.uart.contains("checkpoint: another card, discarded"),
         "{}",
@@ -368,14 +388,28 @@ fn another_card_or_a_corrupt_checkpoint_is_never_resumed() {
     assert_ne!(new.header.id, saved.header.id);
 
     // Bit flips: in a header, in a record the ring still needs.
-    for flip in [checkpoint::START as usize + 5, checkpoint::RING as usize + 8 + 3] {
+    for flip in [
+        checkpoint::START as usize + 5,
+        checkpoint::RING as usize + 8 + 3,
+    ] {
         let mut bad = eeprom.clone();
         bad[flip] ^= 0x10;
-        let (run, after) = power_on(Some(&bad), job_card(&PATTERN), Some(Cut { at_s: 2.0, ..cut }));
+        let (run, after) = power_on(
+            Some(&bad),
+            job_card(&PATTERN),
+            Some(Cut { at_s: 2.0, ..cut }),
+        );
         let ignored = run.uart.contains("checkpoint: corrupt, ignored")
             || run.uart.contains("checkpoint: another card, discarded");
         assert!(ignored, "flip at {flip}:\n{}", run.uart);
-        assert!(!run.uart.contains(">>> resume "), "flip at {flip}:\n{}", run.uart);
-        assert!(!matches!(checkpoint::scan(|a| after[a as usize]), Found::Corrupt { .. }));
+        assert!(
+            !run.uart.contains(">>> resume "),
+            "flip at {flip}:\n{}",
+            run.uart
+        );
+        assert!(!matches!(
+            checkpoint::scan(|a| after[a as usize]),
+            Found::Corrupt { .. }
+        ));
     }
 }

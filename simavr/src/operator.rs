@@ -129,7 +129,8 @@ impl Operator {
     fn click(&mut self, sim: &Sim, pin: u8) {
         let from = self.script.back().map_or(sim.time_s(), |s| s.0 + GAP_S);
         self.script.push_back((from, pin, true));
-        self.script.push_back((from + PRESS.as_secs_f64(), pin, false));
+        self.script
+            .push_back((from + PRESS.as_secs_f64(), pin, false));
     }
 }
 

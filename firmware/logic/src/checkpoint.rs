@@ -205,10 +205,14 @@ pub enum Found {
     /// Never written (a new board: every byte 0xFF).
     Blank,
     /// No job under way.
-    Idle { seq: u16 },
+    Idle {
+        seq: u16,
+    },
     Job(Saved),
     /// Bad headers or records: ignored, with a warning.
-    Corrupt { seq: u16 },
+    Corrupt {
+        seq: u16,
+    },
 }
 
 impl Found {

@@ -109,7 +109,13 @@ fn the_newest_record_counts_and_the_ring_wraps() {
     e.header(header(9, Phase::Winding));
     let total = 3 * SLOTS as u32 + 17;
     for n in 1..=total {
-        e.record(9, Record { n, gap: n as u16 % 24 });
+        e.record(
+            9,
+            Record {
+                n,
+                gap: n as u16 % 24,
+            },
+        );
         // Scanning is slow in a debug build: near the ends and a sample.
         if n > 40 && n < total - 40 && n % 97 != 0 {
             continue;
@@ -151,7 +157,11 @@ fn torn_record_writes_fall_back_to_the_record_before() {
         for n in 1..=base {
             e.record(11, Record { n, gap: 1 });
         }
-        let new = Record { n: base + 1, gap: 2 }.encode(11);
+        let new = Record {
+            n: base + 1,
+            gap: 2,
+        }
+        .encode(11);
         let at = Record::address(base + 1);
         for cut in 0..RECORD_BYTES as usize {
             for torn in [0xFF, 0x00, new[cut] ^ 0x10, new[cut] & 0xF0] {

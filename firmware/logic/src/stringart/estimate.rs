@@ -13,9 +13,9 @@
 
 use super::job::{Action, Actions, Event, Job, State};
 use super::{machine_time, Drilling, MachineStep, Overlap, Save, Winder, Winding};
-use crate::checkpoint::{self, Header, Record};
 use crate::axis::PerAxis;
 use crate::buttons::ButtonEvent;
+use crate::checkpoint::{self, Header, Record};
 use crate::config::MachineConfig;
 use crate::files::check::{CardId, Checked, Files, Next};
 use crate::files::param::Params;

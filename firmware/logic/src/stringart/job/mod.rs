@@ -539,7 +539,12 @@ impl Job {
         let Some(drilling) = plan.drilling.take() else {
             return;
         };
-        self.steps = Some(PhaseSteps::drill(drilling, plan.board.nails(), None, now_ms));
+        self.steps = Some(PhaseSteps::drill(
+            drilling,
+            plan.board.nails(),
+            None,
+            now_ms,
+        ));
         self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
     }
 

@@ -232,7 +232,11 @@ impl PhaseSteps {
     /// so, the needle inside the ring at its last gap.
     pub fn jump(&mut self, k: u32) -> Option<Record> {
         let Work::Wind {
-            wrap, feed, fed, saved_at, ..
+            wrap,
+            feed,
+            fed,
+            saved_at,
+            ..
         } = &mut self.work
         else {
             return None;

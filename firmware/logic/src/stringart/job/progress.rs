@@ -89,7 +89,11 @@ impl Reporter {
             phase: self.phase,
             done,
             total: self.total,
-            left_s: left_s(done.saturating_sub(self.from), self.total.saturating_sub(self.from), elapsed),
+            left_s: left_s(
+                done.saturating_sub(self.from),
+                self.total.saturating_sub(self.from),
+                elapsed,
+            ),
         }
     }
 

@@ -429,8 +429,7 @@ fn long_press_pauses_after_the_batch_and_a_short_press_resumes() {
     // The hole is finished first: its dwell and retract still come (the
     // machine stands with the drill raised), then nothing.
     // The hole's record comes between them.
-    let mut rest: std::vec::Vec<MachineStep> =
-        core::iter::from_fn(|| b.job.next_step()).collect();
+    let mut rest: std::vec::Vec<MachineStep> = core::iter::from_fn(|| b.job.next_step()).collect();
     assert!(
         matches!(
             rest[..],
@@ -775,7 +774,10 @@ fn winding_waits_for_the_card_reader() {
     // The reader is slow: nothing fed yet. The entry needs no index.
     b.pulling = false;
     let mut entry: Vec<MachineStep> = core::iter::from_fn(|| b.job.next_step()).collect();
-    assert_eq!(entry.remove(0), MachineStep::Save(Save::Begin(Phase::Winding)));
+    assert_eq!(
+        entry.remove(0),
+        MachineStep::Save(Save::Begin(Phase::Winding))
+    );
     assert_eq!(entry.len(), 4);
     assert_eq!(b.send(Event::MotionDone), [], "no index yet: it waits");
     assert!(b.job.wants_nail());

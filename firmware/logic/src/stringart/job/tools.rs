@@ -5,20 +5,23 @@
 //! | --- | --- | --- |
 //! | `$wrap_test=<nail>` | waiting for nails, zeroed | the four-move wrap around one nail from the zero pose and back (in through the gap before it, out through the gap after it): clearances checked before a job |
 //! | `$wrap_step=1` | paused while winding | one wrap more, then paused again |
+//! | `$wrap_step=-1` | paused while winding | one wrap back: the last wrap counted undone, wound again on green (a `$wrap_jump` to it) |
 //! | `$wrap_jump=<k>` | paused while winding | go on at wrap k+1 (k wraps counted done): the pattern is read on from there, the needle goes there from inside the ring (the safe path), the checkpoint says so |
 //! | `$drift=<nail>` | paused while winding, waiting for nails | the base to that nail's angle, the count of base steps said against the nail's, and back |
 
 use super::phase::Phase;
 use super::{Action, Job, Msg, Out, State};
+use crate::axis::Axis;
 use crate::checkpoint::Record;
 use crate::stringart::{bit, MachineStep, Save, Wrap};
-use crate::axis::Axis;
 
 /// A tool asked for on the console.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tool {
     WrapTest(u16),
     Step,
+    /// One wrap back: a jump to the wrap before the next.
+    Back,
     Jump(u32),
     Drift(u16),
 }
@@ -32,16 +35,22 @@ pub enum ToolError {
 
 /// The tool a `$key=value` line names; `None`: not a tool (a setting).
 pub fn parse(key: &str, value: &str) -> Option<Result<Tool, ToolError>> {
-    let number = || value.trim_start_matches('+').parse::<u32>().map_err(|_| ToolError::BadValue);
+    let number = || {
+        value
+            .trim_start_matches('+')
+            .parse::<u32>()
+            .map_err(|_| ToolError::BadValue)
+    };
     let nail = || number().and_then(|n| u16::try_from(n).map_err(|_| ToolError::BadValue));
     let is = |name: &str| key.eq_ignore_ascii_case(name);
     Some(if is("wrap_test") {
         nail().map(Tool::WrapTest)
     } else if is("wrap_step") {
-        number().and_then(|n| match n {
-            1 => Ok(Tool::Step),
+        match value.trim_start_matches('+') {
+            "1" => Ok(Tool::Step),
+            "-1" => Ok(Tool::Back),
             _ => Err(ToolError::BadValue),
-        })
+        }
     } else if is("wrap_jump") {
         number().map(Tool::Jump)
     } else if is("drift") {
@@ -78,6 +87,13 @@ impl Job {
         let (nails, count) = (plan.board.nails(), plan.count);
         let winding_paused = self.state == State::Paused(Phase::Winding) && !self.lost;
         let waiting = self.state == State::WaitingForNails && self.loose == 0;
+        let t = match t {
+            Tool::Back if winding_paused => match self.steps.as_ref().map_or(0, |s| s.done) {
+                0 => return o.push(Action::Log(Msg::ToolRange)),
+                done => Tool::Jump(done - 1),
+            },
+            t => t,
+        };
         let run = match t {
             Tool::WrapTest(k) | Tool::Drift(k) if k >= nails => {
                 return o.push(Action::Log(Msg::ToolRange));
@@ -160,9 +176,7 @@ impl Job {
     /// The tool's batch is done: its report, its next batch or its end.
     pub(in crate::stringart::job) fn tool_done(&mut self, o: &mut Out) {
         match &mut self.run {
-            Some(Run::Drift {
-                nail, there, i, ..
-            }) if *i == 1 => {
+            Some(Run::Drift { nail, there, i, .. }) if *i == 1 => {
                 o.push(Action::Drift {
                     nail: *nail,
                     expected: *there,

@@ -34,7 +34,13 @@ fn event(k: usize, nail: u16) -> Event<'static> {
         9 => Event::Nail(nail),
         10 => Event::PatternLost,
         27 => Event::Abort,
-        28 => Event::Saved(super::resume::saved(SMALL, 3, Phase::Winding, nail as u32 % 8, nail % 4)),
+        28 => Event::Saved(super::resume::saved(
+            SMALL,
+            3,
+            Phase::Winding,
+            nail as u32 % 8,
+            nail % 4,
+        )),
         11..=14 => Event::Button(ButtonEvent::Pressed(button)),
         15..=18 => Event::Button(ButtonEvent::Released {
             button,

@@ -166,7 +166,11 @@ fn drilling_resumes_with_the_drill_raised_at_the_hole_after_the_record() {
         // The drill goes up first, then the holes from n on, once each.
         assert_eq!(b.steps[0], MachineStep::to(Axis::Drill, -1385), "from {n}");
         let drilling_end = b.steps.len() - wound(HEX, &PATTERN).len();
-        assert_eq!(plunges(&b.steps[..drilling_end]), all[n as usize..], "from {n}");
+        assert_eq!(
+            plunges(&b.steps[..drilling_end]),
+            all[n as usize..],
+            "from {n}"
+        );
         // No header again: the phase's records go on from n.
         let first = b.saves.iter().find_map(|s| match s {
             Save::Record(r) => Some(r.n),

@@ -17,6 +17,8 @@ fn tool_lines() {
     assert_eq!(parse("drift", "0"), Some(Ok(Tool::Drift(0))));
     assert_eq!(parse("wrap_test", "70000"), Some(Err(ToolError::BadValue)));
     assert_eq!(parse("wrap_step", "2"), Some(Err(ToolError::BadValue)));
+    assert_eq!(parse("wrap_step", "-1"), Some(Ok(Tool::Back)));
+    assert_eq!(parse("wrap_step", "-2"), Some(Err(ToolError::BadValue)));
     assert_eq!(parse("drift", "x"), Some(Err(ToolError::BadValue)));
     assert_eq!(parse("base_accel", "500"), None);
 }
@@ -39,7 +41,10 @@ fn wrap_test_wraps_one_nail_from_the_zero_pose_and_back() {
     let go = tool(&mut b, Tool::WrapTest(k));
     assert_eq!(go, [Action::DriversOn(0b011), Action::NextMoves]);
     assert!(b.job.owns_motion());
-    assert_eq!(tool(&mut b, Tool::WrapTest(2)), [Action::Log(Msg::ToolMoving)]);
+    assert_eq!(
+        tool(&mut b, Tool::WrapTest(2)),
+        [Action::Log(Msg::ToolMoving)]
+    );
     b.batch();
     // In through the gap before nail 7, the wrap, out at the edge, home.
     let mut w = Winder::new(board(HEX), &CONFIG).unwrap();
@@ -57,7 +62,10 @@ fn wrap_test_wraps_one_nail_from_the_zero_pose_and_back() {
     assert_eq!(b.job.state(), State::WaitingForNails);
     assert!(!b.job.owns_motion());
     assert!(b.actions.contains(&Action::Log(Msg::WrapTested)));
-    assert_eq!(b.actions.last(), Some(&Action::Prompt(Prompt::StartWinding)));
+    assert_eq!(
+        b.actions.last(),
+        Some(&Action::Prompt(Prompt::StartWinding))
+    );
     // No checkpoint: nothing of the job was done.
     assert!(b.saves.len() == 25, "{:?}", b.saves);
     // And the job winds as it would have.
@@ -71,12 +79,18 @@ fn wrap_test_wraps_one_nail_from_the_zero_pose_and_back() {
 fn tools_are_refused_while_the_job_moves_or_out_of_place() {
     let mut b = Bench::new(HEX, &PATTERN);
     b.ready();
-    assert_eq!(tool(&mut b, Tool::WrapTest(1)), [Action::Log(Msg::ToolNotNow)]);
+    assert_eq!(
+        tool(&mut b, Tool::WrapTest(1)),
+        [Action::Log(Msg::ToolNotNow)]
+    );
     b.green();
     assert_eq!(tool(&mut b, Tool::Drift(0)), [Action::Log(Msg::ToolMoving)]);
     assert_eq!(tool(&mut b, Tool::Step), [Action::Log(Msg::ToolMoving)]);
     let mut b = waiting_for_nails();
-    assert_eq!(tool(&mut b, Tool::WrapTest(24)), [Action::Log(Msg::ToolRange)]);
+    assert_eq!(
+        tool(&mut b, Tool::WrapTest(24)),
+        [Action::Log(Msg::ToolRange)]
+    );
     assert_eq!(tool(&mut b, Tool::Jump(3)), [Action::Log(Msg::ToolNotNow)]);
 }
 
@@ -107,7 +121,31 @@ fn wrap_step_winds_one_wrap_and_pauses_again() {
     assert!(!b.batch(), "nothing more until green");
     b.green();
     b.run();
-    assert_eq!(b.steps, [drilled(HEX), wound(HEX, &PATTERN)].concat()[drilled(HEX).len()..]);
+    assert_eq!(
+        b.steps,
+        [drilled(HEX), wound(HEX, &PATTERN)].concat()[drilled(HEX).len()..]
+    );
+}
+
+#[test]
+fn wrap_step_back_winds_the_last_wrap_again() {
+    let mut b = paused_after(2);
+    let go = tool(&mut b, Tool::Back);
+    assert_eq!(go, [Action::OpenPattern { skip: 1 }, Action::NextMoves]);
+    b.batch();
+    assert!(b.actions.contains(&Action::Log(Msg::Jumped)));
+    let before = b.steps.len();
+    b.green();
+    b.run();
+    // Wraps 2 to 5: the second wound again, two outs each.
+    let outs = b.steps[before..]
+        .iter()
+        .filter(|s| matches!(s, MachineStep::Move([None, Some(_), None, None])))
+        .count();
+    assert_eq!(outs, 8);
+    // Before any wrap, nothing to step back to; not while drilling.
+    let mut b = paused_after(0);
+    assert_eq!(tool(&mut b, Tool::Back), [Action::Log(Msg::ToolRange)]);
 }
 
 #[test]
@@ -122,7 +160,10 @@ fn wrap_jump_goes_on_at_the_wrap_asked_with_its_checkpoint() {
         panic!("{:?}", b.saves)
     };
     assert_eq!(r.n, 6);
-    assert_eq!(Some(&Save::Record(Record { n: 2, gap: r.gap })), b.saves.get(saves - 1));
+    assert_eq!(
+        Some(&Save::Record(Record { n: 2, gap: r.gap })),
+        b.saves.get(saves - 1)
+    );
     assert!(b.actions.contains(&Action::Log(Msg::Jumped)));
     assert_eq!(b.job.state(), State::Paused(Phase::Winding));
     let before = b.steps.len();
