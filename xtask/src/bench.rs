@@ -36,9 +36,81 @@ pub fn run() -> Result<()> {
             figures.insert(key, json!((value * 1000.0).round() / 1000.0));
         }
     }
+    println!("\n== checkpoint (EEPROM wear, resume)");
+    for (key, value) in checkpoint_figures(&img.elf)? {
+        println!("{key:<36} {value}");
+        figures.insert(key.into(), value);
+    }
     std::fs::write(&out, serde_json::to_string_pretty(&figures)?)?;
     println!("\n== string art on the host (taut bench)");
     run::studio(&["bench".into(), "--json".into(), out.display().to_string()])
+}
+
+/// EEPROM wear of a 250-hole, 3 000-wrap job (datasheet endurance
+/// 100 000 writes per cell), and the simulated time from power-on to the
+/// resume prompt after a cut while winding (a 12-nail card on quick axes,
+/// cut at its second wrap's log line, then powered on with its EEPROM).
+fn checkpoint_figures(elf: &std::path::Path) -> Result<Vec<(&'static str, Value)>> {
+    use taut_logic::checkpoint;
+    let (holes, wraps) = (250, 3000);
+    let dir = root().join("target/bench-resume");
+    std::fs::create_dir_all(&dir)?;
+    std::fs::write(
+        dir.join("param.txt"),
+        "tvar = 0\npocet_hrebiku = 12\npolomer_matrice = 20.0\n",
+    )?;
+    std::fs::write(dir.join("poradi.txt"), "6,5,0,7,3,10,2\n")?;
+    std::fs::write(
+        dir.join("machine.txt"),
+        "base_steps_per_unit = 1200/360\nradial_steps_per_unit = 4\ndrill_steps_per_unit = 200/12\n\
+         base_accel = 8000\nradial_accel = 8000\ndrill_accel = 8000\n",
+    )?;
+    let eeprom = dir.join("eeprom.bin");
+    let _ = std::fs::remove_file(&eeprom);
+    let report = dir.join("report.json");
+    let sim = |cut_on: &str| -> Result<Value> {
+        let args: Vec<String> = [
+            &elf.display().to_string(),
+            "--sd",
+            &dir.display().to_string(),
+            "--auto-confirm",
+            "--eeprom",
+            &eeprom.display().to_string(),
+            "--power-cut-on",
+            cut_on,
+            "--for",
+            "120",
+            "--report",
+            &report.display().to_string(),
+        ]
+        .map(String::from)
+        .to_vec();
+        run::bin("taut-sim", &args)?;
+        Ok(serde_json::from_str(&std::fs::read_to_string(&report)?)?)
+    };
+    sim("wind 2/")?;
+    let resumed = sim(">>> resume ")?;
+    let prompt_s = resumed["sim_seconds"]
+        .as_f64()
+        .ok_or("report: no sim_seconds")?;
+    if resumed["ended"].as_str() != Some("power cut") {
+        return Err("the resumed run did not reach its prompt".into());
+    }
+    Ok(vec![
+        (
+            "eeprom_writes_per_job",
+            json!(checkpoint::byte_writes_per_job(holes, wraps)),
+        ),
+        (
+            "eeprom_cell_writes_per_job",
+            json!(checkpoint::cell_writes_per_job(holes, wraps)),
+        ),
+        (
+            "jobs_before_wear_out",
+            json!(checkpoint::jobs_before_wear_out(holes, wraps, 100_000)),
+        ),
+        ("resume_prompt_ms", json!((prompt_s * 1000.0).round())),
+    ])
 }
 
 /// The seed's example size: a 250-nail circle of 40.2 cm and 3 000
