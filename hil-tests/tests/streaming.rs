@@ -190,3 +190,151 @@ fn tiny_moves_with_status_reports() {
     sim.run_for(Duration::from_millis(100));
     check_stream(&mut sim, &lines, Some(Duration::from_millis(50)), expected);
 }
+
+/// What a character-counting stream saw.
+struct Counted {
+    /// Every line's reply, in order.
+    replies: Vec<String>,
+    /// The most bytes sent and not yet answered.
+    most_in_flight: usize,
+    /// Status reports received.
+    reports: usize,
+    /// Steps on the pins over the held stretch (after the brake), by axis.
+    held: [[i64; 3]; 2],
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Hold {
+    Before,
+    Braking,
+    /// Since then (simulated s).
+    Standing(f64),
+    After,
+}
+
+/// Grbl's receive buffer, as senders count it.
+const RX_BUFFER: usize = 128;
+
+/// Character counting as CNCjs, UGS and bCNC stream by default: a line
+/// goes as soon as it fits beside the bytes not yet answered (at most
+/// `RX_BUFFER - 1`), so the receive buffer stays full; `?` every 100 ms;
+/// `!` when half the lines are answered and `~` 300 ms after the machine
+/// stands.
+fn stream_counting(sim: &mut Sim, lines: &[String]) -> Counted {
+    let start = sim.uart_bytes().len();
+    let mut read = start;
+    let mut in_flight: std::collections::VecDeque<usize> = Default::default();
+    let mut next = 0;
+    let mut out = Counted {
+        replies: Vec::new(),
+        most_in_flight: 0,
+        reports: 0,
+        held: [[0; 3]; 2],
+    };
+    let mut next_status = sim.time_s();
+    let mut hold = Hold::Before;
+    let limit = sim.time_s() + 600.0;
+    while out.replies.len() < lines.len() {
+        while next < lines.len() {
+            let len = lines[next].len() + 1;
+            if in_flight.iter().sum::<usize>() + len > RX_BUFFER - 1 {
+                break;
+            }
+            sim.uart_send(format!("{}\n", lines[next]).as_bytes());
+            in_flight.push_back(len);
+            next += 1;
+        }
+        out.most_in_flight = out.most_in_flight.max(in_flight.iter().sum());
+        let outcome = sim.run_for(Duration::from_micros(500));
+        assert!(
+            matches!(outcome, Outcome::Running),
+            "{outcome:?}\n{}",
+            log_tail(sim)
+        );
+        let now = sim.time_s();
+        if now >= next_status {
+            sim.uart_send_at(Duration::from_secs_f64(now), b"?");
+            next_status = now + 0.1;
+        }
+        // The hold: `!`; once a report says it stands (`Hold:0`), the
+        // steps then and 300 ms later; then `~`.
+        match hold {
+            Hold::Before if out.replies.len() >= lines.len() / 2 => {
+                sim.uart_send_at(Duration::from_secs_f64(now), b"!");
+                hold = Hold::Braking;
+            }
+            Hold::Standing(at) if now >= at + 0.3 => {
+                out.held[1] = steps_on_pins(sim);
+                sim.uart_send_at(Duration::from_secs_f64(now), b"~");
+                hold = Hold::After;
+            }
+            _ => {}
+        }
+        let bytes = sim.uart_bytes();
+        if let Some(end) = bytes[read..].iter().rposition(|&b| b == b'\n') {
+            let text = String::from_utf8_lossy(&bytes[read..read + end + 1]).into_owned();
+            read += end + 1;
+            for line in text.lines() {
+                if line.starts_with('<') {
+                    out.reports += 1;
+                    if hold == Hold::Braking && line.starts_with("<Hold:0") {
+                        out.held[0] = steps_on_pins(sim);
+                        hold = Hold::Standing(sim.time_s());
+                    }
+                } else if line == "ok" || line.starts_with("error") {
+                    assert!(
+                        in_flight.pop_front().is_some(),
+                        "a reply to nothing: {line}"
+                    );
+                    out.replies.push(line.to_string());
+                }
+            }
+        }
+        assert!(sim.time_s() < limit, "stuck\n{}", log_tail(sim));
+    }
+    out
+}
+
+/// Issue 12: the receive buffer kept full by character counting for a
+/// whole file of short moves, with `?` every 100 ms and a feed hold and
+/// cycle start in the middle: every line answered `ok` once, no byte
+/// refused by the receive ring, the hold stands, the end exact.
+#[test]
+fn character_counting_keeps_the_buffer_full_with_reports_and_a_hold() {
+    let (lines, expected) = radial_pieces(0.3, 1200);
+    let mut sim = boot_enabled();
+    sim.run_for(Duration::from_millis(100));
+    let c = stream_counting(&mut sim, &lines);
+    assert!(
+        c.replies.iter().all(|r| r == "ok"),
+        "{:?}",
+        c.replies.iter().find(|r| *r != "ok")
+    );
+    assert_eq!(c.replies.len(), lines.len());
+    assert!(
+        c.most_in_flight >= RX_BUFFER - 20,
+        "the buffer was not kept full: {}",
+        c.most_in_flight
+    );
+    assert_ne!(c.held[1], [0; 3], "the hold never stood");
+    assert_eq!(c.held[0], c.held[1], "steps while held");
+    send_ok(&mut sim, "M400", Duration::from_secs(600));
+    assert!(
+        c.reports as f64 >= sim.time_s() * 5.0,
+        "{} reports in {:.1} s",
+        c.reports,
+        sim.time_s()
+    );
+    assert_eq!(steps_on_pins(&sim), expected, "pulses on the pins");
+    assert_eq!(reported_steps(&mut sim), expected, "M114");
+    let start = sim.uart_bytes().len();
+    send_ok(&mut sim, "$Q", Duration::from_secs(1));
+    let q = sim.uart_text_from(start);
+    let rx = q
+        .lines()
+        .find(|l| l.contains("rx sent:"))
+        .unwrap_or_default();
+    assert!(rx.contains(" refused:0 "), "{q}");
+    assert_eq!(sim.watchdog_resets(), 0);
+    hil_tests::assert_ram_budget(&sim);
+}
