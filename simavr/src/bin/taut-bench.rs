@@ -12,6 +12,7 @@ use serde_json::{json, Map, Value};
 use std::path::Path;
 use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
+use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::driver;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
@@ -423,6 +424,97 @@ fn segment_cycles(elf: &Path) -> ([u64; 4], u64) {
     )
 }
 
+/// `?` received (its receive interrupt) to the report's last byte queued
+/// (the return of `realtime::status`), µs: worst and 90th percentile,
+/// under the load of [`latency_cycles`] (planner full, the job reading),
+/// a `?` every 25 ms (a report takes ~6 ms on the wire: faster polling
+/// measures the UART's backlog, not the firmware).
+fn status_report_latency_us(elf: &Path, card: &Path) -> (f64, f64) {
+    let status = taut_simavr::elf::function_address(elf, "8realtime6status")
+        .expect("ELF symbols")
+        .expect("realtime::status");
+    let mut sim = boot(elf);
+    sim.insert_sd(SdImage::from_path(card).expect("sample card"));
+    for line in ["M17", "G0 X-200", "G91"] {
+        send(&mut sim, line, Duration::from_millis(100));
+    }
+    sim.watch_pc(RX_VECTOR);
+    sim.watch_calls(status);
+    let oks = |s: &Sim| s.uart_text().matches("ok\n").count();
+    let mut sent = oks(&sim);
+    let mut asked = Vec::new();
+    for k in 0..1000 {
+        if oks(&sim) >= sent {
+            sim.uart_send(b"G1 X0.1 F60000\n");
+            sent += 1;
+        }
+        if k % 5 == 0 {
+            asked.push(sim.cycles());
+            sim.uart_send_at(Duration::from_secs_f64(sim.time_s()), b"?");
+        }
+        sim.run_for(Duration::from_millis(5));
+    }
+    sim.run_for(Duration::from_millis(50));
+    let rx = sim.pc_hits(RX_VECTOR);
+    let runs = sim.call_runs(status);
+    let mut us: Vec<f64> = asked
+        .iter()
+        .map(|&at| {
+            let r = rx[rx.partition_point(|&c| c < at)];
+            let (start, len) = runs[runs.partition_point(|&(c, _)| c < r)];
+            (start + len - r) as f64 / 16.0
+        })
+        .collect();
+    us.sort_by(f64::total_cmp);
+    (us[us.len() - 1], us[us.len() * 9 / 10])
+}
+
+/// Lines of 1 mm moves at the maximum feed answered per second when
+/// streamed by character counting (each line sent once it fits beside
+/// the unanswered bytes in Grbl's 128), from the 100th answer to the
+/// 300th; beside it the UART's bound (115 200 baud, 10 bits a byte) and
+/// the motion's (the firmware's planner timing the same lines on the
+/// host, `GcodeTime`): the smallest of the three bounds is the limit.
+fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64) {
+    let mut sim = boot(elf);
+    for line in ["M17", "G0 X-200", "G91"] {
+        send(&mut sim, line, Duration::from_millis(100));
+    }
+    let lines: Vec<String> = (0..400)
+        .map(|k| format!("G1 X{} F60000", if k / 100 % 4 < 2 { 1 } else { -1 }))
+        .collect();
+    let mut timing = taut_logic::interp::estimate::GcodeTime::new(&MachineConfig::STRING_ART)
+        .expect("kinematics");
+    timing.push(b"G91\n");
+    for l in &lines[100..300] {
+        timing.push(format!("{l}\n").as_bytes());
+    }
+    let motion_bound = 200.0 / timing.finish();
+    let line_bytes = lines[0].len() + 1;
+    let uart_bound = 11_520.0 / line_bytes as f64;
+    let start = sim.uart_bytes().len();
+    let (mut next, mut answered, mut in_flight) = (0, 0, std::collections::VecDeque::new());
+    let mut t100 = 0.0;
+    while answered < 300 {
+        while next < lines.len() && in_flight.iter().sum::<usize>() + line_bytes < 128 {
+            sim.uart_send(format!("{}\n", lines[next]).as_bytes());
+            in_flight.push_back(line_bytes);
+            next += 1;
+        }
+        assert_eq!(sim.run_for(Duration::from_micros(500)), Outcome::Running);
+        let now = sim.uart_text_from(start).matches("ok\n").count();
+        for _ in answered..now {
+            in_flight.pop_front();
+        }
+        if answered < 100 && now >= 100 {
+            t100 = sim.time_s();
+        }
+        answered = now;
+        assert!(sim.time_s() < 120.0, "the stream stalled");
+    }
+    (200.0 / (sim.time_s() - t100), uart_bound, motion_bound)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [fw, busy, out] = &args[..] else {
@@ -463,6 +555,25 @@ fn main() {
     let (worst, p90, status_stack) = latency_cycles(fw, &card, "4taut8realtime", b'?');
     f.insert("status_latency_cycles".into(), json!(worst));
     f.insert("status_latency_p90_cycles".into(), json!(p90));
+    let (worst, p90) = status_report_latency_us(fw, &card);
+    f.insert("status_report_latency_us".into(), json!(round(worst, 1)));
+    f.insert("status_report_latency_p90_us".into(), json!(round(p90, 1)));
+    let (rate, uart, motion) = stream_lines_per_s(fw);
+    f.insert("stream_lines_per_s".into(), json!(round(rate, 1)));
+    f.insert(
+        "stream_uart_bound_lines_per_s".into(),
+        json!(round(uart, 1)),
+    );
+    f.insert(
+        "stream_motion_bound_lines_per_s".into(),
+        json!(round(motion, 1)),
+    );
+    let limit = match rate {
+        r if r >= 0.9 * motion => "motion (the planner's own timing)",
+        r if r >= 0.9 * uart => "uart",
+        _ => "firmware line intake (below both bounds)",
+    };
+    f.insert("stream_limit".into(), json!(limit));
     // A real-time `?` also interrupts a line in flight: the console sees
     // a line's bytes arrive mid-stream, which is what this measures.
     let (worst, p90, console_stack) = latency_cycles(fw, &card, "4taut7console", b' ');
