@@ -79,6 +79,17 @@ impl Line {
         l
     }
 
+    /// A `[MSG:…]` push message in Grbl's form: no level, time or module;
+    /// closed by `]` even when cut.
+    pub fn message() -> Line {
+        let mut l = Line::bare();
+        l.msg = true;
+        for c in [b'[', b'M', b'S', b'G', b':'] {
+            let _ = l.buf.push(c);
+        }
+        l
+    }
+
     /// A console reply: no level, time or module. Replies and log lines
     /// share this type, so each value's `ufmt` code exists once.
     pub fn bare() -> Line {

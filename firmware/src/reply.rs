@@ -1,4 +1,4 @@
-//! Console replies: `ok`, `error:<code> <text>`, reports. A reply line is
+//! Console replies: `ok`, `error:<code>` after its message, reports. A reply line is
 //! assembled on the stack and queued whole, never cut: it runs only once
 //! the TX ring has [`ROOM`] free bytes, and no reply is longer.
 #![deny(unsafe_code)]
@@ -10,9 +10,10 @@ use taut_logic::gcode::Error;
 use taut_logic::text::ErrorKind;
 use ufmt::{uWrite, uwrite};
 
-/// Longest reply line, its newline included: `M114` at the extremes of
-/// three axes is 93 bytes.
-pub const ROOM: usize = crate::log::LINE;
+/// Room for the longest reply, newlines included: a line (`M114` at the
+/// extremes of three axes is 93 bytes), or an error's message line and
+/// its `error:<code>` line.
+pub const ROOM: usize = crate::log::LINE + "error:255\n".len();
 
 /// Axes in position reports: the machine's three (the aux channel is
 /// not reported).
@@ -54,15 +55,23 @@ pub fn error(e: &Error) {
     error_because(e, None);
 }
 
-/// `error:<code> <text>[: <why>] (col <c>)`: `why` from the settings'
-/// and job files' own errors.
+/// `[MSG:<text>[: <why>] (col <c>)]`, then Grbl's bare `error:<code>`:
+/// senders read the code from a line of its own (CNCjs takes the rest of
+/// the line as the number), people the message; `why` from the settings'
+/// and job files' own errors. Both fit in [`ROOM`].
 #[inline(never)]
 pub fn error_because(e: &Error, why: Option<ErrorKind>) {
-    let mut r = line();
-    let _ = uwrite!(r, "{}", Because(e, why));
+    let mut r = Line::message();
+    let _ = uwrite!(r, "{}", texts::error(e.kind()));
+    if let Some(why) = why {
+        let _ = uwrite!(r, ": {}", why);
+    }
     if let Some(c) = e.column() {
         let _ = uwrite!(r, "{}{})", flash_str!(" (col "), c);
     }
+    r.send();
+    let mut r = line();
+    let _ = uwrite!(r, "{}{}", flash_str!("error:"), e.code());
     r.send();
 }
 

@@ -81,6 +81,8 @@ fn banner_build_info_parser_state_offsets_and_status_in_grbl_formats() {
         "ok",
     ];
     assert_eq!(replies(&offsets), expected);
+    // bCNC's greeting: two empty lines, two `ok`.
+    assert_eq!(replies(&bytes_then(&mut sim, b"\n\n", 20)), ["ok", "ok"]);
     // The buffer state (every planner block and receive byte free), the
     // feed, and the work offset in the first report.
     let report = bytes_then(&mut sim, b"?", 20);
@@ -178,12 +180,19 @@ fn numbered_settings_list_and_write_through_to_the_named_ones() {
         listing.contains(&"$radial_max_rate=1000".to_string()),
         "{listing:?}"
     );
+    let from = sim.uart_bytes().len();
     match sim.send_line("$21=1", Duration::from_secs(2)) {
         Ok(hil_tests::sim::Reply::Error(e)) => {
             assert_eq!(e, "error:3 Invalid statement: expected 0 to 0 (col 5)")
         }
         other => panic!("{other:?}\n{}", log_tail(&sim)),
     }
+    // On the wire as Grbl's: the code alone on its line (senders parse
+    // what follows `error:` as the number), the words in a message before.
+    assert_eq!(
+        sim.uart_text_from(from),
+        "[MSG:Invalid statement: expected 0 to 0 (col 5)]\nerror:3\n"
+    );
 }
 
 /// The setting lines of a reply and its `ok`.

@@ -141,7 +141,7 @@ fn a_reset_at_a_seeded_moment_of_an_arc_stops_it_for_good() {
         );
         let log = sim.uart_text();
         assert!(
-            log.contains("reset during motion: position unknown"),
+            log.contains("ALARM:3") && log.contains("position unknown until $H"),
             "seed {seed}: {}",
             log_tail(&sim)
         );

@@ -41,23 +41,36 @@ impl Sim {
 /// The first `ok` / `error:` reply line of `out` that ends past byte
 /// `start`; a line under way at `start` is judged whole. Every other line
 /// (log lines, the status reports `<…>` a `?` asks for, a banner) is
-/// skipped, and so is a line not yet ended.
+/// skipped, and so is a line not yet ended. An error comes as Grbl's
+/// bare `error:<code>` after its `[MSG:<text>]` line: the reply is read
+/// as `error:<code> <text>`.
 fn reply_after(out: &[u8], start: usize) -> Option<Reply> {
     let from = out[..start]
         .iter()
         .rposition(|&b| b == b'\n')
         .map_or(0, |i| i + 1);
-    let mut lines = out[from..].split_inclusive(|&b| b == b'\n');
-    lines.find_map(|l| {
-        let l = l.strip_suffix(b"\n")?.trim_ascii_end();
+    let mut before: &[u8] = b"";
+    let lines = out[from..].split_inclusive(|&b| b == b'\n');
+    for l in lines {
+        let Some(l) = l.strip_suffix(b"\n").map(<[u8]>::trim_ascii_end) else {
+            return None;
+        };
         if l == b"ok" {
-            Some(Reply::Ok)
-        } else if l.starts_with(b"error:") {
-            Some(Reply::Error(String::from_utf8_lossy(l).into_owned()))
-        } else {
-            None
+            return Some(Reply::Ok);
         }
-    })
+        if l.starts_with(b"error:") {
+            let mut text = String::from_utf8_lossy(l).into_owned();
+            if let Some(m) = before
+                .strip_prefix(b"[MSG:")
+                .and_then(|m| m.strip_suffix(b"]"))
+            {
+                text = format!("{text} {}", String::from_utf8_lossy(m));
+            }
+            return Some(Reply::Error(text));
+        }
+        before = l;
+    }
+    None
 }
 
 #[cfg(test)]
@@ -74,7 +87,7 @@ mod tests {
             "an unfinished line is no reply"
         );
         assert_eq!(
-            reply(b"error:20 Unsupported command (col 1)\r\n"),
+            reply(b"[MSG:Unsupported command (col 1)]\r\nerror:20\r\n"),
             Some(Reply::Error("error:20 Unsupported command (col 1)".into()))
         );
         assert_eq!(reply(b"[I 1 look] ok\n"), None);
