@@ -268,7 +268,7 @@ fn cut_of(seed: u64) -> Cut {
     let mut rng = Rng::new(seed);
     Cut {
         at_s: rng.between(2.2, 6.0),
-        mid_write: (seed % 3 == 0).then(|| rng.between(0.0, 0.036)),
+        mid_write: seed.is_multiple_of(3).then(|| rng.between(0.0, 0.036)),
         torn: [0xFF, 0x00, rng.below(256) as u8][rng.below(3) as usize],
     }
 }

@@ -52,3 +52,92 @@ fn grbl_streamer_streams_2000_lines_counting_characters_and_the_pulses_follow() 
     // here: the planner, not the protocol, decides it).
     eprintln!("{} pulses; {}", path.len(), underruns(&sim));
 }
+
+/// `taut send` (studio/), built once: the workspace's release binary.
+fn taut_bin() -> PathBuf {
+    static BUILT: std::sync::Once = std::sync::Once::new();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    BUILT.call_once(|| {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+        let status = Command::new(cargo)
+            .current_dir(&root)
+            .args([
+                "build",
+                "--quiet",
+                "--release",
+                "-p",
+                "taut-studio",
+                "--bin",
+                "taut",
+            ])
+            .status()
+            .unwrap();
+        assert!(status.success(), "building taut");
+    });
+    root.join("target/release/taut")
+}
+
+/// Runs `taut send FILE --port <pty> --machine flatbed` against a booted
+/// flatbed; its output (stdout and stderr) and exit status.
+fn taut_send(sim: &mut hil_tests::sim::Sim, file: &std::path::Path) -> (bool, String) {
+    let mut client = Command::new(taut_bin());
+    client.args([
+        "send",
+        file.to_str().unwrap(),
+        "--machine",
+        "flatbed",
+        "--port",
+    ]);
+    let out = serve(
+        sim,
+        &mut client,
+        &[],
+        Duration::from_secs(180),
+        |_, _, _| {},
+    );
+    let said =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    (out.status.success(), said)
+}
+
+fn flatbed() -> hil_tests::sim::Sim {
+    let mut sim = boot_machine();
+    for line in ["$machine=flatbed", "$homing_at_start=0", "M17"] {
+        send_ok(&mut sim, line, Duration::from_secs(2));
+    }
+    sim
+}
+
+/// `taut send` streams the same 2 000-line walk as grbl-streamer, counting
+/// characters, with the same result on the pulses; a file with a line the
+/// machine refuses ends with a non-zero status and that line named.
+#[test]
+fn taut_send_streams_the_walk_and_fails_on_a_refused_line() {
+    let (lines, ends) = random_walk(7, 2000);
+    let file = clients_dir().join(format!("walk-send-{}.gcode", std::process::id()));
+    std::fs::create_dir_all(clients_dir()).unwrap();
+    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
+    let mut sim = flatbed();
+    let (ok, said) = taut_send(&mut sim, &file);
+    assert!(ok, "{said}\n{}", hil_tests::log_tail(&sim));
+    assert!(!said.contains("error:"), "{said}");
+    assert_path_through(&sim, &ends);
+    eprintln!("{}", said.lines().last().unwrap_or_default());
+
+    // Line 3 is past the flatbed's 140 mm: refused before anything moves.
+    std::fs::write(
+        &file,
+        "G21 G90\nG1 X10 Y10 F3000\nG1 X500 Y10\nG1 X20 Y10\n",
+    )
+    .unwrap();
+    let mut sim = flatbed();
+    let (ok, said) = taut_send(&mut sim, &file);
+    std::fs::remove_file(&file).unwrap();
+    assert!(!ok, "{said}");
+    assert!(
+        said.contains("line 3: G1 X500 Y10: error:15 Travel exceeded"),
+        "{said}"
+    );
+    // The lines around it ran.
+    assert_path_through(&sim, &[[400, 400], [800, 400]]);
+}

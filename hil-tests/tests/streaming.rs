@@ -217,7 +217,7 @@ const RX_BUFFER: usize = 128;
 
 /// Character counting as CNCjs, UGS and bCNC stream by default: a line
 /// goes as soon as it fits beside the bytes not yet answered (at most
-/// `RX_BUFFER - 1`), so the receive buffer stays full; `?` every 100 ms;
+/// all `RX_BUFFER`: taut's ring uses every byte), so the receive buffer stays full; `?` every 100 ms;
 /// `!` when half the lines are answered and `~` 300 ms after the machine
 /// stands.
 fn stream_counting(sim: &mut Sim, lines: &[String]) -> Counted {
@@ -237,7 +237,7 @@ fn stream_counting(sim: &mut Sim, lines: &[String]) -> Counted {
     while out.replies.len() < lines.len() {
         while next < lines.len() {
             let len = lines[next].len() + 1;
-            if in_flight.iter().sum::<usize>() + len > RX_BUFFER - 1 {
+            if in_flight.iter().sum::<usize>() + len > RX_BUFFER {
                 break;
             }
             sim.uart_send(format!("{}\n", lines[next]).as_bytes());

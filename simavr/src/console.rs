@@ -52,9 +52,7 @@ fn reply_after(out: &[u8], start: usize) -> Option<Reply> {
     let mut before: &[u8] = b"";
     let lines = out[from..].split_inclusive(|&b| b == b'\n');
     for l in lines {
-        let Some(l) = l.strip_suffix(b"\n").map(<[u8]>::trim_ascii_end) else {
-            return None;
-        };
+        let l = l.strip_suffix(b"\n").map(<[u8]>::trim_ascii_end)?;
         if l == b"ok" {
             return Some(Reply::Ok);
         }

@@ -1,7 +1,8 @@
 //! taut's host tools, one command a module: `stringart` (a picture to a
 //! string-art card), `template` (a 1:1 drilling template), `vectorize` (a
 //! picture to plotter G-code), `text` (Hershey text to G-code), `preview`
-//! (G-code or a simulator trace to a picture). They share the firmware's
+//! (G-code or a simulator trace to a picture), `send` (a G-code file
+//! streamed to the machine, Grbl's way). They share the firmware's
 //! logic crate (`taut_logic`): its nail geometry, card parsers, G-code
 //! parser and interpreter, kinematics and machine-time estimate, so what
 //! the tools predict is what the machine does.
@@ -15,6 +16,7 @@ pub mod plot;
 pub mod preview;
 pub mod progress;
 pub mod raster;
+pub mod send;
 pub mod stringart;
 pub mod svg;
 pub mod template;

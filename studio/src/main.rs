@@ -2,7 +2,7 @@
 
 use std::process::ExitCode;
 use taut_studio::args::Args;
-use taut_studio::{bench, preview, stringart, template, text, vectorize};
+use taut_studio::{bench, preview, send, stringart, template, text, vectorize};
 
 const HELP: &str = "usage: taut <command> [args]   (cargo run --release --bin taut -- <command> …)";
 
@@ -13,6 +13,7 @@ fn usage() -> String {
         vectorize::USAGE,
         text::USAGE,
         preview::USAGE,
+        send::USAGE,
         bench::USAGE,
     ]
     .join("\n\n")
@@ -31,6 +32,7 @@ fn main() -> ExitCode {
         "vectorize" => run(vectorize::run),
         "text" => run(text::run),
         "preview" => run(preview::run),
+        "send" => run(send::run),
         "bench" => run(bench::run),
         "help" | "--help" | "-h" => {
             println!("{HELP}\n\n{}", usage());

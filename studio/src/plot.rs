@@ -79,7 +79,7 @@ pub fn plot(
     feed: f64,
     title: &str,
 ) -> Result<(String, Toolpath), String> {
-    if !(feed >= 10.0) {
+    if feed.is_nan() || feed < 10.0 {
         return Err("--feed must be at least 10 mm/min".into());
     }
     let g = gcode(strokes, machine, feed, title);

@@ -92,7 +92,7 @@ pub fn generate(
     if options.lines == 0 {
         return Err("--lines must be at least 1".into());
     }
-    if !(options.thread_mm > 0.0) {
+    if options.thread_mm.is_nan() || options.thread_mm <= 0.0 {
         return Err("--thread-mm must be above 0".into());
     }
     if !(16..=4096).contains(&options.resolution) {

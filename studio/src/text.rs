@@ -33,7 +33,7 @@ pub fn strokes(
     wrap_mm: Option<f64>,
     at: [f64; 2],
 ) -> Result<Vec<Polyline>, String> {
-    if !(height_mm > 0.0) {
+    if height_mm.is_nan() || height_mm <= 0.0 {
         return Err("--height-mm must be above 0".into());
     }
     let scale = height_mm / f64::from(BASE_LINE - CAP_LINE);

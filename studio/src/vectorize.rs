@@ -88,7 +88,7 @@ pub struct Vectorized {
 const MAX_SIDE: usize = 2000;
 
 pub fn vectorize(image: &Gray, o: &Options, title: &str) -> Result<Vectorized, String> {
-    if !(o.width_mm > 0.0) {
+    if o.width_mm.is_nan() || o.width_mm <= 0.0 {
         return Err("--width-mm must be above 0".into());
     }
     let image = match image.width.max(image.height) > MAX_SIDE {
@@ -118,7 +118,7 @@ pub fn vectorize(image: &Gray, o: &Options, title: &str) -> Result<Vectorized, S
             spacing_mm,
             angle,
         } => {
-            if !(spacing_mm > 0.0) {
+            if spacing_mm.is_nan() || spacing_mm <= 0.0 {
                 return Err("--hatch-mm must be above 0".into());
             }
             let smooth = match o.blur > 0.0 {

@@ -142,8 +142,10 @@ impl Across<'_> {
                 } else if (first..last).contains(&y) {
                     // Along the row y.
                     let row = &mut rows[(y - first) * size..][..size];
-                    for xx in x.saturating_sub(r)..=(x + r).min(size - 1) {
-                        row[xx] += h * self.kernel[xx + r - x];
+                    let from = x.saturating_sub(r);
+                    let cells = &mut row[from..=(x + r).min(size - 1)];
+                    for (xx, cell) in (from..).zip(cells) {
+                        *cell += h * self.kernel[xx + r - x];
                     }
                 }
             }
