@@ -3,11 +3,13 @@
 //! many lines in flight as fit the firmware's 128-byte receive buffer, one
 //! freed per `ok` or `error:N`. A bar shows the file's progress in machine
 //! time, with the ETA the firmware's own planner works out for it on the
-//! host (`taut_logic::interp::estimate`). Keys while it streams: `!` or
+//! host (`taut_logic::interp::estimate`, with the figures the machine
+//! lists in `$$`). Keys while it streams: `!` or
 //! space holds, `~` or space again resumes, `q` or Ctrl-C stops the machine
 //! (Ctrl-X) and quits. Every `error:N` is shown with its line and the
-//! message the firmware put before it (`[MSG:…]`); the exit status is
-//! non-zero after any error or alarm.
+//! message the firmware put before it (`[MSG:…]`); at the end, a summary
+//! once the machine stands; the exit status is non-zero after any error,
+//! alarm or stop.
 //!
 //! The port: a Mega on USB (`/dev/ttyACM0`, the default; it resets when the
 //! port opens, which is waited out: its greeting comes within a few
@@ -26,6 +28,7 @@ use std::time::{Duration, Instant};
 use taut_logic::config::MachineConfig;
 use taut_logic::interp::estimate::GcodeTime;
 use taut_logic::machine::Machine;
+use taut_logic::settings;
 
 pub const USAGE: &str = "\
 taut send FILE [--port PATH] [--machine NAME]
@@ -33,9 +36,9 @@ taut send FILE [--port PATH] [--machine NAME]
     buffer), with progress and the firmware planner's ETA; keys: ! or space
     hold, ~ or space resume, q or Ctrl-C stop (Ctrl-X) and quit. PATH: the
     Mega (/dev/ttyACM0, default) or the simulator's terminal (cargo xtask sim
-    --pty PATH). NAME: the machine the ETA is worked out for (default
-    string_art; the file's own moves set the pace either way). Exit status 1
-    after any error or alarm.";
+    --pty PATH). NAME: the machine whose default figures the ETA is worked
+    out with (default: the figures the machine lists in $$). Exit status 1
+    after any error, alarm or stop.";
 
 /// Grbl 1.1's receive buffer; senders keep one byte of it free, as Grbl's
 /// own stream.py and grbl-streamer do (bytes of lines sent and not yet
@@ -73,21 +76,54 @@ impl Window {
 pub fn run(mut args: Args) -> Result<(), String> {
     let file = args.positional("FILE")?;
     let port = args.value("port").unwrap_or_else(|| "/dev/ttyACM0".into());
-    let machine = match args.value("machine") {
-        Some(name) => Machine::parse(name.as_bytes()).ok_or(format!("no machine {name:?}"))?,
-        None => Machine::StringArt,
+    let machine = args.value("machine");
+    let chosen = match &machine {
+        Some(name) => Some(Machine::parse(name.as_bytes()).ok_or(format!("no machine {name:?}"))?),
+        None => None,
     };
     args.finish()?;
     let text = std::fs::read(&file).map_err(|e| format!("{file}: {e}"))?;
     let lines = lines_of(&text);
-    let eta = Eta::of(&lines, &MachineConfig::defaults(machine));
+    // A line longer than the buffer would never fit beside nothing: the
+    // stream would wait for it forever.
+    if let Some((n, l)) = lines.iter().find(|(_, l)| !Window::default().fits(l)) {
+        return Err(format!(
+            "line {n}: {} characters, more than Grbl's buffer takes ({}): {l}",
+            l.len(),
+            RX_BUFFER - 2
+        ));
+    }
     let mut port = Port::open(&port)?;
     let mut replies = port.replies()?;
     greet(&mut port, &mut replies)?;
+    // The ETA plans for the figures the machine runs with, read from its
+    // `$$`, unless told which machine's defaults to take.
+    let (name, config) = match (chosen, machine) {
+        (Some(m), Some(name)) => (name, MachineConfig::defaults(m)),
+        _ => listed_config(&mut port, &mut replies)
+            .unwrap_or(("string_art".into(), MachineConfig::STRING_ART)),
+    };
+    let eta = Eta::of(&lines, &config);
+    eprintln!(
+        "taut send: {} lines to the {name}, {} of machine time by its planner",
+        lines.len(),
+        clock(eta.total)
+    );
     let keys = keys();
+    let started = Instant::now();
     let outcome = stream(&mut port, &mut replies, &lines, &eta, &keys);
-    keys.restore();
-    let Outcome { errors, alarm } = outcome?;
+    drop(keys);
+    let Outcome {
+        answered,
+        errors,
+        alarm,
+    } = outcome?;
+    println!(
+        "taut send: {answered} of {} lines answered, {errors} error(s), {} (the planner said {})",
+        lines.len(),
+        clock(started.elapsed().as_secs_f64()),
+        clock(eta.total)
+    );
     match (errors, alarm) {
         (0, None) => Ok(()),
         (n, None) => Err(format!("{n} line(s) answered with an error")),
@@ -95,18 +131,98 @@ pub fn run(mut args: Args) -> Result<(), String> {
     }
 }
 
-/// The file's lines as sent: comments and blanks kept out (they cost
-/// buffer space and change nothing), each with its line number.
+/// `m:ss.s`, or `h:mm:ss` from an hour.
+fn clock(s: f64) -> String {
+    let s = s.max(0.0);
+    match s < 3600.0 {
+        true => format!("{}:{:04.1}", (s / 60.0) as u64, s % 60.0),
+        false => {
+            let t = s as u64;
+            format!("{}:{:02}:{:02}", t / 3600, t / 60 % 60, t % 60)
+        }
+    }
+}
+
+/// The file's lines as sent, each with its line number: blanks, `%` tape
+/// marks and comments (`( … )`, `;` to the end) kept home, and G-code's
+/// spaces too, as Grbl's stream.py does (every byte in flight is a byte of
+/// the 128); `$` lines only trimmed (their values are text).
 fn lines_of(text: &[u8]) -> Vec<(usize, String)> {
     String::from_utf8_lossy(text)
         .lines()
         .enumerate()
-        .map(|(i, l)| (i + 1, l.split(';').next().unwrap_or("").trim().to_string()))
+        .map(|(i, l)| (i + 1, clean(l)))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('%'))
         .collect()
 }
 
+fn clean(line: &str) -> String {
+    let mut code = String::new();
+    let mut in_comment = false;
+    for c in line.chars() {
+        match c {
+            _ if in_comment => in_comment = c != ')',
+            '(' => in_comment = true,
+            ';' => break,
+            c => code.push(c),
+        }
+    }
+    let code = code.trim();
+    match code.starts_with('$') && !code.starts_with("$J=") {
+        true => code.to_string(),
+        false => code.chars().filter(|c| !c.is_whitespace()).collect(),
+    }
+}
+
+/// The machine's configuration from its `$$`: the defaults of the machine
+/// `$machine` names under the named settings listed after it. `None` from
+/// a Grbl that is not taut (no `$machine`) or no listing.
+fn listed_config(
+    port: &mut Port,
+    replies: &mut Receiver<String>,
+) -> Option<(String, MachineConfig)> {
+    port.write(b"$$\n").ok()?;
+    let until = Instant::now() + Duration::from_secs(3);
+    let mut listing = Vec::new();
+    loop {
+        let line = replies
+            .recv_timeout(until.checked_duration_since(Instant::now())?)
+            .ok()?;
+        match line.as_str() {
+            "ok" => break,
+            l if l.starts_with("error:") => return None,
+            l => listing.push(l.to_string()),
+        }
+    }
+    config_of(&listing)
+}
+
+fn config_of(listing: &[String]) -> Option<(String, MachineConfig)> {
+    // Grbl's numbered settings (`$110=…`) stand for named ones: skipped.
+    let named: Vec<(&str, &str)> = listing
+        .iter()
+        .filter_map(|l| l.strip_prefix('$')?.split_once('='))
+        .filter(|(k, _)| !k.starts_with(|c: char| c.is_ascii_digit()))
+        .collect();
+    let (_, name) = named
+        .iter()
+        .find(|(k, _)| k.eq_ignore_ascii_case("machine"))?;
+    let mut cfg = MachineConfig::defaults(Machine::parse(name.trim().as_bytes())?);
+    // Each setting must leave the whole valid (`settings::set` checks):
+    // one the first pass refuses for a neighbour not yet set, the second
+    // takes.
+    for _ in 0..2 {
+        for (k, v) in named.iter().filter(|(k, _)| *k != "machine") {
+            let _ = settings::set(&mut cfg, k, v);
+        }
+    }
+    Some((name.trim().to_string(), cfg))
+}
+
 /// Machine time at the end of each line, from the firmware's planner.
+/// Counted when the planner hands a block on, it lags the line by the
+/// planner's depth, as the machine lags the `ok` (the firmware answers a
+/// line when it is queued): the two lags cancel on the bar.
 struct Eta {
     after: Vec<f64>,
     total: f64,
@@ -145,7 +261,7 @@ fn greet(port: &mut Port, replies: &mut Receiver<String>) -> Result<(), String> 
         let until = Instant::now() + wait;
         while let Some(left) = until.checked_duration_since(Instant::now()) {
             match replies.recv_timeout(left) {
-                Ok(line) if line.starts_with("Grbl ") => return true,
+                Ok(line) if line.contains("Grbl ") => return true,
                 Ok(_) => {}
                 Err(_) => return false,
             }
@@ -163,9 +279,48 @@ fn greet(port: &mut Port, replies: &mut Receiver<String>) -> Result<(), String> 
     Ok(())
 }
 
+#[derive(Default)]
 struct Outcome {
+    answered: usize,
     errors: usize,
     alarm: Option<String>,
+}
+
+/// The bar: machine milliseconds done of the planner's total, the time
+/// left by the planner, and whether the machine is held.
+struct Progress {
+    bar: ProgressBar,
+    left: f64,
+    held: bool,
+}
+
+impl Progress {
+    fn new(total: f64) -> Result<Progress, String> {
+        let bar = ProgressBar::new((total * 1000.0) as u64);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} {elapsed_precise} [{bar:40}] {percent:>3}% {msg}",
+            )
+            .map_err(|e| e.to_string())?
+            .progress_chars("=> "),
+        );
+        let p = Progress {
+            bar,
+            left: total,
+            held: false,
+        };
+        p.show();
+        Ok(p)
+    }
+
+    fn show(&self) {
+        let held = match self.held {
+            true => "  HELD: ~ or space resumes",
+            false => "",
+        };
+        self.bar
+            .set_message(format!("ETA {}{held}", clock(self.left)));
+    }
 }
 
 fn stream(
@@ -175,68 +330,43 @@ fn stream(
     eta: &Eta,
     keys: &Keys,
 ) -> Result<Outcome, String> {
-    let bar = ProgressBar::new((eta.total * 1000.0) as u64);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} {elapsed_precise} [{bar:40}] {msg} ETA {eta_precise}",
-        )
-        .map_err(|e| e.to_string())?,
-    );
+    let mut p = Progress::new(eta.total)?;
     let mut window = Window::default();
-    let (mut next, mut answered, mut errors) = (0, 0, 0);
-    let mut held = false;
-    // The firmware's words for an error come just before its `error:N`.
+    let mut next = 0;
+    let mut o = Outcome::default();
+    // The firmware's words for an error or alarm come just before it.
     let mut message = String::new();
-    loop {
+    while o.answered < lines.len() {
         // Fill the buffer.
         while let Some((_, line)) = lines.get(next).filter(|(_, l)| window.fits(l)) {
             port.write(format!("{line}\n").as_bytes())?;
             window.sent(next, line);
             next += 1;
         }
-        if answered == lines.len() {
-            break;
-        }
-        for key in keys.pressed() {
-            match key {
-                b'!' | b' ' if !held => {
-                    port.write(b"!")?;
-                    held = true;
-                    bar.set_message("held (~ or space resumes)");
-                }
-                b'~' | b' ' if held => {
-                    port.write(b"~")?;
-                    held = false;
-                    bar.set_message("");
-                }
-                b'q' | 0x03 => {
-                    port.write(&[0x18])?;
-                    bar.abandon();
-                    return Err("stopped from the keyboard (Ctrl-X sent)".into());
-                }
-                _ => {}
-            }
-        }
-        let Ok(reply) = replies.recv_timeout(Duration::from_millis(50)) else {
-            continue;
+        keys.act(port, &mut p)?;
+        let reply = match replies.recv_timeout(Duration::from_millis(50)) {
+            Ok(reply) => reply,
+            Err(mpsc::RecvTimeoutError::Timeout) => continue,
+            Err(mpsc::RecvTimeoutError::Disconnected) => return Err("the port closed".into()),
         };
         if reply == "ok" || reply.starts_with("error:") {
             let i = window
                 .answered()
                 .ok_or(format!("a reply with no line sent: {reply}"))?;
-            answered += 1;
+            o.answered += 1;
             if reply != "ok" {
-                errors += 1;
+                o.errors += 1;
                 let (number, text) = &lines[i];
-                bar.suspend(|| eprintln!("line {number}: {text}: {reply} {message}"));
+                p.bar
+                    .suspend(|| eprintln!("line {number}: {text}: {reply} {message}"));
             }
-            bar.set_position((eta.after[i] * 1000.0) as u64);
+            p.bar.set_position((eta.after[i] * 1000.0) as u64);
+            p.left = eta.total - eta.after[i];
+            p.show();
         } else if reply.starts_with("ALARM:") {
-            bar.abandon();
-            return Ok(Outcome {
-                errors,
-                alarm: Some(reply),
-            });
+            p.bar.abandon();
+            o.alarm = Some(format!("{reply} {message}").trim().to_string());
+            return Ok(o);
         } else if let Some(m) = reply
             .strip_prefix("[MSG:")
             .and_then(|m| m.strip_suffix(']'))
@@ -247,20 +377,28 @@ fn stream(
         message.clear();
     }
     // Every line queued: wait until the machine stands.
-    let end = wait_idle(port, replies);
-    bar.finish();
-    end.map(|alarm| Outcome { errors, alarm })
+    o.alarm = wait_idle(port, replies, keys, &mut p)?;
+    p.bar.finish();
+    Ok(o)
 }
 
-/// Polls `?` until the status report says `Idle`; an alarm on the way.
-fn wait_idle(port: &mut Port, replies: &mut Receiver<String>) -> Result<Option<String>, String> {
+/// Polls `?` every 200 ms until the status report says `Idle` (keys still
+/// act: a hold near the end must be resumable, a stop possible); an alarm
+/// on the way.
+fn wait_idle(
+    port: &mut Port,
+    replies: &mut Receiver<String>,
+    keys: &Keys,
+    p: &mut Progress,
+) -> Result<Option<String>, String> {
     loop {
+        keys.act(port, p)?;
         port.write(b"?")?;
         let until = Instant::now() + Duration::from_millis(200);
         while let Some(left) = until.checked_duration_since(Instant::now()) {
             match replies.recv_timeout(left) {
                 Ok(r) if r.starts_with("<Idle") => return Ok(None),
-                Ok(r) if r.starts_with("ALARM:") => return Ok(Some(r)),
+                Ok(r) if r.starts_with("ALARM:") || r.starts_with("<Alarm") => return Ok(Some(r)),
                 Ok(_) => {}
                 Err(mpsc::RecvTimeoutError::Timeout) => break,
                 Err(mpsc::RecvTimeoutError::Disconnected) => return Err("the port closed".into()),
@@ -269,34 +407,54 @@ fn wait_idle(port: &mut Port, replies: &mut Receiver<String>) -> Result<Option<S
     }
 }
 
-/// The keyboard, one key at a time when it is a terminal.
+/// The keyboard, one key at a time when it is a terminal (its mode put
+/// back when this drops); SIGINT caught when it is not.
 struct Keys {
     pressed: Receiver<u8>,
-    saved: Option<port::TermMode>,
+    _raw: Option<port::TermMode>,
 }
 
 impl Keys {
-    fn pressed(&self) -> Vec<u8> {
-        self.pressed.try_iter().collect()
-    }
-
-    fn restore(self) {
-        if let Some(mode) = self.saved {
-            mode.restore();
+    /// Sends what the keys pressed since the last call ask for; an error
+    /// after a stop (the machine reset with Ctrl-X).
+    fn act(&self, port: &mut Port, p: &mut Progress) -> Result<(), String> {
+        let interrupt = port::interrupted().then_some(0x03);
+        for key in self.pressed.try_iter().chain(interrupt) {
+            match key {
+                b'!' | b' ' if !p.held => {
+                    port.write(b"!")?;
+                    p.held = true;
+                }
+                b'~' | b' ' if p.held => {
+                    port.write(b"~")?;
+                    p.held = false;
+                }
+                b'q' | b'Q' | 0x03 => {
+                    port.write(&[0x18])?;
+                    p.bar.abandon();
+                    return Err("stopped from the keyboard (Ctrl-X sent)".into());
+                }
+                _ => continue,
+            }
+            p.show();
         }
+        Ok(())
     }
 }
 
 fn keys() -> Keys {
-    let saved = port::TermMode::raw_stdin();
+    let raw = port::TermMode::raw_stdin();
     let (tx, pressed) = mpsc::channel();
-    if saved.is_some() {
-        std::thread::spawn(move || {
-            let mut byte = [0u8];
-            while std::io::stdin().read_exact(&mut byte).is_ok() && tx.send(byte[0]).is_ok() {}
-        });
+    match raw {
+        Some(_) => {
+            std::thread::spawn(move || {
+                let mut byte = [0u8];
+                while std::io::stdin().read_exact(&mut byte).is_ok() && tx.send(byte[0]).is_ok() {}
+            });
+        }
+        None => port::catch_sigint(),
     }
-    Keys { pressed, saved }
+    Keys { pressed, _raw: raw }
 }
 
 #[cfg(test)]
@@ -304,16 +462,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn comments_and_blanks_stay_home_and_lines_keep_their_numbers() {
-        let lines = lines_of(b"; a drawing\nG21\n\n G1 X1 ; out\n%\nM5\n");
-        assert_eq!(
-            lines,
-            [
-                (2, "G21".to_string()),
-                (4, "G1 X1".into()),
-                (6, "M5".into())
-            ]
-        );
+    fn comments_blanks_and_spaces_stay_home_and_lines_keep_their_numbers() {
+        let text = b"; a drawing\nG21\n\n G1 X1 ; out\n%\n(setup)\nG0 X2 (a; b) Y3\r\nM5 (open\n\t$machine = flatbed ; $ text\n$J=G91 X1 F100\n";
+        let lines = lines_of(text);
+        let want = [
+            (2, "G21"),
+            (4, "G1X1"),
+            (7, "G0X2Y3"),
+            (8, "M5"),
+            (9, "$machine = flatbed"),
+            (10, "$J=G91X1F100"),
+        ];
+        let want: Vec<(usize, String)> = want.iter().map(|(n, l)| (*n, l.to_string())).collect();
+        assert_eq!(lines, want);
     }
 
     #[test]
@@ -354,5 +515,47 @@ mod tests {
             "{}",
             eta.total
         );
+    }
+
+    /// `$$` as the firmware lists it (Grbl's numbered settings, then the
+    /// named ones) gives back the configuration it was listed from.
+    #[test]
+    fn the_listing_gives_the_machine_s_figures() {
+        struct Line(String);
+        impl ufmt::uWrite for Line {
+            type Error = std::convert::Infallible;
+            fn write_str(&mut self, s: &str) -> Result<(), Self::Error> {
+                self.0.push_str(s);
+                Ok(())
+            }
+        }
+        let mut cfg = MachineConfig::defaults(Machine::Flatbed);
+        settings::set(&mut cfg, "x_max_rate", "3100").unwrap();
+        settings::set(&mut cfg, "y_accel", "1234").unwrap();
+        settings::set(&mut cfg, "homing_at_start", "0").unwrap();
+        assert_ne!(cfg, MachineConfig::defaults(Machine::Flatbed));
+        let mut listing = vec!["[MSG:a note]".to_string()];
+        for i in 0.. {
+            let Some(listed) = settings::listed(i, &cfg) else {
+                break;
+            };
+            let mut line = Line(String::new());
+            ufmt::uwrite!(line, "{}", listed).unwrap();
+            listing.push(line.0);
+        }
+        assert!(
+            listing.iter().any(|l| l.starts_with("$110=")),
+            "{listing:?}"
+        );
+        assert_eq!(config_of(&listing), Some(("flatbed".to_string(), cfg)));
+        // Not taut's (no $machine): no figures.
+        assert_eq!(config_of(&["$110=500.000".to_string()]), None);
+    }
+
+    #[test]
+    fn clock_reads_as_minutes_or_hours() {
+        assert_eq!(clock(0.0), "0:00.0");
+        assert_eq!(clock(65.34), "1:05.3");
+        assert_eq!(clock(3725.0), "1:02:05");
     }
 }

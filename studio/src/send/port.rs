@@ -1,11 +1,13 @@
 //! The serial port, raw at 115 200 baud (a Mega's USB serial or the
 //! simulator's pseudo-terminal), its replies as lines from a reader thread;
-//! and the keyboard in raw mode while a file streams.
+//! and the keyboard in raw mode while a file streams (or SIGINT caught
+//! when there is no keyboard).
 
 use std::fs::{File, OpenOptions};
 use std::io::{BufRead, BufReader, Write};
 use std::os::fd::AsRawFd;
 use std::os::unix::fs::OpenOptionsExt;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver};
 
 pub struct Port {
@@ -66,12 +68,14 @@ impl Port {
     }
 }
 
-/// The terminal's mode before it was made raw, to put back.
+/// The terminal's mode before it was made raw, put back when dropped (on
+/// every way out of a stream, a panic's unwinding included).
 pub struct TermMode(libc::termios);
 
 impl TermMode {
     /// Standard input one key at a time, without echo, if it is a
-    /// terminal; the mode it had.
+    /// terminal; the mode it had. Ctrl-C comes as a key (ISIG off), so a
+    /// stop always sends Ctrl-X to the machine first.
     pub fn raw_stdin() -> Option<TermMode> {
         // SAFETY: termios structs filled by tcgetattr on fd 0; isatty first.
         unsafe {
@@ -89,9 +93,30 @@ impl TermMode {
             (libc::tcsetattr(0, libc::TCSANOW, &raw) == 0).then_some(TermMode(saved))
         }
     }
+}
 
-    pub fn restore(self) {
+impl Drop for TermMode {
+    fn drop(&mut self) {
         // SAFETY: puts back the mode tcgetattr gave for fd 0.
         unsafe { libc::tcsetattr(0, libc::TCSANOW, &self.0) };
     }
+}
+
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_sigint(_: libc::c_int) {
+    INTERRUPTED.store(true, Ordering::Relaxed);
+}
+
+/// Without a terminal (stdin piped), SIGINT still has to stop the machine:
+/// it only raises a flag the stream loop reads as Ctrl-C.
+pub fn catch_sigint() {
+    let handler: extern "C" fn(libc::c_int) = on_sigint;
+    // SAFETY: the handler only stores to an atomic (async-signal-safe).
+    unsafe { libc::signal(libc::SIGINT, handler as libc::sighandler_t) };
+}
+
+/// Whether SIGINT came since the last call.
+pub fn interrupted() -> bool {
+    INTERRUPTED.swap(false, Ordering::Relaxed)
 }
