@@ -9,9 +9,9 @@ use hil_tests::senders::{
     assert_path_through, client_script, clients_dir, install_clients, random_walk, serve, underruns,
 };
 use hil_tests::{boot_machine, send_ok};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// The venv's Python with grbl-streamer (installed by `install_clients`).
 fn grbl_streamer_python() -> PathBuf {
@@ -77,17 +77,12 @@ fn taut_bin() -> PathBuf {
     root.join("target/release/taut")
 }
 
-/// Runs `taut send FILE --port <pty> --machine flatbed` against a booted
-/// flatbed; its output (stdout and stderr) and exit status.
-fn taut_send(sim: &mut hil_tests::sim::Sim, file: &std::path::Path) -> (bool, String) {
+/// Runs `taut send FILE <extra> --port <pty>` against a booted flatbed;
+/// its output (stdout and stderr) and exit status.
+fn taut_send(sim: &mut hil_tests::sim::Sim, file: &Path, extra: &[&str]) -> (bool, String) {
     let mut client = Command::new(taut_bin());
-    client.args([
-        "send",
-        file.to_str().unwrap(),
-        "--machine",
-        "flatbed",
-        "--port",
-    ]);
+    client.args(["send", file.to_str().unwrap()]);
+    client.args(extra).arg("--port");
     let out = serve(
         sim,
         &mut client,
@@ -109,20 +104,32 @@ fn flatbed() -> hil_tests::sim::Sim {
 }
 
 /// `taut send` streams the same 2 000-line walk as grbl-streamer, counting
-/// characters, with the same result on the pulses; a file with a line the
-/// machine refuses ends with a non-zero status and that line named.
+/// characters, with the same result on the pulses (the ETA planned with
+/// the figures the machine lists in `$$`: the flatbed's); a file with a
+/// line the machine refuses ends with a non-zero status and that line
+/// named; a line too long for Grbl's buffer is refused before anything is
+/// sent.
 #[test]
 fn taut_send_streams_the_walk_and_fails_on_a_refused_line() {
     let (lines, ends) = random_walk(7, 2000);
     let file = clients_dir().join(format!("walk-send-{}.gcode", std::process::id()));
     std::fs::create_dir_all(clients_dir()).unwrap();
-    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
+    // A comment and a blank line cost nothing on the wire.
+    let text = format!("(walk, seed 7)\n\n{}\n", lines.join(" ; a step\n"));
+    std::fs::write(&file, text).unwrap();
     let mut sim = flatbed();
-    let (ok, said) = taut_send(&mut sim, &file);
+    let started = Instant::now();
+    let (ok, said) = taut_send(&mut sim, &file, &[]);
+    let wall = started.elapsed();
     assert!(ok, "{said}\n{}", hil_tests::log_tail(&sim));
     assert!(!said.contains("error:"), "{said}");
+    assert!(said.contains("2000 lines to the flatbed"), "{said}");
+    assert!(
+        said.contains("2000 of 2000 lines answered, 0 error(s)"),
+        "{said}"
+    );
     assert_path_through(&sim, &ends);
-    eprintln!("{}", said.lines().last().unwrap_or_default());
+    eprintln!("{}\n{wall:?} wall; {}", said.trim(), underruns(&sim));
 
     // Line 3 is past the flatbed's 140 mm: refused before anything moves.
     std::fs::write(
@@ -131,13 +138,29 @@ fn taut_send_streams_the_walk_and_fails_on_a_refused_line() {
     )
     .unwrap();
     let mut sim = flatbed();
-    let (ok, said) = taut_send(&mut sim, &file);
-    std::fs::remove_file(&file).unwrap();
+    let (ok, said) = taut_send(&mut sim, &file, &["--machine", "flatbed"]);
     assert!(!ok, "{said}");
     assert!(
-        said.contains("line 3: G1 X500 Y10: error:15 Travel exceeded"),
+        said.contains("line 3: G1X500Y10: error:15 Travel exceeded"),
         "{said}"
     );
+    assert!(said.contains("4 of 4 lines answered, 1 error(s)"), "{said}");
     // The lines around it ran.
     assert_path_through(&sim, &[[400, 400], [800, 400]]);
+
+    // Longer than the 127 bytes in flight can be: refused up front (no
+    // port needed).
+    std::fs::write(
+        &file,
+        format!("G21\nG1 X1{}\n", " ".repeat(60) + &"Y1".repeat(70)),
+    )
+    .unwrap();
+    let out = Command::new(taut_bin())
+        .args(["send", file.to_str().unwrap(), "--port", "/nonexistent"])
+        .output()
+        .unwrap();
+    std::fs::remove_file(&file).unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(said.contains("line 2: 144 characters"), "{said}");
 }
