@@ -96,6 +96,10 @@ pub fn run(mut args: Args) -> Result<(), String> {
     let mut port = Port::open(&port)?;
     let mut replies = port.replies()?;
     greet(&mut port, &mut replies)?;
+    // In alarm every line would be refused, one error each: say so once.
+    if state(&mut port, &mut replies)?.as_deref() == Some("Alarm") {
+        return Err("the machine is in alarm: unlock it ($X) or home it ($H) first".into());
+    }
     // The ETA plans for the figures the machine runs with, read from its
     // `$$`, unless told which machine's defaults to take.
     let (name, config) = match (chosen, machine) {
@@ -279,6 +283,23 @@ fn greet(port: &mut Port, replies: &mut Receiver<String>) -> Result<(), String> 
     Ok(())
 }
 
+/// The machine's state from a status report (`<Idle|…>` → `Idle`).
+fn state(port: &mut Port, replies: &mut Receiver<String>) -> Result<Option<String>, String> {
+    port.write(b"?")?;
+    let until = Instant::now() + Duration::from_secs(1);
+    while let Some(left) = until.checked_duration_since(Instant::now()) {
+        match replies.recv_timeout(left) {
+            Ok(r) if r.starts_with('<') => {
+                let word = r[1..].split(['|', ':', '>']).next().unwrap_or_default();
+                return Ok(Some(word.to_string()));
+            }
+            Ok(_) => {}
+            Err(_) => break,
+        }
+    }
+    Ok(None)
+}
+
 #[derive(Default)]
 struct Outcome {
     answered: usize,
@@ -299,7 +320,7 @@ impl Progress {
         let bar = ProgressBar::new((total * 1000.0) as u64);
         bar.set_style(
             ProgressStyle::with_template(
-                "{spinner} {elapsed_precise} [{bar:40}] {percent:>3}% {msg}",
+                "{spinner} {elapsed_precise} [{wide_bar}] {percent:>3}% {msg}",
             )
             .map_err(|e| e.to_string())?
             .progress_chars("=> "),
@@ -315,11 +336,23 @@ impl Progress {
 
     fn show(&self) {
         let held = match self.held {
-            true => "  HELD: ~ or space resumes",
+            true => "  HELD (~ resumes)",
             false => "",
         };
         self.bar
             .set_message(format!("ETA {}{held}", clock(self.left)));
+    }
+}
+
+/// The bar left as it stands on every way out, the cursor under it
+/// (indicatif leaves it at the line's end, where the next message would
+/// run on).
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.bar.abandon();
+        if !self.bar.is_hidden() {
+            eprintln!();
+        }
     }
 }
 
@@ -364,7 +397,6 @@ fn stream(
             p.left = eta.total - eta.after[i];
             p.show();
         } else if reply.starts_with("ALARM:") {
-            p.bar.abandon();
             o.alarm = Some(format!("{reply} {message}").trim().to_string());
             return Ok(o);
         } else if let Some(m) = reply
@@ -378,7 +410,11 @@ fn stream(
     }
     // Every line queued: wait until the machine stands.
     o.alarm = wait_idle(port, replies, keys, &mut p)?;
-    p.bar.finish();
+    if o.alarm.is_none() {
+        p.left = 0.0;
+        p.bar.set_position(p.bar.length().unwrap_or(0));
+        p.show();
+    }
     Ok(o)
 }
 
@@ -391,8 +427,18 @@ fn wait_idle(
     keys: &Keys,
     p: &mut Progress,
 ) -> Result<Option<String>, String> {
+    // The planner's last blocks are timed only as a whole (after the last
+    // `ok`): the bar runs on through them by the clock.
+    let (from, left) = (Instant::now(), p.left);
     loop {
         keys.act(port, p)?;
+        if !p.held {
+            p.left = (left - from.elapsed().as_secs_f64()).max(0.0);
+            let len = p.bar.length().unwrap_or(0);
+            p.bar
+                .set_position(len - (p.left * 1000.0).min(len as f64) as u64);
+            p.show();
+        }
         port.write(b"?")?;
         let until = Instant::now() + Duration::from_millis(200);
         while let Some(left) = until.checked_duration_since(Instant::now()) {
@@ -431,8 +477,7 @@ impl Keys {
                 }
                 b'q' | b'Q' | 0x03 => {
                     port.write(&[0x18])?;
-                    p.bar.abandon();
-                    return Err("stopped from the keyboard (Ctrl-X sent)".into());
+                    return Err("stopped (Ctrl-X sent: the machine reset)".into());
                 }
                 _ => continue,
             }
