@@ -332,3 +332,20 @@ pub fn pen_deg_at(sim: &sim::Sim, cycle: u64) -> Option<f64> {
     let us = (edges[fall].cycle - edges[rise].cycle) as f64 / 16.0;
     Some((us - 1000.0) * 180.0 / 1000.0)
 }
+
+/// A string-art card's `machine.txt` with coarser steps and quicker ramps
+/// than the defaults: a job's moves in an eighth of the pulses and a tenth
+/// of the time, so jobs cut again and again simulate in CI's time.
+pub const QUICK_MACHINE_TXT: &str = "base_steps_per_unit = 1200/360\nradial_steps_per_unit = 4\n\
+    drill_steps_per_unit = 200/12\nbase_accel = 8000\nradial_accel = 8000\ndrill_accel = 8000\n";
+
+/// The string-art machine as a card with [`QUICK_MACHINE_TXT`] sets it
+/// up: what its pulses are read with.
+pub fn quick_string_art() -> taut_logic::config::MachineConfig {
+    let mut cfg = taut_logic::config::MachineConfig::STRING_ART;
+    for line in QUICK_MACHINE_TXT.lines() {
+        let (key, value) = line.split_once('=').unwrap();
+        taut_logic::settings::set(&mut cfg, key.trim(), value.trim()).unwrap();
+    }
+    cfg
+}

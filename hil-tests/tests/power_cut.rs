@@ -16,10 +16,11 @@ use hil_tests::sim::replay::{Crossing, Direction, JobReplay};
 use hil_tests::sim::sdcard::SdImage;
 use hil_tests::sim::vcd::Signal;
 use hil_tests::sim::{Outcome, Sim};
-use hil_tests::{assert_ram_budget, card, machine, soak_or, Rng};
+use hil_tests::{
+    assert_ram_budget, card, machine, quick_string_art, soak_or, Rng, QUICK_MACHINE_TXT,
+};
 use std::time::{Duration, Instant};
 use taut_logic::checkpoint::{self, Found};
-use taut_logic::config::MachineConfig;
 use taut_logic::geometry::{Board, StepScale};
 use taut_logic::units::Milli;
 
@@ -28,11 +29,6 @@ const NAILS: u16 = 12;
 const PATTERN: [u16; 30] = [
     9, 4, 11, 5, 11, 10, 8, 0, 7, 3, 10, 0, 2, 1, 5, 7, 3, 6, 8, 1, 9, 3, 0, 11, 3, 6, 4, 2, 6, 2,
 ];
-/// Coarser steps and quicker ramps than the defaults: the same moves in an
-/// eighth of the pulses and a tenth of the time, so twenty cuts simulate
-/// in CI's time.
-const MACHINE_TXT: &str = "base_steps_per_unit = 1200/360\nradial_steps_per_unit = 4\n\
-    drill_steps_per_unit = 200/12\nbase_accel = 8000\nradial_accel = 8000\ndrill_accel = 8000\n";
 /// A run that has not finished (or been cut) by then has hung.
 const RUN_TIMEOUT_S: f64 = 600.0;
 
@@ -48,18 +44,8 @@ fn job_card(pattern: &[u16]) -> SdImage {
             b"tvar = 0\npocet_hrebiku = 12\npolomer_matrice = 20.0\n",
         ),
         ("poradi.txt", poradi(pattern).as_bytes()),
-        ("machine.txt", MACHINE_TXT.as_bytes()),
+        ("machine.txt", QUICK_MACHINE_TXT.as_bytes()),
     ])
-}
-
-/// The machine as the card sets it up: what the pulses are read with.
-fn config() -> MachineConfig {
-    let mut cfg = MachineConfig::STRING_ART;
-    for line in MACHINE_TXT.lines() {
-        let (key, value) = line.split_once('=').unwrap();
-        taut_logic::settings::set(&mut cfg, key.trim(), value.trim()).unwrap();
-    }
-    cfg
 }
 
 fn board() -> Board {
@@ -192,7 +178,7 @@ fn shorter(from: i64, to: i64, turn: i64) -> i64 {
 /// Checks the union of the runs' traces; returns (holes drilled twice,
 /// wraps completed across a cut).
 fn check_union(runs: &[Run], pattern: &[u16]) -> (usize, usize) {
-    let cfg = config();
+    let cfg = quick_string_art();
     let board = board();
     let scale = StepScale::from_config(&cfg);
     let turn = i64::from(scale.steps_per_turn);

@@ -7,27 +7,14 @@
 use hil_tests::sim::operator::{Operator, Seen};
 use hil_tests::sim::replay::JobReplay;
 use hil_tests::sim::{Outcome, Sim};
-use hil_tests::{assert_ram_budget, card, machine};
+use hil_tests::{assert_ram_budget, card, machine, quick_string_art, QUICK_MACHINE_TXT};
 use std::time::Duration;
-use taut_logic::config::MachineConfig;
 use taut_logic::geometry::{Board, StepScale};
 use taut_logic::pinmap::Button;
 use taut_logic::units::Milli;
 
 const NAILS: u16 = 12;
 const PATTERN: [u16; 8] = [5, 0, 7, 3, 10, 2, 8, 1];
-/// The power-cut test's quick machine: the same moves in fewer pulses.
-const MACHINE_TXT: &str = "base_steps_per_unit = 1200/360\nradial_steps_per_unit = 4\n\
-    drill_steps_per_unit = 200/12\nbase_accel = 8000\nradial_accel = 8000\ndrill_accel = 8000\n";
-
-fn config() -> MachineConfig {
-    let mut cfg = MachineConfig::STRING_ART;
-    for line in MACHINE_TXT.lines() {
-        let (key, value) = line.split_once('=').unwrap();
-        taut_logic::settings::set(&mut cfg, key.trim(), value.trim()).unwrap();
-    }
-    cfg
-}
 
 fn ns(sim: &Sim) -> u64 {
     (sim.time_s() * 1e9) as u64
@@ -95,7 +82,7 @@ fn tools_wrap_drift_step_and_step_back_on_the_pulses() {
             b"tvar = 0\npocet_hrebiku = 12\npolomer_matrice = 20.0\n",
         ),
         ("poradi.txt", poradi.as_bytes()),
-        ("machine.txt", MACHINE_TXT.as_bytes()),
+        ("machine.txt", QUICK_MACHINE_TXT.as_bytes()),
     ]));
     let mut op = Operator::confirming();
     let state = |name: &str| {
@@ -161,7 +148,7 @@ fn tools_wrap_drift_step_and_step_back_on_the_pulses() {
     op.confirm = true;
     run_until(&mut sim, &mut op, |_, op, _| op.finished);
 
-    let cfg = config();
+    let cfg = quick_string_art();
     let board = Board::new(0, NAILS, Milli(200_000)).unwrap();
     let mut job = JobReplay::from_signals(&sim.vcd_signals(), board, &cfg).unwrap();
     // The wrap test: nail 3 only, through gaps, back at the zero pose.
