@@ -2,6 +2,7 @@
 //! harness's fast path) and one instruction at a time side by side, comparing
 //! cycles, sleep, UART, stack and interrupts-masked figures after every step:
 //! the batched run must see exactly what instruction-by-instruction watching does.
+use std::time::Duration;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::Sim;
 fn main() {
