@@ -42,10 +42,14 @@ pub(crate) struct Shared {
     /// Where the core was when simavr declared it crashed (a program
     /// counter past the flash).
     pub crash_pc: Option<u32>,
-    /// Byte addresses of the `cli` instructions trapped (sorted).
-    pub cli_sites: Vec<u32>,
+    /// The `cli` instructions trapped: a bit per flash word.
+    pub cli_sites: Vec<u64>,
     /// Address 0 holds a trap: reaching it (but from reset) is a crash.
     pub zero_trap: bool,
+    /// simavr cycle the run loop's deadline timer is set for, while set.
+    pub deadline_at: Option<u64>,
+    /// simavr's cycle count when a timer (the watchdog's) reset the MCU.
+    pub reset_at: Option<u64>,
 }
 
 /// simavr's IRQs the SD card slot reads and writes.
@@ -74,6 +78,8 @@ impl Shared {
             crash_pc: None,
             cli_sites: Vec::new(),
             zero_trap: false,
+            deadline_at: None,
+            reset_at: None,
         }
     }
 
@@ -164,7 +170,12 @@ pub(crate) unsafe extern "C" fn on_bad_opcode(_irq: *mut avr_irq_t, _op: u32, pa
     // simavr's decoder: a state other than running on return means the
     // IRQ served the opcode (`cpu_StepDone`: resume at `avr->pc`); the
     // instruction's one cycle is added after.
-    if shared.cli_sites.binary_search(&pc).is_ok() {
+    let word = pc as usize / 2;
+    if shared
+        .cli_sites
+        .get(word / 64)
+        .is_some_and(|w| w >> (word % 64) & 1 != 0)
+    {
         // `cli` as simavr runs it (`avr_sreg_set(avr, S_I, 0)`).
         (*avr).sreg[7] = 0;
         (*avr).interrupt_state = 0;
@@ -236,11 +247,15 @@ pub(crate) unsafe extern "C" fn on_sreg_write(
 /// The run loop's own deadline: a cycle timer, so simavr ends its run of
 /// instructions on the first boundary at or past it, as it does for the
 /// MCU's timers. It does nothing when it fires.
+///
+/// # Safety
+/// As `on_uart_tx`.
 unsafe extern "C" fn deadline(
     _avr: *mut avr_t,
     _when: simavr_ffi::avr_cycle_count_t,
-    _param: *mut c_void,
+    param: *mut c_void,
 ) -> simavr_ffi::avr_cycle_count_t {
+    (*(param as *mut Shared)).deadline_at = None;
     0
 }
 
@@ -278,8 +293,13 @@ pub(crate) unsafe extern "C" fn run(avr: *mut avr_t) {
     }
     if state(avr) == cpu_Sleeping {
         simavr_ffi::avr_cycle_timer_cancel(avr, DEADLINE, shared as *mut c_void);
+        (*shared).deadline_at = None;
     }
+    let before = (*avr).cycle;
     let sleep = simavr_ffi::avr_cycle_timer_process(avr);
+    if (*avr).cycle < before {
+        (*shared).reset_at = Some(before);
+    }
     if state(avr) == cpu_Sleeping {
         if (*avr).sreg[7] == 0 {
             (*avr).state = cpu_Done as _;

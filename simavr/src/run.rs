@@ -143,10 +143,12 @@ impl Sim {
         if cycle < self.last_avr_cycle {
             // Only a reset sets simavr's counter back, and in a run only the
             // watchdog resets.
-            let before = self.last_avr_cycle;
+            let last = self.last_avr_cycle;
             let shared = self.shared_mut();
-            shared.cycle_base += before;
+            shared.cycle_base += shared.reset_at.take().unwrap_or(last);
             shared.uart.rx_ready = false;
+            // The reset emptied simavr's timers.
+            shared.deadline_at = None;
             self.last_avr_cycle = cycle;
             self.resets += 1;
             return Some(Outcome::WatchdogReset { count: self.resets });

@@ -244,8 +244,13 @@ impl Sim {
             if has_code {
                 self.write_flash_word(0, crate::traps::TRAP);
             }
+            let mut bits = vec![0u64; self.code.len().div_ceil(64)];
+            for &at in &sites {
+                let word = at as usize / 2;
+                bits[word / 64] |= 1 << (word % 64);
+            }
             let shared = self.shared_mut();
-            shared.cli_sites = sites;
+            shared.cli_sites = bits;
             shared.zero_trap = has_code;
         }
         self.code_ranges = ranges;
