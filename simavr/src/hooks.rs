@@ -222,7 +222,13 @@ pub(crate) unsafe extern "C" fn on_sp_write(
     // Between the two bytes of a 16-bit update this may be a value the
     // stack never held; the run loop checks the real one after the
     // instruction.
-    let sp = u16::from_le_bytes([*data.add(SPL), *data.add(SPH)]);
+    // (The byte just stored is not read back: a wider load over a fresh
+    // narrow store stalls the host for longer than the rest of this.)
+    let sp = if usize::from(addr) == SPL {
+        u16::from_le_bytes([v, *data.add(SPH)])
+    } else {
+        u16::from_le_bytes([*data.add(SPL), v])
+    };
     if sp < shared.sp_floor {
         end_batch(avr);
     }
