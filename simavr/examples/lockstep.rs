@@ -1,8 +1,10 @@
 //! `lockstep ELF [CARD] [STEP_US] [TOTAL_MS]`: runs a firmware batched (the
 //! harness's fast path) and one instruction at a time side by side, comparing
-//! cycles, sleep, UART, stack and interrupts-masked figures after every step:
+//! cycles, sleep, UART, stack and interrupts-masked figures after every step
+//! (a simulated operator pressing green whenever the job asks, in both):
 //! the batched run must see exactly what instruction-by-instruction watching does.
 use std::time::Duration;
+use taut_simavr::operator::Operator;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::Sim;
 fn main() {
@@ -22,11 +24,15 @@ fn main() {
         s
     };
     let (mut x, mut y) = (mk(false), mk(true));
+    // The simulated operator presses green whenever the job asks.
+    let (mut opx, mut opy) = (Operator::confirming(), Operator::confirming());
     let mut t = 0;
     while t < total_ms * 1000 {
         let ox = x.run_for(Duration::from_micros(step_us));
         let oy = y.run_for(Duration::from_micros(step_us));
         t += step_us;
+        opx.step(&mut x);
+        opy.step(&mut y);
         let fx = (
             ox,
             x.cycles(),

@@ -78,7 +78,7 @@ pub fn function_address(path: &Path, part: &str) -> Result<Option<u32>, Error> {
         .map(|s| s.address() as u32))
 }
 
-/// The byte ranges of flash holding code (end exclusive): each function
+/// The byte ranges of flash holding code (end exclusive): each code
 /// symbol's, to the next symbol when it has no size (the C runtime's
 /// labels). Constants in flash are data symbols and never inside one.
 pub(crate) fn code_ranges(path: &Path) -> Result<Vec<(u32, u32)>, Error> {
@@ -93,7 +93,10 @@ pub(crate) fn code_ranges(path: &Path) -> Result<Vec<(u32, u32)>, Error> {
         .symbols()
         .filter(|s| s.section_index() == Some(text.index()))
         .map(|s| {
-            let code = s.kind() == object::SymbolKind::Text;
+            // Functions, and the untyped labels of the C runtime's and
+            // libgcc's assembly (`__prologue_saves__`, `_exit`…); objects
+            // (constants in flash) only end the range before them.
+            let code = s.kind() != object::SymbolKind::Data;
             (s.address() as u32, s.size() as u32, code)
         })
         .collect();

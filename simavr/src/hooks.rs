@@ -50,6 +50,9 @@ pub(crate) struct Shared {
     pub deadline_at: Option<u64>,
     /// simavr's cycle count when a timer (the watchdog's) reset the MCU.
     pub reset_at: Option<u64>,
+    /// A batch saw the interrupts unmasked that began with them on and
+    /// never saw them masked: code the traps missed masked them.
+    pub unseen_mask: bool,
 }
 
 /// simavr's IRQs the SD card slot reads and writes.
@@ -80,6 +83,7 @@ impl Shared {
             zero_trap: false,
             deadline_at: None,
             reset_at: None,
+            unseen_mask: false,
         }
     }
 
@@ -291,7 +295,14 @@ pub(crate) unsafe extern "C" fn run(avr: *mut avr_t) {
     let shared = (*avr).custom.data as *mut Shared;
     let state = |avr: *mut avr_t| (*avr).state as u32;
     if state(avr) == cpu_Running {
+        let masked_before = (*avr).sreg[7] == 0;
         let pc = avr_run_one(avr);
+        // simavr stops right after the I flag rises (`interrupt_state` < 0);
+        // every way it can fall ends the batch too, so a rise in a batch
+        // that began unmasked means a fall went unseen.
+        if !masked_before && (*avr).interrupt_state < 0 {
+            (*shared).unseen_mask = true;
+        }
         if state(avr) == cpu_Crashed {
             (*shared).crash_pc = Some((*avr).pc);
         }

@@ -83,6 +83,13 @@ impl Sim {
             }
         };
         self.clear_deadline();
+        if std::mem::take(&mut self.shared_mut().unseen_mask) && !self.warned_unseen_mask {
+            self.warned_unseen_mask = true;
+            eprintln!(
+                "taut-simavr: interrupts were masked by code outside the ELF's code symbols \
+                 (an untrapped cli): interrupts-masked figures may be short"
+            );
+        }
         self.last_speed = Some((self.cycles() - start, wall.elapsed()));
         if outcome.is_fatal() {
             self.ended = Some(outcome);

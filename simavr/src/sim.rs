@@ -86,6 +86,8 @@ pub struct Sim {
     /// and its function ranges: where a jump to 0 is traced back to.
     pub(crate) code: Vec<u16>,
     pub(crate) code_ranges: Vec<(u32, u32)>,
+    /// `unseen_mask` was reported once.
+    pub(crate) warned_unseen_mask: bool,
 }
 
 impl Sim {
@@ -209,6 +211,7 @@ impl Sim {
             profile: None,
             code: Vec::new(),
             code_ranges: Vec::new(),
+            warned_unseen_mask: false,
         }
     }
 
