@@ -53,6 +53,9 @@ pub(crate) struct Shared {
     /// A batch saw the interrupts unmasked that began with them on and
     /// never saw them masked: code the traps missed masked them.
     pub unseen_mask: bool,
+    /// The I flag before the last SREG write (simavr has unpacked the new
+    /// value by the time the write hook runs).
+    i_on: bool,
 }
 
 /// simavr's IRQs the SD card slot reads and writes.
@@ -84,6 +87,7 @@ impl Shared {
             deadline_at: None,
             reset_at: None,
             unseen_mask: false,
+            i_on: false,
         }
     }
 
@@ -180,12 +184,16 @@ pub(crate) unsafe extern "C" fn on_bad_opcode(_irq: *mut avr_irq_t, _op: u32, pa
         .get(word / 64)
         .is_some_and(|w| w >> (word % 64) & 1 != 0)
     {
-        // `cli` as simavr runs it (`avr_sreg_set(avr, S_I, 0)`).
+        // `cli` as simavr runs it (`avr_sreg_set(avr, S_I, 0)`); the run
+        // loop must see it only if it masked the interrupts.
+        if (*avr).sreg[7] != 0 {
+            end_batch(avr);
+        }
         (*avr).sreg[7] = 0;
         (*avr).interrupt_state = 0;
         (*avr).pc = pc + 2;
         (*avr).state = simavr_ffi::cpu_StepDone as _;
-        end_batch(avr);
+        shared.i_on = false;
         return;
     }
     if pc == 0 && shared.zero_trap {
@@ -238,18 +246,20 @@ pub(crate) unsafe extern "C" fn on_sp_write(
     }
 }
 
-/// A write of SREG (simavr has stored and unpacked it already): the
-/// interrupts may just have been masked, which the run loop must see.
+/// A write of SREG (simavr has stored and unpacked it already): if it
+/// masked the interrupts, the run loop must see it.
 ///
 /// # Safety
-/// `avr` is the live avr_t.
+/// As `on_uart_tx`; `avr` is the live avr_t.
 pub(crate) unsafe extern "C" fn on_sreg_write(
     avr: *mut avr_t,
     _addr: simavr_ffi::avr_io_addr_t,
     v: u8,
-    _param: *mut c_void,
+    param: *mut c_void,
 ) {
-    if v & 0x80 == 0 {
+    let shared = &mut *(param as *mut Shared);
+    let was_on = std::mem::replace(&mut shared.i_on, v & 0x80 != 0);
+    if was_on && !shared.i_on {
         end_batch(avr);
     }
 }
@@ -294,6 +304,8 @@ pub(crate) unsafe extern "C" fn run(avr: *mut avr_t) {
     use simavr_ffi::{cpu_Crashed, cpu_Done, cpu_Running, cpu_Sleeping};
     let shared = (*avr).custom.data as *mut Shared;
     let state = |avr: *mut avr_t| (*avr).state as u32;
+    // The I flag changes within a batch only where the hooks see it.
+    (*shared).i_on = (*avr).sreg[7] != 0;
     if state(avr) == cpu_Running {
         let masked_before = (*avr).sreg[7] == 0;
         let pc = avr_run_one(avr);
