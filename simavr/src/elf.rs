@@ -77,3 +77,47 @@ pub fn function_address(path: &Path, part: &str) -> Result<Option<u32>, Error> {
         .find(|s| s.name().is_ok_and(|n| n.contains(part)))
         .map(|s| s.address() as u32))
 }
+
+/// The byte ranges of flash holding code (end exclusive): each code
+/// symbol's, to the next symbol when it has no size (the C runtime's
+/// labels). Constants in flash are data symbols and never inside one.
+pub(crate) fn code_ranges(path: &Path) -> Result<Vec<(u32, u32)>, Error> {
+    let bytes = std::fs::read(path).map_err(|e| Error::Io(path.to_owned(), e))?;
+    let file =
+        object::File::parse(&*bytes).map_err(|e| Error::Elf(format!("{}: {e}", path.display())))?;
+    let Some(text) = file.section_by_name(".text") else {
+        return Ok(Vec::new());
+    };
+    let text_end = (text.address() + text.size()) as u32;
+    let mut symbols: Vec<(u32, u32, bool)> = file
+        .symbols()
+        .filter(|s| s.section_index() == Some(text.index()))
+        .map(|s| {
+            // Functions, and the untyped labels of the C runtime's and
+            // libgcc's assembly (`__prologue_saves__`, `_exit`…); objects
+            // (constants in flash) only end the range before them.
+            let code = s.kind() != object::SymbolKind::Data;
+            (s.address() as u32, s.size() as u32, code)
+        })
+        .collect();
+    symbols.sort_unstable();
+    let mut ranges = Vec::new();
+    for (i, &(at, size, code)) in symbols.iter().enumerate() {
+        if !code {
+            continue;
+        }
+        let end = if size > 0 {
+            at + size
+        } else {
+            symbols[i + 1..]
+                .iter()
+                .map(|s| s.0)
+                .find(|&a| a > at)
+                .unwrap_or(text_end)
+        };
+        ranges.push((at, end.min(text_end)));
+    }
+    ranges.sort_unstable();
+    ranges.dedup();
+    Ok(ranges)
+}

@@ -32,6 +32,30 @@ pub(crate) struct Shared {
     pub sd: Slot,
     /// The slot's wires, once connected.
     spi: Option<SpiWires>,
+    /// A stack pointer write below this ends the batch, so the run sees
+    /// the new depth at the instruction boundary (the lowest seen so far).
+    pub sp_floor: u16,
+    /// Program counter and simavr cycle of the last stack pointer write.
+    pub last_sp_write: (u32, u64),
+    /// Cycles the core has slept.
+    pub asleep: u64,
+    /// Where the core was when simavr declared it crashed (a program
+    /// counter past the flash).
+    pub crash_pc: Option<u32>,
+    /// The `cli` instructions trapped: a bit per flash word.
+    pub cli_sites: Vec<u64>,
+    /// Address 0 holds a trap: reaching it (but from reset) is a crash.
+    pub zero_trap: bool,
+    /// simavr cycle the run loop's deadline timer is set for, while set.
+    pub deadline_at: Option<u64>,
+    /// simavr's cycle count when a timer (the watchdog's) reset the MCU.
+    pub reset_at: Option<u64>,
+    /// A batch saw the interrupts unmasked that began with them on and
+    /// never saw them masked: code the traps missed masked them.
+    pub unseen_mask: bool,
+    /// The I flag before the last SREG write (simavr has unpacked the new
+    /// value by the time the write hook runs).
+    i_on: bool,
 }
 
 /// simavr's IRQs the SD card slot reads and writes.
@@ -54,6 +78,16 @@ impl Shared {
             bad_opcode_pc: None,
             sd: Slot::default(),
             spi: None,
+            sp_floor: crate::elf::RAM_END,
+            last_sp_write: (0, 0),
+            asleep: 0,
+            crash_pc: None,
+            cli_sites: Vec::new(),
+            zero_trap: false,
+            deadline_at: None,
+            reset_at: None,
+            unseen_mask: false,
+            i_on: false,
         }
     }
 
@@ -71,6 +105,22 @@ impl Shared {
         // SAFETY: `avr` is valid while `Shared` is reachable (see module doc).
         self.cycle_base + unsafe { (*self.avr).cycle }
     }
+
+    /// Something the run loop must see happened: simavr finishes the
+    /// instruction under way and returns from `avr_run`.
+    fn end_batch(&mut self) {
+        // SAFETY: `avr` is valid while `Shared` is reachable (see module doc).
+        unsafe { end_batch(self.avr) }
+    }
+}
+
+/// Ends simavr's run of instructions after the current one: `avr_run_one`
+/// goes on only while its cycle budget exceeds the instruction's cycles.
+///
+/// # Safety
+/// `avr` is live.
+unsafe fn end_batch(avr: *mut avr_t) {
+    (*avr).run_cycle_count = 0;
 }
 
 /// Parameter of a pin callback: which probe of which `Shared`.
@@ -87,6 +137,7 @@ pub(crate) unsafe extern "C" fn on_pin(_irq: *mut avr_irq_t, value: u32, param: 
     let now = shared.now();
     shared.probes[hook.probe].record(now, value & 0xff != 0);
     shared.events += 1;
+    shared.end_batch();
 }
 
 /// # Safety
@@ -95,6 +146,7 @@ pub(crate) unsafe extern "C" fn on_uart_tx(_irq: *mut avr_irq_t, value: u32, par
     let shared = &mut *(param as *mut Shared);
     shared.uart.tx.push(value as u8);
     shared.events += 1;
+    shared.end_batch();
 }
 
 /// # Safety
@@ -104,6 +156,7 @@ pub(crate) unsafe extern "C" fn on_uart_xon(_irq: *mut avr_irq_t, value: u32, pa
     if value != 0 && !shared.uart.rx_ready {
         shared.uart.rx_ready = true;
         shared.events += 1;
+        shared.end_batch();
     }
 }
 
@@ -120,10 +173,174 @@ pub(crate) unsafe extern "C" fn on_uart_xoff(_irq: *mut avr_irq_t, value: u32, p
 /// As `on_uart_tx`.
 pub(crate) unsafe extern "C" fn on_bad_opcode(_irq: *mut avr_irq_t, _op: u32, param: *mut c_void) {
     let shared = &mut *(param as *mut Shared);
+    let avr = shared.avr;
+    let pc = (*avr).pc;
+    // simavr's decoder: a state other than running on return means the
+    // IRQ served the opcode (`cpu_StepDone`: resume at `avr->pc`); the
+    // instruction's one cycle is added after.
+    let word = pc as usize / 2;
+    if shared
+        .cli_sites
+        .get(word / 64)
+        .is_some_and(|w| w >> (word % 64) & 1 != 0)
+    {
+        // `cli` as simavr runs it (`avr_sreg_set(avr, S_I, 0)`); the run
+        // loop must see it only if it masked the interrupts.
+        if (*avr).sreg[7] != 0 {
+            end_batch(avr);
+        }
+        (*avr).sreg[7] = 0;
+        (*avr).interrupt_state = 0;
+        (*avr).pc = pc + 2;
+        (*avr).state = simavr_ffi::cpu_StepDone as _;
+        shared.i_on = false;
+        return;
+    }
+    if pc == 0 && shared.zero_trap {
+        // Execution reached the reset vector: stop there, the trap taking
+        // no cycle, as if the run had ended on the jump.
+        (*avr).cycle = (*avr).cycle.wrapping_sub(1);
+        (*avr).state = simavr_ffi::cpu_StepDone as _;
+        end_batch(avr);
+        return;
+    }
     if shared.bad_opcode_pc.is_none() {
-        shared.bad_opcode_pc = Some((*shared.avr).pc);
+        shared.bad_opcode_pc = Some(pc);
     }
     shared.events += 1;
+    end_batch(avr);
+}
+
+/// Stack pointer registers in data space.
+pub(crate) const SPL: usize = 0x5D;
+pub(crate) const SPH: usize = 0x5E;
+
+/// A write of SPL or SPH (pushes, pops, calls, returns, interrupt entries
+/// and the firmware's own `out`s all come here): stores it, notes where it
+/// happened, and ends the batch when the stack may be deeper than ever.
+///
+/// # Safety
+/// As `on_uart_tx`; `avr` is the live avr_t.
+pub(crate) unsafe extern "C" fn on_sp_write(
+    avr: *mut avr_t,
+    addr: simavr_ffi::avr_io_addr_t,
+    v: u8,
+    param: *mut c_void,
+) {
+    let shared = &mut *(param as *mut Shared);
+    let data = (*avr).data;
+    *data.add(usize::from(addr)) = v;
+    shared.last_sp_write = ((*avr).pc, (*avr).cycle);
+    // Between the two bytes of a 16-bit update this may be a value the
+    // stack never held; the run loop checks the real one after the
+    // instruction.
+    // (The byte just stored is not read back: a wider load over a fresh
+    // narrow store stalls the host for longer than the rest of this.)
+    let sp = if usize::from(addr) == SPL {
+        u16::from_le_bytes([v, *data.add(SPH)])
+    } else {
+        u16::from_le_bytes([*data.add(SPL), v])
+    };
+    if sp < shared.sp_floor {
+        end_batch(avr);
+    }
+}
+
+/// A write of SREG (simavr has stored and unpacked it already): if it
+/// masked the interrupts, the run loop must see it.
+///
+/// # Safety
+/// As `on_uart_tx`; `avr` is the live avr_t.
+pub(crate) unsafe extern "C" fn on_sreg_write(
+    avr: *mut avr_t,
+    _addr: simavr_ffi::avr_io_addr_t,
+    v: u8,
+    param: *mut c_void,
+) {
+    let shared = &mut *(param as *mut Shared);
+    let was_on = std::mem::replace(&mut shared.i_on, v & 0x80 != 0);
+    if was_on && !shared.i_on {
+        end_batch(avr);
+    }
+}
+
+/// The run loop's own deadline: a cycle timer, so simavr ends its run of
+/// instructions on the first boundary at or past it, as it does for the
+/// MCU's timers. It does nothing when it fires.
+///
+/// # Safety
+/// As `on_uart_tx`.
+unsafe extern "C" fn deadline(
+    _avr: *mut avr_t,
+    _when: simavr_ffi::avr_cycle_count_t,
+    param: *mut c_void,
+) -> simavr_ffi::avr_cycle_count_t {
+    (*(param as *mut Shared)).deadline_at = None;
+    0
+}
+
+/// The one pointer to `deadline` that registers and cancels it: simavr
+/// finds a timer by its function's address, and Rust does not promise one
+/// address per function.
+pub(crate) static DEADLINE: simavr_ffi::avr_cycle_timer_t = Some(deadline);
+
+extern "C" {
+    /// simavr's decoder (sim_core.h, left out of the bindings): runs
+    /// instructions from `avr->pc` while `run_cycle_count` lasts and no
+    /// interrupt is due; returns the next program counter.
+    fn avr_run_one(avr: *mut avr_t) -> simavr_ffi::avr_flashaddr_t;
+}
+
+/// `avr->run`: simavr's `avr_callback_run_raw` (a run of instructions,
+/// the cycle timers, a sleep stretch to the next timer, interrupt entry),
+/// besides noting the cycles slept and where a crash happened, and taking
+/// the run loop's deadline out of the timers before a sleep so the stretch
+/// ends where it would without it.
+///
+/// # Safety
+/// Called by `avr_run` on a live avr_t whose `custom.data` is its `Shared`
+/// (module invariants).
+pub(crate) unsafe extern "C" fn run(avr: *mut avr_t) {
+    use simavr_ffi::{cpu_Crashed, cpu_Done, cpu_Running, cpu_Sleeping};
+    let shared = (*avr).custom.data as *mut Shared;
+    let state = |avr: *mut avr_t| (*avr).state as u32;
+    // The I flag changes within a batch only where the hooks see it.
+    (*shared).i_on = (*avr).sreg[7] != 0;
+    if state(avr) == cpu_Running {
+        let masked_before = (*avr).sreg[7] == 0;
+        let pc = avr_run_one(avr);
+        // simavr stops right after the I flag rises (`interrupt_state` < 0);
+        // every way it can fall ends the batch too, so a rise in a batch
+        // that began unmasked means a fall went unseen.
+        if !masked_before && (*avr).interrupt_state < 0 {
+            (*shared).unseen_mask = true;
+        }
+        if state(avr) == cpu_Crashed {
+            (*shared).crash_pc = Some((*avr).pc);
+        }
+        (*avr).pc = pc;
+    }
+    if state(avr) == cpu_Sleeping {
+        simavr_ffi::avr_cycle_timer_cancel(avr, DEADLINE, shared as *mut c_void);
+        (*shared).deadline_at = None;
+    }
+    let before = (*avr).cycle;
+    let sleep = simavr_ffi::avr_cycle_timer_process(avr);
+    if (*avr).cycle < before {
+        (*shared).reset_at = Some(before);
+    }
+    if state(avr) == cpu_Sleeping {
+        if (*avr).sreg[7] == 0 {
+            (*avr).state = cpu_Done as _;
+            return;
+        }
+        (*avr).cycle += 1 + sleep;
+        (*shared).asleep += 1 + sleep;
+    }
+    let awake_or_asleep = state(avr) == cpu_Running || state(avr) == cpu_Sleeping;
+    if awake_or_asleep && (*avr).interrupt_state != 0 {
+        simavr_ffi::avr_service_interrupts(avr);
+    }
 }
 
 /// A byte the MCU clocked out through SPDR: the card in the slot (if any)

@@ -13,6 +13,8 @@ pub(crate) struct MaskedSpans {
     totals: Vec<(u32, u64, u64)>,
     /// Interrupts were enabled once: start-up (masked from reset) is over.
     started: bool,
+    /// Start address -> its index in `longest` and `totals` (the same).
+    index: std::collections::HashMap<u32, usize>,
 }
 
 impl MaskedSpans {
@@ -27,16 +29,18 @@ impl MaskedSpans {
             (Some((start, at)), true) => {
                 self.open = None;
                 let len = cycle - start;
-                match self.longest.iter_mut().find(|(_, p)| *p == at) {
-                    Some(e) => e.0 = e.0.max(len),
-                    None => self.longest.push((len, at)),
-                }
-                match self.totals.iter_mut().find(|(p, _, _)| *p == at) {
-                    Some(t) => {
+                match self.index.get(&at) {
+                    Some(&i) => {
+                        let (e, t) = (&mut self.longest[i], &mut self.totals[i]);
+                        e.0 = e.0.max(len);
                         t.1 += 1;
                         t.2 += len;
                     }
-                    None => self.totals.push((at, 1, len)),
+                    None => {
+                        self.index.insert(at, self.longest.len());
+                        self.longest.push((len, at));
+                        self.totals.push((at, 1, len));
+                    }
                 }
             }
             _ => {}

@@ -1,11 +1,24 @@
-//! Running the MCU: one instruction at a time, watching after each for a
-//! crash, a hang, a watchdog reset and the stack crossing into the statics,
-//! and applying the outside world's inputs when they fall due.
+//! Running the MCU: watching for a crash, a hang, a watchdog reset and the
+//! stack crossing into the statics, timing the interrupts-masked spans, and
+//! applying the outside world's inputs when they fall due.
+//!
+//! simavr runs the instructions in batches (its own loop, up to the next
+//! cycle timer): the run loop's deadlines (the next input, the next poll,
+//! the end) are a cycle timer too, and every change the loop must see at
+//! the instruction boundary where it happens ends the batch there — a pin
+//! edge or UART byte (callbacks), the stack pointer going below its lowest
+//! (its register writes), the I flag going off (SREG writes, interrupt
+//! entry, and each `cli`, trapped: see `traps`) or on (simavr stops for
+//! that itself), an invalid opcode, reaching address 0 (trapped), sleep.
+//! So every figure is what instruction-by-instruction watching gives.
+//! Watches of program addresses, call timing and the profile need every
+//! instruction: with any of them on, it runs one instruction at a time.
 
 use crate::clock::cycles_in;
 use crate::outcome::Outcome;
 use crate::serial::{self, CYCLES_PER_BYTE};
 use crate::sim::{Core, Executed, Sim};
+use crate::traps::ZeroOrigin;
 use std::time::{Duration, Instant};
 
 /// A predicate is checked after anything a callback reported, and at least
@@ -42,6 +55,8 @@ impl Sim {
         let start = self.cycles();
         let deadline = start + timeout;
         let wall = Instant::now();
+        let batched =
+            self.profile.is_none() && self.pc_watches.is_empty() && self.call_watches.is_empty();
         let mut next_poll = start;
         let mut seen_events = None;
         let mut next_input = 0;
@@ -62,10 +77,19 @@ impl Sim {
             if now >= deadline {
                 break Outcome::Running;
             }
-            if let Some(end) = self.step() {
+            let budget = batched.then(|| next_input.min(next_poll).min(deadline) - now);
+            if let Some(end) = self.step(budget) {
                 break end;
             }
         };
+        self.clear_deadline();
+        if std::mem::take(&mut self.shared_mut().unseen_mask) && !self.warned_unseen_mask {
+            self.warned_unseen_mask = true;
+            eprintln!(
+                "taut-simavr: interrupts were masked by code outside the ELF's code symbols \
+                 (an untrapped cli): interrupts-masked figures may be short"
+            );
+        }
         self.last_speed = Some((self.cycles() - start, wall.elapsed()));
         if outcome.is_fatal() {
             self.ended = Some(outcome);
@@ -113,24 +137,25 @@ impl Sim {
         next
     }
 
-    /// Executes one instruction (or one sleep stretch) and says whether it
-    /// ended the run.
-    fn step(&mut self) -> Option<Outcome> {
+    /// Executes one instruction, or a batch of them for at most `budget`
+    /// cycles, or one sleep stretch, and says whether it ended the run.
+    fn step(&mut self, budget: Option<u64>) -> Option<Outcome> {
         let Executed {
             pc_before,
             pc,
             avr_cycle: cycle,
             interrupts_on,
             core,
-            was_asleep,
-        } = self.execute();
+        } = self.execute(budget);
         if cycle < self.last_avr_cycle {
             // Only a reset sets simavr's counter back, and in a run only the
             // watchdog resets.
-            let before = self.last_avr_cycle;
+            let last = self.last_avr_cycle;
             let shared = self.shared_mut();
-            shared.cycle_base += before;
+            shared.cycle_base += shared.reset_at.take().unwrap_or(last);
             shared.uart.rx_ready = false;
+            // The reset emptied simavr's timers.
+            shared.deadline_at = None;
             self.last_avr_cycle = cycle;
             self.resets += 1;
             return Some(Outcome::WatchdogReset { count: self.resets });
@@ -138,14 +163,6 @@ impl Sim {
         if let Some(profile) = &mut self.profile {
             profile.add(pc_before, cycle - self.last_avr_cycle);
         }
-        // simavr sleeps in the same call that runs `sleep` (1 cycle), and in
-        // every call after until an interrupt wakes the core.
-        let spent = cycle - self.last_avr_cycle;
-        self.asleep += match (was_asleep, core) {
-            (true, _) => spent,
-            (false, Core::Sleeping) => spent.saturating_sub(1),
-            _ => 0,
-        };
         self.last_avr_cycle = cycle;
         let now = self.shared().cycle_base + cycle;
         self.masked.observe(now, pc, interrupts_on);
@@ -155,15 +172,31 @@ impl Sim {
             }
         }
         match core {
-            Core::Crashed => return Some(Outcome::Crashed { pc: pc_before }),
-            Core::Hung => return Some(Outcome::Hung { pc: pc_before }),
+            Core::Crashed => {
+                let at = self.shared().crash_pc.unwrap_or(pc_before);
+                return Some(Outcome::Crashed { pc: at });
+            }
+            // The `sleep` (one word) that found the interrupts masked.
+            Core::Hung => return Some(Outcome::Hung { pc: pc - 2 }),
             Core::Running | Core::Sleeping => {}
         }
         if let Some(pc) = self.shared().bad_opcode_pc {
             return Some(Outcome::Crashed { pc });
         }
         if pc == 0 {
-            return Some(Outcome::Crashed { pc: pc_before });
+            let from = match budget {
+                None => pc_before,
+                Some(_) => ZeroOrigin {
+                    flash: &self.code,
+                    ranges: &self.code_ranges,
+                    last_sp_write: self.shared().last_sp_write,
+                    arrived: cycle,
+                    z: self.z(),
+                }
+                .find()
+                .unwrap_or(pc_before),
+            };
+            return Some(Outcome::Crashed { pc: from });
         }
         let sp = self.sp();
         for w in &mut self.call_watches {
@@ -172,6 +205,7 @@ impl Sim {
         if sp < self.min_sp {
             self.min_sp = sp;
             self.min_sp_pc = pc;
+            self.shared_mut().sp_floor = sp;
             // The last push wrote at sp + 1.
             if u32::from(sp) + 1 < u32::from(self.ram_limit) {
                 return Some(Outcome::StackOverflow {

@@ -38,9 +38,9 @@ extern "C" {
     fn free(ptr: *mut c_void);
 }
 
-/// Stack pointer registers in data space.
-const SPL: usize = 0x5D;
-const SPH: usize = 0x5E;
+use crate::hooks::{SPH, SPL};
+/// SREG in data space.
+const SREG: u16 = 0x5F;
 
 /// The number simavr builds an ioctl code from four characters with.
 /// EEPROM bytes of the ATmega2560.
@@ -78,14 +78,18 @@ pub struct Sim {
     pub(crate) last_speed: Option<(u64, Duration)>,
     /// Interrupts-masked spans: the open one, and the longest so far.
     pub(crate) masked: MaskedSpans,
-    /// Cycles the core has slept.
-    pub(crate) asleep: u64,
     /// Functions whose runs are timed ([`Sim::watch_calls`]).
     pub(crate) call_watches: Vec<crate::calls::CallWatch>,
     /// Cycles per program word, when asked for ([`Sim::enable_profile`]).
     pub(crate) profile: Option<crate::profile::Profile>,
     /// EEPROM byte writes, when watched (`power`).
     pub(crate) eeprom_watch: Option<Box<crate::power::EepromWatch>>,
+    /// The code as loaded (flash words from address 0, before any trap)
+    /// and its function ranges: where a jump to 0 is traced back to.
+    pub(crate) code: Vec<u16>,
+    pub(crate) code_ranges: Vec<(u32, u32)>,
+    /// `unseen_mask` was reported once.
+    pub(crate) warned_unseen_mask: bool,
 }
 
 impl Sim {
@@ -107,7 +111,10 @@ impl Sim {
         let avr = new_mcu()?;
         // SAFETY: `avr` is initialised; `firmware` was filled by simavr.
         unsafe { ffi::avr_load_firmware(avr.as_ptr(), &mut firmware) };
-        Ok(Sim::attach(avr, Some(info), info.static_ram_end))
+        let ranges = elf::code_ranges(elf_path)?;
+        let mut sim = Sim::attach(avr, Some(info), info.static_ram_end);
+        sim.set_traps(ranges);
+        Ok(sim)
     }
 
     /// Loads raw machine code (little-endian 16-bit words) at address 0, for
@@ -125,7 +132,9 @@ impl Sim {
         }
         // SAFETY: simavr copies `bytes.len()` bytes, which fit in flash.
         unsafe { ffi::avr_loadcode(avr.as_ptr(), bytes.as_mut_ptr(), bytes.len() as u32, 0) };
-        Ok(Sim::attach(avr, None, RAM_START))
+        let mut sim = Sim::attach(avr, None, RAM_START);
+        sim.set_traps(vec![(0, bytes.len() as u32)]);
+        Ok(sim)
     }
 
     /// Wires the harness into an initialised MCU with its code loaded.
@@ -170,7 +179,15 @@ impl Sim {
             );
             let bad = ffi::avr_get_core_irq(a, ffi::AVR_CORE_BAD_OPCODE as i32);
             ffi::avr_irq_register_notify(bad, Some(hooks::on_bad_opcode), param);
-            uart(ffi::UART_IRQ_INPUT)
+            // Batched runs: simavr's run loop, and the register writes
+            // that end a batch where the run loop must look.
+            ffi::avr_register_io_write(a, SPL as u16, Some(hooks::on_sp_write), param);
+            ffi::avr_register_io_write(a, SPH as u16, Some(hooks::on_sp_write), param);
+            ffi::avr_register_io_write(a, SREG, Some(hooks::on_sreg_write), param);
+            let input = uart(ffi::UART_IRQ_INPUT);
+            (*a).custom.data = param;
+            (*a).run = Some(hooks::run);
+            input
         };
         Sim {
             avr,
@@ -192,10 +209,67 @@ impl Sim {
             step_dir: Vec::new(),
             last_speed: None,
             masked: MaskedSpans::default(),
-            asleep: 0,
             call_watches: Vec::new(),
             profile: None,
             eeprom_watch: None,
+            code: Vec::new(),
+            code_ranges: Vec::new(),
+            warned_unseen_mask: false,
+        }
+    }
+
+    /// Puts the traps of `traps` into the loaded code: on every `cli` in
+    /// `ranges` (byte ranges of code) and on the reset vector.
+    fn set_traps(&mut self, mut ranges: Vec<(u32, u32)>) {
+        let avr = self.avr.as_ptr();
+        // SAFETY: `avr` is live; `flash` holds `flashend + 1` bytes and
+        // every index below is kept under that.
+        unsafe {
+            let flash_bytes = (*avr).flashend + 1;
+            for r in &mut ranges {
+                r.1 = r.1.min(flash_bytes) & !1;
+                r.0 = r.0.min(r.1);
+            }
+            let end = ranges.iter().map(|r| r.1).max().unwrap_or(0);
+            let flash = (*avr).flash;
+            self.code = (0..end as usize / 2)
+                .map(|i| u16::from_le_bytes([*flash.add(2 * i), *flash.add(2 * i + 1)]))
+                .collect();
+            let mut sites: Vec<u32> = ranges
+                .iter()
+                .flat_map(|&(a, b)| {
+                    crate::traps::cli_sites(&self.code[a as usize / 2..b as usize / 2], a)
+                })
+                .collect();
+            sites.sort_unstable();
+            sites.dedup();
+            for &at in &sites {
+                self.write_flash_word(at, crate::traps::TRAP);
+            }
+            let has_code = !self.code.is_empty();
+            if has_code {
+                self.write_flash_word(0, crate::traps::TRAP);
+            }
+            let mut bits = vec![0u64; self.code.len().div_ceil(64)];
+            for &at in &sites {
+                let word = at as usize / 2;
+                bits[word / 64] |= 1 << (word % 64);
+            }
+            let shared = self.shared_mut();
+            shared.cli_sites = bits;
+            shared.zero_trap = has_code;
+        }
+        self.code_ranges = ranges;
+    }
+
+    fn write_flash_word(&mut self, at: u32, word: u16) {
+        let avr = self.avr.as_ptr();
+        // SAFETY: callers pass addresses inside the loaded code, which is
+        // inside the flash.
+        unsafe {
+            let [lo, hi] = word.to_le_bytes();
+            *(*avr).flash.add(at as usize) = lo;
+            *(*avr).flash.add(at as usize + 1) = hi;
         }
     }
 
@@ -292,7 +366,7 @@ impl Sim {
     /// Cycles the MCU has spent asleep (waiting for an interrupt) since
     /// power-on: the rest of [`Sim::cycles`] it was awake.
     pub fn asleep_cycles(&self) -> u64 {
-        self.asleep
+        self.shared().asleep
     }
 
     /// Time every run of the function at byte address `pc` from now on (a
@@ -310,7 +384,7 @@ impl Sim {
             .map_or(&[], |w| &w.runs)
     }
 
-    /// Lowest stack pointer seen, an address (checked after every
+    /// Lowest stack pointer seen, an address (as it stood after any
     /// instruction); `peak_stack_bytes` says how deep that is.
     pub fn lowest_sp(&self) -> u16 {
         self.min_sp
@@ -360,7 +434,7 @@ impl Sim {
 
 /// What one `avr_run` did.
 pub(crate) struct Executed {
-    /// Byte address of the instruction that ran.
+    /// Byte address of the (first) instruction that ran.
     pub pc_before: u32,
     /// Byte address of the next one.
     pub pc: u32,
@@ -369,8 +443,6 @@ pub(crate) struct Executed {
     /// The I flag afterwards.
     pub interrupts_on: bool,
     pub core: Core,
-    /// The core was asleep when the step began: its cycles were slept.
-    pub was_asleep: bool,
 }
 
 /// The core's state as simavr left it.
@@ -387,18 +459,43 @@ pub(crate) enum Core {
 /// The wires between simavr and the outside world: pins, USART0's input,
 /// the SD card slot on the SPI bus.
 impl Sim {
-    /// Executes one instruction (or one sleep stretch).
-    pub(crate) fn execute(&mut self) -> Executed {
+    /// Executes one instruction (or one sleep stretch) when `budget` is
+    /// None; else instructions until `budget` cycles have run (ending on the
+    /// first instruction boundary at or past it), something a callback
+    /// reports happens, the interrupts are masked or unmasked, an
+    /// interrupt is entered or the core sleeps (then the sleep stretch).
+    pub(crate) fn execute(&mut self, budget: Option<u64>) -> Executed {
         let avr = self.avr.as_ptr();
+        let shared = self.shared.as_ptr() as *mut c_void;
+        // From reset the reset vector runs as loaded, one instruction.
+        // SAFETY: `avr` is live (invariants); no callback runs here.
+        let from_reset = unsafe { (*avr).pc == 0 && (*avr).cycle == 0 } && !self.code.is_empty();
+        if from_reset {
+            self.write_flash_word(0, self.code[0]);
+        }
+        // SAFETY: as above; the deadline timer's param is our `Shared`,
+        // which outlives the avr_t.
+        unsafe {
+            match budget {
+                Some(cycles) if !from_reset => {
+                    (*avr).run_cycle_limit = u64::MAX;
+                    if (*avr).state == ffi::cpu_Running as std::os::raw::c_int {
+                        ffi::avr_cycle_timer_register(avr, cycles.max(1), hooks::DEADLINE, shared);
+                    }
+                }
+                _ => {
+                    (*avr).run_cycle_limit = 1;
+                    (*avr).run_cycle_count = 1;
+                }
+            }
+        }
         // SAFETY: `avr` is live (invariants); callbacks it triggers only
         // touch `Shared`, and no reference into it is held here. `sreg` is
         // simavr's unpacked status register.
-        let (was_asleep, pc_before, state, pc, avr_cycle, interrupts_on) = unsafe {
-            let was_asleep = (*avr).state == ffi::cpu_Sleeping as std::os::raw::c_int;
+        let (pc_before, state, pc, avr_cycle, interrupts_on) = unsafe {
             let pc_before = (*avr).pc;
             let state = ffi::avr_run(avr) as u32;
             (
-                was_asleep,
                 pc_before,
                 state,
                 (*avr).pc,
@@ -406,6 +503,9 @@ impl Sim {
                 (*avr).sreg[7] != 0,
             )
         };
+        if from_reset {
+            self.write_flash_word(0, crate::traps::TRAP);
+        }
         let core = match state {
             ffi::cpu_Crashed => Core::Crashed,
             ffi::cpu_Done => Core::Hung,
@@ -413,12 +513,33 @@ impl Sim {
             _ => Core::Running,
         };
         Executed {
-            was_asleep,
             pc_before,
             pc,
             avr_cycle,
             interrupts_on,
             core,
+        }
+    }
+
+    /// Takes the run loop's deadline out of simavr's timers.
+    pub(crate) fn clear_deadline(&mut self) {
+        // SAFETY: live avr_t; cancelling a timer that is not there is a
+        // no-op.
+        unsafe {
+            ffi::avr_cycle_timer_cancel(
+                self.avr.as_ptr(),
+                hooks::DEADLINE,
+                self.shared.as_ptr() as *mut c_void,
+            )
+        };
+    }
+
+    /// Z and EIND, as a 24-bit word address.
+    pub(crate) fn z(&self) -> u32 {
+        // SAFETY: `data` holds `ramend + 1` bytes, far above 0x5C.
+        unsafe {
+            let data = (*self.avr.as_ptr()).data;
+            u32::from_le_bytes([*data.add(30), *data.add(31), *data.add(0x5C), 0])
         }
     }
 

@@ -260,3 +260,52 @@ fn cycles_asleep_are_counted_apart() {
         sim.cycles()
     );
 }
+
+/// Pushes, calls and critical sections (`in SREG; cli; …; out SREG` and
+/// `cli; …; sei`) forever.
+const MASKING_LOOP: [u16; 17] = [
+    0xE000, // ldi r16, 0
+    0x9478, // sei
+    0x930F, // loop: push r16
+    0x910F, // pop r16
+    0xB60F, // in r0, SREG
+    CLI,    // masked from byte 12
+    0x0000, // nop
+    0x0000, // nop
+    0xBE0F, // out SREG, r0
+    0xD001, // rcall f
+    0xCFF7, // rjmp loop
+    0x930F, // f: push r16
+    CLI,    // masked from byte 26
+    0x0000, // nop
+    0x9478, // sei
+    0x910F, // pop r16
+    0x9508, // ret
+];
+
+#[test]
+fn batched_runs_see_what_single_instructions_see() {
+    let run = |single: bool| {
+        let mut sim = Sim::from_program(&MASKING_LOOP).unwrap();
+        if single {
+            // Any address watch runs one instruction at a time.
+            sim.watch_pc(0x3_FFFE);
+        }
+        let end = sim.run_for(ms(1));
+        (
+            end,
+            sim.cycles(),
+            sim.lowest_sp(),
+            sim.peak_stack_pc(),
+            sim.masked_spans(),
+            sim.masked_stats(12),
+        )
+    };
+    let batched = run(false);
+    assert_eq!(batched, run(true));
+    let spans = &batched.4;
+    assert_eq!(spans.len(), 2, "{spans:?}");
+    assert!(spans.iter().any(|s| s.1 == 12) && spans.iter().any(|s| s.1 == 26));
+    // in, cli, nop, nop, out: masked from after the cli to after the out.
+    assert_eq!(batched.5.map(|s| s.2), Some(3));
+}
