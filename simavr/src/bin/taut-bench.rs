@@ -472,10 +472,14 @@ fn status_report_latency_us(elf: &Path, card: &Path) -> (f64, f64) {
 /// Lines of 1 mm moves at the maximum feed answered per second when
 /// streamed by character counting (each line sent once it fits beside
 /// the unanswered bytes in Grbl's 128), from the 100th answer to the
-/// 300th; beside it the UART's bound (115 200 baud, 10 bits a byte) and
-/// the motion's (the firmware's planner timing the same lines on the
-/// host, `GcodeTime`): the smallest of the three bounds is the limit.
-fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64) {
+/// 300th; beside it the UART's bound (115 200 baud, 10 bits a byte), the
+/// host estimate's (`GcodeTime`: the same planner, handing a block on
+/// only when full, so its look-ahead is a block or two deeper than the
+/// machine's, whose preparer holds the running ones) and the share of
+/// `?` reports (one per 50 ms) with the planner full (`Bf:0,…`): a full
+/// planner means the lines wait for the planner, not for the UART or
+/// the firmware's reading of them.
+fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64, f64) {
     let mut sim = boot(elf);
     for line in ["M17", "G0 X-200", "G91"] {
         send(&mut sim, line, Duration::from_millis(100));
@@ -494,12 +498,16 @@ fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64) {
     let uart_bound = 11_520.0 / line_bytes as f64;
     let start = sim.uart_bytes().len();
     let (mut next, mut answered, mut in_flight) = (0, 0, std::collections::VecDeque::new());
-    let mut t100 = 0.0;
+    let (mut t100, mut t300, mut polls) = (0.0, 0.0, 0);
     while answered < 300 {
         while next < lines.len() && in_flight.iter().sum::<usize>() + line_bytes < 128 {
             sim.uart_send(format!("{}\n", lines[next]).as_bytes());
             in_flight.push_back(line_bytes);
             next += 1;
+        }
+        polls += 1;
+        if answered >= 100 && polls % 100 == 0 {
+            sim.uart_send(b"?");
         }
         assert_eq!(sim.run_for(Duration::from_micros(500)), Outcome::Running);
         let now = sim.uart_text_from(start).matches("ok\n").count();
@@ -509,10 +517,21 @@ fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64) {
         if answered < 100 && now >= 100 {
             t100 = sim.time_s();
         }
+        if answered < 300 && now >= 300 {
+            t300 = sim.time_s();
+        }
         answered = now;
         assert!(sim.time_s() < 120.0, "the stream stalled");
     }
-    (200.0 / (sim.time_s() - t100), uart_bound, motion_bound)
+    let text = sim.uart_text_from(start);
+    let reports: Vec<&str> = text.lines().filter(|l| l.starts_with('<')).collect();
+    let full = reports.iter().filter(|r| r.contains("|Bf:0,")).count();
+    (
+        200.0 / (t300 - t100),
+        uart_bound,
+        motion_bound,
+        full as f64 / reports.len().max(1) as f64,
+    )
 }
 
 fn main() {
@@ -558,20 +577,24 @@ fn main() {
     let (worst, p90) = status_report_latency_us(fw, &card);
     f.insert("status_report_latency_us".into(), json!(round(worst, 1)));
     f.insert("status_report_latency_p90_us".into(), json!(round(p90, 1)));
-    let (rate, uart, motion) = stream_lines_per_s(fw);
+    let (rate, uart, motion, planner_full) = stream_lines_per_s(fw);
     f.insert("stream_lines_per_s".into(), json!(round(rate, 1)));
     f.insert(
         "stream_uart_bound_lines_per_s".into(),
         json!(round(uart, 1)),
     );
     f.insert(
-        "stream_motion_bound_lines_per_s".into(),
+        "stream_estimate_lines_per_s".into(),
         json!(round(motion, 1)),
     );
+    f.insert(
+        "stream_planner_full_percent".into(),
+        json!(round(100.0 * planner_full, 1)),
+    );
     let limit = match rate {
-        r if r >= 0.9 * motion => "motion (the planner's own timing)",
+        _ if planner_full >= 0.9 => "planner (full while the lines wait)",
         r if r >= 0.9 * uart => "uart",
-        _ => "firmware line intake (below both bounds)",
+        _ => "firmware line intake (planner not full, uart not busy)",
     };
     f.insert("stream_limit".into(), json!(limit));
     // A real-time `?` also interrupts a line in flight: the console sees
