@@ -475,11 +475,12 @@ fn status_report_latency_us(elf: &Path, card: &Path) -> (f64, f64) {
 /// 300th; beside it the UART's bound (115 200 baud, 10 bits a byte), the
 /// host estimate's (`GcodeTime`: the same planner, handing a block on
 /// only when full, so its look-ahead is a block or two deeper than the
-/// machine's, whose preparer holds the running ones) and the share of
-/// `?` reports (one per 50 ms) with the planner full (`Bf:0,…`): a full
-/// planner means the lines wait for the planner, not for the UART or
-/// the firmware's reading of them.
-fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64, f64) {
+/// machine's, whose preparer holds the running ones), and from `?`
+/// reports (one per 50 ms) the planner's mean free blocks and whether a
+/// whole line always waited in the receive buffer (`Bf:<blocks>,<bytes>`):
+/// lines waiting beside a planner with less than a block free on average
+/// mean the planner is the limit, not the UART or the reading of lines.
+fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64, f64, bool) {
     let mut sim = boot(elf);
     for line in ["M17", "G0 X-200", "G91"] {
         send(&mut sim, line, Duration::from_millis(100));
@@ -525,12 +526,22 @@ fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64, f64) {
     }
     let text = sim.uart_text_from(start);
     let reports: Vec<&str> = text.lines().filter(|l| l.starts_with('<')).collect();
-    let full = reports.iter().filter(|r| r.contains("|Bf:0,")).count();
+    let bf: Vec<(f64, usize)> = reports
+        .iter()
+        .filter_map(|r| {
+            let f = r.split("|Bf:").nth(1)?.split('|').next()?;
+            let (blocks, bytes) = f.split_once(',')?;
+            Some((blocks.parse().ok()?, bytes.parse().ok()?))
+        })
+        .collect();
+    let free = bf.iter().map(|b| b.0).sum::<f64>() / bf.len().max(1) as f64;
+    let waiting = bf.iter().all(|&(_, rx_free)| rx_free + line_bytes <= 128);
     (
         200.0 / (t300 - t100),
         uart_bound,
         motion_bound,
-        full as f64 / reports.len().max(1) as f64,
+        free,
+        waiting,
     )
 }
 
@@ -577,7 +588,7 @@ fn main() {
     let (worst, p90) = status_report_latency_us(fw, &card);
     f.insert("status_report_latency_us".into(), json!(round(worst, 1)));
     f.insert("status_report_latency_p90_us".into(), json!(round(p90, 1)));
-    let (rate, uart, motion, planner_full) = stream_lines_per_s(fw);
+    let (rate, uart, motion, free, waiting) = stream_lines_per_s(fw);
     f.insert("stream_lines_per_s".into(), json!(round(rate, 1)));
     f.insert(
         "stream_uart_bound_lines_per_s".into(),
@@ -588,13 +599,14 @@ fn main() {
         json!(round(motion, 1)),
     );
     f.insert(
-        "stream_planner_full_percent".into(),
-        json!(round(100.0 * planner_full, 1)),
+        "stream_planner_free_blocks_mean".into(),
+        json!(round(free, 2)),
     );
+    f.insert("stream_lines_always_waiting".into(), json!(waiting));
     let limit = match rate {
-        _ if planner_full >= 0.9 => "planner (full while the lines wait)",
+        _ if waiting && free < 1.0 => "planner (lines wait for its room)",
         r if r >= 0.9 * uart => "uart",
-        _ => "firmware line intake (planner not full, uart not busy)",
+        _ => "firmware line intake (planner has room, uart not busy)",
     };
     f.insert("stream_limit".into(), json!(limit));
     // A real-time `?` also interrupts a line in flight: the console sees

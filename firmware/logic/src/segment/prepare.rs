@@ -11,7 +11,7 @@
 //! - lag carried from the previous segment ≤ 66; the interrupt's tick
 //!   truncation < 256.
 
-use super::trapezoid::{cbrt_floor_approx, Phase, Speeds, Trapezoid};
+use super::trapezoid::{cbrt_floor_approx, div_to_u32, Phase, Speeds, Trapezoid};
 use super::{Segment, NEW_BLOCK, STOP, SUBTICKS_PER_S as Q};
 use crate::units::div_round;
 
@@ -218,13 +218,20 @@ impl Preparer {
         if v == 0 {
             return 1;
         }
-        // A cube root within 26 % below the true one: segments at most that
-        // much shorter than the error budget allows, for 1/20 of the cost.
-        let c = cbrt_floor_approx(to_stop);
+        // v / 40 from below (1638 / 2^16 < 1/40), without a division.
+        const _: () = assert!(MAX_SEGMENT_PER_S == 40);
+        let v = v.min(1 << 20);
+        let most = ((v * 1638) >> 16).min(MAX_RAMP_EVENTS);
+        // d ≤ 43·∛τ², in events: d·v / Q with Q = 125 000·2^15. A cube
+        // root within 26 % below the true one: segments at most that much
+        // shorter than the error budget allows, for 1/20 of the cost. Past
+        // 2^15 (τ over two hours) `most` is the bound anyway.
+        let c = cbrt_floor_approx(to_stop).min(1 << 15);
         let duration = FIT_GAIN * c * c;
-        let n = duration / (Q / v);
-        n.min(v / MAX_SEGMENT_PER_S)
-            .clamp(1, MAX_RAMP_EVENTS as u64) as u32
+        // Below 2^36·2^20 / 2^15: a 32-bit quotient (a general u64
+        // division is ~3 000 cycles).
+        let n = div_to_u32((duration * v as u64) >> 15, 125_000);
+        n.min(most).max(1)
     }
 
     /// Sub-ticks from the last placed event to the ideal time of `k`.
@@ -248,18 +255,33 @@ impl Preparer {
             n &= !1;
             let (m, ni) = (n / 2, n as i64);
             let (ym, yn) = (self.ahead(k0 + m), self.ahead(k0 + n));
-            let add = div_round(4 * (yn - 2 * ym), ni * ni);
-            let interval = div_round(yn - add * ni * (ni - 1) / 2, ni);
-            let last = interval + add * (ni - 1);
-            let fits = i32::try_from(add).is_ok()
-                && interval.min(last) >= 1
-                && interval.max(last) <= u32::MAX as i64;
-            if fits {
-                return segment(interval, n, add as i32);
+            let fitted = round_div32(4 * (yn - 2 * ym), n * n).and_then(|add| {
+                let interval = round_div32(yn - add * ni * (ni - 1) / 2, n)?;
+                let last = interval + add * (ni - 1);
+                let fits = i32::try_from(add).is_ok()
+                    && interval.min(last) >= 1
+                    && interval.max(last) <= u32::MAX as i64;
+                fits.then(|| segment(interval, n, add as i32))
+            });
+            if let Some(seg) = fitted {
+                return seg;
             }
             n /= 2;
         }
     }
+}
+
+/// `n / d` rounded half away from zero, when its magnitude fits 32 bits
+/// (a segment's `add` and `interval` must): one narrow division, a fifth
+/// of a general `i64` one on the AVR. `None` when it does not fit.
+fn round_div32(n: i64, d: u32) -> Option<i64> {
+    let half = (d / 2) as u64;
+    let m = n.unsigned_abs().checked_add(half)?;
+    if m >> 32 >= d as u64 {
+        return None;
+    }
+    let q = div_to_u32(m, d) as i64;
+    Some(if n < 0 { -q } else { q })
 }
 
 /// A segment with its interval clamped to what the interrupt can time (only

@@ -31,6 +31,8 @@ pub struct Trapezoid {
     /// `u64` division costs ~3 000 cycles on the AVR).
     per_speed: u64,
     per_speed_shift: u32,
+    /// `Q / accel` rounded down: sub-ticks to stop per event/s of speed.
+    stop_per_speed: u32,
     s0: u64,
     s1: u64,
     /// Length of the ramps in units of `1 / (2a)` events.
@@ -62,6 +64,7 @@ impl Trapezoid {
             shift: 0,
             per_speed: 0,
             per_speed_shift: 32,
+            stop_per_speed: 0,
             s0: 0,
             s1: 0,
             acc2: 0,
@@ -126,6 +129,8 @@ impl Trapezoid {
             shift,
             per_speed,
             per_speed_shift,
+            // Q / a = per_speed / 2^(per_speed_shift - shift), below 2^33.
+            stop_per_speed: (per_speed >> (per_speed_shift - shift)).min(u32::MAX as u64) as u32,
             acc2: peak - v0_sqr,
             dec2: peak - v1_sqr,
             ..Self::idle()
@@ -212,17 +217,27 @@ impl Trapezoid {
         None
     }
 
-    /// Speed at event `k` of a ramp as (time to stop from it at `accel`,
-    /// sub-ticks; speed, events/s, rounded down).
-    pub fn ramp_speed(&self, k: u32) -> (u64, u64) {
+    /// Speed at event `k` of a ramp, for sizing a segment: (time to stop
+    /// from it at `accel`, sub-ticks; speed, events/s), both rounded down
+    /// and at most 2^-14 below the exact figures: a 32-bit root of the
+    /// speed²'s top bits and one product (a segment's size needs no more;
+    /// the exact root and the variable 64-bit shifts of [`Trapezoid::time`]
+    /// cost several times as much on the AVR).
+    pub fn ramp_speed(&self, k: u32) -> (u64, u32) {
         let x = self.two_a * k as u64;
-        let v_sqr = if x <= self.acc2 {
+        let mut v_sqr = if x <= self.acc2 {
             self.v0_sqr + x
         } else {
             self.v1_sqr + self.two_a * (self.events - k) as u64
         };
-        let s = self.scaled_speed(v_sqr);
-        (self.ramp_time(s, 0), s >> self.shift)
+        // Two bits at a time (constant shifts: no loop over the bytes).
+        let mut half = 0;
+        while v_sqr >> 32 != 0 {
+            v_sqr >>= 2;
+            half += 1;
+        }
+        let v = isqrt32(v_sqr as u32) << half;
+        (v as u64 * self.stop_per_speed as u64, v)
     }
 
     fn scaled_speed(&self, v_sqr: u64) -> u64 {
@@ -377,10 +392,15 @@ pub fn cbrt_floor_approx(x: u64) -> u64 {
         return 0;
     }
     let bits = 63 - x.leading_zeros(); // 2^bits ≤ x
-    let base = 1u64 << (bits / 3);
-    match bits % 3 {
-        0 => base,
-        1 => base * 1260 / 1000, // ∛2 = 1.2599…
-        _ => base * 1587 / 1000, // ∛4 = 1.5874…
-    }
+                                       // ∛2 = 1.2599… > 1290/1024, ∛4 = 1.5874… > 1625/1024: 32-bit shifts
+                                       // only (a u64 division by a constant is a long multiplication on the
+                                       // AVR, a variable u64 shift a loop over eight bytes).
+    let mantissa = [1024u32, 1290, 1625][(bits % 3) as usize];
+    let third = bits / 3;
+    let c = if third >= 10 {
+        mantissa << (third - 10)
+    } else {
+        mantissa >> (10 - third)
+    };
+    c as u64
 }
