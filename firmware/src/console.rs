@@ -299,6 +299,12 @@ impl Console {
             if let Err(wait) = self.read(m, cfg, owner) {
                 return wait;
             }
+            // A line read whole is carried out in a run of its own: reading
+            // and planning one each take up to ~3 ms, and `?` waits for
+            // the run in progress.
+            if matches!(self.pending, Some(Pending::Line(_) | Pending::Jog(_))) {
+                return Poll::Again;
+            }
         }
     }
 

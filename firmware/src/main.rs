@@ -333,8 +333,8 @@ fn timers() {
 #[inline(never)]
 #[optimize(speed)]
 fn motion() {
-    /// Pieces of work per run (a block's profile or a segment, up to ~4 ms
-    /// each): one keeps `?` answered in 10 ms.
+    /// Pieces of work per run (a part of a block's profile or of a
+    /// segment, ≤ ~1 ms each): one keeps the console's wait short.
     const BATCH: usize = 1;
     let (freed, more, idle) = MOTION.with(|m| {
         let m = m.as_mut().unwrap();

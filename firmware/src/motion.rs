@@ -14,6 +14,7 @@ use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Overrides, Planner};
 use taut_logic::prep::{Hold, Prep};
+use taut_logic::segment::Later;
 use taut_logic::segment::{Buffered, StepBlock};
 use taut_logic::units::Milli;
 
@@ -130,23 +131,35 @@ impl Motion {
     }
 
     /// Move planned blocks into the interrupt's queues, at most `max`
-    /// pieces of work (a block's profile, a segment: up to a few ms each;
-    /// runs stay short so other tasks interleave), and start the interrupt.
+    /// pieces of work (taking a block, a part of its profile or of a
+    /// segment: ≤ ~1 ms each, so other tasks interleave), and start the
+    /// interrupt.
     /// Returns (a planner slot was freed, more can be prepared).
     pub fn refill(&mut self, max: usize) -> (bool, bool) {
         let mut freed = false;
         let mut made = 0;
+        let mut pushed = false;
         let mut room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
         while room && made < max && self.buffered.queued_us(SEGMENTS.len()) < QUEUED_MAX_US {
-            // A block's profile and a segment each count as one piece of
-            // work (each costs up to a few ms).
-            if PLANNER.with(|p| self.prep.load(p)) {
-                freed = true;
+            // Taking a block, a part of its profile and a part of a
+            // segment each count as one piece of work (each ≤ ~1 ms).
+            let (loaded, took) = PLANNER.with(|p| {
+                let queued = p.queued();
+                (self.prep.load(p), p.queued() < queued)
+            });
+            freed |= took;
+            if loaded {
                 made += 1;
                 continue;
             }
-            let Some(cut) = PLANNER.with(|p| self.prep.next(p)) else {
-                break;
+            let cut = match PLANNER.with(|p| self.prep.next_part(p)) {
+                Ok(Some(cut)) => cut,
+                Ok(None) => break,
+                // Half a segment worked out: the rest next run.
+                Err(Later) => {
+                    made += 1;
+                    continue;
+                }
             };
             let mut seg = cut.segment;
             if let Some(block) = cut.block {
@@ -160,10 +173,12 @@ impl Motion {
             }
             let _ = SEGMENTS.push(seg);
             self.buffered.push(&seg);
+            pushed = true;
             made += 1;
             room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
         }
-        if made > 0 {
+        // Only a new segment moves where the queue counts as short.
+        if pushed {
             let short = self
                 .buffered
                 .short_at(URGENT_BUDGET_US)

@@ -49,6 +49,18 @@ pub struct Planned {
     pub ev_per_milli_sqr: f32,
 }
 
+/// A block taken with its speeds, its profile not made yet: the segment
+/// preparer makes it in parts ([`Trapezoid::begin`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Taken {
+    pub block: StepBlock,
+    /// Events/s².
+    pub accel: u32,
+    /// Events²/s².
+    pub speeds: Speeds,
+    pub ev_per_milli_sqr: f32,
+}
+
 #[derive(Clone, Copy, Debug, Default)]
 struct Block {
     step: StepBlock,
@@ -254,6 +266,16 @@ impl Planner {
     /// Hands the oldest block to the segment preparer. Its exit speed is
     /// what the look-ahead allows now; the next block's entry is fixed to it.
     pub fn take(&mut self) -> Option<Planned> {
+        let t = self.take_speeds()?;
+        Some(Planned {
+            block: t.block,
+            profile: Trapezoid::new(t.block.events, t.accel, &t.speeds),
+            ev_per_milli_sqr: t.ev_per_milli_sqr,
+        })
+    }
+
+    /// [`Planner::take`] without making the profile.
+    pub fn take_speeds(&mut self) -> Option<Taken> {
         if self.len == 0 {
             return None;
         }
@@ -267,18 +289,15 @@ impl Planner {
         };
         self.carry_sqr = exit_sqr;
         let to_events = |v: u64| (v as f32 * b.ev_per_milli_sqr) as u64;
-        Some(Planned {
-            ev_per_milli_sqr: b.ev_per_milli_sqr,
+        Some(Taken {
             block: b.step,
-            profile: Trapezoid::new(
-                b.step.events,
-                b.accel,
-                &Speeds {
-                    entry_sqr: to_events(b.entry_sqr),
-                    cruise_sqr: to_events(b.nominal_sqr()),
-                    exit_sqr: to_events(exit_sqr),
-                },
-            ),
+            accel: b.accel,
+            speeds: Speeds {
+                entry_sqr: to_events(b.entry_sqr),
+                cruise_sqr: to_events(b.nominal_sqr()),
+                exit_sqr: to_events(exit_sqr),
+            },
+            ev_per_milli_sqr: b.ev_per_milli_sqr,
         })
     }
 

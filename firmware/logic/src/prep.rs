@@ -12,7 +12,7 @@
 //! position is kept exactly.
 
 use crate::planner::{Planned, Planner};
-use crate::segment::{Preparer, Segment, StepBlock};
+use crate::segment::{Later, Preparer, Segment, StepBlock};
 
 /// Where a feed hold stands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,20 +71,55 @@ impl Prep {
         self.cut.speed_sqr() as f32 / self.ev_per_milli_sqr
     }
 
-    /// Every block taken has been cut whole (no hold stopped one short).
+    /// Every block taken has been cut whole (no hold stopped one short),
+    /// and none is half loaded.
     pub fn is_idle(&self) -> bool {
-        self.cut.is_idle()
+        self.cut.is_idle() && !self.cut.is_loading()
     }
 
-    /// Take the next block from `planner` now if the last is all cut (its
-    /// profile costs about as much as a segment: a caller keeping its runs
-    /// short does this in a run of its own). True if it took one.
+    /// One bounded part of loading the next block, if the last is all
+    /// cut: taking it from `planner`, or one part of its profile (a whole
+    /// profile costs two segments; a caller keeping its runs short calls
+    /// this in runs of its own until it returns false). True if it did
+    /// any work. During a hold the block is taken and made at once.
     pub fn load(&mut self, planner: &mut Planner) -> bool {
+        if self.cut.is_loading() {
+            self.cut.advance_block();
+            return true;
+        }
         if !self.cut.is_idle() {
             return false;
         }
-        self.block = self.take(planner);
-        self.block.is_some()
+        if self.hold != Hold::Off {
+            self.block = self.take(planner);
+            return self.block.is_some();
+        }
+        let Some(t) = planner.take_speeds() else {
+            return false;
+        };
+        self.cut.begin_block(t.block.events, t.accel, &t.speeds);
+        self.ev_per_milli_sqr = t.ev_per_milli_sqr;
+        self.block = Some(t.block);
+        true
+    }
+
+    /// [`Prep::next`] bounded as [`Preparer::next_part`]: `Err(Later)`
+    /// when the segment needs another call. Loads at once what
+    /// [`Prep::load`] left unmade.
+    pub fn next_part(&mut self, planner: &mut Planner) -> Result<Option<Cut>, Later> {
+        if self.cut.is_idle() && !self.cut.is_loading() {
+            return Ok(self.next(planner));
+        }
+        while !self.cut.advance_block() {}
+        match self.cut.next_part()? {
+            Some(segment) => {
+                let block = self.block.take();
+                Ok(Some(Cut { block, segment }))
+            }
+            // A leg ended short of the block's end, or the block is cut:
+            // the unbounded path takes it from here.
+            None => Ok(self.next(planner)),
+        }
     }
 
     /// The next segment, taking the next block from `planner` when the last
@@ -151,6 +186,9 @@ impl Prep {
 
     /// Feed hold: brake to a stop from the speed of the last segment cut.
     pub fn hold(&mut self) {
+        // A block half loaded is finished first: its entry is where the
+        // braking starts.
+        while !self.cut.advance_block() {}
         if self.hold == Hold::Off {
             self.hold = Hold::Braking;
             self.cut.stop();

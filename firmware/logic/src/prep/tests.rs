@@ -22,6 +22,27 @@ struct Run {
 /// cuts until the stop, then resumes (or `resume_early`: right after the
 /// hold, while still braking) and cuts the rest.
 fn run(moves: &[PerAxis<i32>], hold_after: usize, resume_early: bool) -> Run {
+    run_as(moves, hold_after, resume_early, false)
+}
+
+/// The firmware's way: one bounded piece of work per call ([`Prep::load`],
+/// [`Prep::next_part`]); at most `MAX_PIECES` calls a segment.
+const MAX_PIECES: usize = 12;
+
+fn next_bounded(prep: &mut Prep, planner: &mut Planner) -> Option<Cut> {
+    for _ in 0..MAX_PIECES {
+        if prep.load(planner) {
+            continue;
+        }
+        match prep.next_part(planner) {
+            Err(Later) => continue,
+            Ok(cut) => return cut,
+        }
+    }
+    panic!("a segment took more than {MAX_PIECES} calls");
+}
+
+fn run_as(moves: &[PerAxis<i32>], hold_after: usize, resume_early: bool, bounded: bool) -> Run {
     let mut planner = Planner::new(&square());
     let mut prep = Prep::new();
     let (mut segs, mut blocks) = (Vec::new(), Vec::new());
@@ -44,7 +65,11 @@ fn run(moves: &[PerAxis<i32>], hold_after: usize, resume_early: bool) -> Run {
                 assert!(prep.resume(&mut planner));
             }
         }
-        match prep.next(&mut planner) {
+        let next = match bounded {
+            true => next_bounded(&mut prep, &mut planner),
+            false => prep.next(&mut planner),
+        };
+        match next {
             Some(c) => {
                 blocks.extend(c.block);
                 cut_events += c.segment.count as usize;
@@ -176,6 +201,9 @@ proptest! {
                 .sum()
         };
         let r = run(&targets, (hold_frac * total as f64) as usize, early);
+        // Cut in bounded pieces, the same events at the same times.
+        let b = run_as(&targets, (hold_frac * total as f64) as usize, early, true);
+        prop_assert!(b.events == r.events, "bounded pieces cut other events");
         prop_assert_eq!(travel(&r.events), at);
         prop_assert_eq!(r.events.len(), total);
         if let (Some(held), Some(stood)) = (r.held_at, r.stood_at) {
@@ -203,4 +231,59 @@ proptest! {
             }
         }
     }
+}
+
+/// A hold while a block's profile is half made: it is finished, and the
+/// braking starts from the block's entry speed; every step still made.
+#[test]
+fn a_hold_while_a_profile_is_made_brakes_from_its_entry() {
+    let moves: Vec<PerAxis<i32>> = (1..=6).map(|k| [k * 3000, 0, 0, 0]).collect();
+    let mut planner = Planner::new(&square());
+    for m in &moves {
+        planner.push(*m, Feed::Rapid).unwrap();
+    }
+    let mut prep = Prep::new();
+    let (mut segs, mut blocks) = (Vec::new(), Vec::new());
+    // The first block cut whole, then the second begun.
+    loop {
+        if prep.load(&mut planner) {
+            continue;
+        }
+        if let Ok(Some(c)) = prep.next_part(&mut planner) {
+            blocks.extend(c.block);
+            segs.push(c.segment);
+            if prep.is_idle() {
+                break;
+            }
+        }
+    }
+    assert!(prep.load(&mut planner), "the second block begun");
+    prep.hold();
+    loop {
+        match next_bounded(&mut prep, &mut planner) {
+            Some(c) => {
+                blocks.extend(c.block);
+                segs.push(c.segment);
+            }
+            None if prep.hold_state() == Hold::Stopped => {
+                assert!(prep.resume(&mut planner));
+            }
+            None => break,
+        }
+    }
+    let events: Vec<Event> = expand(segs, blocks).collect();
+    assert_eq!(travel(&events), [18_000, 0, 0, 0]);
+}
+
+/// A block half loaded is work still to do: the motion task must run on
+/// (and `M400` wait) until its profile is made and cut.
+#[test]
+fn a_half_loaded_block_is_not_idle() {
+    let mut planner = Planner::new(&square());
+    planner.push([9600, 0, 0, 0], Feed::Rapid).unwrap();
+    let mut prep = Prep::new();
+    assert!(prep.is_idle());
+    assert!(prep.load(&mut planner));
+    assert!(planner.is_idle(), "taken from the planner");
+    assert!(!prep.is_idle(), "its profile is still being made");
 }

@@ -24,6 +24,12 @@ const MAX_CRUISE_EVENTS: u32 = 4096;
 const MAX_SEGMENT_PER_S: u64 = 40;
 /// `d ≤ 43·∛τ²` keeps the quadratic fit's error ≤ 2048 sub-ticks.
 const FIT_GAIN: u64 = 43;
+/// Budget units ([`Preparer::next_part`]): an event time (~8 000
+/// cycles), a ramp segment's size (~4 000 an acceleration's, ~8 000 a
+/// deceleration's), and what one call may spend: one of them.
+const TIME_COST: u8 = 1;
+const SIZE_COST: u8 = 1;
+const PART_BUDGET: u8 = 1;
 
 /// Turns one block's [`Trapezoid`] after another into segments.
 ///
@@ -52,7 +58,23 @@ pub struct Preparer {
     accel: u32,
     cruise_sqr: u64,
     exit_sqr: u64,
+    /// The last two event times worked out on this leg, (event,
+    /// sub-ticks), and which was used last: a bounded call
+    /// ([`Preparer::next_part`]) that ran out of budget finds them there
+    /// when called again.
+    memo: [(u32, u64); 2],
+    memo_last: u8,
+    /// (first event, events): a fit too long for a segment's figures
+    /// goes on from the shorter run next call.
+    shorter: (u32, u32),
+    /// What the current call may still work out: [`TIME_COST`] an event
+    /// time, [`SIZE_COST`] a ramp segment's size.
+    budget: u8,
 }
+
+/// A bounded call ran out of budget: call again to go on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Later;
 
 impl Default for Preparer {
     fn default() -> Self {
@@ -72,6 +94,10 @@ impl Preparer {
             accel: 1,
             cruise_sqr: 0,
             exit_sqr: 0,
+            memo: [(u32::MAX, 0); 2],
+            memo_last: 0,
+            shorter: (u32::MAX, 0),
+            budget: u8::MAX,
         }
     }
 
@@ -90,6 +116,39 @@ impl Preparer {
     /// end, so timing errors never accumulate across blocks.
     pub fn start(&mut self, profile: Trapezoid) {
         self.switch(profile);
+        self.adopt();
+    }
+
+    /// [`Preparer::start`] in parts: the block's profile is begun here and
+    /// made by [`Preparer::advance_block`], one bounded part per call (the
+    /// preparer stays idle until then). Only once the last block is cut.
+    pub fn begin_block(&mut self, events: u32, accel: u32, speeds: &Speeds) {
+        debug_assert!(self.is_idle());
+        self.switch(Trapezoid::begin(events, accel, speeds));
+    }
+
+    /// The next part of the profile begun by [`Preparer::begin_block`];
+    /// true once it is whole and the block started (at once when no
+    /// profile is being made).
+    pub fn advance_block(&mut self) -> bool {
+        if !self.is_loading() {
+            return true;
+        }
+        if !self.profile.advance() {
+            return false;
+        }
+        self.adopt();
+        true
+    }
+
+    /// A block's profile is being made ([`Preparer::begin_block`]).
+    pub fn is_loading(&self) -> bool {
+        !self.profile.is_whole()
+    }
+
+    /// The profile in place is the new block's.
+    fn adopt(&mut self) {
+        let profile = &self.profile;
         self.before = 0;
         self.events = profile.events();
         self.accel = profile.accel();
@@ -172,44 +231,67 @@ impl Preparer {
         self.before += self.done;
         self.profile = leg;
         self.done = 0;
+        self.memo = [(u32::MAX, 0); 2];
+        self.shorter = (u32::MAX, 0);
     }
 
     /// The next segment of the current leg, `None` when it is done.
     pub fn next_segment(&mut self) -> Option<Segment> {
+        self.budget = u8::MAX;
+        self.segment().unwrap_or(None)
+    }
+
+    /// [`Preparer::next_segment`] in bounded parts: one event time worked
+    /// out afresh (a 64-bit root: ~8 000 cycles on the AVR) or one ramp
+    /// segment's size; `Later` when the segment needs another call (what
+    /// a call worked out is kept for the next). A cruise segment takes one
+    /// call, a ramp's three.
+    pub fn next_part(&mut self) -> Result<Option<Segment>, Later> {
+        self.budget = PART_BUDGET;
+        self.segment()
+    }
+
+    fn segment(&mut self) -> Result<Option<Segment>, Later> {
         if self.done >= self.profile.events() {
-            return None;
+            return Ok(None);
         }
         let k0 = self.done;
         let mut seg = match self.profile.phase_after(k0) {
-            None => self.fit(k0, 1),
+            None => self.fit(k0, 1)?,
             Some((Phase::Cruise, end)) => {
                 let n = (end - k0)
                     .min(MAX_CRUISE_EVENTS)
                     .min(self.profile.cruise_events_in(Q / MAX_SEGMENT_PER_S));
-                self.cruise(k0, n.max(1))
+                self.cruise(k0, n.max(1))?
+            }
+            // A call that ran out of budget sized this segment already.
+            Some((Phase::Accel | Phase::Decel, _)) if self.shorter.0 == k0 => {
+                self.fit(k0, self.shorter.1)?
             }
             Some((Phase::Accel, end)) => {
+                self.spend(SIZE_COST)?;
                 let n = self.ramp_run(k0).min(end - k0);
-                self.fit(k0, n)
+                self.fit(k0, n)?
             }
             Some((Phase::Decel, end)) => {
+                self.spend(SIZE_COST)?;
                 // The slow end of a deceleration is the segment's end.
                 let first = self.ramp_run(k0).min(end - k0);
                 let n = self.ramp_run(k0 + first).min(first);
-                self.fit(k0, n)
+                self.fit(k0, n)?
             }
         };
         if self.fresh {
             seg.flags |= NEW_BLOCK;
             self.fresh = false;
         }
-        let n = seg.count as i64;
-        self.now += n * seg.interval as i64 + seg.add as i64 * n * (n - 1) / 2;
+        let n = seg.count as u32;
+        self.now += mul_wide(seg.interval as i64, n) + mul_wide(seg.add as i64, n * (n - 1) / 2);
         self.done += seg.count as u32;
         if self.is_stopped() {
             seg.flags |= STOP;
         }
-        Some(seg)
+        Ok(Some(seg))
     }
 
     /// Events a ramp segment may span from a speed at event `k`.
@@ -234,37 +316,65 @@ impl Preparer {
         n.min(most).max(1)
     }
 
-    /// Sub-ticks from the last placed event to the ideal time of `k`.
-    fn ahead(&self, k: u32) -> i64 {
-        self.profile.time(k) as i64 - self.now
+    /// Takes `units` of the call's budget, or `Later` when too few are left.
+    fn spend(&mut self, units: u8) -> Result<(), Later> {
+        self.budget = self.budget.checked_sub(units).ok_or(Later)?;
+        Ok(())
+    }
+
+    /// Sub-ticks from the last placed event to the ideal time of `k`;
+    /// `Later` when it is not known yet and the budget is spent.
+    fn ahead(&mut self, k: u32) -> Result<i64, Later> {
+        let t = match self.memo.iter().position(|m| m.0 == k) {
+            Some(i) => {
+                self.memo_last = i as u8;
+                self.memo[i].1
+            }
+            None => {
+                self.spend(TIME_COST)?;
+                let t = self.profile.time(k);
+                // In place of the one not used last.
+                self.memo_last ^= 1;
+                self.memo[self.memo_last as usize] = (k, t);
+                t
+            }
+        };
+        Ok(t as i64 - self.now)
     }
 
     /// Constant interval: the ideal times are equally spaced.
-    fn cruise(&self, k0: u32, n: u32) -> Segment {
-        let interval = div_round(self.ahead(k0 + n), n as i64);
-        segment(interval, n, 0)
+    fn cruise(&mut self, k0: u32, n: u32) -> Result<Segment, Later> {
+        let interval = div_round(self.ahead(k0 + n)?, n as i64);
+        Ok(segment(interval, n, 0))
     }
 
     /// Quadratic through the last placed event and the ideal middle and end
     /// events; shorter runs when `add` or the intervals do not fit.
-    fn fit(&self, k0: u32, mut n: u32) -> Segment {
+    /// The end's time first: a shorter run's end is this run's middle,
+    /// which the memo then still holds.
+    fn fit(&mut self, k0: u32, mut n: u32) -> Result<Segment, Later> {
+        if self.shorter.0 == k0 {
+            n = n.min(self.shorter.1);
+        }
         loop {
+            self.shorter = (k0, n);
             if n < 2 {
-                return segment(self.ahead(k0 + 1), 1, 0);
+                return Ok(segment(self.ahead(k0 + 1)?, 1, 0));
             }
             n &= !1;
-            let (m, ni) = (n / 2, n as i64);
-            let (ym, yn) = (self.ahead(k0 + m), self.ahead(k0 + n));
+            let m = n / 2;
+            let yn = self.ahead(k0 + n)?;
+            let ym = self.ahead(k0 + m)?;
             let fitted = round_div32(4 * (yn - 2 * ym), n * n).and_then(|add| {
-                let interval = round_div32(yn - add * ni * (ni - 1) / 2, n)?;
-                let last = interval + add * (ni - 1);
+                let interval = round_div32(yn - mul_wide(add, n * (n - 1) / 2), n)?;
+                let last = interval + mul_wide(add, n - 1);
                 let fits = i32::try_from(add).is_ok()
                     && interval.min(last) >= 1
                     && interval.max(last) <= u32::MAX as i64;
                 fits.then(|| segment(interval, n, add as i32))
             });
             if let Some(seg) = fitted {
-                return seg;
+                return Ok(seg);
             }
             n /= 2;
         }
@@ -282,6 +392,23 @@ fn round_div32(n: i64, d: u32) -> Option<i64> {
     }
     let q = div_to_u32(m, d) as i64;
     Some(if n < 0 { -q } else { q })
+}
+
+/// `a · b` for `|a| < 2^32` and `b < 2^24`: four 16-bit products (a u32
+/// multiplication is a short library routine on the AVR, a u64 one
+/// several times longer).
+pub fn mul_wide(a: i64, b: u32) -> i64 {
+    debug_assert!(a.unsigned_abs() < 1 << 32 && b < 1 << 24);
+    let m = a.unsigned_abs() as u32;
+    let (a0, a1) = (m & 0xFFFF, m >> 16);
+    let (b0, b1) = (b & 0xFFFF, b >> 16);
+    let mid = (a0 * b1) as u64 + (a1 * b0) as u64;
+    let p = (a0 * b0) as u64 + (mid << 16) + (((a1 * b1) as u64) << 32);
+    if a < 0 {
+        -(p as i64)
+    } else {
+        p as i64
+    }
 }
 
 /// A segment with its interval clamped to what the interrupt can time (only

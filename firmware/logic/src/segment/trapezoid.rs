@@ -33,6 +33,8 @@ pub struct Trapezoid {
     per_speed_shift: u32,
     /// `Q / accel` rounded down: sub-ticks to stop per event/s of speed.
     stop_per_speed: u32,
+    /// The part [`Trapezoid::advance`] makes next; 0 when whole.
+    part: u8,
     s0: u64,
     s1: u64,
     /// Length of the ramps in units of `1 / (2a)` events.
@@ -65,6 +67,7 @@ impl Trapezoid {
             per_speed: 0,
             per_speed_shift: 32,
             stop_per_speed: 0,
+            part: 0,
             s0: 0,
             s1: 0,
             acc2: 0,
@@ -102,6 +105,18 @@ impl Trapezoid {
     /// (seen here: the cruise speed arrived as garbage once this function
     /// stopped being inlined).
     pub fn new(events: u32, accel: u32, speeds: &Speeds) -> Self {
+        let mut t = Self::begin(events, accel, speeds);
+        while !t.advance() {}
+        t
+    }
+
+    /// [`Trapezoid::new`] in parts that each cost at most ~14 000 cycles
+    /// on the AVR (a whole one ~30 000: three 64-bit roots and several
+    /// divisions), so the task that makes it keeps its runs short: this
+    /// is the first part (the speeds clamped, the scale chosen), then
+    /// [`Trapezoid::advance`] until it returns true. Until then the
+    /// profile must not be read.
+    pub fn begin(events: u32, accel: u32, speeds: &Speeds) -> Self {
         let Speeds {
             entry_sqr,
             cruise_sqr,
@@ -118,8 +133,7 @@ impl Trapezoid {
             .max(v0_sqr)
             .max(v1_sqr);
         let shift = (64 - (64 - peak.leading_zeros())) / 2;
-        let (per_speed, per_speed_shift) = per_speed(a as u32, shift);
-        let mut t = Trapezoid {
+        Trapezoid {
             events,
             accel: a,
             two_a,
@@ -127,24 +141,56 @@ impl Trapezoid {
             v1_sqr,
             cruise_sqr,
             shift,
-            per_speed,
-            per_speed_shift,
-            // Q / a = per_speed / 2^(per_speed_shift - shift), below 2^33.
-            stop_per_speed: (per_speed >> (per_speed_shift - shift)).min(u32::MAX as u64) as u32,
             acc2: peak - v0_sqr,
             dec2: peak - v1_sqr,
+            part: 1,
             ..Self::idle()
-        };
-        let sp = t.scaled_speed(peak);
-        t.s0 = t.scaled_speed(v0_sqr);
-        t.s1 = t.scaled_speed(v1_sqr);
-        t.cruise_iv = (Q << 31) / sp;
-        t.t_acc = t.ramp_time(sp, t.s0);
-        t.t_dec = t.t_acc + t.cruise_time(two_ae - t.acc2 - t.dec2);
-        t.t_end = t.t_dec + t.ramp_time(sp, t.s1);
-        t.k_acc = (t.acc2 / two_a) as u32;
-        t.k_dec = events - t.dec2.div_ceil(two_a) as u32;
-        t
+        }
+    }
+
+    /// The next part of the profile begun by [`Trapezoid::begin`]; true
+    /// once it is whole (and for every profile after).
+    #[inline(always)]
+    pub fn advance(&mut self) -> bool {
+        let two_ae = self.two_a * self.events as u64;
+        match self.part {
+            0 => return true,
+            // The roots. The peak's scaled speed waits in `cruise_iv`.
+            1 => {
+                self.cruise_iv = self.scaled_speed(self.v0_sqr + self.acc2);
+                self.s0 = self.scaled_speed(self.v0_sqr);
+                self.s1 = self.scaled_speed(self.v1_sqr);
+            }
+            2 => {
+                let sp = self.cruise_iv;
+                let (per_speed, per_speed_shift) = per_speed(self.accel as u32, self.shift);
+                self.per_speed = per_speed;
+                self.per_speed_shift = per_speed_shift;
+                // Q / a = per_speed / 2^(per_speed_shift - shift), below 2^33.
+                self.stop_per_speed =
+                    (per_speed >> (per_speed_shift - self.shift)).min(u32::MAX as u64) as u32;
+                self.cruise_iv = (Q << 31) / sp;
+                self.t_acc = self.ramp_time(sp, self.s0);
+                // The peak's scaled speed until the last part.
+                self.t_end = sp;
+            }
+            _ => {
+                let sp = self.t_end;
+                self.t_dec = self.t_acc + self.cruise_time(two_ae - self.acc2 - self.dec2);
+                self.t_end = self.t_dec + self.ramp_time(sp, self.s1);
+                self.k_acc = (self.acc2 / self.two_a) as u32;
+                self.k_dec = self.events - self.dec2.div_ceil(self.two_a) as u32;
+                self.part = 0;
+                return true;
+            }
+        }
+        self.part += 1;
+        false
+    }
+
+    /// Every part made ([`Trapezoid::advance`]).
+    pub fn is_whole(&self) -> bool {
+        self.part == 0
     }
 
     pub fn events(&self) -> u32 {
@@ -188,6 +234,9 @@ impl Trapezoid {
     /// Ideal time of event `k` (0..=events), sub-ticks after event 0.
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     pub fn time(&self, k: u32) -> u64 {
+        if k == self.events {
+            return self.t_end;
+        }
         let x = self.two_a * k as u64;
         let y = self.two_a * (self.events - k) as u64;
         if x <= self.acc2 {

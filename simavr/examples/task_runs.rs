@@ -1,0 +1,85 @@
+//! Where the console's longest runs go (the wait a `?` or a line may have,
+//! issue #13's dispatch latency): the string-art machine streams 300
+//! random 3-axis moves, a `?` every tenth, no card in the slot; prints the
+//! three longest console runs with the calls inside them, then each
+//! watched function's run count, longest and 99th percentile (cycles).
+//! Run from the workspace root after `cargo xtask build`:
+//! `cargo run --release -p taut-simavr --example task_runs`.
+use std::path::Path;
+use std::time::Duration;
+use taut_simavr::Sim;
+fn main() {
+    let elf = Path::new("firmware/target/avr-none/release/taut.elf");
+    let f = |p: &str| taut_simavr::elf::function_address(elf, p).unwrap().unwrap();
+    let names = [
+        "4taut7console",
+        "Console8run_line",
+        "Interpreter4plan",
+        "Motion4push",
+        "Planner11recalculate",
+        "Console4read",
+        "7console5parse",
+        "Kinematics7inverse",
+        "4taut8realtime",
+        "realtime6status",
+    ];
+    let pcs: Vec<u32> = names.iter().map(|n| f(n)).collect();
+    let mut sim = Sim::load(elf).unwrap();
+    for &pc in &pcs {
+        sim.watch_calls(pc);
+    }
+    sim.run_until_uart_contains("reset:", Duration::from_millis(50));
+    sim.send_line("M17", Duration::from_millis(100)).unwrap();
+    let mut x: u64 = 1234;
+    let (mut c, mut r, mut z) = (0.0f64, -100.0f64, -10.0f64);
+    for k in 0..300 {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        let d = ((x % 3000) as f64 + 10.0) / 1000.0 * if x & 8 == 0 { 1.0 } else { -1.0 };
+        match (x >> 4) % 3 {
+            0 => c += d,
+            1 => r = (r + d).clamp(-400.0, 20.0),
+            _ => z = (z + d).clamp(-25.0, 10.0),
+        }
+        let feed = 10 + (x >> 8) % 6000;
+        if k % 10 == 0 {
+            sim.uart_send(b"?");
+        }
+        let _ = sim.send_line(
+            &format!("G1 C{c:.3} X{r:.3} Z{z:.3} F{feed}"),
+            Duration::from_secs(30),
+        );
+    }
+    let mut top: Vec<(u64, u64)> = sim.call_runs(pcs[0]).to_vec();
+    top.sort_by_key(|r| std::cmp::Reverse(r.1));
+    for &(start, len) in top.iter().take(3) {
+        print!("console run {len}:");
+        for (i, &pc) in pcs.iter().enumerate().skip(1) {
+            let inside: Vec<u64> = sim
+                .call_runs(pc)
+                .iter()
+                .filter(|r| r.0 >= start && r.0 < start + len)
+                .map(|r| r.1)
+                .collect();
+            if !inside.is_empty() {
+                print!(" {}={:?}", names[i], inside);
+            }
+        }
+        println!();
+    }
+    for (i, &pc) in pcs.iter().enumerate() {
+        let mut runs: Vec<u64> = sim.call_runs(pc).iter().map(|r| r.1).collect();
+        runs.sort();
+        let n = runs.len();
+        if n > 0 {
+            println!(
+                "{:<16} runs {:>6} max {:>7} p99 {:>7}",
+                names[i],
+                n,
+                runs[n - 1],
+                runs[n * 99 / 100]
+            );
+        }
+    }
+}
