@@ -180,6 +180,9 @@ impl Fletcher {
 
     /// Both sums stay below 255, so one subtraction reduces them (a `%`
     /// is a 16-bit division on the AVR, twice a byte).
+    /// Inlined: once a byte of the image each time the store task looks
+    /// for a change (at `z` it was a call).
+    #[inline(always)]
     fn add(&mut self, x: u8) {
         self.a += x as u16;
         if self.a >= 255 {
