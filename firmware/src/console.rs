@@ -988,9 +988,10 @@ fn serial_line_waits() -> bool {
 }
 
 /// One byte into the parser. Out of line: its copies of the line being
-/// finished are gone before the line is carried out.
+/// finished are gone before the line is carried out. Built for size
+/// (3.4 KB less than for speed): bytes wait in the receive ring, and a
+/// stream keeps its pace (`stream_lines_per_s` of `cargo xtask bench`).
 #[inline(never)]
-#[optimize(speed)]
 fn parse(parser: &mut Parser, byte: u8) -> Option<Result<Input, Error>> {
     parser.push(byte)
 }

@@ -47,17 +47,36 @@ pub struct Line {
 
 impl ufmt::uWrite for Line {
     type Error = core::convert::Infallible;
+    /// Inlined: a format string's one- and two-byte pieces (`":"`, `": "`) become a
+    /// pushed constant instead of a string the AVR would keep in SRAM.
+    #[inline(always)]
     fn write_str(&mut self, s: &str) -> Result<(), Self::Error> {
-        for &b in s.as_bytes() {
-            if self.buf.push(b).is_err() {
-                self.cut = true;
+        match s.as_bytes() {
+            [b] => self.push(*b),
+            [a, b] => {
+                self.push(*a);
+                self.push(*b);
             }
+            bytes => self.push_all(bytes),
         }
         Ok(())
     }
 }
 
 impl Line {
+    fn push(&mut self, b: u8) {
+        if self.buf.push(b).is_err() {
+            self.cut = true;
+        }
+    }
+
+    #[inline(never)]
+    fn push_all(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.push(b);
+        }
+    }
+
     pub fn new(level: Level, module: FlashStr) -> Line {
         let mut l = Line {
             buf: heapless::Vec::new(),

@@ -38,8 +38,8 @@ use taut_firmware::board::{
     self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
 };
 use taut_firmware::buttons::{self, ButtonPins, ButtonsTask};
-use taut_firmware::checkpoint;
 use taut_firmware::card::{self, CardReader};
+use taut_firmware::checkpoint;
 use taut_firmware::console::{Activity, Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
@@ -55,6 +55,7 @@ use taut_firmware::{
     nested_vector, step_vector,
 };
 use taut_firmware::{endstop, flash_str, info, reply, warn};
+use taut_logic::checkpoint::Found;
 use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::kinematics::AnyKinematics;
 use taut_logic::planner::Overrides;
@@ -124,15 +125,15 @@ static READY: TaskCell<Ready<Task, 11, 5>> = TaskCell::new(Ready::new());
 static TIMERS: TaskCell<Timers<Task, 8>> = TaskCell::new(Timers::new());
 /// Tasks waiting for each [`Signal`] (bit = task).
 static WAITING: TaskCell<[u16; SIGNALS]> = TaskCell::new([0; SIGNALS]);
-static MOTION: TaskCell<Option<Motion>> = TaskCell::new(None);
-static CONSOLE: TaskCell<Console> = TaskCell::new(Console::new());
+static MOTION: TaskCell<Option<Motion>> = TaskCell::zeroed();
+static CONSOLE: TaskCell<Console> = TaskCell::zeroed();
 static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
 /// The kinematics of `CONFIG`, rebuilt when a setting changes.
-static KIN: TaskCell<Option<AnyKinematics>> = TaskCell::new(None);
+static KIN: TaskCell<Option<AnyKinematics>> = TaskCell::zeroed();
 static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::new(ButtonsTask::new());
-static JOB: TaskCell<JobTask> = TaskCell::new(JobTask::new());
-static CARD: TaskCell<Option<CardReader>> = TaskCell::new(None);
-static STORE: TaskCell<Option<Store>> = TaskCell::new(None);
+static JOB: TaskCell<JobTask> = TaskCell::zeroed();
+static CARD: TaskCell<Option<CardReader>> = TaskCell::zeroed();
+static STORE: TaskCell<Option<Store>> = TaskCell::zeroed();
 
 /// Boot blink of the status LED: this many flashes, 100 ms on, 100 ms off.
 const BOOT_BLINKS: u32 = 3;
@@ -215,6 +216,14 @@ fn main() -> ! {
 #[inline(never)]
 #[optimize(size)]
 fn init() -> Watchdog {
+    // The zeroed cells' values (in `.bss`: their starting values in
+    // `.data` were 2 KB of flash, nearly all zeros).
+    MOTION.init(None);
+    CONSOLE.init(Console::new());
+    KIN.init(None);
+    JOB.init(JobTask::new());
+    CARD.init(None);
+    STORE.init(None);
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
     let reset = ResetCause::take(&dp.CPU);
     let watchdog = Watchdog::start(dp.WDT);
@@ -225,17 +234,7 @@ fn init() -> Watchdog {
     let status_led = pins.d13.into_output_at(false);
     clock::Clock::start(dp.TC0);
     usart::Usart0::start(dp.USART0);
-    let mut store = Store::new(Eeprom::new(dp.EEPROM));
-    // CONFIG starts as the defaults (naming the constant here would keep a
-    // second copy of it in SRAM).
-    // Read in place from here on: a copy would sit on init's stack.
-    let store_now = CONFIG.with(|c| {
-        let (config, store_now) = store.load(c);
-        *c = config;
-        store_now
-    });
-    let found = store.load_checkpoint();
-    STORE.with(|s| *s = Some(store));
+    let (store_now, found) = load_store(Eeprom::new(dp.EEPROM));
     // Settings are only taken whole, kinematics included: never `None`.
     KIN.with(|k| *k = CONFIG.with(|c| AnyKinematics::of(c).ok()));
     let enable = EnablePins {
@@ -263,9 +262,10 @@ fn init() -> Watchdog {
         pins.d11.into_output(),
         PenConfig::pulse_us(CONFIG.with(|c| c.pen.up_deg)),
     );
-    MOTION.with(|m| *m = Some(CONFIG.with(|c| Motion::new(c, stepper, drivers, pen))));
-    let spi = CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53);
-    CARD.with(|c| *c = Some(CardReader::new(spi)));
+    start_motion(stepper, drivers, pen);
+    start_card(CardSpi::start(
+        dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53,
+    ));
     buttons::start(ButtonPins {
         confirm: pins.d2.into_pull_up_input(),
         zero_base: pins.d3.into_pull_up_input(),
@@ -276,21 +276,7 @@ fn init() -> Watchdog {
     unsafe { avr_device::interrupt::enable() };
     reply::banner();
 
-    info!(
-        flash_str!(concat!(
-            "taut ",
-            env!("CARGO_PKG_VERSION"),
-            " git ",
-            env!("TAUT_GIT_HASH"),
-            " atmega2560 "
-        )),
-        F_CPU / 1_000_000,
-        "MHz reset:",
-        reset.name()
-    );
-    if reset == ResetCause::Watchdog {
-        warn!("watchdog reset: a task did not return");
-    }
+    boot_log(reset);
     let (saved, note) = checkpoint::found(found, reset);
     match store_now || STORE.with(|s| s.as_ref().unwrap().saving()) {
         true => spawn(Task::Store),
@@ -313,6 +299,62 @@ fn init() -> Watchdog {
     spawn(Task::Led);
 
     watchdog
+}
+
+/// Settings and checkpoint from EEPROM into `CONFIG` and `STORE`: whether
+/// the store has bytes to write, and the checkpoint found. Out of `init`
+/// (also `boot_log`): their locals would stay in `init`'s frame under
+/// everything it calls (the stack peak at boot).
+#[inline(never)]
+#[optimize(size)]
+fn load_store(eeprom: Eeprom) -> (bool, Found) {
+    let mut store = Store::new(eeprom);
+    // CONFIG starts as the defaults (naming the constant here would keep a
+    // second copy of it in SRAM).
+    // Read in place from here on: a copy would sit on init's stack.
+    let store_now = CONFIG.with(|c| {
+        let (config, store_now) = store.load(c);
+        *c = config;
+        store_now
+    });
+    let found = store.load_checkpoint();
+    STORE.with(|s| *s = Some(store));
+    (store_now, found)
+}
+
+#[inline(never)]
+#[optimize(size)]
+fn boot_log(reset: ResetCause) {
+    info!(
+        flash_str!(concat!(
+            "taut ",
+            env!("CARGO_PKG_VERSION"),
+            " git ",
+            env!("TAUT_GIT_HASH"),
+            " atmega2560 "
+        )),
+        F_CPU / 1_000_000,
+        "MHz reset:",
+        reset.name()
+    );
+    if reset == ResetCause::Watchdog {
+        warn!("watchdog reset: a task did not return");
+    }
+}
+
+/// The motion task's state. Out of `init` (also `start_card`): built on
+/// the stack and copied into place, a big value would stay in `init`'s
+/// frame under everything `init` calls (the stack peak at boot).
+#[inline(never)]
+#[optimize(size)]
+fn start_motion(stepper: Stepper, drivers: Drivers, pen: PenServo) {
+    MOTION.with(|m| *m = Some(CONFIG.with(|c| Motion::new(c, stepper, drivers, pen))));
+}
+
+#[inline(never)]
+#[optimize(size)]
+fn start_card(spi: CardSpi) {
+    CARD.with(|c| *c = Some(CardReader::new(spi)));
 }
 
 /// Move due timers into the ready set and re-arm the tick's alarm.
@@ -435,7 +477,7 @@ fn realtime() {
             }
         }
         if r.overrides() != 0 {
-            if let Some(o) = STANDING.with(|rt| rt.apply(r.overrides()).then_some(rt.overrides)) {
+            if let Some(o) = STANDING.with(|rt| rt.apply(r.overrides(), r.feed_presses()).then_some(rt.overrides)) {
                 m.set_overrides(o);
             }
         }

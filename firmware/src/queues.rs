@@ -5,7 +5,7 @@
 //! (`$Q`, and the end of a job).
 #![deny(unsafe_code)]
 
-use crate::rt::{Flags, Ring};
+use crate::rt::{Flags, Ring, Tally};
 use core::sync::atomic::AtomicBool;
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
@@ -22,6 +22,9 @@ pub static RX: Ring<u8, 128, true> = Ring::new();
 pub static TX: Ring<u8, 128> = Ring::new();
 /// UART receive interrupt → `Realtime` task: `?`, `!`, `~`, Ctrl-X.
 pub static REALTIME: Flags = Flags::new();
+/// UART receive interrupt → `Realtime` task: the feed override's ±10 %
+/// and ±1 % presses since the last run, summed (each one counts).
+pub static FEED_PRESSES: Tally = Tally::new();
 
 /// Motion task → step interrupt: segments, and the blocks they start.
 pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();

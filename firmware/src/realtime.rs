@@ -9,7 +9,7 @@
 use crate::console::Activity;
 use crate::endstop;
 use crate::motion::{self, Motion};
-use crate::queues::{REALTIME, RX};
+use crate::queues::{FEED_PRESSES, REALTIME, RX};
 use crate::reply;
 use crate::rt::TaskCell;
 use crate::stepper;
@@ -54,7 +54,19 @@ pub fn on_receive(byte: u8) -> bool {
         None => match byte {
             SAFETY_DOOR_BYTE => DOOR,
             JOG_CANCEL_BYTE => JOG_CANCEL,
-            0x90..=0x97 => OVERRIDES + (byte - OVERRIDE_BYTES),
+            0x90..=0x97 => {
+                // 0x90 (100 %) cancels the presses before it; 0x91-0x94
+                // each add theirs, however many come before the task runs.
+                match byte {
+                    0x90 => FEED_PRESSES.clear(),
+                    0x91 => FEED_PRESSES.add(10),
+                    0x92 => FEED_PRESSES.add(-10),
+                    0x93 => FEED_PRESSES.add(1),
+                    0x94 => FEED_PRESSES.add(-1),
+                    _ => {}
+                }
+                OVERRIDES + (byte - OVERRIDE_BYTES)
+            }
             0x80.. => return true,
             _ => return false,
         },
@@ -66,11 +78,12 @@ pub fn on_receive(byte: u8) -> bool {
 /// The commands taken for one run of the task, in the order they act:
 /// reset, jog cancel, hold, resume, overrides, status.
 #[derive(Clone, Copy)]
-pub struct Requests(u16);
+pub struct Requests(u16, i16);
 
 impl Requests {
     pub fn take() -> Requests {
-        Requests(REALTIME.take())
+        // Masked each: a press between the two takes runs the task again.
+        Requests(REALTIME.take(), FEED_PRESSES.take())
     }
 
     fn has(self, bit: u8) -> bool {
@@ -101,6 +114,12 @@ impl Requests {
     /// The override bytes that came: bit `i` for 0x90 + `i`.
     pub fn overrides(self) -> u8 {
         (self.0 >> OVERRIDES) as u8
+    }
+
+    /// The feed override's presses summed, percent (after a 0x90 if one
+    /// came).
+    pub fn feed_presses(self) -> i16 {
+        self.1
     }
 
     pub fn status(self) -> bool {
@@ -161,10 +180,11 @@ impl Standing {
         *self = Standing::new();
     }
 
-    /// Override bytes (bit `i`: 0x90 + `i`); true if the overrides changed
-    /// (the next report carries them).
-    pub fn apply(&mut self, bits: u8) -> bool {
-        let changed = self.overrides.apply(bits);
+    /// Override bytes (bit `i`: 0x90 + `i`) with the feed's presses
+    /// counted apart (`feed`, percent); true if the overrides changed (the
+    /// next report carries them).
+    pub fn apply(&mut self, bits: u8, feed: i16) -> bool {
+        let changed = self.overrides.apply_counted(bits, feed);
         if changed {
             self.refresh.overrides_changed();
         }

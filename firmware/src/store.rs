@@ -94,6 +94,9 @@ impl Store {
     }
 
     /// A phase of the job starts: a new header, its records after it.
+    /// Out of line (also `record`): inlined into the job task, their frames
+    /// would add to its own (the stack peak).
+    #[inline(never)]
     pub fn begin(&mut self, phase: Phase, (nails, count, id): (u16, u32, CardId)) {
         self.seq = self.seq.wrapping_add(1);
         let h = Header {
@@ -106,6 +109,7 @@ impl Store {
         self.start(Header::address(self.seq), &h.encode());
     }
 
+    #[inline(never)]
     pub fn record(&mut self, r: Record) {
         self.start(Record::address(r.n), &r.encode(self.seq));
     }

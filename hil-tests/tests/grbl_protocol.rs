@@ -284,14 +284,16 @@ fn feed_and_rapid_overrides_change_the_speed_of_queued_moves() {
             false => status(sim),
         }
     };
-    // 13 moves of 1 mm at F600 (320 steps/s) queue up; halve the feed
-    // (five 10 % steps, each its own run of the task).
+    // 13 moves of 1 mm at F600 (320 steps/s) queue up; halve the feed:
+    // five 10 % steps, two of them back to back (before the task runs:
+    // each press counts all the same).
     for _ in 0..13 {
         send(&mut sim, "G1 X-1 F600");
     }
-    for _ in 0..5 {
+    for _ in 0..3 {
         bytes_then(&mut sim, &[0x92], 5);
     }
+    bytes_then(&mut sim, &[0x92, 0x92], 5);
     let r = ov(&mut sim);
     assert!(r.ends_with("|Ov:50,100,100>"), "{r}");
     send_ok(&mut sim, "M400", Duration::from_secs(30));

@@ -321,6 +321,9 @@ impl Planner {
 
     /// New overrides: the cruise speeds of the moves not yet taken, as
     /// Grbl's (the block being cut keeps its profile).
+    /// Built for speed (also `recalculate`): the real-time task runs it for
+    /// each override byte, and a move's planning waits for `recalculate`.
+    #[cfg_attr(target_arch = "avr", optimize(speed))]
     pub fn set_overrides(&mut self, overrides: Overrides) {
         self.overrides = Some(overrides);
         for i in 0..self.len {
@@ -342,6 +345,7 @@ impl Planner {
     /// and both cruise speeds allow and what still stops at the end of the
     /// queue; forwards, at most what the previous block can reach from its
     /// entry. Integer only.
+    #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn recalculate(&mut self) {
         let at = |i: usize| (self.head + i) % PLANNER_BLOCKS;
         let mut next_entry = 0u64;

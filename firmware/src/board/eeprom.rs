@@ -34,6 +34,8 @@ impl Eeprom {
 
     /// Byte `addr`; waits for a write in progress to end (callers check
     /// [`Eeprom::busy`] first where that matters).
+    /// Inlined: the settings image is read a byte at a time.
+    #[inline(always)]
     pub fn read(&self, addr: u16) -> u8 {
         while self.busy() {}
         // SAFETY: the EEPROM registers belong to this owner; setting EERE

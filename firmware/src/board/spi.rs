@@ -39,6 +39,8 @@ impl Spi {
         self.spi.spsr().write(|w| w.spi2x().set_bit());
     }
 
+    /// Inlined: once a byte of every card block (at `z` it was a call).
+    #[inline(always)]
     fn exchange(&mut self, out: u8) -> u8 {
         // SAFETY: SPDR takes any byte.
         self.spi.spdr().write(|w| unsafe { w.bits(out) });

@@ -42,3 +42,37 @@ impl Default for Flags {
         Self::new()
     }
 }
+
+/// A running sum the receive interrupt adds to and a task takes: presses
+/// that come faster than the task runs are counted, not merged.
+pub struct Tally(UnsafeCell<i16>);
+
+// SAFETY: as `Flags`: every access is masked.
+unsafe impl Sync for Tally {}
+
+impl Tally {
+    pub const fn new() -> Self {
+        Tally(UnsafeCell::new(0))
+    }
+
+    #[inline(always)]
+    pub fn add(&self, v: i8) {
+        // SAFETY: masked read-modify-write.
+        avr_device::interrupt::free(|_| unsafe {
+            let t = &mut *self.0.get();
+            *t = t.saturating_add(v.into());
+        });
+    }
+
+    #[inline(always)]
+    pub fn clear(&self) {
+        // SAFETY: masked write.
+        avr_device::interrupt::free(|_| unsafe { *self.0.get() = 0 });
+    }
+
+    /// The sum so far, and zero from now on.
+    pub fn take(&self) -> i16 {
+        // SAFETY: masked read-modify-write.
+        avr_device::interrupt::free(|_| unsafe { core::mem::take(&mut *self.0.get()) })
+    }
+}

@@ -9,7 +9,7 @@ pub mod ring;
 pub mod stack;
 pub mod task_cell;
 
-pub use flags::Flags;
+pub use flags::{Flags, Tally};
 
 /// What a software task wants after a run; the app reschedules it.
 #[derive(Clone, Copy, PartialEq, Eq)]

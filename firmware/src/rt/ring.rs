@@ -106,7 +106,9 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
         }
     }
 
-    /// Consumer: the oldest message, if any.
+    /// Consumer: the oldest message, if any. Inlined: the step interrupt
+    /// takes its blocks with it, and a call there deepens the stack peak.
+    #[inline(always)]
     pub fn pop(&self) -> Option<T> {
         let t = self.tail.load(Relaxed);
         if t == self.head.load(Relaxed) {

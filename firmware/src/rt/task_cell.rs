@@ -5,9 +5,10 @@
 //! must not touch a `TaskCell` (they use a `Ring` or `Flags`).
 
 use core::cell::{Cell, UnsafeCell};
+use core::mem::MaybeUninit;
 
 pub struct TaskCell<T> {
-    value: UnsafeCell<T>,
+    value: UnsafeCell<MaybeUninit<T>>,
     borrowed: Cell<bool>,
 }
 
@@ -18,16 +19,38 @@ unsafe impl<T> Sync for TaskCell<T> {}
 impl<T> TaskCell<T> {
     pub const fn new(value: T) -> Self {
         TaskCell {
-            value: UnsafeCell::new(value),
+            value: UnsafeCell::new(MaybeUninit::new(value)),
             borrowed: Cell::new(false),
         }
+    }
+
+    /// A cell of zeros, given its value by [`TaskCell::init`] at boot
+    /// before any [`TaskCell::with`]. For big state whose starting value
+    /// is nearly all zeros: a `new` cell's value is in `.data`, whose
+    /// every byte is also a byte of flash; this one is in `.bss` (same
+    /// SRAM, no flash).
+    pub const fn zeroed() -> Self {
+        TaskCell {
+            value: UnsafeCell::new(MaybeUninit::zeroed()),
+            borrowed: Cell::new(false),
+        }
+    }
+
+    /// The starting value of a [`TaskCell::zeroed`] cell (at boot, before
+    /// any task runs).
+    pub fn init(&self, value: T) {
+        assert!(!self.borrowed.get());
+        // SAFETY: exclusive as in `with`; the old value (zeros) is not
+        // dropped, only overwritten.
+        unsafe { (*self.value.get()).write(value) };
     }
 
     /// Run `f` with the state. Panics if a task re-enters it.
     pub fn with<R>(&self, f: impl FnOnce(&mut T) -> R) -> R {
         assert!(!self.borrowed.replace(true));
         // SAFETY: exclusive by the flag and the task-only contract.
-        let r = f(unsafe { &mut *self.value.get() });
+        // Initialised: by `new`, or by `init` at boot for a `zeroed` cell.
+        let r = f(unsafe { (*self.value.get()).assume_init_mut() });
         self.borrowed.set(false);
         r
     }

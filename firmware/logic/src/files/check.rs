@@ -120,6 +120,9 @@ impl Files {
         }
     }
 
+    /// Out of line (also `end`, `missing`): inlined into the job task, their
+    /// frames would add to its own (the stack peak).
+    #[inline(never)]
     pub fn push(&mut self, chunk: &[u8]) -> Result<(), FileError> {
         match &mut self.stage {
             Stage::Param(p) => {
@@ -136,6 +139,7 @@ impl Files {
 
     /// The current file ended. `base`: the configuration in force, which
     /// `machine.txt` amends.
+    #[inline(never)]
     pub fn end(&mut self, base: &MachineConfig) -> Result<Next, FileError> {
         // Finished in place: the parsers are too big to move around on the
         // AVR's stack.
@@ -170,6 +174,7 @@ impl Files {
 
     /// The card has no such file: only `machine.txt` may be left out, or
     /// `param.txt` on a plotter's card.
+    #[inline(never)]
     pub fn missing(&mut self, base: &MachineConfig) -> Result<Next, FileError> {
         match self.stage {
             Stage::Param(_) => {

@@ -35,6 +35,7 @@ pub struct FileError {
 }
 
 impl FileError {
+    #[inline(always)]
     pub const fn at(file: FileName, line: u32, col: u32, kind: ErrorKind) -> Self {
         FileError {
             file,
@@ -45,6 +46,7 @@ impl FileError {
     }
 
     /// An error about the whole file, printed without line and column.
+    #[inline(always)]
     pub const fn whole(file: FileName, kind: ErrorKind) -> Self {
         Self::at(file, 0, 0, kind)
     }
@@ -56,7 +58,10 @@ impl uDisplay for FileError {
         if self.line != 0 {
             uwrite!(f, ":{}:{}", self.line, self.col)?;
         }
-        uwrite!(f, ": {}", self.kind)
+        // Not `": "`: a string constant would sit in SRAM on the AVR.
+        f.write_char(':')?;
+        f.write_char(' ')?;
+        uwrite!(f, "{}", self.kind)
     }
 }
 

@@ -170,10 +170,17 @@ impl Seen {
             1 => {
                 let n = parse_u32(item.value).map_err(number_error)?;
                 if !(3..=MAX_NAILS as u32).contains(&n) {
-                    return Err(out_of_range(ErrorKind::Range {
-                        min: 3,
-                        max: MAX_NAILS as u32,
-                    }));
+                    // Built here: through the closure it would be a
+                    // constant in SRAM.
+                    return Err(FileError::at(
+                        FILE,
+                        item.line,
+                        item.value_col,
+                        ErrorKind::Range {
+                            min: 3,
+                            max: MAX_NAILS as u32,
+                        },
+                    ));
                 }
                 self.nails = Some(n as u16);
             }

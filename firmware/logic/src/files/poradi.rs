@@ -33,23 +33,33 @@ impl Sequence {
 
     /// Takes a number of the list; returns it if it is a nail index.
     fn take(&mut self, n: Number) -> Result<Option<u16>, FileError> {
-        let at = |kind| FileError::at(FILE, n.line, n.col, kind);
+        // No closure: called, its error would be a constant in SRAM.
         if self.declared.is_none() {
             if !(1..=MAX_CONNECTIONS).contains(&n.value) {
-                return Err(at(ErrorKind::Range {
-                    min: 1,
-                    max: MAX_CONNECTIONS,
-                }));
+                return Err(FileError::at(
+                    FILE,
+                    n.line,
+                    n.col,
+                    ErrorKind::Range {
+                        min: 1,
+                        max: MAX_CONNECTIONS,
+                    },
+                ));
             }
             self.declared = Some(n);
             return Ok(None);
         }
         self.found += 1;
         if n.value >= self.nails as u32 {
-            return Err(at(ErrorKind::Nail {
-                index: n.value,
-                nails: self.nails,
-            }));
+            return Err(FileError::at(
+                FILE,
+                n.line,
+                n.col,
+                ErrorKind::Nail {
+                    index: n.value,
+                    nails: self.nails,
+                },
+            ));
         }
         Ok(Some(n.value as u16))
     }

@@ -63,18 +63,23 @@ impl Overrides {
     /// Grbl's order — reset, coarse, fine — the feed kept within 10–200 %;
     /// true if anything changed.
     pub fn apply(&mut self, bits: u8) -> bool {
+        let has = |i: u8| bits >> i & 1 != 0;
+        let presses = [(1, 10), (2, -10), (3, 1), (4, -1)]
+            .iter()
+            .filter(|&&(i, _)| has(i))
+            .map(|&(_, step)| step)
+            .sum();
+        self.apply_counted(bits, presses)
+    }
+
+    /// As [`Overrides::apply`], the feed's ±10 % and ±1 % presses summed
+    /// in `feed` (each one counts, however many came together; bits 1–4
+    /// are then ignored): after a reset to 100 % (bit 0) if one came.
+    pub fn apply_counted(&mut self, bits: u8, feed: i16) -> bool {
         let before = *self;
         let has = |i: u8| bits >> i & 1 != 0;
-        let mut feed = self.feed as i16;
-        if has(0) {
-            feed = 100;
-        }
-        for (i, step) in [(1, 10), (2, -10), (3, 1), (4, -1)] {
-            if has(i) {
-                feed += step;
-            }
-        }
-        self.feed = feed.clamp(10, 200) as u8;
+        let base = if has(0) { 100 } else { self.feed as i16 };
+        self.feed = base.saturating_add(feed).clamp(10, 200) as u8;
         for (i, rapid) in [(5, 100), (6, 50), (7, 25)] {
             if has(i) {
                 self.rapid = rapid;

@@ -54,6 +54,8 @@ impl<T: TaskId, const N: usize, const P: usize> Ready<T, N, P> {
     }
 
     /// The oldest spawn at priority `level`, if any.
+    /// Inlined: the dispatcher's every pick (at `z` it was a call).
+    #[inline(always)]
     pub fn pop_level(&mut self, level: u8) -> Option<T> {
         let l = level as usize;
         let task = self.head[l]?;

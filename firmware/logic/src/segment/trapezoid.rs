@@ -103,7 +103,10 @@ impl Trapezoid {
     /// The speeds come by reference: on the AVR, arguments beyond 18 bytes
     /// go on the stack, and the compiler passes stacked `u64`s wrongly
     /// (seen here: the cruise speed arrived as garbage once this function
-    /// stopped being inlined).
+    /// stopped being inlined). Built for speed: once a block, and built for
+    /// size its frame is 130 bytes deeper (the stack peak is the motion
+    /// task's cut of a segment).
+    #[cfg_attr(target_arch = "avr", optimize(speed))]
     pub fn new(events: u32, accel: u32, speeds: &Speeds) -> Self {
         let mut t = Self::begin(events, accel, speeds);
         while !t.advance() {}

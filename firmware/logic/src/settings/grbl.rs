@@ -257,15 +257,20 @@ impl Numbered {
         // Lengths and rates are never below zero.
         let milli = milli.map(|m| m.0.max(0));
         let StepsPerUnit { num, den } = a.steps_per_unit;
-        let steps = |m: i32, scale: u64| {
-            Value::Number(per(&[m as u64, num as u64, den as u64 * scale]) as u32)
+        // Units per second or minute as steps: the divisor's scale, then
+        // one product in place (a closure taking the `u64` scale got it as
+        // garbage on the AVR once it was not inlined, at `opt-level = "z"`).
+        let scale: u64 = match unit {
+            Unit::PerSecond => 1000,
+            _ => 60_000,
         };
         let value = match (setting.get(cfg), unit) {
             (Value::Ratio(_), _) => Value::Ratio(parse_ratio(text)?),
             (Value::Milli(_), Unit::Same) => Value::Milli(Milli(milli?)),
             (Value::Number(_), Unit::Micro) => Value::Number(milli? as u32),
-            (Value::Number(_), Unit::PerSecond) => steps(milli?, 1000),
-            (Value::Number(_), Unit::PerMinute) => steps(milli?, 60_000),
+            (Value::Number(_), Unit::PerSecond | Unit::PerMinute) => {
+                Value::Number(per(&[milli? as u64, num as u64, den as u64 * scale]) as u32)
+            }
             // The travel keeps its upper end.
             (_, Unit::Span) => Value::Milli(Milli(a.travel.1 .0.saturating_sub(milli?))),
             (_, _) => Value::Number(whole?),

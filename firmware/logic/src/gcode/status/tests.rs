@@ -180,6 +180,12 @@ fn override_bytes_step_and_clamp_as_grbl_s() {
     // Reset, then the coarse and fine steps that came with it.
     o.apply(bit(0x90) | bit(0x91) | bit(0x93));
     assert_eq!(o.feed, 111);
+    // Presses counted apart: five 0x92 that came before one report are
+    // five steps down, not one.
+    assert!(o.apply_counted(bit(0x92), -50));
+    assert_eq!(o.feed, 61);
+    o.apply_counted(bit(0x90) | bit(0x91), 20);
+    assert_eq!(o.feed, 120, "reset, then the presses after it");
     o.apply(bit(0x96));
     assert_eq!(o.rapid, 50);
     o.apply(bit(0x97));
@@ -188,7 +194,7 @@ fn override_bytes_step_and_clamp_as_grbl_s() {
     assert_eq!(
         o,
         Overrides {
-            feed: 111,
+            feed: 120,
             rapid: 100
         }
     );

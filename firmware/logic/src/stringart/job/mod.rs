@@ -158,6 +158,9 @@ impl Job {
     /// or outside drilling and winding. A pause takes effect at the end of
     /// the batch: its remaining steps still come (drill raised, needle
     /// inside the ring before the machine stands).
+    /// Out of line: inlined into the job task, its frame would add to the
+    /// task's own (the stack peak).
+    #[inline(never)]
     pub fn next_step(&mut self) -> Option<MachineStep> {
         if self.run.is_some() {
             return self.tool_step();
