@@ -7,25 +7,25 @@
 //! prompts and the bad-file messages must reach the user.
 #![deny(unsafe_code)]
 
+use crate::checkpoint::BootNote;
 use crate::motion::Motion;
 use crate::queues::{
     CardMsg, Control, Request, Signal, What, BUTTONS, CARD_IN, CARD_OUT, CHUNK, JOB_CLAIMS_TX,
     JOB_CONTROL, TX,
 };
-use crate::checkpoint::BootNote;
 use crate::rt::Poll;
 use crate::store::Store;
 use crate::{error, info, report, texts};
 use core::sync::atomic::Ordering::Relaxed;
 use heapless::Deque;
 use taut_logic::axis::AXES;
+use taut_logic::checkpoint::Saved;
 use taut_logic::config::MachineConfig;
 use taut_logic::fat::Name;
 use taut_logic::files::check::{Files, Next};
 use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::planner::Feed;
-use taut_logic::checkpoint::Saved;
 use taut_logic::stringart::job::{Action, Event, Job, Phase, State};
 use taut_logic::stringart::{MachineStep, Save};
 
@@ -300,7 +300,12 @@ impl JobTask {
         self.ticket = self.ticket.wrapping_add(1).max(1);
         // The reader takes requests before anything else: one slot will do,
         // and a full one means the last request is being replaced anyway.
-        let name = Name::new(name.name().as_bytes()).unwrap_or(Name::EMPTY);
+        // Byte by byte from flash (the names fit a `Name`).
+        let text = name.name();
+        let mut name = Name::EMPTY;
+        for i in 0..text.len() {
+            let _ = name.push(text.byte(i));
+        }
         while CARD_IN.push(Request::Open(name, self.ticket)).is_err() {
             let _ = CARD_IN.pop();
         }
@@ -513,11 +518,7 @@ fn offer(phase: Phase, next: u32, total: u32) {
     };
     info!(
         ">>> resume ",
-        what,
-        next,
-        "/",
-        total,
-        "? green: resume, hold green 2 s: discard"
+        what, next, "/", total, "? green: resume, hold green 2 s: discard"
     );
 }
 

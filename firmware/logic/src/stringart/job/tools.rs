@@ -42,18 +42,20 @@ pub fn parse(key: &str, value: &str) -> Option<Result<Tool, ToolError>> {
             .map_err(|_| ToolError::BadValue)
     };
     let nail = || number().and_then(|n| u16::try_from(n).map_err(|_| ToolError::BadValue));
-    let is = |name: &str| key.eq_ignore_ascii_case(name);
-    Some(if is("wrap_test") {
+    // The names in flash: string constants would sit in the AVR's SRAM.
+    let is = |name: taut_progmem::Text| name.eq_ignore_ascii_case(key.as_bytes());
+    use taut_progmem::text;
+    Some(if is(text!("wrap_test")) {
         nail().map(Tool::WrapTest)
-    } else if is("wrap_step") {
-        match value.trim_start_matches('+') {
-            "1" => Ok(Tool::Step),
-            "-1" => Ok(Tool::Back),
+    } else if is(text!("wrap_step")) {
+        match value.trim_start_matches('+').as_bytes() {
+            [b'1'] => Ok(Tool::Step),
+            [b'-', b'1'] => Ok(Tool::Back),
             _ => Err(ToolError::BadValue),
         }
-    } else if is("wrap_jump") {
+    } else if is(text!("wrap_jump")) {
         number().map(Tool::Jump)
-    } else if is("drift") {
+    } else if is(text!("drift")) {
         nail().map(Tool::Drift)
     } else {
         return None;
