@@ -225,18 +225,18 @@ impl Line {
     /// constant's copy would keep its bytes in SRAM on the AVR.
     pub const fn empty() -> Line {
         Line {
-        n: None,
-        checksum: None,
-        distance: None,
-        plane: None,
-        units: None,
-        command: Command::Empty,
-        axes: [MaybeMilli::NONE; AXIS_WORDS],
-        f: MaybeMilli::NONE,
-        p: MaybeMilli::NONE,
-        offsets: [MaybeMilli::NONE; 3],
-        r: MaybeMilli::NONE,
-        s: MaybeMilli::NONE,
+            n: None,
+            checksum: None,
+            distance: None,
+            plane: None,
+            units: None,
+            command: Command::Empty,
+            axes: [MaybeMilli::NONE; AXIS_WORDS],
+            f: MaybeMilli::NONE,
+            p: MaybeMilli::NONE,
+            offsets: [MaybeMilli::NONE; 3],
+            r: MaybeMilli::NONE,
+            s: MaybeMilli::NONE,
         }
     }
 
