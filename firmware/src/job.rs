@@ -7,25 +7,25 @@
 //! prompts and the bad-file messages must reach the user.
 #![deny(unsafe_code)]
 
+use crate::checkpoint::BootNote;
 use crate::motion::Motion;
 use crate::queues::{
     CardMsg, Control, Request, Signal, What, BUTTONS, CARD_IN, CARD_OUT, CHUNK, JOB_CLAIMS_TX,
     JOB_CONTROL, TX,
 };
-use crate::checkpoint::BootNote;
 use crate::rt::Poll;
 use crate::store::Store;
 use crate::{error, info, report, texts};
 use core::sync::atomic::Ordering::Relaxed;
 use heapless::Deque;
 use taut_logic::axis::AXES;
+use taut_logic::checkpoint::Saved;
 use taut_logic::config::MachineConfig;
 use taut_logic::fat::Name;
-use taut_logic::files::check::{Files, Next};
+use taut_logic::files::check::{Checked, Files, Next};
 use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::planner::Feed;
-use taut_logic::checkpoint::Saved;
 use taut_logic::stringart::job::{Action, Event, Job, Phase, State};
 use taut_logic::stringart::{MachineStep, Save};
 
@@ -249,50 +249,69 @@ impl JobTask {
         };
         match next {
             Ok(Next::Open(name)) => self.open(name),
-            Ok(Next::Machine(c)) => {
-                // A plotter's card: that machine from here on, standing
-                // where it is as its zero (as `$machine=` does).
-                self.stream = Stream::None;
-                *config = c;
-                m.configure(config);
-                m.set_position([0; AXES]);
-                m.renew();
-                info!("machine.txt: the card is for the ", c.machine.name());
-                self.event(Event::OtherMachine, now);
-            }
-            Ok(Next::Done(c)) => {
-                self.stream = Stream::None;
-                info!(
-                    "files ok: shape ",
-                    c.params.shape,
-                    " nails ",
-                    c.params.nails,
-                    " radius ",
-                    c.params.radius_um,
-                    "um connections ",
-                    c.count
-                );
-                self.nails = c.params.nails;
-                // A new job takes the card's machine figures; a card coming
-                // back mid-job is only compared with the job's.
-                if self.job.state() == State::Reading && m.is_idle() {
-                    *config = c.config;
-                    m.configure(config);
-                }
-                let event = Event::FilesValid {
-                    params: c.params,
-                    count: c.count,
-                    config,
-                    id: c.id,
-                };
-                self.event(event, now);
-            }
-            Err(e) => {
-                self.stream = Stream::None;
-                error!(e);
-                self.event(Event::FilesInvalid, now);
-            }
+            Ok(Next::Machine(c)) => self.other_machine(&c, m, config, now),
+            Ok(Next::Done(c)) => self.files_valid(&c, m, config, now),
+            Err(e) => self.files_invalid(&e, now),
         }
+    }
+
+    // The answers to a file's end, out of line: their log lines are on
+    // the stack only while they are written, not beside the checks of
+    // every file (`Files::end`, the deepest of the job's calls).
+
+    /// A plotter's card: that machine from here on, standing where it is
+    /// as its zero (as `$machine=` does).
+    #[inline(never)]
+    fn other_machine(
+        &mut self,
+        c: &MachineConfig,
+        m: &mut Motion,
+        config: &mut MachineConfig,
+        now: u32,
+    ) {
+        self.stream = Stream::None;
+        *config = *c;
+        m.configure(config);
+        m.set_position([0; AXES]);
+        m.renew();
+        info!("machine.txt: the card is for the ", c.machine.name());
+        self.event(Event::OtherMachine, now);
+    }
+
+    #[inline(never)]
+    fn files_valid(&mut self, c: &Checked, m: &mut Motion, config: &mut MachineConfig, now: u32) {
+        self.stream = Stream::None;
+        info!(
+            "files ok: shape ",
+            c.params.shape,
+            " nails ",
+            c.params.nails,
+            " radius ",
+            c.params.radius_um,
+            "um connections ",
+            c.count
+        );
+        self.nails = c.params.nails;
+        // A new job takes the card's machine figures; a card coming
+        // back mid-job is only compared with the job's.
+        if self.job.state() == State::Reading && m.is_idle() {
+            *config = c.config;
+            m.configure(config);
+        }
+        let event = Event::FilesValid {
+            params: c.params,
+            count: c.count,
+            config,
+            id: c.id,
+        };
+        self.event(event, now);
+    }
+
+    #[inline(never)]
+    fn files_invalid(&mut self, e: &FileError, now: u32) {
+        self.stream = Stream::None;
+        error!(*e);
+        self.event(Event::FilesInvalid, now);
     }
 
     /// Ask the card reader for a file; its messages carry the new ticket.
@@ -300,7 +319,12 @@ impl JobTask {
         self.ticket = self.ticket.wrapping_add(1).max(1);
         // The reader takes requests before anything else: one slot will do,
         // and a full one means the last request is being replaced anyway.
-        let name = Name::new(name.name().as_bytes()).unwrap_or(Name::EMPTY);
+        // Byte by byte from flash (the names fit a `Name`).
+        let text = name.name();
+        let mut name = Name::EMPTY;
+        for i in 0..text.len() {
+            let _ = name.push(text.byte(i));
+        }
         while CARD_IN.push(Request::Open(name, self.ticket)).is_err() {
             let _ = CARD_IN.pop();
         }
@@ -513,11 +537,7 @@ fn offer(phase: Phase, next: u32, total: u32) {
     };
     info!(
         ">>> resume ",
-        what,
-        next,
-        "/",
-        total,
-        "? green: resume, hold green 2 s: discard"
+        what, next, "/", total, "? green: resume, hold green 2 s: discard"
     );
 }
 

@@ -78,24 +78,29 @@ impl Line {
     }
 
     pub fn new(level: Level, module: FlashStr) -> Line {
-        let mut l = Line {
-            buf: heapless::Vec::new(),
-            cut: false,
-            msg: true,
-        };
+        let mut l = Line::bare();
+        l.begin(level, module);
+        l
+    }
+
+    /// A log line's start, in a line made with [`Line::bare`] where it is
+    /// used (`log!`): a line returned by [`Line::new`] is built and then
+    /// copied, two lines on the stack.
+    #[inline(never)]
+    pub fn begin(&mut self, level: Level, module: FlashStr) {
+        self.msg = true;
         let tag = [b'E', b'W', b'I', b'D'][level as usize];
         // Pushed byte by byte: format strings' pieces would sit in SRAM.
         for c in [b'[', b'M', b'S', b'G', b':'] {
-            let _ = l.buf.push(c);
+            let _ = self.buf.push(c);
         }
-        let _ = l.buf.push(tag);
-        let _ = l.buf.push(b' ');
-        let _ = ufmt::uwrite!(l, "{}", clock::millis());
-        let _ = l.buf.push(b' ');
-        let _ = ufmt::uwrite!(l, "{}", module);
-        let _ = l.buf.push(b':');
-        let _ = l.buf.push(b' ');
-        l
+        let _ = self.buf.push(tag);
+        let _ = self.buf.push(b' ');
+        let _ = ufmt::uwrite!(self, "{}", clock::millis());
+        let _ = self.buf.push(b' ');
+        let _ = ufmt::uwrite!(self, "{}", module);
+        let _ = self.buf.push(b':');
+        let _ = self.buf.push(b' ');
     }
 
     /// A `[MSG:…]` push message in Grbl's form: no level, time or module;
@@ -139,24 +144,36 @@ impl Line {
         let _ = self.buf.push(b'\n');
     }
 
-    /// Queue the line, or count it as dropped.
-    pub fn emit(mut self) {
+    /// Queue the line, or count it as dropped. By reference: a line moved
+    /// into the call would be copied on the caller's stack, beside it.
+    pub fn emit(&mut self) {
         self.end();
         let dropped = dropped();
-        if dropped > 0 {
-            let mut note = Line::new(Level::Warn, crate::flash_str!("log"));
-            let _ = ufmt::uwrite!(note, "{}{}", dropped, crate::flash_str!(" lines dropped"));
-            note.end();
-            if note.buf.len() + self.buf.len() > crate::queues::TX.free() {
-                return count_drop();
-            }
-            usart::send(&note.buf);
-            avr_device::interrupt::free(|cs| DROPPED.borrow(cs).set(0));
+        if dropped > 0 && !note_dropped(dropped, self.buf.len()) {
+            return count_drop();
         }
         if !usart::send(&self.buf) {
             count_drop();
         }
     }
+}
+
+/// `n lines dropped`, queued if it fits with the `then` bytes of the line
+/// that follows it. Out of line: its line is on the stack only while
+/// there is a count to tell, not beside every line emitted.
+#[inline(never)]
+#[cold]
+fn note_dropped(dropped: u16, then: usize) -> bool {
+    let mut note = Line::bare();
+    note.begin(Level::Warn, crate::flash_str!("log"));
+    let _ = ufmt::uwrite!(note, "{}{}", dropped, crate::flash_str!(" lines dropped"));
+    note.end();
+    if note.buf.len() + then > crate::queues::TX.free() {
+        return false;
+    }
+    usart::send(&note.buf);
+    avr_device::interrupt::free(|cs| DROPPED.borrow(cs).set(0));
+    true
 }
 
 fn count_drop() {
@@ -204,7 +221,8 @@ macro_rules! log {
     ($level:expr, $($parts:tt)*) => {
         if $level <= $crate::log::MAX_LEVEL {
             #[allow(unused_mut)]
-            let mut line = $crate::log::Line::new($level, $crate::__log_module!());
+            let mut line = $crate::log::Line::bare();
+            line.begin($level, $crate::__log_module!());
             $crate::__log_parts!(line; $($parts)*);
             line.emit();
         }

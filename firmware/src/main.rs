@@ -98,6 +98,7 @@ const _: () = {
     let mut i = 0;
     while i < Task::ALL.len() {
         assert!(Task::ALL[i] as usize == i);
+        assert!(task_of(i as u8) as usize == i);
         i += 1;
     }
 };
@@ -156,13 +157,29 @@ fn reschedule(task: Task, poll: Poll<Signal>) {
 /// `s` happened: run the tasks waiting for it.
 fn signal(s: Signal) {
     let waiting = WAITING.with(|w| core::mem::take(&mut w[s as usize]));
-    for task in Task::ALL.iter().filter(|&&t| waiting >> t as u8 & 1 != 0) {
-        spawn(*task);
+    for id in 0..Task::ALL.len() as u8 {
+        if waiting >> id & 1 != 0 {
+            spawn(task_of(id));
+        }
     }
 }
 
-fn task_of(id: u8) -> Task {
-    Task::ALL[id as usize]
+/// `Task::ALL[id]`, worked out: a table would sit in SRAM.
+const fn task_of(id: u8) -> Task {
+    match id {
+        0 => Task::Timers,
+        1 => Task::Realtime,
+        2 => Task::Refill,
+        3 => Task::Motion,
+        4 => Task::Console,
+        5 => Task::Buttons,
+        6 => Task::Job,
+        7 => Task::Card,
+        8 => Task::Logger,
+        9 => Task::Led,
+        10 => Task::Store,
+        _ => unreachable!(),
+    }
 }
 
 /// Spawn `task` in `ms`, replacing its earlier one-shot timer.

@@ -418,13 +418,16 @@ impl Print {
     pub fn line_failed(&mut self, e: &Error, why: Option<taut_logic::text::ErrorKind>) {
         // A `\r` ended the line before its `\n` was counted.
         let line = self.at.lines + u32::from(self.last != b'\n');
-        let mut r = Line::new(Level::Error, crate::__log_module!());
-        let _ = uwrite!(r, "{}:{}:", self.name, line);
-        if let Some(c) = e.column() {
-            let _ = uwrite!(r, "{}:", c);
+        {
+            let mut r = Line::bare();
+            r.begin(Level::Error, crate::__log_module!());
+            let _ = uwrite!(r, "{}:{}:", self.name, line);
+            if let Some(c) = e.column() {
+                let _ = uwrite!(r, "{}:", c);
+            }
+            let _ = uwrite!(r, " {}", reply::Because(e, why));
+            r.emit();
         }
-        let _ = uwrite!(r, " {}", reply::Because(e, why));
-        r.emit();
         if e.kind() != ErrorKind::UnsupportedCommand {
             warn!("print stopped");
             self.close();

@@ -160,7 +160,7 @@ fn entered(sim: &hil_tests::sim::Sim, state: &str) -> f64 {
 /// the same files (`taut_logic::stringart::estimate`), within 1 %.
 fn machine_time_is_the_estimate(sim: &hil_tests::sim::Sim, card: &Path) {
     use taut_logic::files::FileName;
-    let read = |f: FileName| std::fs::read(card.join(f.name())).ok();
+    let read = |f: FileName| std::fs::read(card.join(f.name().to_string())).ok();
     let files = [FileName::Param, FileName::Machine, FileName::Poradi].map(|f| (f, read(f)));
     let file = |name| {
         files

@@ -37,6 +37,9 @@ pub(crate) struct Shared {
     pub sp_floor: u16,
     /// Program counter and simavr cycle of the last stack pointer write.
     pub last_sp_write: (u32, u64),
+    /// The last stack pointer write was of SPH: a 16-bit update may be
+    /// half done (its SPL write still to come).
+    pub sph_alone: bool,
     /// Cycles the core has slept.
     pub asleep: u64,
     /// Where the core was when simavr declared it crashed (a program
@@ -80,6 +83,7 @@ impl Shared {
             spi: None,
             sp_floor: crate::elf::RAM_END,
             last_sp_write: (0, 0),
+            sph_alone: false,
             asleep: 0,
             crash_pc: None,
             cli_sites: Vec::new(),
@@ -231,9 +235,12 @@ pub(crate) unsafe extern "C" fn on_sp_write(
     let data = (*avr).data;
     *data.add(usize::from(addr)) = v;
     shared.last_sp_write = ((*avr).pc, (*avr).cycle);
+    // An `out SPH` (a push or call writes SPL then SPH in one go).
+    shared.sph_alone = usize::from(addr) == SPH && out_to((*avr).flash, (*avr).pc) == Some(SPH);
     // Between the two bytes of a 16-bit update this may be a value the
     // stack never held; the run loop checks the real one after the
-    // instruction.
+    // instruction, or after the SPL write that completes a frame set-up
+    // (`Sim::sp_half_written`).
     // (The byte just stored is not read back: a wider load over a fresh
     // narrow store stalls the host for longer than the rest of this.)
     let sp = if usize::from(addr) == SPL {
@@ -244,6 +251,17 @@ pub(crate) unsafe extern "C" fn on_sp_write(
     if sp < shared.sp_floor {
         end_batch(avr);
     }
+}
+
+/// The data address an `out` instruction at byte address `pc` of `flash`
+/// writes, if it is one.
+///
+/// # Safety
+/// `flash` holds at least `pc + 2` bytes.
+pub(crate) unsafe fn out_to(flash: *const u8, pc: u32) -> Option<usize> {
+    let w = u16::from_le_bytes([*flash.add(pc as usize), *flash.add(pc as usize + 1)]);
+    // OUT A, Rr: 1011 1AAr rrrr AAAA; A is an I/O address (data - 0x20).
+    (w & 0xF800 == 0xB800).then(|| usize::from(((w >> 5) & 0x30) | (w & 0x0F)) + 0x20)
 }
 
 /// A write of SREG (simavr has stored and unpacked it already): if it

@@ -202,7 +202,7 @@ impl Sim {
         for w in &mut self.call_watches {
             w.observe(pc, sp, now);
         }
-        if sp < self.min_sp {
+        if sp < self.min_sp && !self.sp_half_written(pc) {
             self.min_sp = sp;
             self.min_sp_pc = pc;
             self.shared_mut().sp_floor = sp;
@@ -215,5 +215,34 @@ impl Sim {
             }
         }
         None
+    }
+
+    /// Whether the stack pointer holds half of a 16-bit update: the code
+    /// wrote SPH and writes SPL next, with at most the SREG restore between
+    /// (the compilers' frame set-up: `out SPH; out SREG; out SPL`). The I
+    /// flag that restore may set takes effect only after the next
+    /// instruction (in simavr too), so nothing uses the stack at the
+    /// half-written value, which may lie up to 255 bytes below both the old
+    /// and the new one: the new depth counts once SPL is written.
+    fn sp_half_written(&self, pc: u32) -> bool {
+        use crate::hooks::{out_to, SPL};
+        const SREG: usize = 0x5F;
+        if !self.shared().sph_alone {
+            return false;
+        }
+        let avr = self.avr.as_ptr();
+        // SAFETY: `avr` is live; `flash` holds `flashend + 1` bytes, and
+        // `pc + 4` is checked against it.
+        unsafe {
+            let flash = (*avr).flash;
+            if pc + 4 > (*avr).flashend + 1 {
+                return false;
+            }
+            match out_to(flash, pc) {
+                Some(SPL) => true,
+                Some(SREG) => out_to(flash, pc + 2) == Some(SPL),
+                _ => false,
+            }
+        }
     }
 }

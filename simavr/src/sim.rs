@@ -51,7 +51,7 @@ const fn ioctl(a: u8, b: u8, c: u8, d: u8) -> u32 {
 }
 
 pub struct Sim {
-    avr: NonNull<ffi::avr_t>,
+    pub(crate) avr: NonNull<ffi::avr_t>,
     shared: NonNull<Shared>,
     /// Boxed: simavr holds their addresses, which must survive the Vec growing.
     #[allow(clippy::vec_box)]

@@ -309,3 +309,39 @@ fn batched_runs_see_what_single_instructions_see() {
     // in, cli, nop, nop, out: masked from after the cli to after the out.
     assert_eq!(batched.5.map(|s| s.2), Some(3));
 }
+
+/// A frame set up as the compilers do (`out SPH; out SREG; out SPL`) from
+/// SP 0x2105 to 0x20F5, then a push. Between the two writes SP reads
+/// 0x2005, a value the stack never holds: interrupts wait for the
+/// instruction after the SREG restore.
+const FRAME_ACROSS_A_PAGE: [u16; 14] = [
+    0x9478, // sei
+    0xE005, // ldi r16, 0x05
+    0xBF0D, // out SPL, r16: SP 0x2105
+    0xB7CD, // in r28, SPL
+    0xB7DE, // in r29, SPH
+    0x9760, // sbiw r28, 0x10
+    0xB60F, // in r0, SREG
+    CLI,    //
+    0xBFDE, // out SPH, r29
+    0xBE0F, // out SREG, r0
+    0xBFCD, // out SPL, r28: SP 0x20F5
+    0x930F, // push r16: SP 0x20F4
+    0x0000, // nop
+    0xCFFF, // rjmp .-2
+];
+
+#[test]
+fn a_half_written_stack_pointer_is_not_a_depth() {
+    for single in [false, true] {
+        let mut sim = Sim::from_program(&FRAME_ACROSS_A_PAGE).unwrap();
+        if single {
+            sim.watch_pc(0x3_FFFE);
+        }
+        sim.run_for(ms(1));
+        assert_eq!(sim.lowest_sp(), 0x20F4, "single {single}");
+        assert_eq!(sim.peak_stack_bytes(), 0x21FF - 0x20F4);
+        // After the push.
+        assert_eq!(sim.peak_stack_pc(), 24);
+    }
+}

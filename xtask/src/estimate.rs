@@ -37,7 +37,7 @@ pub fn run(args: &[String]) -> Result<()> {
 
 /// The job of the card folder `dir`, timed.
 pub fn estimate(dir: &Path) -> Result<CardEstimate> {
-    let read = |name: FileName| std::fs::read(dir.join(name.name())).ok();
+    let read = |name: FileName| std::fs::read(dir.join(name.name().to_string())).ok();
     let files = [FileName::Param, FileName::Machine, FileName::Poradi].map(|f| (f, read(f)));
     let file = |name: FileName| {
         files

@@ -132,6 +132,81 @@ const GLOBAL_FIELDS: [GlobalField; 22] = [
     GlobalField::ReportInches,
 ];
 
+// The tables above in order of discriminant: `at` works them out.
+const _: () = {
+    let mut i = 0;
+    while i < GLOBAL_FIELDS.len() {
+        assert!(GLOBAL_FIELDS[i] as usize == i);
+        i += 1;
+    }
+    let mut i = 0;
+    while i < AXIS_FIELDS.len() {
+        assert!(AXIS_FIELDS[i] as usize == i);
+        i += 1;
+    }
+};
+
+impl GlobalField {
+    /// `GLOBAL_FIELDS[i]`, worked out rather than looked up: a table
+    /// would sit in SRAM on the AVR.
+    fn at(i: usize) -> Option<GlobalField> {
+        use GlobalField::*;
+        Some(match i {
+            0 => Machine,
+            1 => StepPulseUs,
+            2 => DirSetupUs,
+            3 => EnableSetupUs,
+            4 => JunctionDeviationUm,
+            5 => ArcToleranceUm,
+            6 => Length1,
+            7 => Length2,
+            8 => OriginX,
+            9 => OriginY,
+            10 => Crosstalk,
+            11 => PenUp,
+            12 => PenDown,
+            13 => PenSettleMs,
+            14 => DwellPMs,
+            15 => HomingAxes,
+            16 => HomingAtStart,
+            17 => HomingSeek,
+            18 => HomingLocate,
+            19 => HomingPullOff,
+            20 => StatusReport,
+            21 => ReportInches,
+            _ => return None,
+        })
+    }
+}
+
+impl AxisField {
+    /// `AXIS_FIELDS[i % 8]`, worked out (see [`GlobalField::at`]).
+    fn at(i: usize) -> AxisField {
+        use AxisField::*;
+        match i % AXIS_FIELDS.len() {
+            0 => StepsPerUnit,
+            1 => MaxRate,
+            2 => Accel,
+            3 => DirInvert,
+            4 => EnableActiveHigh,
+            5 => SoftLimits,
+            6 => TravelMin,
+            7 => TravelMax,
+            _ => TravelMax,
+        }
+    }
+}
+
+/// Every global field, in order.
+fn global_fields() -> impl Iterator<Item = GlobalField> + Clone {
+    (0..GLOBAL_FIELDS.len()).filter_map(GlobalField::at)
+}
+
+/// Every axis field, in order.
+fn axis_fields() -> impl Iterator<Item = AxisField> + Clone {
+    (0..AXIS_FIELDS.len()).map(AxisField::at)
+}
+
 /// Largest denominator of steps per unit (nine decimals): Grbl's units
 /// of `$110` and `$120` are then worked out in 64 bits.
 pub const MAX_DEN: u32 = 1_000_000_000;
@@ -188,8 +263,8 @@ impl GlobalField {
 pub fn all() -> impl Iterator<Item = Setting> {
     let per_axis = Axis::ALL
         .into_iter()
-        .flat_map(|a| AXIS_FIELDS.into_iter().map(move |f| Setting::Axis(a, f)));
-    let globals = GLOBAL_FIELDS.into_iter().map(Setting::Global);
+        .flat_map(|a| axis_fields().map(move |f| Setting::Axis(a, f)));
+    let globals = global_fields().map(Setting::Global);
     globals
         .clone()
         .take(1)
@@ -257,14 +332,11 @@ impl Setting {
                 key.len() > prefix.len() && prefix.is_prefix_of(key) && key[prefix.len()] == b'_';
             if named {
                 let rest = &key[prefix.len() + 1..];
-                let field = AXIS_FIELDS
-                    .into_iter()
-                    .find(|f| f.name().eq_ignore_ascii_case(rest))?;
+                let field = axis_fields().find(|f| f.name().eq_ignore_ascii_case(rest))?;
                 return Some(Setting::Axis(axis, field));
             }
         }
-        GLOBAL_FIELDS
-            .into_iter()
+        global_fields()
             .find(|f| f.name().eq_ignore_ascii_case(key))
             .map(Setting::Global)
     }
@@ -277,9 +349,9 @@ impl Setting {
             0 => Some(Setting::Global(GlobalField::Machine)),
             i if i <= per_axis => {
                 let (axis, field) = ((i - 1) / AXIS_FIELDS.len(), (i - 1) % AXIS_FIELDS.len());
-                Some(Setting::Axis(Axis::ALL[axis], AXIS_FIELDS[field]))
+                Some(Setting::Axis(Axis::ALL[axis], AxisField::at(field)))
             }
-            i => GLOBAL_FIELDS.get(i - per_axis).map(|g| Setting::Global(*g)),
+            i => GlobalField::at(i - per_axis).map(Setting::Global),
         }
     }
 
@@ -557,6 +629,17 @@ mod tests {
     use proptest::prelude::*;
     use std::string::String;
     use std::vec::Vec;
+
+    #[test]
+    fn fields_worked_out_are_the_tables() {
+        for (i, g) in GLOBAL_FIELDS.iter().enumerate() {
+            assert_eq!(GlobalField::at(i), Some(*g));
+        }
+        assert_eq!(GlobalField::at(GLOBAL_FIELDS.len()), None);
+        for (i, a) in AXIS_FIELDS.iter().enumerate() {
+            assert_eq!(AxisField::at(i), *a);
+        }
+    }
 
     fn listing(cfg: &MachineConfig) -> Vec<String> {
         let mut lines = Vec::new();

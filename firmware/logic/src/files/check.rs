@@ -143,22 +143,23 @@ impl Files {
     pub fn end(&mut self, base: &MachineConfig) -> Result<Next, FileError> {
         // Finished in place: the parsers are too big to move around on the
         // AVR's stack.
+        // The next stage is built out of line, off the frame of the checks.
         match &mut self.stage {
             Stage::Param(p) => {
                 let params = p.finish()?;
-                self.stage = Stage::Machine(params, MachineFile::new(*base));
+                self.machine_next(params, base);
             }
             Stage::Plotter(m) => {
-                let config = m.finish()?;
+                let config = m.finish_in_place()?;
                 return match config.machine.is_string_art() {
                     true => Err(FileError::whole(FileName::Param, ErrorKind::NotFound)),
-                    false => Ok(Next::Machine(config)),
+                    false => Ok(Next::Machine(*config)),
                 };
             }
             Stage::Machine(params, m) => {
                 let params = *params;
-                let config = m.finish()?;
-                self.stage = Stage::Poradi(params, config, PoradiCheck::new(params.nails));
+                m.finish_in_place()?;
+                self.poradi_next(params);
             }
             Stage::Poradi(params, config, c) => {
                 return Ok(Next::Done(Checked {
@@ -170,6 +171,20 @@ impl Files {
             }
         }
         Ok(Next::Open(self.file()))
+    }
+
+    #[inline(never)]
+    fn machine_next(&mut self, params: Params, base: &MachineConfig) {
+        self.stage = Stage::Machine(params, MachineFile::new(*base));
+    }
+
+    /// `poradi.txt` next, with the configuration `machine.txt` made.
+    #[inline(never)]
+    fn poradi_next(&mut self, params: Params) {
+        if let Stage::Machine(_, m) = &mut self.stage {
+            let config = *m.config();
+            self.stage = Stage::Poradi(params, config, PoradiCheck::new(params.nails));
+        }
     }
 
     /// The card has no such file: only `machine.txt` may be left out, or

@@ -2,6 +2,7 @@
 //! expected, printed as a single log line `file:line:col: message`.
 
 use crate::text::ErrorKind;
+use taut_progmem::{text, Text};
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
 /// The files the machine reads from the card.
@@ -13,12 +14,12 @@ pub enum FileName {
 }
 
 impl FileName {
-    /// The 8.3 name on the card (matched case-insensitively).
-    pub const fn name(self) -> &'static str {
+    /// The 8.3 name on the card (matched case-insensitively); in flash.
+    pub fn name(self) -> Text {
         match self {
-            FileName::Param => "param.txt",
-            FileName::Poradi => "poradi.txt",
-            FileName::Machine => "machine.txt",
+            FileName::Param => text!("param.txt"),
+            FileName::Poradi => text!("poradi.txt"),
+            FileName::Machine => text!("machine.txt"),
         }
     }
 }
@@ -54,7 +55,7 @@ impl FileError {
 
 impl uDisplay for FileError {
     fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
-        f.write_str(self.file.name())?;
+        uwrite!(f, "{}", self.file.name())?;
         if self.line != 0 {
             uwrite!(f, ":{}:{}", self.line, self.col)?;
         }

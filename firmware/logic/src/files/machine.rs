@@ -48,13 +48,24 @@ impl MachineFile {
 
     /// The configuration with the file's overrides, checked as a whole.
     pub fn finish(&mut self) -> Result<MachineConfig, FileError> {
+        self.finish_in_place().copied()
+    }
+
+    /// The configuration as the lines so far made it.
+    pub fn config(&self) -> &MachineConfig {
+        &self.cfg
+    }
+
+    /// [`MachineFile::finish`] leaving the configuration where it is: no
+    /// copy on the (AVR's small) stack.
+    pub fn finish_in_place(&mut self) -> Result<&MachineConfig, FileError> {
         if let Some(item) = self.kv.finish()? {
             apply(&mut self.cfg, &mut self.seen, item)?;
         }
         self.cfg
             .validate()
             .map_err(|kind| FileError::whole(FILE, kind))?;
-        Ok(self.cfg)
+        Ok(&self.cfg)
     }
 }
 

@@ -219,20 +219,26 @@ pub struct Line {
 
 impl Line {
     /// A blank line (or one holding only comments): answered with `ok`.
-    pub const EMPTY: Line = Line {
-        n: None,
-        checksum: None,
-        distance: None,
-        plane: None,
-        units: None,
-        command: Command::Empty,
-        axes: [MaybeMilli::NONE; AXIS_WORDS],
-        f: MaybeMilli::NONE,
-        p: MaybeMilli::NONE,
-        offsets: [MaybeMilli::NONE; 3],
-        r: MaybeMilli::NONE,
-        s: MaybeMilli::NONE,
-    };
+    pub const EMPTY: Line = Line::empty();
+
+    /// [`Line::EMPTY`] built by code where it is used at run time: a
+    /// constant's copy would keep its bytes in SRAM on the AVR.
+    pub const fn empty() -> Line {
+        Line {
+            n: None,
+            checksum: None,
+            distance: None,
+            plane: None,
+            units: None,
+            command: Command::Empty,
+            axes: [MaybeMilli::NONE; AXIS_WORDS],
+            f: MaybeMilli::NONE,
+            p: MaybeMilli::NONE,
+            offsets: [MaybeMilli::NONE; 3],
+            r: MaybeMilli::NONE,
+            s: MaybeMilli::NONE,
+        }
+    }
 
     pub fn axis(&self, word: AxisWord) -> Option<Milli> {
         self.axes[word.index()].get()

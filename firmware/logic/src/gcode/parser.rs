@@ -228,7 +228,7 @@ impl Parser {
         match self.statement {
             Statement::Start => Ok(Input::Line(Line {
                 checksum,
-                ..Line::EMPTY
+                ..Line::empty()
             })),
             Statement::GCode(words) => {
                 let jog = words.is_jog();

@@ -108,7 +108,7 @@ impl SystemBuilder {
 
     /// `$RST=` has just been read: its `*` is no checksum.
     pub(super) fn restores(&self) -> bool {
-        self.equals && self.value.is_empty() && self.key.eq_ignore_ascii_case("RST")
+        self.equals && self.value.is_empty() && is_rst(&self.key)
     }
 
     /// `$J=` has just been read: the rest is a jog's G-code.
@@ -120,11 +120,11 @@ impl SystemBuilder {
         if let Some(e) = self.error {
             return Err(e);
         }
-        if self.equals && self.key.eq_ignore_ascii_case("RST") {
-            return match self.value.as_str() {
-                "$" => Ok(SystemLine::Restore(Restore::Settings)),
-                "#" => Ok(SystemLine::Restore(Restore::Offsets)),
-                "*" => Ok(SystemLine::Restore(Restore::All)),
+        if self.equals && is_rst(&self.key) {
+            return match self.value.as_bytes() {
+                [b'$'] => Ok(SystemLine::Restore(Restore::Settings)),
+                [b'#'] => Ok(SystemLine::Restore(Restore::Offsets)),
+                [b'*'] => Ok(SystemLine::Restore(Restore::All)),
                 _ => Err(Error::new(ErrorKind::InvalidStatement, self.dollar + 5)),
             };
         }
@@ -138,23 +138,29 @@ impl SystemBuilder {
                 })
             };
         }
-        match self.key.as_str() {
-            "$" => Ok(SystemLine::PrintSettings),
-            "Q" | "q" => Ok(SystemLine::QueueStats),
-            "S" | "s" => Ok(SystemLine::Stack),
-            "X" | "x" => Ok(SystemLine::Unlock),
-            "H" | "h" => Ok(SystemLine::Home),
-            "I" | "i" => Ok(SystemLine::BuildInfo),
-            "G" | "g" => Ok(SystemLine::ParserState),
-            "#" => Ok(SystemLine::Offsets),
-            "N" | "n" => Ok(SystemLine::StartupLines),
-            "C" | "c" => Ok(SystemLine::CheckMode),
-            "SLP" | "slp" => Ok(SystemLine::Sleep),
-            "T1" | "t1" => Ok(SystemLine::Pattern(1)),
-            "T5" | "t5" => Ok(SystemLine::Pattern(5)),
-            "T6" | "t6" => Ok(SystemLine::Pattern(6)),
-            "T7" | "t7" => Ok(SystemLine::Pattern(7)),
+        // Byte patterns, not string ones: those compare with constant
+        // strings, which the AVR keeps in SRAM.
+        match self.key.as_bytes() {
+            [b'$'] => Ok(SystemLine::PrintSettings),
+            [b'Q' | b'q'] => Ok(SystemLine::QueueStats),
+            [b'S' | b's'] => Ok(SystemLine::Stack),
+            [b'X' | b'x'] => Ok(SystemLine::Unlock),
+            [b'H' | b'h'] => Ok(SystemLine::Home),
+            [b'I' | b'i'] => Ok(SystemLine::BuildInfo),
+            [b'G' | b'g'] => Ok(SystemLine::ParserState),
+            [b'#'] => Ok(SystemLine::Offsets),
+            [b'N' | b'n'] => Ok(SystemLine::StartupLines),
+            [b'C' | b'c'] => Ok(SystemLine::CheckMode),
+            [b'S', b'L', b'P'] | [b's', b'l', b'p'] => Ok(SystemLine::Sleep),
+            [b'T', n] | [b't', n] if matches!(n, b'1' | b'5' | b'6' | b'7') => {
+                Ok(SystemLine::Pattern(n - b'0'))
+            }
             _ => Err(Error::new(ErrorKind::InvalidStatement, self.dollar)),
         }
     }
+}
+
+/// `RST`, in any case (compared with a text in flash).
+fn is_rst(key: &str) -> bool {
+    taut_progmem::text!("RST").eq_ignore_ascii_case(key.as_bytes())
 }

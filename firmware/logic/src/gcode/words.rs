@@ -41,7 +41,7 @@ pub(super) struct Words {
 impl Words {
     pub(super) const fn new(jog: bool) -> Words {
         Words {
-            line: Line::EMPTY,
+            line: Line::empty(),
             word: None,
             error: None,
             command_column: 0,

@@ -42,20 +42,20 @@ pub fn parse(key: &str, value: &str) -> Option<Result<Tool, ToolError>> {
             .map_err(|_| ToolError::BadValue)
     };
     let nail = || number().and_then(|n| u16::try_from(n).map_err(|_| ToolError::BadValue));
-    // The names in flash and the values as byte patterns: string
-    // constants would sit in SRAM on the AVR.
+    // The names in flash: string constants would sit in the AVR's SRAM.
     let is = |name: taut_progmem::Text| name.eq_ignore_ascii_case(key.as_bytes());
-    Some(if is(taut_progmem::text!("wrap_test")) {
+    use taut_progmem::text;
+    Some(if is(text!("wrap_test")) {
         nail().map(Tool::WrapTest)
-    } else if is(taut_progmem::text!("wrap_step")) {
+    } else if is(text!("wrap_step")) {
         match value.trim_start_matches('+').as_bytes() {
             [b'1'] => Ok(Tool::Step),
             [b'-', b'1'] => Ok(Tool::Back),
             _ => Err(ToolError::BadValue),
         }
-    } else if is(taut_progmem::text!("wrap_jump")) {
+    } else if is(text!("wrap_jump")) {
         number().map(Tool::Jump)
-    } else if is(taut_progmem::text!("drift")) {
+    } else if is(text!("drift")) {
         nail().map(Tool::Drift)
     } else {
         return None;
