@@ -11,7 +11,7 @@
 //! event of every block is still executed after [`Prep::resume`], so the
 //! position is kept exactly.
 
-use crate::planner::{Planned, Planner};
+use crate::planner::Planner;
 use crate::segment::{Later, Preparer, Segment, StepBlock};
 
 /// Where a feed hold stands.
@@ -151,28 +151,24 @@ impl Prep {
             Hold::Braking if carried == 0 => return self.stopped_at_block_end(planner),
             _ => {}
         }
-        let Some(p) = planner.take() else {
+        let Some(t) = planner.take_speeds() else {
             // The queue ends at rest: a hold's stop is there.
             return match self.hold {
                 Hold::Braking => self.stopped_at_block_end(planner),
                 _ => None,
             };
         };
-        let Planned {
-            block,
-            profile,
-            ev_per_milli_sqr,
-        } = p;
+        // Made in place, whole: this path is the hold's, or a caller's
+        // that does not bound its runs.
+        self.cut.begin_block(t.block.events, t.accel, &t.speeds);
+        self.cut.finish_block();
         if self.hold == Hold::Braking {
             // The same path speed in the new block's events.
-            let entry = (carried as f32 * (ev_per_milli_sqr / self.ev_per_milli_sqr)) as u64;
-            self.cut
-                .start_stopping(profile, entry.min(profile.speed_sqr(0)));
-        } else {
-            self.cut.start(profile);
+            let entry = (carried as f32 * (t.ev_per_milli_sqr / self.ev_per_milli_sqr)) as u64;
+            self.cut.brake_from(entry);
         }
-        self.ev_per_milli_sqr = ev_per_milli_sqr;
-        Some(block)
+        self.ev_per_milli_sqr = t.ev_per_milli_sqr;
+        Some(t.block)
     }
 
     /// A hold's stop fell on a block's end: nothing more until resumed.

@@ -124,7 +124,20 @@ impl Preparer {
     /// preparer stays idle until then). Only once the last block is cut.
     pub fn begin_block(&mut self, events: u32, accel: u32, speeds: &Speeds) {
         debug_assert!(self.is_idle());
-        self.switch(Trapezoid::begin(events, accel, speeds));
+        self.leave_leg();
+        self.profile.begin_in_place(events, accel, speeds);
+    }
+
+    /// A block begun by [`Preparer::begin_block`] made whole at once.
+    pub fn finish_block(&mut self) {
+        while !self.advance_block() {}
+    }
+
+    /// Starts the block just made braking from `entry_sqr` (at most its
+    /// planned entry): a hold that did not stop inside the previous
+    /// block; returns the speed² left at its end.
+    pub fn brake_from(&mut self, entry_sqr: u64) -> u64 {
+        self.brake(entry_sqr.min(self.speed_sqr()))
     }
 
     /// The next part of the profile begun by [`Preparer::begin_block`];
@@ -166,19 +179,12 @@ impl Preparer {
     /// Feed hold: the rest of the block becomes the quickest stop from the
     /// current speed at the block's acceleration. Returns the speed² left
     /// at the end of the block when it is too short to stop in (the next
-    /// block must go on braking: [`Preparer::start_stopping`]), else 0.
+    /// block must go on braking: [`Preparer::brake_from`]), else 0.
     pub fn stop(&mut self) -> u64 {
         if self.is_idle() {
             return self.speed_sqr();
         }
         self.brake(self.speed_sqr())
-    }
-
-    /// Starts the next block braking from `entry_sqr` (a hold that did not
-    /// stop inside the previous block); returns the speed² left at its end.
-    pub fn start_stopping(&mut self, profile: Trapezoid, entry_sqr: u64) -> u64 {
-        self.start(profile);
-        self.brake(entry_sqr)
     }
 
     /// After a hold stopped the block: the rest of it from rest, to the
@@ -191,9 +197,8 @@ impl Preparer {
             cruise_sqr: self.cruise_sqr,
             exit_sqr: self.exit_sqr,
         };
-        let leg = Trapezoid::new(left, self.accel, &speeds);
-        self.switch(leg);
-        leg.exit_sqr()
+        self.switch_to(left, &speeds);
+        self.profile.exit_sqr()
     }
 
     /// The rest of the block: braking from `v_sqr` to a stop, or to its end.
@@ -205,31 +210,45 @@ impl Preparer {
             _ => (left, v_sqr - two_a * left),
         };
         // Standing already: an empty leg (a profile needs an event).
-        let leg = match n {
-            0 => Trapezoid::idle(),
+        match n {
+            0 => self.switch(Trapezoid::idle()),
             n => {
                 let speeds = Speeds {
                     entry_sqr: v_sqr,
                     cruise_sqr: v_sqr,
                     exit_sqr: end_sqr,
                 };
-                Trapezoid::new(n as u32, self.accel, &speeds)
+                self.switch_to(n as u32, &speeds);
             }
-        };
-        self.switch(leg);
+        }
         end_sqr
+    }
+
+    /// [`Preparer::switch`] to a leg of `events` at the block's
+    /// acceleration, made in place: a hold's legs come deep in the stack
+    /// (a feed hold inside a card print's line), where a profile's copy
+    /// would cost its size again.
+    fn switch_to(&mut self, events: u32, speeds: &Speeds) {
+        self.leave_leg();
+        self.profile.begin_in_place(events, self.accel, speeds);
+        while !self.profile.advance() {}
     }
 
     /// Make `leg` the profile from the last event cut on. Its ideal start
     /// is that event's ideal time on the leg before.
     fn switch(&mut self, leg: Trapezoid) {
+        self.leave_leg();
+        self.profile = leg;
+    }
+
+    /// The last event cut becomes the next leg's start.
+    fn leave_leg(&mut self) {
         self.now = if self.done > 0 {
             self.now - self.profile.time(self.done) as i64
         } else {
             self.now
         };
         self.before += self.done;
-        self.profile = leg;
         self.done = 0;
         self.memo = [(u32::MAX, 0); 2];
         self.shorter = (u32::MAX, 0);

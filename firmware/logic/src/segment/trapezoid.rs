@@ -120,6 +120,15 @@ impl Trapezoid {
     /// [`Trapezoid::advance`] until it returns true. Until then the
     /// profile must not be read.
     pub fn begin(events: u32, accel: u32, speeds: &Speeds) -> Self {
+        let mut t = Self::idle();
+        t.begin_in_place(events, accel, speeds);
+        t
+    }
+
+    /// [`Trapezoid::begin`] over this profile, every field written in
+    /// place: no copy of a profile (130 bytes) on the stack, where a feed
+    /// hold's legs are made deep in a card print's line.
+    pub fn begin_in_place(&mut self, events: u32, accel: u32, speeds: &Speeds) {
         let Speeds {
             entry_sqr,
             cruise_sqr,
@@ -135,20 +144,17 @@ impl Trapezoid {
             .min((v0_sqr + v1_sqr + two_ae) / 2)
             .max(v0_sqr)
             .max(v1_sqr);
-        let shift = (64 - (64 - peak.leading_zeros())) / 2;
-        Trapezoid {
-            events,
-            accel: a,
-            two_a,
-            v0_sqr,
-            v1_sqr,
-            cruise_sqr,
-            shift,
-            acc2: peak - v0_sqr,
-            dec2: peak - v1_sqr,
-            part: 1,
-            ..Self::idle()
-        }
+        self.events = events;
+        self.accel = a;
+        self.two_a = two_a;
+        self.v0_sqr = v0_sqr;
+        self.v1_sqr = v1_sqr;
+        self.cruise_sqr = cruise_sqr;
+        self.shift = (64 - (64 - peak.leading_zeros())) / 2;
+        self.acc2 = peak - v0_sqr;
+        self.dec2 = peak - v1_sqr;
+        // The rest is made by `advance`, in order.
+        self.part = 1;
     }
 
     /// The next part of the profile begun by [`Trapezoid::begin`]; true
