@@ -124,16 +124,27 @@ pub fn serve(
 /// The path rebuilt from the step pulses (base and radial, i.e. X and Y)
 /// passes through every line's end in `ends`, in order, and stands at the
 /// last; the path.
-pub fn assert_path_through(sim: &Sim, ends: &[[i64; 2]]) -> Vec<[i64; 2]> {
+pub fn assert_path_through(sim: &mut Sim, ends: &[[i64; 2]]) -> Vec<[i64; 2]> {
     let path: Vec<[i64; 2]> = track(sim).iter().map(|(_, s)| [s[0], s[1]]).collect();
     let mut at = 0;
     for (i, end) in ends.iter().enumerate() {
         match path[at..].iter().position(|p| p == end) {
             Some(k) => at += k,
-            None => panic!(
-                "line {} ends at {end:?}, never reached after pulse {at}",
-                i + 2
-            ),
+            None => {
+                // What tells a lost byte from a lost step: the queues'
+                // counts (the receive ring's refusals) and where the path
+                // went instead.
+                let near = path[at..]
+                    .iter()
+                    .min_by_key(|p| (p[0] - end[0]).abs() + (p[1] - end[1]).abs());
+                let from = sim.uart_bytes().len();
+                let _ = sim.send_line("$Q", std::time::Duration::from_secs(1));
+                panic!(
+                    "line {} ends at {end:?}, never reached after pulse {at} (nearest {near:?})\n{}",
+                    i + 2,
+                    sim.uart_text_from(from)
+                )
+            }
         }
     }
     assert_eq!(

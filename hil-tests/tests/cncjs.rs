@@ -222,7 +222,7 @@ fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
     assert!(after > 0, "no pulses in the 100 ms after the cycle start");
 
     // Every line's end, in order, on the path the pulses made.
-    let path = assert_path_through(&sim, &ends);
+    let path = assert_path_through(&mut sim, &ends);
 
     // What CNCjs wrote besides the job: on connecting, then its polls.
     let rx = String::from_utf8_lossy(&rx);

@@ -47,7 +47,7 @@ fn grbl_streamer_streams_2000_lines_counting_characters_and_the_pulses_follow() 
     }
     eprintln!("{}", said.trim());
     // Every line's end, in order, on the path the pulses made.
-    let path = assert_path_through(&sim, &ends);
+    let path = assert_path_through(&mut sim, &ends);
     // The step queue's health under this load, reported (not judged
     // here: the planner, not the protocol, decides it).
     eprintln!("{} pulses; {}", path.len(), underruns(&sim));
@@ -128,7 +128,7 @@ fn taut_send_streams_the_walk_and_fails_on_a_refused_line() {
         said.contains("2000 of 2000 lines answered, 0 error(s)"),
         "{said}"
     );
-    assert_path_through(&sim, &ends);
+    assert_path_through(&mut sim, &ends);
     eprintln!("{}\n{wall:?} wall; {}", said.trim(), underruns(&sim));
 
     // Line 3 is past the flatbed's 140 mm: refused before anything moves.
@@ -146,7 +146,7 @@ fn taut_send_streams_the_walk_and_fails_on_a_refused_line() {
     );
     assert!(said.contains("4 of 4 lines answered, 1 error(s)"), "{said}");
     // The lines around it ran.
-    assert_path_through(&sim, &[[400, 400], [800, 400]]);
+    assert_path_through(&mut sim, &[[400, 400], [800, 400]]);
 
     // Longer than the 127 bytes in flight can be: refused up front (no
     // port needed).
