@@ -50,6 +50,12 @@ pub struct Tally(UnsafeCell<i16>);
 // SAFETY: as `Flags`: every access is masked.
 unsafe impl Sync for Tally {}
 
+impl Default for Tally {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Tally {
     pub const fn new() -> Self {
         Tally(UnsafeCell::new(0))
