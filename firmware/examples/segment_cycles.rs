@@ -19,7 +19,9 @@ const N: u32 = 64;
 #[avr_device::entry]
 fn main() -> ! {
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
-    dp.PORTB.ddrb().write(|w| w.pb7().set_bit().pb6().set_bit().pb5().set_bit());
+    dp.PORTB
+        .ddrb()
+        .write(|w| w.pb7().set_bit().pb6().set_bit().pb5().set_bit());
     // Quotients with every bit pattern, remainders up to the divisor.
     let mut x: u32 = 0x9E37_79B9;
     let mut agree = true;
@@ -42,7 +44,9 @@ fn main() -> ! {
     let toggle = || dp.PORTB.pinb().write(|w| w.pb6().set_bit());
     led(true);
     for i in 0..N {
-        black_box(isqrt(black_box(0x3FFF_0000_0000_0000 - (i as u64) * 0x1234_5678_9ABC)));
+        black_box(isqrt(black_box(
+            0x3FFF_0000_0000_0000 - (i as u64) * 0x1234_5678_9ABC,
+        )));
     }
     led(false);
     let speeds = Speeds {

@@ -494,7 +494,10 @@ fn realtime() {
             }
         }
         if r.overrides() != 0 {
-            if let Some(o) = STANDING.with(|rt| rt.apply(r.overrides(), r.feed_presses()).then_some(rt.overrides)) {
+            if let Some(o) = STANDING.with(|rt| {
+                rt.apply(r.overrides(), r.feed_presses())
+                    .then_some(rt.overrides)
+            }) {
                 m.set_overrides(o);
             }
         }
