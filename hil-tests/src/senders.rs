@@ -121,6 +121,40 @@ pub fn serve(
     }
 }
 
+/// The client sent every move of the job once, in order: the ends (in
+/// steps, as [`random_walk`] gives them) of the lines with `X` and `Y`
+/// words among the bytes it `wrote`, real-time bytes left out. A client
+/// that skips or repeats a line fails here, before the pulses are blamed.
+pub fn assert_sent_in_order(client: &str, wrote: &[u8], ends: &[[i64; 2]]) {
+    let text: String = wrote
+        .iter()
+        .filter(|&&b| b.is_ascii() && !matches!(b, b'?' | b'!' | b'~' | 0x18))
+        .map(|&b| b as char)
+        .collect();
+    let word = |line: &str, letter: char| {
+        let at = line.find(letter)? + 1;
+        let end = line[at..]
+            .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+            .map_or(line.len(), |k| at + k);
+        line[at..end].parse::<f64>().ok()
+    };
+    let sent: Vec<[i64; 2]> = text
+        .lines()
+        .filter(|l| !l.starts_with('$'))
+        .filter_map(|l| Some([word(l, 'X')?, word(l, 'Y')?]))
+        .map(|[x, y]| [(x * 40.0).round() as i64, (y * 40.0).round() as i64])
+        .collect();
+    if let Some(i) = (0..sent.len().max(ends.len())).find(|&i| sent.get(i) != ends.get(i)) {
+        panic!(
+            "{client} sent move {} as {:?}, the file has {:?} (line {}): the client skipped or repeated a line",
+            i + 1,
+            sent.get(i),
+            ends.get(i),
+            i + 2
+        );
+    }
+}
+
 /// The path rebuilt from the step pulses (base and radial, i.e. X and Y)
 /// passes through every line's end in `ends`, in order, and stands at the
 /// last; the path.

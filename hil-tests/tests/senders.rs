@@ -6,7 +6,8 @@
 //! every line's end point, in order.
 
 use hil_tests::senders::{
-    assert_path_through, client_script, clients_dir, install_clients, random_walk, serve, underruns,
+    assert_path_through, assert_sent_in_order, client_script, clients_dir, install_clients,
+    random_walk, serve, underruns,
 };
 use hil_tests::{boot_machine, send_ok};
 use std::path::{Path, PathBuf};
@@ -35,7 +36,10 @@ fn grbl_streamer_streams_2000_lines_counting_characters_and_the_pulses_follow() 
     client.arg(script);
     let limit = Duration::from_secs(120);
     let args = [file.to_str().unwrap(), &limit.as_secs().to_string()];
-    let out = serve(&mut sim, &mut client, &args, limit, |_, _, _| {});
+    let mut wrote = Vec::new();
+    let out = serve(&mut sim, &mut client, &args, limit, |_, bytes, _| {
+        wrote.extend_from_slice(bytes)
+    });
     std::fs::remove_file(&file).unwrap();
     let said =
         String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
@@ -46,6 +50,7 @@ fn grbl_streamer_streams_2000_lines_counting_characters_and_the_pulses_follow() 
         panic!("{said}\n{queues}");
     }
     eprintln!("{}", said.trim());
+    assert_sent_in_order("grbl-streamer", &wrote, &ends);
     // Every line's end, in order, on the path the pulses made.
     let path = assert_path_through(&mut sim, &ends);
     // The step queue's health under this load, reported (not judged
