@@ -18,16 +18,16 @@ use crate::store::Store;
 use crate::{error, info, report, texts};
 use core::sync::atomic::Ordering::Relaxed;
 use heapless::Deque;
-use taut_logic::axis::AXES;
+use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::checkpoint::Saved;
 use taut_logic::config::MachineConfig;
 use taut_logic::fat::Name;
-use taut_logic::files::check::{Checked, Files, Next};
+use taut_logic::files::check::{CardId, Checked, Files, Next};
 use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
-use taut_logic::planner::Feed;
-use taut_logic::stringart::job::{Action, Event, Job, Phase, State};
-use taut_logic::stringart::{MachineStep, Save};
+use taut_logic::planner::{Feed, Full};
+use taut_logic::stringart::job::{Action, Event, Feeder, Feeding, Job, Machine, Phase, State};
+use taut_logic::stringart::Save;
 
 /// Room for a whole log line, claimed from the console while there is none.
 fn room_for_a_line() -> bool {
@@ -70,12 +70,9 @@ pub struct JobTask {
     /// Numbers the card requests; messages of older ones are dropped.
     ticket: u8,
     nails: u16,
-    /// Between `NextMoves` and `MotionDone`: taking steps, then waiting
-    /// for the machine to stand.
-    pulling: bool,
-    settling: bool,
-    pending: Option<MachineStep>,
-    dwell_until: Option<u32>,
+    /// Between `NextMoves` and `MotionDone`: the batch's steps handed to
+    /// the planner, then the wait for the machine to stand.
+    feeder: Feeder,
     /// Queue figures are logged line by line after a job ends.
     report_line: Option<u8>,
     /// What the boot found of a checkpoint, to say once there is room.
@@ -96,10 +93,7 @@ impl JobTask {
             stream: Stream::None,
             ticket: 0,
             nails: 0,
-            pulling: false,
-            settling: false,
-            pending: None,
-            dwell_until: None,
+            feeder: Feeder::new(),
             report_line: None,
             boot_note: None,
         }
@@ -182,12 +176,7 @@ impl JobTask {
             let e = match c {
                 Control::Resume => Event::Resume,
                 Control::Abort => {
-                    // The machine stopped and its queues were emptied: the
-                    // steps in hand and the wait for them are gone too.
-                    self.pulling = false;
-                    self.settling = false;
-                    self.pending = None;
-                    self.dwell_until = None;
+                    self.feeder.abort();
                     if matches!(self.stream, Stream::Pattern(_)) {
                         self.stream = Stream::None;
                     }
@@ -429,7 +418,7 @@ impl JobTask {
                     at[axis.index()] = 0;
                     m.set_position(at);
                 }
-                Action::NextMoves => self.pulling = true,
+                Action::NextMoves => self.feeder.pull(),
                 Action::Progress(p) => info!(p),
                 Action::Offer { phase, next, total } => offer(phase, next, total),
                 Action::Drift { nail, expected } => {
@@ -459,72 +448,53 @@ impl JobTask {
     /// Hand the job's steps to the planner; report `MotionDone` when the
     /// machine stands after the last one.
     fn run_steps(&mut self, m: &mut Motion, store: &mut Store, now: u32) -> Poll<Signal> {
-        // A checkpoint is durable before the next step.
-        if store.saving() {
-            return Poll::After(4);
-        }
-        if let Some(until) = self.dwell_until {
-            let left = until.wrapping_sub(now) as i32;
-            if left > 0 {
-                return Poll::After(left as u16);
+        let mut rig = Rig { m, store };
+        match self.feeder.run(&mut self.job, &mut rig, now, STEPS_PER_RUN) {
+            Feeding::Again => Poll::Again,
+            Feeding::Motion => Poll::Wait(Signal::Motion),
+            Feeding::After(ms) => Poll::After(ms),
+            Feeding::Done => {
+                self.event(Event::MotionDone, now);
+                Poll::Again
             }
-            self.dwell_until = None;
+            Feeding::Idle => Poll::Idle,
         }
-        let mut budget = STEPS_PER_RUN;
-        while self.pulling {
-            if budget == 0 {
-                return Poll::Again;
-            }
-            budget -= 1;
-            let Some(step) = self.pending.take().or_else(|| self.job.next_step()) else {
-                self.pulling = false;
-                self.settling = true;
-                break;
-            };
-            match step {
-                MachineStep::Move(targets) => {
-                    let mut at = m.target();
-                    for i in 0..AXES {
-                        if let Some(t) = targets[i] {
-                            at[i] = t;
-                        }
-                    }
-                    if m.push(at, Feed::Rapid).is_err() {
-                        self.pending = Some(step);
-                        return Poll::Wait(Signal::Motion);
-                    }
-                }
-                // Dwells and driver switches wait for the machine to stand.
-                _ if !m.is_idle() => {
-                    self.pending = Some(step);
-                    return Poll::Wait(Signal::Motion);
-                }
-                MachineStep::Dwell(ms) => {
-                    self.dwell_until = Some(now.wrapping_add(ms as u32));
-                    return Poll::After(ms);
-                }
-                MachineStep::Drivers { mask, on } => m.drivers.set(mask, on),
-                MachineStep::Save(save) => {
-                    match save {
-                        Save::Begin(phase) => match self.job.card() {
-                            Some(card) => store.begin(phase, card),
-                            None => continue,
-                        },
-                        Save::Record(r) => store.record(r),
-                    }
-                    return Poll::After(4);
-                }
-            }
+    }
+}
+
+/// The machine the job's steps run on: the motion, and the store that
+/// writes their checkpoints.
+struct Rig<'a> {
+    m: &'a mut Motion,
+    store: &'a mut Store,
+}
+
+impl Machine for Rig<'_> {
+    fn target(&self) -> PerAxis<i32> {
+        self.m.target()
+    }
+
+    fn push(&mut self, to: PerAxis<i32>) -> Result<(), Full> {
+        self.m.push(to, Feed::Rapid)
+    }
+
+    fn is_idle(&self) -> bool {
+        self.m.is_idle()
+    }
+
+    fn drivers(&mut self, mask: u8, on: bool) {
+        self.m.drivers.set(mask, on)
+    }
+
+    fn save(&mut self, save: Save, card: (u16, u32, CardId)) {
+        match save {
+            Save::Begin(phase) => self.store.begin(phase, card),
+            Save::Record(r) => self.store.record(r),
         }
-        if self.settling {
-            if !m.is_idle() {
-                return Poll::Wait(Signal::Motion);
-            }
-            self.settling = false;
-            self.event(Event::MotionDone, now);
-            return Poll::Again;
-        }
-        Poll::Idle
+    }
+
+    fn saving(&self) -> bool {
+        self.store.saving()
     }
 }
 

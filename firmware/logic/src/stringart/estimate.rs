@@ -5,14 +5,15 @@
 //! between batches (a few ms each) are left out. The operator is assumed
 //! to answer every prompt at once.
 //!
-//! How the firmware carries the steps out (`firmware/src/job.rs`): the
-//! moves of a batch go into the planner together, so it blends them; a
-//! dwell or a driver switch waits until the machine stands, and so does
-//! the end of every batch and every checkpoint write (`firmware/src/store.rs`:
-//! one differing EEPROM byte per 4 ms run, the job back 4 ms after).
+//! The steps are carried out by the firmware's own [`Feeder`]: the moves
+//! of a batch go into the planner while it has room, so it blends them
+//! (a block runs when the planner is full); a dwell, a driver switch, the
+//! end of every batch and every checkpoint write wait until the machine
+//! stands (`firmware/src/store.rs`: one differing EEPROM byte per 4 ms
+//! run, the job looking again every 4 ms).
 
-use super::job::{Action, Actions, Event, Job, State};
-use super::{machine_time, Drilling, MachineStep, Overlap, Save, Winder, Winding};
+use super::job::{Action, Actions, Event, Feeder, Feeding, Job, Machine, State, SAVE_POLL_MS};
+use super::{machine_time, Drilling, Overlap, Save, Winder, Winding};
 use crate::axis::PerAxis;
 use crate::buttons::ButtonEvent;
 use crate::checkpoint::{self, Header, Record};
@@ -23,7 +24,7 @@ use crate::files::poradi::PoradiReader;
 use crate::files::{FileError, FileName};
 use crate::geometry::Board;
 use crate::pinmap::Button;
-use crate::planner::{Feed, Planner};
+use crate::planner::{Feed, Full, Planner};
 use crate::segment::SUBTICKS_PER_S;
 use crate::units::Milli;
 
@@ -50,34 +51,43 @@ pub enum EstimateError {
 }
 
 /// The machine: the firmware's planner, and the time its blocks take.
-struct Machine {
+struct Timed {
     planner: Planner,
-    /// Sub-ticks of motion and dwell so far.
+    /// Sub-ticks of motion and waiting so far.
     subticks: u64,
     /// The EEPROM as the checkpoint writes leave it (blank at first), and
     /// the header in force: only differing bytes take time.
     eeprom: [u8; checkpoint::END as usize],
     seq: u16,
+    /// Sub-ticks the checkpoint being written still takes.
+    saving: u64,
 }
 
 /// A run of the Store task, and the job's wait between its looks.
-const SAVE_RUN_MS: u64 = 4;
+const SAVE_RUN_MS: u64 = SAVE_POLL_MS as u64;
 
-impl Machine {
-    /// Every planned block run to its end: the machine stands.
-    fn settle(&mut self) {
-        while let Some(p) = self.planner.take() {
+impl Timed {
+    /// The oldest planned block run to its end.
+    fn run_block(&mut self) {
+        if let Some(p) = self.planner.take() {
             self.subticks += p.profile.time(p.profile.events());
         }
+    }
+
+    /// `ms` pass with the machine standing.
+    fn wait(&mut self, ms: u16) {
+        let t = ms as u64 * SUBTICKS_PER_S / 1000;
+        self.subticks += t;
+        self.saving = self.saving.saturating_sub(t);
     }
 
     fn ms(&self) -> u32 {
         (self.subticks * 1000 / SUBTICKS_PER_S) as u32
     }
 
-    /// The checkpoint bytes `bytes` written at `at`, the machine standing.
-    fn save(&mut self, at: u16, bytes: &[u8]) {
-        self.settle();
+    /// The checkpoint bytes `bytes` written at `at`: a run of the store
+    /// per differing byte, and its first look.
+    fn write(&mut self, at: u16, bytes: &[u8]) {
         let mut ms = SAVE_RUN_MS;
         for (cell, &b) in self.eeprom[at as usize..].iter_mut().zip(bytes) {
             if *cell != b {
@@ -85,34 +95,28 @@ impl Machine {
                 ms += SAVE_RUN_MS;
             }
         }
-        self.subticks += ms * SUBTICKS_PER_S / 1000;
+        self.saving = ms * SUBTICKS_PER_S / 1000;
+    }
+}
+
+impl Machine for Timed {
+    fn target(&self) -> PerAxis<i32> {
+        self.planner.position()
     }
 
-    /// `card`: the job's ([`Job::card`]), named by a phase's header.
-    fn carry_out(&mut self, step: MachineStep, card: Option<(u16, u32, CardId)>) {
-        match step {
-            MachineStep::Move(targets) => {
-                let mut at = self.planner.position();
-                for (a, t) in at.iter_mut().zip(targets) {
-                    if let Some(t) = t {
-                        *a = t;
-                    }
-                }
-                if self.planner.is_full() {
-                    self.settle();
-                }
-                // Not full: cannot fail.
-                let _ = self.planner.push(at, Feed::Rapid);
-            }
-            MachineStep::Dwell(ms) => {
-                self.settle();
-                self.subticks += ms as u64 * SUBTICKS_PER_S / 1000;
-            }
-            MachineStep::Drivers { .. } => self.settle(),
-            MachineStep::Save(Save::Begin(phase)) => {
-                let Some((nails, count, id)) = card else {
-                    return;
-                };
+    fn push(&mut self, to: PerAxis<i32>) -> Result<(), Full> {
+        self.planner.push(to, Feed::Rapid)
+    }
+
+    fn is_idle(&self) -> bool {
+        self.planner.is_idle()
+    }
+
+    fn drivers(&mut self, _: u8, _: bool) {}
+
+    fn save(&mut self, save: Save, (nails, count, id): (u16, u32, CardId)) {
+        match save {
+            Save::Begin(phase) => {
                 self.seq = self.seq.wrapping_add(1);
                 let header = Header {
                     seq: self.seq,
@@ -121,12 +125,14 @@ impl Machine {
                     count,
                     id,
                 };
-                self.save(Header::address(self.seq), &header.encode());
+                self.write(Header::address(self.seq), &header.encode());
             }
-            MachineStep::Save(Save::Record(r)) => {
-                self.save(Record::address(r.n), &r.encode(self.seq));
-            }
+            Save::Record(r) => self.write(Record::address(r.n), &r.encode(self.seq)),
         }
+    }
+
+    fn saving(&self) -> bool {
+        self.saving > 0
     }
 }
 
@@ -148,16 +154,17 @@ pub fn job_time(
     config: &MachineConfig,
     mut pattern: impl Iterator<Item = u16>,
 ) -> Result<JobTime, EstimateError> {
-    let mut m = Machine {
+    let mut m = Timed {
         planner: Planner::new(config),
         subticks: 0,
         eeprom: [0xFF; checkpoint::END as usize],
         seq: 0,
+        saving: 0,
     };
     let mut job = Job::new();
     let mut time = JobTime::default();
     let mut started = 0;
-    let mut pulling = false;
+    let mut feeder = Feeder::new();
     let mut pending = Pending::new();
     queue(&mut pending, job.on(Event::PowerOn, 0));
     queue(&mut pending, job.on(Event::CardInserted, 0));
@@ -198,7 +205,7 @@ pub fn job_time(
                     Actions::new()
                 }
                 Action::NextMoves => {
-                    pulling = true;
+                    feeder.pull();
                     Actions::new()
                 }
                 _ => Actions::new(),
@@ -212,17 +219,16 @@ pub fn job_time(
         if !pending.is_empty() {
             continue;
         }
-        if !pulling {
+        let now = m.ms();
+        match feeder.run(&mut job, &mut m, now, u8::MAX) {
+            Feeding::Again => {}
+            Feeding::Motion => m.run_block(),
+            Feeding::After(ms) => m.wait(ms),
+            Feeding::Done => queue(&mut pending, job.on(Event::MotionDone, m.ms())),
             // Nothing moves and nothing is asked: the job waits for
             // what the pattern no longer has.
-            return Err(EstimateError::PatternShort);
+            Feeding::Idle => return Err(EstimateError::PatternShort),
         }
-        pulling = false;
-        while let Some(step) = job.next_step() {
-            m.carry_out(step, job.card());
-        }
-        m.settle();
-        queue(&mut pending, job.on(Event::MotionDone, m.ms()));
     }
 }
 

@@ -31,22 +31,23 @@
 //! The firmware's loop, in outline:
 //! ```text
 //! on each event e:    for a in job.on(e, now_ms) { carry out a }
-//!                     (NextMoves sets `pulling`)
+//!                     (NextMoves: feeder.pull())
 //! while job.wants_nail() and the pattern reader has an index j:
 //!                     for a in job.on(Event::Nail(j), now_ms) { … }
-//! while pulling and the motion queue has room:
-//!                     match job.next_step() { Some(s) => queue s,
-//!                                             None => pulling = false }
-//! when !pulling, the queue is empty and the machine stands, once per
-//! NextMoves:          for a in job.on(Event::MotionDone, now_ms) { … }
+//! then:               match feeder.run(job, machine, now_ms, budget) {
+//!                         Done => job.on(Event::MotionDone, now_ms), … }
 //! ```
+//! The [`Feeder`] hands the batch's steps to the machine and waits for it
+//! to stand: the same code in the firmware and in the host's estimate.
 
+mod feed;
 mod io;
 mod phase;
 mod phase_steps;
 mod progress;
 pub mod tools;
 
+pub use feed::{Feeder, Feeding, Machine, SAVE_POLL_MS};
 pub use io::{Action, Actions, Event, Msg, Prompt, State, PROMPT_MARK};
 pub use phase::Phase;
 pub use phase_steps::FEED;

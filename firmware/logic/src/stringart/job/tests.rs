@@ -5,6 +5,7 @@ use super::*;
 use crate::stringart::{Save, Winding};
 use std::vec::Vec;
 
+mod feed;
 mod props;
 mod resume;
 mod tools;
