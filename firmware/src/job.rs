@@ -44,8 +44,6 @@ const LINE_ROOM: usize = 96;
 /// `poradi.txt` streamed for winding.
 struct Pattern {
     reader: PoradiReader,
-    /// Indices to pass over (already wound before the card was lost).
-    skip: u32,
     chunk: [u8; CHUNK],
     at: u8,
     len: u8,
@@ -348,10 +346,6 @@ impl JobTask {
                     return;
                 }
             };
-            if p.skip > 0 {
-                p.skip -= 1;
-                continue;
-            }
             self.event(Event::Nail(nail), now);
         }
     }
@@ -386,8 +380,8 @@ impl JobTask {
                     self.stream = Stream::Files(Files::new());
                     self.open(FileName::Param);
                 }
-                Action::OpenPattern { skip } => {
-                    self.stream = Stream::Pattern(Pattern::new(self.nails, skip));
+                Action::OpenPattern => {
+                    self.stream = Stream::Pattern(Pattern::new(self.nails));
                     self.open(FileName::Poradi);
                 }
                 Action::StopMotion | Action::NextMoves if !m.is_idle() => {
@@ -512,10 +506,9 @@ fn offer(phase: Phase, next: u32, total: u32) {
 }
 
 impl Pattern {
-    fn new(nails: u16, skip: u32) -> Self {
+    fn new(nails: u16) -> Self {
         Pattern {
             reader: PoradiReader::new(nails),
-            skip,
             chunk: [0; CHUNK],
             at: 0,
             len: 0,

@@ -200,10 +200,6 @@ pub fn job_time(
                     m.planner.set_position(at);
                     Actions::new()
                 }
-                Action::OpenPattern { skip } => {
-                    (&mut pattern).take(skip as usize).for_each(drop);
-                    Actions::new()
-                }
                 Action::NextMoves => {
                     feeder.pull();
                     Actions::new()

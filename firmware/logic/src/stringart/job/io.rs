@@ -222,11 +222,10 @@ pub enum Action {
     /// Read and check the card's files; answer with `FilesValid` or
     /// `FilesInvalid`.
     ReadFiles,
-    /// Open `poradi.txt` for streaming ([`crate::files::poradi::PoradiReader`])
-    /// and pass over its first `skip` nail indices (already fed).
-    OpenPattern {
-        skip: u32,
-    },
+    /// Open `poradi.txt` for streaming from its start
+    /// ([`crate::files::poradi::PoradiReader`]), each index an
+    /// [`Event::Nail`]; the job passes over those it already had.
+    OpenPattern,
     /// Stop any motion under way (a console jog) and drop what is queued,
     /// before what follows (the card went while the machine may move).
     StopMotion,

@@ -100,6 +100,9 @@ pub struct Job {
     moving: bool,
     /// Winding lost its pattern stream (card removed or unreadable).
     lost: bool,
+    /// Indices of a pattern opened again to pass over: fed before it was
+    /// lost, or wound before a power cut or a jump.
+    skip: u32,
     /// A power cut's checkpoint, until resumed or discarded.
     saved: Option<Saved>,
     /// Axes zeroed since the resume offer was taken.
@@ -137,6 +140,7 @@ impl Job {
             loose: 0,
             moving: false,
             lost: false,
+            skip: 0,
             saved: None,
             zeroed: 0,
             run: None,
@@ -182,7 +186,11 @@ impl Job {
 
     /// Winding wants the next index of the pattern ([`Event::Nail`]).
     pub fn wants_nail(&self) -> bool {
-        !self.lost && self.steps.as_ref().is_some_and(PhaseSteps::wants_nail)
+        !self.lost
+            && self
+                .steps
+                .as_ref()
+                .is_some_and(|s| self.skip > 0 || s.wants_nail())
     }
 
     /// Handles one event; `now_ms` is the firmware's millisecond clock
@@ -387,8 +395,7 @@ impl Job {
         o.push(Action::Log(Msg::CardOk));
         if self.lost {
             self.lost = false;
-            let skip = self.steps.as_ref().map_or(0, PhaseSteps::fed);
-            o.push(Action::OpenPattern { skip });
+            self.open_pattern(self.steps.as_ref().map_or(0, PhaseSteps::fed), o);
         }
         match self.state {
             State::WaitingForNails => o.push(Action::Prompt(Prompt::StartWinding)),
@@ -520,7 +527,7 @@ impl Job {
                     return;
                 };
                 self.steps = Some(PhaseSteps::wind(winder, plan.count, Some(s.last), now_ms));
-                o.push(Action::OpenPattern { skip: s.done() });
+                self.open_pattern(s.done(), o);
                 // The resume entry switches the drill's driver off itself.
                 self.go(State::Winding, MACHINE_DRIVERS, o, now_ms);
             }
@@ -567,9 +574,16 @@ impl Job {
         o.push(Action::SetZero(Axis::Base));
         // The winder's entry switches the drill's driver off itself.
         o.push(Action::DriversOn(bit(Axis::Base) | bit(Axis::Radial)));
-        o.push(Action::OpenPattern { skip: 0 });
+        self.open_pattern(0, o);
         o.push(Action::Progress(first));
         self.next_moves(o);
+    }
+
+    /// The pattern read from its start, its first `skip` indices passed
+    /// over.
+    fn open_pattern(&mut self, skip: u32, o: &mut Out) {
+        self.skip = skip;
+        o.push(Action::OpenPattern);
     }
 
     fn next_moves(&mut self, o: &mut Out) {
@@ -671,6 +685,10 @@ impl Job {
             // The check pass accepted this file: the card has changed.
             self.card = Card::Absent;
             self.lose_pattern(o, now_ms);
+            return;
+        }
+        if self.skip > 0 {
+            self.skip -= 1;
             return;
         }
         let Some(m) = &mut self.steps else { return };

@@ -124,7 +124,7 @@ impl Job {
             Tool::Jump(k) if winding_paused => {
                 let Some(steps) = &mut self.steps else { return };
                 let record = steps.jump(k);
-                o.push(Action::OpenPattern { skip: k });
+                self.open_pattern(k, o);
                 Run::Jump(record)
             }
             _ => return o.push(Action::Log(Msg::ToolNotNow)),

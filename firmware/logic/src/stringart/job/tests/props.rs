@@ -93,7 +93,7 @@ fn send(job: &mut Job, e: Event) -> Result<(), TestCaseError> {
                 "drivers on in {:?}",
                 after
             ),
-            Action::OpenPattern { .. } => prop_assert!(matches!(
+            Action::OpenPattern => prop_assert!(matches!(
                 after,
                 State::Winding | State::Paused(Phase::Winding)
             )),

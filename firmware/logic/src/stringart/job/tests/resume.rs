@@ -217,8 +217,9 @@ fn winding_resumes_through_the_gap_of_the_record() {
                 total: 5
             })
         );
-        // The pattern is read on from the wraps done.
-        assert!(b.actions.contains(&Action::OpenPattern { skip: r.n / 2 }));
+        // The pattern is read from its start, the wraps done passed over
+        // (the count of wraps below).
+        assert!(b.actions.contains(&Action::OpenPattern));
         // Entry: the drill's driver off, the base to the record's gap (the
         // needle outside), the needle in.
         let gap = scale.shorter_rotation(0, board.gap_after(r.gap));
