@@ -57,6 +57,9 @@ enum Stream {
     Files(Files),
     /// `poradi.txt` while winding.
     Pattern(Pattern),
+    /// The machine the checked files describe, until the job takes it
+    /// ([`Action::Configure`]) if it does.
+    Checked(MachineConfig),
 }
 
 pub struct JobTask {
@@ -132,7 +135,7 @@ impl JobTask {
             note.log();
         }
         loop {
-            if let Some(p) = self.carry_out(m, store) {
+            if let Some(p) = self.carry_out(m, config, store) {
                 return p;
             }
             if let Some(line) = self.report_line {
@@ -217,7 +220,7 @@ impl JobTask {
             _ => {}
         }
         let files = match &mut self.stream {
-            Stream::None => return,
+            Stream::None | Stream::Checked(_) => return,
             Stream::Pattern(_) => return self.pattern_ended(msg, now),
             Stream::Files(files) => files,
         };
@@ -237,7 +240,7 @@ impl JobTask {
         match next {
             Ok(Next::Open(name)) => self.open(name),
             Ok(Next::Machine(c)) => self.other_machine(&c, m, config, now),
-            Ok(Next::Done(c)) => self.files_valid(&c, m, config, now),
+            Ok(Next::Done(c)) => self.files_valid(&c, now),
             Err(e) => self.files_invalid(&e, now),
         }
     }
@@ -266,8 +269,7 @@ impl JobTask {
     }
 
     #[inline(never)]
-    fn files_valid(&mut self, c: &Checked, m: &mut Motion, config: &mut MachineConfig, now: u32) {
-        self.stream = Stream::None;
+    fn files_valid(&mut self, c: &Checked, now: u32) {
         info!(
             "files ok: shape ",
             c.params.shape,
@@ -279,19 +281,18 @@ impl JobTask {
             c.count
         );
         self.nails = c.params.nails;
-        // A new job takes the card's machine figures; a card coming
-        // back mid-job is only compared with the job's.
-        if self.job.state() == State::Reading && m.is_idle() {
-            *config = c.config;
-            m.configure(config);
-        }
+        self.stream = Stream::Checked(c.config);
         let event = Event::FilesValid {
             params: c.params,
             count: c.count,
-            config,
+            config: &c.config,
             id: c.id,
         };
         self.event(event, now);
+        // The job asks first, if it takes the card's machine at all.
+        if !matches!(self.todo.front(), Some(Action::Configure)) {
+            self.stream = Stream::None;
+        }
     }
 
     #[inline(never)]
@@ -351,7 +352,12 @@ impl JobTask {
     }
 
     /// Carry out actions while their log lines fit; `Some` to stop the run.
-    fn carry_out(&mut self, m: &mut Motion, store: &mut Store) -> Option<Poll<Signal>> {
+    fn carry_out(
+        &mut self,
+        m: &mut Motion,
+        config: &mut MachineConfig,
+        store: &mut Store,
+    ) -> Option<Poll<Signal>> {
         while let Some(&a) = self.todo.front() {
             let logs = matches!(
                 a,
@@ -402,10 +408,18 @@ impl JobTask {
                 Action::StopMotion => {}
                 Action::DriversOn(mask) => m.drivers.set(mask, true),
                 Action::DriversOff(mask) => m.drivers.set(mask, false),
-                Action::SetZero(_) if !m.is_idle() => {
-                    // A console jog still running: zero where it ends.
+                Action::Configure | Action::SetZero(_) if !m.is_idle() => {
+                    // A console jog still running: configure, or zero
+                    // where it ends.
                     let _ = self.todo.push_front(a);
                     return Some(Poll::Wait(Signal::Motion));
+                }
+                Action::Configure => {
+                    if let Stream::Checked(c) = self.stream {
+                        self.stream = Stream::None;
+                        *config = c;
+                        m.configure(config);
+                    }
                 }
                 Action::SetZero(axis) => {
                     let mut at = m.target();

@@ -71,6 +71,8 @@ pub enum Event<'c> {
     FilesValid {
         params: Params,
         count: u32,
+        /// The machine the card describes (`machine.txt` over the
+        /// string-art defaults).
         config: &'c MachineConfig,
         /// The files' lengths and checksums: a card back mid-job must
         /// hold the very same.
@@ -222,6 +224,10 @@ pub enum Action {
     /// Read and check the card's files; answer with `FilesValid` or
     /// `FilesInvalid`.
     ReadFiles,
+    /// Make the card's machine (the `config` of `FilesValid`) the
+    /// machine's own, once it stands: a new job runs on its card's
+    /// figures (a card back mid-job is only compared with the job's).
+    Configure,
     /// Open `poradi.txt` for streaming from its start
     /// ([`crate::files::poradi::PoradiReader`]), each index an
     /// [`Event::Nail`]; the job passes over those it already had.

@@ -357,6 +357,7 @@ impl Job {
         o: &mut Out,
     ) {
         if self.state == State::Reading {
+            o.push(Action::Configure);
             match Self::plan(params, count, id, config) {
                 Some(plan) => {
                     self.plan = Some(plan);

@@ -213,6 +213,7 @@ fn a_whole_hexagon_job() {
     assert_eq!(
         b.send(valid(HEX, 5)),
         [
+            Action::Configure,
             Action::DriversOn(ALL),
             Action::Enter(State::PrepDrill),
             Action::Prompt(Prompt::StartDrilling)
@@ -581,6 +582,7 @@ fn bad_files_wait_without_moving() {
     assert_eq!(
         b.send(valid(tiny, 5)),
         [
+            Action::Configure,
             Action::Log(Msg::BadBoard),
             Action::Enter(State::BadFiles),
             Action::Prompt(Prompt::ReplaceCard)

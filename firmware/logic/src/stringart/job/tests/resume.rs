@@ -266,6 +266,7 @@ fn another_card_discards_the_checkpoint() {
     assert_eq!(
         b.send(valid_pattern(HEX, 5, 1)),
         [
+            Action::Configure,
             Action::Log(Msg::SavedOtherCard),
             Action::Forget,
             Action::DriversOn(ALL),
@@ -289,7 +290,7 @@ fn green_held_at_the_offer_discards_and_a_pulled_card_keeps_it() {
     assert_eq!(b.job.state(), State::WaitingForCard);
     b.send(Event::CardInserted);
     let again = b.send(valid(HEX, 5));
-    assert_eq!(again[0], Action::Enter(State::Offer));
+    assert_eq!(again[..2], [Action::Configure, Action::Enter(State::Offer)]);
     assert_eq!(
         b.send(LONG_GREEN),
         [
