@@ -14,8 +14,12 @@ use crate::{flash_str, warn};
 use taut_logic::checkpoint::{self, Found, Header, Record, HEADER_BYTES};
 use taut_logic::config::MachineConfig;
 use taut_logic::files::check::CardId;
-use taut_logic::settings::image::{self, Unusable};
+use taut_logic::settings::image::{self, Scan, Step, Unusable};
 use taut_logic::stringart::job::Phase;
+
+/// Settings compared per run (each ~0.05 ms): the run stays short, as
+/// every task waits behind it.
+const SETTINGS_PER_RUN: u8 = 8;
 
 pub struct Store {
     eeprom: Eeprom,
@@ -27,6 +31,8 @@ pub struct Store {
     /// be written. Only then are the settings compared: a card's
     /// `machine.txt` figures are the job's, not kept.
     settings_due: bool,
+    /// How far the settings' image has been compared with the EEPROM.
+    scan: Scan,
     /// The checkpoint header in force (its number mixes into records).
     seq: u16,
     /// The checkpoint bytes being written: where, how many, how far.
@@ -42,6 +48,7 @@ impl Store {
             eeprom,
             unusable: None,
             settings_due: false,
+            scan: Scan::new(),
             seq: 0,
             buf: [0; HEADER_BYTES as usize],
             at: 0,
@@ -78,6 +85,8 @@ impl Store {
     /// A `$` change came: write the settings' image back.
     pub fn settings_changed(&mut self) {
         self.settings_due = true;
+        // Bytes already compared may differ now.
+        self.scan = Scan::new();
     }
 
     /// A checkpoint write is under way (its last byte included): the job
@@ -156,13 +165,18 @@ impl Store {
         if !self.settings_due {
             return Poll::Wait(Signal::Settings);
         }
-        match image::first_difference(cfg, |i| self.eeprom.read(i as u16)) {
-            Some((i, b)) => {
+        match self
+            .scan
+            .step(cfg, |i| self.eeprom.read(i as u16), SETTINGS_PER_RUN)
+        {
+            Step::Write(i, b) => {
                 self.eeprom.start_write(i as u16, b);
                 Poll::After(4)
             }
-            None => {
+            Step::More => Poll::Again,
+            Step::Same => {
                 self.settings_due = false;
+                self.scan = Scan::new();
                 Poll::Wait(Signal::Settings)
             }
         }

@@ -99,6 +99,9 @@ impl StepsPerUnit {
 pub struct Decimal(pub i32, pub u8);
 
 impl ufmt::uDisplay for Decimal {
+    /// Each digit by subtracting its power of ten: a `u32` division is a
+    /// ~650-cycle call on the AVR, and dividing took ~7 000 cycles a
+    /// number (a status report prints three to six).
     fn fmt<W: ufmt::uWrite + ?Sized>(
         &self,
         f: &mut ufmt::Formatter<'_, W>,
@@ -107,18 +110,42 @@ impl ufmt::uDisplay for Decimal {
         if v < 0 {
             f.write_char('-')?;
         }
-        let scale = 10u32.pow(places as u32);
-        let a = v.unsigned_abs();
-        ufmt::uwrite!(f, "{}", a / scale)?;
-        if places > 0 {
-            f.write_char('.')?;
-        }
-        let mut digit = scale / 10;
-        while digit > 0 {
-            f.write_char((b'0' + (a / digit % 10) as u8) as char)?;
-            digit /= 10;
+        let mut a = v.unsigned_abs();
+        let mut shown = false;
+        for p in (0..10u8).rev() {
+            let power = power_of_ten(p);
+            let mut digit = b'0';
+            while a >= power {
+                a -= power;
+                digit += 1;
+            }
+            // No leading zeros, but the units digit and the decimals.
+            shown |= digit != b'0' || p <= places;
+            if shown {
+                f.write_char(digit as char)?;
+            }
+            if p == places && p > 0 {
+                f.write_char('.')?;
+            }
         }
         Ok(())
+    }
+}
+
+/// 10^`p`, `p` ≤ 9. A match, not a loop of multiplies (a call each on
+/// the AVR).
+fn power_of_ten(p: u8) -> u32 {
+    match p {
+        0 => 1,
+        1 => 10,
+        2 => 100,
+        3 => 1_000,
+        4 => 10_000,
+        5 => 100_000,
+        6 => 1_000_000,
+        7 => 10_000_000,
+        8 => 100_000_000,
+        _ => 1_000_000_000,
     }
 }
 
@@ -150,6 +177,56 @@ mod tests {
         #[test]
         fn maybe_milli_reads_back_what_it_was_given(v in -i32::MAX..=i32::MAX) {
             prop_assert_eq!(MaybeMilli::new(Some(Milli(v))).get(), Some(Milli(v)));
+        }
+    }
+
+    /// What `Decimal` prints, worked out with `std`'s formatting.
+    fn decimal_by_std(v: i32, places: u8) -> std::string::String {
+        let scale = 10i64.pow(places as u32);
+        let a = (v as i64).abs();
+        let sign = if v < 0 { "-" } else { "" };
+        match places {
+            0 => std::format!("{sign}{a}"),
+            p => std::format!("{sign}{}.{:0w$}", a / scale, a % scale, w = p as usize),
+        }
+    }
+
+    fn decimal(v: i32, places: u8) -> std::string::String {
+        crate::text::error::tests::show(&Decimal(v, places))
+    }
+
+    #[test]
+    fn decimals_print_as_std_does() {
+        for v in [
+            0,
+            1,
+            -1,
+            9,
+            10,
+            999,
+            1000,
+            -12_345,
+            i32::MAX,
+            i32::MIN,
+            -i32::MAX,
+        ] {
+            for places in 0..=9 {
+                assert_eq!(
+                    decimal(v, places),
+                    decimal_by_std(v, places),
+                    "{v} {places}"
+                );
+            }
+        }
+        assert_eq!(decimal(-12_345, 3), "-12.345");
+        assert_eq!(decimal(7, 0), "7");
+        assert_eq!(decimal(5, 3), "0.005");
+    }
+
+    proptest! {
+        #[test]
+        fn any_decimal_prints_as_std_does(v in any::<i32>(), places in 0u8..=9) {
+            prop_assert_eq!(decimal(v, places), decimal_by_std(v, places));
         }
     }
 

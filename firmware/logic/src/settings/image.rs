@@ -8,7 +8,7 @@
 //! Written by streaming [`bytes`] (no copy in RAM: the firmware compares
 //! each byte with the EEPROM and writes only those that differ).
 
-use super::{all, Setting, Value};
+use super::{all, Setting, Value, COUNT};
 use crate::config::MachineConfig;
 use crate::machine::Machine;
 use crate::units::{Milli, StepsPerUnit};
@@ -66,42 +66,97 @@ pub fn bytes(cfg: &MachineConfig) -> impl Iterator<Item = u8> + '_ {
     })
 }
 
-/// The first byte of `cfg`'s image that differs from what `read(i)` holds
-/// at byte `i`, and its new value; `None` when they agree. What [`bytes`]
-/// gives, in plain loops: the settings task looks for one byte to write
-/// per run, and the iterator chain took ~11 ms a run on the AVR.
-/// Built for speed: a byte at a time through the image on every run of
-/// the store task, which the real-time task waits behind.
-#[cfg_attr(target_arch = "avr", optimize(speed))]
-pub fn first_difference(cfg: &MachineConfig, read: impl Fn(usize) -> u8) -> Option<(usize, u8)> {
-    let mut sum = Fletcher::new();
-    let mut at = 0;
-    let mut differs = |b: u8, sum: &mut Fletcher| {
-        let i = at;
-        at += 1;
-        sum.add(b);
-        (read(i) != b).then_some((i, b))
-    };
-    for b in MAGIC.into_iter().chain([VERSION]) {
-        if let Some(d) = differs(b, &mut sum) {
-            return Some(d);
+/// A comparison of `cfg`'s image with the EEPROM, resumable: the store
+/// task looks for one byte to write per run, and walking the whole image
+/// in one run took ~2.3 ms on the AVR (every task waits behind a run).
+/// [`Scan::step`] goes on where the last call stopped, with the checksum
+/// summed so far. Start a new scan when the settings change.
+#[derive(Clone, Copy, Debug)]
+pub struct Scan {
+    /// The next part: 0 the header, then setting `next - 1` (an index of
+    /// [`Setting::at`]) up to [`COUNT`], then the checksum.
+    next: u8,
+    /// Its first byte in the image.
+    at: u16,
+    sum: Fletcher,
+}
+
+/// What [`Scan::step`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// Byte `.0` of the EEPROM must become `.1`; the scan compares it
+    /// again next (once written, it goes on).
+    Write(usize, u8),
+    /// No difference in the parts compared; more to compare.
+    More,
+    /// The EEPROM holds the image.
+    Same,
+}
+
+const LAST_SETTING: u8 = COUNT as u8;
+const _: () = assert!(COUNT < u8::MAX as usize - 1);
+
+impl Scan {
+    pub const fn new() -> Scan {
+        Scan {
+            next: 0,
+            at: 0,
+            sum: Fletcher::new(),
         }
     }
-    for s in all() {
-        let (buf, n) = value_array(s.get(cfg));
-        for &b in &buf[..n] {
-            if let Some(d) = differs(b, &mut sum) {
-                return Some(d);
+
+    /// Compares up to `parts` parts of the image (the header, a setting,
+    /// the checksum) with what `read(i)` holds at byte `i`.
+    /// Built for speed: the store task runs it, which every task waits
+    /// behind.
+    #[cfg_attr(target_arch = "avr", optimize(speed))]
+    pub fn step(&mut self, cfg: &MachineConfig, read: impl Fn(usize) -> u8, parts: u8) -> Step {
+        for _ in 0..parts {
+            let (buf, n, checksum) = match self.next {
+                0 => {
+                    let m = MAGIC;
+                    ([m[0], m[1], m[2], m[3], VERSION, 0, 0, 0], HEADER, false)
+                }
+                i if i <= LAST_SETTING => match Setting::at(i as usize - 1) {
+                    Some(s) => {
+                        let (buf, n) = value_array(s.get(cfg));
+                        (buf, n, false)
+                    }
+                    None => ([0; 8], 0, false),
+                },
+                i if i == LAST_SETTING + 1 => (widen2(self.sum.value().to_le_bytes()), 2, true),
+                _ => return Step::Same,
+            };
+            // The checksum is not summed: its bytes compare plainly.
+            let mut sum = self.sum;
+            for (k, &b) in buf[..n].iter().enumerate() {
+                let i = self.at as usize + k;
+                if read(i) != b {
+                    return Step::Write(i, b);
+                }
+                if !checksum {
+                    sum.add(b);
+                }
             }
+            self.sum = sum;
+            self.at += n as u16;
+            self.next += 1;
+        }
+        match self.next > LAST_SETTING + 1 {
+            true => Step::Same,
+            false => Step::More,
         }
     }
-    let mut tail = Fletcher::new();
-    for b in sum.value().to_le_bytes() {
-        if let Some(d) = differs(b, &mut tail) {
-            return Some(d);
-        }
+}
+
+impl Default for Scan {
+    fn default() -> Self {
+        Scan::new()
     }
-    None
+}
+
+fn widen2(b: [u8; 2]) -> [u8; 8] {
+    [b[0], b[1], 0, 0, 0, 0, 0, 0]
 }
 
 /// Value bytes: up to 8, the unused ones skipped.
@@ -171,6 +226,7 @@ pub fn decode(read: impl Fn(usize) -> u8, base: &MachineConfig) -> Result<Machin
 
 /// Fletcher-16: two running sums mod 255 (catches swapped and zeroed
 /// bytes, which a plain sum misses).
+#[derive(Clone, Copy, Debug)]
 struct Fletcher {
     a: u16,
     b: u16,

@@ -89,6 +89,18 @@ fn first_difference_by_bytes(cfg: &MachineConfig, eeprom: &[u8]) -> Option<(usiz
     bytes(cfg).enumerate().find(|&(i, b)| eeprom[i] != b)
 }
 
+/// A scan run to its first difference (or its end), `parts` at a time.
+fn first_difference(cfg: &MachineConfig, eeprom: &[u8], parts: u8) -> Option<(usize, u8)> {
+    let mut scan = Scan::new();
+    loop {
+        match scan.step(cfg, |i| eeprom[i], parts) {
+            Step::Write(i, b) => return Some((i, b)),
+            Step::More => {}
+            Step::Same => return None,
+        }
+    }
+}
+
 #[test]
 fn the_first_difference_is_the_image_s_and_writing_it_converges() {
     use crate::machine::Machine;
@@ -107,19 +119,29 @@ fn the_first_difference_is_the_image_s_and_writing_it_converges() {
             flipped[i] ^= 0x41;
             eeproms.push(flipped);
         }
-        for mut eeprom in eeproms {
-            assert_eq!(
-                first_difference(cfg, |i| eeprom[i]),
-                first_difference_by_bytes(cfg, &eeprom)
-            );
-            // The settings task: one byte a run until they agree.
-            let mut writes = 0;
-            while let Some((i, b)) = first_difference(cfg, |i| eeprom[i]) {
-                eeprom[i] = b;
-                writes += 1;
-                assert!(writes <= len(), "never converges");
+        for (k, mut eeprom) in eeproms.into_iter().enumerate() {
+            let want = first_difference_by_bytes(cfg, &eeprom);
+            for parts in [1, 3, u8::MAX] {
+                assert_eq!(first_difference(cfg, &eeprom, parts), want);
+            }
+            // The store task: a bounded part a run, resumed, writing each
+            // difference as it comes, until they agree.
+            let mut scan = Scan::new();
+            let (mut writes, mut runs) = (0, 0);
+            loop {
+                match scan.step(cfg, |i| eeprom[i], 1 + k as u8 % 4) {
+                    Step::Write(i, b) => {
+                        eeprom[i] = b;
+                        writes += 1;
+                    }
+                    Step::More => {}
+                    Step::Same => break,
+                }
+                runs += 1;
+                assert!(writes <= len() && runs < 10 * len(), "never converges");
             }
             assert_eq!(eeprom, image(cfg));
+            assert_eq!(scan.step(cfg, |i| eeprom[i], 1), Step::Same);
         }
     }
 }
