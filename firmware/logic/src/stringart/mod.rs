@@ -5,15 +5,19 @@
 //! firmware's own job, planner and trapezoids; `timing` the same for the
 //! original firmware's moves, one axis after another.
 
+mod blend;
+mod clearance;
 mod drilling;
 pub mod estimate;
 pub mod job;
 mod timing;
 mod winding;
 
+pub use blend::{BlendWinder, BlendWrap};
+pub use clearance::CLEARANCE_MM;
 pub use drilling::Drilling;
 pub use timing::{machine_time, Overlap};
-pub use winding::{WindError, Winder, Winding, Wrap};
+pub use winding::{WindError, Winder, Winding, Wrap, Wraps};
 
 use crate::axis::{Axis, PerAxis, AXES};
 
