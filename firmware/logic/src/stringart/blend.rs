@@ -12,9 +12,9 @@
 //! [`CLEARANCE_MM`] from every nail. Each nail blocks the angles within α
 //! of its own; between two nails lies a gap's *window* of whole base
 //! steps where any radius is safe. Inside `inner` (the smallest nail
-//! radius − c) and, over nail j, outside `outer` (the largest radius of
-//! j and its neighbours + c) the needle is clear of the nails at any
-//! angle. A wrap of nail j, approached from below (forwards):
+//! radius − c) the needle is clear of the nails at any angle, and over
+//! nail j (at the angles it blocks) outside `outer` (the ring's largest
+//! radius there + c). A wrap of nail j, approached from below (forwards):
 //!
 //! ```text
 //!   A = (base clamped into the window before j, inner)   rotation, inside
@@ -39,7 +39,7 @@
 //! Cost on the AVR: per wrap, three nails (`Board::nail`, the polygon's
 //! trigonometry), three square roots and divisions; nothing per block.
 
-use super::clearance::{around, blocked, turns_to, window, Window, CLEARANCE_MM};
+use super::clearance::{around, blocked, turns_to, window, Blocked, Window, CLEARANCE_MM};
 use super::{bit, MachineStep, WindError, MACHINE_DRIVERS};
 use crate::axis::Axis;
 use crate::config::MachineConfig;
@@ -80,6 +80,11 @@ impl BlendWrap {
     /// through, each named by the nail before it.
     pub fn gaps(&self) -> [u16; 2] {
         self.gaps
+    }
+
+    /// The base's position once the wrap is done.
+    pub fn end_base(&self) -> i32 {
+        self.moves[3].0
     }
 }
 
@@ -182,7 +187,7 @@ impl BlendWinder {
         };
         let before = shift(window(&b[0], &b[1]).ok_or(WindError::GapTooNarrow(prev))?);
         let after = shift(window(&b[1], &b[2]).ok_or(WindError::GapTooNarrow(j))?);
-        let top = b[0].radius.max(b[1].radius).max(b[2].radius) + CLEARANCE_MM;
+        let top = ring_over(&b) + CLEARANCE_MM;
         let outer = libm::ceilf((top - self.board.radius()) * s.radial.as_f32() + EPS) as i32;
         let inner = self.inner;
         // Nail j ahead: out through the window before it, forwards.
@@ -231,6 +236,19 @@ impl BlendWinder {
             on: false,
         }
     }
+}
+
+/// The ring's largest radius over the angles nail `b[1]` blocks, mm: the
+/// ring runs straight from nail to nail, and a straight line's radius is
+/// convex in the angle, so interpolating the nails' radii linearly in the
+/// angle bounds it from above.
+fn ring_over(b: &[Blocked; 3]) -> f32 {
+    let j = &b[1];
+    let side = |n: &Blocked| {
+        let t = (j.half / (n.at - j.at).abs()).min(1.0);
+        j.radius + (n.radius - j.radius).max(0.0) * t
+    };
+    side(&b[0]).max(side(&b[2]))
 }
 
 #[cfg(test)]
