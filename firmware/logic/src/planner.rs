@@ -11,6 +11,7 @@
 //! squared speeds, `u64` (µm/s)². The block handed to the segment preparer
 //! is converted to events (steps of its dominant axis).
 
+mod axis_jump;
 mod junction;
 
 #[cfg(test)]
@@ -20,6 +21,7 @@ use crate::axis::{PerAxis, AXES};
 use crate::config::MachineConfig;
 use crate::segment::{Speeds, StepBlock, Trapezoid};
 use crate::units::Milli;
+use axis_jump::AxisJumps;
 use junction::{Corner, Geometry};
 
 /// Number of moves the planner holds.
@@ -141,6 +143,7 @@ pub struct Planner {
     /// Target of the last move, steps.
     position: PerAxis<i32>,
     geometry: Geometry,
+    jumps: AxisJumps,
     /// Direction of the last move, for the next junction.
     last: Option<[f32; AXES]>,
     /// `None`: none (100 %). An `Option`, so that `EMPTY` is all zeros: a
@@ -158,6 +161,7 @@ impl Planner {
         carry_sqr: 0,
         position: [0; AXES],
         geometry: Geometry::EMPTY,
+        jumps: AxisJumps::EMPTY,
         last: None,
         overrides: None,
     };
@@ -169,6 +173,7 @@ impl Planner {
         self.len = 0;
         self.carry_sqr = 0;
         self.geometry = Geometry::new(config);
+        self.jumps = AxisJumps::new(config);
         self.last = None;
     }
 
@@ -180,6 +185,7 @@ impl Planner {
             carry_sqr: 0,
             position: [0; AXES],
             geometry: Geometry::new(config),
+            jumps: AxisJumps::new(config),
             last: None,
             overrides: None,
         }
@@ -225,7 +231,8 @@ impl Planner {
         let junction_sqr = match self.last {
             Some(prev_unit) => self
                 .geometry
-                .junction_sqr(&Corner::new(&prev_unit, &path.unit)),
+                .junction_sqr(&Corner::new(&prev_unit, &path.unit))
+                .min(self.jumps.limit_sqr(&prev_unit, &path.unit)),
             None => 0,
         };
         let slot = (self.head + self.len) % PLANNER_BLOCKS;

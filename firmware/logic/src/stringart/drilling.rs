@@ -7,6 +7,7 @@
 
 use super::{
     MachineStep, DRILL_ANGLE_DEG, DRILL_CLEARANCE_MM, DWELL_MS, HOLE_DEPTH_MM, MACHINE_DRIVERS,
+    SIDEWAYS_CLEARANCE_MM,
 };
 use crate::axis::{Axis, AXES};
 use crate::config::MachineConfig;
@@ -55,6 +56,15 @@ impl Drilling {
             base: 0,
             stage: Stage::Raise,
         }
+    }
+
+    /// Drilling as the firmware runs it: the tool crosses from hole to
+    /// hole [`SIDEWAYS_CLEARANCE_MM`] above the surface, so the retract
+    /// and the next plunge each end as soon as the tip is clear of it.
+    pub fn blended(board: Board, config: &MachineConfig) -> Self {
+        let mut d = Self::new(board, config);
+        d.raised = -tool_axis_steps(config, SIDEWAYS_CLEARANCE_MM);
+        d
     }
 
     /// After a power cut: the drill raised first, then on from hole

@@ -5,15 +5,19 @@
 //! firmware's own job, planner and trapezoids; `timing` the same for the
 //! original firmware's moves, one axis after another.
 
+mod blend;
+mod clearance;
 mod drilling;
 pub mod estimate;
 pub mod job;
 mod timing;
 mod winding;
 
+pub use blend::{BlendWinder, BlendWrap};
+pub use clearance::CLEARANCE_MM;
 pub use drilling::Drilling;
 pub use timing::{machine_time, Overlap};
-pub use winding::{WindError, Winder, Winding, Wrap};
+pub use winding::{WindError, Winder, Winding, Wrap, Wraps};
 
 use crate::axis::{Axis, PerAxis, AXES};
 
@@ -22,6 +26,11 @@ pub const DRILL_ANGLE_DEG: f32 = 74.333;
 /// Holes are drilled this deep, from this high above the surface, mm.
 pub const HOLE_DEPTH_MM: f32 = 10.0;
 pub const DRILL_CLEARANCE_MM: f32 = 10.0;
+/// Blended drilling moves the tool sideways this far above the surface
+/// (the original rose 1 cm): the board's flatness (±0.5 mm over its
+/// radius) and the chips and raised rim a hole leaves (under 1 mm),
+/// with margin, mm.
+pub const SIDEWAYS_CLEARANCE_MM: f32 = 2.0;
 /// The drill rests at the bottom of each hole this long.
 pub const DWELL_MS: u16 = 250;
 /// While winding, the needle turns this far inside the smallest nail

@@ -19,6 +19,45 @@ pub enum WindError {
     BadNail(u16),
     /// The inner winding radius would reach the board's centre.
     BoardTooSmall,
+    /// The nails beside this gap (named by the nail before it) stand too
+    /// close for the needle to pass between them (blended winding).
+    GapTooNarrow(u16),
+}
+
+/// Plans the moves of a winding: today's four single-axis moves a wrap
+/// ([`Winder`]) or the blended path ([`super::BlendWinder`]).
+pub trait Wraps {
+    type Wrap: Iterator<Item = MachineStep>;
+    /// Step `i` of the entry from the zero pose; `None` after the last.
+    fn entry_step(&mut self, resume: Option<u16>, i: u8) -> Option<MachineStep>;
+    fn wrap(&mut self, j: u16) -> Result<Self::Wrap, WindError>;
+    fn finish(&self) -> MachineStep;
+}
+
+impl Wraps for Winder {
+    type Wrap = Wrap;
+    fn entry_step(&mut self, resume: Option<u16>, i: u8) -> Option<MachineStep> {
+        Winder::entry_step(self, resume, i)
+    }
+    fn wrap(&mut self, j: u16) -> Result<Wrap, WindError> {
+        Winder::wrap(self, j)
+    }
+    fn finish(&self) -> MachineStep {
+        Winder::finish(self)
+    }
+}
+
+impl Wraps for super::BlendWinder {
+    type Wrap = super::BlendWrap;
+    fn entry_step(&mut self, resume: Option<u16>, i: u8) -> Option<MachineStep> {
+        super::BlendWinder::entry_step(self, resume, i)
+    }
+    fn wrap(&mut self, j: u16) -> Result<super::BlendWrap, WindError> {
+        super::BlendWinder::wrap(self, j)
+    }
+    fn finish(&self) -> MachineStep {
+        super::BlendWinder::finish(self)
+    }
 }
 
 /// Plans the wraps one nail at a time, so the pattern can be streamed from
@@ -161,38 +200,42 @@ impl Winder {
 }
 
 /// The whole winding as one sequence: entry, a wrap per nail, drivers off.
-pub struct Winding<I> {
-    winder: Winder,
+pub struct Winding<I, W: Wraps = Winder> {
+    winder: W,
     pattern: I,
-    entry: Option<core::array::IntoIter<MachineStep, 4>>,
-    wrap: Option<Wrap>,
+    /// The entry's next step, until it has been handed out.
+    entry: Option<u8>,
+    wrap: Option<W::Wrap>,
     finished: bool,
 }
 
-impl<I: Iterator<Item = u16>> Winding<I> {
-    pub fn new(winder: Winder, pattern: I) -> Self {
+impl<I: Iterator<Item = u16>, W: Wraps> Winding<I, W> {
+    pub fn new(winder: W, pattern: I) -> Self {
         Winding {
             winder,
             pattern,
-            entry: None,
+            entry: Some(0),
             wrap: None,
             finished: false,
         }
     }
 }
 
-impl<I: Iterator<Item = u16>> Iterator for Winding<I> {
+impl<I: Iterator<Item = u16>, W: Wraps> Iterator for Winding<I, W> {
     type Item = Result<MachineStep, WindError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         if self.finished {
             return None;
         }
-        let entry = self
-            .entry
-            .get_or_insert_with(|| self.winder.entry().into_iter());
-        if let Some(step) = entry.next() {
-            return Some(Ok(step));
+        if let Some(i) = self.entry {
+            match self.winder.entry_step(None, i) {
+                Some(step) => {
+                    self.entry = Some(i + 1);
+                    return Some(Ok(step));
+                }
+                None => self.entry = None,
+            }
         }
         loop {
             if let Some(step) = self.wrap.as_mut().and_then(Iterator::next) {

@@ -53,7 +53,7 @@ pub use phase::Phase;
 pub use phase_steps::FEED;
 pub use progress::{left_s, Progress};
 
-use super::{bit, Drilling, MachineStep, Winder, MACHINE_DRIVERS};
+use super::{bit, BlendWinder, Drilling, MachineStep, MACHINE_DRIVERS};
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;
 use crate::checkpoint::Saved;
@@ -85,7 +85,7 @@ struct Plan {
     board: Board,
     scale: StepScale,
     drilling: Option<Drilling>,
-    winder: Option<Winder>,
+    winder: Option<BlendWinder>,
 }
 
 pub struct Job {
@@ -413,8 +413,8 @@ impl Job {
             id,
             board,
             scale: StepScale::from_config(config),
-            drilling: Some(Drilling::new(board, config)),
-            winder: Some(Winder::new(board, config).ok()?),
+            drilling: Some(Drilling::blended(board, config)),
+            winder: Some(BlendWinder::new(board, config).ok()?),
         })
     }
 

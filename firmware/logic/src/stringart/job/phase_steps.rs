@@ -6,7 +6,7 @@
 use super::phase::Phase;
 use super::progress::Reporter;
 use crate::checkpoint::Record;
-use crate::stringart::{Drilling, MachineStep, Save, Winder, Wrap};
+use crate::stringart::{BlendWinder, BlendWrap, Drilling, MachineStep, Save};
 
 /// Nail indices buffered ahead of the winder: the card is read while the
 /// machine moves.
@@ -25,14 +25,15 @@ enum Work {
         retract: Option<MachineStep>,
     },
     Wind {
-        winder: Winder,
+        winder: BlendWinder,
         /// The entry's next step, until it has been handed out.
         entry: Option<u8>,
         /// The entry after a power cut goes in through the gap after
         /// this nail.
         resume_gap: Option<u16>,
-        wrap: Option<Wrap>,
-        /// The wrap's move count at its last record (1 or 3), 0 if none.
+        wrap: Option<BlendWrap>,
+        /// The wrap's records written: 1 the outward one (before its
+        /// first move), 3 the inward one too (after its third), 0 none.
         saved_at: u8,
         feed: heapless::Deque<u16, FEED>,
         /// Indices received so far (the buffered ones included).
@@ -86,7 +87,12 @@ impl PhaseSteps {
 
     /// Winding a new job's pattern (`resume: None`), or on from a
     /// checkpoint's record (`Some(None)`: none written yet).
-    pub fn wind(winder: Winder, count: u32, resume: Option<Option<Record>>, now_ms: u32) -> Self {
+    pub fn wind(
+        winder: BlendWinder,
+        count: u32,
+        resume: Option<Option<Record>>,
+        now_ms: u32,
+    ) -> Self {
         let last = resume.flatten();
         let done = last.map_or(0, |r| r.n / 2);
         let work = Work::Wind {
@@ -187,16 +193,11 @@ impl PhaseSteps {
                     return None;
                 }
                 if let Some(w) = wrap {
-                    let handed = w.handed();
-                    if (handed == 1 || handed == 3) && *saved_at != handed {
-                        // At the gap the needle goes out / comes back in.
-                        *saved_at = handed;
-                        let (half, gap) = match handed {
-                            1 => (1, w.gaps()[0]),
-                            _ => (2, w.gaps()[1]),
-                        };
-                        self.gap = gap;
-                        return Some(save(2 * self.done + half, gap));
+                    if w.handed() == 3 && *saved_at != 3 {
+                        // Beyond the nail, before coming back in.
+                        *saved_at = 3;
+                        self.gap = w.gaps()[1];
+                        return Some(save(2 * self.done + 2, self.gap));
                     }
                     if let Some(step) = w.next() {
                         return Some(step);
@@ -212,9 +213,13 @@ impl PhaseSteps {
                 }
                 // Indices are range-checked when fed, so `wrap` succeeds.
                 let j = feed.pop_front()?;
-                *saved_at = 0;
-                *wrap = winder.wrap(j).ok();
-                wrap.as_mut().and_then(Iterator::next)
+                let w = wrap.insert(winder.wrap(j).ok()?);
+                // The gap the needle will go out through, written while
+                // the machine stands between batches: the rotation to it
+                // and the crossing then run as one.
+                *saved_at = 1;
+                self.gap = w.gaps()[0];
+                Some(save(2 * self.done + 1, self.gap))
             }
         }
     }

@@ -56,11 +56,11 @@ fn board(params: Params) -> Board {
 
 /// The whole drilling / winding sequence as the planners make it.
 fn drilled(params: Params) -> Vec<MachineStep> {
-    Drilling::new(board(params), &CONFIG).collect()
+    Drilling::blended(board(params), &CONFIG).collect()
 }
 
 fn wound(params: Params, pattern: &[u16]) -> Vec<MachineStep> {
-    let winder = Winder::new(board(params), &CONFIG).unwrap();
+    let winder = BlendWinder::new(board(params), &CONFIG).unwrap();
     Winding::new(winder, pattern.iter().copied())
         .map(Result::unwrap)
         .collect()
@@ -781,7 +781,7 @@ fn winding_waits_for_the_card_reader() {
         entry.remove(0),
         MachineStep::Save(Save::Begin(Phase::Winding))
     );
-    assert_eq!(entry.len(), 4);
+    assert_eq!(entry.len(), 3);
     assert_eq!(b.send(Event::MotionDone), [], "no index yet: it waits");
     assert!(b.job.wants_nail());
     assert_eq!(b.send(Event::Nail(0)), [Action::NextMoves]);

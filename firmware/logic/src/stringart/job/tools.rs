@@ -13,7 +13,7 @@ use super::phase::Phase;
 use super::{Action, Job, Msg, Out, State};
 use crate::axis::Axis;
 use crate::checkpoint::Record;
-use crate::stringart::{bit, MachineStep, Save, Wrap};
+use crate::stringart::{bit, BlendWrap, MachineStep, Save};
 
 /// A tool asked for on the console.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,7 +66,11 @@ pub fn parse(key: &str, value: &str) -> Option<Result<Tool, ToolError>> {
 #[derive(Clone, Debug)]
 pub(super) enum Run {
     /// Step `i` of the wrap test on nail `k`.
-    WrapTest { k: u16, i: u8, wrap: Option<Wrap> },
+    WrapTest {
+        k: u16,
+        i: u8,
+        wrap: Option<BlendWrap>,
+    },
     /// To the nail's angle (`there`), said, then back (`back`).
     Drift {
         nail: u16,

@@ -81,21 +81,19 @@ fn a_job_checkpoints_each_hole_and_twice_each_wrap() {
     for (s, pos) in &saves[1..25] {
         assert!(pos[Axis::Drill.index()] > 0, "{s:?} at {pos:?}");
     }
-    // Each wrap's records with the base at the gap named, the needle
-    // inside the ring (going out next), then outside (coming in next).
+    // Each wrap's records: the outward one with the needle inside the
+    // ring (before the rotation to its gap), the inward one with the
+    // needle outside, the base in the window of the gap named.
     let scale = StepScale::from_config(&CONFIG);
     let board = board(HEX);
     let inner = saves.iter().map(|(_, p)| p[1]).min().unwrap();
     for (i, (s, pos)) in saves[26..].iter().enumerate() {
         let Save::Record(r) = s else { panic!() };
-        let gap = scale.shorter_rotation(0, board.gap_after(r.gap));
-        assert_eq!(
-            (pos[0] - gap).rem_euclid(scale.steps_per_turn),
-            0,
-            "{r:?} at {pos:?}"
-        );
         let out = pos[Axis::Radial.index()] != inner;
         assert_eq!(out, i % 2 == 1, "{r:?} at {pos:?}");
+        if out {
+            assert!(in_gap(&scale, &board, pos[0], r.gap), "{r:?} at {pos:?}");
+        }
         let nail = PATTERN[i / 2];
         let beside = [(nail + 23) % 24, nail];
         assert!(beside.contains(&r.gap), "{r:?} beside nail {nail}");
@@ -103,6 +101,16 @@ fn a_job_checkpoints_each_hole_and_twice_each_wrap() {
     // The end of the job forgets the checkpoint.
     let forget = b.actions.iter().position(|a| *a == Action::Forget);
     assert_eq!(forget, Some(b.actions.len() - 3), "{:?}", b.actions);
+}
+
+/// Whether base position `base` lies strictly between the nails beside
+/// the gap after nail `g`.
+fn in_gap(scale: &StepScale, board: &Board, base: i32, g: u16) -> bool {
+    let turn = scale.steps_per_turn;
+    let at = |i: u16| scale.base_steps(board.nail(i % board.nails()).angle);
+    let (lo, width) = (at(g), (at(g + 1) - at(g)).rem_euclid(turn));
+    let d = (base - lo).rem_euclid(turn);
+    0 < d && d < width
 }
 
 /// Boots a fresh job with `saved` in EEPROM and the same card, takes the
@@ -164,7 +172,8 @@ fn drilling_resumes_with_the_drill_raised_at_the_hole_after_the_record() {
             }
         );
         // The drill goes up first, then the holes from n on, once each.
-        assert_eq!(b.steps[0], MachineStep::to(Axis::Drill, -1385), "from {n}");
+        // 2 mm above the surface along the tilted axis.
+        assert_eq!(b.steps[0], MachineStep::to(Axis::Drill, -277), "from {n}");
         let drilling_end = b.steps.len() - wound(HEX, &PATTERN).len();
         assert_eq!(
             plunges(&b.steps[..drilling_end]),
@@ -198,14 +207,20 @@ fn winding_resumes_through_the_gap_of_the_record() {
         .collect();
     let scale = StepScale::from_config(&CONFIG);
     let board = board(HEX);
-    // Needle moves out: radial moves to anywhere but the inner radius.
+    // Needle moves out: from the inner radius to anywhere else.
     let outs = |steps: &[MachineStep]| {
-        let radial = steps.iter().filter_map(|s| match s {
-            MachineStep::Move(t) => t[1],
-            _ => None,
-        });
-        let inner = radial.clone().min().unwrap();
-        radial.filter(|&r| r != inner).count()
+        let radial: Vec<i32> = steps
+            .iter()
+            .filter_map(|s| match s {
+                MachineStep::Move(t) => t[1],
+                _ => None,
+            })
+            .collect();
+        let inner = *radial.iter().min().unwrap();
+        radial
+            .windows(2)
+            .filter(|w| w[0] == inner && w[1] != inner)
+            .count()
     };
     for r in winding {
         let (b, offer) = resumed(saved(HEX, 5, Phase::Winding, r.n, r.gap));
@@ -220,20 +235,23 @@ fn winding_resumes_through_the_gap_of_the_record() {
         // The pattern is read from its start, the wraps done passed over
         // (the count of wraps below).
         assert!(b.actions.contains(&Action::OpenPattern));
-        // Entry: the drill's driver off, the base to the record's gap (the
-        // needle outside), the needle in.
-        let gap = scale.shorter_rotation(0, board.gap_after(r.gap));
+        // Entry: the drill's driver off, the base into the record's gap
+        // (the needle outside), the needle in across it.
         assert_eq!(
-            b.steps[..2],
-            [
-                MachineStep::Drivers {
-                    mask: 0b100,
-                    on: false
-                },
-                MachineStep::to(Axis::Base, gap),
-            ]
+            b.steps[0],
+            MachineStep::Drivers {
+                mask: 0b100,
+                on: false
+            }
         );
-        assert!(matches!(b.steps[2], MachineStep::Move([None, Some(r), None, None]) if r < 0));
+        let MachineStep::Move([Some(at), None, None, None]) = b.steps[1] else {
+            panic!("{:?}", b.steps[1])
+        };
+        assert!(in_gap(&scale, &board, at, r.gap), "{at} for {r:?}");
+        let MachineStep::Move([Some(at), Some(inner), None, None]) = b.steps[2] else {
+            panic!("{:?}", b.steps[2])
+        };
+        assert!(in_gap(&scale, &board, at, r.gap) && inner < 0);
         // Then the wraps not yet wound, each out and back once.
         assert_eq!(outs(&b.steps), 5 - r.n as usize / 2, "from {r:?}");
         let ns: Vec<u32> = b

@@ -47,7 +47,7 @@ fn wrap_test_wraps_one_nail_from_the_zero_pose_and_back() {
     );
     b.batch();
     // In through the gap before nail 7, the wrap, out at the edge, home.
-    let mut w = Winder::new(board(HEX), &CONFIG).unwrap();
+    let mut w = BlendWinder::new(board(HEX), &CONFIG).unwrap();
     let mut expect: Vec<MachineStep> = (0..3).filter_map(|i| w.entry_step(Some(6), i)).collect();
     let wrap = w.wrap(k).unwrap();
     assert_eq!(wrap.gaps(), [6, 7], "out before nail 7, in after it");
@@ -109,6 +109,12 @@ fn paused_after(wraps: usize) -> Bench {
     b
 }
 
+/// Moves of the base and the carriage together: four a wrap.
+fn blended_moves(steps: &[MachineStep]) -> usize {
+    let both = |s: &&MachineStep| matches!(s, MachineStep::Move([Some(_), Some(_), None, None]));
+    steps.iter().filter(both).count()
+}
+
 #[test]
 fn wrap_step_winds_one_wrap_and_pauses_again() {
     let mut b = paused_after(1);
@@ -137,12 +143,8 @@ fn wrap_step_back_winds_the_last_wrap_again() {
     let before = b.steps.len();
     b.green();
     b.run();
-    // Wraps 2 to 5: the second wound again, two outs each.
-    let outs = b.steps[before..]
-        .iter()
-        .filter(|s| matches!(s, MachineStep::Move([None, Some(_), None, None])))
-        .count();
-    assert_eq!(outs, 8);
+    // Wraps 2 to 5: the second wound again, four blended moves each.
+    assert_eq!(blended_moves(&b.steps[before..]), 16);
     // Before any wrap, nothing to step back to; not while drilling.
     let mut b = paused_after(0);
     assert_eq!(tool(&mut b, Tool::Back), [Action::Log(Msg::ToolRange)]);
@@ -170,11 +172,7 @@ fn wrap_jump_goes_on_at_the_wrap_asked_with_its_checkpoint() {
     b.green();
     b.run();
     // Wraps 4 and 5 of the pattern, then the drivers off.
-    let outs = b.steps[before..]
-        .iter()
-        .filter(|s| matches!(s, MachineStep::Move([None, Some(_), None, None])))
-        .count();
-    assert_eq!(outs, 4);
+    assert_eq!(blended_moves(&b.steps[before..]), 8);
     assert_eq!(b.job.state(), State::End);
 }
 

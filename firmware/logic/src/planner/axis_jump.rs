@@ -1,0 +1,77 @@
+//! Per-axis bounds on the velocity change at a junction, on top of Grbl's
+//! junction deviation (which bounds a fictitious arc's acceleration, not
+//! what each motor sees).
+//!
+//! At a junction the path's speed v is kept, and each axis's velocity
+//! jumps from v·u_i to v·u′_i (u, u′ the unit directions of the two
+//! blocks). A stepper whose commanded velocity jumps by Δv falls behind
+//! until it has caught up at its acceleration a: by Δv² / 2a. It keeps
+//! step while that lag is under two full steps (half an electrical turn);
+//! we allow half of that, one full step — 8 steps at the string-art
+//! machine's ×8 microstepping — so Δv ≤ √(2·a·8 steps) per axis: 89
+//! steps/s at 500 steps/s². Within blocks the planner already keeps each
+//! axis's share of speed and acceleration within its own limits
+//! (`Geometry::limits`), so with this bound the axes' limits hold in
+//! joint space at every block and every junction.
+
+use crate::axis::AXES;
+use crate::config::MachineConfig;
+
+/// The commanded position may lead a motor by this many steps at a
+/// junction.
+pub const LAG_STEPS: u32 = 8;
+
+/// Each axis's largest velocity change at a junction, path milli-units/s.
+pub struct AxisJumps {
+    milli: [f32; AXES],
+}
+
+impl AxisJumps {
+    pub const EMPTY: AxisJumps = AxisJumps { milli: [0.0; AXES] };
+
+    pub fn new(config: &MachineConfig) -> Self {
+        let mut milli = [0.0; AXES];
+        for (m, a) in milli.iter_mut().zip(&config.axes) {
+            let steps_per_s = crate::fmath::sqrt((2 * a.accel * LAG_STEPS) as f32);
+            *m = steps_per_s * 1000.0 / a.steps_per_unit.as_f32();
+        }
+        AxisJumps { milli }
+    }
+
+    /// The largest path speed², (milli-units/s)², at which the turn from
+    /// direction `prev` to `next` (unit vectors in path milli-units)
+    /// changes no axis's velocity by more than its bound.
+    pub fn limit_sqr(&self, prev: &[f32; AXES], next: &[f32; AXES]) -> u64 {
+        let mut v = f32::MAX;
+        for i in 0..AXES {
+            let change = (next[i] - prev[i]).abs();
+            if change > 0.0 {
+                v = v.min(self.milli[i] / change);
+            }
+        }
+        if v == f32::MAX {
+            return u64::MAX;
+        }
+        (v * v) as u64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_right_angle_between_base_and_radial_is_a_near_stop() {
+        let j = AxisJumps::new(&MachineConfig::STRING_ART);
+        // Base 1° = 26.67 steps, radial 1 mm = 32 steps: √8000 steps/s is
+        // 3354 mdeg/s of the base and 2795 µm/s of the carriage.
+        let (base, radial) = ([1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]);
+        let v = (j.limit_sqr(&base, &radial) as f32).sqrt();
+        assert!((v - 2795.1).abs() < 1.0, "{v}");
+        // Straight on: no bound; a reversal of the base: half its jump.
+        assert_eq!(j.limit_sqr(&base, &base), u64::MAX);
+        let back = [-1.0, 0.0, 0.0, 0.0];
+        let v = (j.limit_sqr(&base, &back) as f32).sqrt();
+        assert!((v - 3354.1 / 2.0).abs() < 1.0, "{v}");
+    }
+}

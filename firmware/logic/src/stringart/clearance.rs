@@ -1,0 +1,96 @@
+//! How close the needle may come to a nail, and where that leaves it free
+//! to cross the ring of nails: the geometric constraint of blended winding.
+//!
+//! The needle's axis must stay at least `c` from every nail's axis, with
+//! `c` = nail radius + needle radius + a margin (the thread it carries, a
+//! nail leaning at half its height, the base's step of 0.25 mm at the
+//! ring). A nail at radius r blocks the angles within α of its own, with
+//! sin α = c / r: a ray at an angle outside that passes the nail at
+//! r·sin α ≥ c, whatever its radius. Between two nails' blocked angles
+//! lies the gap's *window*; at angles in no window (near a nail) the
+//! needle must keep to radii outside r ± c. So the needle may be anywhere
+//! inside `min radius − c` or, over nail j, outside `r_j + c`, and it
+//! crosses the band between only at window angles.
+//!
+//! Windows are whole base steps, rounded inwards from the exact nail
+//! angles: a needle standing on a window's edge step is still clear.
+
+use crate::geometry::{Board, StepScale};
+use core::f32::consts::TAU;
+
+/// A string-art nail (1.8 mm panel pin) and the winding needle (a 1.5 mm
+/// hollow needle the thread runs through), mm.
+pub const NAIL_DIAMETER_MM: f32 = 1.8;
+pub const NEEDLE_DIAMETER_MM: f32 = 1.5;
+/// The thread beside the needle (0.3 mm), a nail leaning up to 0.5 mm at
+/// the needle's height, and the base's step at the ring (0.25 mm at
+/// 387 mm), rounded up, mm.
+pub const CLEARANCE_MARGIN_MM: f32 = 1.5;
+
+/// Centre to centre, needle to nail, at the least, mm.
+pub const CLEARANCE_MM: f32 = (NAIL_DIAMETER_MM + NEEDLE_DIAMETER_MM) / 2.0 + CLEARANCE_MARGIN_MM;
+
+/// A gap's window: the base positions (absolute steps, both included) at
+/// which the needle may cross the ring.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Window {
+    pub lo: i32,
+    pub hi: i32,
+}
+
+/// Nail `i`'s exact position in base steps (fractional), and the half
+/// width of the angles it blocks, steps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blocked {
+    pub at: f32,
+    pub half: f32,
+    /// The nail's radius, mm.
+    pub radius: f32,
+}
+
+/// Nail `i` as the window maths needs it: one `nail()` (trigonometry
+/// for a polygon's nail), a square root and a division.
+pub fn blocked(board: &Board, scale: &StepScale, i: u16) -> Blocked {
+    let nail = board.nail(i);
+    let turn = scale.steps_per_turn as f32;
+    // tan(asin x) ≥ asin x: a bound on α without an arcsine.
+    let x = (CLEARANCE_MM / nail.radius).min(0.99);
+    let alpha = x / crate::fmath::sqrt(1.0 - x * x);
+    Blocked {
+        at: nail.angle / TAU * turn,
+        half: alpha / TAU * turn,
+        radius: nail.radius,
+    }
+}
+
+/// Slack for f32 rounding when a blocked edge falls on a whole step.
+const EPS: f32 = 0.01;
+
+/// The window between nails `a` (below) and `b` (above), with `a.at` and
+/// `b.at` already in the same frame (`b.at > a.at`). `None`: the nails
+/// are too close for the needle to pass between them.
+pub fn window(a: &Blocked, b: &Blocked) -> Option<Window> {
+    let lo = libm::ceilf(a.at + a.half + EPS) as i32;
+    let hi = libm::floorf(b.at - b.half - EPS) as i32;
+    (lo <= hi).then_some(Window { lo, hi })
+}
+
+/// Nails `prev`, `j`, `next` around nail j, in nail j's turn: prev moved
+/// below it and next above (across the 0/2π seam when they wrap), so the
+/// windows come out as small numbers of the first turn.
+pub fn around(mut n: [Blocked; 3], turn: i32) -> [Blocked; 3] {
+    let turn = turn as f32;
+    let wrap = |d: f32| if d <= 0.0 { d + turn } else { d };
+    n[0].at = n[1].at - wrap(n[1].at - n[0].at);
+    n[2].at = n[1].at + wrap(n[2].at - n[1].at);
+    n
+}
+
+/// The whole turns to add to nail j's first-turn position `at` (steps) to
+/// bring it nearest the base position `near`: integer, so no f32 loses
+/// steps far from the base's zero.
+pub fn turns_to(at: f32, near: i32, turn: i32) -> i32 {
+    let at = libm::roundf(at) as i32;
+    let d = near - at;
+    (d + turn / 2).div_euclid(turn) * turn
+}
