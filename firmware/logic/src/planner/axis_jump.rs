@@ -61,7 +61,6 @@ mod tests {
     use super::*;
     use crate::planner::{Feed, Planner, PLANNER_BLOCKS};
     use proptest::prelude::*;
-    use std::vec::Vec;
 
     proptest! {
         /// Any polyline of base and radial moves, planned: within each
