@@ -106,6 +106,14 @@ fn the_sample_job_drills_and_winds_as_its_pulses_show() {
     assert_eq!(crossings.len(), 1 + 2 * pattern.len(), "{crossings:#?}");
     let bad = job.crossings_outside_gaps();
     assert!(bad.is_empty(), "crossed the ring at a nail: {bad:#?}");
+    // At every step, not only at the ends of moves: the blended paths
+    // cross the ring mid-move. Within a micrometre of the clearance (the
+    // replay's floats against the firmware's).
+    let (closest, at_ns, nail) = job.closest_to_nails();
+    assert!(
+        closest >= f64::from(taut_logic::stringart::CLEARANCE_MM) - 1e-3,
+        "{closest:.3} mm from nail {nail} at {at_ns} ns"
+    );
     // The drill's driver is off while winding, the others hold: checked
     // at every crossing of the ring.
     for c in &crossings {

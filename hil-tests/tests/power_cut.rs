@@ -25,9 +25,11 @@ use taut_logic::geometry::{Board, StepScale};
 use taut_logic::units::Milli;
 
 const NAILS: u16 = 12;
-/// The pattern: 30 wraps, no nail twice in a row.
-const PATTERN: [u16; 30] = [
+/// The pattern: 40 wraps, no nail twice in a row (long enough for the
+/// blended job to take more than twenty cuts).
+const PATTERN: [u16; 40] = [
     9, 4, 11, 5, 11, 10, 8, 0, 7, 3, 10, 0, 2, 1, 5, 7, 3, 6, 8, 1, 9, 3, 0, 11, 3, 6, 4, 2, 6, 2,
+    5, 8, 1, 10, 4, 9, 0, 7, 11, 2,
 ];
 /// A run that has not finished (or been cut) by then has hung.
 const RUN_TIMEOUT_S: f64 = 600.0;
@@ -341,7 +343,9 @@ fn another_card_or_a_corrupt_checkpoint_is_never_resumed() {
     let mut sim = machine();
     sim.insert_sd(job_card(&PATTERN));
     let mut op = Operator::confirming();
-    while !sim.uart_text().contains("wind 3/30") {
+    // Progress is said every 5 %: every other wrap of 40.
+    let fourth = format!("wind 4/{}", PATTERN.len());
+    while !sim.uart_text().contains(&fourth) {
         assert_eq!(sim.run_for(Duration::from_millis(10)), Outcome::Running);
         op.step(&mut sim);
         assert!(sim.time_s() < RUN_TIMEOUT_S, "{}", sim.uart_text());
@@ -350,7 +354,7 @@ fn another_card_or_a_corrupt_checkpoint_is_never_resumed() {
     let Found::Job(saved) = checkpoint::scan(|a| eeprom[a as usize]) else {
         panic!("no checkpoint")
     };
-    assert_eq!(saved.done(), 3);
+    assert_eq!(saved.done(), 4);
 
     // Another pattern on the same board: not this job.
     let mut other = PATTERN;

@@ -271,6 +271,33 @@ impl JobReplay {
         self.wraps().into_iter().flat_map(|w| w.nails).collect()
     }
 
+    /// The needle's closest approach to a nail while winding: the
+    /// distance between their axes (mm), when (ns), and the nail. Checked
+    /// at every step, the position replayed from the pulses, so a blended
+    /// path that crosses the ring mid-move is judged where it crosses.
+    pub fn closest_to_nails(&self) -> (f64, u64, u16) {
+        let (from, to) = self.winding;
+        let t = &self.trace;
+        let mut at = [t.position(Axis::Base, from), t.position(Axis::Radial, from)];
+        let nails: Vec<(f64, f64)> = (0..self.ring.nails())
+            .map(|i| self.ring.nail_xy(i))
+            .collect();
+        let mut best = (f64::INFINITY, from, 0);
+        let first = self.events.partition_point(|e| e.at_ns <= from);
+        let window = self.events[first..].iter().take_while(|e| e.at_ns <= to);
+        for e in window.filter(|e| e.axis < 2) {
+            at[e.axis] = e.pos;
+            let (x, y) = self.tool_xy(at[0], at[1]);
+            for (i, &(nx, ny)) in nails.iter().enumerate() {
+                let d = (x - nx).hypot(y - ny);
+                if d < best.0 {
+                    best = (d, e.at_ns, i as u16);
+                }
+            }
+        }
+        best
+    }
+
     /// The crossings while winding that were not inside a gap.
     pub fn crossings_outside_gaps(&self) -> Vec<Crossing> {
         self.crossings()

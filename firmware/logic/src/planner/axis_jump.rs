@@ -59,6 +59,45 @@ impl AxisJumps {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::planner::{Feed, Planner, PLANNER_BLOCKS};
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Any polyline of base and radial moves, planned: within each
+        /// block every axis's speed and acceleration are its share of the
+        /// block's and within its own limits, and at each junction each
+        /// axis's velocity changes by at most its jump.
+        #[test]
+        fn every_axis_keeps_its_limits_in_joint_space(
+            points in prop::collection::vec((-3000i32..3000, -800i32..800), 1..PLANNER_BLOCKS),
+        ) {
+            let c = MachineConfig::STRING_ART;
+            let mut p = Planner::new(&c);
+            for &(b, r) in &points {
+                p.push([b, r, 0, 0], Feed::Rapid).unwrap();
+            }
+            let mut last: Option<[f64; 2]> = None;
+            while let Some(t) = p.take_speeds() {
+                let e = f64::from(t.block.events);
+                let sign = |i: usize| if t.block.dir & (1 << i) != 0 { 1.0 } else { -1.0 };
+                let share = |i: usize| f64::from(t.block.steps[i]) / e * sign(i);
+                let v = |sqr: u64| (sqr as f64).sqrt();
+                for i in 0..2 {
+                    let a = &c.axes[i];
+                    prop_assert!(v(t.speeds.cruise_sqr) * share(i).abs() <= f64::from(a.max_rate) + 1.0);
+                    prop_assert!(f64::from(t.accel) * share(i).abs() <= f64::from(a.accel) + 1.0);
+                }
+                let entry = [0, 1].map(|i| v(t.speeds.entry_sqr) * share(i));
+                let jump = (2.0 * 500.0 * f64::from(LAG_STEPS)).sqrt();
+                for i in 0..2 {
+                    let before = last.map_or(0.0, |l| l[i]);
+                    prop_assert!((entry[i] - before).abs() <= jump * 1.01 + 1.0,
+                        "axis {}: {} → {} steps/s", i, before, entry[i]);
+                }
+                last = Some([0, 1].map(|i| v(t.speeds.exit_sqr) * share(i)));
+            }
+        }
+    }
 
     #[test]
     fn a_right_angle_between_base_and_radial_is_a_near_stop() {

@@ -189,13 +189,28 @@ mod tests {
     #[test]
     fn base_and_carriage_move_only_with_the_drill_raised() {
         let board = Board::new(0, 250, Milli(402_000)).unwrap();
+        let c = MachineConfig::STRING_ART;
+        // Blended: raised only 2 mm, 277 steps along the tilted axis.
+        for (drilling, raised) in [
+            (Drilling::new(board, &c), -1385),
+            (Drilling::blended(board, &c), -277),
+        ] {
+            sideways_only_above_the_surface(drilling, raised);
+        }
+    }
+
+    /// No step of the base or the carriage below the surface (the drill
+    /// never moves in the same block as they do, so checking each move's
+    /// start is checking each of its steps); a hole at every nail.
+    fn sideways_only_above_the_surface(drilling: Drilling, raised: i32) {
         let mut drill = 0;
         let mut holes = Vec::new();
         let mut base = 0;
-        for step in Drilling::new(board, &MachineConfig::STRING_ART) {
+        for step in drilling {
             if let MachineStep::Move(t) = step {
                 if t[0].is_some() || t[1].is_some() {
-                    assert!(drill < 0, "{step:?} with the drill at {drill}");
+                    assert!(t[2].is_none(), "{step:?}");
+                    assert_eq!(drill, raised, "{step:?} with the drill at {drill}");
                 }
                 base = t[0].unwrap_or(base);
                 if let Some(d) = t[2] {

@@ -127,12 +127,6 @@ impl Winder {
         })
     }
 
-    /// The drill's driver off (the needle holds its height unpowered),
-    /// then the entry move.
-    pub fn entry(&mut self) -> [MachineStep; 4] {
-        [0, 1, 2, 3].map(|i| self.entry_step(None, i).expect("four steps"))
-    }
-
     /// Step `i` of the entry from the zero pose (needle outside the ring
     /// at the board's edge), made when needed rather than kept: a new
     /// job's (`resume: None`: half a nail round to the gap after nail 0,
