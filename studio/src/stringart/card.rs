@@ -9,7 +9,7 @@ use taut_logic::files::check::{Files, Next};
 use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::geometry::Board;
-use taut_logic::stringart::{estimate, BlendWinder, WindError};
+use taut_logic::stringart::{estimate, Winder};
 
 /// The board as the card describes it: shape (0 circle, n ≥ 3 n-gon),
 /// nails, radius in µm.
@@ -41,16 +41,7 @@ impl Spec {
         let radius = taut_logic::units::Milli(self.radius_um as i32);
         let board =
             Board::new(self.shape, self.nails, radius).map_err(|e| e.message().to_string())?;
-        // The firmware's winder: it refuses nails too close for the needle.
-        BlendWinder::new(board, &base).map_err(|e| match e {
-            WindError::GapTooNarrow(g) => {
-                format!(
-                    "nails {g} and {} stand too close for the needle",
-                    (g + 1) % self.nails
-                )
-            }
-            _ => "the board is too small to wind".to_string(),
-        })?;
+        Winder::new(board, &base).map_err(|_| "the board is too small to wind".to_string())?;
         Ok(board)
     }
 }
