@@ -27,8 +27,11 @@ pub const NEEDLE_DIAMETER_MM: f32 = 1.5;
 /// 387 mm), rounded up, mm.
 pub const CLEARANCE_MARGIN_MM: f32 = 1.5;
 
-/// Centre to centre, needle to nail, at the least, mm.
-pub const CLEARANCE_MM: f32 = (NAIL_DIAMETER_MM + NEEDLE_DIAMETER_MM) / 2.0 + CLEARANCE_MARGIN_MM;
+/// Centre to centre, needle touching a nail, mm.
+pub const CONTACT_MM: f32 = (NAIL_DIAMETER_MM + NEEDLE_DIAMETER_MM) / 2.0;
+/// Centre to centre, needle to nail, at the least where the gaps allow
+/// it, mm.
+pub const CLEARANCE_MM: f32 = CONTACT_MM + CLEARANCE_MARGIN_MM;
 
 /// A gap's window: the base positions (absolute steps, both included) at
 /// which the needle may cross the ring.
@@ -67,12 +70,26 @@ pub fn blocked(board: &Board, scale: &StepScale, i: u16) -> Blocked {
 const EPS: f32 = 0.01;
 
 /// The window between nails `a` (below) and `b` (above), with `a.at` and
-/// `b.at` already in the same frame (`b.at > a.at`). `None`: the nails
-/// are too close for the needle to pass between them.
+/// `b.at` already in the same frame (`b.at > a.at`). Nails closer than
+/// the margin allows (dense boards: under ~6.3 mm apart) leave the gap's
+/// middle step, where the needle passes both by half the gap, as the
+/// four single-axis moves always crossed; `None`: not even the needle's
+/// own width passes between them.
 pub fn window(a: &Blocked, b: &Blocked) -> Option<Window> {
     let lo = libm::ceilf(a.at + a.half + EPS) as i32;
     let hi = libm::floorf(b.at - b.half - EPS) as i32;
-    (lo <= hi).then_some(Window { lo, hi })
+    if lo <= hi {
+        return Some(Window { lo, hi });
+    }
+    // α grows a little faster than c / r: scaling it down bounds the
+    // angles the bare nail blocks from above.
+    let bare = CONTACT_MM / CLEARANCE_MM;
+    let mid = libm::roundf((a.at + b.at) / 2.0);
+    let clear = a.at + a.half * bare + EPS < mid && mid < b.at - b.half * bare - EPS;
+    clear.then_some(Window {
+        lo: mid as i32,
+        hi: mid as i32,
+    })
 }
 
 /// Nails `prev`, `j`, `next` around nail j, in nail j's turn: prev moved
