@@ -22,7 +22,7 @@ use crate::config::MachineConfig;
 use crate::segment::{Speeds, StepBlock, Trapezoid};
 use crate::units::Milli;
 use axis_jump::AxisJumps;
-use junction::{Corner, Geometry};
+use junction::Geometry;
 
 /// Number of moves the planner holds.
 pub const PLANNER_BLOCKS: usize = 13;
@@ -71,9 +71,10 @@ struct Block {
     /// The speed asked for, events/s, before the overrides and the axes'
     /// limits; 0: a rapid.
     feed_ev: f32,
-    /// Cruise speed along the path with the overrides, milli-units/s in
-    /// 24.8 fixed point.
-    nominal: u32,
+    /// Cruise speed² along the path with the overrides, (milli-units/s)²:
+    /// kept squared, as the look-ahead passes compare it (a 64-bit
+    /// multiply each time was a third of a pass on the AVR).
+    nominal_sqr: u64,
     /// (events per path milli-unit)²: converts path speeds² to events²/s².
     ev_per_milli_sqr: f32,
     /// Path speeds², (milli-units/s)²: what the junction with the block
@@ -93,17 +94,12 @@ impl Block {
         },
         accel: 0,
         feed_ev: 0.0,
-        nominal: 0,
+        nominal_sqr: 0,
         ev_per_milli_sqr: 0.0,
         junction_sqr: 0,
         entry_sqr: 0,
         delta_sqr: 0,
     };
-
-    /// Cruise speed², path units.
-    fn nominal_sqr(&self) -> u64 {
-        (self.nominal as u64 * self.nominal as u64) >> 16
-    }
 }
 
 /// The feed and rapid overrides, percent (Grbl's 10–200 and 25/50/100).
@@ -121,15 +117,39 @@ impl Overrides {
 
     /// The cruise speed along the path of a move asking `feed_ev` events/s
     /// (0: rapid) whose axes allow `rate`, with `ev_per_milli` events per
-    /// path milli-unit: milli-units/s in 24.8 fixed point.
-    fn nominal(self, feed_ev: f32, rate: u32, ev_per_milli: f32) -> u32 {
+    /// path milli-unit, squared: (milli-units/s)², from the speed in 24.8
+    /// fixed point.
+    fn nominal_sqr(self, feed_ev: f32, rate: u32, ev_per_milli: f32) -> u64 {
         let (asked, percent) = match feed_ev == 0.0 {
             true => (rate as f32, self.rapid),
             false => (feed_ev, self.feed),
         };
         let ev = (asked * percent as f32 / 100.0).clamp(1.0, rate as f32);
-        (ev * 256.0 / ev_per_milli) as u32
+        let nominal = (ev * 256.0 / ev_per_milli) as u32 as u64;
+        (nominal * nominal) >> 16
     }
+}
+
+/// How far the newest move has been planned: [`Planner::stage`] only
+/// records it, [`Planner::plan_part`] works it out in bounded parts (on
+/// the AVR ~0.9 ms at most each; a move planned whole is ~2.3 ms), so
+/// that a caller may spread a move over several runs of its task. Its
+/// block sits in the slot after the queue, counted in the queue once the
+/// last part is done.
+/// `repr(u8)`: `Done` is then a zero byte, and `Planner::EMPTY` all
+/// zeros (a static of it needs no initial image, in flash or `.data`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(u8)]
+enum Stage {
+    /// No move is being planned.
+    Done,
+    /// Its steps are in the slot; the path comes next.
+    Pushed(Feed),
+    /// Direction, junction and asked speed worked out; the axes' limits
+    /// come next.
+    Path { ev_per_milli: f32 },
+    /// Its figures are complete; the look-ahead passes come next.
+    Limits,
 }
 
 pub struct Planner {
@@ -149,6 +169,7 @@ pub struct Planner {
     /// `None`: none (100 %). An `Option`, so that `EMPTY` is all zeros: a
     /// static of it then costs no initial image in flash.
     overrides: Option<Overrides>,
+    stage: Stage,
 }
 
 impl Planner {
@@ -164,6 +185,7 @@ impl Planner {
         jumps: AxisJumps::EMPTY,
         last: None,
         overrides: None,
+        stage: Stage::Done,
     };
 
     /// Take the machine's figures, in place; drops queued moves and keeps
@@ -175,6 +197,7 @@ impl Planner {
         self.geometry = Geometry::new(config);
         self.jumps = AxisJumps::new(config);
         self.last = None;
+        self.stage = Stage::Done;
     }
 
     pub fn new(config: &MachineConfig) -> Self {
@@ -188,6 +211,7 @@ impl Planner {
             jumps: AxisJumps::new(config),
             last: None,
             overrides: None,
+            stage: Stage::Done,
         }
     }
 
@@ -197,22 +221,34 @@ impl Planner {
         self.len
     }
 
+    /// No room for a move: the queue is full, or a move is still being
+    /// planned.
     pub fn is_full(&self) -> bool {
-        self.len == PLANNER_BLOCKS
+        self.len == PLANNER_BLOCKS || self.stage != Stage::Done
     }
 
-    /// Adds a move to the absolute step position `target`. A move of no
-    /// step is dropped.
+    /// Adds a move to the absolute step position `target`, planned whole.
+    /// A move of no step is dropped.
     pub fn push(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
+        self.stage(target, feed)?;
+        while self.plan_part() {}
+        Ok(())
+    }
+
+    /// Records a move to the absolute step position `target`, to be
+    /// planned by [`Planner::plan_part`]; the next move waits for it
+    /// (`Full`). A move of no step is dropped.
+    // Indexed: zipping the two arrays costs ~270 B of flash at `z`.
+    #[allow(clippy::needless_range_loop)]
+    pub fn stage(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
         if self.is_full() {
             return Err(Full);
         }
         let mut step = StepBlock::default();
-        let mut delta = [0i64; AXES];
         for i in 0..AXES {
-            delta[i] = target[i] as i64 - self.position[i] as i64;
-            step.steps[i] = delta[i].unsigned_abs() as u32;
-            if delta[i] > 0 {
+            let delta = target[i] as i64 - self.position[i] as i64;
+            step.steps[i] = delta.unsigned_abs() as u32;
+            if delta > 0 {
                 step.dir |= 1 << i;
             }
         }
@@ -220,42 +256,87 @@ impl Planner {
         if step.events == 0 {
             return Ok(());
         }
-        let (accel, rate) = self.geometry.limits(&step);
-        let path = self.geometry.path(&delta);
-        let feed_ev = match feed {
+        self.blocks[self.staged()] = Block {
+            step,
+            ..Block::EMPTY
+        };
+        self.position = target;
+        self.stage = Stage::Pushed(feed);
+        Ok(())
+    }
+
+    /// A move staged is still being planned.
+    pub fn is_planning(&self) -> bool {
+        self.stage != Stage::Done
+    }
+
+    /// The slot of the move being planned: the one after the queue.
+    fn staged(&self) -> usize {
+        (self.head + self.len) % PLANNER_BLOCKS
+    }
+
+    /// One bounded part of planning the move [`Planner::stage`] recorded
+    /// (each under ~0.9 ms on the AVR); false when there is none. Once
+    /// the last is done the move is queued, and there is room again.
+    pub fn plan_part(&mut self) -> bool {
+        match self.stage {
+            Stage::Done => return false,
+            Stage::Pushed(feed) => self.plan_path(feed),
+            Stage::Path { ev_per_milli } => self.plan_limits(ev_per_milli),
+            Stage::Limits => {
+                self.len += 1;
+                self.recalculate();
+                self.stage = Stage::Done;
+            }
+        }
+        true
+    }
+
+    /// The staged move's direction, the junction with the move before it
+    /// and the speed asked, in events/s. Out of line, as each part: the
+    /// parts are measured apart (issue #13's `task_runs`).
+    #[inline(never)]
+    #[cfg_attr(target_arch = "avr", optimize(speed))]
+    fn plan_path(&mut self, feed: Feed) {
+        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        let path = self.geometry.path(&b.step);
+        b.feed_ev = match feed {
             Feed::Rapid => 0.0,
             // Never 0, which means a rapid.
             Feed::PerMinute(f) => f.0.max(1) as f32 / 60.0 * path.ev_per_milli,
         };
-        let k2 = path.ev_per_milli * path.ev_per_milli;
-        let junction_sqr = match self.last {
+        b.junction_sqr = match self.last {
             Some(prev_unit) => self
                 .geometry
-                .junction_sqr(&Corner::new(&prev_unit, &path.unit))
+                .junction_sqr(&prev_unit, &path.unit)
                 .min(self.jumps.limit_sqr(&prev_unit, &path.unit)),
             None => 0,
         };
-        let slot = (self.head + self.len) % PLANNER_BLOCKS;
-        self.blocks[slot] = Block {
-            step,
-            accel,
-            feed_ev,
-            nominal: self.overrides().nominal(feed_ev, rate, path.ev_per_milli),
-            ev_per_milli_sqr: k2,
-            junction_sqr,
-            entry_sqr: 0,
-            delta_sqr: ((2 * accel as u64 * step.events as u64) as f32 / k2) as u64,
-        };
-        self.len += 1;
-        self.position = target;
         self.last = Some(path.unit);
-        self.recalculate();
-        Ok(())
+        self.stage = Stage::Path {
+            ev_per_milli: path.ev_per_milli,
+        };
     }
 
-    /// No move is waiting for the preparer.
+    /// The staged move's acceleration and cruise speed within the axes'
+    /// limits, and how much its speed² can change over it.
+    #[inline(never)]
+    #[cfg_attr(target_arch = "avr", optimize(speed))]
+    fn plan_limits(&mut self, ev_per_milli: f32) {
+        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        let (accel, rate) = self.geometry.limits(&b.step);
+        let k2 = ev_per_milli * ev_per_milli;
+        let overrides = self.overrides.unwrap_or(Overrides::NONE);
+        b.accel = accel;
+        b.nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
+        b.ev_per_milli_sqr = k2;
+        b.delta_sqr = ((2 * accel as u64 * b.step.events as u64) as f32 / k2) as u64;
+        self.stage = Stage::Limits;
+    }
+
+    /// No move is waiting for the preparer or being planned.
     pub fn is_idle(&self) -> bool {
-        self.len == 0
+        self.len == 0 && self.stage == Stage::Done
     }
 
     /// Target of the last move pushed, steps.
@@ -301,7 +382,7 @@ impl Planner {
             accel: b.accel,
             speeds: Speeds {
                 entry_sqr: to_events(b.entry_sqr),
-                cruise_sqr: to_events(b.nominal_sqr()),
+                cruise_sqr: to_events(b.nominal_sqr),
                 exit_sqr: to_events(exit_sqr),
             },
             ev_per_milli_sqr: b.ev_per_milli_sqr,
@@ -323,6 +404,7 @@ impl Planner {
         self.head = 0;
         self.len = 0;
         self.carry_sqr = 0;
+        self.stage = Stage::Done;
         self.set_position(position);
     }
 
@@ -337,38 +419,45 @@ impl Planner {
             let b = &mut self.blocks[(self.head + i) % PLANNER_BLOCKS];
             let (_, rate) = self.geometry.limits(&b.step);
             let ev_per_milli = crate::fmath::sqrt(b.ev_per_milli_sqr);
-            b.nominal = overrides.nominal(b.feed_ev, rate, ev_per_milli);
+            b.nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
         }
         if self.len > 0 {
             self.recalculate();
         }
     }
 
-    fn overrides(&self) -> Overrides {
-        self.overrides.unwrap_or(Overrides::NONE)
-    }
-
     /// Grbl's passes: backwards, each entry is at most what the junction
     /// and both cruise speeds allow and what still stops at the end of the
     /// queue; forwards, at most what the previous block can reach from its
-    /// entry. Integer only.
+    /// entry. Integer only; the ring stepped by hand (a `%` is a 16-bit
+    /// division call on the AVR).
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn recalculate(&mut self) {
-        let at = |i: usize| (self.head + i) % PLANNER_BLOCKS;
+        if self.len == 0 {
+            return;
+        }
+        let mut i = (self.head + self.len - 1) % PLANNER_BLOCKS;
+        let mut nominal_sqr = self.blocks[i].nominal_sqr;
         let mut next_entry = 0u64;
-        for i in (1..self.len).rev() {
-            let prev_nominal_sqr = self.blocks[at(i - 1)].nominal_sqr();
-            let b = &mut self.blocks[at(i)];
-            let max_entry_sqr = b.junction_sqr.min(b.nominal_sqr()).min(prev_nominal_sqr);
+        for _ in 1..self.len {
+            let prev = i.checked_sub(1).unwrap_or(PLANNER_BLOCKS - 1);
+            let prev_nominal_sqr = self.blocks[prev].nominal_sqr;
+            let b = &mut self.blocks[i];
+            let max_entry_sqr = b.junction_sqr.min(nominal_sqr).min(prev_nominal_sqr);
             b.entry_sqr = max_entry_sqr.min(next_entry.saturating_add(b.delta_sqr));
             next_entry = b.entry_sqr;
+            nominal_sqr = prev_nominal_sqr;
+            i = prev;
         }
-        self.blocks[self.head].entry_sqr = self.carry_sqr;
-        for i in 1..self.len {
-            let prev = self.blocks[at(i - 1)];
-            let reach = prev.entry_sqr.saturating_add(prev.delta_sqr);
-            let b = &mut self.blocks[at(i)];
+        let first = &mut self.blocks[self.head];
+        first.entry_sqr = self.carry_sqr;
+        let mut reach = first.entry_sqr.saturating_add(first.delta_sqr);
+        let mut i = self.head;
+        for _ in 1..self.len {
+            i = if i + 1 == PLANNER_BLOCKS { 0 } else { i + 1 };
+            let b = &mut self.blocks[i];
             b.entry_sqr = b.entry_sqr.min(reach);
+            reach = b.entry_sqr.saturating_add(b.delta_sqr);
         }
     }
 }

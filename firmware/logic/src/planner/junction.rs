@@ -5,16 +5,16 @@
 use crate::axis::AXES;
 use crate::config::MachineConfig;
 use crate::segment::{StepBlock, MAX_ACCEL};
-/// Square root without libm's 256-byte table (which the AVR would copy
-/// into SRAM): a bit-level first guess and three Newton steps, good to
-/// f32 precision for the positive, finite values used here.
-fn sqrtf(x: f32) -> f32 {
-    if x <= 0.0 {
-        return 0.0;
-    }
-    let mut y = f32::from_bits((x.to_bits() >> 1) + 0x1FC0_0000);
+/// 1/√x for the positive, finite values used here, without libm's
+/// 256-byte table (which the AVR would copy into SRAM) and without a
+/// division (~5 multiplies on the AVR): a bit-level first guess and three
+/// Newton steps of multiplies, good to a few f32 ulps. Lengths are
+/// normalised by multiplying with it.
+fn rsqrt(x: f32) -> f32 {
+    let half = 0.5 * x;
+    let mut y = f32::from_bits(0x5F37_5A86 - (x.to_bits() >> 1));
     for _ in 0..3 {
-        y = 0.5 * (y + x / y);
+        y *= 1.5 - half * y * y;
     }
     y
 }
@@ -26,8 +26,9 @@ const STRAIGHT: f32 = 0.999_999;
 /// The axes' figures in the units the planner needs.
 pub struct Geometry {
     milli_per_step: [f32; AXES],
-    /// Acceleration along each axis, milli-units/s².
-    accel_milli: [f32; AXES],
+    /// 1 / acceleration along each axis, s²/milli-unit: the junction's
+    /// limit multiplies rather than divides.
+    per_accel_milli: [f32; AXES],
     accel: [u32; AXES],
     max_rate: [u32; AXES],
     deviation_milli: f32,
@@ -39,18 +40,11 @@ pub struct Path {
     pub ev_per_milli: f32,
 }
 
-/// A junction between two moves: Grbl's `junction_cos_theta` (1 = full
-/// reversal, -1 = straight on) and the direction the velocity changes in.
-pub struct Corner {
-    cos: f32,
-    change: [f32; AXES],
-}
-
 impl Geometry {
     /// No axis can move until [`Geometry::new`] replaces it.
     pub const EMPTY: Geometry = Geometry {
         milli_per_step: [0.0; AXES],
-        accel_milli: [0.0; AXES],
+        per_accel_milli: [0.0; AXES],
         accel: [0; AXES],
         max_rate: [0; AXES],
         deviation_milli: 0.0,
@@ -59,14 +53,14 @@ impl Geometry {
     pub fn new(config: &MachineConfig) -> Self {
         let mut g = Geometry {
             milli_per_step: [0.0; AXES],
-            accel_milli: [0.0; AXES],
+            per_accel_milli: [0.0; AXES],
             accel: [0; AXES],
             max_rate: [0; AXES],
             deviation_milli: config.junction_deviation_um as f32,
         };
         for (i, a) in config.axes.iter().enumerate() {
             g.milli_per_step[i] = 1000.0 / a.steps_per_unit.as_f32();
-            g.accel_milli[i] = a.accel as f32 * g.milli_per_step[i];
+            g.per_accel_milli[i] = 1.0 / (a.accel as f32 * g.milli_per_step[i]);
             g.accel[i] = a.accel;
             g.max_rate[i] = a.max_rate;
         }
@@ -90,71 +84,82 @@ impl Geometry {
         (accel.max(1) as u32, rate.max(1) as u32)
     }
 
-    /// Direction and scale of a move of `delta` steps per axis.
-    pub fn path(&self, delta: &[i64; AXES]) -> Path {
+    /// Direction and scale of the move `step`.
+    pub fn path(&self, step: &StepBlock) -> Path {
         let mut unit = [0.0; AXES];
         let mut len_sqr = 0.0;
-        let mut events = 0;
-        for i in 0..AXES {
-            unit[i] = delta[i] as f32 * self.milli_per_step[i];
-            len_sqr += unit[i] * unit[i];
-            events = events.max(delta[i].unsigned_abs());
+        for (i, u) in unit.iter_mut().enumerate() {
+            // Most moves leave an axis or two idle: a multiply is ~100
+            // cycles on the AVR.
+            if step.steps[i] == 0 {
+                continue;
+            }
+            let milli = step.steps[i] as f32 * self.milli_per_step[i];
+            *u = if step.dir >> i & 1 != 0 {
+                milli
+            } else {
+                -milli
+            };
+            len_sqr += *u * *u;
         }
-        let len = sqrtf(len_sqr);
-        unit.iter_mut().for_each(|u| *u /= len);
+        let per_len = rsqrt(len_sqr);
+        unit.iter_mut().for_each(|u| *u *= per_len);
         Path {
             unit,
-            ev_per_milli: events as f32 / len,
+            ev_per_milli: step.events as f32 * per_len,
         }
     }
 
-    /// Grbl's junction speed²: the speed at which a circle tangent to both
-    /// moves, passing `junction_deviation` from the corner, is driven at the
-    /// acceleration the axes allow in the direction the velocity changes.
-    pub fn junction_sqr(&self, c: &Corner) -> u64 {
-        if c.cos > STRAIGHT {
-            return 0;
-        }
-        if c.cos < -STRAIGHT {
-            return u64::MAX;
-        }
-        let mut accel = f32::MAX;
+    /// Grbl's junction speed² between moves along the unit vectors
+    /// `prev` and `next`: the speed at which a circle tangent to both
+    /// moves, passing `junction_deviation` from the corner, is driven at
+    /// the acceleration the axes allow in the direction the velocity
+    /// changes.
+    pub fn junction_sqr(&self, prev: &[f32; AXES], next: &[f32; AXES]) -> u64 {
+        // Grbl's `junction_cos_theta` (1 = full reversal, -1 = straight
+        // on), and 1 / the acceleration allowed along the change, per unit
+        // of change: the axes' tightest, scaled by its share along each.
+        let mut cos = 0.0f32;
+        let mut per_accel = 0.0f32;
         for i in 0..AXES {
-            if c.change[i] != 0.0 {
-                accel = accel.min(self.accel_milli[i] / c.change[i].abs());
+            // An axis idle in both moves adds nothing (sign bits aside).
+            if (prev[i].to_bits() | next[i].to_bits()) << 1 == 0 {
+                continue;
+            }
+            cos -= prev[i] * next[i];
+            let a = (next[i] - prev[i]).abs() * self.per_accel_milli[i];
+            // Not `f32::max`: a library call several times a compare's
+            // cost on the AVR.
+            if a > per_accel {
+                per_accel = a;
             }
         }
-        let sin_half = sqrtf(0.5 * (1.0 - c.cos));
-        (accel * self.deviation_milli * sin_half / (1.0 - sin_half)) as u64
-    }
-}
-
-impl Corner {
-    pub fn new(prev: &[f32; AXES], next: &[f32; AXES]) -> Self {
-        let mut cos = 0.0;
-        let mut change = [0.0; AXES];
-        let mut len_sqr = 0.0;
-        for i in 0..AXES {
-            cos -= prev[i] * next[i];
-            change[i] = next[i] - prev[i];
-            len_sqr += change[i] * change[i];
+        if cos > STRAIGHT {
+            return 0;
         }
-        let len = sqrtf(len_sqr);
-        if len > 0.0 {
-            change.iter_mut().for_each(|c| *c /= len);
+        if cos < -STRAIGHT {
+            return u64::MAX;
         }
-        Corner { cos, change }
+        // The change's length without summing its squares: |next − prev|²
+        // = 2·(1 + cos) for unit vectors.
+        let per_accel = per_accel * rsqrt(2.0 * (1.0 + cos));
+        let half = 0.5 * (1.0 - cos);
+        let sin_half = half * rsqrt(half);
+        (self.deviation_milli * sin_half / ((1.0 - sin_half) * per_accel)) as u64
     }
 }
 
 #[cfg(test)]
-mod sqrt_tests {
+mod rsqrt_tests {
     #[test]
-    fn sqrt_matches_std() {
-        for x in [1e-6f32, 0.25, 0.5, 1.0, 2.0, 3.0, 1e3, 12345.678, 1e12] {
-            let (got, want) = (super::sqrtf(x), x.sqrt());
-            assert!((got - want).abs() <= want * 2e-7, "{x}: {got} vs {want}");
+    fn rsqrt_matches_std() {
+        let sweep = (0..20_000).map(|k| 1e-9f32 * 1.002f32.powi(k));
+        for x in [1e-12f32, 0.25, 0.5, 1.0, 2.0, 3.0, 12345.678, 3e30]
+            .into_iter()
+            .chain(sweep)
+        {
+            let (got, want) = (super::rsqrt(x), 1.0 / x.sqrt());
+            assert!((got - want).abs() <= want * 4e-7, "{x}: {got} vs {want}");
         }
-        assert_eq!(super::sqrtf(0.0), 0.0);
     }
 }

@@ -81,6 +81,47 @@ fn full_queue_pushes_back() {
     assert_eq!(p.position(), [0; AXES]);
 }
 
+#[test]
+fn a_staged_move_is_planned_in_parts_and_queued_by_the_last() {
+    let mut p = Planner::new(&square());
+    let mut whole = Planner::new(&square());
+    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
+    whole.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
+    let second = ([20_000, 20_000, 0, 0], Feed::PerMinute(Milli(600_000)));
+    p.stage(second.0, second.1).unwrap();
+    whole.push(second.0, second.1).unwrap();
+    assert_eq!(p.position(), second.0);
+    let mut parts = 0;
+    while p.queued() == 1 {
+        // No room and not idle until queued; the preparer sees only the
+        // queue.
+        assert!(p.is_full() && !p.is_idle());
+        assert_eq!(p.stage([0; AXES], Feed::Rapid), Err(Full));
+        assert!(p.plan_part());
+        parts += 1;
+    }
+    assert_eq!(parts, 3);
+    assert!(!p.plan_part() && !p.is_full());
+    assert_eq!(entries(&p), entries(&whole));
+    assert_eq!(p.take(), whole.take());
+    // A move of no step is dropped at once.
+    p.stage(second.0, Feed::Rapid).unwrap();
+    assert!(!p.plan_part());
+}
+
+#[test]
+fn a_block_taken_while_the_next_is_planned_stops_at_its_end() {
+    let mut p = Planner::new(&square());
+    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
+    p.stage([40_000, 0, 0, 0], Feed::Rapid).unwrap();
+    assert!(p.plan_part());
+    let t = p.take_speeds().unwrap();
+    assert_eq!((t.block.steps[0], t.speeds.exit_sqr), (20_000, 0));
+    while p.plan_part() {}
+    assert_eq!(p.take_speeds().unwrap().block.steps[0], 20_000);
+    assert!(p.is_idle());
+}
+
 /// Plans `moves`, taking blocks when the queue is full, and replays what
 /// the step interrupt would do.
 fn run(
