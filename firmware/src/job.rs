@@ -58,7 +58,8 @@ enum Stream {
     /// `poradi.txt` while winding.
     Pattern(Pattern),
     /// The machine the checked files describe, until the job takes it
-    /// ([`Action::Configure`]) if it does.
+    /// ([`Action::Configure`]) if it does: at once if the machine stands,
+    /// else before the job's first move (a console jog may still run).
     Checked(MachineConfig),
 }
 
@@ -302,6 +303,16 @@ impl JobTask {
         self.event(Event::FilesInvalid, now);
     }
 
+    /// The card's machine taken, if the job asked for it and the machine
+    /// stands: its figures never change under a move.
+    fn configure(&mut self, m: &mut Motion, config: &mut MachineConfig) {
+        if let (Stream::Checked(c), true) = (&self.stream, m.is_idle()) {
+            *config = *c;
+            self.stream = Stream::None;
+            m.configure(config);
+        }
+    }
+
     /// Ask the card reader for a file; its messages carry the new ticket.
     fn open(&mut self, name: FileName) {
         self.ticket = self.ticket.wrapping_add(1).max(1);
@@ -386,6 +397,16 @@ impl JobTask {
                     self.stream = Stream::Files(Files::new());
                     self.open(FileName::Param);
                 }
+                Action::OpenPattern if matches!(self.stream, Stream::Checked(_)) => {
+                    // The card's machine, not yet taken, before the pattern
+                    // takes its place.
+                    if !m.is_idle() {
+                        let _ = self.todo.push_front(a);
+                        return Some(Poll::Wait(Signal::Motion));
+                    }
+                    self.configure(m, config);
+                    let _ = self.todo.push_front(a);
+                }
                 Action::OpenPattern => {
                     self.stream = Stream::Pattern(Pattern::new(self.nails));
                     self.open(FileName::Poradi);
@@ -408,25 +429,21 @@ impl JobTask {
                 Action::StopMotion => {}
                 Action::DriversOn(mask) => m.drivers.set(mask, true),
                 Action::DriversOff(mask) => m.drivers.set(mask, false),
-                Action::Configure | Action::SetZero(_) if !m.is_idle() => {
-                    // A console jog still running: configure, or zero
-                    // where it ends.
+                Action::SetZero(_) if !m.is_idle() => {
+                    // A console jog still running: zero where it ends.
                     let _ = self.todo.push_front(a);
                     return Some(Poll::Wait(Signal::Motion));
                 }
-                Action::Configure => {
-                    if let Stream::Checked(c) = self.stream {
-                        self.stream = Stream::None;
-                        *config = c;
-                        m.configure(config);
-                    }
-                }
+                Action::Configure => self.configure(m, config),
                 Action::SetZero(axis) => {
                     let mut at = m.target();
                     at[axis.index()] = 0;
                     m.set_position(at);
                 }
-                Action::NextMoves => self.feeder.pull(),
+                Action::NextMoves => {
+                    self.configure(m, config);
+                    self.feeder.pull();
+                }
                 Action::Progress(p) => info!(p),
                 Action::Offer { phase, next, total } => offer(phase, next, total),
                 Action::Drift { nail, expected } => {

@@ -119,11 +119,27 @@ impl BlendWinder {
             inner: inner as i32,
             base: 0,
         };
-        // Every gap once, at reading time (a polygon's nails cost ~4 ms
-        // each on the AVR): a board too dense for the needle is refused
-        // before anything moves, and no wrap can fail for it later.
-        for g in 0..board.nails() {
-            w.window_after(g, 0)?;
+        // Every gap once, at reading time: a board too dense for the
+        // needle is refused before anything moves, and no wrap can fail
+        // for it later. Each nail is worked out once (a polygon's costs
+        // trigonometry): the job task's run stays well inside the step
+        // queue's 30 ms.
+        let (n, turn) = (board.nails(), scale.steps_per_turn as f32);
+        let first = blocked(&board, &scale, 0);
+        let mut below = first;
+        for g in 0..n {
+            let mut above = match g + 1 {
+                next if next < n => blocked(&board, &scale, next),
+                _ => first,
+            };
+            if above.at <= below.at {
+                above.at += turn;
+            }
+            window(&below, &above).ok_or(WindError::GapTooNarrow(g))?;
+            below = above;
+            if below.at >= turn {
+                below.at -= turn;
+            }
         }
         Ok(w)
     }
