@@ -58,6 +58,7 @@ use taut_firmware::{endstop, flash_str, info, reply, warn};
 use taut_logic::checkpoint::Found;
 use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::kinematics::AnyKinematics;
+use taut_logic::machine::Machine;
 use taut_logic::planner::Overrides;
 use taut_logic::sched::{Ready, TaskId, Timers};
 
@@ -128,7 +129,7 @@ static TIMERS: TaskCell<Timers<Task, 8>> = TaskCell::new(Timers::new());
 static WAITING: TaskCell<[u16; SIGNALS]> = TaskCell::new([0; SIGNALS]);
 static MOTION: TaskCell<Option<Motion>> = TaskCell::zeroed();
 static CONSOLE: TaskCell<Console> = TaskCell::zeroed();
-static CONFIG: TaskCell<MachineConfig> = TaskCell::new(MachineConfig::STRING_ART);
+static CONFIG: TaskCell<MachineConfig> = TaskCell::zeroed();
 /// The kinematics of `CONFIG`, rebuilt when a setting changes.
 static KIN: TaskCell<Option<AnyKinematics>> = TaskCell::zeroed();
 static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::new(ButtonsTask::new());
@@ -326,9 +327,10 @@ fn init() -> Watchdog {
 #[optimize(size)]
 fn load_store(eeprom: Eeprom) -> (bool, Found) {
     let mut store = Store::new(eeprom);
-    // CONFIG starts as the defaults (naming the constant here would keep a
-    // second copy of it in SRAM).
-    // Read in place from here on: a copy would sit on init's stack.
+    // CONFIG starts as the defaults, read from flash (a starting value in
+    // `.data` would be a second copy of them in flash). Read in place from
+    // here on: a copy would sit on init's stack.
+    CONFIG.init(MachineConfig::defaults(Machine::StringArt));
     let store_now = CONFIG.with(|c| {
         let (config, store_now) = store.load(c);
         *c = config;

@@ -2,7 +2,8 @@
 //! issue #13's dispatch latency): the string-art machine streams 300
 //! random 3-axis moves, a `?` every tenth, no card in the slot; prints the
 //! three longest console runs with the calls inside them, then each
-//! watched function's run count, longest and 99th percentile (cycles).
+//! watched function's run count, longest and 99th percentile (cycles),
+//! the motion task's (segment preparation) last.
 //! Run from the workspace root after `cargo xtask build`:
 //! `cargo run --release -p taut-simavr --example task_runs`.
 use std::path::Path;
@@ -22,6 +23,8 @@ fn main() {
         "Kinematics7inverse",
         "4taut8realtime",
         "realtime6status",
+        // The motion task: a block's profile and segments cut in parts.
+        "4taut6motion",
     ];
     let pcs: Vec<u32> = names.iter().map(|n| f(n)).collect();
     let mut sim = Sim::load(elf).unwrap();

@@ -136,79 +136,20 @@ pub const DRILL_TRAVEL_MM: (i32, i32) = (-30, 12);
 impl MachineConfig {
     /// The string-art machine: base 200×6×8 = 9600 steps per turn, radial
     /// 200/5 mm × 8 = 32 steps/mm, drill 200/12 mm × 8 = 1600 steps per 12 mm.
-    pub const STRING_ART: MachineConfig = MachineConfig::defaults(Machine::StringArt);
+    pub const STRING_ART: MachineConfig = seed(Machine::StringArt);
 
-    /// The seed's figures.
+    /// The seed's figures, a copy of them from a table in flash (1 KB
+    /// less than the code that built them).
     #[inline(never)]
-    pub const fn defaults(machine: Machine) -> MachineConfig {
-        match machine {
-            // Built like the plotters' (a copy of one constant would be a
-            // second template in SRAM on the AVR).
-            Machine::StringArt => {
-                let mut cfg = plotter(
-                    machine,
-                    [
-                        axis(StepsPerUnit::new(9600, 360), 2000, 500, None),
-                        axis(StepsPerUnit::new(32, 1), 2000, 500, Some(RADIAL_TRAVEL_MM)),
-                    ],
-                );
-                cfg.axes[2] = axis(
-                    StepsPerUnit::new(1600, 12),
-                    2000,
-                    500,
-                    Some(DRILL_TRAVEL_MM),
-                );
-                cfg
-            }
-            // 28BYJ-48: 2048 steps a turn; a GT2 belt pulls 40 mm a turn;
-            // the 90 mm drum carries π·90 mm of paper a turn.
-            Machine::Drum => plotter(
-                machine,
-                [
-                    axis(StepsPerUnit::new(2048, 40), 600, 1500, Some((0, 200))),
-                    axis(StepsPerUnit::new(2_048_000, 282_743), 600, 1500, None),
-                ],
-            ),
-            // EasyDriver at 1/8 step: 0.025 mm a step; X 140 mm, homed
-            // against its switch at power-on.
-            Machine::Flatbed => {
-                let mut cfg = plotter(
-                    machine,
-                    [
-                        axis(StepsPerUnit::new(40, 1), 2000, 4000, Some((0, 140))),
-                        axis(StepsPerUnit::new(40, 1), 2000, 4000, None),
-                    ],
-                );
-                cfg.homing.axes = 1;
-                cfg.homing.at_start = true;
-                cfg
-            }
-            // 2000 steps a turn on a 9-tooth sprocket of ½" chain
-            // (114.3 mm a turn); the motors 1.2 m apart, the drawing's
-            // origin 0.6 m right of and below the left one.
-            Machine::Whiteboard => {
-                let chain = axis(StepsPerUnit::new(20_000, 1143), 2000, 1000, None);
-                let mut cfg = plotter(machine, [chain, chain]);
-                cfg.geometry = Geometry {
-                    lengths: [Milli::from_units(1200), Milli(0)],
-                    origin: [Milli::from_units(600), Milli::from_units(-600)],
-                    crosstalk: StepsPerUnit::new(0, 1),
-                };
-                cfg
-            }
-            // Marlin's MORGAN_SCARA figures: 150 mm arms, the shoulder at
-            // (100, −56); 200 × 16 steps and a 3:1 belt a turn, ECR 3.
-            Machine::Scara => {
-                let joint = axis(StepsPerUnit::new(9600, 360), 2000, 2000, None);
-                let mut cfg = plotter(machine, [joint, joint]);
-                cfg.geometry = Geometry {
-                    lengths: [Milli::from_units(150), Milli::from_units(150)],
-                    origin: [Milli::from_units(100), Milli::from_units(-56)],
-                    crosstalk: StepsPerUnit::new(3, 1),
-                };
-                cfg
-            }
-        }
+    pub fn defaults(machine: Machine) -> MachineConfig {
+        let table = taut_progmem::table!(MachineConfig; 5; [
+            seed(Machine::StringArt),
+            seed(Machine::Drum),
+            seed(Machine::Flatbed),
+            seed(Machine::Whiteboard),
+            seed(Machine::Scara),
+        ]);
+        table.get(machine as usize)
     }
 
     pub fn axis(&self, i: usize) -> &AxisConfig {
@@ -254,6 +195,76 @@ impl MachineConfig {
 impl Default for MachineConfig {
     fn default() -> Self {
         Self::STRING_ART
+    }
+}
+
+/// The seed's figures, at compile time.
+const fn seed(machine: Machine) -> MachineConfig {
+    match machine {
+        Machine::StringArt => {
+            let mut cfg = plotter(
+                machine,
+                [
+                    axis(StepsPerUnit::new(9600, 360), 2000, 500, None),
+                    axis(StepsPerUnit::new(32, 1), 2000, 500, Some(RADIAL_TRAVEL_MM)),
+                ],
+            );
+            cfg.axes[2] = axis(
+                StepsPerUnit::new(1600, 12),
+                2000,
+                500,
+                Some(DRILL_TRAVEL_MM),
+            );
+            cfg
+        }
+        // 28BYJ-48: 2048 steps a turn; a GT2 belt pulls 40 mm a turn;
+        // the 90 mm drum carries π·90 mm of paper a turn.
+        Machine::Drum => plotter(
+            machine,
+            [
+                axis(StepsPerUnit::new(2048, 40), 600, 1500, Some((0, 200))),
+                axis(StepsPerUnit::new(2_048_000, 282_743), 600, 1500, None),
+            ],
+        ),
+        // EasyDriver at 1/8 step: 0.025 mm a step; X 140 mm, homed
+        // against its switch at power-on.
+        Machine::Flatbed => {
+            let mut cfg = plotter(
+                machine,
+                [
+                    axis(StepsPerUnit::new(40, 1), 2000, 4000, Some((0, 140))),
+                    axis(StepsPerUnit::new(40, 1), 2000, 4000, None),
+                ],
+            );
+            cfg.homing.axes = 1;
+            cfg.homing.at_start = true;
+            cfg
+        }
+        // 2000 steps a turn on a 9-tooth sprocket of ½" chain
+        // (114.3 mm a turn); the motors 1.2 m apart, the drawing's
+        // origin 0.6 m right of and below the left one.
+        Machine::Whiteboard => {
+            let chain = axis(StepsPerUnit::new(20_000, 1143), 2000, 1000, None);
+            let mut cfg = plotter(machine, [chain, chain]);
+            cfg.geometry = Geometry {
+                lengths: [Milli::from_units(1200), Milli(0)],
+                origin: [Milli::from_units(600), Milli::from_units(-600)],
+                crosstalk: StepsPerUnit::new(0, 1),
+            };
+            cfg
+        }
+        // Marlin's MORGAN_SCARA figures: 150 mm arms, the shoulder at
+        // (100, −56); 200 × 16 steps and a 3:1 belt a turn, ECR 3.
+        Machine::Scara => {
+            let joint = axis(StepsPerUnit::new(9600, 360), 2000, 2000, None);
+            let mut cfg = plotter(machine, [joint, joint]);
+            cfg.geometry = Geometry {
+                lengths: [Milli::from_units(150), Milli::from_units(150)],
+                origin: [Milli::from_units(100), Milli::from_units(-56)],
+                crosstalk: StepsPerUnit::new(3, 1),
+            };
+            cfg
+        }
     }
 }
 

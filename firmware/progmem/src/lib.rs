@@ -2,7 +2,8 @@
 //! copied into SRAM at start-up on the AVR (a pointer cannot reach flash);
 //! [`text!`] places it in `.progmem.data` instead, and [`Text`] reads it
 //! back byte by byte with `lpm`. On the host it is ordinary memory, so the
-//! logic crate's tests read the same texts.
+//! logic crate's tests read the same texts. [`table!`] does the same for
+//! constant values of any type.
 #![no_std]
 #![cfg_attr(target_arch = "avr", feature(asm_experimental_arch))]
 
@@ -77,6 +78,49 @@ impl Text {
     }
 }
 
+/// A table of constant values made by [`table!`], kept in flash on the
+/// AVR: it costs its bytes of flash, not the code that would build each
+/// value in place; [`Table::get`] copies one out.
+#[derive(Clone, Copy)]
+pub struct Table<T: 'static> {
+    items: &'static [T],
+}
+
+impl<T: Copy> Table<T> {
+    /// # Safety
+    /// `items` must be a static made by [`table!`] (in `.progmem.data` on
+    /// the AVR).
+    #[doc(hidden)]
+    pub const unsafe fn from_static(items: &'static [T]) -> Table<T> {
+        Table { items }
+    }
+
+    /// A copy of item `i`, read a byte at a time with `lpm` on the AVR.
+    pub fn get(&self, i: usize) -> T {
+        let item = &self.items[i];
+        #[cfg(target_arch = "avr")]
+        {
+            let mut out = core::mem::MaybeUninit::<T>::uninit();
+            let from = (item as *const T).cast::<u8>();
+            let to = out.as_mut_ptr().cast::<u8>();
+            for k in 0..core::mem::size_of::<T>() {
+                let b: u8;
+                // SAFETY: `from + k` lies inside the progmem static
+                // (`from_static`'s contract); `lpm` reads flash and has no
+                // other effect; `to + k` inside `out`.
+                unsafe {
+                    core::arch::asm!("lpm {0}, Z", out(reg) b, in("Z") from.wrapping_add(k), options(pure, readonly, nostack));
+                    to.add(k).write(b);
+                }
+            }
+            // SAFETY: every byte copied from a value of `T`, a `Copy` type.
+            unsafe { out.assume_init() }
+        }
+        #[cfg(not(target_arch = "avr"))]
+        *item
+    }
+}
+
 impl PartialEq for Text {
     fn eq(&self, other: &Text) -> bool {
         self.len == other.len && self.bytes().eq(other.bytes())
@@ -146,6 +190,18 @@ macro_rules! text {
         // SAFETY: `T` is a static holding the whole of `S`, in flash on
         // the AVR.
         unsafe { $crate::Text::from_static(&T) }
+    }};
+}
+
+/// An array of constant values as a [`Table`] kept in flash on the AVR:
+/// `table!(T; N; [a, b, …])`.
+#[macro_export]
+macro_rules! table {
+    ($t:ty; $n:expr; $items:expr) => {{
+        #[cfg_attr(target_arch = "avr", link_section = ".progmem.data")]
+        static T: [$t; $n] = $items;
+        // SAFETY: `T` is a static, in flash on the AVR.
+        unsafe { $crate::Table::from_static(&T) }
     }};
 }
 
