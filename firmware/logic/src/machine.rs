@@ -37,13 +37,14 @@ impl Machine {
 
     /// The name `$machine=` takes and `$$` prints.
     pub fn name(self) -> Text {
-        match self {
-            Machine::StringArt => text!("string_art"),
-            Machine::Drum => text!("drum"),
-            Machine::Flatbed => text!("flatbed"),
-            Machine::Whiteboard => text!("whiteboard"),
-            Machine::Scara => text!("scara"),
-        }
+        taut_progmem::text_table!(Machine; [
+            StringArt => "string_art",
+            Drum => "drum",
+            Flatbed => "flatbed",
+            Whiteboard => "whiteboard",
+            Scara => "scara",
+        ])
+        .get(self as usize)
     }
 
     /// The machine named `name`, in any case.
