@@ -83,32 +83,26 @@ impl Line {
     /// static [`LOG`] is begun again for each line).
     #[inline(never)]
     pub fn begin(&mut self, level: Level, module: FlashStr) {
-        self.buf.clear();
-        self.cut = false;
-        self.msg = true;
-        let tag = [b'E', b'W', b'I', b'D'][level as usize];
-        // Pushed byte by byte: format strings' pieces would sit in SRAM.
-        for c in [b'[', b'M', b'S', b'G', b':'] {
-            let _ = self.buf.push(c);
-        }
-        let _ = self.buf.push(tag);
-        let _ = self.buf.push(b' ');
-        let _ = ufmt::uwrite!(self, "{}", clock::millis());
-        let _ = self.buf.push(b' ');
-        let _ = ufmt::uwrite!(self, "{}", module);
-        let _ = self.buf.push(b':');
-        let _ = self.buf.push(b' ');
+        self.open();
+        self.push([b'E', b'W', b'I', b'D'][level as usize]);
+        let _ = ufmt::uwrite!(self, " {} {}: ", clock::millis(), module);
     }
 
     /// A `[MSG:…]` push message in Grbl's form: no level, time or module;
     /// closed by `]` even when cut.
     pub fn message() -> Line {
         let mut l = Line::bare();
-        l.msg = true;
-        for c in [b'[', b'M', b'S', b'G', b':'] {
-            let _ = l.buf.push(c);
-        }
+        l.open();
         l
+    }
+
+    /// `[MSG:`, a log line's or a push message's start, in an emptied line.
+    /// From flash: a format string's pieces would sit in SRAM.
+    fn open(&mut self) {
+        self.buf.clear();
+        self.cut = false;
+        self.msg = true;
+        let _ = ufmt::uwrite!(self, "{}", crate::flash_str!("[MSG:"));
     }
 
     /// A console reply: no level, time or module. Replies and log lines
