@@ -80,29 +80,29 @@ impl Line {
     }
 
     /// A log line's start; what the line held before is dropped (the
-    /// static [`LOG`] is begun again for each line).
+    /// static [`LOG`] is begun again for each line). `[MSG:` from flash:
+    /// a format string's pieces would sit in SRAM, pushed bytes cost code.
     #[inline(never)]
     pub fn begin(&mut self, level: Level, module: FlashStr) {
-        self.open();
+        self.buf.clear();
+        self.cut = false;
+        self.msg = true;
+        let _ = ufmt::uwrite!(self, "{}", crate::flash_str!("[MSG:"));
         self.push([b'E', b'W', b'I', b'D'][level as usize]);
         let _ = ufmt::uwrite!(self, " {} {}: ", clock::millis(), module);
     }
 
     /// A `[MSG:…]` push message in Grbl's form: no level, time or module;
-    /// closed by `]` even when cut.
+    /// closed by `]` even when cut. Its bytes pushed here, not by a call
+    /// taking the line by reference: the line would then be built apart
+    /// and copied into the caller's, two lines in its frame.
     pub fn message() -> Line {
         let mut l = Line::bare();
-        l.open();
+        l.msg = true;
+        for c in [b'[', b'M', b'S', b'G', b':'] {
+            let _ = l.buf.push(c);
+        }
         l
-    }
-
-    /// `[MSG:`, a log line's or a push message's start, in an emptied line.
-    /// From flash: a format string's pieces would sit in SRAM.
-    fn open(&mut self) {
-        self.buf.clear();
-        self.cut = false;
-        self.msg = true;
-        let _ = ufmt::uwrite!(self, "{}", crate::flash_str!("[MSG:"));
     }
 
     /// A console reply: no level, time or module. Replies and log lines
@@ -115,8 +115,10 @@ impl Line {
         }
     }
 
-    /// Queue a reply whole; the caller made room (`reply::room`).
-    pub fn send(mut self) {
+    /// Queue a reply whole; the caller made room (`reply::room`). By
+    /// reference: a line moved into the call can be copied first, a
+    /// second line in the caller's frame.
+    pub fn send(&mut self) {
         self.end();
         usart::send(&self.buf);
     }
