@@ -5,12 +5,14 @@
 //! are printed with `ufmt`. Each line reads `[MSG:I 1234 module: text]`:
 //! level, milliseconds since boot, module, in Grbl 1.1's message brackets,
 //! which every sender shows and none takes for a reply, an error or an
-//! alarm (grbl-streamer aborts a stream on a bare line holding "error"). A line is formatted on the stack and queued
-//! whole; when the TX ring has no room it is dropped and counted, and the
+//! alarm (grbl-streamer aborts a stream on a bare line holding "error"). A
+//! line is built in one static line, [`LOG`], part by part with out-of-line
+//! calls, and queued whole; when the TX ring has no room it is dropped and counted, and the
 //! count is reported on the next line that fits. Levels below `MAX_LEVEL`
 //! (cargo feature `log-debug` lowers it) compile to nothing.
 
 use crate::board::{clock, flash::FlashStr, usart};
+use crate::rt::TaskCell;
 use avr_device::interrupt::Mutex;
 use core::cell::Cell;
 
@@ -77,34 +79,23 @@ impl Line {
         }
     }
 
-    pub fn new(level: Level, module: FlashStr) -> Line {
-        let mut l = Line::bare();
-        l.begin(level, module);
-        l
-    }
-
-    /// A log line's start, in a line made with [`Line::bare`] where it is
-    /// used (`log!`): a line returned by [`Line::new`] is built and then
-    /// copied, two lines on the stack.
+    /// A log line's start; what the line held before is dropped (the
+    /// static [`LOG`] is begun again for each line). `[MSG:` from flash:
+    /// a format string's pieces would sit in SRAM, pushed bytes cost code.
     #[inline(never)]
     pub fn begin(&mut self, level: Level, module: FlashStr) {
+        self.buf.clear();
+        self.cut = false;
         self.msg = true;
-        let tag = [b'E', b'W', b'I', b'D'][level as usize];
-        // Pushed byte by byte: format strings' pieces would sit in SRAM.
-        for c in [b'[', b'M', b'S', b'G', b':'] {
-            let _ = self.buf.push(c);
-        }
-        let _ = self.buf.push(tag);
-        let _ = self.buf.push(b' ');
-        let _ = ufmt::uwrite!(self, "{}", clock::millis());
-        let _ = self.buf.push(b' ');
-        let _ = ufmt::uwrite!(self, "{}", module);
-        let _ = self.buf.push(b':');
-        let _ = self.buf.push(b' ');
+        let _ = ufmt::uwrite!(self, "{}", crate::flash_str!("[MSG:"));
+        self.push([b'E', b'W', b'I', b'D'][level as usize]);
+        let _ = ufmt::uwrite!(self, " {} {}: ", clock::millis(), module);
     }
 
     /// A `[MSG:…]` push message in Grbl's form: no level, time or module;
-    /// closed by `]` even when cut.
+    /// closed by `]` even when cut. Its bytes pushed here, not by a call
+    /// taking the line by reference: the line would then be built apart
+    /// and copied into the caller's, two lines in its frame.
     pub fn message() -> Line {
         let mut l = Line::bare();
         l.msg = true;
@@ -124,8 +115,10 @@ impl Line {
         }
     }
 
-    /// Queue a reply whole; the caller made room (`reply::room`).
-    pub fn send(mut self) {
+    /// Queue a reply whole; the caller made room (`reply::room`). By
+    /// reference: a line moved into the call can be copied first, a
+    /// second line in the caller's frame.
+    pub fn send(&mut self) {
         self.end();
         usart::send(&self.buf);
     }
@@ -146,7 +139,7 @@ impl Line {
 
     /// Queue the line, or count it as dropped. By reference: a line moved
     /// into the call would be copied on the caller's stack, beside it.
-    pub fn emit(&mut self) {
+    fn emit(&mut self) {
         self.end();
         let dropped = dropped();
         if dropped > 0 && !note_dropped(dropped, self.buf.len()) {
@@ -174,6 +167,54 @@ fn note_dropped(dropped: u16, then: usize) -> bool {
     usart::send(&note.buf);
     avr_device::interrupt::free(|cs| DROPPED.borrow(cs).set(0));
     true
+}
+
+/// The log line being built. A log call begins it, appends each part and
+/// queues it with out-of-line calls ([`start`], [`text`], [`part`],
+/// [`finish`]): its caller's frame holds no 100-byte line, which pushed
+/// the caller's other stack slots past the AVR's 63-byte `ldd`/`std`
+/// reach (each access then costs pointer arithmetic), and each value's
+/// formatting is one function, not repeated at every call site. One line
+/// serves all: only tasks log, and they run one at a time, to completion.
+/// Zeroed (an empty line): in `.bss`, no flash.
+static LOG: TaskCell<Line> = TaskCell::zeroed();
+
+/// A log line's start: level, time, module (`log!`).
+#[doc(hidden)]
+#[inline(never)]
+pub fn start(level: Level, module: FlashStr) {
+    LOG.with(|l| l.begin(level, module));
+}
+
+/// Append a text from flash to the log line (`log!`'s string literals).
+#[doc(hidden)]
+#[inline(never)]
+pub fn text(s: FlashStr) {
+    LOG.with(|l| {
+        let _ = ufmt::uwrite!(l, "{}", s);
+    });
+}
+
+/// Append a value to the log line: one function per type.
+#[doc(hidden)]
+#[inline(never)]
+pub fn part<T: ufmt::uDisplay + ?Sized>(value: &T) {
+    with_line(|l| {
+        let _ = ufmt::uwrite!(l, "{}", value);
+    });
+}
+
+/// Append to the log line what `f` writes (a line put together by hand,
+/// between [`start`] and [`finish`]).
+pub fn with_line(f: impl FnOnce(&mut Line)) {
+    LOG.with(f);
+}
+
+/// Queue the log line whole, or count it as dropped.
+#[doc(hidden)]
+#[inline(never)]
+pub fn finish() {
+    LOG.with(Line::emit);
 }
 
 fn count_drop() {
@@ -205,14 +246,14 @@ macro_rules! __log_module {
 #[macro_export]
 #[doc(hidden)]
 macro_rules! __log_parts {
-    ($l:ident;) => {};
-    ($l:ident; $s:literal $(, $($rest:tt)*)?) => {
-        let _ = ufmt::uwrite!($l, "{}", $crate::flash_str!($s));
-        $crate::__log_parts!($l; $($($rest)*)?);
+    () => {};
+    ($s:literal $(, $($rest:tt)*)?) => {
+        $crate::log::text($crate::flash_str!($s));
+        $crate::__log_parts!($($($rest)*)?);
     };
-    ($l:ident; $e:expr $(, $($rest:tt)*)?) => {
-        let _ = ufmt::uwrite!($l, "{}", $e);
-        $crate::__log_parts!($l; $($($rest)*)?);
+    ($e:expr $(, $($rest:tt)*)?) => {
+        $crate::log::part(&$e);
+        $crate::__log_parts!($($($rest)*)?);
     };
 }
 
@@ -220,11 +261,9 @@ macro_rules! __log_parts {
 macro_rules! log {
     ($level:expr, $($parts:tt)*) => {
         if $level <= $crate::log::MAX_LEVEL {
-            #[allow(unused_mut)]
-            let mut line = $crate::log::Line::bare();
-            line.begin($level, $crate::__log_module!());
-            $crate::__log_parts!(line; $($parts)*);
-            line.emit();
+            $crate::log::start($level, $crate::__log_module!());
+            $crate::__log_parts!($($parts)*);
+            $crate::log::finish();
         }
     };
 }

@@ -12,7 +12,7 @@
 #![deny(unsafe_code)]
 
 use crate::board::flash::FlashStr;
-use crate::log::{Level, Line};
+use crate::log::Level;
 use crate::queues::{CardMsg, Request, What, CARD_IN, CARD_OUT};
 use crate::reply;
 use crate::{flash_str, info, warn};
@@ -418,16 +418,15 @@ impl Print {
     pub fn line_failed(&mut self, e: &Error, why: Option<taut_logic::text::ErrorKind>) {
         // A `\r` ended the line before its `\n` was counted.
         let line = self.at.lines + u32::from(self.last != b'\n');
-        {
-            let mut r = Line::bare();
-            r.begin(Level::Error, crate::__log_module!());
+        crate::log::start(Level::Error, crate::__log_module!());
+        crate::log::with_line(|r| {
             let _ = uwrite!(r, "{}:{}:", self.name, line);
             if let Some(c) = e.column() {
                 let _ = uwrite!(r, "{}:", c);
             }
             let _ = uwrite!(r, " {}", reply::Because(e, why));
-            r.emit();
-        }
+        });
+        crate::log::finish();
         if e.kind() != ErrorKind::UnsupportedCommand {
             warn!("print stopped");
             self.close();

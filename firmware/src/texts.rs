@@ -18,6 +18,27 @@ macro_rules! in_flash {
     };
 }
 
+/// `in_flash!` for a fieldless enum, every variant listed: its codes and
+/// texts as tables in flash, the code searched for.
+macro_rules! searched_in_flash {
+    ($value:expr; $ty:ident::$method:ident; [$($v:ident),* $(,)?]) => {{
+        const N: usize = [$($ty::$v),*].len();
+        // Not called: fails to compile if a variant is missing.
+        #[allow(dead_code)]
+        const fn every_variant(v: $ty) {
+            match v {
+                $($ty::$v => {})*
+            }
+        }
+        let codes = taut_progmem::table!(u8; N; [$($ty::$v as u8),*]);
+        let texts = taut_progmem::table!(FlashStr; N; [$(flash_str!($ty::$v.$method())),*]);
+        let code = $value as u8;
+        // Every variant is listed, so the code is found (`0` is not
+        // reached: no panic path).
+        texts.get((0..N).position(|i| codes.get(i) == code).unwrap_or(0))
+    }};
+}
+
 pub fn state(s: State) -> FlashStr {
     use State::*;
     in_flash!(s, name, [
@@ -78,42 +99,44 @@ pub fn msg(m: Msg) -> FlashStr {
     ])
 }
 
-/// Grbl's error texts of the console's replies.
+/// Grbl's error texts of the console's replies, found by code in two
+/// tables in flash: a `match` returning each text cost ~15 bytes of code
+/// per arm, an entry costs 5 (the codes are sparse, up to 76, so they
+/// are searched, not indexed: an error reply is rare).
 pub fn error(e: ErrorKind) -> FlashStr {
-    use ErrorKind::*;
-    in_flash!(e, message, [
-        ExpectedCommandLetter => ExpectedCommandLetter,
-        BadNumberFormat => BadNumberFormat,
-        InvalidStatement => InvalidStatement,
-        NegativeValue => NegativeValue,
-        NotIdle => NotIdle,
-        Locked => Locked,
-        LineOverflow => LineOverflow,
-        TravelExceeded => TravelExceeded,
-        UnsupportedCommand => UnsupportedCommand,
-        ModalGroupViolation => ModalGroupViolation,
-        UndefinedFeedRate => UndefinedFeedRate,
-        AxisWordConflict => AxisWordConflict,
-        RepeatedWord => RepeatedWord,
-        NoAxisWords => NoAxisWords,
-        InvalidLineNumber => InvalidLineNumber,
-        ValueWordMissing => ValueWordMissing,
-        UnusedAxisWords => UnusedAxisWords,
-        InvalidTarget => InvalidTarget,
-        ArcNoAxisInPlane => ArcNoAxisInPlane,
-        ArcRadiusInvalid => ArcRadiusInvalid,
-        ArcNoOffsetInPlane => ArcNoOffsetInPlane,
-        UnusedValueWords => UnusedValueWords,
-        BadChecksum => BadChecksum,
-        JobOwnsMotion => JobOwnsMotion,
-        FeedTooLow => FeedTooLow,
-        PenWithMove => PenWithMove,
-        NoHoming => NoHoming,
-        InvalidJogCommand => InvalidJogCommand,
-        NoCard => NoCard,
-        CardFailed => CardFailed,
-        FileNotFound => FileNotFound,
-        Printing => Printing,
-        NoFileSelected => NoFileSelected,
+    searched_in_flash!(e; ErrorKind::message; [
+        ExpectedCommandLetter,
+        BadNumberFormat,
+        InvalidStatement,
+        NegativeValue,
+        NotIdle,
+        Locked,
+        LineOverflow,
+        TravelExceeded,
+        UnsupportedCommand,
+        ModalGroupViolation,
+        UndefinedFeedRate,
+        AxisWordConflict,
+        RepeatedWord,
+        NoAxisWords,
+        InvalidLineNumber,
+        ValueWordMissing,
+        UnusedAxisWords,
+        InvalidTarget,
+        ArcNoAxisInPlane,
+        ArcRadiusInvalid,
+        ArcNoOffsetInPlane,
+        UnusedValueWords,
+        BadChecksum,
+        JobOwnsMotion,
+        FeedTooLow,
+        PenWithMove,
+        NoHoming,
+        InvalidJogCommand,
+        NoCard,
+        CardFailed,
+        FileNotFound,
+        Printing,
+        NoFileSelected,
     ])
 }

@@ -37,13 +37,14 @@ impl Machine {
 
     /// The name `$machine=` takes and `$$` prints.
     pub fn name(self) -> Text {
-        match self {
-            Machine::StringArt => text!("string_art"),
-            Machine::Drum => text!("drum"),
-            Machine::Flatbed => text!("flatbed"),
-            Machine::Whiteboard => text!("whiteboard"),
-            Machine::Scara => text!("scara"),
-        }
+        taut_progmem::text_table!(Machine; [
+            StringArt => "string_art",
+            Drum => "drum",
+            Flatbed => "flatbed",
+            Whiteboard => "whiteboard",
+            Scara => "scara",
+        ])
+        .get(self as usize)
     }
 
     /// The machine named `name`, in any case.
@@ -60,19 +61,30 @@ impl Machine {
     /// What the machine calls each channel: setting names
     /// (`<channel>_max_rate`), log lines and the VCD's signals.
     pub fn channel(self, axis: Axis) -> Text {
-        match (self, axis) {
-            (_, Axis::Aux) => text!("aux"),
-            (Machine::StringArt, Axis::Base) => text!("base"),
-            (Machine::StringArt, Axis::Radial) => text!("radial"),
-            (Machine::StringArt, Axis::Drill) => text!("drill"),
-            (_, Axis::Drill) => text!("z"),
-            (Machine::Drum | Machine::Flatbed, Axis::Base) => text!("x"),
-            (Machine::Drum | Machine::Flatbed, Axis::Radial) => text!("y"),
-            (Machine::Whiteboard, Axis::Base) => text!("left"),
-            (Machine::Whiteboard, Axis::Radial) => text!("right"),
-            (Machine::Scara, Axis::Base) => text!("shoulder"),
-            (Machine::Scara, Axis::Radial) => text!("elbow"),
-        }
+        // A table in flash by machine, then axis: a `match` on the pair
+        // cost 176 B of code. Texts named once, not a copy per row.
+        const AUX: Text = text!("aux");
+        const Z: Text = text!("z");
+        const X: Text = text!("x");
+        const Y: Text = text!("y");
+        const N: usize = Machine::ALL.len() * AXES;
+        const _: () = {
+            let mut m = 0;
+            while m < Machine::ALL.len() {
+                assert!(Machine::ALL[m] as usize == m);
+                m += 1;
+            }
+            assert!(Axis::Base as usize == 0 && Axis::Radial as usize == 1);
+            assert!(Axis::Drill as usize == 2 && Axis::Aux as usize == 3 && AXES == 4);
+        };
+        let names = taut_progmem::table!(Text; N; [
+            text!("base"), text!("radial"), text!("drill"), AUX, // StringArt
+            X, Y, Z, AUX, // Drum
+            X, Y, Z, AUX, // Flatbed
+            text!("left"), text!("right"), Z, AUX, // Whiteboard
+            text!("shoulder"), text!("elbow"), Z, AUX, // Scara
+        ]);
+        names.get(self as usize * AXES + axis as usize)
     }
 
     /// The G-code word of each coordinate.

@@ -216,45 +216,47 @@ pub const COUNT: usize = AXES * AXIS_FIELDS.len() + GLOBAL_FIELDS.len();
 
 impl AxisField {
     pub fn name(self) -> Text {
-        match self {
-            AxisField::StepsPerUnit => text!("steps_per_unit"),
-            AxisField::MaxRate => text!("max_rate"),
-            AxisField::Accel => text!("accel"),
-            AxisField::DirInvert => text!("dir_invert"),
-            AxisField::EnableActiveHigh => text!("enable_active_high"),
-            AxisField::SoftLimits => text!("soft_limits"),
-            AxisField::TravelMin => text!("travel_min"),
-            AxisField::TravelMax => text!("travel_max"),
-        }
+        taut_progmem::text_table!(AxisField; [
+            StepsPerUnit => "steps_per_unit",
+            MaxRate => "max_rate",
+            Accel => "accel",
+            DirInvert => "dir_invert",
+            EnableActiveHigh => "enable_active_high",
+            SoftLimits => "soft_limits",
+            TravelMin => "travel_min",
+            TravelMax => "travel_max",
+        ])
+        .get(self as usize)
     }
 }
 
 impl GlobalField {
     pub fn name(self) -> Text {
-        match self {
-            GlobalField::StepPulseUs => text!("step_pulse_us"),
-            GlobalField::DirSetupUs => text!("dir_setup_us"),
-            GlobalField::EnableSetupUs => text!("enable_setup_us"),
-            GlobalField::JunctionDeviationUm => text!("junction_deviation_um"),
-            GlobalField::ArcToleranceUm => text!("arc_tolerance_um"),
-            GlobalField::Machine => text!("machine"),
-            GlobalField::Length1 => text!("length_1"),
-            GlobalField::Length2 => text!("length_2"),
-            GlobalField::OriginX => text!("origin_x"),
-            GlobalField::OriginY => text!("origin_y"),
-            GlobalField::Crosstalk => text!("crosstalk"),
-            GlobalField::PenUp => text!("pen_up"),
-            GlobalField::PenDown => text!("pen_down"),
-            GlobalField::PenSettleMs => text!("pen_settle_ms"),
-            GlobalField::DwellPMs => text!("dwell_p_ms"),
-            GlobalField::HomingAxes => text!("homing_axes"),
-            GlobalField::HomingAtStart => text!("homing_at_start"),
-            GlobalField::HomingSeek => text!("homing_seek"),
-            GlobalField::HomingLocate => text!("homing_locate"),
-            GlobalField::HomingPullOff => text!("homing_pull_off"),
-            GlobalField::StatusReport => text!("status_report"),
-            GlobalField::ReportInches => text!("report_inches"),
-        }
+        taut_progmem::text_table!(GlobalField; [
+            Machine => "machine",
+            StepPulseUs => "step_pulse_us",
+            DirSetupUs => "dir_setup_us",
+            EnableSetupUs => "enable_setup_us",
+            JunctionDeviationUm => "junction_deviation_um",
+            ArcToleranceUm => "arc_tolerance_um",
+            Length1 => "length_1",
+            Length2 => "length_2",
+            OriginX => "origin_x",
+            OriginY => "origin_y",
+            Crosstalk => "crosstalk",
+            PenUp => "pen_up",
+            PenDown => "pen_down",
+            PenSettleMs => "pen_settle_ms",
+            DwellPMs => "dwell_p_ms",
+            HomingAxes => "homing_axes",
+            HomingAtStart => "homing_at_start",
+            HomingSeek => "homing_seek",
+            HomingLocate => "homing_locate",
+            HomingPullOff => "homing_pull_off",
+            StatusReport => "status_report",
+            ReportInches => "report_inches",
+        ])
+        .get(self as usize)
     }
 }
 

@@ -205,6 +205,34 @@ macro_rules! table {
     }};
 }
 
+/// The names of a fieldless enum's variants as a [`Table`] of [`Text`]s
+/// in flash, indexed by discriminant: `text_table!(Enum; [A => "a", B =>
+/// "b"]).get(v as usize)`. Every variant, in discriminant order from 0
+/// (both checked at compile time). On the AVR a `match` returning a text
+/// per variant costs ~15 bytes of code per arm; an entry here costs 4.
+#[macro_export]
+macro_rules! text_table {
+    ($ty:ident; [$($v:ident => $s:expr),* $(,)?]) => {{
+        const N: usize = [$(stringify!($v)),*].len();
+        const _: () = {
+            let mut i = 0;
+            $(
+                assert!($ty::$v as usize == i);
+                i += 1;
+            )*
+            assert!(i == N);
+        };
+        // Not called: fails to compile if a variant is missing.
+        #[allow(dead_code)]
+        const fn every_variant(v: $ty) {
+            match v {
+                $($ty::$v => {})*
+            }
+        }
+        $crate::table!($crate::Text; N; [$($crate::text!($s)),*])
+    }};
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;

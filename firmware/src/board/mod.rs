@@ -51,13 +51,14 @@ impl ResetCause {
     }
 
     pub fn name(self) -> flash::FlashStr {
-        match self {
-            ResetCause::PowerOn => crate::flash_str!("power-on"),
-            ResetCause::External => crate::flash_str!("external"),
-            ResetCause::BrownOut => crate::flash_str!("brown-out"),
-            ResetCause::Watchdog => crate::flash_str!("watchdog"),
-            ResetCause::Jtag => crate::flash_str!("jtag"),
-            ResetCause::Unknown => crate::flash_str!("unknown"),
-        }
+        taut_progmem::text_table!(ResetCause; [
+            PowerOn => "power-on",
+            External => "external",
+            BrownOut => "brown-out",
+            Watchdog => "watchdog",
+            Jtag => "jtag",
+            Unknown => "unknown",
+        ])
+        .get(self as usize)
     }
 }
