@@ -471,7 +471,9 @@ impl JobTask {
     }
 
     /// Hand the job's steps to the planner; report `MotionDone` when the
-    /// machine stands after the last one.
+    /// machine stands after the last one. Out of line: its frame is not
+    /// under the job's events (the stack's peak).
+    #[inline(never)]
     fn run_steps(&mut self, m: &mut Motion, store: &mut Store, now: u32) -> Poll<Signal> {
         let mut rig = Rig { m, store };
         match self.feeder.run(&mut self.job, &mut rig, now, STEPS_PER_RUN) {

@@ -88,7 +88,7 @@ fn banner_build_info_parser_state_offsets_and_status_in_grbl_formats() {
     let report = bytes_then(&mut sim, b"?", 20);
     assert_eq!(
         report,
-        "<Idle|MPos:0.000,0.000,0.000|Bf:13,128|FS:0,0|WCO:0.000,0.000,0.000>\n",
+        "<Idle|MPos:0.000,0.000,0.000|Bf:12,128|FS:0,0|WCO:0.000,0.000,0.000>\n",
         "{}",
         log_tail(&sim)
     );
@@ -238,7 +238,7 @@ fn status_fields_follow_dollar_10_and_13_and_the_words_take_grbl_s_places() {
     send_ok(&mut sim, "M400", Duration::from_secs(30));
     let r = status(&mut sim);
     assert!(
-        r.starts_with("<Idle|MPos:-25.000,90.000,-1.200|Bf:13,128|FS:0,0"),
+        r.starts_with("<Idle|MPos:-25.000,90.000,-1.200|Bf:12,128|FS:0,0"),
         "{r}"
     );
     send(&mut sim, "$10=0");

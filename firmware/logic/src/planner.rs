@@ -25,7 +25,7 @@ use axis_jump::AxisJumps;
 use junction::Geometry;
 
 /// Number of moves the planner holds.
-pub const PLANNER_BLOCKS: usize = 13;
+pub const PLANNER_BLOCKS: usize = 12;
 
 /// Requested speed of a move.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -106,6 +106,9 @@ fn to(base: i32, radial: i32) -> MachineStep {
 impl BlendWinder {
     /// From the winding zero pose: nail 0 under the needle, needle at the
     /// board's edge.
+    // Out of line: inlined into the job's event handling, its nails
+    // would sit in the frame under every job event (the stack's peak).
+    #[inline(never)]
     pub fn new(board: Board, config: &MachineConfig) -> Result<Self, WindError> {
         let inner_mm = board.min_nail_radius() - CLEARANCE_MM;
         if inner_mm <= 0.0 {

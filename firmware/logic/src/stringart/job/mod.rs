@@ -348,6 +348,9 @@ impl Job {
         }
     }
 
+    // Out of line: the board's plan is big, and inlined into `on` it
+    // would sit in the frame under every event (the stack's peak).
+    #[inline(never)]
     fn files_valid(
         &mut self,
         params: Params,
