@@ -50,7 +50,7 @@ fn banner_build_info_parser_state_offsets_and_status_in_grbl_formats() {
         replies(&send(&mut sim, "$I")),
         [
             format!("[VER:1.1h.taut-{version}:string_art]").as_str(),
-            "[OPT:,13,128]",
+            "[OPT:,12,128]",
             "ok"
         ]
     );
