@@ -397,17 +397,16 @@ impl JobTask {
                     self.stream = Stream::Files(Files::new());
                     self.open(FileName::Param);
                 }
-                Action::OpenPattern if matches!(self.stream, Stream::Checked(_)) => {
+                Action::OpenPattern
+                    if matches!(self.stream, Stream::Checked(_)) && !m.is_idle() =>
+                {
                     // The card's machine, not yet taken, before the pattern
                     // takes its place.
-                    if !m.is_idle() {
-                        let _ = self.todo.push_front(a);
-                        return Some(Poll::Wait(Signal::Motion));
-                    }
-                    self.configure(m, config);
                     let _ = self.todo.push_front(a);
+                    return Some(Poll::Wait(Signal::Motion));
                 }
                 Action::OpenPattern => {
+                    self.configure(m, config);
                     self.stream = Stream::Pattern(Pattern::new(self.nails));
                     self.open(FileName::Poradi);
                 }
@@ -471,9 +470,7 @@ impl JobTask {
     }
 
     /// Hand the job's steps to the planner; report `MotionDone` when the
-    /// machine stands after the last one. Out of line: its frame is not
-    /// under the job's events (the stack's peak).
-    #[inline(never)]
+    /// machine stands after the last one.
     fn run_steps(&mut self, m: &mut Motion, store: &mut Store, now: u32) -> Poll<Signal> {
         let mut rig = Rig { m, store };
         match self.feeder.run(&mut self.job, &mut rig, now, STEPS_PER_RUN) {
