@@ -17,16 +17,17 @@ use crate::rt::Poll;
 use crate::store::Store;
 use crate::{error, info, report, texts};
 use core::sync::atomic::Ordering::Relaxed;
-use heapless::Deque;
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::checkpoint::Saved;
 use taut_logic::config::MachineConfig;
 use taut_logic::fat::Name;
-use taut_logic::files::check::{CardId, Checked, Files, Next};
+use taut_logic::files::check::{CardId, Files, Next};
 use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::planner::{Feed, Full};
-use taut_logic::stringart::job::{Action, Event, Feeder, Feeding, Job, Machine, Phase, State};
+use taut_logic::stringart::job::{
+    Action, Actions, Event, Feeder, Feeding, Job, Machine, Phase, State,
+};
 use taut_logic::stringart::Save;
 
 /// Room for a whole log line, claimed from the console while there is none.
@@ -57,17 +58,30 @@ enum Stream {
     Files(Files),
     /// `poradi.txt` while winding.
     Pattern(Pattern),
+}
+
+impl Stream {
+    /// Files being checked, not yet all read.
+    fn checking(&self) -> bool {
+        matches!(self, Stream::Files(f) if f.checked().is_none())
+    }
+
     /// The machine the checked files describe, until the job takes it
     /// ([`Action::Configure`]) if it does: at once if the machine stands,
     /// else before the job's first move (a console jog may still run).
-    Checked(MachineConfig),
+    fn checked_machine(&self) -> Option<&MachineConfig> {
+        match self {
+            Stream::Files(f) => f.checked().map(|c| &c.config),
+            _ => None,
+        }
+    }
 }
 
 pub struct JobTask {
     job: Job,
     /// Actions not yet carried out, in order: one event's at most, as
     /// inputs are taken only when the last event's are done.
-    todo: Deque<Action, 6>,
+    todo: Actions,
     stream: Stream,
     /// Numbers the card requests; messages of older ones are dropped.
     ticket: u8,
@@ -91,7 +105,7 @@ impl JobTask {
     pub const fn new() -> Self {
         JobTask {
             job: Job::new(),
-            todo: Deque::new(),
+            todo: Actions::new(),
             stream: Stream::None,
             ticket: 0,
             nails: 0,
@@ -162,10 +176,7 @@ impl JobTask {
     }
 
     fn event(&mut self, e: Event<'_>, now: u32) {
-        for a in self.job.on(e, now) {
-            let pushed = self.todo.push_back(a);
-            debug_assert!(pushed.is_ok(), "an event's actions fit");
-        }
+        self.job.on_into(e, now, &mut self.todo);
     }
 
     /// The next input: a button, a card message, the console. False: none.
@@ -193,7 +204,7 @@ impl JobTask {
             return false;
         };
         // Checking the files ends in a log line (`files ok` or the error).
-        if matches!(self.stream, Stream::Files(_)) && !room_for_a_line() {
+        if self.stream.checking() && !room_for_a_line() {
             return false;
         }
         // Pattern bytes wait in the queue until winding wants them.
@@ -210,7 +221,7 @@ impl JobTask {
         match msg.what {
             What::Inserted => return self.event(Event::CardInserted, now),
             What::Removed => {
-                if matches!(self.stream, Stream::Files(_)) {
+                if self.stream.checking() {
                     self.stream = Stream::None;
                 }
                 return self.event(Event::CardRemoved, now);
@@ -221,9 +232,9 @@ impl JobTask {
             _ => {}
         }
         let files = match &mut self.stream {
-            Stream::None | Stream::Checked(_) => return,
+            Stream::Files(files) if files.checked().is_none() => files,
             Stream::Pattern(_) => return self.pattern_ended(msg, now),
-            Stream::Files(files) => files,
+            _ => return,
         };
         let next = match msg.what {
             What::Data { len, bytes } => match files.push(&bytes[..len as usize]) {
@@ -240,8 +251,8 @@ impl JobTask {
         };
         match next {
             Ok(Next::Open(name)) => self.open(name),
-            Ok(Next::Machine(c)) => self.other_machine(&c, m, config, now),
-            Ok(Next::Done(c)) => self.files_valid(&c, now),
+            Ok(Next::Machine) => self.other_machine(m, config, now),
+            Ok(Next::Done) => self.files_valid(now),
             Err(e) => self.files_invalid(&e, now),
         }
     }
@@ -253,24 +264,26 @@ impl JobTask {
     /// A plotter's card: that machine from here on, standing where it is
     /// as its zero (as `$machine=` does).
     #[inline(never)]
-    fn other_machine(
-        &mut self,
-        c: &MachineConfig,
-        m: &mut Motion,
-        config: &mut MachineConfig,
-        now: u32,
-    ) {
+    fn other_machine(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) {
+        if let Stream::Files(f) = &self.stream {
+            *config = *f.machine().expect("machine.txt read");
+        }
         self.stream = Stream::None;
-        *config = *c;
         m.configure(config);
         m.set_position([0; AXES]);
         m.renew();
-        info!("machine.txt: the card is for the ", c.machine.name());
+        info!("machine.txt: the card is for the ", config.machine.name());
         self.event(Event::OtherMachine, now);
     }
 
     #[inline(never)]
-    fn files_valid(&mut self, c: &Checked, now: u32) {
+    fn files_valid(&mut self, now: u32) {
+        let Some(c) = (match &self.stream {
+            Stream::Files(f) => f.checked(),
+            _ => None,
+        }) else {
+            return;
+        };
         info!(
             "files ok: shape ",
             c.params.shape,
@@ -282,16 +295,17 @@ impl JobTask {
             c.count
         );
         self.nails = c.params.nails;
-        self.stream = Stream::Checked(c.config);
         let event = Event::FilesValid {
             params: c.params,
             count: c.count,
             config: &c.config,
             id: c.id,
         };
-        self.event(event, now);
+        // The checked files stay where they are (the stream) while the job
+        // takes them: a copy would sit on the stack under its deepest calls.
+        self.job.on_into(event, now, &mut self.todo);
         // The job asks first, if it takes the card's machine at all.
-        if !matches!(self.todo.front(), Some(Action::Configure)) {
+        if !matches!(self.todo.first(), Some(Action::Configure)) {
             self.stream = Stream::None;
         }
     }
@@ -306,7 +320,7 @@ impl JobTask {
     /// The card's machine taken, if the job asked for it and the machine
     /// stands: its figures never change under a move.
     fn configure(&mut self, m: &mut Motion, config: &mut MachineConfig) {
-        if let (Stream::Checked(c), true) = (&self.stream, m.is_idle()) {
+        if let (Some(c), true) = (self.stream.checked_machine(), m.is_idle()) {
             *config = *c;
             self.stream = Stream::None;
             m.configure(config);
@@ -369,7 +383,7 @@ impl JobTask {
         config: &mut MachineConfig,
         store: &mut Store,
     ) -> Option<Poll<Signal>> {
-        while let Some(&a) = self.todo.front() {
+        while let Some(&a) = self.todo.first() {
             let logs = matches!(
                 a,
                 Action::Enter(_)
@@ -382,7 +396,7 @@ impl JobTask {
             if logs && !room_for_a_line() {
                 return Some(Poll::After(5));
             }
-            let _ = self.todo.pop_front();
+            self.todo.remove(0);
             match a {
                 Action::Enter(s) => {
                     info!("state: ", texts::state(s));
@@ -397,12 +411,10 @@ impl JobTask {
                     self.stream = Stream::Files(Files::new());
                     self.open(FileName::Param);
                 }
-                Action::OpenPattern
-                    if matches!(self.stream, Stream::Checked(_)) && !m.is_idle() =>
-                {
+                Action::OpenPattern if self.stream.checked_machine().is_some() && !m.is_idle() => {
                     // The card's machine, not yet taken, before the pattern
                     // takes its place.
-                    let _ = self.todo.push_front(a);
+                    let _ = self.todo.insert(0, a);
                     return Some(Poll::Wait(Signal::Motion));
                 }
                 Action::OpenPattern => {
@@ -417,12 +429,12 @@ impl JobTask {
                     if a == Action::StopMotion {
                         m.cancel();
                     }
-                    let _ = self.todo.push_front(a);
+                    let _ = self.todo.insert(0, a);
                     return Some(Poll::Wait(Signal::Motion));
                 }
                 Action::DriversOff(mask) if m.busy_axes() & mask != 0 => {
                     // Never from under an axis that a jog is moving.
-                    let _ = self.todo.push_front(a);
+                    let _ = self.todo.insert(0, a);
                     return Some(Poll::Wait(Signal::Motion));
                 }
                 Action::StopMotion => {}
@@ -430,7 +442,7 @@ impl JobTask {
                 Action::DriversOff(mask) => m.drivers.set(mask, false),
                 Action::SetZero(_) if !m.is_idle() => {
                     // A console jog still running: zero where it ends.
-                    let _ = self.todo.push_front(a);
+                    let _ = self.todo.insert(0, a);
                     return Some(Poll::Wait(Signal::Motion));
                 }
                 Action::Configure => self.configure(m, config),
@@ -460,7 +472,7 @@ impl JobTask {
                 // After a write under way (the last record): the header
                 // goes in the other slot, but one write at a time.
                 Action::Forget if store.saving() => {
-                    let _ = self.todo.push_front(a);
+                    let _ = self.todo.insert(0, a);
                     return Some(Poll::After(4));
                 }
                 Action::Forget => store.forget(),

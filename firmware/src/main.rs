@@ -331,11 +331,7 @@ fn load_store(eeprom: Eeprom) -> (bool, Found) {
     // `.data` would be a second copy of them in flash). Read in place from
     // here on: a copy would sit on init's stack.
     CONFIG.init(MachineConfig::defaults(Machine::StringArt));
-    let store_now = CONFIG.with(|c| {
-        let (config, store_now) = store.load(c);
-        *c = config;
-        store_now
-    });
+    let store_now = CONFIG.with(|c| store.load(c));
     let found = store.load_checkpoint();
     STORE.with(|s| *s = Some(store));
     (store_now, found)

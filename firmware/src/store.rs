@@ -14,6 +14,7 @@ use crate::{flash_str, warn};
 use taut_logic::checkpoint::{self, Found, Header, Record, HEADER_BYTES};
 use taut_logic::config::MachineConfig;
 use taut_logic::files::check::CardId;
+use taut_logic::machine::Machine;
 use taut_logic::settings::image::{self, Scan, Step, Unusable};
 use taut_logic::stringart::job::Phase;
 
@@ -57,18 +58,21 @@ impl Store {
         }
     }
 
-    /// The settings in EEPROM, or `defaults` when they cannot be used: the
-    /// task's first run then says why in one warning line and writes the
-    /// defaults. True when the task must run.
-    pub fn load(&mut self, defaults: &MachineConfig) -> (MachineConfig, bool) {
-        match image::decode(|i| self.eeprom.read(i as u16), defaults) {
-            Ok(cfg) => (cfg, false),
-            Err(why) => {
-                self.unusable = Some(why);
-                self.settings_due = true;
-                (*defaults, true)
-            }
+    /// The settings in EEPROM onto `cfg`, the defaults, in place; the
+    /// defaults when they cannot be used: the task's first run then says
+    /// why in one warning line and writes them. True when the task must
+    /// run.
+    pub fn load(&mut self, cfg: &mut MachineConfig) -> bool {
+        let why = match image::decode_into(|i| self.eeprom.read(i as u16), cfg) {
+            Ok(()) => return false,
+            Err(why) => why,
+        };
+        if why == Unusable::Inconsistent {
+            *cfg = MachineConfig::defaults(Machine::StringArt);
         }
+        self.unusable = Some(why);
+        self.settings_due = true;
+        true
     }
 
     /// The job's checkpoint as the last power-off left it. A corrupt one

@@ -349,6 +349,17 @@ impl Sim {
         }
     }
 
+    /// `len` bytes of data memory from `addr` (registers, I/O, SRAM), e.g.
+    /// the stack for a backtrace.
+    pub fn ram(&self, addr: u16, len: usize) -> Vec<u8> {
+        assert!(addr as usize + len <= RAM_END as usize + 1, "past RAMEND");
+        // SAFETY: `data` holds `ramend + 1` bytes, checked above.
+        unsafe {
+            let data = (*self.avr.as_ptr()).data;
+            std::slice::from_raw_parts(data.add(addr as usize), len).to_vec()
+        }
+    }
+
     /// Record every cycle at which execution reaches byte address `pc` (an
     /// interrupt vector, a task's entry): latencies measured exactly.
     pub fn watch_pc(&mut self, pc: u32) {

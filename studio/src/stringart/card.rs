@@ -71,7 +71,7 @@ pub fn check(param: &[u8], poradi: &[u8]) -> Result<Vec<u16>, String> {
     files.missing(&base).map_err(show)?;
     files.push(poradi).map_err(show)?;
     let checked = match files.end(&base).map_err(show)? {
-        Next::Done(c) => c,
+        Next::Done => *files.checked().expect("checked"),
         other => return Err(format!("the card check did not finish: {other:?}")),
     };
     let mut reader = PoradiReader::new(checked.params.nails);

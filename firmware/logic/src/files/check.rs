@@ -75,13 +75,15 @@ pub struct CardId {
     pub poradi: FileSum,
 }
 
-/// After a file: open the next one, or all are read.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// After a file: open the next one, or all are read. The result stays in
+/// the [`Files`] ([`Files::checked`], [`Files::machine`]): on the AVR a
+/// copy of it is 187 bytes on the stack under the job's deepest calls.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Next {
     Open(FileName),
-    Done(Checked),
+    Done,
     /// A plotter's card: `machine.txt` names it, with its settings.
-    Machine(MachineConfig),
+    Machine,
 }
 
 enum Stage {
@@ -90,6 +92,7 @@ enum Stage {
     Plotter(MachineFile),
     Machine(Params, MachineFile),
     Poradi(Params, MachineConfig, PoradiCheck),
+    Checked(Checked),
 }
 
 pub struct Files {
@@ -116,7 +119,24 @@ impl Files {
         match self.stage {
             Stage::Param(_) => FileName::Param,
             Stage::Plotter(_) | Stage::Machine(..) => FileName::Machine,
-            Stage::Poradi(..) => FileName::Poradi,
+            Stage::Poradi(..) | Stage::Checked(_) => FileName::Poradi,
+        }
+    }
+
+    /// The job's files, once [`Next::Done`].
+    pub fn checked(&self) -> Option<&Checked> {
+        match &self.stage {
+            Stage::Checked(c) => Some(c),
+            _ => None,
+        }
+    }
+
+    /// A plotter card's machine, once [`Next::Machine`] (before, the
+    /// lines of `machine.txt` so far).
+    pub fn machine(&self) -> Option<&MachineConfig> {
+        match &self.stage {
+            Stage::Plotter(m) => Some(m.config()),
+            _ => None,
         }
     }
 
@@ -134,6 +154,7 @@ impl Files {
                 self.id.poradi.add(chunk);
                 c.push(chunk)
             }
+            Stage::Checked(_) => Ok(()),
         }
     }
 
@@ -153,7 +174,7 @@ impl Files {
                 let config = m.finish_in_place()?;
                 return match config.machine.is_string_art() {
                     true => Err(FileError::whole(FileName::Param, ErrorKind::NotFound)),
-                    false => Ok(Next::Machine(*config)),
+                    false => Ok(Next::Machine),
                 };
             }
             Stage::Machine(params, m) => {
@@ -161,16 +182,28 @@ impl Files {
                 m.finish_in_place()?;
                 self.poradi_next(params);
             }
-            Stage::Poradi(params, config, c) => {
-                return Ok(Next::Done(Checked {
-                    params: *params,
-                    config: *config,
-                    count: c.finish()?,
-                    id: self.id,
-                }));
+            Stage::Poradi(_, _, c) => {
+                let count = c.finish()?;
+                self.checked_next(count);
+                return Ok(Next::Done);
             }
+            Stage::Checked(_) => return Ok(Next::Done),
         }
         Ok(Next::Open(self.file()))
+    }
+
+    /// In place: the stage's figures become the result.
+    #[inline(never)]
+    fn checked_next(&mut self, count: u32) {
+        if let Stage::Poradi(params, config, _) = &self.stage {
+            let (params, config, id) = (*params, *config, self.id);
+            self.stage = Stage::Checked(Checked {
+                params,
+                config,
+                count,
+                id,
+            });
+        }
     }
 
     #[inline(never)]
@@ -215,14 +248,13 @@ mod tests {
 
     /// Reads a card given as (file, contents or None when missing).
     fn read(card: &[(FileName, Option<&[u8]>)]) -> Result<Checked, FileError> {
-        match read_any(card)? {
-            Next::Done(c) => Ok(c),
-            other => panic!("{other:?}"),
-        }
+        let (next, files) = read_any(card)?;
+        assert_eq!(next, Next::Done);
+        Ok(*files.checked().expect("a job's files"))
     }
 
     /// Reads a card to its end: a job's files, or a plotter's.
-    fn read_any(card: &[(FileName, Option<&[u8]>)]) -> Result<Next, FileError> {
+    fn read_any(card: &[(FileName, Option<&[u8]>)]) -> Result<(Next, Files), FileError> {
         let base = MachineConfig::STRING_ART;
         let mut files = Files::new();
         loop {
@@ -239,7 +271,7 @@ mod tests {
                 }
             };
             if !matches!(next, Next::Open(_)) {
-                return Ok(next);
+                return Ok((next, files));
             }
         }
     }
@@ -250,16 +282,16 @@ mod tests {
             FileName::Machine,
             Some(b"machine = flatbed\nx_max_rate = 1500\n"),
         )];
-        let Ok(Next::Machine(cfg)) = read_any(card) else {
-            panic!("{:?}", read_any(card));
-        };
+        let (next, files) = read_any(card).unwrap();
+        assert_eq!(next, Next::Machine);
+        let cfg = files.machine().unwrap();
         assert_eq!(cfg.machine, crate::machine::Machine::Flatbed);
         assert_eq!(cfg.axes[0].max_rate, 1500);
         // Without param.txt, a string-art machine.txt is a bad job card.
         let string_art: &[(FileName, Option<&[u8]>)] =
             &[(FileName::Machine, Some(b"base_max_rate = 1500\n"))];
         assert_eq!(
-            show(&read_any(string_art).unwrap_err()),
+            show(&read_any(string_art).err().expect("refused")),
             "param.txt: file not found"
         );
     }

@@ -187,6 +187,16 @@ fn widen(b: [u8; 4]) -> [u8; 8] {
 /// Reads an image through `read(i)` (byte `i` of the EEPROM) onto the
 /// defaults `base`.
 pub fn decode(read: impl Fn(usize) -> u8, base: &MachineConfig) -> Result<MachineConfig, Unusable> {
+    let mut cfg = *base;
+    decode_into(read, &mut cfg).map(|()| cfg)
+}
+
+/// [`decode`] in place, onto `cfg` (the defaults on entry): on the AVR no
+/// copy of the settings sits on the stack. Every value is checked before
+/// any is taken, so on an error `cfg` is unchanged, except after
+/// [`Unusable::Inconsistent`] (each value fine, the set not): the caller
+/// loads the defaults again.
+pub fn decode_into(read: impl Fn(usize) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
     if (0..HEADER).all(|i| read(i) == 0xFF) {
         return Err(Unusable::Blank);
     }
@@ -200,28 +210,30 @@ pub fn decode(read: impl Fn(usize) -> u8, base: &MachineConfig) -> Result<Machin
     if !magic_ok || u16::from_le_bytes([read(n - 2), read(n - 1)]) != sum.value() {
         return Err(Unusable::Checksum);
     }
-    let word = |i: usize| u32::from_le_bytes([read(i), read(i + 1), read(i + 2), read(i + 3)]);
-    let mut cfg = *base;
-    let mut at = HEADER;
-    for s in all() {
-        let value = match s.get(base) {
-            Value::Number(_) => Value::Number(word(at)),
-            Value::Milli(_) => Value::Milli(Milli(word(at) as i32)),
-            Value::Machine(_) => match u8::try_from(word(at)).ok().and_then(Machine::from_index) {
-                Some(m) => Value::Machine(m),
-                None => return Err(Unusable::Refused(s)),
-            },
-            Value::Ratio(_) => Value::Ratio(StepsPerUnit::new(word(at), word(at + 4))),
-        };
-        at += width(s);
-        s.check(value).map_err(|_| Unusable::Refused(s))?;
-        s.force(&mut cfg, value);
+    for take in [false, true] {
+        let mut at = HEADER;
+        for s in all() {
+            let value = value(&read, s.get(cfg), at).ok_or(Unusable::Refused(s))?;
+            at += width(s);
+            s.check(value).map_err(|_| Unusable::Refused(s))?;
+            if take {
+                s.force(cfg, value);
+            }
+        }
     }
     // Each value in range; now the set as a whole.
-    match super::check_whole(&cfg) {
-        Ok(()) => Ok(cfg),
-        Err(_) => Err(Unusable::Inconsistent),
-    }
+    super::check_whole(cfg).map_err(|_| Unusable::Inconsistent)
+}
+
+/// The value in the image at byte `at`, of the kind `like` is.
+fn value(read: &impl Fn(usize) -> u8, like: Value, at: usize) -> Option<Value> {
+    let word = |i: usize| u32::from_le_bytes([read(i), read(i + 1), read(i + 2), read(i + 3)]);
+    Some(match like {
+        Value::Number(_) => Value::Number(word(at)),
+        Value::Milli(_) => Value::Milli(Milli(word(at) as i32)),
+        Value::Machine(_) => Value::Machine(Machine::from_index(u8::try_from(word(at)).ok()?)?),
+        Value::Ratio(_) => Value::Ratio(StepsPerUnit::new(word(at), word(at + 4))),
+    })
 }
 
 /// Fletcher-16: two running sums mod 255 (catches swapped and zeroed

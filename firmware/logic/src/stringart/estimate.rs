@@ -284,8 +284,8 @@ pub fn card<'a>(file: impl Fn(FileName) -> Option<&'a [u8]>) -> Result<CardEstim
         };
         match next.map_err(CardError::File)? {
             Next::Open(_) => {}
-            Next::Done(c) => break c,
-            Next::Machine(_) => return Err(CardError::Plotter),
+            Next::Done => break *files.checked().expect("checked"),
+            Next::Machine => return Err(CardError::Plotter),
         }
     };
     let poradi = file(FileName::Poradi).unwrap_or_default();

@@ -64,6 +64,16 @@ fn a_consistent_image_with_a_refused_value_is_refused() {
     body.iter().for_each(|&b| sum.add(b));
     body.extend_from_slice(&sum.value().to_le_bytes());
     assert!(matches!(read(&body), Err(Unusable::Refused(_))));
+    // In place: a refused value leaves every setting as it was, those
+    // before it in the image too.
+    let mut cfg = BASE;
+    set(&mut cfg, "radial_accel", "321").unwrap();
+    let before = cfg;
+    let found = decode_into(|i| body[i], &mut cfg);
+    assert!(matches!(found, Err(Unusable::Refused(_))));
+    assert_eq!(cfg, before);
+    assert_eq!(decode_into(|i| image(&before)[i], &mut cfg), Ok(()));
+    assert_eq!(cfg, before);
 }
 
 #[test]

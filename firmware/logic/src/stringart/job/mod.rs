@@ -120,9 +120,9 @@ impl Default for Job {
 }
 
 /// Collects one event's actions.
-struct Out(Actions);
+struct Out<'a>(&'a mut Actions);
 
-impl Out {
+impl Out<'_> {
     fn push(&mut self, a: Action) {
         // The capacity covers the longest sequence (starting to wind).
         let pushed = self.0.push(a);
@@ -196,7 +196,15 @@ impl Job {
     /// Handles one event; `now_ms` is the firmware's millisecond clock
     /// (for the time-left estimate; it may wrap).
     pub fn on(&mut self, event: Event<'_>, now_ms: u32) -> Actions {
-        let mut out = Out(Actions::new());
+        let mut actions = Actions::new();
+        self.on_into(event, now_ms, &mut actions);
+        actions
+    }
+
+    /// [`Job::on`] adding the actions to `actions` (on the AVR, the job
+    /// task's queue of them: no copy on the stack).
+    pub fn on_into(&mut self, event: Event<'_>, now_ms: u32, actions: &mut Actions) {
+        let mut out = Out(actions);
         let o = &mut out;
         match event {
             Event::PowerOn => {
@@ -240,7 +248,6 @@ impl Job {
                 }
             }
         }
-        out.0
     }
 
     /// The phase of drilling, winding or their pause.
