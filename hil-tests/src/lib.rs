@@ -2,6 +2,7 @@
 //! demand so `cargo test -p hil-tests` works on its own (xtask builds them
 //! first anyway).
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Once;
@@ -105,9 +106,20 @@ pub fn send_ok(sim: &mut sim::Sim, line: &str, timeout: std::time::Duration) {
 pub const RAM_BUDGET: u32 = 6144;
 
 /// Checked at the end of every HIL test that runs the release image.
+/// Each test's figure is also added to `target/hil-stack-peaks.txt` (test,
+/// stack bytes, where), to find the deepest path of a whole run.
 pub fn assert_ram_budget(sim: &sim::Sim) {
     let statics = sim.elf().unwrap().ram_static_bytes();
     let stack = sim.peak_stack_bytes() as u32;
+    let log = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/hil-stack-peaks.txt");
+    if let Ok(mut f) = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(log)
+    {
+        let test = std::thread::current().name().unwrap_or("?").to_string();
+        let _ = writeln!(f, "{test} {stack} {:#x}", sim.peak_stack_pc());
+    }
     assert!(
         statics + stack < RAM_BUDGET,
         "static {statics} B + stack {stack} B, deepest at {:#x} (avr-addr2line -fe taut.elf)",

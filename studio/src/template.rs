@@ -221,13 +221,23 @@ mod tests {
     fn crowded_numbers_thin_out() {
         assert_eq!(labels(9.7), (5.0, 1));
         assert_eq!(labels(0.24), (1.5, 10));
+        // The densest boards the firmware's needle passes (~3.7 mm apart)
+        // keep every number; denser ones are refused.
         let doc = template(&Spec {
             shape: 0,
-            nails: 10_000,
+            nails: 680,
             radius_um: 402_000,
         })
         .unwrap();
-        assert!(doc.contains(">9990</text>") && !doc.contains(">9991</text>"));
+        assert!(doc.contains(">678</text>") && doc.contains(">679</text>"));
+        let dense = Spec {
+            shape: 0,
+            nails: 10_000,
+            radius_um: 402_000,
+        };
+        assert!(template(&dense)
+            .unwrap_err()
+            .contains("too close for the needle"));
     }
 
     #[test]

@@ -9,7 +9,7 @@ use taut_logic::files::check::{Files, Next};
 use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::geometry::Board;
-use taut_logic::stringart::{estimate, Winder};
+use taut_logic::stringart::{estimate, BlendWinder, WindError};
 
 /// The board as the card describes it: shape (0 circle, n ≥ 3 n-gon),
 /// nails, radius in µm.
@@ -41,7 +41,15 @@ impl Spec {
         let radius = taut_logic::units::Milli(self.radius_um as i32);
         let board =
             Board::new(self.shape, self.nails, radius).map_err(|e| e.message().to_string())?;
-        Winder::new(board, &base).map_err(|_| "the board is too small to wind".to_string())?;
+        // The firmware's own check (its `bad board`): the blended winder
+        // needs room for the needle in every gap.
+        BlendWinder::new(board, &base).map_err(|e| match e {
+            WindError::GapTooNarrow(g) => format!(
+                "nails {g} and {} stand too close for the needle to pass between them",
+                (g + 1) % self.nails
+            ),
+            _ => "the board is too small to wind".to_string(),
+        })?;
         Ok(board)
     }
 }
@@ -192,6 +200,12 @@ mod tests {
             Some("polomer_matrice = 35.25")
         );
         assert!(spec(1000, 3, 10_000_000).board().is_ok());
+        // What the firmware's blended winder refuses: 0.25 mm between nails.
+        assert_eq!(
+            spec(0, 10_000, 402_000).board().unwrap_err(),
+            "nails 0 and 1 stand too close for the needle to pass between them"
+        );
+        assert!(spec(0, 600, 402_000).board().is_ok());
     }
 
     #[test]

@@ -133,7 +133,8 @@ fn every_board_shape_and_size_the_firmware_takes_winds() {
         (6, 24),
         (8, 200),
         (1000, 50),
-        (0, 2000),
+        // The densest circle of this radius the needle passes (3.7 mm).
+        (0, 500),
     ] {
         let mut o = options(shape, nails, 30);
         o.resolution = 48;
@@ -170,6 +171,10 @@ fn clear_errors_for_what_cannot_be_wound() {
     assert_eq!(
         err(small, &img),
         "param.txt:3:19: expected more than 3.5 cm"
+    );
+    assert_eq!(
+        err(options(0, 2000, 10), &img),
+        "nails 0 and 1 stand too close for the needle to pass between them"
     );
     let white = Gray::new(10, 10, 1.0);
     assert!(err(options(0, 100, 10), &white).starts_with("nothing to wind"));
