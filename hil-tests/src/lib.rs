@@ -122,7 +122,8 @@ pub fn assert_ram_budget(sim: &sim::Sim) {
     }
     assert!(
         statics + stack < RAM_BUDGET,
-        "static {statics} B + stack {stack} B, deepest at {:#x} (avr-addr2line -fe taut.elf)",
+        "static {statics} B + stack {stack} B, deepest at {:#x} (avr-addr2line -fe taut.elf; \
+         the call chain: simavr/examples/stack_trace.rs)",
         sim.peak_stack_pc()
     );
 }

@@ -15,6 +15,7 @@
 //! instruction: with any of them on, it runs one instruction at a time.
 
 use crate::clock::cycles_in;
+use crate::elf::RAM_END;
 use crate::outcome::Outcome;
 use crate::serial::{self, CYCLES_PER_BYTE};
 use crate::sim::{Core, Executed, Sim};
@@ -205,6 +206,9 @@ impl Sim {
         if sp < self.min_sp && !self.sp_half_written(pc) {
             self.min_sp = sp;
             self.min_sp_pc = pc;
+            if self.peak_stack.is_some() {
+                self.peak_stack = Some(self.ram(sp + 1, usize::from(RAM_END - sp)));
+            }
             self.shared_mut().sp_floor = sp;
             // The last push wrote at sp + 1.
             if u32::from(sp) + 1 < u32::from(self.ram_limit) {

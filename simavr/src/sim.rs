@@ -62,6 +62,9 @@ pub struct Sim {
     pub(crate) min_sp: u16,
     /// Where the program was when the stack was deepest (byte address).
     pub(crate) min_sp_pc: u32,
+    /// The stack's bytes at its deepest, once asked for
+    /// ([`Sim::keep_peak_stack`]).
+    pub(crate) peak_stack: Option<Vec<u8>>,
     /// Watched program addresses and the cycles execution reached them.
     pub(crate) pc_watches: Vec<(u32, Vec<u64>)>,
     pub(crate) resets: u32,
@@ -199,6 +202,7 @@ impl Sim {
             ram_limit,
             min_sp: RAM_END,
             min_sp_pc: 0,
+            peak_stack: None,
             pc_watches: Vec::new(),
             resets: 0,
             last_avr_cycle: 0,
@@ -410,6 +414,20 @@ impl Sim {
     /// up with `avr-addr2line -fe taut.elf`.
     pub fn peak_stack_pc(&self) -> u32 {
         self.min_sp_pc
+    }
+
+    /// From now on, keep a copy of the stack each time it goes deeper
+    /// than ever: [`Sim::peak_stack`] then holds the return addresses of
+    /// the deepest call chain (`simavr/examples/stack_trace.rs` reads them).
+    pub fn keep_peak_stack(&mut self) {
+        self.peak_stack.get_or_insert_with(Vec::new);
+    }
+
+    /// The stack's bytes (from the stack pointer + 1 up to RAMEND) as they
+    /// stood at the deepest point, if [`Sim::keep_peak_stack`] was called
+    /// before it.
+    pub fn peak_stack(&self) -> Option<&[u8]> {
+        self.peak_stack.as_deref()
     }
 
     /// First address past the statics: the stack must stay above it.
