@@ -88,6 +88,8 @@ impl Line {
         self.cut = false;
         self.msg = true;
         let _ = ufmt::uwrite!(self, "{}", crate::flash_str!("[MSG:"));
+        // Immediates, not a byte string: that would be a copy in SRAM.
+        #[allow(clippy::byte_char_slices)]
         self.push([b'E', b'W', b'I', b'D'][level as usize]);
         let _ = ufmt::uwrite!(self, " {} {}: ", clock::millis(), module);
     }
@@ -99,6 +101,7 @@ impl Line {
     pub fn message() -> Line {
         let mut l = Line::bare();
         l.msg = true;
+        #[allow(clippy::byte_char_slices)] // (as in `begin`)
         for c in [b'[', b'M', b'S', b'G', b':'] {
             let _ = l.buf.push(c);
         }

@@ -229,9 +229,7 @@ impl Print {
             if data && ours && self.state != State::Idle {
                 return None;
             }
-            let Some(msg) = CARD_OUT.pop() else {
-                return None;
-            };
+            let msg = CARD_OUT.pop()?;
             match msg.what {
                 What::Opened { name, size } if ours => return self.opened(name, size),
                 What::Listed if ours => {

@@ -325,8 +325,8 @@ impl Stepper {
             }
         };
         let mut p = start;
-        for i in 0..AXES {
-            p[i] += signed(done(&block, block.events - left, i), block.dir, i);
+        for (i, p) in p.iter_mut().enumerate() {
+            *p += signed(done(&block, block.events - left, i), block.dir, i);
         }
         p
     }

@@ -30,6 +30,12 @@ pub struct Ring<T: Copy, const N: usize, const WHOLE: bool = false> {
 // inside a critical section (see `stats`).
 unsafe impl<T: Copy + Send, const N: usize, const WHOLE: bool> Sync for Ring<T, N, WHOLE> {}
 
+impl<T: Copy, const N: usize, const WHOLE: bool> Default for Ring<T, N, WHOLE> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
     const MASK: u8 = (N - 1) as u8;
 
