@@ -110,8 +110,9 @@ fn the_sample_job_drills_and_winds_as_its_pulses_show() {
     // cross the ring mid-move. Within a micrometre of the clearance (the
     // replay's floats against the firmware's).
     let (closest, at_ns, nail) = job.closest_to_nails();
+    let clearance = taut_logic::stringart::Clearance::of(&MachineConfig::STRING_ART).mm;
     assert!(
-        closest >= f64::from(taut_logic::stringart::CLEARANCE_MM) - 1e-3,
+        closest >= f64::from(clearance) - 1e-3,
         "{closest:.3} mm from nail {nail} at {at_ns} ns"
     );
     // The drill's driver is off while winding, the others hold: checked
@@ -195,4 +196,45 @@ fn machine_time_is_the_estimate(sim: &hil_tests::sim::Sim, card: &Path) {
             "{phase}: {sim_s:.2} s simulated, {est_s:.2} s estimated"
         );
     }
+}
+
+/// A thicker needle (`needle_diameter` in the card's `machine.txt`): the
+/// firmware takes it with the card, and the needle, replayed from the
+/// pulses, keeps the larger clearance at every step of the winding.
+#[test]
+fn a_thicker_needle_from_machine_txt_keeps_its_clearance() {
+    let param = b"tvar = 0\npocet_hrebiku = 8\npolomer_matrice = 10.0\n";
+    let poradi = b"6,0,3,6,1,4,7\n";
+    let card = hil_tests::card(&[
+        ("param.txt", param),
+        ("machine.txt", b"needle_diameter = 4.0\n"),
+        ("poradi.txt", poradi),
+    ]);
+    let mut sim = boot_machine();
+    sim.insert_sd(card);
+    let mut op = Operator::confirming();
+    while !op.finished {
+        assert_eq!(sim.run_for(Duration::from_millis(10)), Outcome::Running);
+        op.step(&mut sim);
+        assert!(sim.time_s() < 600.0, "not finished:\n{}", sim.uart_text());
+    }
+    let path = std::env::temp_dir().join(format!("taut-hil-needle-{}.vcd", std::process::id()));
+    sim.write_vcd(&path).unwrap();
+    let signals = vcd::parse(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let mut config = MachineConfig::STRING_ART;
+    config.winding.needle_um = 4000;
+    let board = board_from_param(param).unwrap();
+    let job = JobReplay::from_signals(&signals, board, &config).unwrap();
+    assert_eq!(job.wrapped_nails(), [0, 3, 6, 1, 4, 7]);
+    assert!(job.crossings_outside_gaps().is_empty());
+    let (closest, at_ns, nail) = job.closest_to_nails();
+    let thick = taut_logic::stringart::Clearance::of(&config).mm;
+    let default = taut_logic::stringart::Clearance::of(&MachineConfig::STRING_ART).mm;
+    assert!(thick > default + 1.0, "{thick} mm");
+    assert!(
+        closest >= f64::from(thick) - 1e-3,
+        "{closest:.3} mm from nail {nail} at {at_ns} ns, clearance {thick} mm"
+    );
+    assert_ram_budget(&sim);
 }

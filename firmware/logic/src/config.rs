@@ -65,6 +65,28 @@ pub struct MachineConfig {
     pub status_report: u8,
     /// Grbl's `$13`: positions and feeds in reports in inches.
     pub report_inches: bool,
+    /// The string-art machine's nails and winding needle.
+    pub winding: WindingConfig,
+}
+
+/// What the needle must clear while winding (`stringart::clearance`): the
+/// nails' and the needle's diameters, µm.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WindingConfig {
+    pub nail_um: u16,
+    pub needle_um: u16,
+}
+
+impl WindingConfig {
+    /// A 1.8 mm panel pin and a 1.5 mm hollow needle the thread runs
+    /// through.
+    pub const DEFAULT: WindingConfig = WindingConfig {
+        nail_um: 1800,
+        needle_um: 1500,
+    };
+    /// Either diameter, at most (`stringart::clearance` relies on it).
+    pub const MAX_UM: u16 = 10_000;
+    pub const MIN_UM: u16 = 100;
 }
 
 /// The arm or string geometry of the non-linear machines, mm.
@@ -308,6 +330,7 @@ const fn plotter(machine: Machine, xy: [AxisConfig; 2]) -> MachineConfig {
         // character count from `Bf:`.
         status_report: 3,
         report_inches: false,
+        winding: WindingConfig::DEFAULT,
     }
 }
 

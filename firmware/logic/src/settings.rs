@@ -6,7 +6,7 @@
 //! every string costs SRAM on the AVR. Printing uses ufmt only.
 
 use crate::axis::{Axis, AXES};
-use crate::config::MachineConfig;
+use crate::config::{MachineConfig, WindingConfig};
 use crate::kinematics::AnyKinematics;
 use crate::machine::Machine;
 use crate::text::num::{parse_milli, parse_ratio, parse_u32, trim, NumError};
@@ -78,6 +78,10 @@ pub enum GlobalField {
     /// Grbl's `$10` and `$13`: the status report's fields, and inches.
     StatusReport,
     ReportInches,
+    /// String art: the nails' and the winding needle's diameters (mm),
+    /// which the needle's clearance from the nails is worked out from.
+    NailDiameter,
+    NeedleDiameter,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,7 +111,7 @@ const AXIS_FIELDS: [AxisField; 8] = [
     AxisField::TravelMax,
 ];
 
-const GLOBAL_FIELDS: [GlobalField; 22] = [
+const GLOBAL_FIELDS: [GlobalField; 24] = [
     GlobalField::Machine,
     GlobalField::StepPulseUs,
     GlobalField::DirSetupUs,
@@ -130,6 +134,8 @@ const GLOBAL_FIELDS: [GlobalField; 22] = [
     GlobalField::HomingPullOff,
     GlobalField::StatusReport,
     GlobalField::ReportInches,
+    GlobalField::NailDiameter,
+    GlobalField::NeedleDiameter,
 ];
 
 // The tables above in order of discriminant: `at` works them out.
@@ -174,6 +180,8 @@ impl GlobalField {
             19 => HomingPullOff,
             20 => StatusReport,
             21 => ReportInches,
+            22 => NailDiameter,
+            23 => NeedleDiameter,
             _ => return None,
         })
     }
@@ -255,6 +263,8 @@ impl GlobalField {
             HomingPullOff => "homing_pull_off",
             StatusReport => "status_report",
             ReportInches => "report_inches",
+            NailDiameter => "nail_diameter",
+            NeedleDiameter => "needle_diameter",
         ])
         .get(self as usize)
     }
@@ -407,6 +417,12 @@ impl Setting {
             }
             Setting::Global(GlobalField::StatusReport) => cfg.status_report as u32,
             Setting::Global(GlobalField::ReportInches) => cfg.report_inches as u32,
+            Setting::Global(GlobalField::NailDiameter) => {
+                return Value::Milli(Milli(i32::from(cfg.winding.nail_um)))
+            }
+            Setting::Global(GlobalField::NeedleDiameter) => {
+                return Value::Milli(Milli(i32::from(cfg.winding.needle_um)))
+            }
         })
     }
 
@@ -456,9 +472,10 @@ impl Setting {
                     })
                 }
             },
-            Setting::Global(Length1 | Length2 | OriginX | OriginY | HomingPullOff) => {
-                Value::Milli(parse_milli(text)?)
-            }
+            Setting::Global(
+                Length1 | Length2 | OriginX | OriginY | HomingPullOff | NailDiameter
+                | NeedleDiameter,
+            ) => Value::Milli(parse_milli(text)?),
             Setting::Global(Crosstalk) => Value::Ratio(parse_ratio(text)?),
             Setting::Axis(_, AxisField::StepsPerUnit) => Value::Ratio(parse_ratio(text)?),
             Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax) => {
@@ -497,13 +514,21 @@ impl Setting {
                     false => Err(ErrorKind::Invalid(HomingPullOff.name())),
                 }
             }
+            (Setting::Global(f @ (NailDiameter | NeedleDiameter)), Value::Milli(m)) => {
+                let (min, max) = (WindingConfig::MIN_UM, WindingConfig::MAX_UM);
+                match (i32::from(min)..=i32::from(max)).contains(&m.0) {
+                    true => Ok(()),
+                    false => Err(ErrorKind::Invalid(f.name())),
+                }
+            }
             (Setting::Global(Crosstalk), Value::Ratio(r)) => match r.den != 0 {
                 true => Ok(()),
                 false => Err(ErrorKind::Invalid(Crosstalk.name())),
             },
             (
                 Setting::Global(
-                    Machine | Length1 | Length2 | OriginX | OriginY | Crosstalk | HomingPullOff,
+                    Machine | Length1 | Length2 | OriginX | OriginY | Crosstalk | HomingPullOff
+                    | NailDiameter | NeedleDiameter,
                 ),
                 _,
             ) => Err(ErrorKind::NotANumber),
@@ -565,6 +590,13 @@ impl Setting {
             }
             (Setting::Global(GlobalField::HomingPullOff), Value::Milli(m)) => {
                 cfg.homing.pull_off_um = m.0 as u16
+            }
+            // `check` keeps these within u16.
+            (Setting::Global(GlobalField::NailDiameter), Value::Milli(m)) => {
+                cfg.winding.nail_um = m.0 as u16
+            }
+            (Setting::Global(GlobalField::NeedleDiameter), Value::Milli(m)) => {
+                cfg.winding.needle_um = m.0 as u16
             }
             (_, Value::Ratio(_) | Value::Milli(_) | Value::Machine(_)) => {}
             // The ranges keep these within u8.

@@ -9,7 +9,7 @@
 //! construction, and a replay of the steps can check it.
 //!
 //! The constraint is [`super::clearance`]'s: the needle stays
-//! [`CLEARANCE_MM`] from every nail. Each nail blocks the angles within α
+//! [`Clearance`] from every nail. Each nail blocks the angles within α
 //! of its own; between two nails lies a gap's *window* of whole base
 //! steps where any radius is safe. Inside `inner` (the smallest nail
 //! radius − c) the needle is clear of the nails at any angle, and over
@@ -39,15 +39,11 @@
 //! Cost on the AVR: per wrap, three nails (`Board::nail`, the polygon's
 //! trigonometry), three square roots and divisions; nothing per block.
 
-use super::clearance::{around, blocked, turns_to, window, Blocked, Window, CLEARANCE_MM};
+use super::clearance::{around, turns_to, Blocked, Clearance, Window};
 use super::{bit, MachineStep, WindError, MACHINE_DRIVERS};
 use crate::axis::Axis;
 use crate::config::MachineConfig;
-use crate::geometry::{Board, StepScale, NAIL_MARGIN_MM};
-
-// The zero pose (radial 0, the needle at the board's edge) must be clear
-// of the nails, which stand NAIL_MARGIN_MM inside it.
-const _: () = assert!(CLEARANCE_MM < NAIL_MARGIN_MM);
+use crate::geometry::{Board, StepScale};
 
 /// Rounding of f32 radii to whole steps always away from the nails.
 const EPS: f32 = 0.01;
@@ -57,6 +53,7 @@ const EPS: f32 = 0.01;
 pub struct BlendWinder {
     board: Board,
     scale: StepScale,
+    clearance: Clearance,
     /// Inside the band at every angle, radial steps.
     inner: i32,
     base: i32,
@@ -110,7 +107,8 @@ impl BlendWinder {
     // would sit in the frame under every job event (the stack's peak).
     #[inline(never)]
     pub fn new(board: Board, config: &MachineConfig) -> Result<Self, WindError> {
-        let inner_mm = board.min_nail_radius() - CLEARANCE_MM;
+        let clearance = Clearance::of(config);
+        let inner_mm = board.min_nail_radius() - clearance.mm;
         if inner_mm <= 0.0 {
             return Err(WindError::BoardTooSmall);
         }
@@ -119,6 +117,7 @@ impl BlendWinder {
         let w = BlendWinder {
             board,
             scale,
+            clearance,
             inner: inner as i32,
             base: 0,
         };
@@ -128,17 +127,17 @@ impl BlendWinder {
         // trigonometry): the job task's run stays well inside the step
         // queue's 30 ms.
         let (n, turn) = (board.nails(), scale.steps_per_turn as f32);
-        let first = blocked(&board, &scale, 0);
+        let first = clearance.blocked(&board, &scale, 0);
         let mut below = first;
         for g in 0..n {
             let mut above = match g + 1 {
-                next if next < n => blocked(&board, &scale, next),
+                next if next < n => clearance.blocked(&board, &scale, next),
                 _ => first,
             };
             if above.at <= below.at {
                 above.at += turn;
             }
-            window(&below, &above).ok_or(WindError::GapTooNarrow(g))?;
+            (clearance.window(&below, &above)).ok_or(WindError::GapTooNarrow(g))?;
             below = above;
             if below.at >= turn {
                 below.at -= turn;
@@ -151,12 +150,12 @@ impl BlendWinder {
     /// (each was checked by [`BlendWinder::new`]).
     fn window_after(&self, g: u16, near: i32) -> Result<Window, WindError> {
         let n = self.board.nails();
-        let (s, turn) = (&self.scale, self.scale.steps_per_turn);
+        let (s, turn, c) = (&self.scale, self.scale.steps_per_turn, &self.clearance);
         let b = around(
-            [g, (g + 1) % n, (g + 2) % n].map(|i| blocked(&self.board, s, i)),
+            [g, (g + 1) % n, (g + 2) % n].map(|i| c.blocked(&self.board, s, i)),
             turn,
         );
-        let w = window(&b[0], &b[1]).ok_or(WindError::GapTooNarrow(g))?;
+        let w = c.window(&b[0], &b[1]).ok_or(WindError::GapTooNarrow(g))?;
         let k = turns_to((b[0].at + b[1].at) / 2.0, near, turn);
         Ok(Window {
             lo: w.lo + k,
@@ -194,9 +193,9 @@ impl BlendWinder {
             return Err(WindError::BadNail(j));
         }
         let prev = (j + n - 1) % n;
-        let (s, turn) = (&self.scale, self.scale.steps_per_turn);
+        let (s, turn, c) = (&self.scale, self.scale.steps_per_turn, &self.clearance);
         let b = around(
-            [prev, j, (j + 1) % n].map(|i| blocked(&self.board, s, i)),
+            [prev, j, (j + 1) % n].map(|i| c.blocked(&self.board, s, i)),
             turn,
         );
         let k = turns_to(b[1].at, self.base, turn);
@@ -204,9 +203,12 @@ impl BlendWinder {
             lo: w.lo + k,
             hi: w.hi + k,
         };
-        let before = shift(window(&b[0], &b[1]).ok_or(WindError::GapTooNarrow(prev))?);
-        let after = shift(window(&b[1], &b[2]).ok_or(WindError::GapTooNarrow(j))?);
-        let top = ring_over(&b) + CLEARANCE_MM;
+        let before = shift(
+            c.window(&b[0], &b[1])
+                .ok_or(WindError::GapTooNarrow(prev))?,
+        );
+        let after = shift(c.window(&b[1], &b[2]).ok_or(WindError::GapTooNarrow(j))?);
+        let top = ring_over(&b) + c.mm;
         let outer = libm::ceilf((top - self.board.radius()) * s.radial.as_f32() + EPS) as i32;
         let inner = self.inner;
         // Nail j ahead: out through the window before it, forwards.

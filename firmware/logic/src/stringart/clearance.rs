@@ -15,23 +15,88 @@
 //! Windows are whole base steps, rounded inwards from the exact nail
 //! angles: a needle standing on a window's edge step is still clear.
 
+use crate::config::{MachineConfig, WindingConfig};
 use crate::geometry::{Board, StepScale};
 use core::f32::consts::TAU;
 
-/// A string-art nail (1.8 mm panel pin) and the winding needle (a 1.5 mm
-/// hollow needle the thread runs through), mm.
-pub const NAIL_DIAMETER_MM: f32 = 1.8;
-pub const NEEDLE_DIAMETER_MM: f32 = 1.5;
 /// The thread beside the needle (0.3 mm), a nail leaning up to 0.5 mm at
 /// the needle's height, and the base's step at the ring (0.25 mm at
 /// 387 mm), rounded up, mm.
 pub const CLEARANCE_MARGIN_MM: f32 = 1.5;
 
-/// Centre to centre, needle touching a nail, mm.
-pub const CONTACT_MM: f32 = (NAIL_DIAMETER_MM + NEEDLE_DIAMETER_MM) / 2.0;
-/// Centre to centre, needle to nail, at the least where the gaps allow
-/// it, mm.
-pub const CLEARANCE_MM: f32 = CONTACT_MM + CLEARANCE_MARGIN_MM;
+// The zero pose (radial 0, the needle at the board's edge) must be clear
+// of the nails, which stand NAIL_MARGIN_MM inside it, whatever the
+// diameters (the settings' range bounds them).
+const _: () = assert!(
+    WindingConfig::MAX_UM as f32 / 1000.0 + CLEARANCE_MARGIN_MM < crate::geometry::NAIL_MARGIN_MM
+);
+
+/// How far the needle's axis keeps from a nail's, from the nail and needle
+/// diameters (`nail_diameter`, `needle_diameter`: by default a 1.8 mm
+/// panel pin and a 1.5 mm hollow needle, 3.15 mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clearance {
+    /// Centre to centre, needle to nail, at the least where the gaps allow
+    /// it, mm.
+    pub mm: f32,
+    /// Centre to centre, needle touching a nail, mm.
+    pub contact_mm: f32,
+}
+
+impl Clearance {
+    pub fn of(config: &MachineConfig) -> Clearance {
+        let w = &config.winding;
+        let contact_mm = (f32::from(w.nail_um) + f32::from(w.needle_um)) / 2000.0;
+        Clearance {
+            mm: contact_mm + CLEARANCE_MARGIN_MM,
+            contact_mm,
+        }
+    }
+
+    /// Nail `i` as the window maths needs it: one `nail()` (trigonometry
+    /// for a polygon's nail), a square root and a division.
+    pub fn blocked(&self, board: &Board, scale: &StepScale, i: u16) -> Blocked {
+        let nail = board.nail(i);
+        let turn = scale.steps_per_turn as f32;
+        // tan(asin x) ≥ asin x: a bound on α without an arcsine.
+        let x = (self.mm / nail.radius).min(0.99);
+        let alpha = x / crate::fmath::sqrt(1.0 - x * x);
+        Blocked {
+            at: nail.angle / TAU * turn,
+            half: alpha / TAU * turn,
+            radius: nail.radius,
+        }
+    }
+
+    /// The window between nails `a` (below) and `b` (above), with `a.at`
+    /// and `b.at` already in the same frame (`b.at > a.at`). Nails closer
+    /// than the margin allows (dense boards: under ~6.3 mm apart with the
+    /// default diameters) leave the gap's middle step, where the needle
+    /// passes both by half the gap, as the four single-axis moves always
+    /// crossed; `None`: not even the needle's own width passes between
+    /// them.
+    pub fn window(&self, a: &Blocked, b: &Blocked) -> Option<Window> {
+        // The nails stay behind their references: LLVM would pass them
+        // and the clearance by value instead, partly on the stack, where
+        // the AVR backend read garbage for them at `opt-level = "z"`
+        // (every window refused: "bad board"; inlining it costs 1.4 KB).
+        let (a, b) = core::hint::black_box((a, b));
+        let lo = libm::ceilf(a.at + a.half + EPS) as i32;
+        let hi = libm::floorf(b.at - b.half - EPS) as i32;
+        if lo <= hi {
+            return Some(Window { lo, hi });
+        }
+        // α grows a little faster than c / r: scaling it down bounds the
+        // angles the bare nail blocks from above.
+        let bare = self.contact_mm / self.mm;
+        let mid = libm::roundf((a.at + b.at) / 2.0);
+        let clear = a.at + a.half * bare + EPS < mid && mid < b.at - b.half * bare - EPS;
+        clear.then_some(Window {
+            lo: mid as i32,
+            hi: mid as i32,
+        })
+    }
+}
 
 /// A gap's window: the base positions (absolute steps, both included) at
 /// which the needle may cross the ring.
@@ -51,46 +116,8 @@ pub struct Blocked {
     pub radius: f32,
 }
 
-/// Nail `i` as the window maths needs it: one `nail()` (trigonometry
-/// for a polygon's nail), a square root and a division.
-pub fn blocked(board: &Board, scale: &StepScale, i: u16) -> Blocked {
-    let nail = board.nail(i);
-    let turn = scale.steps_per_turn as f32;
-    // tan(asin x) ≥ asin x: a bound on α without an arcsine.
-    let x = (CLEARANCE_MM / nail.radius).min(0.99);
-    let alpha = x / crate::fmath::sqrt(1.0 - x * x);
-    Blocked {
-        at: nail.angle / TAU * turn,
-        half: alpha / TAU * turn,
-        radius: nail.radius,
-    }
-}
-
 /// Slack for f32 rounding when a blocked edge falls on a whole step.
 const EPS: f32 = 0.01;
-
-/// The window between nails `a` (below) and `b` (above), with `a.at` and
-/// `b.at` already in the same frame (`b.at > a.at`). Nails closer than
-/// the margin allows (dense boards: under ~6.3 mm apart) leave the gap's
-/// middle step, where the needle passes both by half the gap, as the
-/// four single-axis moves always crossed; `None`: not even the needle's
-/// own width passes between them.
-pub fn window(a: &Blocked, b: &Blocked) -> Option<Window> {
-    let lo = libm::ceilf(a.at + a.half + EPS) as i32;
-    let hi = libm::floorf(b.at - b.half - EPS) as i32;
-    if lo <= hi {
-        return Some(Window { lo, hi });
-    }
-    // α grows a little faster than c / r: scaling it down bounds the
-    // angles the bare nail blocks from above.
-    let bare = CONTACT_MM / CLEARANCE_MM;
-    let mid = libm::roundf((a.at + b.at) / 2.0);
-    let clear = a.at + a.half * bare + EPS < mid && mid < b.at - b.half * bare - EPS;
-    clear.then_some(Window {
-        lo: mid as i32,
-        hi: mid as i32,
-    })
-}
 
 /// Nails `prev`, `j`, `next` around nail j, in nail j's turn: prev moved
 /// below it and next above (across the 0/2π seam when they wrap), so the

@@ -14,7 +14,7 @@ mod timing;
 mod winding;
 
 pub use blend::{BlendWinder, BlendWrap};
-pub use clearance::CLEARANCE_MM;
+pub use clearance::Clearance;
 pub use drilling::Drilling;
 pub use timing::{machine_time, Overlap};
 pub use winding::{WindError, Winder, Winding, Wrap, Wraps};

@@ -4,7 +4,8 @@
 //! pattern's.
 
 use super::*;
-use crate::stringart::clearance::CONTACT_MM;
+use crate::config::WindingConfig;
+use crate::stringart::clearance::Clearance;
 use crate::stringart::Winding;
 use crate::units::Milli;
 use proptest::prelude::*;
@@ -104,8 +105,12 @@ impl Needle {
     }
 }
 
-fn blend(board: Board, pattern: &[u16]) -> Result<Vec<MachineStep>, WindError> {
-    let winder = BlendWinder::new(board, &CONFIG)?;
+fn blend(
+    board: Board,
+    config: &MachineConfig,
+    pattern: &[u16],
+) -> Result<Vec<MachineStep>, WindError> {
+    let winder = BlendWinder::new(board, config)?;
     Winding::new(winder, pattern.iter().copied()).collect()
 }
 
@@ -135,15 +140,25 @@ proptest! {
         nails in 3u16..300,
         radius in 150_000i32..500_000,
         pattern in prop::collection::vec(any::<u16>(), 1..30),
+        // The default nail and needle half the time, else any (µm).
+        diameters in prop_oneof![
+            Just((1800u16, 1500u16)),
+            (500u16..4000, 300u16..3000),
+        ],
     ) {
         let board = Board::new(shape, nails, Milli(radius)).unwrap();
         let pattern: Vec<u16> = pattern.iter().map(|j| j % nails).collect();
-        let steps = match blend(board, &pattern) {
+        let config = MachineConfig {
+            winding: WindingConfig { nail_um: diameters.0, needle_um: diameters.1 },
+            ..CONFIG
+        };
+        let clearance = Clearance::of(&config);
+        let steps = match blend(board, &config, &pattern) {
             Err(e) => {
                 let WindError::GapTooNarrow(g) = e else {
                     return Err(TestCaseError::fail(std::format!("{e:?}")));
                 };
-                prop_assert!(too_close(&board, g, CONTACT_MM), "gap {}", g);
+                prop_assert!(too_close(&board, g, clearance.contact_mm), "gap {}", g);
                 return Ok(());
             }
             Ok(steps) => steps,
@@ -152,11 +167,11 @@ proptest! {
         for step in &steps {
             needle.apply(step);
         }
-        let dense = (0..nails).any(|g| too_close(&board, g, CLEARANCE_MM));
-        let c = if dense { CONTACT_MM } else { CLEARANCE_MM };
+        let dense = (0..nails).any(|g| too_close(&board, g, clearance.mm));
+        let c = if dense { clearance.contact_mm } else { clearance.mm };
         prop_assert!(needle.closest >= f64::from(c) - 1e-3, "{} mm", needle.closest);
         prop_assert_eq!(&needle.wrapped, &pattern);
-        prop_assert_eq!(steps.last(), Some(&BlendWinder::new(board, &CONFIG).unwrap().finish()));
+        prop_assert_eq!(steps.last(), Some(&BlendWinder::new(board, &config).unwrap().finish()));
     }
 
     /// Absolute targets: a wrap a whole number of turns away is the same
