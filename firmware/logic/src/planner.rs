@@ -69,7 +69,7 @@ struct Block {
     /// Events/s², the tightest of the axes' limits.
     accel: u32,
     /// The speed asked for, events/s, before the overrides and the axes'
-    /// limits; 0: a rapid.
+    /// limits; 0: a rapid. Milli-units/min until `plan_limits`.
     feed_ev: f32,
     /// Cruise speed² along the path with the overrides, (milli-units/s)²:
     /// kept squared, as the look-ahead passes compare it (a 64-bit
@@ -293,17 +293,18 @@ impl Planner {
     }
 
     /// The staged move's direction, the junction with the move before it
-    /// and the speed asked, in events/s. Out of line, as each part: the
+    /// and the speed asked (in events/s by `plan_limits`). Out of line, as each part: the
     /// parts are measured apart (issue #13's `task_runs`).
     #[inline(never)]
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_path(&mut self, feed: Feed) {
         let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
         let path = self.geometry.path(&b.step);
+        // Scaled to events/s by `plan_limits`: this part is the longer.
         b.feed_ev = match feed {
             Feed::Rapid => 0.0,
             // Never 0, which means a rapid.
-            Feed::PerMinute(f) => f.0.max(1) as f32 / 60.0 * path.ev_per_milli,
+            Feed::PerMinute(f) => f.0.max(1) as f32,
         };
         b.junction_sqr = match self.last {
             Some(prev_unit) => self
@@ -327,6 +328,7 @@ impl Planner {
         let (accel, rate) = self.geometry.limits(&b.step);
         let k2 = ev_per_milli * ev_per_milli;
         let overrides = self.overrides.unwrap_or(Overrides::NONE);
+        b.feed_ev = b.feed_ev / 60.0 * ev_per_milli;
         b.accel = accel;
         b.nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
         b.ev_per_milli_sqr = k2;
