@@ -22,7 +22,7 @@ use crate::config::MachineConfig;
 use crate::segment::{Speeds, StepBlock, Trapezoid};
 use crate::units::Milli;
 use axis_jump::AxisJumps;
-use junction::Geometry;
+use junction::{Geometry, Turn};
 
 /// Number of moves the planner holds.
 pub const PLANNER_BLOCKS: usize = 12;
@@ -145,8 +145,10 @@ enum Stage {
     Done,
     /// Its steps are in the slot; the path comes next.
     Pushed(Feed),
-    /// Direction, junction and asked speed worked out; the axes' limits
-    /// come next.
+    /// Direction, the axes' jumps and asked speed worked out; the
+    /// junction's speed comes next.
+    Turned { ev_per_milli: f32 },
+    /// Its junction too; the axes' limits come next.
     Path { ev_per_milli: f32 },
     /// Its figures are complete; the look-ahead passes come next.
     Limits,
@@ -282,6 +284,7 @@ impl Planner {
         match self.stage {
             Stage::Done => return false,
             Stage::Pushed(feed) => self.plan_path(feed),
+            Stage::Turned { ev_per_milli } => self.plan_junction(ev_per_milli),
             Stage::Path { ev_per_milli } => self.plan_limits(ev_per_milli),
             Stage::Limits => {
                 self.len += 1;
@@ -292,9 +295,10 @@ impl Planner {
         true
     }
 
-    /// The staged move's direction, the junction with the move before it
-    /// and the speed asked (in events/s by `plan_limits`). Out of line, as each part: the
-    /// parts are measured apart (issue #13's `task_runs`).
+    /// The staged move's direction, the axes' jumps at the junction with
+    /// the move before it and the speed asked (in events/s by
+    /// `plan_limits`). Out of line, as each part: the parts are measured
+    /// apart (issue #13's `task_runs`).
     #[inline(never)]
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_path(&mut self, feed: Feed) {
@@ -306,17 +310,33 @@ impl Planner {
             // Never 0, which means a rapid.
             Feed::PerMinute(f) => f.0.max(1) as f32,
         };
-        b.junction_sqr = match self.last {
-            Some(prev_unit) => self
-                .geometry
-                .junction_sqr(&prev_unit, &path.unit)
-                .min(self.jumps.limit_sqr(&prev_unit, &path.unit)),
-            None => 0,
+        // The axes' jumps now, the junction's roots in the next part: the
+        // turn waits in `entry_sqr`, which `recalculate` writes before
+        // anything reads it.
+        (b.junction_sqr, b.entry_sqr) = match self.last {
+            Some(prev) => (
+                self.jumps.limit_sqr(&prev, &path.unit),
+                self.geometry.turn(&prev, &path.unit).pack(),
+            ),
+            None => (0, 0),
         };
         self.last = Some(path.unit);
-        self.stage = Stage::Path {
+        self.stage = Stage::Turned {
             ev_per_milli: path.ev_per_milli,
         };
+    }
+
+    /// The staged move's junction speed: Grbl's, within the axes' jumps.
+    /// Built for size: it is the shortest part.
+    #[inline(never)]
+    fn plan_junction(&mut self, ev_per_milli: f32) {
+        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        // 0: the first move, or a jump that allows no speed.
+        if b.junction_sqr != 0 {
+            let turn = Turn::unpack(b.entry_sqr);
+            b.junction_sqr = b.junction_sqr.min(turn.speed_sqr(&self.geometry));
+        }
+        self.stage = Stage::Path { ev_per_milli };
     }
 
     /// The staged move's acceleration and cruise speed within the axes'

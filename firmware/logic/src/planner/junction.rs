@@ -134,11 +134,12 @@ impl Geometry {
     }
 
     /// Grbl's junction speed² between moves along the unit vectors
-    /// `prev` and `next`: the speed at which a circle tangent to both
+    /// `prev` and `next` — the speed at which a circle tangent to both
     /// moves, passing `junction_deviation` from the corner, is driven at
     /// the acceleration the axes allow in the direction the velocity
-    /// changes.
-    pub fn junction_sqr(&self, prev: &[f32; AXES], next: &[f32; AXES]) -> u64 {
+    /// changes — in two halves, planned in parts of their own: this one
+    /// sums over the axes, [`Turn::speed_sqr`] takes the roots.
+    pub fn turn(&self, prev: &[f32; AXES], next: &[f32; AXES]) -> Turn {
         // Grbl's `junction_cos_theta` (1 = full reversal, -1 = straight
         // on), and 1 / the acceleration allowed along the change, per unit
         // of change: the axes' tightest, scaled by its share along each.
@@ -157,6 +158,36 @@ impl Geometry {
                 per_accel = a;
             }
         }
+        Turn { cos, per_accel }
+    }
+}
+
+/// A junction's figures between [`Geometry::turn`] and
+/// [`Turn::speed_sqr`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Turn {
+    cos: f32,
+    per_accel: f32,
+}
+
+impl Turn {
+    /// Packed into a `u64`: the planner keeps it in a block's field that
+    /// is written again before it is read (no RAM of its own: the margin
+    /// is a few dozen bytes).
+    pub fn pack(self) -> u64 {
+        (self.cos.to_bits() as u64) << 32 | self.per_accel.to_bits() as u64
+    }
+
+    pub fn unpack(bits: u64) -> Turn {
+        Turn {
+            cos: f32::from_bits((bits >> 32) as u32),
+            per_accel: f32::from_bits(bits as u32),
+        }
+    }
+
+    /// The junction speed², (milli-units/s)² (see [`Geometry::turn`]).
+    pub fn speed_sqr(self, g: &Geometry) -> u64 {
+        let Turn { cos, per_accel } = self;
         if cos > STRAIGHT {
             return 0;
         }
@@ -168,7 +199,7 @@ impl Geometry {
         let per_accel = per_accel * rsqrt_rough(2.0 * (1.0 + cos));
         let half = 0.5 * (1.0 - cos);
         let sin_half = half * rsqrt_rough(half);
-        (self.deviation_milli * sin_half / ((1.0 - sin_half) * per_accel)) as u64
+        (g.deviation_milli * sin_half / ((1.0 - sin_half) * per_accel)) as u64
     }
 }
 
