@@ -231,6 +231,11 @@ impl Console {
             self.interp.resync(kin.forward(&m.target()));
         }
         loop {
+            // A move staged by the last run is planned a part a run, each
+            // ahead of anything else: nothing may wait for it to be queued.
+            if m.plan_part() {
+                return Poll::Again;
+            }
             if !reply::room() || JOB_CLAIMS_TX.load(Relaxed) {
                 return Poll::After(2);
             }
@@ -542,7 +547,7 @@ impl Console {
         match order {
             Order::None | Order::WaitIdle => {}
             Order::Move { steps, feed } => {
-                if m.push(*steps, *feed).is_err() {
+                if m.stage(*steps, *feed).is_err() {
                     return Some(Poll::Wait(Signal::Motion));
                 }
             }
@@ -725,7 +730,7 @@ impl Console {
         let before = *path;
         match path.next().map(|p| kin.inverse(&p)) {
             Some(Ok(steps)) => {
-                if m.push(steps, *feed).is_err() {
+                if m.stage(steps, *feed).is_err() {
                     *path = before;
                     return Poll::Wait(Signal::Motion);
                 }

@@ -103,12 +103,27 @@ impl Motion {
     /// Queue a move to the absolute step `target`; `Full` is back-pressure.
     #[optimize(speed)]
     pub fn push(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
+        self.stage(target, feed)?;
+        while self.plan_part() {}
+        Ok(())
+    }
+
+    /// [`Motion::push`] in bounded parts: records the move, which
+    /// [`Motion::plan_part`] then plans a part a run (each ≤ ~1 ms), so
+    /// that a ready task never waits for a whole move's planning.
+    pub fn stage(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
         let from = self.target();
-        PLANNER.with(|p| p.push(target, feed))?;
+        PLANNER.with(|p| p.stage(target, feed))?;
         for (i, (a, b)) in from.iter().zip(&target).enumerate() {
             self.busy |= ((a != b) as u8) << i;
         }
         Ok(())
+    }
+
+    /// One part of planning the staged move; false when none is left.
+    #[optimize(speed)]
+    pub fn plan_part(&mut self) -> bool {
+        PLANNER.with(|p| p.plan_part())
     }
 
     /// Moves queued in the planner, not yet taken to be cut.

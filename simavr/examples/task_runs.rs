@@ -16,7 +16,9 @@ fn main() {
         "4taut7console",
         "Console8run_line",
         "Interpreter4plan",
-        "Motion4push",
+        // A move's planning, a part a console run.
+        "Planner9plan_path",
+        "Planner11plan_limits",
         "Planner11recalculate",
         "Console4read",
         "7console5parse",

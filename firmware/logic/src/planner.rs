@@ -22,7 +22,7 @@ use crate::config::MachineConfig;
 use crate::segment::{Speeds, StepBlock, Trapezoid};
 use crate::units::Milli;
 use axis_jump::AxisJumps;
-use junction::Geometry;
+use junction::{Geometry, Turn};
 
 /// Number of moves the planner holds.
 pub const PLANNER_BLOCKS: usize = 12;
@@ -69,7 +69,7 @@ struct Block {
     /// Events/s², the tightest of the axes' limits.
     accel: u32,
     /// The speed asked for, events/s, before the overrides and the axes'
-    /// limits; 0: a rapid.
+    /// limits; 0: a rapid. Milli-units/min until `plan_limits`.
     feed_ev: f32,
     /// Cruise speed² along the path with the overrides, (milli-units/s)²:
     /// kept squared, as the look-ahead passes compare it (a 64-bit
@@ -145,8 +145,10 @@ enum Stage {
     Done,
     /// Its steps are in the slot; the path comes next.
     Pushed(Feed),
-    /// Direction, junction and asked speed worked out; the axes' limits
-    /// come next.
+    /// Direction, the axes' jumps and asked speed worked out; the
+    /// junction's speed comes next.
+    Turned { ev_per_milli: f32 },
+    /// Its junction too; the axes' limits come next.
     Path { ev_per_milli: f32 },
     /// Its figures are complete; the look-ahead passes come next.
     Limits,
@@ -282,6 +284,7 @@ impl Planner {
         match self.stage {
             Stage::Done => return false,
             Stage::Pushed(feed) => self.plan_path(feed),
+            Stage::Turned { ev_per_milli } => self.plan_junction(ev_per_milli),
             Stage::Path { ev_per_milli } => self.plan_limits(ev_per_milli),
             Stage::Limits => {
                 self.len += 1;
@@ -292,30 +295,48 @@ impl Planner {
         true
     }
 
-    /// The staged move's direction, the junction with the move before it
-    /// and the speed asked, in events/s. Out of line, as each part: the
-    /// parts are measured apart (issue #13's `task_runs`).
+    /// The staged move's direction, the axes' jumps at the junction with
+    /// the move before it and the speed asked (in events/s by
+    /// `plan_limits`). Out of line, as each part: the parts are measured
+    /// apart (issue #13's `task_runs`).
     #[inline(never)]
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_path(&mut self, feed: Feed) {
         let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
         let path = self.geometry.path(&b.step);
+        // Scaled to events/s by `plan_limits`: this part is the longer.
         b.feed_ev = match feed {
             Feed::Rapid => 0.0,
             // Never 0, which means a rapid.
-            Feed::PerMinute(f) => f.0.max(1) as f32 / 60.0 * path.ev_per_milli,
+            Feed::PerMinute(f) => f.0.max(1) as f32,
         };
-        b.junction_sqr = match self.last {
-            Some(prev_unit) => self
-                .geometry
-                .junction_sqr(&prev_unit, &path.unit)
-                .min(self.jumps.limit_sqr(&prev_unit, &path.unit)),
-            None => 0,
+        // The axes' jumps now, the junction's roots in the next part: the
+        // turn waits in `entry_sqr`, which `recalculate` writes before
+        // anything reads it.
+        (b.junction_sqr, b.entry_sqr) = match self.last {
+            Some(prev) => (
+                self.jumps.limit_sqr(&prev, &path.unit),
+                self.geometry.turn(&prev, &path.unit).pack(),
+            ),
+            None => (0, 0),
         };
         self.last = Some(path.unit);
-        self.stage = Stage::Path {
+        self.stage = Stage::Turned {
             ev_per_milli: path.ev_per_milli,
         };
+    }
+
+    /// The staged move's junction speed: Grbl's, within the axes' jumps.
+    /// Built for size: it is the shortest part.
+    #[inline(never)]
+    fn plan_junction(&mut self, ev_per_milli: f32) {
+        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        // 0: the first move, or a jump that allows no speed.
+        if b.junction_sqr != 0 {
+            let turn = Turn::unpack(b.entry_sqr);
+            b.junction_sqr = b.junction_sqr.min(turn.speed_sqr(&self.geometry));
+        }
+        self.stage = Stage::Path { ev_per_milli };
     }
 
     /// The staged move's acceleration and cruise speed within the axes'
@@ -327,6 +348,7 @@ impl Planner {
         let (accel, rate) = self.geometry.limits(&b.step);
         let k2 = ev_per_milli * ev_per_milli;
         let overrides = self.overrides.unwrap_or(Overrides::NONE);
+        b.feed_ev = b.feed_ev / 60.0 * ev_per_milli;
         b.accel = accel;
         b.nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
         b.ev_per_milli_sqr = k2;

@@ -100,7 +100,7 @@ fn a_staged_move_is_planned_in_parts_and_queued_by_the_last() {
         assert!(p.plan_part());
         parts += 1;
     }
-    assert_eq!(parts, 3);
+    assert_eq!(parts, 4);
     assert!(!p.plan_part() && !p.is_full());
     assert_eq!(entries(&p), entries(&whole));
     assert_eq!(p.take(), whole.take());

@@ -113,7 +113,7 @@ impl Trapezoid {
         t
     }
 
-    /// [`Trapezoid::new`] in parts that each cost at most ~14 000 cycles
+    /// [`Trapezoid::new`] in parts that each cost at most ~13 000 cycles
     /// on the AVR (a whole one ~30 000: three 64-bit roots and several
     /// divisions), so the task that makes it keeps its runs short: this
     /// is the first part (the speeds clamped, the scale chosen), then
@@ -164,13 +164,15 @@ impl Trapezoid {
         let two_ae = self.two_a * self.events as u64;
         match self.part {
             0 => return true,
-            // The roots. The peak's scaled speed waits in `cruise_iv`.
+            // The roots (~6 000 cycles each on the AVR), two parts: three
+            // in one kept a ready task waiting ~19 000 (issue #13). The
+            // peak's scaled speed waits in `cruise_iv`.
             1 => {
                 self.cruise_iv = self.scaled_speed(self.v0_sqr + self.acc2);
                 self.s0 = self.scaled_speed(self.v0_sqr);
-                self.s1 = self.scaled_speed(self.v1_sqr);
             }
-            2 => {
+            2 => self.s1 = self.scaled_speed(self.v1_sqr),
+            3 => {
                 let sp = self.cruise_iv;
                 let (per_speed, per_speed_shift) = per_speed(self.accel as u32, self.shift);
                 self.per_speed = per_speed;

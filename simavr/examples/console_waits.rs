@@ -1,0 +1,96 @@
+//! What a ready console waits for (issue #13's `console_latency_cycles`):
+//! the bench's load — the sample card in the slot, 0.1 mm moves at the
+//! maximum feed, each line after the previous `ok`, a byte every 5 ms —
+//! then the three longest waits (receive interrupt → `Console` task) with
+//! the task runs inside each, and each task's longest run and 99th
+//! percentile (cycles).
+//! Run from the workspace root after `cargo xtask build`:
+//! `cargo run --release -p taut-simavr --example console_waits`.
+use std::path::Path;
+use std::time::Duration;
+use taut_simavr::sdcard::SdImage;
+use taut_simavr::Sim;
+
+/// USART0_RX vector (byte address).
+const RX_VECTOR: u32 = 0x64;
+
+fn main() {
+    let elf = Path::new("firmware/target/avr-none/release/taut.elf");
+    let tasks = [
+        "4taut7console",
+        "4taut8realtime",
+        "4taut6motion",
+        "4taut3job",
+        "4taut4card",
+        "4taut5store",
+        "4taut6timers",
+        "4taut7buttons",
+        "4taut3led",
+    ];
+    let f = |p: &str| taut_simavr::elf::function_address(elf, p).unwrap().unwrap();
+    let pcs: Vec<u32> = tasks.iter().map(|n| f(n)).collect();
+    let mut sim = Sim::load(elf).unwrap();
+    for &pc in &pcs {
+        sim.watch_calls(pc);
+    }
+    sim.run_until_uart_contains("reset:", Duration::from_millis(50));
+    sim.insert_sd(SdImage::from_path(Path::new("examples/card")).unwrap());
+    for line in ["M17", "G0 X-200", "G91"] {
+        let _ = sim.send_line(line, Duration::from_millis(100));
+    }
+    let oks = |s: &Sim| {
+        s.uart_text()
+            .split_inclusive('\n')
+            .filter(|l| *l == "ok\n")
+            .count()
+    };
+    let mut sent = oks(&sim);
+    sim.watch_pc(RX_VECTOR);
+    sim.watch_pc(pcs[0]);
+    let mut asked = Vec::new();
+    for _ in 0..400 {
+        if oks(&sim) >= sent {
+            sim.uart_send(b"G1 X0.1 F60000\n");
+            sent += 1;
+        }
+        asked.push(sim.cycles());
+        sim.uart_send_at(Duration::from_secs_f64(sim.time_s()), b" ");
+        sim.run_for(Duration::from_millis(5));
+    }
+    sim.run_for(Duration::from_millis(50));
+    let (rx, starts) = (sim.pc_hits(RX_VECTOR), sim.pc_hits(pcs[0]));
+    let mut waits: Vec<(u64, u64, u64)> = asked
+        .iter()
+        .map(|&at| {
+            let r = rx[rx.partition_point(|&c| c < at)];
+            let s = starts[starts.partition_point(|&c| c < r)];
+            (s - r, r, s)
+        })
+        .collect();
+    waits.sort();
+    for &(wait, rx, start) in waits.iter().rev().take(3) {
+        println!("console waited {wait}:");
+        for (i, &pc) in pcs.iter().enumerate() {
+            for run in sim.call_runs(pc).iter() {
+                if run.0 + run.1 > rx && run.0 < start {
+                    let at = run.0 as i64 - rx as i64;
+                    println!("  {:<16} at {at:>+7} for {:>6}", tasks[i], run.1);
+                }
+            }
+        }
+    }
+    for (i, &pc) in pcs.iter().enumerate() {
+        let mut runs: Vec<u64> = sim.call_runs(pc).iter().map(|r| r.1).collect();
+        runs.sort();
+        let n = runs.len();
+        if n > 0 {
+            println!(
+                "{:<16} runs {:>6} max {:>7} p99 {:>7}",
+                tasks[i],
+                n,
+                runs[n - 1],
+                runs[n * 99 / 100]
+            );
+        }
+    }
+}
