@@ -393,13 +393,16 @@ fn motion() {
     /// Pieces of work per run (a part of a block's profile or of a
     /// segment, ≤ ~1 ms each): one keeps the console's wait short.
     const BATCH: usize = 1;
-    let (freed, more, idle) = MOTION.with(|m| {
+    let (freed, more, idle, stepping) = MOTION.with(|m| {
         let m = m.as_mut().unwrap();
         let (freed, more) = m.refill(BATCH);
-        (freed, more, m.is_idle())
+        (freed, more, m.is_idle(), m.stepper.is_running())
     });
+    // Urgent only while steps run out of it: standing, a motion's first
+    // profile and segments wait behind a console line (≤ 1 ms) rather
+    // than keep a `?` or a line waiting ~7 ms for all their parts.
     if more {
-        spawn(refill_task());
+        spawn(if stepping { refill_task() } else { Task::Motion });
     }
     if freed || idle {
         signal(Signal::Motion);
