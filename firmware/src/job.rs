@@ -506,6 +506,10 @@ impl Machine for Rig<'_> {
         self.m.is_idle()
     }
 
+    fn unbegun(&self) -> u8 {
+        self.m.unbegun()
+    }
+
     fn drivers(&mut self, mask: u8, on: bool) {
         self.m.drivers.set(mask, on)
     }

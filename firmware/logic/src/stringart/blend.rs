@@ -63,17 +63,29 @@ pub struct BlendWinder {
 }
 
 /// The four vertices that wrap one nail: (base, radial) steps.
+///
+/// The two moves along a circle before a crossing of the band — the
+/// rotation to A (from `from`) and B→C over the nail — go out in halves
+/// (when at least two steps long): the checkpoint's record for the
+/// crossing is written while the first half runs, and the second half is
+/// still in the planner when it is durable, so the crossing blends in
+/// (`job::feed`). A half ends on the circle, so the path is the same; and
+/// the first half's profile is too, as the planner stops at the queue's
+/// end (from rest, the triangle's peak or the cruise is reached by the
+/// middle).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BlendWrap {
     moves: [(i32, i32); 4],
+    from: i32,
+    /// Pieces handed out: the halves, then A, B, the half, C, D.
     next: u8,
     gaps: [u16; 2],
 }
 
 impl BlendWrap {
-    /// Moves handed out so far (0 to 4).
+    /// Vertices (A, B, C, D) handed out so far (0 to 4).
     pub fn handed(&self) -> u8 {
-        self.next
+        [0, 0, 1, 2, 2, 3, 4][self.next as usize]
     }
 
     /// The gap the needle goes out through, and the one it comes back in
@@ -92,9 +104,25 @@ impl Iterator for BlendWrap {
     type Item = MachineStep;
 
     fn next(&mut self) -> Option<MachineStep> {
-        let (base, radial) = *self.moves.get(self.next as usize)?;
-        self.next += 1;
-        Some(to(base, radial))
+        let m = &self.moves;
+        let half = |from: i32, (to, radial): (i32, i32)| {
+            ((to - from).abs() >= 2).then(|| (from + (to - from) / 2, radial))
+        };
+        loop {
+            let piece = match self.next {
+                0 => half(self.from, m[0]),
+                1 => Some(m[0]),
+                2 => Some(m[1]),
+                3 => half(m[1].0, m[2]),
+                4 => Some(m[2]),
+                5 => Some(m[3]),
+                _ => return None,
+            };
+            self.next += 1;
+            if let Some((base, radial)) = piece {
+                return Some(to(base, radial));
+            }
+        }
     }
 }
 
@@ -230,9 +258,11 @@ impl BlendWinder {
             ];
             (m, [j, prev])
         };
+        let from = self.base;
         self.base = moves[3].0;
         Ok(BlendWrap {
             moves,
+            from,
             next: 0,
             gaps,
         })

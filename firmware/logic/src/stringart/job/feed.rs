@@ -7,11 +7,21 @@
 //! - Moves go to the planner while it has room, so those of a batch blend.
 //! - A dwell, a driver switch and a checkpoint wait until the machine
 //!   stands; nothing follows a checkpoint until it is written.
+//! - A [`MachineStep::Mark`]'s record is written while the machine moves:
+//!   started once the machine has begun a move handed out after the mark
+//!   (or stands), so the motion before the mark is done; the moves up to
+//!   the next [`MachineStep::Durable`] go out meanwhile, the ones after it
+//!   only once the record is durable. Until then the planner ends its
+//!   queue at rest there: a record late for its vertex stops the machine
+//!   there, one in time lets the next move blend in.
 //! - Once the batch's last step is out and the machine stands,
 //!   [`Feeding::Done`]: the caller sends [`super::Event::MotionDone`].
+//!   While winding runs on ([`Job::chains`]) it is sent at once, the
+//!   machine still moving: the next wrap blends into this one.
 
 use super::Job;
 use crate::axis::PerAxis;
+use crate::checkpoint::Record;
 use crate::files::check::CardId;
 use crate::planner::Full;
 use crate::stringart::{MachineStep, Save};
@@ -24,9 +34,12 @@ pub trait Machine {
     fn push(&mut self, to: PerAxis<i32>) -> Result<(), Full>;
     /// Nothing planned, nothing moving.
     fn is_idle(&self) -> bool;
+    /// Moves handed over (of at least one step) whose first step has
+    /// not been made yet.
+    fn unbegun(&self) -> u8;
     fn drivers(&mut self, mask: u8, on: bool);
-    /// Starts writing a checkpoint, the machine standing. `card` is the
-    /// job's ([`Job::card`]): a phase's header names it.
+    /// Starts writing a checkpoint (after the last one is written). `card`
+    /// is the job's ([`Job::card`]): a phase's header names it.
     fn save(&mut self, save: Save, card: (u16, u32, CardId));
     /// A checkpoint is still being written.
     fn saving(&self) -> bool;
@@ -41,7 +54,8 @@ pub enum Feeding {
     Motion,
     /// This many ms: a dwell, or a checkpoint being written.
     After(u16),
-    /// The batch is done and the machine stands: `MotionDone` is due.
+    /// The batch is done and the machine stands (or winding runs on):
+    /// `MotionDone` is due.
     Done,
     /// No batch: nothing until the next [`Feeder::pull`].
     Idle,
@@ -60,6 +74,12 @@ pub struct Feeder {
     /// A step the machine had no room or time for yet.
     pending: Option<MachineStep>,
     dwell_until: Option<u32>,
+    /// A [`MachineStep::Mark`]'s record not yet started, and the moves
+    /// handed over since its mark.
+    marked: Option<Record>,
+    after: u8,
+    /// Nothing more until the record marked or being written is durable.
+    durable: bool,
 }
 
 impl Feeder {
@@ -69,6 +89,9 @@ impl Feeder {
             settling: false,
             pending: None,
             dwell_until: None,
+            marked: None,
+            after: 0,
+            durable: false,
         }
     }
 
@@ -92,7 +115,7 @@ impl Feeder {
         now_ms: u32,
         mut budget: u8,
     ) -> Feeding {
-        if m.saving() {
+        if self.record_due(job, m) {
             return Feeding::After(SAVE_POLL_MS);
         }
         if let Some(until) = self.dwell_until {
@@ -109,18 +132,38 @@ impl Feeder {
             budget -= 1;
             let Some(step) = self.pending.take().or_else(|| job.next_step()) else {
                 self.pulling = false;
+                if job.chains() {
+                    return Feeding::Done;
+                }
                 self.settling = true;
                 break;
             };
             match step {
                 MachineStep::Move(targets) => {
-                    let mut at = m.target();
+                    let from = m.target();
+                    let mut at = from;
                     for (a, t) in at.iter_mut().zip(targets) {
                         *a = t.unwrap_or(*a);
                     }
                     if m.push(at).is_err() {
                         self.pending = Some(step);
                         return Feeding::Motion;
+                    }
+                    // A move of no step is no block: it never begins.
+                    self.after = self.after.saturating_add((at != from) as u8);
+                }
+                MachineStep::Mark(r) => {
+                    debug_assert!(self.marked.is_none(), "a Durable between marks");
+                    // Without a job's card there is nothing to name.
+                    if job.card().is_some() {
+                        self.marked = Some(r);
+                        self.after = 0;
+                    }
+                }
+                MachineStep::Durable => {
+                    self.durable = true;
+                    if self.record_due(job, m) {
+                        return Feeding::After(SAVE_POLL_MS);
                     }
                 }
                 _ if !m.is_idle() => {
@@ -135,8 +178,15 @@ impl Feeder {
                 // Without a job's card (a tool's steps) there is nothing
                 // to name in a checkpoint.
                 MachineStep::Save(save) => {
+                    // One write at a time: a marked one first.
+                    self.durable = true;
+                    if self.record_due(job, m) {
+                        self.pending = Some(step);
+                        return Feeding::After(SAVE_POLL_MS);
+                    }
                     if let Some(card) = job.card() {
                         m.save(save, card);
+                        self.durable = true;
                         return Feeding::After(SAVE_POLL_MS);
                     }
                 }
@@ -150,5 +200,24 @@ impl Feeder {
             return Feeding::Done;
         }
         Feeding::Idle
+    }
+
+    /// Starts the marked record once the machine has passed its mark (a
+    /// move handed over since has begun, so every one before it is done,
+    /// or the machine stands) and the last record is written. True while
+    /// the steps must wait for a record to be durable.
+    fn record_due(&mut self, job: &Job, m: &mut impl Machine) -> bool {
+        if let Some(r) = self.marked {
+            let passed = self.after > m.unbegun() || m.is_idle();
+            if !passed || m.saving() {
+                return self.durable;
+            }
+            self.marked = None;
+            if let Some(card) = job.card() {
+                m.save(Save::Record(r), card);
+            }
+        }
+        self.durable = self.durable && m.saving();
+        self.durable
     }
 }

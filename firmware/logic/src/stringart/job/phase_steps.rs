@@ -32,8 +32,11 @@ enum Work {
         /// this nail.
         resume_gap: Option<u16>,
         wrap: Option<BlendWrap>,
-        /// The wrap's records written: 1 the outward one (before its
-        /// first move), 3 the inward one too (after its third), 0 none.
+        /// The wrap's checkpoint steps handed out, by the vertices handed
+        /// before them: 1 the outward record made durable (after A, before
+        /// the crossing out), 2 the inward one marked (after B), 3 made
+        /// durable (after C, before the crossing in); 0 only the outward
+        /// one marked (before the rotation to A).
         saved_at: u8,
         feed: heapless::Deque<u16, FEED>,
         /// Indices received so far (the buffered ones included).
@@ -62,6 +65,10 @@ pub(super) struct PhaseSteps {
 
 fn save(n: u32, gap: u16) -> MachineStep {
     MachineStep::Save(Save::Record(Record { n, gap }))
+}
+
+fn mark(n: u32, gap: u16) -> MachineStep {
+    MachineStep::Mark(Record { n, gap })
 }
 
 impl PhaseSteps {
@@ -193,11 +200,18 @@ impl PhaseSteps {
                     return None;
                 }
                 if let Some(w) = wrap {
-                    if w.handed() == 3 && *saved_at != 3 {
-                        // Beyond the nail, before coming back in.
-                        *saved_at = 3;
+                    // Each record is durable before the crossing it is
+                    // about; the inward one is started once the needle is
+                    // out (past B), the outward one once inside (past the
+                    // last wrap's D).
+                    let due = w.handed();
+                    if due > *saved_at && due < 4 {
+                        *saved_at = due;
+                        if due != 2 {
+                            return Some(MachineStep::Durable);
+                        }
                         self.gap = w.gaps()[1];
-                        return Some(save(2 * self.done + 2, self.gap));
+                        return Some(mark(2 * self.done + 2, self.gap));
                     }
                     if let Some(step) = w.next() {
                         return Some(step);
@@ -215,11 +229,10 @@ impl PhaseSteps {
                 let j = feed.pop_front()?;
                 let w = wrap.insert(winder.wrap(j).ok()?);
                 // The gap the needle will go out through, written while
-                // the machine stands between batches: the rotation to it
-                // and the crossing then run as one.
-                *saved_at = 1;
+                // it turns there.
+                *saved_at = 0;
                 self.gap = w.gaps()[0];
-                Some(save(2 * self.done + 1, self.gap))
+                Some(mark(2 * self.done + 1, self.gap))
             }
         }
     }

@@ -168,6 +168,11 @@ impl Bench {
                     self.saves.push(save);
                     continue;
                 }
+                MachineStep::Mark(r) => {
+                    self.saves.push(Save::Record(r));
+                    continue;
+                }
+                MachineStep::Durable => continue,
             }
             self.steps.push(step);
             self.feed();

@@ -57,6 +57,11 @@ impl Machine for Cramped {
         self.queue.is_empty()
     }
 
+    /// The oldest block runs.
+    fn unbegun(&self) -> u8 {
+        self.queue.len().saturating_sub(1) as u8
+    }
+
     fn drivers(&mut self, _: u8, _: bool) {
         let idle = self.is_idle();
         self.did.push(Did::Drivers { idle });
