@@ -65,27 +65,38 @@ pub struct BlendWinder {
 /// The four vertices that wrap one nail: (base, radial) steps.
 ///
 /// The two moves along a circle before a crossing of the band — the
-/// rotation to A (from `from`) and B→C over the nail — go out in halves
-/// (when at least two steps long): the checkpoint's record for the
-/// crossing is written while the first half runs, and the second half is
-/// still in the planner when it is durable, so the crossing blends in
-/// (`job::feed`). A half ends on the circle, so the path is the same; and
-/// the first half's profile is too, as the planner stops at the queue's
-/// end (from rest, the triangle's peak or the cruise is reached by the
-/// middle).
+/// rotation to A ([`BlendWrap::half_turn`], handed out by the job before
+/// the wrap) and B→C over the nail — go out in halves (when at least two
+/// steps long): the checkpoint's record for the crossing is written while
+/// the first half runs, and the second half is still in the planner when
+/// it is durable, so the crossing blends in (`job::feed`). A half ends on
+/// the circle, so the path is the same; and the first half's profile is
+/// too, as the planner stops at the queue's end (from rest, the
+/// triangle's peak or the cruise is reached by the middle).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BlendWrap {
     moves: [(i32, i32); 4],
-    from: i32,
-    /// Pieces handed out: the halves, then A, B, the half, C, D.
+    /// Pieces handed out: A, B, the half, C, D.
     next: u8,
     gaps: [u16; 2],
+}
+
+/// The middle of a move along a circle from base `from`, if it has one.
+fn halfway(from: i32, (to, radial): (i32, i32)) -> Option<MachineStep> {
+    // At least two steps: both halves move.
+    ((to - from + 1) as u32 > 2).then(|| self::to((from + to) >> 1, radial))
 }
 
 impl BlendWrap {
     /// Vertices (A, B, C, D) handed out so far (0 to 4).
     pub fn handed(&self) -> u8 {
-        [0, 0, 1, 2, 2, 3, 4][self.next as usize]
+        self.next - (self.next > 2) as u8
+    }
+
+    /// The first half of the rotation to A from base `from` (where the
+    /// last wrap ended), if it has one.
+    pub fn half_turn(&self, from: i32) -> Option<MachineStep> {
+        halfway(from, self.moves[0])
     }
 
     /// The gap the needle goes out through, and the one it comes back in
@@ -104,25 +115,16 @@ impl Iterator for BlendWrap {
     type Item = MachineStep;
 
     fn next(&mut self) -> Option<MachineStep> {
-        let m = &self.moves;
-        let half = |from: i32, (to, radial): (i32, i32)| {
-            ((to - from).abs() >= 2).then(|| (from + (to - from) / 2, radial))
-        };
-        loop {
-            let piece = match self.next {
-                0 => half(self.from, m[0]),
-                1 => Some(m[0]),
-                2 => Some(m[1]),
-                3 => half(m[1].0, m[2]),
-                4 => Some(m[2]),
-                5 => Some(m[3]),
-                _ => return None,
-            };
-            self.next += 1;
-            if let Some((base, radial)) = piece {
-                return Some(to(base, radial));
+        if self.next == 2 {
+            self.next = 3;
+            if let Some(half) = halfway(self.moves[1].0, self.moves[2]) {
+                return Some(half);
             }
         }
+        let i = self.next - (self.next > 2) as u8;
+        let (base, radial) = *self.moves.get(i as usize)?;
+        self.next += 1;
+        Some(to(base, radial))
     }
 }
 
@@ -258,11 +260,9 @@ impl BlendWinder {
             ];
             (m, [j, prev])
         };
-        let from = self.base;
         self.base = moves[3].0;
         Ok(BlendWrap {
             moves,
-            from,
             next: 0,
             gaps,
         })

@@ -150,8 +150,12 @@ impl Machine for Timed {
                 };
                 self.write(Header::address(self.seq), &header.encode());
             }
-            Save::Record(r) => self.write(Record::address(r.n), &r.encode(self.seq)),
+            Save::Record(r) => self.record(r),
         }
+    }
+
+    fn record(&mut self, r: Record) {
+        self.write(Record::address(r.n), &r.encode(self.seq))
     }
 
     fn saving(&self) -> bool {

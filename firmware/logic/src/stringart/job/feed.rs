@@ -41,6 +41,8 @@ pub trait Machine {
     /// Starts writing a checkpoint (after the last one is written). `card`
     /// is the job's ([`Job::card`]): a phase's header names it.
     fn save(&mut self, save: Save, card: (u16, u32, CardId));
+    /// Starts writing a record (after the last checkpoint is written).
+    fn record(&mut self, r: Record);
     /// A checkpoint is still being written.
     fn saving(&self) -> bool;
 }
@@ -65,39 +67,63 @@ pub enum Feeding {
 /// writes one differing EEPROM byte per run, one run per 4 ms).
 pub const SAVE_POLL_MS: u16 = 4;
 
+/// Where a batch stands.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Stage {
+    #[default]
+    Idle,
+    /// Its steps being handed out.
+    Pulling,
+    /// All out: waiting for the machine to stand.
+    Settling,
+    /// All out, `Done` said with the machine still moving: winding runs
+    /// on into the next batch.
+    Chained,
+}
+
+/// What the steps wait for, besides the machine.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Wait {
+    #[default]
+    None,
+    /// The end of a dwell, ms.
+    Dwell(u32),
+    /// A [`MachineStep::Mark`]'s record not yet started, and the moves
+    /// handed over since its mark.
+    Marked(Record, u8),
+}
+
 /// Where a batch stands: its steps being handed out, then the wait for
 /// the machine to stand.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Feeder {
-    pulling: bool,
-    settling: bool,
-    /// A step the machine had no room or time for yet.
-    pending: Option<MachineStep>,
-    dwell_until: Option<u32>,
-    /// A [`MachineStep::Mark`]'s record not yet started, and the moves
-    /// handed over since its mark.
-    marked: Option<Record>,
-    after: u8,
+    stage: Stage,
     /// Nothing more until the record marked or being written is durable.
     durable: bool,
+    /// A step the machine had no room or time for yet.
+    pending: Option<MachineStep>,
+    wait: Wait,
 }
 
 impl Feeder {
     pub const fn new() -> Self {
         Feeder {
-            pulling: false,
-            settling: false,
-            pending: None,
-            dwell_until: None,
-            marked: None,
-            after: 0,
+            stage: Stage::Idle,
             durable: false,
+            pending: None,
+            wait: Wait::None,
         }
     }
 
     /// [`super::Action::NextMoves`]: the next batch's steps are due.
     pub fn pull(&mut self) {
-        self.pulling = true;
+        self.stage = Stage::Pulling;
+    }
+
+    /// The motion still running is the last batch's, which said `Done`
+    /// early: the next batch follows it without waiting for a stand.
+    pub fn chained(&self) -> bool {
+        self.stage == Stage::Chained
     }
 
     /// The machine was stopped and its queues emptied: the steps in hand
@@ -115,27 +141,27 @@ impl Feeder {
         now_ms: u32,
         mut budget: u8,
     ) -> Feeding {
-        if self.record_due(job, m) {
+        if self.record_due(m) {
             return Feeding::After(SAVE_POLL_MS);
         }
-        if let Some(until) = self.dwell_until {
+        if let Wait::Dwell(until) = self.wait {
             let left = until.wrapping_sub(now_ms) as i32;
             if left > 0 {
                 return Feeding::After(left as u16);
             }
-            self.dwell_until = None;
+            self.wait = Wait::None;
         }
-        while self.pulling {
+        while self.stage == Stage::Pulling {
             if budget == 0 {
                 return Feeding::Again;
             }
             budget -= 1;
             let Some(step) = self.pending.take().or_else(|| job.next_step()) else {
-                self.pulling = false;
                 if job.chains() {
+                    self.stage = Stage::Chained;
                     return Feeding::Done;
                 }
-                self.settling = true;
+                self.stage = Stage::Settling;
                 break;
             };
             match step {
@@ -150,19 +176,21 @@ impl Feeder {
                         return Feeding::Motion;
                     }
                     // A move of no step is no block: it never begins.
-                    self.after = self.after.saturating_add((at != from) as u8);
+                    if let (Wait::Marked(_, after), true) = (&mut self.wait, at != from) {
+                        *after = after.saturating_add(1);
+                    }
                 }
+                // Without a job's card (a tool's steps) there is nothing
+                // to name in a checkpoint.
                 MachineStep::Mark(r) => {
-                    debug_assert!(self.marked.is_none(), "a Durable between marks");
-                    // Without a job's card there is nothing to name.
+                    debug_assert!(self.wait == Wait::None, "a Durable between marks");
                     if job.card().is_some() {
-                        self.marked = Some(r);
-                        self.after = 0;
+                        self.wait = Wait::Marked(r, 0);
                     }
                 }
                 MachineStep::Durable => {
                     self.durable = true;
-                    if self.record_due(job, m) {
+                    if self.record_due(m) {
                         return Feeding::After(SAVE_POLL_MS);
                     }
                 }
@@ -171,32 +199,29 @@ impl Feeder {
                     return Feeding::Motion;
                 }
                 MachineStep::Dwell(ms) => {
-                    self.dwell_until = Some(now_ms.wrapping_add(ms as u32));
+                    self.wait = Wait::Dwell(now_ms.wrapping_add(ms as u32));
                     return Feeding::After(ms);
                 }
                 MachineStep::Drivers { mask, on } => m.drivers(mask, on),
-                // Without a job's card (a tool's steps) there is nothing
-                // to name in a checkpoint.
                 MachineStep::Save(save) => {
-                    // One write at a time: a marked one first.
-                    self.durable = true;
-                    if self.record_due(job, m) {
-                        self.pending = Some(step);
-                        return Feeding::After(SAVE_POLL_MS);
-                    }
                     if let Some(card) = job.card() {
-                        m.save(save, card);
+                        // One write at a time.
                         self.durable = true;
+                        if !m.saving() {
+                            m.save(save, card);
+                        } else {
+                            self.pending = Some(step);
+                        }
                         return Feeding::After(SAVE_POLL_MS);
                     }
                 }
             }
         }
-        if self.settling {
+        if self.stage == Stage::Settling {
             if !m.is_idle() {
                 return Feeding::Motion;
             }
-            self.settling = false;
+            self.stage = Stage::Idle;
             return Feeding::Done;
         }
         Feeding::Idle
@@ -204,20 +229,16 @@ impl Feeder {
 
     /// Starts the marked record once the machine has passed its mark (a
     /// move handed over since has begun, so every one before it is done,
-    /// or the machine stands) and the last record is written. True while
-    /// the steps must wait for a record to be durable.
-    fn record_due(&mut self, job: &Job, m: &mut impl Machine) -> bool {
-        if let Some(r) = self.marked {
-            let passed = self.after > m.unbegun() || m.is_idle();
-            if !passed || m.saving() {
-                return self.durable;
-            }
-            self.marked = None;
-            if let Some(card) = job.card() {
-                m.save(Save::Record(r), card);
+    /// or the machine stands) and the last checkpoint is written. True
+    /// while the steps must wait for a record to be durable.
+    fn record_due(&mut self, m: &mut impl Machine) -> bool {
+        if let Wait::Marked(r, after) = self.wait {
+            if (after > m.unbegun() || m.is_idle()) && !m.saving() {
+                self.wait = Wait::None;
+                m.record(r);
             }
         }
-        self.durable = self.durable && m.saving();
+        self.durable &= m.saving() || matches!(self.wait, Wait::Marked(..));
         self.durable
     }
 }

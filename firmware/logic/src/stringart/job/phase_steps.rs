@@ -57,7 +57,8 @@ pub(super) struct PhaseSteps {
     /// Every step has been handed out.
     pub exhausted: bool,
     pub reporter: Reporter,
-    /// A step to hand out before anything else: a new phase's header.
+    /// A step to hand out before anything else: a new phase's header, or
+    /// the first half of the rotation to a wrap.
     then: Option<MachineStep>,
     /// Winding: the gap the needle last went in through (its record's).
     gap: u16,
@@ -227,7 +228,9 @@ impl PhaseSteps {
                 }
                 // Indices are range-checked when fed, so `wrap` succeeds.
                 let j = feed.pop_front()?;
+                let from = winder.base();
                 let w = wrap.insert(winder.wrap(j).ok()?);
+                self.then = w.half_turn(from);
                 // The gap the needle will go out through, written while
                 // it turns there.
                 *saved_at = 0;

@@ -73,6 +73,12 @@ impl Machine for Cramped {
         self.saving = 3;
     }
 
+    fn record(&mut self, _: crate::checkpoint::Record) {
+        let idle = self.is_idle();
+        self.did.push(Did::Save { idle });
+        self.saving = 3;
+    }
+
     fn saving(&self) -> bool {
         self.saving > 0
     }
