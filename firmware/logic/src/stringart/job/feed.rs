@@ -74,6 +74,9 @@ enum Stage {
     Idle,
     /// Its steps being handed out.
     Pulling,
+    /// Handed out up to a checkpoint: nothing more until the one marked
+    /// or being written is durable.
+    Held,
     /// All out: waiting for the machine to stand.
     Settling,
     /// All out, `Done` said with the machine still moving: winding runs
@@ -88,9 +91,9 @@ enum Wait {
     None,
     /// The end of a dwell, ms.
     Dwell(u32),
-    /// A [`MachineStep::Mark`]'s record not yet started, and the moves
-    /// handed over since its mark.
-    Marked(Record, u8),
+    /// The record of the last [`MachineStep::Mark`] ([`Job::marked`]) is
+    /// not started yet: the moves handed over since the mark.
+    Marked(u8),
 }
 
 /// Where a batch stands: its steps being handed out, then the wait for
@@ -98,8 +101,6 @@ enum Wait {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Feeder {
     stage: Stage,
-    /// Nothing more until the record marked or being written is durable.
-    durable: bool,
     /// A step the machine had no room or time for yet.
     pending: Option<MachineStep>,
     wait: Wait,
@@ -109,7 +110,6 @@ impl Feeder {
     pub const fn new() -> Self {
         Feeder {
             stage: Stage::Idle,
-            durable: false,
             pending: None,
             wait: Wait::None,
         }
@@ -141,7 +141,7 @@ impl Feeder {
         now_ms: u32,
         mut budget: u8,
     ) -> Feeding {
-        if self.record_due(m) {
+        if self.record_due(job, m) {
             return Feeding::After(SAVE_POLL_MS);
         }
         if let Wait::Dwell(until) = self.wait {
@@ -176,21 +176,21 @@ impl Feeder {
                         return Feeding::Motion;
                     }
                     // A move of no step is no block: it never begins.
-                    if let (Wait::Marked(_, after), true) = (&mut self.wait, at != from) {
+                    if let (Wait::Marked(after), true) = (&mut self.wait, at != from) {
                         *after = after.saturating_add(1);
                     }
                 }
                 // Without a job's card (a tool's steps) there is nothing
                 // to name in a checkpoint.
-                MachineStep::Mark(r) => {
+                MachineStep::Mark(_) => {
                     debug_assert!(self.wait == Wait::None, "a Durable between marks");
                     if job.card().is_some() {
-                        self.wait = Wait::Marked(r, 0);
+                        self.wait = Wait::Marked(0);
                     }
                 }
                 MachineStep::Durable => {
-                    self.durable = true;
-                    if self.record_due(m) {
+                    self.stage = Stage::Held;
+                    if self.record_due(job, m) {
                         return Feeding::After(SAVE_POLL_MS);
                     }
                 }
@@ -206,7 +206,7 @@ impl Feeder {
                 MachineStep::Save(save) => {
                     if let Some(card) = job.card() {
                         // One write at a time.
-                        self.durable = true;
+                        self.stage = Stage::Held;
                         if !m.saving() {
                             m.save(save, card);
                         } else {
@@ -231,14 +231,19 @@ impl Feeder {
     /// move handed over since has begun, so every one before it is done,
     /// or the machine stands) and the last checkpoint is written. True
     /// while the steps must wait for a record to be durable.
-    fn record_due(&mut self, m: &mut impl Machine) -> bool {
-        if let Wait::Marked(r, after) = self.wait {
+    fn record_due(&mut self, job: &Job, m: &mut impl Machine) -> bool {
+        if let Wait::Marked(after) = self.wait {
             if (after > m.unbegun() || m.is_idle()) && !m.saving() {
                 self.wait = Wait::None;
-                m.record(r);
+                if let Some(r) = job.marked() {
+                    m.record(r);
+                }
             }
         }
-        self.durable &= m.saving() || matches!(self.wait, Wait::Marked(..));
-        self.durable
+        let held = self.stage == Stage::Held;
+        if held && !m.saving() && self.wait == Wait::None {
+            self.stage = Stage::Pulling;
+        }
+        self.stage == Stage::Held
     }
 }

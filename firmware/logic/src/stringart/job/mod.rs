@@ -178,6 +178,11 @@ impl Job {
         self.steps.as_mut()?.next()
     }
 
+    /// The record of the last [`MachineStep::Mark`] handed out.
+    pub fn marked(&self) -> Option<crate::checkpoint::Record> {
+        self.steps.as_ref()?.marked()
+    }
+
     /// The batch's steps are all out and winding runs on into another
     /// wrap: `MotionDone` need not wait for the machine to stand (its
     /// `advance` pulls the next batch at once), so wraps blend. Not while

@@ -240,6 +240,20 @@ impl PhaseSteps {
         }
     }
 
+    /// The record of the last [`MachineStep::Mark`] handed out, while its
+    /// wrap's crossing waits for it: the outward one until B is out, then
+    /// the inward one.
+    pub fn marked(&self) -> Option<Record> {
+        let Work::Wind { wrap: Some(w), .. } = &self.work else {
+            return None;
+        };
+        let inward = w.handed() >= 2;
+        Some(Record {
+            n: 2 * self.done + 1 + inward as u32,
+            gap: self.gap,
+        })
+    }
+
     /// The base's position after the steps handed out (0 while drilling).
     pub fn base(&self) -> i32 {
         match &self.work {

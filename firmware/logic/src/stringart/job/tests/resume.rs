@@ -121,20 +121,25 @@ fn each_record_is_durable_before_its_crossing() {
     b.green();
     b.run();
     b.green();
-    let (mut marked, mut durable, mut crossings) = (false, 0, 0);
+    let (mut marked, mut durable, mut crossings) = (None, 0, 0);
     let mut at = b.pos;
     while b.pulling || b.job.state() == State::Winding {
         b.feed();
         b.pulling = false;
         while let Some(step) = b.job.next_step() {
+            // The feeder writes the job's record of the mark, up to the
+            // crossing: the mark's own.
+            if marked.is_some() {
+                assert_eq!(b.job.marked(), marked);
+            }
             match step {
-                MachineStep::Mark(_) => {
-                    assert!(!marked, "two marks without a durable");
-                    marked = true;
+                MachineStep::Mark(r) => {
+                    assert!(marked.is_none(), "two marks without a durable");
+                    marked = Some(r);
                 }
                 MachineStep::Durable => {
-                    assert!(marked, "a durable without a mark");
-                    (marked, durable) = (false, durable + 1);
+                    assert!(marked.is_some(), "a durable without a mark");
+                    (marked, durable) = (None, durable + 1);
                 }
                 MachineStep::Move(t) => {
                     let from = at;
@@ -143,7 +148,10 @@ fn each_record_is_durable_before_its_crossing() {
                     }
                     let crossing = from[1] != at[1];
                     crossings += crossing as usize;
-                    assert!(!(marked && crossing), "a crossing before its record");
+                    assert!(
+                        !(marked.is_some() && crossing),
+                        "a crossing before its record"
+                    );
                 }
                 _ => {}
             }
