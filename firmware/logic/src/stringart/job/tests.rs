@@ -6,6 +6,7 @@ use crate::stringart::{Save, Winding};
 use std::vec::Vec;
 
 mod feed;
+mod flow;
 mod props;
 mod resume;
 mod tools;
