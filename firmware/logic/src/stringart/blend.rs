@@ -81,10 +81,10 @@ pub struct BlendWrap {
     gaps: [u16; 2],
 }
 
-/// The middle of a move along a circle from base `from`, if it has one.
-fn halfway(from: i32, (to, radial): (i32, i32)) -> Option<MachineStep> {
-    // At least two steps: both halves move.
-    ((to - from + 1) as u32 > 2).then(|| self::to((from + to) >> 1, radial))
+/// The middle of a move along a circle from base `from` to `to`, if it
+/// has one (at least two steps: both halves move).
+fn halfway(from: i32, to: i32) -> Option<i32> {
+    ((to - from + 1) as u32 > 2).then_some((from + to) >> 1)
 }
 
 impl BlendWrap {
@@ -96,7 +96,8 @@ impl BlendWrap {
     /// The first half of the rotation to A from base `from` (where the
     /// last wrap ended), if it has one.
     pub fn half_turn(&self, from: i32) -> Option<MachineStep> {
-        halfway(from, self.moves[0])
+        let (a, radial) = self.moves[0];
+        halfway(from, a).map(|b| to(b, radial))
     }
 
     /// The gap the needle goes out through, and the one it comes back in
@@ -115,15 +116,18 @@ impl Iterator for BlendWrap {
     type Item = MachineStep;
 
     fn next(&mut self) -> Option<MachineStep> {
-        if self.next == 2 {
-            self.next = 3;
-            if let Some(half) = halfway(self.moves[1].0, self.moves[2]) {
-                return Some(half);
+        let mut i = self.next;
+        if i == 2 {
+            // Over the nail: its half first, if it has one.
+            i = 3;
+            let ((b, radial), (c, _)) = (self.moves[1], self.moves[2]);
+            if let Some(half) = halfway(b, c) {
+                self.next = 3;
+                return Some(to(half, radial));
             }
         }
-        let i = self.next - (self.next > 2) as u8;
-        let (base, radial) = *self.moves.get(i as usize)?;
-        self.next += 1;
+        let (base, radial) = *self.moves.get(i as usize - (i > 2) as usize)?;
+        self.next = i + 1;
         Some(to(base, radial))
     }
 }

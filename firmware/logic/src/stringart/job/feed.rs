@@ -166,17 +166,19 @@ impl Feeder {
             };
             match step {
                 MachineStep::Move(targets) => {
-                    let from = m.target();
-                    let mut at = from;
+                    let mut at = m.target();
+                    let mut moves = false;
                     for (a, t) in at.iter_mut().zip(targets) {
-                        *a = t.unwrap_or(*a);
+                        let t = t.unwrap_or(*a);
+                        moves |= t != *a;
+                        *a = t;
                     }
                     if m.push(at).is_err() {
                         self.pending = Some(step);
                         return Feeding::Motion;
                     }
                     // A move of no step is no block: it never begins.
-                    if let (Wait::Marked(after), true) = (&mut self.wait, at != from) {
+                    if let (Wait::Marked(after), true) = (&mut self.wait, moves) {
                         *after = after.saturating_add(1);
                     }
                 }
