@@ -18,7 +18,7 @@ use crate::store::Store;
 use crate::{error, info, report, texts};
 use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::{PerAxis, AXES};
-use taut_logic::checkpoint::Saved;
+use taut_logic::checkpoint::{Record, Saved};
 use taut_logic::config::MachineConfig;
 use taut_logic::fat::Name;
 use taut_logic::files::check::{CardId, Files, Next};
@@ -422,10 +422,14 @@ impl JobTask {
                     self.stream = Stream::Pattern(Pattern::new(self.nails));
                     self.open(FileName::Poradi);
                 }
+                Action::NextMoves if self.feeder.chained() => {
+                    // The last wrap still runs: the next blends into it.
+                    self.feeder.pull();
+                }
                 Action::StopMotion | Action::NextMoves if !m.is_idle() => {
                     // A console jog is running (the job's own steps are all
-                    // done when it acts): the job takes over once it ends,
-                    // or once it has been stopped.
+                    // done when it acts, unless chained): the job takes
+                    // over once it ends, or once it has been stopped.
                     if a == Action::StopMotion {
                         m.cancel();
                     }
@@ -518,6 +522,10 @@ impl Machine for Rig<'_> {
         self.m.is_idle()
     }
 
+    fn unbegun(&self) -> u8 {
+        self.m.unbegun()
+    }
+
     fn drivers(&mut self, mask: u8, on: bool) {
         self.m.drivers.set(mask, on)
     }
@@ -527,6 +535,10 @@ impl Machine for Rig<'_> {
             Save::Begin(phase) => self.store.begin(phase, card),
             Save::Record(r) => self.store.record(r),
         }
+    }
+
+    fn record(&mut self, r: Record) {
+        self.store.record(r)
     }
 
     fn saving(&self) -> bool {

@@ -131,6 +131,15 @@ impl Motion {
         PLANNER.with(|p| p.queued())
     }
 
+    /// Blocks queued whose first step has not been made: in the planner,
+    /// in the preparer, or waiting for the step interrupt (which takes a
+    /// block from `BLOCKS` as it begins it). The interrupt only lowers
+    /// the count meanwhile, and the tasks do not preempt each other.
+    pub fn unbegun(&self) -> u8 {
+        let planned = PLANNER.with(|p| p.queued()) as u8;
+        planned + self.prep.holds_block() as u8 + BLOCKS.len() as u8
+    }
+
     /// Whether the planner has room for a move.
     pub fn has_room(&self) -> bool {
         !PLANNER.with(|p| p.is_full())

@@ -19,7 +19,10 @@
 //! the middle leaves that one record bad, and the scan falls back to the
 //! one before, which the job made durable before starting the motion the
 //! torn one was about (`stringart::job` writes record n+1 only after n is
-//! out, and moves on only once n+1 is). A header cut mid-write leaves the
+//! out, and moves on only once n+1 is; while winding, record n+1 is
+//! written as the machine moves towards its crossing — started only once
+//! the crossing n was about is done — and that crossing is handed to the
+//! planner only once the record is durable). A header cut mid-write leaves the
 //! older header, which is consistent with its own records. Anything else
 //! wrong — a record missing or bad between the oldest one still expected
 //! and the newest — is corruption: [`Found::Corrupt`], never trusted.

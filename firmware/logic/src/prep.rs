@@ -77,6 +77,11 @@ impl Prep {
         self.cut.is_idle() && !self.cut.is_loading()
     }
 
+    /// A block is taken whose first segment has not gone out yet.
+    pub fn holds_block(&self) -> bool {
+        self.block.is_some()
+    }
+
     /// One bounded part of loading the next block, if the last is all
     /// cut: taking it from `planner`, or one part of its profile (a whole
     /// profile costs two segments; a caller keeping its runs short calls

@@ -60,17 +60,41 @@ pub struct BlendWinder {
 }
 
 /// The four vertices that wrap one nail: (base, radial) steps.
+///
+/// The two moves along a circle before a crossing of the band — the
+/// rotation to A ([`BlendWrap::half_turn`], handed out by the job before
+/// the wrap) and B→C over the nail — go out in halves (when at least two
+/// steps long): the checkpoint's record for the crossing is written while
+/// the first half runs, and the second half is still in the planner when
+/// it is durable, so the crossing blends in (`job::feed`). A half ends on
+/// the circle, so the path is the same; and the first half's profile is
+/// too, as the planner stops at the queue's end (from rest, the
+/// triangle's peak or the cruise is reached by the middle).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BlendWrap {
     moves: [(i32, i32); 4],
+    /// Pieces handed out: A, B, the half, C, D.
     next: u8,
     gaps: [u16; 2],
 }
 
+/// The middle of a move along a circle from base `from` to `to`, if it
+/// has one (at least two steps: both halves move).
+fn halfway(from: i32, to: i32) -> Option<i32> {
+    ((to - from + 1) as u32 > 2).then_some((from + to) >> 1)
+}
+
 impl BlendWrap {
-    /// Moves handed out so far (0 to 4).
+    /// Vertices (A, B, C, D) handed out so far (0 to 4).
     pub fn handed(&self) -> u8 {
-        self.next
+        self.next - (self.next > 2) as u8
+    }
+
+    /// The first half of the rotation to A from base `from` (where the
+    /// last wrap ended), if it has one.
+    pub fn half_turn(&self, from: i32) -> Option<MachineStep> {
+        let (a, radial) = self.moves[0];
+        halfway(from, a).map(|b| to(b, radial))
     }
 
     /// The gap the needle goes out through, and the one it comes back in
@@ -89,8 +113,18 @@ impl Iterator for BlendWrap {
     type Item = MachineStep;
 
     fn next(&mut self) -> Option<MachineStep> {
-        let (base, radial) = *self.moves.get(self.next as usize)?;
-        self.next += 1;
+        let mut i = self.next;
+        if i == 2 {
+            // Over the nail: its half first, if it has one.
+            i = 3;
+            let ((b, radial), (c, _)) = (self.moves[1], self.moves[2]);
+            if let Some(half) = halfway(b, c) {
+                self.next = 3;
+                return Some(to(half, radial));
+            }
+        }
+        let (base, radial) = *self.moves.get(i as usize - (i > 2) as usize)?;
+        self.next = i + 1;
         Some(to(base, radial))
     }
 }

@@ -6,11 +6,12 @@
 //! to answer every prompt at once.
 //!
 //! The steps are carried out by the firmware's own [`Feeder`]: the moves
-//! of a batch go into the planner while it has room, so it blends them
-//! (a block runs when the planner is full); a dwell, a driver switch, the
-//! end of every batch and every checkpoint write wait until the machine
-//! stands (`firmware/src/store.rs`: one differing EEPROM byte per 4 ms
-//! run, the job looking again every 4 ms).
+//! of a batch go into the planner while it has room, so it blends them;
+//! a dwell, a driver switch, the end of a hole and a drilling checkpoint
+//! wait until the machine stands; a winding record is written while the
+//! machine runs on (`firmware/src/store.rs`: one differing EEPROM byte
+//! per 4 ms run, the job looking again every 4 ms), and the crossing
+//! after it waits until it is durable.
 
 use super::job::{Action, Actions, Event, Feeder, Feeding, Job, Machine, State, SAVE_POLL_MS};
 #[cfg(test)]
@@ -53,34 +54,50 @@ pub enum EstimateError {
 }
 
 /// The machine: the firmware's planner, and the time its blocks take.
+/// A block is taken (its exit speed fixed) when the one before it ends,
+/// or at once by a machine standing — after the feeder's run, as the
+/// firmware's refill runs after the job task's.
 struct Timed {
     planner: Planner,
-    /// Sub-ticks of motion and waiting so far.
+    /// Sub-ticks of motion and waiting so far: now.
     subticks: u64,
+    /// When the block the machine runs ends (not after now: it stands).
+    busy_until: u64,
     /// The EEPROM as the checkpoint writes leave it (blank at first), and
     /// the header in force: only differing bytes take time.
     eeprom: [u8; checkpoint::END as usize],
     seq: u16,
-    /// Sub-ticks the checkpoint being written still takes.
-    saving: u64,
+    /// When the checkpoint being written is durable.
+    durable_at: u64,
 }
 
 /// A run of the Store task, and the job's wait between its looks.
 const SAVE_RUN_MS: u64 = SAVE_POLL_MS as u64;
 
 impl Timed {
-    /// The oldest planned block run to its end.
-    fn run_block(&mut self) {
-        if let Some(p) = self.planner.take() {
-            self.subticks += p.profile.time(p.profile.events());
+    /// Time runs on to `t`, each planned block taken as the one before
+    /// it ends.
+    fn advance_to(&mut self, t: u64) {
+        loop {
+            let start = self.busy_until.max(self.subticks);
+            if start > t {
+                break;
+            }
+            let Some(p) = self.planner.take() else { break };
+            self.busy_until = start + p.profile.time(p.profile.events());
         }
+        self.subticks = t;
     }
 
-    /// `ms` pass with the machine standing.
+    /// Until the planner takes a block or the machine stands.
+    fn run_block(&mut self) {
+        self.advance_to(self.subticks);
+        self.advance_to(self.busy_until.max(self.subticks));
+    }
+
+    /// `ms` pass, the machine running on.
     fn wait(&mut self, ms: u16) {
-        let t = ms as u64 * SUBTICKS_PER_S / 1000;
-        self.subticks += t;
-        self.saving = self.saving.saturating_sub(t);
+        self.advance_to(self.subticks + ms as u64 * SUBTICKS_PER_S / 1000);
     }
 
     fn ms(&self) -> u32 {
@@ -97,7 +114,7 @@ impl Timed {
                 ms += SAVE_RUN_MS;
             }
         }
-        self.saving = ms * SUBTICKS_PER_S / 1000;
+        self.durable_at = self.subticks + ms * SUBTICKS_PER_S / 1000;
     }
 }
 
@@ -111,7 +128,11 @@ impl Machine for Timed {
     }
 
     fn is_idle(&self) -> bool {
-        self.planner.is_idle()
+        self.planner.is_idle() && self.busy_until <= self.subticks
+    }
+
+    fn unbegun(&self) -> u8 {
+        self.planner.queued() as u8
     }
 
     fn drivers(&mut self, _: u8, _: bool) {}
@@ -129,12 +150,16 @@ impl Machine for Timed {
                 };
                 self.write(Header::address(self.seq), &header.encode());
             }
-            Save::Record(r) => self.write(Record::address(r.n), &r.encode(self.seq)),
+            Save::Record(r) => self.record(r),
         }
     }
 
+    fn record(&mut self, r: Record) {
+        self.write(Record::address(r.n), &r.encode(self.seq))
+    }
+
     fn saving(&self) -> bool {
-        self.saving > 0
+        self.durable_at > self.subticks
     }
 }
 
@@ -159,9 +184,10 @@ pub fn job_time(
     let mut m = Timed {
         planner: Planner::new(config),
         subticks: 0,
+        busy_until: 0,
         eeprom: [0xFF; checkpoint::END as usize],
         seq: 0,
-        saving: 0,
+        durable_at: 0,
     };
     let mut job = Job::new();
     let mut time = JobTime::default();
@@ -353,6 +379,7 @@ impl Iterator for Nails<'_> {
 mod tests {
     use super::*;
     use crate::stringart::job::FEED;
+    use crate::stringart::MachineStep;
     use std::vec::Vec;
 
     const PARAM: &[u8] = b"tvar = 0\npocet_hrebiku = 12\npolomer_matrice = 15\n";
@@ -381,10 +408,10 @@ mod tests {
 
     /// Each blended move run rest to rest would take its ideal
     /// trapezoid's time (`machine_time`, with floats, the axes together).
-    /// The planner joins them at the speeds the axes' jumps allow, and
-    /// the checkpoint writes add their milliseconds: the wraps take about
-    /// as long — never much less (a corner is nearly a stop at these
-    /// accelerations), never much more.
+    /// The planner joins them at the speeds the axes' jumps allow — the
+    /// base turning on into a crossing, its checkpoint record written
+    /// meanwhile — so the wraps take less (this pattern: 0.83 of it;
+    /// 0.92 when every record stopped the machine), never more.
     #[test]
     fn winding_takes_about_its_ideal_trapezoids() {
         let pattern: Vec<u16> = (0..40).map(|i| (i * 5 % 12) as u16).collect();
@@ -397,13 +424,45 @@ mod tests {
         let board = Board::new(0, 12, Milli(150_000)).unwrap();
         let winder = BlendWinder::new(board, &c).unwrap();
         let winding = Winding::new(winder, pattern.iter().copied());
-        let ideal = machine_time(winding.map(Result::unwrap), &c, Overlap::Together);
+        let ideal = machine_time(
+            whole_moves(winding.map(Result::unwrap)),
+            &c,
+            Overlap::Together,
+        );
         let ratio = e.firmware.winding_s / ideal;
+        std::eprintln!("XX {} {ideal}", e.firmware.winding_s);
         assert!(
-            (0.9..=1.02).contains(&ratio),
+            (0.75..=0.9).contains(&ratio),
             "{} s against {ideal} s",
             e.firmware.winding_s
         );
+    }
+
+    /// The moves with a wrap's halves joined: a turn of the base alone
+    /// on from one the same way is one move.
+    fn whole_moves(steps: impl Iterator<Item = MachineStep>) -> Vec<MachineStep> {
+        let (mut out, mut at, mut turning) = (Vec::new(), [0i32; 4], 0);
+        for step in steps {
+            let MachineStep::Move(t) = step else {
+                out.push(step);
+                continue;
+            };
+            let from = at;
+            for (a, t) in at.iter_mut().zip(t) {
+                *a = t.unwrap_or(*a);
+            }
+            let way = if from[1..] == at[1..] {
+                (at[0] - from[0]).signum()
+            } else {
+                0
+            };
+            if way != 0 && way == turning {
+                out.pop();
+            }
+            turning = way;
+            out.push(MachineStep::Move(at.map(Some)));
+        }
+        out
     }
 
     /// The target: the demo card in at most 70 % of the original's

@@ -52,6 +52,13 @@ pub enum MachineStep {
     /// Make the job's progress durable (EEPROM) with the machine standing,
     /// before any later step: the checkpoint a power cut resumes from.
     Save(Save),
+    /// A record written while the machine moves on: started once the
+    /// machine has passed this point (begun a move handed out after it,
+    /// or stands), the moves after it still going out.
+    Mark(crate::checkpoint::Record),
+    /// Nothing after this until the [`MachineStep::Mark`]'s record is
+    /// durable: the motion it is about comes next.
+    Durable,
 }
 
 /// What a [`MachineStep::Save`] writes.

@@ -52,7 +52,10 @@ pub fn machine_time(
                 total += longest;
             }
             MachineStep::Dwell(ms) => total += ms as f64 / 1000.0,
-            MachineStep::Drivers { .. } | MachineStep::Save(_) => {}
+            MachineStep::Drivers { .. }
+            | MachineStep::Save(_)
+            | MachineStep::Mark(_)
+            | MachineStep::Durable => {}
         }
     }
     total

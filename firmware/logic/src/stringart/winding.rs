@@ -32,6 +32,13 @@ pub trait Wraps {
     fn entry_step(&mut self, resume: Option<u16>, i: u8) -> Option<MachineStep>;
     fn wrap(&mut self, j: u16) -> Result<Self::Wrap, WindError>;
     fn finish(&self) -> MachineStep;
+    /// The base's position after the moves planned so far.
+    fn base(&self) -> i32;
+    /// A step before the wrap's own, from base `from`: the first half of
+    /// the rotation to a blended wrap.
+    fn lead_in(&self, _from: i32, _wrap: &Self::Wrap) -> Option<MachineStep> {
+        None
+    }
 }
 
 impl Wraps for Winder {
@@ -45,6 +52,9 @@ impl Wraps for Winder {
     fn finish(&self) -> MachineStep {
         Winder::finish(self)
     }
+    fn base(&self) -> i32 {
+        Winder::base(self)
+    }
 }
 
 impl Wraps for super::BlendWinder {
@@ -57,6 +67,12 @@ impl Wraps for super::BlendWinder {
     }
     fn finish(&self) -> MachineStep {
         super::BlendWinder::finish(self)
+    }
+    fn base(&self) -> i32 {
+        super::BlendWinder::base(self)
+    }
+    fn lead_in(&self, from: i32, wrap: &super::BlendWrap) -> Option<MachineStep> {
+        wrap.half_turn(from)
     }
 }
 
@@ -200,6 +216,8 @@ pub struct Winding<I, W: Wraps = Winder> {
     /// The entry's next step, until it has been handed out.
     entry: Option<u8>,
     wrap: Option<W::Wrap>,
+    /// The step before the wrap's own ([`Wraps::lead_in`]).
+    lead: Option<MachineStep>,
     finished: bool,
 }
 
@@ -210,6 +228,7 @@ impl<I: Iterator<Item = u16>, W: Wraps> Winding<I, W> {
             pattern,
             entry: Some(0),
             wrap: None,
+            lead: None,
             finished: false,
         }
     }
@@ -232,12 +251,19 @@ impl<I: Iterator<Item = u16>, W: Wraps> Iterator for Winding<I, W> {
             }
         }
         loop {
+            if let Some(step) = self.lead.take() {
+                return Some(Ok(step));
+            }
             if let Some(step) = self.wrap.as_mut().and_then(Iterator::next) {
                 return Some(Ok(step));
             }
+            let from = self.winder.base();
             match self.pattern.next() {
                 Some(j) => match self.winder.wrap(j) {
-                    Ok(w) => self.wrap = Some(w),
+                    Ok(w) => {
+                        self.lead = self.winder.lead_in(from, &w);
+                        self.wrap = Some(w);
+                    }
                     Err(e) => {
                         self.finished = true;
                         return Some(Err(e));

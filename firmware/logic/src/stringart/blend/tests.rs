@@ -206,15 +206,32 @@ fn the_spec_circle_by_hand() {
     // Nail 10 at 384 steps, ahead: out through the window 359..=371 of the
     // gap before it, over it at 387 + 3.15 mm (−379.2 → −379), in
     // through 397..=409.
-    let wrap: Vec<_> = w.wrap(10).unwrap().collect();
+    // The rotation there (from 25) and the move over it go out in halves.
+    let wrap = w.wrap(10).unwrap();
+    assert_eq!(wrap.half_turn(25), Some(to(192, -581)));
+    let wrap: Vec<_> = wrap.collect();
     assert_eq!(
         wrap,
-        [to(359, -581), to(371, -379), to(397, -379), to(409, -581)]
+        [
+            to(359, -581),
+            to(371, -379),
+            to(384, -379),
+            to(397, -379),
+            to(409, -581)
+        ]
     );
     // Nail 5 behind: mirrored, through the gap after it first.
-    let back: Vec<_> = w.wrap(5).unwrap().collect();
+    let back = w.wrap(5).unwrap();
+    assert_eq!(back.half_turn(409), Some(to(313, -581)));
+    let back: Vec<_> = back.collect();
     assert_eq!(
         back,
-        [to(217, -581), to(205, -379), to(179, -379), to(167, -581)]
+        [
+            to(217, -581),
+            to(205, -379),
+            to(192, -379),
+            to(179, -379),
+            to(167, -581)
+        ]
     );
 }

@@ -178,6 +178,27 @@ impl Job {
         self.steps.as_mut()?.next()
     }
 
+    /// The record of the last [`MachineStep::Mark`] handed out.
+    pub fn marked(&self) -> Option<crate::checkpoint::Record> {
+        self.steps.as_ref()?.marked()
+    }
+
+    /// The batch's steps are all out and winding runs on into another
+    /// wrap: `MotionDone` need not wait for the machine to stand (its
+    /// `advance` pulls the next batch at once), so wraps blend. Not while
+    /// a pause, a `$wrap_step` or the pattern's next index is awaited, nor
+    /// at the phase's end: those stop the machine.
+    pub fn chains(&self) -> bool {
+        self.state == State::Winding
+            && self.run.is_none()
+            && self.step_once == 0
+            && !self.lost
+            && self
+                .steps
+                .as_ref()
+                .is_some_and(|s| !s.exhausted && !s.starved())
+    }
+
     /// Drilling or winding, or paused inside them: the job owns the
     /// machine's motion, and nothing else may move it.
     pub fn owns_motion(&self) -> bool {

@@ -32,8 +32,11 @@ enum Work {
         /// this nail.
         resume_gap: Option<u16>,
         wrap: Option<BlendWrap>,
-        /// The wrap's records written: 1 the outward one (before its
-        /// first move), 3 the inward one too (after its third), 0 none.
+        /// The wrap's checkpoint steps handed out, by the vertices handed
+        /// before them: 1 the outward record made durable (after A, before
+        /// the crossing out), 2 the inward one marked (after B), 3 made
+        /// durable (after C, before the crossing in); 0 only the outward
+        /// one marked (before the rotation to A).
         saved_at: u8,
         feed: heapless::Deque<u16, FEED>,
         /// Indices received so far (the buffered ones included).
@@ -54,7 +57,8 @@ pub(super) struct PhaseSteps {
     /// Every step has been handed out.
     pub exhausted: bool,
     pub reporter: Reporter,
-    /// A step to hand out before anything else: a new phase's header.
+    /// A step to hand out before anything else: a new phase's header, or
+    /// the first half of the rotation to a wrap.
     then: Option<MachineStep>,
     /// Winding: the gap the needle last went in through (its record's).
     gap: u16,
@@ -62,6 +66,10 @@ pub(super) struct PhaseSteps {
 
 fn save(n: u32, gap: u16) -> MachineStep {
     MachineStep::Save(Save::Record(Record { n, gap }))
+}
+
+fn mark(n: u32, gap: u16) -> MachineStep {
+    MachineStep::Mark(Record { n, gap })
 }
 
 impl PhaseSteps {
@@ -193,11 +201,18 @@ impl PhaseSteps {
                     return None;
                 }
                 if let Some(w) = wrap {
-                    if w.handed() == 3 && *saved_at != 3 {
-                        // Beyond the nail, before coming back in.
-                        *saved_at = 3;
+                    // Each record is durable before the crossing it is
+                    // about; the inward one is started once the needle is
+                    // out (past B), the outward one once inside (past the
+                    // last wrap's D).
+                    let due = w.handed();
+                    if due > *saved_at && due < 4 {
+                        *saved_at = due;
+                        if due != 2 {
+                            return Some(MachineStep::Durable);
+                        }
                         self.gap = w.gaps()[1];
-                        return Some(save(2 * self.done + 2, self.gap));
+                        return Some(mark(2 * self.done + 2, self.gap));
                     }
                     if let Some(step) = w.next() {
                         return Some(step);
@@ -213,15 +228,30 @@ impl PhaseSteps {
                 }
                 // Indices are range-checked when fed, so `wrap` succeeds.
                 let j = feed.pop_front()?;
+                let from = winder.base();
                 let w = wrap.insert(winder.wrap(j).ok()?);
+                self.then = w.half_turn(from);
                 // The gap the needle will go out through, written while
-                // the machine stands between batches: the rotation to it
-                // and the crossing then run as one.
-                *saved_at = 1;
+                // it turns there.
+                *saved_at = 0;
                 self.gap = w.gaps()[0];
-                Some(save(2 * self.done + 1, self.gap))
+                Some(mark(2 * self.done + 1, self.gap))
             }
         }
+    }
+
+    /// The record of the last [`MachineStep::Mark`] handed out, while its
+    /// wrap's crossing waits for it: the outward one until B is out, then
+    /// the inward one.
+    pub fn marked(&self) -> Option<Record> {
+        let Work::Wind { wrap: Some(w), .. } = &self.work else {
+            return None;
+        };
+        let inward = w.handed() >= 2;
+        Some(Record {
+            n: 2 * self.done + 1 + inward as u32,
+            gap: self.gap,
+        })
     }
 
     /// The base's position after the steps handed out (0 while drilling).

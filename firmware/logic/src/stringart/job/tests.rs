@@ -6,6 +6,7 @@ use crate::stringart::{Save, Winding};
 use std::vec::Vec;
 
 mod feed;
+mod flow;
 mod props;
 mod resume;
 mod tools;
@@ -168,6 +169,11 @@ impl Bench {
                     self.saves.push(save);
                     continue;
                 }
+                MachineStep::Mark(r) => {
+                    self.saves.push(Save::Record(r));
+                    continue;
+                }
+                MachineStep::Durable => continue,
             }
             self.steps.push(step);
             self.feed();

@@ -150,13 +150,15 @@ impl Job {
                 let step = match *i {
                     // In through the gap before nail k, from the zero pose.
                     0..=2 => winder.entry_step(Some((*k + nails - 1) % nails), *i),
-                    3..=6 => {
+                    3 => {
                         let w = wrap.get_or_insert_with(|| winder.wrap(*k).expect("in range"));
-                        w.next()
+                        if let Some(step) = w.next() {
+                            return Some(step);
+                        }
+                        Some(MachineStep::to(Axis::Radial, 0))
                     }
-                    // Out at the board's edge, and back to nail 0.
-                    7 => Some(MachineStep::to(Axis::Radial, 0)),
-                    8 => {
+                    // Out at the board's edge (above), and back to nail 0.
+                    4 => {
                         let at = wrap.as_ref().map_or(0, |w| w.end_base());
                         let home = plan.scale.shorter_rotation(at, plan.board.nail(0).angle);
                         Some(MachineStep::to(Axis::Base, home))

@@ -57,12 +57,23 @@ impl Machine for Cramped {
         self.queue.is_empty()
     }
 
+    /// The oldest block runs.
+    fn unbegun(&self) -> u8 {
+        self.queue.len().saturating_sub(1) as u8
+    }
+
     fn drivers(&mut self, _: u8, _: bool) {
         let idle = self.is_idle();
         self.did.push(Did::Drivers { idle });
     }
 
     fn save(&mut self, _: Save, _: (u16, u32, CardId)) {
+        let idle = self.is_idle();
+        self.did.push(Did::Save { idle });
+        self.saving = 3;
+    }
+
+    fn record(&mut self, _: crate::checkpoint::Record) {
         let idle = self.is_idle();
         self.did.push(Did::Save { idle });
         self.saving = 3;

@@ -50,6 +50,7 @@ fn whole_job(b: &mut Bench) -> Vec<(Save, [i32; 4])> {
                     }
                 }
                 MachineStep::Save(s) => saves.push((s, b.pos)),
+                MachineStep::Mark(r) => saves.push((Save::Record(r), b.pos)),
                 _ => {}
             }
             b.feed();
@@ -81,9 +82,9 @@ fn a_job_checkpoints_each_hole_and_twice_each_wrap() {
     for (s, pos) in &saves[1..25] {
         assert!(pos[Axis::Drill.index()] > 0, "{s:?} at {pos:?}");
     }
-    // Each wrap's records: the outward one with the needle inside the
-    // ring (before the rotation to its gap), the inward one with the
-    // needle outside, the base in the window of the gap named.
+    // Each wrap's records, marked: the outward one with the needle inside
+    // the ring (before the rotation to its gap), the inward one with the
+    // needle outside, just through the outward one's gap.
     let scale = StepScale::from_config(&CONFIG);
     let board = board(HEX);
     let inner = saves.iter().map(|(_, p)| p[1]).min().unwrap();
@@ -92,7 +93,13 @@ fn a_job_checkpoints_each_hole_and_twice_each_wrap() {
         let out = pos[Axis::Radial.index()] != inner;
         assert_eq!(out, i % 2 == 1, "{r:?} at {pos:?}");
         if out {
-            assert!(in_gap(&scale, &board, pos[0], r.gap), "{r:?} at {pos:?}");
+            let Save::Record(outward) = saves[26 + i - 1].0 else {
+                panic!()
+            };
+            assert!(
+                in_gap(&scale, &board, pos[0], outward.gap),
+                "{r:?} at {pos:?}"
+            );
         }
         let nail = PATTERN[i / 2];
         let beside = [(nail + 23) % 24, nail];
@@ -101,6 +108,60 @@ fn a_job_checkpoints_each_hole_and_twice_each_wrap() {
     // The end of the job forgets the checkpoint.
     let forget = b.actions.iter().position(|a| *a == Action::Forget);
     assert_eq!(forget, Some(b.actions.len() - 3), "{:?}", b.actions);
+}
+
+/// The order the feeder relies on: each record marked, then made
+/// durable before the crossing of the band it is about, the only moves
+/// between its mark and that along a circle (the base alone); the next
+/// mark only after.
+#[test]
+fn each_record_is_durable_before_its_crossing() {
+    let mut b = Bench::new(HEX, &PATTERN);
+    b.ready();
+    b.green();
+    b.run();
+    b.green();
+    let (mut marked, mut durable, mut crossings) = (None, 0, 0);
+    let mut at = b.pos;
+    while b.pulling || b.job.state() == State::Winding {
+        b.feed();
+        b.pulling = false;
+        while let Some(step) = b.job.next_step() {
+            // The feeder writes the job's record of the mark, up to the
+            // crossing: the mark's own.
+            if marked.is_some() {
+                assert_eq!(b.job.marked(), marked);
+            }
+            match step {
+                MachineStep::Mark(r) => {
+                    assert!(marked.is_none(), "two marks without a durable");
+                    marked = Some(r);
+                }
+                MachineStep::Durable => {
+                    assert!(marked.is_some(), "a durable without a mark");
+                    (marked, durable) = (None, durable + 1);
+                }
+                MachineStep::Move(t) => {
+                    let from = at;
+                    for (p, t) in at.iter_mut().zip(t) {
+                        *p = t.unwrap_or(*p);
+                    }
+                    let crossing = from[1] != at[1];
+                    crossings += crossing as usize;
+                    assert!(
+                        !(marked.is_some() && crossing),
+                        "a crossing before its record"
+                    );
+                }
+                _ => {}
+            }
+            b.feed();
+        }
+        b.send(Event::MotionDone);
+    }
+    assert_eq!(b.job.state(), State::End);
+    // The entry's crossing in, then two a wrap, each after its record.
+    assert_eq!((durable, crossings), (10, 11));
 }
 
 /// Whether base position `base` lies strictly between the nails beside

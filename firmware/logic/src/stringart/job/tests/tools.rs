@@ -53,10 +53,11 @@ fn wrap_test_wraps_one_nail_from_the_zero_pose_and_back() {
     assert_eq!(wrap.gaps(), [6, 7], "out before nail 7, in after it");
     expect.extend(wrap);
     expect.push(MachineStep::to(Axis::Radial, 0));
-    assert_eq!(b.steps[..8], expect[..]);
-    assert_eq!(b.steps[9..], []);
-    let MachineStep::Move([Some(home), None, None, None]) = b.steps[8] else {
-        panic!("{:?}", b.steps[8])
+    let n = expect.len();
+    assert_eq!(b.steps[..n], expect[..]);
+    assert_eq!(b.steps[n + 1..], []);
+    let MachineStep::Move([Some(home), None, None, None]) = b.steps[n] else {
+        panic!("{:?}", b.steps[n])
     };
     assert_eq!(home.rem_euclid(9600), 0);
     assert_eq!(b.job.state(), State::WaitingForNails);
@@ -109,10 +110,17 @@ fn paused_after(wraps: usize) -> Bench {
     b
 }
 
-/// Moves of the base and the carriage together: four a wrap.
-fn blended_moves(steps: &[MachineStep]) -> usize {
-    let both = |s: &&MachineStep| matches!(s, MachineStep::Move([Some(_), Some(_), None, None]));
-    steps.iter().filter(both).count()
+/// Crossings of the band (the carriage's target changes): two a wrap.
+fn crossings(steps: &[MachineStep]) -> usize {
+    let mut radial = None;
+    let mut n = 0;
+    for s in steps {
+        if let MachineStep::Move([_, Some(r), None, None]) = *s {
+            n += radial.is_some_and(|was| was != r) as usize;
+            radial = Some(r);
+        }
+    }
+    n
 }
 
 #[test]
@@ -122,7 +130,7 @@ fn wrap_step_winds_one_wrap_and_pauses_again() {
     let go = tool(&mut b, Tool::Step);
     assert!(go.contains(&Action::NextMoves), "{go:?}");
     b.batch();
-    assert_eq!(b.steps.len() - before, 4, "one wrap");
+    assert_eq!(crossings(&b.steps[before - 1..]), 2, "one wrap");
     assert_eq!(b.job.state(), State::Paused(Phase::Winding));
     assert!(!b.batch(), "nothing more until green");
     b.green();
@@ -143,8 +151,8 @@ fn wrap_step_back_winds_the_last_wrap_again() {
     let before = b.steps.len();
     b.green();
     b.run();
-    // Wraps 2 to 5: the second wound again, four blended moves each.
-    assert_eq!(blended_moves(&b.steps[before..]), 16);
+    // Wraps 2 to 5: the second wound again, two crossings each.
+    assert_eq!(crossings(&b.steps[before - 1..]), 8);
     // Before any wrap, nothing to step back to; not while drilling.
     let mut b = paused_after(0);
     assert_eq!(tool(&mut b, Tool::Back), [Action::Log(Msg::ToolRange)]);
@@ -172,7 +180,7 @@ fn wrap_jump_goes_on_at_the_wrap_asked_with_its_checkpoint() {
     b.green();
     b.run();
     // Wraps 4 and 5 of the pattern, then the drivers off.
-    assert_eq!(blended_moves(&b.steps[before..]), 8);
+    assert_eq!(crossings(&b.steps[before - 1..]), 4);
     assert_eq!(b.job.state(), State::End);
 }
 
