@@ -379,7 +379,7 @@ pub fn isqrt(x: u64) -> u64 {
     let shift = (33 - x.leading_zeros()) & !1;
     // r0 ≤ √x < r0 + 2^(shift/2): start from the upper end, below 2^32
     // (a root of 2^32 would need x ≥ TOP²).
-    let r0 = (((isqrt32((x >> shift) as u32) as u64) + 1) << (shift / 2)).min(TOP) as u32;
+    let r0 = shl(isqrt32((x >> shift) as u32) as u64 + 1, shift / 2).min(TOP) as u32;
     // x / r0 ≤ √x < 2^32: the quotient fits.
     let mut r = (r0 as u64 + div_to_u32(x, r0) as u64) / 2;
     while r * r > x {
