@@ -26,7 +26,7 @@ use core::ptr::{read_volatile, write_volatile};
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::{port_bit, Port, DRIVERS};
-use taut_logic::segment::{mul_wide, Segment, StepBlock, FRAC_BITS, NEW_BLOCK, STOP};
+use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK, STOP};
 
 /// Refill the queues when this few segments are left.
 pub(crate) const LOW_WATER: usize = 24;
@@ -481,7 +481,7 @@ pub const FAST: u8 = 0x80;
 /// DDA has nothing to do. Run by the motion task, not the interrupt.
 pub fn fast_segment(seg: &Segment, block: &StepBlock) -> bool {
     let every_event = block.steps.iter().all(|&s| s == 0 || s == block.events);
-    let last = seg.interval as i64 + mul_wide(seg.add.into(), u32::from(seg.count).max(1) - 1);
+    let last = seg.interval as i64 + i64::from(seg.add) * i64::from(u16::max(seg.count, 1) - 1);
     let longest = last.max(seg.interval as i64) + 255;
     every_event && longest < (LONG_WAIT << FRAC_BITS) as i64
 }

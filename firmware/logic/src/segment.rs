@@ -31,7 +31,7 @@ mod tests;
 
 pub use buffered::Buffered;
 pub use expand::{expand, Event, Expand};
-pub use prepare::{mul_wide, Later, Preparer};
+pub use prepare::{Later, Preparer};
 pub use trapezoid::{cbrt_floor_approx, div_to_u32, isqrt, Speeds, Trapezoid, MAX_ACCEL};
 
 use crate::axis::PerAxis;

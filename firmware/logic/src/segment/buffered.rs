@@ -5,7 +5,7 @@
 //! there are few of them, which at slow speeds would keep it urgent (and
 //! every other task waiting) while the queue holds plenty.
 
-use super::{mul_wide, Segment, FRAC_BITS, TICK_HZ};
+use super::{Segment, FRAC_BITS, TICK_HZ};
 
 /// Sub-ticks per µs: 16 ticks of 256.
 const SUBTICKS_PER_US_SHIFT: u32 = FRAC_BITS + (TICK_HZ / 1_000_000).trailing_zeros();
@@ -21,8 +21,8 @@ impl Segment {
         let us = if self.add == 0 {
             i64::from(cruise)
         } else {
-            let sub =
-                mul_wide(self.interval.into(), n) + mul_wide(self.add.into(), n * (n - 1) / 2);
+            let sub = i64::from(self.interval) * i64::from(n)
+                + i64::from(self.add) * i64::from(n * (n - 1) / 2);
             sub.max(0) >> SUBTICKS_PER_US_SHIFT
         };
         us.min(u16::MAX as i64) as u16

@@ -3,9 +3,11 @@
 //! ideal time.
 //!
 //! Error budget, sub-ticks (tolerance 16 ticks = 4096):
-//! - quadratic through the segment's start, middle and end event: at most
-//!   `0.024·d³/τ²` for a segment lasting `d` at a speed `τ` away from
-//!   standstill (third derivative of the ramp's step times); kept ≤ 2048;
+//! - quadratic through the segment's start and end event, its `add` the
+//!   change of pace (time per event) between them over the events: at
+//!   most `0.024·d³/τ²` for a segment lasting `d` at a speed `τ` away
+//!   from standstill (third derivative of the ramp's step times, the same
+//!   bound as a fit through the middle event); kept ≤ 2048;
 //! - `add` rounded to a whole sub-tick: ≤ n²/16 ≤ 1024 for n ≤ 128;
 //! - `interval` rounded: ≤ n/2 ≤ 2048 in a cruise (no other error there);
 //! - lag carried from the previous segment ≤ 66; the interrupt's tick
@@ -24,8 +26,8 @@ const MAX_CRUISE_EVENTS: u32 = 4096;
 const MAX_SEGMENT_PER_S: u64 = 40;
 /// `d ≤ 43·∛τ²` keeps the quadratic fit's error ≤ 2048 sub-ticks.
 const FIT_GAIN: u64 = 43;
-/// Budget units ([`Preparer::next_part`]): an event time (~8 000
-/// cycles), a ramp segment's size (~4 000 an acceleration's, ~8 000 a
+/// Budget units ([`Preparer::next_part`]): an event time and pace
+/// (~8 500 cycles), a ramp segment's size (~4 000 an acceleration's, ~8 000 a
 /// deceleration's), and what one call may spend: one of them.
 const TIME_COST: u8 = 1;
 const SIZE_COST: u8 = 1;
@@ -58,12 +60,14 @@ pub struct Preparer {
     accel: u32,
     cruise_sqr: u64,
     exit_sqr: u64,
-    /// The last two event times worked out on this leg, (event,
-    /// sub-ticks), and which was used last: a bounded call
-    /// ([`Preparer::next_part`]) that ran out of budget finds them there
-    /// when called again.
-    memo: [(u32, u64); 2],
-    memo_last: u8,
+    /// The last event time worked out on this leg: (event, sub-ticks,
+    /// sub-ticks per event there). A bounded call
+    /// ([`Preparer::next_part`]) that ran out of budget finds it there
+    /// when called again, and a ramp segment its start's pace in it.
+    memo: (u32, u64, u32),
+    /// (event, sub-ticks per event) at a ramp segment's start, when it
+    /// was not the last segment's end.
+    start: (u32, u32),
     /// (first event, events): a fit too long for a segment's figures
     /// goes on from the shorter run next call.
     shorter: (u32, u32),
@@ -94,8 +98,8 @@ impl Preparer {
             accel: 1,
             cruise_sqr: 0,
             exit_sqr: 0,
-            memo: [(u32::MAX, 0); 2],
-            memo_last: 0,
+            memo: (u32::MAX, 0, 0),
+            start: (u32::MAX, 0),
             shorter: (u32::MAX, 0),
             budget: u8::MAX,
         }
@@ -250,7 +254,8 @@ impl Preparer {
         };
         self.before += self.done;
         self.done = 0;
-        self.memo = [(u32::MAX, 0); 2];
+        self.memo = (u32::MAX, 0, 0);
+        self.start = (u32::MAX, 0);
         self.shorter = (u32::MAX, 0);
     }
 
@@ -261,10 +266,11 @@ impl Preparer {
     }
 
     /// [`Preparer::next_segment`] in bounded parts: one event time worked
-    /// out afresh (a 64-bit root: ~8 000 cycles on the AVR) or one ramp
+    /// out afresh (a 64-bit root: ~8 500 cycles on the AVR) or one ramp
     /// segment's size; `Later` when the segment needs another call (what
     /// a call worked out is kept for the next). A cruise segment takes one
-    /// call, a ramp's three.
+    /// call, a ramp's two (three for the first after a cruise or a leg's
+    /// start, whose start pace is not known yet).
     pub fn next_part(&mut self) -> Result<Option<Segment>, Later> {
         self.budget = PART_BUDGET;
         self.segment()
@@ -305,7 +311,7 @@ impl Preparer {
             self.fresh = false;
         }
         let n = seg.count as u32;
-        self.now += mul_wide(seg.interval as i64, n) + mul_wide(seg.add as i64, n * (n - 1) / 2);
+        self.now += seg.interval as i64 * n as i64 + seg.add as i64 * (n * (n - 1) / 2) as i64;
         self.done += seg.count as u32;
         if self.is_stopped() {
             seg.flags |= STOP;
@@ -341,36 +347,42 @@ impl Preparer {
         Ok(())
     }
 
-    /// Sub-ticks from the last placed event to the ideal time of `k`;
-    /// `Later` when it is not known yet and the budget is spent.
-    fn ahead(&mut self, k: u32) -> Result<i64, Later> {
-        let t = match self.memo.iter().position(|m| m.0 == k) {
-            Some(i) => {
-                self.memo_last = i as u8;
-                self.memo[i].1
-            }
-            None => {
-                self.spend(TIME_COST)?;
-                let t = self.profile.time(k);
-                // In place of the one not used last.
-                self.memo_last ^= 1;
-                self.memo[self.memo_last as usize] = (k, t);
-                t
-            }
-        };
-        Ok(t as i64 - self.now)
+    /// Sub-ticks from the last placed event to the ideal time of `k`, and
+    /// the ideal sub-ticks per event there; `Later` when they are not
+    /// known yet and the budget is spent.
+    fn ahead(&mut self, k: u32) -> Result<(i64, u32), Later> {
+        if self.memo.0 != k {
+            self.spend(TIME_COST)?;
+            let (t, pace) = self.profile.time_and_pace(k);
+            self.memo = (k, t, pace);
+        }
+        Ok((self.memo.1 as i64 - self.now, self.memo.2))
+    }
+
+    /// Sub-ticks per event at event `k0`, where the last segment ended
+    /// (in the memo then) or, after a leg's start or a cruise, worked out.
+    fn pace_at(&mut self, k0: u32) -> Result<u32, Later> {
+        if self.memo.0 == k0 {
+            self.start = (k0, self.memo.2);
+        } else if self.start.0 != k0 {
+            self.spend(TIME_COST)?;
+            self.start = (k0, self.profile.time_and_pace(k0).1);
+        }
+        Ok(self.start.1)
     }
 
     /// Constant interval: the ideal times are equally spaced.
     fn cruise(&mut self, k0: u32, n: u32) -> Result<Segment, Later> {
-        let interval = div_round(self.ahead(k0 + n)?, n as i64);
+        let interval = div_round(self.ahead(k0 + n)?.0, n as i64);
         Ok(segment(interval, n, 0))
     }
 
-    /// Quadratic through the last placed event and the ideal middle and end
-    /// events; shorter runs when `add` or the intervals do not fit.
-    /// The end's time first: a shorter run's end is this run's middle,
-    /// which the memo then still holds.
+    /// Quadratic through the last placed event and the ideal end, its
+    /// `add` the mean second difference over the run: the change of pace
+    /// from start to end over the events. One root a segment, where a
+    /// fit through the middle event takes two, and as close (`t'''`
+    /// times `n³/125` at most, either way). Shorter runs when `add` or
+    /// the intervals do not fit.
     fn fit(&mut self, k0: u32, mut n: u32) -> Result<Segment, Later> {
         if self.shorter.0 == k0 {
             n = n.min(self.shorter.1);
@@ -378,15 +390,13 @@ impl Preparer {
         loop {
             self.shorter = (k0, n);
             if n < 2 {
-                return Ok(segment(self.ahead(k0 + 1)?, 1, 0));
+                return Ok(segment(self.ahead(k0 + 1)?.0, 1, 0));
             }
-            n &= !1;
-            let m = n / 2;
-            let yn = self.ahead(k0 + n)?;
-            let ym = self.ahead(k0 + m)?;
-            let fitted = round_div32(4 * (yn - 2 * ym), n * n).and_then(|add| {
-                let interval = round_div32(yn - mul_wide(add, n * (n - 1) / 2), n)?;
-                let last = interval + mul_wide(add, n - 1);
+            let p0 = self.pace_at(k0)?;
+            let (yn, p1) = self.ahead(k0 + n)?;
+            let fitted = round_div32(p1 as i64 - p0 as i64, n).and_then(|add| {
+                let interval = round_div32(yn - add * (n * (n - 1) / 2) as i64, n)?;
+                let last = interval + add * (n - 1) as i64;
                 let fits = i32::try_from(add).is_ok()
                     && interval.min(last) >= 1
                     && interval.max(last) <= u32::MAX as i64;
@@ -411,23 +421,6 @@ fn round_div32(n: i64, d: u32) -> Option<i64> {
     }
     let q = div_to_u32(m, d) as i64;
     Some(if n < 0 { -q } else { q })
-}
-
-/// `a · b` for `|a| < 2^32` and `b < 2^24`: four 16-bit products (a u32
-/// multiplication is a short library routine on the AVR, a u64 one
-/// several times longer).
-pub fn mul_wide(a: i64, b: u32) -> i64 {
-    debug_assert!(a.unsigned_abs() < 1 << 32 && b < 1 << 24);
-    let m = a.unsigned_abs() as u32;
-    let (a0, a1) = (m & 0xFFFF, m >> 16);
-    let (b0, b1) = (b & 0xFFFF, b >> 16);
-    let mid = (a0 * b1) as u64 + (a1 * b0) as u64;
-    let p = (a0 * b0) as u64 + (mid << 16) + (((a1 * b1) as u64) << 32);
-    if a < 0 {
-        -(p as i64)
-    } else {
-        p as i64
-    }
 }
 
 /// A segment with its interval clamped to what the interrupt can time (only

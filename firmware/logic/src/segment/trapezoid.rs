@@ -243,21 +243,46 @@ impl Trapezoid {
     }
 
     /// Ideal time of event `k` (0..=events), sub-ticks after event 0.
-    #[cfg_attr(target_arch = "avr", optimize(speed))]
     pub fn time(&self, k: u32) -> u64 {
-        if k == self.events {
-            return self.t_end;
-        }
+        self.timed(k, false).0
+    }
+
+    /// [`Trapezoid::time`] and the time per event there (`1 / v`,
+    /// sub-ticks; `u32::MAX` at standstill): the speed's root gives both,
+    /// for one more narrow division.
+    pub fn time_and_pace(&self, k: u32) -> (u64, u32) {
+        self.timed(k, true)
+    }
+
+    #[cfg_attr(target_arch = "avr", optimize(speed))]
+    fn timed(&self, k: u32, pace: bool) -> (u64, u32) {
         let x = self.two_a * k as u64;
         let y = self.two_a * (self.events - k) as u64;
-        if x <= self.acc2 {
-            self.ramp_time(self.scaled_speed(self.v0_sqr + x), self.s0)
+        let (t, s) = if k == self.events {
+            (self.t_end, self.s1)
+        } else if x <= self.acc2 {
+            let s = self.scaled_speed(self.v0_sqr + x);
+            (self.ramp_time(s, self.s0), s)
         } else if y <= self.dec2 {
-            let back = self.ramp_time(self.scaled_speed(self.v1_sqr + y), self.s1);
-            self.t_end.saturating_sub(back)
+            let s = self.scaled_speed(self.v1_sqr + y);
+            let back = self.ramp_time(s, self.s1);
+            (self.t_end.saturating_sub(back), s)
         } else {
-            self.t_acc + self.cruise_time(x - self.acc2)
+            let t = self.t_acc + self.cruise_time(x - self.acc2);
+            let iv = self.cruise_iv >> (31 - self.shift);
+            return (t, iv.min(u32::MAX as u64) as u32);
+        };
+        (t, if pace { self.pace(s) } else { 0 })
+    }
+
+    /// Sub-ticks per event at scaled speed `s`: `Q·2^shift / s` (below
+    /// 2^63: the shift is at most 31), saturating.
+    fn pace(&self, s: u64) -> u32 {
+        let n = shl(Q, self.shift);
+        if s == 0 || n >> 32 >= s {
+            return u32::MAX;
         }
+        div_to_u32(n, s as u32)
     }
 
     /// The phase that holds the whole step from event `k0` to `k0 + 1`, and
@@ -301,7 +326,7 @@ impl Trapezoid {
     }
 
     fn scaled_speed(&self, v_sqr: u64) -> u64 {
-        isqrt(v_sqr << (2 * self.shift))
+        isqrt(shl(v_sqr, 2 * self.shift))
     }
 
     /// Time to change speed between two scaled speeds at `accel`: the
@@ -356,13 +381,25 @@ pub fn isqrt(x: u64) -> u64 {
     let shift = (33 - x.leading_zeros()) & !1;
     // r0 ≤ √x < r0 + 2^(shift/2): start from the upper end, below 2^32
     // (a root of 2^32 would need x ≥ TOP²).
-    let r0 = (((isqrt32((x >> shift) as u32) as u64) + 1) << (shift / 2)).min(TOP) as u32;
+    let r0 = shl(isqrt32((x >> shift) as u32) as u64 + 1, shift / 2).min(TOP) as u32;
     // x / r0 ≤ √x < 2^32: the quotient fits.
     let mut r = (r0 as u64 + div_to_u32(x, r0) as u64) / 2;
     while r * r > x {
         r -= 1;
     }
     r
+}
+
+/// `x << n` for `n < 64`: whole bytes, then bits. On the AVR a variable
+/// `u64` shift is a loop of one-bit shifts over eight bytes (~12 cycles a
+/// bit); whole bytes are register moves.
+fn shl(x: u64, n: u32) -> u64 {
+    let bytes = (n / 8) as usize;
+    let mut b = [0u8; 16];
+    b[8..].copy_from_slice(&x.to_le_bytes());
+    let mut out = [0u8; 8];
+    out.copy_from_slice(&b[8 - bytes..16 - bytes]);
+    u64::from_le_bytes(out) << (n % 8)
 }
 
 /// `n / d`, for a quotient known to fit 32 bits (`n >> 32 < d`): restoring
