@@ -139,7 +139,8 @@ fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
     let said = stdout.clone() + &String::from_utf8_lossy(&out.stderr);
     assert!(
         out.status.success(),
-        "{said}\n{}",
+        "{said}\nat most {} bytes of lines in flight\n{}",
+        in_flight.max,
         hil_tests::log_tail(&sim)
     );
     if std::env::var_os("TAUT_CNCJS_LOG").is_some() {
