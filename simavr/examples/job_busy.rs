@@ -34,6 +34,9 @@ fn main() {
     sim.watch_calls(motion);
     let names = [
         "Trapezoid5timed",
+        "4taut3job",
+        "4taut5store",
+        "4taut6timers",
         "Trapezoid7advance",
         "Prep4load",
         "Preparer7segment",
