@@ -402,7 +402,11 @@ fn motion() {
     // profile and segments wait behind a console line (≤ 1 ms) rather
     // than keep a `?` or a line waiting ~7 ms for all their parts.
     if more {
-        spawn(if stepping { refill_task() } else { Task::Motion });
+        spawn(if stepping {
+            refill_task()
+        } else {
+            Task::Motion
+        });
     }
     if freed || idle {
         signal(Signal::Motion);
