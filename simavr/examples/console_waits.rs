@@ -80,17 +80,8 @@ fn main() {
         }
     }
     for (i, &pc) in pcs.iter().enumerate() {
-        let mut runs: Vec<u64> = sim.call_runs(pc).iter().map(|r| r.1).collect();
-        runs.sort();
-        let n = runs.len();
-        if n > 0 {
-            println!(
-                "{:<16} runs {:>6} max {:>7} p99 {:>7}",
-                tasks[i],
-                n,
-                runs[n - 1],
-                runs[n * 99 / 100]
-            );
+        if let Some((n, max, p99)) = sim.call_summary(pc) {
+            println!("{:<16} runs {n:>6} max {max:>7} p99 {p99:>7}", tasks[i]);
         }
     }
 }

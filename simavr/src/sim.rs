@@ -390,6 +390,15 @@ impl Sim {
         self.call_watches.push(crate::calls::CallWatch::new(pc));
     }
 
+    /// The finished runs of a function given to [`Sim::watch_calls`], in
+    /// short: how many, the longest and the 99th percentile (cycles).
+    pub fn call_summary(&self, pc: u32) -> Option<(usize, u64, u64)> {
+        let mut runs: Vec<u64> = self.call_runs(pc).iter().map(|r| r.1).collect();
+        runs.sort_unstable();
+        let n = runs.len();
+        (n > 0).then(|| (n, runs[n - 1], runs[n * 99 / 100]))
+    }
+
     /// The finished runs of a function given to [`Sim::watch_calls`]:
     /// (first cycle, cycles), in order.
     pub fn call_runs(&self, pc: u32) -> &[(u64, u64)] {
