@@ -115,6 +115,14 @@ async function connect() {
   socket.on('serialport:error', (o) => finish(1, `serial port error: ${JSON.stringify(o.err)}`));
   socket.on('serialport:read', (line) => {
     say(`read ${line}`);
+    // The `ok` that ends CNCjs's own `$$` on connecting: a job started
+    // before it (the listing takes ~0.4 s) has CNCjs credit that `ok` to
+    // its first line and send a line past the receive buffer.
+    if (line === 'ok' && lastRead.startsWith('$')) {
+      settingsRead = true;
+      onState(activeState, true);
+    }
+    lastRead = line;
     if (step === 'reset' && line.startsWith('Grbl ')) {
       banner = true;
       check();
@@ -138,12 +146,17 @@ let workflow = 'idle';
 let received = 0;
 let total = 0;
 
-function onState(s) {
-  if (!s || s === activeState) return;
-  activeState = s;
-  say(`state ${s}`);
+let lastRead = '';
+let settingsRead = false;
+
+function onState(s, again = false) {
+  if (!s || (s === activeState && !again)) return;
+  if (!again) {
+    activeState = s;
+    say(`state ${s}`);
+  }
   if (s === 'Alarm') finish(1, 'the machine reports Alarm');
-  if (step === 'connecting' && s === 'Idle') {
+  if (step === 'connecting' && s === 'Idle' && settingsRead) {
     // Ready: CNCjs has seen the banner or a status report.
     step = 'loading';
     socket.emit('command', port, 'watchdir:load', name, (err, sender) => {
