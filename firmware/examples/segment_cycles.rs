@@ -6,7 +6,8 @@
 //! steps/s², 2000 steps/s) cut; D12 is toggled once per segment of that
 //! last batch, so the harness counts them. First, D11 goes high if the
 //! assembly division behind the square root agrees with the compiler's
-//! `u64` division on every case tried (and stays low otherwise).
+//! `u64` division on every case tried, and the assembly square root's
+//! results are floor roots (it stays low otherwise).
 #![no_std]
 #![no_main]
 
@@ -34,6 +35,11 @@ fn main() -> ! {
         let n = q as u64 * d as u64 + (x % d) as u64;
         agree &= div_to_u32(black_box(n), d) as u64 == black_box(n) / d as u64;
         agree &= div_to_u32(black_box(n), d) == q;
+        // Square roots of 32 bits (the assembly one) and of 64.
+        for v in [x as u64, n] {
+            let r = isqrt(black_box(v));
+            agree &= r * r <= v && (r + 1).checked_mul(r + 1).is_none_or(|s| s > v);
+        }
     }
     // The largest dividend whose quotient fits: 2^32 - 1 with the
     // largest remainder.

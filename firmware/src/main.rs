@@ -15,7 +15,7 @@
 //! | `USART0_UDRE` | interrupt | | `TX` | the wire |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
 //! | `Realtime` status, hold, resume, reset | software | 4 | `REALTIME` | `TX`, `JOB_CONTROL` |
-//! | `Refill` planner → segments while the queue holds < 30 ms of motion | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
+//! | `Refill` planner → segments while the queue holds < 20 ms of motion | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
 //! | `Console` one G-code line per run; a plotter's card print | software | 2 | `RX`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `CARD_IN`; signals `CardRoom` |
 //! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` |
 //! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `JOB_CONTROL` | planner, `CARD_IN`, `TX`; signals `CardRoom` |

@@ -21,14 +21,15 @@ use taut_logic::units::Milli;
 /// Preparing segments is urgent (the app runs it at the highest software
 /// priority) while the queue holds less motion than this; otherwise it is
 /// background work. Longer than any other task's run (a card block, a
-/// wrap's planning: under 10 ms), so they never starve the queue.
-const URGENT_BUDGET_US: u32 = 30_000;
+/// wrap's planning: under 10 ms), so they never starve the queue, and
+/// shorter than [`QUEUED_MAX_US`], so a filled queue is not urgent.
+const URGENT_BUDGET_US: u32 = 20_000;
 /// Fewer segments than this are always urgent.
 const URGENT_MIN: u8 = 2;
-/// The queue holds no more motion than this (plus one segment, 25 ms at
+/// The queue holds no more motion than this (plus one segment, 50 ms at
 /// most): a feed hold brakes from the last segment queued, so this bounds
-/// how long a hold waits to begin.
-const QUEUED_MAX_US: u32 = 50_000;
+/// how long a hold waits to begin (≤ 75 ms).
+const QUEUED_MAX_US: u32 = 25_000;
 
 /// At or below this many queued segments the refill is urgent: as many of
 /// the newest as last less than the budget. Set by the refill, read by the
@@ -61,6 +62,10 @@ pub struct Motion {
     buffered: Buffered<SEGMENTS_CAPACITY>,
     /// The block the preparer is cutting (for the fast-path flag).
     block: StepBlock,
+    /// Blocks in `BLOCKS` after the last refill: fewer now, the step
+    /// interrupt has begun one since (what the job waits for to start a
+    /// checkpoint's record).
+    blocks: u8,
     /// Drop the queued motion once a hold has brought the machine to rest.
     cancel: bool,
     /// Bumped by every stop that drops queued moves: whoever queued them
@@ -90,6 +95,7 @@ impl Motion {
             prep: Prep::new(),
             buffered: Buffered::new(),
             block: StepBlock::default(),
+            blocks: 0,
             cancel: false,
             epoch: 0,
             lost: false,
@@ -158,9 +164,10 @@ impl Motion {
     /// pieces of work (taking a block, a part of its profile or of a
     /// segment: ≤ ~1 ms each, so other tasks interleave), and start the
     /// interrupt.
-    /// Returns (a planner slot was freed, more can be prepared).
+    /// Returns (a planner slot was freed or a block begun, more can be
+    /// prepared).
     pub fn refill(&mut self, max: usize) -> (bool, bool) {
-        let mut freed = false;
+        let mut freed = BLOCKS.len() < self.blocks as usize;
         let mut made = 0;
         let mut pushed = false;
         let mut room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
@@ -209,6 +216,7 @@ impl Motion {
                 .max(URGENT_MIN as usize);
             SHORT_AT.store(short as u8, Relaxed);
         }
+        self.blocks = BLOCKS.len() as u8;
         self.stepper.kick();
         if self.cancel && self.prep.hold_state() == Hold::Stopped && !self.stepper.is_running() {
             self.abort();

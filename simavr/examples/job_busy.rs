@@ -38,7 +38,9 @@ fn main() {
         "4taut5store",
         "4taut6timers",
         "Trapezoid7advance",
-        "Prep4load",
+        "Preparer11begin_block",
+        "Preparer8ramp_run",
+        "Preparer5brake",
         "Preparer7segment",
         "Preparer3fit",
         "Preparer8ramp_run",
@@ -92,7 +94,7 @@ fn main() {
             let mut h = prof.hottest(100000);
             h.sort();
             for (pc, c) in h {
-                if (0x732c..0x87e4).contains(&pc) {
+                if (0x2cf6..0x2fae).contains(&pc) {
                     println!("{pc:#07x} {c}");
                 }
             }

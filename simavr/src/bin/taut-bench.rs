@@ -412,7 +412,7 @@ fn segment_cycles(elf: &Path) -> ([u64; 4], u64) {
     sim.run_for(Duration::from_secs(5));
     assert!(
         sim.pin_level(11),
-        "the assembly division disagrees with u64 division"
+        "the assembly division or square root is wrong"
     );
     let edges = sim.probed("batch").edges().to_vec();
     assert_eq!(edges.len(), 8, "four batches");

@@ -208,7 +208,7 @@ proptest! {
         prop_assert_eq!(r.events.len(), total);
         if let (Some(held), Some(stood)) = (r.held_at, r.stood_at) {
             // Braking: v² falls by 2a per event at most, measured over
-            // windows of 16 events (single intervals carry the 1 µs
+            // windows of 16 events (single intervals carry the 4 µs
             // timing tolerance) away from the stop (where a window's mean
             // speed is no longer the speed at its middle), and inside a
             // block (the event rate jumps at a corner where the path

@@ -2,12 +2,12 @@
 //! [`Segment`]s that keep every event within [`TOLERANCE_TICKS`] of its
 //! ideal time.
 //!
-//! Error budget, sub-ticks (tolerance 16 ticks = 4096):
+//! Error budget, sub-ticks (tolerance 64 ticks = 16 384):
 //! - quadratic through the segment's start and end event, its `add` the
 //!   change of pace (time per event) between them over the events: at
 //!   most `0.024·d³/τ²` for a segment lasting `d` at a speed `τ` away
 //!   from standstill (third derivative of the ramp's step times, the same
-//!   bound as a fit through the middle event); kept ≤ 2048;
+//!   bound as a fit through the middle event); kept ≤ 12 288;
 //! - `add` rounded to a whole sub-tick: ≤ n²/16 ≤ 1024 for n ≤ 128;
 //! - `interval` rounded: ≤ n/2 ≤ 2048 in a cruise (no other error there);
 //! - lag carried from the previous segment ≤ 66; the interrupt's tick
@@ -21,11 +21,13 @@ use crate::units::div_round;
 const MAX_RAMP_EVENTS: u32 = 128;
 /// Longest cruise segment: bounds the `interval` rounding error.
 const MAX_CRUISE_EVENTS: u32 = 4096;
-/// No segment lasts longer than this (1/40 s): a feed hold brakes from the
-/// last segment queued, so this bounds how long it waits to begin.
-const MAX_SEGMENT_PER_S: u64 = 40;
-/// `d ≤ 43·∛τ²` keeps the quadratic fit's error ≤ 2048 sub-ticks.
-const FIT_GAIN: u64 = 43;
+/// No segment lasts longer than this (1/20 s): a feed hold brakes from the
+/// last segment queued, so this and the queue's own budget
+/// (`firmware/src/motion.rs`) bound how long it waits to begin.
+const MAX_SEGMENT_PER_S: u64 = 20;
+/// `d ≤ 78·∛τ²` keeps the quadratic fit's error ≤ 12 288 sub-ticks
+/// (`(12 288 / 0.024)^⅓ = 80`).
+const FIT_GAIN: u64 = 78;
 /// Budget units ([`Preparer::next_part`]): an event time and pace
 /// (~8 500 cycles), a ramp segment's size (~4 000 an acceleration's, ~8 000 a
 /// deceleration's), and what one call may spend: one of them.
@@ -325,17 +327,17 @@ impl Preparer {
         if v == 0 {
             return 1;
         }
-        // v / 40 from below (1638 / 2^16 < 1/40), without a division.
-        const _: () = assert!(MAX_SEGMENT_PER_S == 40);
+        // v / 20 from below (3276 / 2^16 < 1/20), without a division.
+        const _: () = assert!(MAX_SEGMENT_PER_S == 20);
         let v = v.min(1 << 20);
-        let most = ((v * 1638) >> 16).min(MAX_RAMP_EVENTS);
-        // d ≤ 43·∛τ², in events: d·v / Q with Q = 125 000·2^15. A cube
-        // root within 26 % below the true one: segments at most that much
-        // shorter than the error budget allows, for 1/20 of the cost. Past
-        // 2^15 (τ over two hours) `most` is the bound anyway.
+        let most = ((v * 3276) >> 16).min(MAX_RAMP_EVENTS);
+        // d ≤ 78·∛τ², in events: d·v / Q with Q = 125 000·2^15. A cube
+        // root within 4.2 % below the true one: segments at most 8 %
+        // shorter than the error budget allows, for a fraction of the
+        // cost. Past 2^15 (τ over two hours) `most` is the bound anyway.
         let c = cbrt_floor_approx(to_stop).min(1 << 15);
         let duration = FIT_GAIN * c * c;
-        // Below 2^36·2^20 / 2^15: a 32-bit quotient (a general u64
+        // Below 2^37·2^20 / 2^15: a 32-bit quotient (a general u64
         // division is ~3 000 cycles).
         let n = div_to_u32((duration * v as u64) >> 15, 125_000);
         n.min(most).max(1)

@@ -52,7 +52,7 @@ pub trait Machine {
 pub enum Feeding {
     /// Nothing: its budget of steps is used and more are waiting.
     Again,
-    /// The planner to take a block, or the machine to stand.
+    /// The planner to take a block, the machine to begin one, or to stand.
     Motion,
     /// This many ms: a dwell, or a checkpoint being written.
     After(u16),
@@ -66,10 +66,6 @@ pub enum Feeding {
 /// How often a checkpoint being written is looked at, ms (the store
 /// writes one differing EEPROM byte per run, one run per 4 ms).
 pub const SAVE_POLL_MS: u16 = 4;
-/// How often the feeder looks whether the machine has passed a record's
-/// mark, ms: a record starts at most this late, and the job task does not
-/// wake every 4 ms through a rotation (6 % of the CPU while winding).
-pub const MARK_POLL_MS: u16 = 20;
 
 /// Where a batch stands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -146,7 +142,7 @@ impl Feeder {
         mut budget: u8,
     ) -> Feeding {
         if self.record_due(job, m) {
-            return Feeding::After(self.poll_ms());
+            return self.held(m);
         }
         if let Wait::Dwell(until) = self.wait {
             let left = until.wrapping_sub(now_ms) as i32;
@@ -197,7 +193,7 @@ impl Feeder {
                 MachineStep::Durable => {
                     self.stage = Stage::Held;
                     if self.record_due(job, m) {
-                        return Feeding::After(self.poll_ms());
+                        return self.held(m);
                     }
                 }
                 _ if !m.is_idle() => {
@@ -233,12 +229,13 @@ impl Feeder {
         Feeding::Idle
     }
 
-    /// While held: a record waits for its mark to be passed, or is being
-    /// written.
-    fn poll_ms(&self) -> u16 {
+    /// While held: a record waits for the machine to pass its mark (it
+    /// wakes the job as it begins a block, not a poll through a long
+    /// rotation), or for the last checkpoint to be written.
+    fn held(&self, m: &impl Machine) -> Feeding {
         match self.wait {
-            Wait::Marked(_) => MARK_POLL_MS,
-            _ => SAVE_POLL_MS,
+            Wait::Marked(after) if !passed(after, m) => Feeding::Motion,
+            _ => Feeding::After(SAVE_POLL_MS),
         }
     }
 
@@ -248,7 +245,7 @@ impl Feeder {
     /// while the steps must wait for a record to be durable.
     fn record_due(&mut self, job: &Job, m: &mut impl Machine) -> bool {
         if let Wait::Marked(after) = self.wait {
-            if (after > m.unbegun() || m.is_idle()) && !m.saving() {
+            if passed(after, m) && !m.saving() {
                 self.wait = Wait::None;
                 if let Some(r) = job.marked() {
                     m.record(r);
@@ -261,4 +258,10 @@ impl Feeder {
         }
         self.stage == Stage::Held
     }
+}
+
+/// The machine has passed a mark with `after` moves handed over since: one
+/// of them has begun, so every one before it is done, or it stands.
+fn passed(after: u8, m: &impl Machine) -> bool {
+    after > m.unbegun() || m.is_idle()
 }
