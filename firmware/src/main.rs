@@ -13,10 +13,10 @@
 //! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `SAMPLES` |
 //! | `USART0_RX` | interrupt | | a byte | `REALTIME` (`?` `!` `~` Ctrl-X, which also stops the steps), else `RX` |
 //! | `USART0_UDRE` | interrupt | | `TX` | the wire |
+//! | `Realtime` status, hold, resume, reset | software | 5 | `REALTIME` | `TX`, `JOB_CONTROL` |
+//! | `Console` one G-code line per run; a plotter's card print | software | 4 | `RX`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `CARD_IN`; signals `CardRoom` |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
-//! | `Realtime` status, hold, resume, reset | software | 4 | `REALTIME` | `TX`, `JOB_CONTROL` |
-//! | `Refill` planner → segments while the queue holds < 20 ms of motion | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
-//! | `Console` one G-code line per run; a plotter's card print | software | 2 | `RX`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `CARD_IN`; signals `CardRoom` |
+//! | `Refill` planner → segments while the queue holds < 20 ms of motion, a part per run, yielding to a ready task between parts | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
 //! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` |
 //! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `JOB_CONTROL` | planner, `CARD_IN`, `TX`; signals `CardRoom` |
 //! | `Led` status LED pattern (timed edges: runs before the long tasks) | software | 2 | its timer | |
@@ -111,9 +111,13 @@ impl TaskId for Task {
     }
     fn priority(self) -> u8 {
         match self {
-            Task::Realtime => 4,
+            Task::Realtime => 5,
+            // Above the urgent refill: a ready console waits for at most
+            // one part of a segment (the refill yields at its parts'
+            // boundaries, `Motion::yield_to`), and its own runs are short.
+            Task::Console => 4,
             Task::Timers | Task::Refill => 3,
-            Task::Console | Task::Buttons | Task::Job | Task::Led => 2,
+            Task::Buttons | Task::Job | Task::Led => 2,
             Task::Card | Task::Motion => 1,
             Task::Logger | Task::Store => 0,
         }
@@ -123,7 +127,7 @@ impl TaskId for Task {
 /// Task ids spawned by interrupts, moved into `READY` by the dispatcher.
 static SPAWNED: Spawned = Spawned::new();
 // Software tasks only: no masking needed.
-static READY: TaskCell<Ready<Task, 11, 5>> = TaskCell::new(Ready::new());
+static READY: TaskCell<Ready<Task, 11, 6>> = TaskCell::new(Ready::new());
 static TIMERS: TaskCell<Timers<Task, 8>> = TaskCell::new(Timers::new());
 /// Tasks waiting for each [`Signal`] (bit = task).
 static WAITING: TaskCell<[u16; SIGNALS]> = TaskCell::new([0; SIGNALS]);
@@ -141,8 +145,12 @@ static STORE: TaskCell<Option<Store>> = TaskCell::zeroed();
 const BOOT_BLINKS: u32 = 3;
 const LOGGER_PERIOD_MS: u32 = 1000;
 
+/// Make `task` ready, after what the interrupts spawned meanwhile.
 fn spawn(task: Task) {
-    READY.with(|r| r.spawn(task));
+    READY.with(|r| {
+        dispatch::admit(&SPAWNED, r, task_of);
+        r.spawn(task)
+    });
 }
 
 /// Run `task` again as its `poll` asks.
@@ -363,7 +371,16 @@ fn boot_log(reset: ResetCause) {
 #[inline(never)]
 #[optimize(size)]
 fn start_motion(stepper: Stepper, drivers: Drivers, pen: PenServo) {
-    MOTION.with(|m| *m = Some(CONFIG.with(|c| Motion::new(c, stepper, drivers, pen))));
+    MOTION.with(|m| {
+        let motion = m.insert(CONFIG.with(|c| Motion::new(c, stepper, drivers, pen)));
+        motion.yield_to(others_ready);
+    });
+}
+
+/// Another task waits to run (an interrupt spawned it, or it is ready): a
+/// motion run ends at its next part's boundary.
+fn others_ready() -> bool {
+    !SPAWNED.is_empty() || READY.with(|r| !r.is_empty())
 }
 
 #[inline(never)]

@@ -106,6 +106,12 @@ impl Motion {
         }
     }
 
+    /// A segment's part ends early when `others` says another task waits
+    /// (`Preparer::yield_to`).
+    pub fn yield_to(&mut self, others: fn() -> bool) {
+        self.prep.yield_to(others);
+    }
+
     /// Queue a move to the absolute step `target`; `Full` is back-pressure.
     #[optimize(speed)]
     pub fn push(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
@@ -186,7 +192,7 @@ impl Motion {
             let cut = match PLANNER.with(|p| self.prep.next_part(p)) {
                 Ok(Some(cut)) => cut,
                 Ok(None) => break,
-                // Half a segment worked out: the rest next run.
+                // Part of a segment worked out: the rest next run.
                 Err(Later) => {
                     made += 1;
                     continue;

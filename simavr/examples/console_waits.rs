@@ -29,8 +29,28 @@ fn main() {
     ];
     let f = |p: &str| taut_simavr::elf::function_address(elf, p).unwrap().unwrap();
     let pcs: Vec<u32> = tasks.iter().map(|n| f(n)).collect();
+    // What the longest motion runs are made of.
+    let inner: Vec<(&str, u32)> = [
+        "Preparer8ramp_run",
+        "Preparer5ahead",
+        "Preparer3fit",
+        "Preparer7segment",
+        "Trapezoid7advance",
+        "Preparer13advance_block",
+        "Planner9plan_part",
+        "5units9div_round",
+        "11round_div32",
+        "10div_to_u32",
+        "__muldi3",
+        "Trapezoid5timed",
+        "Preparer10is_stopped",
+        "memcpy",
+    ]
+    .into_iter()
+    .filter_map(|n| Some((n, taut_simavr::elf::function_address(elf, n).ok()??)))
+    .collect();
     let mut sim = Sim::load(elf).unwrap();
-    for &pc in &pcs {
+    for &pc in pcs.iter().chain(inner.iter().map(|(_, pc)| pc)) {
         sim.watch_calls(pc);
     }
     sim.run_until_uart_contains("reset:", Duration::from_millis(50));
@@ -45,6 +65,9 @@ fn main() {
             .count()
     };
     let mut sent = oks(&sim);
+    if std::env::var_os("PROFILE").is_some() {
+        sim.enable_profile();
+    }
     sim.watch_pc(RX_VECTOR);
     sim.watch_pc(pcs[0]);
     let mut asked = Vec::new();
@@ -78,6 +101,24 @@ fn main() {
                 }
             }
         }
+    }
+    if let Some(prof) = sim.profile() {
+        for (c, n) in prof.by_function(elf).unwrap().iter().take(25) {
+            println!("{c:>12} {n}");
+        }
+    }
+    let mut runs = sim.call_runs(pcs[2]).to_vec();
+    runs.sort_by_key(|r| std::cmp::Reverse(r.1));
+    for &(start, len) in runs.iter().take(3) {
+        print!("motion run {len}:");
+        for &(name, pc) in &inner {
+            for r in sim.call_runs(pc) {
+                if r.0 >= start && r.0 < start + len {
+                    print!(" {name}={}", r.1);
+                }
+            }
+        }
+        println!();
     }
     for (i, &pc) in pcs.iter().enumerate() {
         if let Some((n, max, p99)) = sim.call_summary(pc) {

@@ -108,6 +108,11 @@ impl Prep {
         true
     }
 
+    /// See [`Preparer::yield_to`].
+    pub fn yield_to(&mut self, others: fn() -> bool) {
+        self.cut.yield_to(others);
+    }
+
     /// [`Prep::next`] bounded as [`Preparer::next_part`]: `Err(Later)`
     /// when the segment needs another call. Loads at once what
     /// [`Prep::load`] left unmade.

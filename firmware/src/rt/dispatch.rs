@@ -26,6 +26,32 @@ pub fn spawn_from_isr(spawned: &Spawned, id: u8) {
     spawned.set(id);
 }
 
+/// Moves the interrupts' spawns into `ready` (those that came together in
+/// index order); true when there were any. A task that spawns calls it
+/// first, so what an interrupt spawned during its run is queued ahead of
+/// it, in the order they came (a console byte during a refill run is not
+/// overtaken by the refill's next run).
+#[inline(always)]
+pub fn admit<T: TaskId, const N: usize, const P: usize>(
+    spawned: &Spawned,
+    ready: &mut Ready<T, N, P>,
+    task: fn(u8) -> T,
+) -> bool {
+    let flags = spawned.take();
+    if flags == 0 {
+        return false;
+    }
+    let (mut bits, mut id) = (flags, 0);
+    while bits != 0 {
+        if bits & 1 != 0 {
+            ready.spawn(task(id));
+        }
+        bits >>= 1;
+        id += 1;
+    }
+    true
+}
+
 pub fn run<T: TaskId, const N: usize, const P: usize>(
     spawned: &Spawned,
     ready: &TaskCell<Ready<T, N, P>>,
@@ -37,37 +63,29 @@ pub fn run<T: TaskId, const N: usize, const P: usize>(
     // SAFETY: SMCR (0x53): sleep enable, idle mode (timers and UART run).
     unsafe { core::ptr::write_volatile(0x53 as *mut u8, 0x01) };
     let mut round = Round::new();
-    // Nothing was ready at the last look and no task has run since.
-    let mut idle = false;
     loop {
-        let flags = spawned.take();
-        if flags != 0 {
-            idle = false;
-            ready.with(|r| {
-                for id in (0..T::COUNT as u8).filter(|i| flags >> i & 1 != 0) {
-                    r.spawn(task(id));
-                }
-            });
-        }
-        if idle {
-            // Woken by an interrupt that spawned nothing (each step, each
-            // tick): the set is still empty, and all a round would do is
-            // feed the watchdog. The full look costs ~370 cycles a wake.
-            feed_watchdog();
-        } else if let Some(t) = ready.with(|r| round.next(r, millis(), &feed_watchdog)) {
+        ready.with(|r| admit(spawned, r, task));
+        if let Some(t) = ready.with(|r| round.next(r, millis(), &feed_watchdog)) {
             dispatch(t);
             continue;
         }
-        idle = true;
-        avr_device::interrupt::disable();
-        if spawned.is_empty_masked() {
-            // `sei` takes effect after the next instruction, so an interrupt
-            // arriving now still wakes this `sleep`: no lost wake-up.
+        // Nothing ready: sleep until an interrupt spawns a task. Woken by
+        // one that spawned nothing (each step, each tick), feed the
+        // watchdog and sleep again, ~12 cycles: a round's look costs ~370.
+        loop {
+            avr_device::interrupt::disable();
+            if !spawned.is_empty_masked() {
+                // SAFETY: re-enables interrupts, as they were before
+                // `disable`.
+                unsafe { avr_device::interrupt::enable() };
+                break;
+            }
+            feed_watchdog();
+            // `sei` takes effect after the next instruction, so an
+            // interrupt arriving now still wakes this `sleep`: no lost
+            // wake-up.
             // SAFETY: re-enables interrupts, as they were before `disable`.
             unsafe { asm!("sei", "sleep") };
-        } else {
-            // SAFETY: as above.
-            unsafe { avr_device::interrupt::enable() };
         }
     }
 }

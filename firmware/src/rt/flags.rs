@@ -29,6 +29,11 @@ impl Flags {
         avr_device::interrupt::free(|_| unsafe { core::mem::take(&mut *self.0.get()) })
     }
 
+    /// No bit set (read with interrupts masked: the two bytes agree).
+    pub fn is_empty(&self) -> bool {
+        avr_device::interrupt::free(|_| self.is_empty_masked())
+    }
+
     /// With interrupts masked (the dispatcher's idle path): the two bytes
     /// agree.
     pub fn is_empty_masked(&self) -> bool {

@@ -94,6 +94,11 @@ impl<T: TaskId, const N: usize, const P: usize> Ready<T, N, P> {
         None
     }
 
+    /// No task waits.
+    pub fn is_empty(&self) -> bool {
+        self.head.iter().all(Option::is_none)
+    }
+
     /// The pending tasks as a bit set (`1 << index`; at most 16 tasks).
     pub fn pending_mask(&self) -> u16 {
         const { assert!(T::COUNT <= 16, "a bit per task in a u16") };

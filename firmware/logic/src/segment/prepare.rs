@@ -29,7 +29,7 @@ const MAX_SEGMENT_PER_S: u64 = 20;
 /// (`(12 288 / 0.024)^⅓ = 80`).
 const FIT_GAIN: u64 = 78;
 /// Budget units ([`Preparer::next_part`]): an event time and pace
-/// (~8 500 cycles), a ramp segment's size (~4 000 an acceleration's, ~8 000 a
+/// (~7 000 cycles), a ramp segment's size (~4 000 an acceleration's, ~8 000 a
 /// deceleration's), and what one call may spend: one of them.
 const TIME_COST: u8 = 1;
 const SIZE_COST: u8 = 1;
@@ -76,6 +76,8 @@ pub struct Preparer {
     /// What the current call may still work out: [`TIME_COST`] an event
     /// time, [`SIZE_COST`] a ramp segment's size.
     budget: u8,
+    /// Whether another task waits ([`Preparer::yield_to`]).
+    yield_to: fn() -> bool,
 }
 
 /// A bounded call ran out of budget: call again to go on.
@@ -104,7 +106,15 @@ impl Preparer {
             start: (u32::MAX, 0),
             shorter: (u32::MAX, 0),
             budget: u8::MAX,
+            yield_to: || false,
         }
+    }
+
+    /// A bounded call ([`Preparer::next_part`]) that worked out an event
+    /// time ends before the fit when `others` says another task waits:
+    /// the app's way to keep a ready console's wait within one part.
+    pub fn yield_to(&mut self, others: fn() -> bool) {
+        self.yield_to = others;
     }
 
     /// Every event of the current block has been cut into segments.
@@ -268,11 +278,12 @@ impl Preparer {
     }
 
     /// [`Preparer::next_segment`] in bounded parts: one event time worked
-    /// out afresh (a 64-bit root: ~8 500 cycles on the AVR) or one ramp
-    /// segment's size; `Later` when the segment needs another call (what
-    /// a call worked out is kept for the next). A cruise segment takes one
-    /// call, a ramp's two (three for the first after a cruise or a leg's
-    /// start, whose start pace is not known yet).
+    /// out afresh (a 64-bit root: ~7 000 cycles on the AVR) or one ramp
+    /// segment's size; `Later` when the segment needs another
+    /// call (what a call worked out is kept for the next). A cruise segment
+    /// takes one call, a ramp's two (three for the first after a cruise or
+    /// a leg's start, whose start pace is not known yet; one more when the
+    /// fit yields, [`Preparer::yield_to`]).
     pub fn next_part(&mut self) -> Result<Option<Segment>, Later> {
         self.budget = PART_BUDGET;
         self.segment()
@@ -286,9 +297,10 @@ impl Preparer {
         let mut seg = match self.profile.phase_after(k0) {
             None => self.fit(k0, 1)?,
             Some((Phase::Cruise, end)) => {
-                let n = (end - k0)
-                    .min(MAX_CRUISE_EVENTS)
-                    .min(self.profile.cruise_events_in(Q / MAX_SEGMENT_PER_S));
+                let n = (end - k0).min(MAX_CRUISE_EVENTS).min(
+                    self.profile
+                        .cruise_events_in((Q / MAX_SEGMENT_PER_S) as u32),
+                );
                 self.cruise(k0, n.max(1))?
             }
             // A call that ran out of budget sized this segment already.
@@ -375,7 +387,8 @@ impl Preparer {
 
     /// Constant interval: the ideal times are equally spaced.
     fn cruise(&mut self, k0: u32, n: u32) -> Result<Segment, Later> {
-        let interval = div_round(self.ahead(k0 + n)?.0, n as i64);
+        let ahead = self.ahead(k0 + n)?.0;
+        let interval = round_div32(ahead, n).unwrap_or_else(|| div_round(ahead, n as i64));
         Ok(segment(interval, n, 0))
     }
 
@@ -396,6 +409,11 @@ impl Preparer {
             }
             let p0 = self.pace_at(k0)?;
             let (yn, p1) = self.ahead(k0 + n)?;
+            // A call that worked out the time ends here if a task waits:
+            // the fit (~3 000 cycles) next call, on the time kept.
+            if self.budget == 0 && (self.yield_to)() {
+                return Err(Later);
+            }
             let fitted = round_div32(p1 as i64 - p0 as i64, n).and_then(|add| {
                 let interval = round_div32(yn - add * (n * (n - 1) / 2) as i64, n)?;
                 let last = interval + add * (n - 1) as i64;

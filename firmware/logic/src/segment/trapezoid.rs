@@ -218,10 +218,13 @@ impl Trapezoid {
         self.cruise_sqr
     }
 
-    /// Cruise events that fit in `subticks` (at least one).
-    pub fn cruise_events_in(&self, subticks: u64) -> u32 {
-        let n = (subticks << (31 - self.shift)) / self.cruise_iv.max(1);
-        n.clamp(1, u32::MAX as u64) as u32
+    /// Cruise events that fit in `subticks` (at least one): a 32-bit
+    /// quotient by the interval rounded up (a `u64` division, ~3 000
+    /// cycles on the AVR, once a cruise segment kept a ready console
+    /// waiting).
+    pub fn cruise_events_in(&self, subticks: u32) -> u32 {
+        let pace = (self.cruise_iv >> (31 - self.shift)).min(u32::MAX as u64 - 1) as u32 + 1;
+        div_to_u32(subticks as u64, pace).max(1)
     }
 
     /// Speed² at the last event, events²/s².
@@ -268,7 +271,7 @@ impl Trapezoid {
             let back = self.ramp_time(s, self.s1);
             (self.t_end.saturating_sub(back), s)
         } else {
-            let t = self.t_acc + self.cruise_time(x - self.acc2);
+            let t = self.t_acc + self.cruise_time_to(k);
             let iv = self.cruise_iv >> (31 - self.shift);
             return (t, iv.min(u32::MAX as u64) as u32);
         };
@@ -292,7 +295,7 @@ impl Trapezoid {
         if k0 < self.k_acc {
             return Some((Phase::Accel, self.k_acc));
         }
-        let past_accel = k0 > self.k_acc || self.acc2.is_multiple_of(self.two_a);
+        let past_accel = k0 > self.k_acc || self.two_a * self.k_acc as u64 == self.acc2;
         if past_accel && k0 < self.k_dec {
             return Some((Phase::Cruise, self.k_dec));
         }
@@ -331,13 +334,34 @@ impl Trapezoid {
 
     /// Time to change speed between two scaled speeds at `accel`: the
     /// difference (below 2^32: the scale keeps the peak's below 2^64) times
-    /// `per_speed`, a 96-bit product cut to its top bits.
-    #[cfg_attr(target_arch = "avr", optimize(speed))]
+    /// `per_speed`, a 96-bit product cut to its top bits. Always inlined:
+    /// called, its second `u64` would go on the stack, which the AVR
+    /// backend passes wrongly (it was garbage once this stopped being
+    /// inlined).
+    #[inline(always)]
     fn ramp_time(&self, s_hi: u64, s_lo: u64) -> u64 {
         let ds = s_hi - s_lo;
         let low = ds * (self.per_speed & 0xFFFF_FFFF);
         let high = ds * (self.per_speed >> 32);
         (high + (low >> 32)) >> (self.per_speed_shift - 32)
+    }
+
+    /// [`Trapezoid::cruise_time`] from the end of the acceleration to
+    /// event `k` of the cruise, without its divisions: `2a·k − acc2` is
+    /// `2a·(k − k_acc) − ρ` with `ρ = acc2 − 2a·k_acc` below `2a`, and
+    /// the fraction's quotient fits 32 bits when the interval does.
+    fn cruise_time_to(&self, k: u32) -> u64 {
+        let rho = self.acc2 - self.two_a * self.k_acc as u64;
+        let (q, r) = match rho {
+            0 => (k - self.k_acc, 0),
+            _ => (k - self.k_acc - 1, self.two_a - rho),
+        };
+        let part = r * self.cruise_iv;
+        let frac = match self.two_a as u32 {
+            d if part >> 32 < d as u64 => div_to_u32(part, d) as u64,
+            _ => part / self.two_a,
+        };
+        (q as u64 * self.cruise_iv + frac) >> (31 - self.shift)
     }
 
     /// Time to cruise `w / (2a)` events.
