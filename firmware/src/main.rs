@@ -16,7 +16,7 @@
 //! | `Realtime` status, hold, resume, reset | software | 5 | `REALTIME` | `TX`, `JOB_CONTROL` |
 //! | `Console` one G-code line per run; a plotter's card print | software | 4 | `RX`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `CARD_IN`; signals `CardRoom` |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
-//! | `Refill` planner → segments while the queue holds < 20 ms of motion, a part per run, yielding to a ready task between parts | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
+//! | `Refill` planner → segments while the queue holds < 30 ms of motion, a part per run, yielding to a ready task between parts | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
 //! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` |
 //! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `JOB_CONTROL` | planner, `CARD_IN`, `TX`; signals `CardRoom` |
 //! | `Led` status LED pattern (timed edges: runs before the long tasks) | software | 2 | its timer | |

@@ -23,13 +23,14 @@ use taut_logic::units::Milli;
 /// background work. Longer than any other task's run (a card block, a
 /// wrap's planning: under 10 ms), so they never starve the queue, and
 /// shorter than [`QUEUED_MAX_US`], so a filled queue is not urgent.
-const URGENT_BUDGET_US: u32 = 20_000;
+const URGENT_BUDGET_US: u32 = 30_000;
 /// Fewer segments than this are always urgent.
 const URGENT_MIN: u8 = 2;
 /// The queue holds no more motion than this (plus one segment, 50 ms at
 /// most): a feed hold brakes from the last segment queued, so this bounds
-/// how long a hold waits to begin (≤ 75 ms).
-const QUEUED_MAX_US: u32 = 25_000;
+/// how long a hold waits to begin (≤ 90 ms). 25 ms starved a SCARA arm's
+/// stream of tiny moves (`plotter_stress`).
+const QUEUED_MAX_US: u32 = 40_000;
 
 /// At or below this many queued segments the refill is urgent: as many of
 /// the newest as last less than the budget. Set by the refill, read by the

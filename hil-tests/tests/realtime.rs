@@ -79,7 +79,7 @@ fn feed_hold_brakes_and_resume_ends_on_the_exact_target() {
     let (report, ms) = status(&mut sim);
     assert!(report.starts_with("<Hold:0|"), "{report}");
     assert!(ms <= 10.0, "status after {ms} ms");
-    // Braking begins once the motion already queued (≤ 75 ms) has run:
+    // Braking begins once the motion already queued (≤ 90 ms) has run:
     // the fastest step comes within 100 ms of the `!`, and from there the
     // machine stops in v²/2a steps.
     let r = rising(&sim, "base_step");
