@@ -28,8 +28,12 @@ pub static FEED_PRESSES: Tally = Tally::new();
 
 /// Motion task → step interrupt: segments, and the blocks they start.
 pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
-/// Slots of the segment ring (one fewer can be queued).
-pub const SEGMENTS_CAPACITY: usize = 32;
+/// Slots of the segment ring (one fewer can be queued). The shortest
+/// segments are a top-speed ramp's, 128 events (2.2 ms at 59 kHz): 15 of
+/// them are 33 ms, above the 30 ms under which the refill is urgent; slower
+/// segments fill the 40 ms budget with fewer (`motion.rs`). 32 slots were
+/// 176 B more.
+pub const SEGMENTS_CAPACITY: usize = 16;
 pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
 
 /// Tick → buttons task: one raw sample (bit `Button as u8` = pressed) per

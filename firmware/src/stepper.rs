@@ -28,8 +28,8 @@ use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::{port_bit, Port, DRIVERS};
 use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK, STOP};
 
-/// Refill the queues when this few segments are left.
-pub(crate) const LOW_WATER: usize = 24;
+/// Refill the queues when this few segments are left (of 15).
+pub(crate) const LOW_WATER: usize = 12;
 
 /// Timer3 registers (data-space addresses). Timer1 drives the pen servo
 /// on OC1A (D11, RAMPS SERVO0).

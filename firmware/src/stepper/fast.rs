@@ -27,11 +27,11 @@ pub const REFILL: usize = offset_of!(Exec, refill);
 #[doc(hidden)]
 pub const BLOCK_LEFT: usize = offset_of!(Exec, block_left);
 #[doc(hidden)]
-pub const RING_HEAD: usize = Ring::<Segment, 32>::HEAD;
+pub const RING_HEAD: usize = Ring::<Segment, 16>::HEAD;
 #[doc(hidden)]
-pub const RING_TAIL: usize = Ring::<Segment, 32>::TAIL;
+pub const RING_TAIL: usize = Ring::<Segment, 16>::TAIL;
 #[doc(hidden)]
-pub const RING_MASK: u8 = 31;
+pub const RING_MASK: u8 = 15;
 #[doc(hidden)]
 pub const SEG_ADD: usize = offset_of!(Segment, add);
 #[doc(hidden)]
