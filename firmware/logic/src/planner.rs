@@ -8,8 +8,10 @@
 //! thus equally long; that is the only way to compare degrees with mm.
 //! Floats are used once per block when it is added (its length, the
 //! junction cosine); the look-ahead passes are additions and comparisons of
-//! squared speeds, `u64` (µm/s)². The block handed to the segment preparer
-//! is converted to events (steps of its dominant axis).
+//! squared speeds, `u32` (µm/s)² shifted right by [`Planner`]'s `shift`
+//! (0 unless the machine's top speed needs more than 32 bits: 16 B a
+//! block less than `u64`, and cheaper on the AVR). The block handed to the
+//! segment preparer is converted to events (steps of its dominant axis).
 
 mod axis_jump;
 mod junction;
@@ -71,18 +73,19 @@ struct Block {
     /// The speed asked for, events/s, before the overrides and the axes'
     /// limits; 0: a rapid. Milli-units/min until `plan_limits`.
     feed_ev: f32,
-    /// Cruise speed² along the path with the overrides, (milli-units/s)²:
-    /// kept squared, as the look-ahead passes compare it (a 64-bit
-    /// multiply each time was a third of a pass on the AVR).
-    nominal_sqr: u64,
+    /// Cruise speed² along the path with the overrides, (milli-units/s)²
+    /// (as all the speeds² here, shifted by `Planner::shift`): kept
+    /// squared, as the look-ahead passes compare it (a multiply each time
+    /// was a third of a pass on the AVR).
+    nominal_sqr: u32,
     /// (events per path milli-unit)²: converts path speeds² to events²/s².
     ev_per_milli_sqr: f32,
-    /// Path speeds², (milli-units/s)²: what the junction with the block
-    /// before allows, and the entry planned.
-    junction_sqr: u64,
-    entry_sqr: u64,
+    /// Path speeds²: what the junction with the block before allows, and
+    /// the entry planned.
+    junction_sqr: u32,
+    entry_sqr: u32,
     /// Largest change of speed² over the block: 2·accel·length.
-    delta_sqr: u64,
+    delta_sqr: u32,
 }
 
 impl Block {
@@ -161,7 +164,10 @@ pub struct Planner {
     len: usize,
     /// Entry speed² of the oldest block, fixed: the exit speed of the block
     /// the preparer took before it.
-    carry_sqr: u64,
+    carry_sqr: u32,
+    /// Right shift of the speeds² kept: the fewest bits that hold the
+    /// machine's top speed² in a `u32`.
+    shift: u8,
     /// Target of the last move, steps.
     position: PerAxis<i32>,
     geometry: Geometry,
@@ -182,6 +188,7 @@ impl Planner {
         head: 0,
         len: 0,
         carry_sqr: 0,
+        shift: 0,
         position: [0; AXES],
         geometry: Geometry::EMPTY,
         jumps: AxisJumps::EMPTY,
@@ -197,24 +204,16 @@ impl Planner {
         self.len = 0;
         self.carry_sqr = 0;
         self.geometry = Geometry::new(config);
+        self.shift = shift_for(self.geometry.max_speed_sqr());
         self.jumps = AxisJumps::new(config);
         self.last = None;
         self.stage = Stage::Done;
     }
 
     pub fn new(config: &MachineConfig) -> Self {
-        Planner {
-            blocks: [Block::default(); PLANNER_BLOCKS],
-            head: 0,
-            len: 0,
-            carry_sqr: 0,
-            position: [0; AXES],
-            geometry: Geometry::new(config),
-            jumps: AxisJumps::new(config),
-            last: None,
-            overrides: None,
-            stage: Stage::Done,
-        }
+        let mut p = Planner::EMPTY;
+        p.configure(config);
+        p
     }
 
     /// Whether [`Planner::push`] would refuse for want of room.
@@ -311,14 +310,14 @@ impl Planner {
             Feed::PerMinute(f) => f.0.max(1) as f32,
         };
         // The axes' jumps now, the junction's roots in the next part: the
-        // turn waits in `entry_sqr`, which `recalculate` writes before
-        // anything reads it.
-        (b.junction_sqr, b.entry_sqr) = match self.last {
+        // turn waits in `entry_sqr` and `delta_sqr`, which `plan_limits`
+        // and `recalculate` write before anything reads them.
+        (b.junction_sqr, (b.entry_sqr, b.delta_sqr)) = match self.last {
             Some(prev) => (
-                self.jumps.limit_sqr(&prev, &path.unit),
+                down(self.jumps.limit_sqr(&prev, &path.unit), self.shift),
                 self.geometry.turn(&prev, &path.unit).pack(),
             ),
-            None => (0, 0),
+            None => (0, (0, 0)),
         };
         self.last = Some(path.unit);
         self.stage = Stage::Turned {
@@ -333,8 +332,9 @@ impl Planner {
         let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
         // 0: the first move, or a jump that allows no speed.
         if b.junction_sqr != 0 {
-            let turn = Turn::unpack(b.entry_sqr);
-            b.junction_sqr = b.junction_sqr.min(turn.speed_sqr(&self.geometry));
+            let turn = Turn::unpack((b.entry_sqr, b.delta_sqr));
+            let speed_sqr = down(turn.speed_sqr(&self.geometry), self.shift);
+            b.junction_sqr = b.junction_sqr.min(speed_sqr);
         }
         self.stage = Stage::Path { ev_per_milli };
     }
@@ -350,9 +350,13 @@ impl Planner {
         let overrides = self.overrides.unwrap_or(Overrides::NONE);
         b.feed_ev = b.feed_ev / 60.0 * ev_per_milli;
         b.accel = accel;
-        b.nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
+        b.nominal_sqr = down(
+            overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli),
+            self.shift,
+        );
         b.ev_per_milli_sqr = k2;
-        b.delta_sqr = ((2 * accel as u64 * b.step.events as u64) as f32 / k2) as u64;
+        let delta = ((2 * accel as u64 * b.step.events as u64) as f32 / k2) as u64;
+        b.delta_sqr = down(delta, self.shift);
         self.stage = Stage::Limits;
     }
 
@@ -398,7 +402,8 @@ impl Planner {
             0
         };
         self.carry_sqr = exit_sqr;
-        let to_events = |v: u64| (v as f32 * b.ev_per_milli_sqr) as u64;
+        let k2 = times_pow2(b.ev_per_milli_sqr, self.shift);
+        let to_events = |v: u32| (v as f32 * k2) as u64;
         Some(Taken {
             block: b.step,
             accel: b.accel,
@@ -414,7 +419,7 @@ impl Planner {
     /// The oldest block may enter at `path_sqr` at most, (milli-units/s)²:
     /// the block before it was held and can no longer leave faster.
     pub fn limit_entry(&mut self, path_sqr: u64) {
-        self.carry_sqr = self.carry_sqr.min(path_sqr);
+        self.carry_sqr = self.carry_sqr.min(down(path_sqr, self.shift));
         if self.len > 0 {
             self.recalculate();
         }
@@ -441,7 +446,8 @@ impl Planner {
             let b = &mut self.blocks[(self.head + i) % PLANNER_BLOCKS];
             let (_, rate) = self.geometry.limits(&b.step);
             let ev_per_milli = crate::fmath::sqrt(b.ev_per_milli_sqr);
-            b.nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
+            let nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
+            b.nominal_sqr = down(nominal_sqr, self.shift);
         }
         if self.len > 0 {
             self.recalculate();
@@ -460,7 +466,7 @@ impl Planner {
         }
         let mut i = (self.head + self.len - 1) % PLANNER_BLOCKS;
         let mut nominal_sqr = self.blocks[i].nominal_sqr;
-        let mut next_entry = 0u64;
+        let mut next_entry = 0u32;
         for _ in 1..self.len {
             let prev = i.checked_sub(1).unwrap_or(PLANNER_BLOCKS - 1);
             let prev_nominal_sqr = self.blocks[prev].nominal_sqr;
@@ -481,5 +487,32 @@ impl Planner {
             b.entry_sqr = b.entry_sqr.min(reach);
             reach = b.entry_sqr.saturating_add(b.delta_sqr);
         }
+    }
+}
+
+/// The right shift that brings speeds² up to `max_sqr` into a `u32`.
+fn shift_for(max_sqr: f32) -> u8 {
+    let mut shift = 0;
+    // `u32::MAX as f32` rounds up to 2³²: compare with 2³¹ and halve.
+    let mut top = max_sqr * 0.5;
+    while top >= (1u32 << 31) as f32 {
+        top *= 0.5;
+        shift += 1;
+    }
+    shift
+}
+
+/// A speed² for the planner's fields: shifted, at most `u32::MAX` (a
+/// straight junction's "no limit").
+fn down(v: u64, shift: u8) -> u32 {
+    (v >> shift).min(u32::MAX as u64) as u32
+}
+
+/// `x · 2^k` by its exponent (a multiply is ~1 000 cycles on the AVR); `x`
+/// normal or zero, and no overflow: the events² of a planner speed².
+fn times_pow2(x: f32, k: u8) -> f32 {
+    match x == 0.0 {
+        true => x,
+        false => f32::from_bits(x.to_bits() + ((k as u32) << 23)),
     }
 }

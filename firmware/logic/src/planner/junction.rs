@@ -74,6 +74,17 @@ impl Geometry {
         g
     }
 
+    /// The fastest any move can go along the path, squared,
+    /// (milli-units/s)²: every axis at its own top speed.
+    pub fn max_speed_sqr(&self) -> f32 {
+        let mut sum = 0.0;
+        for i in 0..AXES {
+            let v = self.max_rate[i] as f32 * self.milli_per_step[i];
+            sum += v * v;
+        }
+        sum
+    }
+
     /// Acceleration (events/s²) and speed (events/s) of the block that
     /// keep every axis within its own: an axis making `n` of the `e` steps
     /// runs at `n / e` of the event rate. The tightest axis is found by
@@ -171,17 +182,17 @@ pub struct Turn {
 }
 
 impl Turn {
-    /// Packed into a `u64`: the planner keeps it in a block's field that
-    /// is written again before it is read (no RAM of its own: the margin
-    /// is a few dozen bytes).
-    pub fn pack(self) -> u64 {
-        (self.cos.to_bits() as u64) << 32 | self.per_accel.to_bits() as u64
+    /// Packed into two `u32`s: the planner keeps it in two of a block's
+    /// fields that are written again before they are read (no RAM of its
+    /// own).
+    pub fn pack(self) -> (u32, u32) {
+        (self.cos.to_bits(), self.per_accel.to_bits())
     }
 
-    pub fn unpack(bits: u64) -> Turn {
+    pub fn unpack((cos, per_accel): (u32, u32)) -> Turn {
         Turn {
-            cos: f32::from_bits((bits >> 32) as u32),
-            per_accel: f32::from_bits(bits as u32),
+            cos: f32::from_bits(cos),
+            per_accel: f32::from_bits(per_accel),
         }
     }
 

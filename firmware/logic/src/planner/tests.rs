@@ -6,13 +6,45 @@ use std::vec::Vec;
 
 fn entries(p: &Planner) -> Vec<u64> {
     (0..p.len)
-        .map(|i| p.blocks[(p.head + i) % PLANNER_BLOCKS].entry_sqr)
+        .map(|i| (p.blocks[(p.head + i) % PLANNER_BLOCKS].entry_sqr as u64) << p.shift)
         .collect()
 }
 
 /// Nominal path speed² of a 4000 steps/s move on one axis of `square()`:
 /// 40 units/s = 40 000 milli/s.
 const FULL_SQR: u64 = 40_000 * 40_000;
+
+#[test]
+fn speeds_of_a_fast_machine_are_kept_shifted() {
+    // 10 steps/unit at 100 000 steps/s: 10 000 units/s on each axis,
+    // 10⁷ milli/s; 4·10¹⁴ squared on the four: 32 bits only shifted
+    // right by 17.
+    let mut c = square();
+    for a in &mut c.axes {
+        a.steps_per_unit = crate::units::StepsPerUnit::new(10, 1);
+        a.max_rate = 100_000;
+        a.accel = 100_000;
+    }
+    let mut p = Planner::new(&c);
+    assert_eq!(p.shift, 17);
+    for k in 1..=3 {
+        p.push([k * 200_000, 0, 0, 0], Feed::Rapid).unwrap();
+    }
+    let e = entries(&p);
+    let full = 1e14;
+    assert_eq!(e[0], 0);
+    assert!((e[1] as f64 - full).abs() < full * 1e-4, "{e:?}");
+    let t = p.take_speeds().unwrap();
+    let cruise = 100_000f64 * 100_000.0;
+    assert!(
+        (t.speeds.cruise_sqr as f64 - cruise).abs() < cruise * 1e-4,
+        "{t:?}"
+    );
+    assert!(
+        (t.speeds.exit_sqr as f64 - cruise).abs() < cruise * 1e-4,
+        "{t:?}"
+    );
+}
 
 #[test]
 fn straight_on_keeps_full_speed() {
