@@ -980,11 +980,9 @@ fn offsets_line(line: u8) -> bool {
     true
 }
 
-/// The machine's defaults in place of `cfg`. Out of line: the copy they
-/// are made in stays off the console's frame.
-#[inline(never)]
+/// The machine's defaults in place of `cfg`.
 fn restore_defaults(cfg: &mut MachineConfig) {
-    *cfg = MachineConfig::defaults(cfg.machine);
+    cfg.load_defaults(cfg.machine);
 }
 
 /// Grbl's feedback message: `[MSG:<text>]`.

@@ -200,24 +200,30 @@ impl JobTask {
             self.event(e, now);
             return true;
         }
-        let Some(msg) = CARD_OUT.peek() else {
-            return false;
-        };
-        // Checking the files ends in a log line (`files ok` or the error).
-        if self.stream.checking() && !room_for_a_line() {
-            return false;
-        }
-        // Pattern bytes wait in the queue until winding wants them.
-        let winding = matches!(self.stream, Stream::Pattern(_));
-        if matches!(msg.what, What::Data { .. }) && winding && msg.ticket == self.ticket {
+        // Read in place, taken once handled: a copy would sit on the stack
+        // under the file checks. The reader, a task that never runs in
+        // the middle of this one, writes only free slots.
+        let taken = CARD_OUT.peek_with(|msg| {
+            // Checking the files ends in a log line (`files ok` or the error).
+            if self.stream.checking() && !room_for_a_line() {
+                return false;
+            }
+            // Pattern bytes wait in the queue until winding wants them.
+            let winding = matches!(self.stream, Stream::Pattern(_));
+            if matches!(msg.what, What::Data { .. }) && winding && msg.ticket == self.ticket {
+                return false;
+            }
+            self.card(msg, m, config, now);
+            true
+        });
+        if taken != Some(true) {
             return false;
         }
         let _ = CARD_OUT.pop();
-        self.card(msg, m, config, now);
         true
     }
 
-    fn card(&mut self, msg: CardMsg, m: &mut Motion, config: &mut MachineConfig, now: u32) {
+    fn card(&mut self, msg: &CardMsg, m: &mut Motion, config: &mut MachineConfig, now: u32) {
         match msg.what {
             What::Inserted => return self.event(Event::CardInserted, now),
             What::Removed => {
@@ -237,7 +243,7 @@ impl JobTask {
             _ => return,
         };
         let next = match msg.what {
-            What::Data { len, bytes } => match files.push(&bytes[..len as usize]) {
+            What::Data { len, ref bytes } => match files.push(&bytes[..len as usize]) {
                 Ok(()) => return,
                 Err(e) => Err(e),
             },
@@ -327,6 +333,21 @@ impl JobTask {
         }
     }
 
+    // The streams are built out of line: their values would sit in the
+    // job task's frame, under its deepest calls (the files' checks).
+
+    #[inline(never)]
+    fn read_files(&mut self) {
+        self.stream = Stream::Files(Files::new());
+        self.open(FileName::Param);
+    }
+
+    #[inline(never)]
+    fn open_pattern(&mut self) {
+        self.stream = Stream::Pattern(Pattern::new(self.nails));
+        self.open(FileName::Poradi);
+    }
+
     /// Ask the card reader for a file; its messages carry the new ticket.
     fn open(&mut self, name: FileName) {
         self.ticket = self.ticket.wrapping_add(1).max(1);
@@ -344,8 +365,8 @@ impl JobTask {
     }
 
     /// End, loss or failure of `poradi.txt` while winding.
-    fn pattern_ended(&mut self, msg: CardMsg, now: u32) {
-        match (&mut self.stream, msg.what) {
+    fn pattern_ended(&mut self, msg: &CardMsg, now: u32) {
+        match (&mut self.stream, &msg.what) {
             (Stream::Pattern(p), What::End) => p.ended = true,
             _ => {
                 self.stream = Stream::None;
@@ -407,10 +428,7 @@ impl JobTask {
                 }
                 Action::Log(msg) => info!(texts::msg(msg)),
                 Action::Prompt(p) => info!(texts::prompt(p)),
-                Action::ReadFiles => {
-                    self.stream = Stream::Files(Files::new());
-                    self.open(FileName::Param);
-                }
+                Action::ReadFiles => self.read_files(),
                 Action::OpenPattern if self.stream.checked_machine().is_some() && !m.is_idle() => {
                     // The card's machine, not yet taken, before the pattern
                     // takes its place.
@@ -419,8 +437,7 @@ impl JobTask {
                 }
                 Action::OpenPattern => {
                     self.configure(m, config);
-                    self.stream = Stream::Pattern(Pattern::new(self.nails));
-                    self.open(FileName::Poradi);
+                    self.open_pattern();
                 }
                 Action::NextMoves if self.feeder.chained() => {
                     // The last wrap still runs: the next blends into it.

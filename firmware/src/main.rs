@@ -288,6 +288,7 @@ fn init() -> Watchdog {
         pins.d11.into_output(),
         PenConfig::pulse_us(CONFIG.with(|c| c.pen.up_deg)),
     );
+    CONFIG.with(|c| motion::configure_planner(c));
     start_motion(stepper, drivers, pen);
     start_card(CardSpi::start(
         dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53,
@@ -336,9 +337,9 @@ fn init() -> Watchdog {
 fn load_store(eeprom: Eeprom) -> (bool, Found) {
     let mut store = Store::new(eeprom);
     // CONFIG starts as the defaults, read from flash (a starting value in
-    // `.data` would be a second copy of them in flash). Read in place from
-    // here on: a copy would sit on init's stack.
-    CONFIG.init(MachineConfig::defaults(Machine::StringArt));
+    // `.data` would be a second copy of them in flash), in place: a copy
+    // would sit on init's stack.
+    CONFIG.init_with(|c| MachineConfig::init_defaults(Machine::StringArt, c));
     let store_now = CONFIG.with(|c| store.load(c));
     let found = store.load_checkpoint();
     STORE.with(|s| *s = Some(store));
@@ -372,7 +373,7 @@ fn boot_log(reset: ResetCause) {
 #[optimize(size)]
 fn start_motion(stepper: Stepper, drivers: Drivers, pen: PenServo) {
     MOTION.with(|m| {
-        let motion = m.insert(CONFIG.with(|c| Motion::new(c, stepper, drivers, pen)));
+        let motion = m.insert(Motion::new(stepper, drivers, pen));
         motion.yield_to(others_ready);
     });
 }

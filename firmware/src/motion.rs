@@ -84,14 +84,15 @@ pub struct Motion {
     pub pen: PenServo,
 }
 
+/// The planner's figures at boot, before [`Motion::new`]: out of the frame
+/// the motion's state is built in (the stack peak at boot).
+pub fn configure_planner(config: &MachineConfig) {
+    PLANNER.with(|p| p.configure(config));
+}
+
 impl Motion {
-    pub fn new(
-        config: &MachineConfig,
-        stepper: Stepper,
-        drivers: Drivers,
-        pen: PenServo,
-    ) -> Motion {
-        PLANNER.with(|p| p.configure(config));
+    /// After [`configure_planner`].
+    pub fn new(stepper: Stepper, drivers: Drivers, pen: PenServo) -> Motion {
         Motion {
             prep: Prep::new(),
             buffered: Buffered::new(),

@@ -68,7 +68,7 @@ impl Store {
             Err(why) => why,
         };
         if why == Unusable::Inconsistent {
-            *cfg = MachineConfig::defaults(Machine::StringArt);
+            cfg.load_defaults(Machine::StringArt);
         }
         self.unusable = Some(why);
         self.settings_due = true;

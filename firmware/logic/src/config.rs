@@ -7,6 +7,7 @@ use crate::homing::HomingConfig;
 use crate::machine::Machine;
 use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
+use core::mem::MaybeUninit;
 
 /// Per-axis figures. Rates are in steps so the step generator never converts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -162,16 +163,20 @@ impl MachineConfig {
 
     /// The seed's figures, a copy of them from a table in flash (1 KB
     /// less than the code that built them).
-    #[inline(never)]
     pub fn defaults(machine: Machine) -> MachineConfig {
-        let table = taut_progmem::table!(MachineConfig; 5; [
-            seed(Machine::StringArt),
-            seed(Machine::Drum),
-            seed(Machine::Flatbed),
-            seed(Machine::Whiteboard),
-            seed(Machine::Scara),
-        ]);
-        table.get(machine as usize)
+        seeds().get(machine as usize)
+    }
+
+    /// [`MachineConfig::defaults`] in place of `self`: no copy on the
+    /// (AVR's small) stack.
+    #[inline(never)]
+    pub fn load_defaults(&mut self, machine: Machine) {
+        seeds().get_into(machine as usize, self)
+    }
+
+    /// [`MachineConfig::defaults`] written into `out`, in place.
+    pub fn init_defaults(machine: Machine, out: &mut MaybeUninit<MachineConfig>) -> &mut Self {
+        seeds().init(machine as usize, out)
     }
 
     pub fn axis(&self, i: usize) -> &AxisConfig {
@@ -218,6 +223,17 @@ impl Default for MachineConfig {
     fn default() -> Self {
         Self::STRING_ART
     }
+}
+
+/// The seeds' figures, in flash.
+fn seeds() -> taut_progmem::Table<MachineConfig> {
+    taut_progmem::table!(MachineConfig; 5; [
+        seed(Machine::StringArt),
+        seed(Machine::Drum),
+        seed(Machine::Flatbed),
+        seed(Machine::Whiteboard),
+        seed(Machine::Scara),
+    ])
 }
 
 /// The seed's figures, at compile time.

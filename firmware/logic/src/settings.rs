@@ -492,7 +492,7 @@ impl Setting {
         self.check(value)?;
         // Another machine: its defaults, whole (they always hold).
         if let Value::Machine(m) = value {
-            *cfg = MachineConfig::defaults(m);
+            cfg.load_defaults(m);
             return Ok(());
         }
         // Changed in place and put back on an error: no copy of the whole

@@ -95,6 +95,38 @@ impl<T: Copy> Table<T> {
         Table { items }
     }
 
+    /// Item `i` copied into `out`, in place: no copy on the stack (a
+    /// big item's is, on the AVR, under whatever the caller calls next).
+    pub fn get_into(&self, i: usize, out: &mut T) {
+        // SAFETY: a whole value of `T` is written, and nothing reads `out`
+        // before (the bounds are checked first: no panic midway).
+        self.init(i, unsafe {
+            &mut *(out as *mut T).cast::<core::mem::MaybeUninit<T>>()
+        });
+    }
+
+    /// Item `i` written into `out`, in place (as [`Table::get_into`]).
+    pub fn init<'a>(&self, i: usize, out: &'a mut core::mem::MaybeUninit<T>) -> &'a mut T {
+        let item = &self.items[i];
+        #[cfg(target_arch = "avr")]
+        {
+            let from = (item as *const T).cast::<u8>();
+            let to = out.as_mut_ptr().cast::<u8>();
+            for k in 0..core::mem::size_of::<T>() {
+                let b: u8;
+                // SAFETY: as in `get`.
+                unsafe {
+                    core::arch::asm!("lpm {0}, Z", out(reg) b, in("Z") from.wrapping_add(k), options(pure, readonly, nostack));
+                    to.add(k).write(b);
+                }
+            }
+        }
+        #[cfg(not(target_arch = "avr"))]
+        out.write(*item);
+        // SAFETY: every byte of `out` written from a value of `T`, `Copy`.
+        unsafe { out.assume_init_mut() }
+    }
+
     /// A copy of item `i`, read a byte at a time with `lpm` on the AVR.
     pub fn get(&self, i: usize) -> T {
         let item = &self.items[i];

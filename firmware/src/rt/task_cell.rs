@@ -45,6 +45,15 @@ impl<T> TaskCell<T> {
         unsafe { (*self.value.get()).write(value) };
     }
 
+    /// [`TaskCell::init`] by `f`, which writes the value in place (a big
+    /// one, built on the stack and copied, would deepen it) and returns it
+    /// initialised.
+    pub fn init_with(&self, f: impl for<'a> FnOnce(&'a mut MaybeUninit<T>) -> &'a mut T) {
+        assert!(!self.borrowed.get());
+        // SAFETY: exclusive as in `with`.
+        f(unsafe { &mut *self.value.get() });
+    }
+
     /// Run `f` with the state. Panics if a task re-enters it.
     pub fn with<R>(&self, f: impl FnOnce(&mut T) -> R) -> R {
         assert!(!self.borrowed.replace(true));
