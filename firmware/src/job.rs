@@ -398,6 +398,7 @@ impl JobTask {
     }
 
     /// Carry out actions while their log lines fit; `Some` to stop the run.
+    #[inline(never)]
     fn carry_out(
         &mut self,
         m: &mut Motion,

@@ -589,11 +589,8 @@ fn job() {
     if saving {
         spawn(Task::Store);
     }
-    // A plotter's card switched the machine: its kinematics, kept in EEPROM.
     if CONFIG.with(|cfg| cfg.machine) != machine {
-        CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
-        settings_changed();
-        spawn(Task::Console);
+        machine_switched();
     }
     spawn(Task::Motion);
     reschedule(Task::Job, poll);
@@ -603,6 +600,16 @@ fn job() {
     if CARD_OUT.free() >= card::ROOM {
         signal(Signal::CardRoom);
     }
+}
+
+/// A plotter's card switched the machine: its kinematics, kept in EEPROM.
+/// Out of line: the kinematics, made on the stack, would sit in the job
+/// task's frame under its deepest calls.
+#[inline(never)]
+fn machine_switched() {
+    CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
+    settings_changed();
+    spawn(Task::Console);
 }
 
 #[inline(never)]
