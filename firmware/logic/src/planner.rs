@@ -65,9 +65,27 @@ pub struct Taken {
     pub ev_per_milli_sqr: f32,
 }
 
-#[derive(Clone, Copy, Debug, Default)]
+/// A move's steps and directions, as a [`StepBlock`] without its events
+/// (the most steps of an axis): 4 B a block less.
+#[derive(Clone, Copy, Debug)]
+struct Steps {
+    steps: [u32; AXES],
+    dir: u8,
+}
+
+impl Steps {
+    fn block(&self) -> StepBlock {
+        StepBlock {
+            steps: self.steps,
+            events: self.steps.iter().copied().max().unwrap_or(0),
+            dir: self.dir,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
 struct Block {
-    step: StepBlock,
+    step: Steps,
     /// Events/s², the tightest of the axes' limits.
     accel: u32,
     /// The speed asked for, events/s, before the overrides and the axes'
@@ -90,9 +108,8 @@ struct Block {
 
 impl Block {
     const EMPTY: Block = Block {
-        step: StepBlock {
+        step: Steps {
             steps: [0; AXES],
-            events: 0,
             dir: 0,
         },
         accel: 0,
@@ -245,7 +262,10 @@ impl Planner {
         if self.is_full() {
             return Err(Full);
         }
-        let mut step = StepBlock::default();
+        let mut step = Steps {
+            steps: [0; AXES],
+            dir: 0,
+        };
         for i in 0..AXES {
             let delta = target[i] as i64 - self.position[i] as i64;
             step.steps[i] = delta.unsigned_abs() as u32;
@@ -253,14 +273,12 @@ impl Planner {
                 step.dir |= 1 << i;
             }
         }
-        step.events = step.steps.iter().copied().max().unwrap_or(0);
-        if step.events == 0 {
+        if step.steps.iter().all(|&n| n == 0) {
             return Ok(());
         }
-        self.blocks[self.staged()] = Block {
-            step,
-            ..Block::EMPTY
-        };
+        // Its other fields are all written by the parts before they are read.
+        let slot = self.staged();
+        self.blocks[slot].step = step;
         self.position = target;
         self.stage = Stage::Pushed(feed);
         Ok(())
@@ -302,7 +320,7 @@ impl Planner {
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_path(&mut self, feed: Feed) {
         let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
-        let path = self.geometry.path(&b.step);
+        let path = self.geometry.path(&b.step.block());
         // Scaled to events/s by `plan_limits`: this part is the longer.
         b.feed_ev = match feed {
             Feed::Rapid => 0.0,
@@ -345,7 +363,8 @@ impl Planner {
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_limits(&mut self, ev_per_milli: f32) {
         let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
-        let (accel, rate) = self.geometry.limits(&b.step);
+        let step = b.step.block();
+        let (accel, rate) = self.geometry.limits(&step);
         let k2 = ev_per_milli * ev_per_milli;
         let overrides = self.overrides.unwrap_or(Overrides::NONE);
         b.feed_ev = b.feed_ev / 60.0 * ev_per_milli;
@@ -355,7 +374,7 @@ impl Planner {
             self.shift,
         );
         b.ev_per_milli_sqr = k2;
-        let delta = ((2 * accel as u64 * b.step.events as u64) as f32 / k2) as u64;
+        let delta = ((2 * accel as u64 * step.events as u64) as f32 / k2) as u64;
         b.delta_sqr = down(delta, self.shift);
         self.stage = Stage::Limits;
     }
@@ -405,7 +424,7 @@ impl Planner {
         let k2 = times_pow2(b.ev_per_milli_sqr, self.shift);
         let to_events = |v: u32| (v as f32 * k2) as u64;
         Some(Taken {
-            block: b.step,
+            block: b.step.block(),
             accel: b.accel,
             speeds: Speeds {
                 entry_sqr: to_events(b.entry_sqr),
@@ -444,7 +463,7 @@ impl Planner {
         self.overrides = Some(overrides);
         for i in 0..self.len {
             let b = &mut self.blocks[(self.head + i) % PLANNER_BLOCKS];
-            let (_, rate) = self.geometry.limits(&b.step);
+            let (_, rate) = self.geometry.limits(&b.step.block());
             let ev_per_milli = crate::fmath::sqrt(b.ev_per_milli_sqr);
             let nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
             b.nominal_sqr = down(nominal_sqr, self.shift);
