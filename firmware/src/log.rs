@@ -6,9 +6,9 @@
 //! level, milliseconds since boot, module, in Grbl 1.1's message brackets,
 //! which every sender shows and none takes for a reply, an error or an
 //! alarm (grbl-streamer aborts a stream on a bare line holding "error"). A
-//! line is built in one static line, [`LOG`], part by part with out-of-line
-//! calls, and queued whole; when the TX ring has no room it is dropped and counted, and the
-//! count is reported on the next line that fits. Levels below `MAX_LEVEL`
+//! line is built in the TX ring itself, part by part with out-of-line
+//! calls, and queued whole; when the ring has no room it is dropped and
+//! counted, and the count is reported on the next line that fits. Levels below `MAX_LEVEL`
 //! (cargo feature `log-debug` lowers it) compile to nothing.
 
 use crate::board::{clock, flash::FlashStr, usart};
@@ -40,9 +40,26 @@ pub fn dropped() -> u16 {
     avr_device::interrupt::free(|cs| DROPPED.borrow(cs).get())
 }
 
+/// A line being written: a reply, a push message or a log line, staged
+/// in the TX ring itself ([`Ring::stage`]) and queued whole at its end, so
+/// that no 100-byte copy of it sits in a frame or a static. A line begun,
+/// or bytes sent ([`usart::send`]), take the ring's free slots: a line
+/// still open then is dropped whole (counted as refused), never mixed.
+/// Replies and log lines share this type, so each value's `ufmt` code
+/// exists once.
+///
+/// [`Ring::stage`]: crate::rt::Ring::stage
 pub struct Line {
-    buf: heapless::Vec<u8, LINE>,
+    /// Its [`usart::staging`] number: another one means the slots are no
+    /// longer its own.
+    owner: u8,
+    /// Bytes staged: a log line's note of dropped lines, then the line.
+    at: u8,
+    /// Where the line starts (after the note).
+    start: u8,
     cut: bool,
+    /// A byte did not fit, or the slots were taken: the line is dropped.
+    lost: bool,
     /// A log line: closed by `]`.
     msg: bool,
 }
@@ -66,9 +83,12 @@ impl ufmt::uWrite for Line {
 }
 
 impl Line {
+    /// Staged if it fits the line (else the line is cut).
     fn push(&mut self, b: u8) {
-        if self.buf.push(b).is_err() {
+        if usize::from(self.at - self.start) >= LINE {
             self.cut = true;
+        } else {
+            self.stage(b);
         }
     }
 
@@ -79,14 +99,67 @@ impl Line {
         }
     }
 
-    /// A log line's start; what the line held before is dropped (the
-    /// static [`LOG`] is begun again for each line). `[MSG:` from flash:
-    /// a format string's pieces would sit in SRAM, pushed bytes cost code.
     #[inline(never)]
-    pub fn begin(&mut self, level: Level, module: FlashStr) {
-        self.buf.clear();
-        self.cut = false;
-        self.msg = true;
+    fn stage(&mut self, b: u8) {
+        self.lost |= !usart::stage(self.owner, usize::from(self.at), b);
+        self.at += 1;
+    }
+
+    /// A new line, the ring's free slots its own.
+    fn new(msg: bool) -> Line {
+        Line {
+            owner: usart::begin_staging(),
+            at: 0,
+            start: 0,
+            cut: false,
+            lost: false,
+            msg,
+        }
+    }
+
+    /// A `[MSG:…]` push message in Grbl's form: no level, time or module;
+    /// closed by `]` even when cut.
+    #[inline(never)]
+    pub fn message() -> Line {
+        let mut l = Line::new(true);
+        let _ = ufmt::uwrite!(l, "{}", crate::flash_str!("[MSG:"));
+        l
+    }
+
+    /// A console reply: no level, time or module.
+    pub fn bare() -> Line {
+        Line::new(false)
+    }
+
+    /// Queue a reply whole; the caller made room (`reply::room`).
+    #[inline(never)]
+    pub fn send(&mut self) {
+        self.end();
+        self.queue();
+    }
+
+    /// Queue what is staged; false (counted as refused) if it was lost.
+    fn queue(&self) -> bool {
+        usart::publish(self.owner, usize::from(self.at), self.lost)
+    }
+
+    /// The newline, always, after a log line's `]`: a line that did not
+    /// fit ends in `~` first.
+    fn end(&mut self) {
+        let close = usize::from(self.msg);
+        if self.cut || usize::from(self.at - self.start) + close + 1 > LINE {
+            self.at = self.start + (LINE - 2 - close) as u8;
+            self.stage(b'~');
+        }
+        if self.msg {
+            self.stage(b']');
+        }
+        self.stage(b'\n');
+    }
+
+    /// A log line's start: `[MSG:` from flash (a format string's pieces
+    /// would sit in SRAM, pushed bytes cost code), level, time, module.
+    fn head(&mut self, level: Level, module: FlashStr) {
         let _ = ufmt::uwrite!(self, "{}", crate::flash_str!("[MSG:"));
         // Immediates, not a byte string: that would be a copy in SRAM.
         #[allow(clippy::byte_char_slices)]
@@ -94,99 +167,48 @@ impl Line {
         let _ = ufmt::uwrite!(self, " {} {}: ", clock::millis(), module);
     }
 
-    /// A `[MSG:…]` push message in Grbl's form: no level, time or module;
-    /// closed by `]` even when cut. Its bytes pushed here, not by a call
-    /// taking the line by reference: the line would then be built apart
-    /// and copied into the caller's, two lines in its frame.
-    pub fn message() -> Line {
-        let mut l = Line::bare();
-        l.msg = true;
-        #[allow(clippy::byte_char_slices)] // (as in `begin`)
-        for c in [b'[', b'M', b'S', b'G', b':'] {
-            let _ = l.buf.push(c);
+    /// A new log line; `n lines dropped` before it while lines were
+    /// dropped (queued only together with it).
+    #[inline(never)]
+    fn begin(level: Level, module: FlashStr) -> Line {
+        let mut l = Line::new(true);
+        let dropped = dropped();
+        if dropped > 0 {
+            l.head(Level::Warn, crate::flash_str!("log"));
+            let _ = ufmt::uwrite!(l, "{}{}", dropped, crate::flash_str!(" lines dropped"));
+            l.end();
+            l.start = l.at;
+            l.cut = false;
         }
+        l.head(level, module);
         l
     }
 
-    /// A console reply: no level, time or module. Replies and log lines
-    /// share this type, so each value's `ufmt` code exists once.
-    pub fn bare() -> Line {
-        Line {
-            buf: heapless::Vec::new(),
-            cut: false,
-            msg: false,
-        }
-    }
-
-    /// Queue a reply whole; the caller made room (`reply::room`). By
-    /// reference: a line moved into the call can be copied first, a
-    /// second line in the caller's frame.
-    pub fn send(&mut self) {
-        self.end();
-        usart::send(&self.buf);
-    }
-
-    /// The newline, always, after a log line's `]`: a line that did not
-    /// fit ends in `~` first.
-    fn end(&mut self) {
-        let close = usize::from(self.msg);
-        if self.cut || self.buf.len() + close + 1 > LINE {
-            self.buf.truncate(LINE - 2 - close);
-            let _ = self.buf.push(b'~');
-        }
-        if self.msg {
-            let _ = self.buf.push(b']');
-        }
-        let _ = self.buf.push(b'\n');
-    }
-
-    /// Queue the line, or count it as dropped. By reference: a line moved
-    /// into the call would be copied on the caller's stack, beside it.
+    /// Queue the log line (and the note before it), or count it as
+    /// dropped.
     fn emit(&mut self) {
         self.end();
-        let dropped = dropped();
-        if dropped > 0 && !note_dropped(dropped, self.buf.len()) {
+        if !self.queue() {
             return count_drop();
         }
-        if !usart::send(&self.buf) {
-            count_drop();
+        if self.start > 0 {
+            avr_device::interrupt::free(|cs| DROPPED.borrow(cs).set(0));
         }
     }
-}
-
-/// `n lines dropped`, queued if it fits with the `then` bytes of the line
-/// that follows it. Out of line: its line is on the stack only while
-/// there is a count to tell, not beside every line emitted.
-#[inline(never)]
-#[cold]
-fn note_dropped(dropped: u16, then: usize) -> bool {
-    let mut note = Line::bare();
-    note.begin(Level::Warn, crate::flash_str!("log"));
-    let _ = ufmt::uwrite!(note, "{}{}", dropped, crate::flash_str!(" lines dropped"));
-    note.end();
-    if note.buf.len() + then > crate::queues::TX.free() {
-        return false;
-    }
-    usart::send(&note.buf);
-    avr_device::interrupt::free(|cs| DROPPED.borrow(cs).set(0));
-    true
 }
 
 /// The log line being built. A log call begins it, appends each part and
 /// queues it with out-of-line calls ([`start`], [`text`], [`part`],
-/// [`finish`]): its caller's frame holds no 100-byte line, which pushed
-/// the caller's other stack slots past the AVR's 63-byte `ldd`/`std`
-/// reach (each access then costs pointer arithmetic), and each value's
-/// formatting is one function, not repeated at every call site. One line
-/// serves all: only tasks log, and they run one at a time, to completion.
-/// Zeroed (an empty line): in `.bss`, no flash.
+/// [`finish`]): each value's formatting is one function, not repeated at
+/// every call site. Only tasks log, one at a time, to completion, and a
+/// line's parts only format. Zeroed: in `.bss`.
 static LOG: TaskCell<Line> = TaskCell::zeroed();
 
 /// A log line's start: level, time, module (`log!`).
 #[doc(hidden)]
 #[inline(never)]
 pub fn start(level: Level, module: FlashStr) {
-    LOG.with(|l| l.begin(level, module));
+    LOG.with(|l| *l = Line::begin(level, module));
 }
 
 /// Append a text from flash to the log line (`log!`'s string literals).

@@ -5,6 +5,7 @@
 
 use crate::queues::{RX, TX};
 use avr_device::atmega2560::USART0;
+use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 
 pub struct Usart0;
 
@@ -28,15 +29,55 @@ fn regs() -> &'static avr_device::atmega2560::usart0::RegisterBlock {
     unsafe { &*USART0::ptr() }
 }
 
-/// Queue bytes for sending; all or nothing. Returns false when the ring is full.
+/// Queue bytes for sending; all or nothing. Returns false when the ring is
+/// full. A line being staged loses its slots (`stage`).
+#[inline(never)]
 pub fn send(bytes: &[u8]) -> bool {
+    begin_staging();
     let ok = TX.push_all(bytes);
     if ok {
-        // Data-register-empty interrupt on: it drains the ring and turns
-        // itself off when the ring is empty. Set atomically with the ISR.
-        avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.udrie0().set_bit()));
+        wake();
     }
     ok
+}
+
+/// Data-register-empty interrupt on: it drains the ring and turns itself
+/// off when the ring is empty. Set atomically with the ISR.
+fn wake() {
+    avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.udrie0().set_bit()));
+}
+
+/// The number of the line staged in the ring's free slots: bumped by
+/// every line begun, sent or queued. Tasks only.
+static STAGING: AtomicU8 = AtomicU8::new(0);
+
+/// The ring's free slots are now the new line's: its number.
+pub fn begin_staging() -> u8 {
+    let n = STAGING.load(Relaxed).wrapping_add(1);
+    STAGING.store(n, Relaxed);
+    n
+}
+
+/// Stage byte `k` of line `owner` (`Ring::stage`): false if it does not
+/// fit or the slots are no longer the line's.
+pub fn stage(owner: u8, k: usize, b: u8) -> bool {
+    owner == STAGING.load(Relaxed) && TX.stage(k, b)
+}
+
+/// Queue the `n` bytes line `owner` staged, unless it `lost` some or its
+/// slots (refused, then).
+#[inline(never)]
+pub fn publish(owner: u8, n: usize, lost: bool) -> bool {
+    let current = STAGING.load(Relaxed);
+    // Queued, the slots are no longer the line's.
+    begin_staging();
+    if lost || owner != current {
+        TX.refuse();
+        return false;
+    }
+    TX.publish(n);
+    wake();
+    true
 }
 
 /// USART0 control register B and its interrupt-enable bits, for the

@@ -104,6 +104,37 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
         true
     }
 
+    /// Producer: write `item` `k` slots past the last one queued, if that
+    /// slot is free; the consumer sees it once [`Ring::publish`] counts it
+    /// in. A message built in the ring itself (a log line): no copy of it
+    /// elsewhere. Nothing else may be pushed meanwhile.
+    pub fn stage(&self, k: usize, item: T) -> bool {
+        if k >= self.free() {
+            return false;
+        }
+        let h = self.head.load(Relaxed).wrapping_add(k as u8);
+        // SAFETY: slot `h` is free (checked above) and the producer's.
+        unsafe { (*self.buf.get())[(h & Self::MASK) as usize] = MaybeUninit::new(item) };
+        true
+    }
+
+    /// Producer: queue the first `n` items staged (all written).
+    pub fn publish(&self, n: usize) {
+        // SAFETY: only the producer touches `stats` mutably.
+        let stats = unsafe { &mut *self.stats.get() };
+        let h = self.head.load(Relaxed).wrapping_add(n as u8);
+        compiler_fence(Release);
+        self.head
+            .store(if WHOLE { h } else { h & Self::MASK }, Relaxed);
+        stats.on_send(self.len());
+    }
+
+    /// Producer: count a message refused (a staged one that did not fit).
+    pub fn refuse(&self) {
+        // SAFETY: only the producer touches `stats` mutably.
+        unsafe { (*self.stats.get()).on_refused() };
+    }
+
     pub fn push(&self, item: T) -> Result<(), T> {
         if self.push_all(&[item]) {
             Ok(())
