@@ -376,6 +376,7 @@ impl JobTask {
     }
 
     /// While winding wants nails and the card has delivered them.
+    #[inline(never)]
     fn feed_nails(&mut self, now: u32) {
         // One nail's actions at a time: `todo` holds one event's.
         while self.todo.is_empty() && self.job.wants_nail() {
@@ -606,18 +607,21 @@ impl Pattern {
                 self.ended = false;
                 return self.reader.finish();
             }
-            match CARD_OUT.peek() {
-                Some(CardMsg {
-                    what: What::Data { len, bytes },
-                    ..
-                }) => {
-                    let _ = CARD_OUT.pop();
-                    self.chunk = bytes;
+            // Copied in place: a copy of the message would sit in the job
+            // task's frame.
+            let took = CARD_OUT.peek_with(|msg| match &msg.what {
+                What::Data { len, bytes } => {
+                    self.chunk = *bytes;
                     self.at = 0;
-                    self.len = len;
+                    self.len = *len;
+                    true
                 }
-                _ => return Ok(None),
+                _ => false,
+            });
+            if took != Some(true) {
+                return Ok(None);
             }
+            let _ = CARD_OUT.pop();
         }
     }
 }
