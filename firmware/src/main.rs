@@ -242,14 +242,7 @@ fn main() -> ! {
 #[inline(never)]
 #[optimize(size)]
 fn init() -> Watchdog {
-    // The zeroed cells' values (in `.bss`: their starting values in
-    // `.data` were 2 KB of flash, nearly all zeros).
-    MOTION.init(None);
-    CONSOLE.init(Console::new());
-    KIN.init(None);
-    JOB.init(JobTask::new());
-    CARD.init(None);
-    STORE.init(None);
+    init_cells();
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
     let reset = ResetCause::take(&dp.CPU);
     let watchdog = Watchdog::start(dp.WDT);
@@ -326,6 +319,20 @@ fn init() -> Watchdog {
     spawn(Task::Led);
 
     watchdog
+}
+
+/// The zeroed cells' values (in `.bss`: their starting values in `.data`
+/// were 2 KB of flash, nearly all zeros). Out of `init`: a value built on
+/// the stack would stay in its frame under everything it calls.
+#[inline(never)]
+#[optimize(size)]
+fn init_cells() {
+    MOTION.init(None);
+    CONSOLE.init(Console::new());
+    KIN.init(None);
+    JOB.init(JobTask::new());
+    CARD.init(None);
+    STORE.init(None);
 }
 
 /// Settings and checkpoint from EEPROM into `CONFIG` and `STORE`: whether

@@ -226,12 +226,29 @@ impl BlendWinder {
         if j >= n {
             return Err(WindError::BadNail(j));
         }
+        // In two calls, the nails' trigonometry first: under the figures
+        // of the wrap's frame, it made the job's deepest stack.
+        let b = self.nails_around(j);
+        self.wrap_between(j, &b)
+    }
+
+    /// Nails j − 1, j and j + 1 as [`around`] puts them.
+    #[inline(never)]
+    fn nails_around(&self, j: u16) -> [Blocked; 3] {
+        let n = self.board.nails();
+        let (s, c) = (&self.scale, &self.clearance);
+        let b = [(j + n - 1) % n, j, (j + 1) % n].map(|i| c.blocked(&self.board, s, i));
+        around(b, self.scale.steps_per_turn)
+    }
+
+    /// [`BlendWinder::wrap`] of nail `j`, `b` its [`nails_around`].
+    ///
+    /// [`nails_around`]: BlendWinder::nails_around
+    #[inline(never)]
+    fn wrap_between(&mut self, j: u16, b: &[Blocked; 3]) -> Result<BlendWrap, WindError> {
+        let n = self.board.nails();
         let prev = (j + n - 1) % n;
         let (s, turn, c) = (&self.scale, self.scale.steps_per_turn, &self.clearance);
-        let b = around(
-            [prev, j, (j + 1) % n].map(|i| c.blocked(&self.board, s, i)),
-            turn,
-        );
         let k = turns_to(b[1].at, self.base, turn);
         let shift = |w: Window| Window {
             lo: w.lo + k,
@@ -242,7 +259,7 @@ impl BlendWinder {
                 .ok_or(WindError::GapTooNarrow(prev))?,
         );
         let after = shift(c.window(&b[1], &b[2]).ok_or(WindError::GapTooNarrow(j))?);
-        let top = ring_over(&b) + c.mm;
+        let top = ring_over(b) + c.mm;
         let outer = libm::ceilf((top - self.board.radius()) * s.radial.as_f32() + EPS) as i32;
         let inner = self.inner;
         // Nail j ahead: out through the window before it, forwards.
