@@ -44,8 +44,9 @@ pub static SAMPLES: Ring<u8, 16> = Ring::new();
 /// human's presses).
 pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
 
-/// Job → card reader.
-pub static CARD_IN: Ring<Request, 2> = Ring::new();
+/// Job → card reader: one request (the reader takes them first), its
+/// one slot usable.
+pub static CARD_IN: Ring<Request, 1, true> = Ring::new();
 /// Card reader → job. Full: the reader keeps its block and waits.
 pub static CARD_OUT: Ring<CardMsg, 4> = Ring::new();
 /// File bytes per message.
