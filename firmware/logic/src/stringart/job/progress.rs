@@ -46,17 +46,17 @@ pub(super) struct Reporter {
     /// Time spent paused so far, and the start of the current pause.
     paused_ms: u32,
     pause_from: Option<u32>,
-    /// A line is due when `done` reaches `next`; lines are `every` apart
-    /// (at most 5 % of the total, at least one unit).
-    every: u32,
+    /// A line is due when `done` reaches `next`; lines are
+    /// [`Reporter::every`] apart.
     next: u32,
-    last: Option<u32>,
+    /// The last line said the total.
+    said_total: bool,
 }
 
 impl Reporter {
     /// A phase started with `from` units done (0, or a resumed phase's).
     pub fn start_at(phase: Phase, total: u32, from: u32, now_ms: u32) -> Self {
-        let every = (total / 20).max(1);
+        let every = Self::every(total);
         Reporter {
             phase,
             total,
@@ -64,10 +64,14 @@ impl Reporter {
             started_ms: now_ms,
             paused_ms: 0,
             pause_from: None,
-            every,
             next: (from / every + 1) * every,
-            last: None,
+            said_total: false,
         }
+    }
+
+    /// Units between lines: 5 % of the total, at least one.
+    fn every(total: u32) -> u32 {
+        (total / 20).max(1)
     }
 
     pub fn pause(&mut self, now_ms: u32) {
@@ -81,7 +85,7 @@ impl Reporter {
     }
 
     fn line(&mut self, done: u32, now_ms: u32) -> Progress {
-        self.last = Some(done);
+        self.said_total = done == self.total;
         let elapsed = now_ms
             .wrapping_sub(self.started_ms)
             .wrapping_sub(self.paused_ms);
@@ -107,15 +111,16 @@ impl Reporter {
         if done < self.next {
             return None;
         }
+        let every = Self::every(self.total);
         while self.next <= done {
-            self.next += self.every;
+            self.next += every;
         }
         Some(self.line(done, now_ms))
     }
 
     /// The phase's last line, unless the last update already said it.
     pub fn finish(&mut self, now_ms: u32) -> Option<Progress> {
-        (self.last != Some(self.total)).then(|| self.line(self.total, now_ms))
+        (!self.said_total).then(|| self.line(self.total, now_ms))
     }
 }
 
