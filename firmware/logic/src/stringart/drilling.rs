@@ -39,6 +39,22 @@ pub struct Drilling {
     stage: Stage,
 }
 
+/// The drill's positions of [`Drilling::blended`], steps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Depths {
+    raised: i32,
+    plunged: i32,
+}
+
+impl Depths {
+    pub fn blended(config: &MachineConfig) -> Self {
+        Depths {
+            raised: -tool_axis_steps(config, SIDEWAYS_CLEARANCE_MM),
+            plunged: tool_axis_steps(config, HOLE_DEPTH_MM),
+        }
+    }
+}
+
 /// Drill steps for a vertical distance, along the tilted axis: rounded once.
 fn tool_axis_steps(config: &MachineConfig, vertical_mm: f32) -> i32 {
     let along = vertical_mm / fmath::sin_cos(DRILL_ANGLE_DEG.to_radians()).0;
@@ -62,9 +78,25 @@ impl Drilling {
     /// hole [`SIDEWAYS_CLEARANCE_MM`] above the surface, so the retract
     /// and the next plunge each end as soon as the tip is clear of it.
     pub fn blended(board: Board, config: &MachineConfig) -> Self {
-        let mut d = Self::new(board, config);
-        d.raised = -tool_axis_steps(config, SIDEWAYS_CLEARANCE_MM);
-        d
+        Self::on(
+            board,
+            StepScale::from_config(config),
+            Depths::blended(config),
+        )
+    }
+
+    /// Drilling `board` with the figures kept apart (the job keeps a
+    /// board and its scale once, not in each phase's planner too).
+    pub fn on(board: Board, scale: StepScale, depths: Depths) -> Self {
+        Drilling {
+            board,
+            scale,
+            raised: depths.raised,
+            plunged: depths.plunged,
+            nail: 0,
+            base: 0,
+            stage: Stage::Raise,
+        }
     }
 
     /// After a power cut: the drill raised first, then on from hole

@@ -15,7 +15,7 @@ mod winding;
 
 pub use blend::{BlendWinder, BlendWrap};
 pub use clearance::Clearance;
-pub use drilling::Drilling;
+pub use drilling::{Depths, Drilling};
 pub use timing::{machine_time, Overlap};
 pub use winding::{WindError, Winder, Winding, Wrap, Wraps};
 

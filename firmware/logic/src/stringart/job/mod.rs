@@ -53,7 +53,7 @@ pub use phase::Phase;
 pub use phase_steps::FEED;
 pub use progress::{left_s, Progress};
 
-use super::{bit, BlendWinder, Drilling, MachineStep, MACHINE_DRIVERS};
+use super::{bit, BlendWinder, Depths, Drilling, MachineStep, MACHINE_DRIVERS};
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;
 use crate::checkpoint::Saved;
@@ -84,7 +84,8 @@ struct Plan {
     id: CardId,
     board: Board,
     scale: StepScale,
-    drilling: Option<Drilling>,
+    /// The drilling's own figures: its planner is made when it starts.
+    depths: Depths,
     winder: Option<BlendWinder>,
 }
 
@@ -437,9 +438,9 @@ impl Job {
         }
     }
 
-    /// The job's plan, made in place (on the stack it would sit under
-    /// the winder's checks of every gap); false when the board cannot be
-    /// made, and then there is none.
+    /// The job's plan, put together after the winder's checks of every
+    /// gap (on the stack it would sit under them); false when the board
+    /// cannot be made, and then there is none.
     fn plan(&mut self, params: Params, count: u32, id: CardId, config: &MachineConfig) -> bool {
         self.plan = None;
         let Ok(radius) = i32::try_from(params.radius_um) else {
@@ -451,15 +452,14 @@ impl Job {
         let Ok(winder) = BlendWinder::new(board, config) else {
             return false;
         };
-        let plan = self.plan.insert(Plan {
+        self.plan = Some(Plan {
             count,
             id,
             board,
             scale: StepScale::from_config(config),
-            drilling: None,
+            depths: Depths::blended(config),
             winder: Some(winder),
         });
-        plan.drilling = Some(Drilling::blended(board, config));
         true
     }
 
@@ -560,11 +560,10 @@ impl Job {
         let (Some(s), Some(plan)) = (self.saved.take(), &mut self.plan) else {
             return;
         };
-        let drilling = plan.drilling.take();
-        match (s.phase(), drilling) {
-            (Phase::Drilling, Some(d)) => {
+        match s.phase() {
+            Phase::Drilling => {
                 let hole = s.n().min(plan.board.nails() as u32);
-                let d = d.from_hole(hole as u16);
+                let d = Drilling::on(plan.board, plan.scale, plan.depths).from_hole(hole as u16);
                 self.steps = Some(PhaseSteps::drill(d, plan.board.nails(), Some(hole), now_ms));
                 self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
             }
@@ -592,12 +591,9 @@ impl Job {
     }
 
     fn start_drilling(&mut self, o: &mut Out, now_ms: u32) {
-        let Some(plan) = &mut self.plan else { return };
-        let Some(drilling) = plan.drilling.take() else {
-            return;
-        };
+        let Some(plan) = &self.plan else { return };
         self.steps = Some(PhaseSteps::drill(
-            drilling,
+            Drilling::on(plan.board, plan.scale, plan.depths),
             plan.board.nails(),
             None,
             now_ms,
