@@ -24,7 +24,7 @@ use embedded_hal::spi::{Operation, SpiDevice};
 use embedded_sdmmc::sdcard::spi::AcquireOpts;
 use embedded_sdmmc::{Block, BlockDevice, BlockIdx, SdCard, SdCardError};
 use taut_logic::fat::{
-    BlockRead, Dir, Entry, FatError, File, Scan, Slot as DirSlot, Volume, BLOCK,
+    BlockRead, Dir, Entry, FatError, File, Name, Scan, Slot as DirSlot, Volume, BLOCK,
 };
 use ufmt::uwrite;
 
@@ -105,8 +105,7 @@ pub struct CardReader {
     slot: Slot,
     /// The file being streamed, its request's ticket.
     file: Option<(File, u8)>,
-    block: Block,
-    /// Bytes of `block` not yet sent: `at..len`.
+    /// Bytes of [`BLOCK`] not yet sent: `at..len`.
     at: u16,
     len: u16,
     /// Failed reads of the block being read.
@@ -133,6 +132,34 @@ struct Listing {
 
 /// Directory entries per block.
 const ENTRIES: u8 = (BLOCK / 32) as u8;
+
+/// The block read last. Its file bytes are read in place by the job or
+/// the console (`What::Data`): no block is read while one of them waits
+/// in `CARD_OUT` ([`data_waits`]). All zeros: in `.bss`.
+static BUF: TaskCell<[u8; BLOCK]> = TaskCell::new([0; BLOCK]);
+
+/// The name of the file opened last (`What::Opened`).
+static OPENED: TaskCell<Name> = TaskCell::new(Name::EMPTY);
+
+/// `f` of the file's bytes a `What::Data { at, len }` names.
+pub fn bytes<R>(at: u16, len: u8, f: impl FnOnce(&[u8]) -> R) -> R {
+    BUF.with(|b| f(&b[usize::from(at)..usize::from(at) + usize::from(len)]))
+}
+
+/// Byte `i` of the block (of a `What::Data`'s bytes).
+pub fn byte(i: u16) -> u8 {
+    BUF.with(|b| b[usize::from(i) % BLOCK])
+}
+
+/// The name of the file `What::Opened` announced.
+pub fn opened_name() -> Name {
+    OPENED.with(|n| *n)
+}
+
+/// File bytes wait in `CARD_OUT`: the block is theirs.
+fn data_waits() -> bool {
+    CARD_OUT.any(|m| matches!(m.what, What::Data { .. }))
+}
 
 // The FAT reader fills `Block::contents` through a `[u8; 512]` view.
 const _: () = assert!(size_of::<Block>() == BLOCK && offset_of!(Block, contents) == 0);
@@ -179,7 +206,6 @@ impl CardReader {
             sd: SdCard::new_with_options(TimedSpi(spi), TimedDelay, options),
             slot: Slot::Empty,
             file: None,
-            block: Block::new(),
             at: 0,
             len: 0,
             failures: 0,
@@ -231,15 +257,16 @@ impl CardReader {
             return Poll::Idle;
         };
         if let Some(request) = CARD_IN.peek() {
-            if CARD_OUT.free() < ROOM {
+            // Each but `Close` reads blocks: not while file bytes wait
+            // (an older request's, which their owner drops).
+            let reads = !matches!(request, Request::Close);
+            if CARD_OUT.free() < ROOM || reads && data_waits() {
                 return Poll::Wait(Signal::CardRoom);
             }
             let _ = CARD_IN.pop();
             match request {
-                Request::Open(name, ticket) => {
-                    self.open(volume, ticket, &mut |e| e.matches(name.as_bytes()))
-                }
-                Request::OpenFirst(ticket) => self.open(volume, ticket, &mut Entry::is_gcode),
+                Request::Open(name, ticket) => self.open(volume, ticket, Some(&name)),
+                Request::OpenFirst(ticket) => self.open(volume, ticket, None),
                 Request::List(ticket) => self.list_from_start(volume, ticket),
                 Request::Close => self.file = None,
             }
@@ -259,6 +286,10 @@ impl CardReader {
 
     #[inline(never)]
     fn look_for_card(&mut self) -> Poll<Signal> {
+        // A pulled card's last bytes may still wait: the next check then.
+        if data_waits() {
+            return Poll::Idle;
+        }
         WAITED.with(|w| w.1 = u16::MAX);
         let present = self.sd.spi(|spi| {
             spi.0.bus.slow_speed();
@@ -281,7 +312,7 @@ impl CardReader {
             sd: &self.sd,
             lba: 0,
         };
-        let volume = match Volume::mount(&mut dev, &mut self.block.contents) {
+        let volume = match BUF.with(|b| Volume::mount(&mut dev, b)) {
             Ok(v) => {
                 log_mounted(blocks, v.is_fat32());
                 Some(v)
@@ -308,10 +339,11 @@ impl CardReader {
         Poll::Idle
     }
 
-    /// Open the first file `pick` wants; `Opened` and its bytes follow.
-    /// `dyn`: one copy for both requests (1 KB less than one each).
+    /// Open the file `name`, or the first G-code file; `Opened` and its
+    /// bytes follow. One search for both requests (1 KB less than one
+    /// each).
     #[inline(never)]
-    fn open(&mut self, volume: Option<Volume>, ticket: u8, pick: &mut dyn FnMut(&Entry) -> bool) {
+    fn open(&mut self, volume: Option<Volume>, ticket: u8, name: Option<&Name>) {
         self.file = None;
         self.listing = None;
         self.at = 0;
@@ -323,14 +355,19 @@ impl CardReader {
             sd: &self.sd,
             lba: 0,
         };
-        let found = v
-            .find(&mut dev, &mut self.block.contents, pick)
+        let found = BUF
+            .with(|b| {
+                v.find(&mut dev, b, |e: &Entry| match name {
+                    Some(n) => e.matches(n.as_bytes()),
+                    None => e.is_gcode(),
+                })
+            })
             .and_then(|e| v.file(&e).map(|f| (e, f)));
         match found {
             Ok((e, f)) => {
                 self.file = Some((f, ticket));
-                let (name, size) = (e.name(), e.size);
-                Self::send(What::Opened { name, size }, ticket);
+                OPENED.with(|n| *n = e.name());
+                Self::send(What::Opened { size: e.size }, ticket);
             }
             Err(FatError::NotFound) => Self::send(What::Missing, ticket),
             Err(FatError::Device(e)) => {
@@ -374,7 +411,7 @@ impl CardReader {
                 sd: &self.sd,
                 lba: 0,
             };
-            match volume.read_dir(&mut l.dir, &mut dev, &mut self.block.contents) {
+            match BUF.with(|b| volume.read_dir(&mut l.dir, &mut dev, b)) {
                 Ok(true) => l.at = 0,
                 Ok(false) => return self.listed(l.ticket),
                 Err(FatError::Device(e)) => {
@@ -397,7 +434,7 @@ impl CardReader {
                 return Poll::After(2);
             }
             let at = usize::from(l.at) * 32;
-            let slot = l.scan.take(&self.block.contents[at..at + 32]);
+            let slot = BUF.with(|b| l.scan.take(&b[at..at + 32]));
             l.at += 1;
             match slot {
                 DirSlot::End => return self.listed(l.ticket),
@@ -432,27 +469,22 @@ impl CardReader {
             if CARD_OUT.free() == 0 {
                 return Poll::Wait(Signal::CardRoom);
             }
-            let from = self.at as usize;
             let n = (self.len - self.at).min(CHUNK as u16);
-            let mut bytes = [0; CHUNK];
-            bytes[..n as usize].copy_from_slice(&self.block.contents[from..from + n as usize]);
-            Self::send(
-                What::Data {
-                    len: n as u8,
-                    bytes,
-                },
-                ticket,
-            );
+            let at = self.at;
+            Self::send(What::Data { at, len: n as u8 }, ticket);
             self.at += n;
         }
-        if CARD_OUT.free() < ROOM {
+        // The next block is read over the bytes still waiting; at the
+        // file's end nothing is read, and `End` follows them at once.
+        let reads = file.pos() < file.size();
+        if CARD_OUT.free() < ROOM || reads && data_waits() {
             return Poll::Wait(Signal::CardRoom);
         }
         let mut dev = Device {
             sd: &self.sd,
             lba: 0,
         };
-        match file.read_next(&volume, &mut dev, &mut self.block.contents) {
+        match BUF.with(|b| file.read_next(&volume, &mut dev, b)) {
             Ok(0) => {
                 self.file = None;
                 Self::send(What::End, ticket);

@@ -243,7 +243,7 @@ impl JobTask {
             _ => return,
         };
         let next = match msg.what {
-            What::Data { len, ref bytes } => match files.push(&bytes[..len as usize]) {
+            What::Data { at, len } => match crate::card::bytes(at, len, |b| files.push(b)) {
                 Ok(()) => return,
                 Err(e) => Err(e),
             },
@@ -609,11 +609,11 @@ impl Pattern {
             }
             // Copied in place: a copy of the message would sit in the job
             // task's frame.
-            let took = CARD_OUT.peek_with(|msg| match &msg.what {
-                What::Data { len, bytes } => {
-                    self.chunk = *bytes;
+            let took = CARD_OUT.peek_with(|msg| match msg.what {
+                What::Data { at, len } => {
+                    crate::card::bytes(at, len, |b| self.chunk[..b.len()].copy_from_slice(b));
                     self.at = 0;
-                    self.len = *len;
+                    self.len = len;
                     true
                 }
                 _ => false,

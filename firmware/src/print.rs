@@ -231,7 +231,7 @@ impl Print {
             }
             let msg = CARD_OUT.pop()?;
             match msg.what {
-                What::Opened { name, size } if ours => return self.opened(name, size),
+                What::Opened { size } if ours => return self.opened(size),
                 What::Listed if ours => {
                     self.state = State::Idle;
                     send_line(flash_str!("End file list"));
@@ -256,7 +256,7 @@ impl Print {
 
     #[inline(never)]
     #[optimize(size)]
-    fn opened(&mut self, name: Name, size: u32) -> Answer {
+    fn opened(&mut self, size: u32) -> Answer {
         let State::Opening { start } = self.state else {
             return None;
         };
@@ -270,6 +270,7 @@ impl Print {
             self.state = State::Running;
             return Some(Ok(()));
         }
+        let name = crate::card::opened_name();
         self.name = name;
         self.size = size;
         self.line_start = self.at;
@@ -349,8 +350,8 @@ impl Print {
         }
         loop {
             let head = CARD_OUT.peek_with(|m| match m.what {
-                What::Data { len, bytes } if m.ticket == self.ticket => {
-                    Some((len, bytes[usize::from(self.taken).min(bytes.len() - 1)]))
+                What::Data { at, len } if m.ticket == self.ticket => {
+                    Some((len, crate::card::byte(at + u16::from(self.taken))))
                 }
                 _ => None,
             });

@@ -49,7 +49,7 @@ pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
 pub static CARD_IN: Ring<Request, 1, true> = Ring::new();
 /// Card reader → job. Full: the reader keeps its block and waits.
 pub static CARD_OUT: Ring<CardMsg, 4> = Ring::new();
-/// File bytes per message.
+/// File bytes per message at most.
 pub const CHUNK: usize = 32;
 
 /// `Realtime` task → job: `~` with no feed hold, Ctrl-X.
@@ -87,18 +87,19 @@ pub struct CardMsg {
 pub enum What {
     Inserted,
     Removed,
-    /// The file asked for is open (its name as the user gave it); its
+    /// The file asked for is open (its name: `card::opened_name`); its
     /// bytes follow.
     Opened {
-        name: Name,
         size: u32,
     },
     /// The listing asked for is written.
     Listed,
-    /// The next bytes of the file.
+    /// The next bytes of the file: `len` bytes of the reader's block from
+    /// `at`, read in place (`card::bytes`): no copy of them in the queue.
+    /// The reader reads no block while one waits.
     Data {
+        at: u16,
         len: u8,
-        bytes: [u8; CHUNK],
     },
     End,
     /// No such file on the card.
