@@ -103,8 +103,8 @@ enum Slot {
 pub struct CardReader {
     sd: Sd,
     slot: Slot,
-    /// The file being streamed, its request's ticket.
-    file: Option<(File, u8)>,
+    /// The file being streamed or the listing being written.
+    reading: Reading,
     /// Bytes of [`BLOCK`] not yet sent: `at..len`.
     at: u16,
     len: u16,
@@ -116,8 +116,17 @@ pub struct CardReader {
     faulty: Option<(u32, FlashStr, u8)>,
     /// When the card is next looked for or checked.
     check_at: u32,
+}
+
+/// What the reader is reading: one thing at a time (a request drops the
+/// last one's).
+#[derive(Clone, Copy)]
+enum Reading {
+    Nothing,
+    /// A file, its request's ticket.
+    File(File, u8),
     /// `M20` in progress.
-    listing: Option<Listing>,
+    Listing(Listing),
 }
 
 /// A directory listing written line by line as the TX ring has room.
@@ -205,13 +214,12 @@ impl CardReader {
         CardReader {
             sd: SdCard::new_with_options(TimedSpi(spi), TimedDelay, options),
             slot: Slot::Empty,
-            file: None,
+            reading: Reading::Nothing,
             at: 0,
             len: 0,
             failures: 0,
             faulty: None,
             check_at: 0,
-            listing: None,
         }
     }
 
@@ -268,13 +276,16 @@ impl CardReader {
                 Request::Open(name, ticket) => self.open(volume, ticket, Some(&name)),
                 Request::OpenFirst(ticket) => self.open(volume, ticket, None),
                 Request::List(ticket) => self.list_from_start(volume, ticket),
-                Request::Close => self.file = None,
+                Request::Close if matches!(self.reading, Reading::File(..)) => {
+                    self.reading = Reading::Nothing
+                }
+                Request::Close => {}
             }
             return Poll::Again;
         }
         match volume {
-            Some(v) if self.listing.is_some() => self.list(v),
-            Some(v) if self.file.is_some() => self.stream(v),
+            Some(v) if matches!(self.reading, Reading::Listing(_)) => self.list(v),
+            Some(v) if matches!(self.reading, Reading::File(..)) => self.stream(v),
             _ => Poll::Idle,
         }
     }
@@ -344,8 +355,7 @@ impl CardReader {
     /// each).
     #[inline(never)]
     fn open(&mut self, volume: Option<Volume>, ticket: u8, name: Option<&Name>) {
-        self.file = None;
-        self.listing = None;
+        self.reading = Reading::Nothing;
         self.at = 0;
         self.len = 0;
         let Some(v) = volume else {
@@ -365,7 +375,7 @@ impl CardReader {
             .and_then(|e| v.file(&e).map(|f| (e, f)));
         match found {
             Ok((e, f)) => {
-                self.file = Some((f, ticket));
+                self.reading = Reading::File(f, ticket);
                 OPENED.with(|n| *n = e.name());
                 Self::send(What::Opened { size: e.size }, ticket);
             }
@@ -384,10 +394,13 @@ impl CardReader {
         }
     }
 
+    /// A listing from the root directory's start; a file being read is
+    /// dropped (the print's `Close` before `List` makes way for it in the
+    /// one-slot request ring).
     fn list_from_start(&mut self, volume: Option<Volume>, ticket: u8) {
         match volume {
             Some(v) => {
-                self.listing = Some(Listing {
+                self.reading = Reading::Listing(Listing {
                     dir: v.root(),
                     scan: Scan::new(),
                     at: ENTRIES,
@@ -403,7 +416,7 @@ impl CardReader {
     /// this one is done.
     #[inline(never)]
     fn list(&mut self, volume: Volume) -> Poll<Signal> {
-        let Some(mut l) = self.listing else {
+        let Reading::Listing(mut l) = self.reading else {
             return Poll::Idle;
         };
         if l.at == ENTRIES {
@@ -430,7 +443,7 @@ impl CardReader {
         }
         while l.at < ENTRIES {
             if !crate::reply::room() {
-                self.listing = Some(l);
+                self.reading = Reading::Listing(l);
                 return Poll::After(2);
             }
             let at = usize::from(l.at) * 32;
@@ -449,12 +462,12 @@ impl CardReader {
                 }
             }
         }
-        self.listing = Some(l);
+        self.reading = Reading::Listing(l);
         Poll::Again
     }
 
     fn listed(&mut self, ticket: u8) -> Poll<Signal> {
-        self.listing = None;
+        self.reading = Reading::Nothing;
         Self::send(What::Listed, ticket);
         Poll::Idle
     }
@@ -462,7 +475,7 @@ impl CardReader {
     /// Sends what is left of the block, then reads the next one.
     #[inline(never)]
     fn stream(&mut self, volume: Volume) -> Poll<Signal> {
-        let Some((mut file, ticket)) = self.file else {
+        let Reading::File(mut file, ticket) = self.reading else {
             return Poll::Idle;
         };
         while self.at < self.len {
@@ -486,13 +499,13 @@ impl CardReader {
         };
         match BUF.with(|b| file.read_next(&volume, &mut dev, b)) {
             Ok(0) => {
-                self.file = None;
+                self.reading = Reading::Nothing;
                 Self::send(What::End, ticket);
                 Poll::Idle
             }
             Ok(n) => {
                 self.failures = 0;
-                self.file = Some((file, ticket));
+                self.reading = Reading::File(file, ticket);
                 self.at = 0;
                 self.len = n as u16;
                 Poll::Again
@@ -509,7 +522,7 @@ impl CardReader {
             }
             Err(_) => {
                 warn!("card: broken cluster chain");
-                self.file = None;
+                self.reading = Reading::Nothing;
                 Self::send(What::Failed, ticket);
                 Poll::Idle
             }
@@ -543,7 +556,10 @@ impl CardReader {
             "card: block ",
             lba, " ", what, " ", TRIES, " times: the card is failing, replace it"
         );
-        let reading = self.file.take().is_some() || self.listing.take().is_some();
+        let reading = !matches!(
+            core::mem::replace(&mut self.reading, Reading::Nothing),
+            Reading::Nothing
+        );
         if reading || ticket != 0 {
             Self::send(What::Failed, ticket);
         }
@@ -556,14 +572,21 @@ impl CardReader {
         if self.sd.num_bytes().is_ok() {
             return true;
         }
-        self.removed(self.file.map_or(0, |(_, t)| t));
+        let ticket = match self.reading {
+            Reading::File(_, t) => t,
+            _ => 0,
+        };
+        self.removed(ticket);
         false
     }
 
     /// The card stopped answering: pulled out (or dead, which the user
     /// treats the same way). A file being read fails first.
     fn removed(&mut self, ticket: u8) {
-        if self.file.take().is_some() || self.listing.take().is_some() {
+        if !matches!(
+            core::mem::replace(&mut self.reading, Reading::Nothing),
+            Reading::Nothing
+        ) {
             Self::send(What::Failed, ticket);
         }
         self.failures = 0;
