@@ -2,7 +2,8 @@
 //! the winding window's cycles by function and the motion task's longest
 //! runs (what is inside them). After `cargo xtask build`:
 //! `cargo run --release -p taut-simavr --example job_busy -- \
-//!    firmware/target/avr-none/release/taut.elf`.
+//!    firmware/target/avr-none/release/taut.elf`. With `PCS=FROM-TO` (hex
+//! addresses, from `llvm-nm -S`), the cycles by instruction in that range.
 use std::path::Path;
 use std::time::Duration;
 use taut_logic::axis::Axis;
@@ -90,11 +91,16 @@ fn main() {
         for (c, n) in by.iter().take(45) {
             println!("{:6.2} % {:>12} {}", 100.0 * *c as f64 / total as f64, c, n);
         }
-        if std::env::var_os("PCS").is_some() {
+        // `PCS=0x2cf6-0x2fae`: cycles by instruction in that range.
+        if let Some((from, to)) = std::env::var("PCS").ok().and_then(|r| {
+            let (a, b) = r.split_once('-')?;
+            let hex = |x: &str| u32::from_str_radix(x.trim_start_matches("0x"), 16).ok();
+            Some((hex(a)?, hex(b)?))
+        }) {
             let mut h = prof.hottest(100000);
             h.sort();
             for (pc, c) in h {
-                if (0x2cf6..0x2fae).contains(&pc) {
+                if (from..to).contains(&pc) {
                     println!("{pc:#07x} {c}");
                 }
             }

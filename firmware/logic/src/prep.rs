@@ -226,7 +226,9 @@ impl Prep {
     /// Drop the block being cut and any hold: a stop that abandons the
     /// queued motion (the planner is cleared by the caller).
     pub fn clear(&mut self) {
+        let others = self.cut.yields_to();
         *self = Prep::new();
+        self.cut.yield_to(others);
     }
 }
 

@@ -29,6 +29,54 @@ fn run(moves: &[PerAxis<i32>], hold_after: usize, resume_early: bool) -> Run {
 /// [`Prep::next_part`]); at most `MAX_PIECES` calls a segment.
 const MAX_PIECES: usize = 12;
 
+std::thread_local! {
+    /// What [`others_wait`] says in this test's thread.
+    static OTHERS_WAIT: core::cell::Cell<bool> = const { core::cell::Cell::new(false) };
+}
+
+/// The app's "another task waits" ([`Prep::yield_to`]), as the test sets it.
+fn others_wait() -> bool {
+    OTHERS_WAIT.with(|w| w.get())
+}
+
+/// Calls of [`Prep::load`] and [`Prep::next_part`] to cut `moves` whole.
+fn bounded_calls(prep: &mut Prep, moves: &[PerAxis<i32>]) -> usize {
+    let mut planner = Planner::new(&square());
+    for m in moves {
+        planner.push(*m, Feed::Rapid).unwrap();
+    }
+    let mut calls = 0;
+    loop {
+        calls += 1;
+        if prep.load(&mut planner) {
+            continue;
+        }
+        match prep.next_part(&mut planner) {
+            Err(Later) | Ok(Some(_)) => {}
+            Ok(None) => return calls,
+        }
+    }
+}
+
+/// A call that worked out an event time ends before the fit while another
+/// task waits: more calls, the same segments (the proptest below), and a
+/// cleared preparer (a stop at once) still yields.
+#[test]
+fn a_waiting_task_ends_a_call_before_the_fit() {
+    let moves: Vec<PerAxis<i32>> = (1..=3).map(|k| [k * 2000, k * 700, 0, 0]).collect();
+    let mut prep = Prep::new();
+    prep.yield_to(others_wait);
+    let alone = bounded_calls(&mut prep, &moves);
+    OTHERS_WAIT.with(|w| w.set(true));
+    prep.clear();
+    let yielding = bounded_calls(&mut prep, &moves);
+    OTHERS_WAIT.with(|w| w.set(false));
+    assert!(
+        yielding > alone + 10,
+        "{alone} calls alone, {yielding} yielding"
+    );
+}
+
 fn next_bounded(prep: &mut Prep, planner: &mut Planner) -> Option<Cut> {
     for _ in 0..MAX_PIECES {
         if prep.load(planner) {
@@ -45,6 +93,7 @@ fn next_bounded(prep: &mut Prep, planner: &mut Planner) -> Option<Cut> {
 fn run_as(moves: &[PerAxis<i32>], hold_after: usize, resume_early: bool, bounded: bool) -> Run {
     let mut planner = Planner::new(&square());
     let mut prep = Prep::new();
+    prep.yield_to(others_wait);
     let (mut segs, mut blocks) = (Vec::new(), Vec::new());
     let mut cut_events = 0usize;
     let (mut held_at, mut stood_at) = (None, None);
@@ -179,7 +228,9 @@ proptest! {
         moves in proptest::collection::vec((-3000i32..3000, -3000i32..3000), 1..6),
         hold_frac in 0.0f64..1.0,
         early in any::<bool>(),
+        yielding in any::<bool>(),
     ) {
+        OTHERS_WAIT.with(|w| w.set(yielding));
         let mut at = [0i32; AXES];
         let targets: Vec<PerAxis<i32>> = moves
             .iter()
@@ -201,7 +252,8 @@ proptest! {
                 .sum()
         };
         let r = run(&targets, (hold_frac * total as f64) as usize, early);
-        // Cut in bounded pieces, the same events at the same times.
+        // Cut in bounded pieces (ending before a fit when `yielding`), the
+        // same events at the same times.
         let b = run_as(&targets, (hold_frac * total as f64) as usize, early, true);
         prop_assert!(b.events == r.events, "bounded pieces cut other events");
         prop_assert_eq!(travel(&r.events), at);

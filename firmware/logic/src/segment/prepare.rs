@@ -117,6 +117,11 @@ impl Preparer {
         self.yield_to = others;
     }
 
+    /// What [`Preparer::yield_to`] set (kept over a clear).
+    pub(crate) fn yields_to(&self) -> fn() -> bool {
+        self.yield_to
+    }
+
     /// Every event of the current block has been cut into segments.
     pub fn is_idle(&self) -> bool {
         self.before + self.done >= self.events

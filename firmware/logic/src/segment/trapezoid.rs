@@ -348,26 +348,30 @@ impl Trapezoid {
 
     /// [`Trapezoid::cruise_time`] from the end of the acceleration to
     /// event `k` of the cruise, without its divisions: `2a·k − acc2` is
-    /// `2a·(k − k_acc) − ρ` with `ρ = acc2 − 2a·k_acc` below `2a`, and
-    /// the fraction's quotient fits 32 bits when the interval does.
+    /// `2a·(k − k_acc) − ρ` with `ρ = acc2 − 2a·k_acc` below `2a`.
     fn cruise_time_to(&self, k: u32) -> u64 {
         let rho = self.acc2 - self.two_a * self.k_acc as u64;
-        let (q, r) = match rho {
-            0 => (k - self.k_acc, 0),
-            _ => (k - self.k_acc - 1, self.two_a - rho),
-        };
+        match rho {
+            0 => self.cruise_span((k - self.k_acc) as u64, 0),
+            _ => self.cruise_span((k - self.k_acc - 1) as u64, self.two_a - rho),
+        }
+    }
+
+    /// Time to cruise `w / (2a)` events.
+    fn cruise_time(&self, w: u64) -> u64 {
+        self.cruise_span(w / self.two_a, w % self.two_a)
+    }
+
+    /// Time to cruise `q + r / (2a)` events (`r` below `2a`): the
+    /// fraction's quotient fits 32 bits when the interval does (a `u64`
+    /// division is ~3 000 cycles on the AVR).
+    fn cruise_span(&self, q: u64, r: u64) -> u64 {
         let part = r * self.cruise_iv;
         let frac = match self.two_a as u32 {
             d if part >> 32 < d as u64 => div_to_u32(part, d) as u64,
             _ => part / self.two_a,
         };
-        (q as u64 * self.cruise_iv + frac) >> (31 - self.shift)
-    }
-
-    /// Time to cruise `w / (2a)` events.
-    fn cruise_time(&self, w: u64) -> u64 {
-        let (q, r) = (w / self.two_a, w % self.two_a);
-        (q * self.cruise_iv + r * self.cruise_iv / self.two_a) >> (31 - self.shift)
+        (q * self.cruise_iv + frac) >> (31 - self.shift)
     }
 }
 
