@@ -29,9 +29,14 @@ impl Flags {
         avr_device::interrupt::free(|_| unsafe { core::mem::take(&mut *self.0.get()) })
     }
 
-    /// No bit set (read with interrupts masked: the two bytes agree).
-    pub fn is_empty(&self) -> bool {
-        avr_device::interrupt::free(|_| self.is_empty_masked())
+    /// No bit set, as far as a read without masking sees: a bit set while
+    /// it reads may be missed (a hint for a task deciding whether to end
+    /// its run early; the step interrupt is not delayed by it).
+    pub fn seems_empty(&self) -> bool {
+        // SAFETY: a volatile read of a value only ever changed whole by a
+        // masked read-modify-write; a torn read is one of its two values'
+        // halves, which may only miss a bit just set.
+        unsafe { core::ptr::read_volatile(self.0.get()) == 0 }
     }
 
     /// With interrupts masked (the dispatcher's idle path): the two bytes
