@@ -386,9 +386,10 @@ fn start_motion(stepper: Stepper, drivers: Drivers, pen: PenServo) {
 }
 
 /// Another task waits to run (an interrupt spawned it, or it is ready): a
-/// motion run ends at its next part's boundary. Read without masking:
-/// with a masked read here, the `scheduler` HIL test measured a cruise
-/// pulse 2.03 µs off its grid (the bar is 2).
+/// motion run ends at its next part's boundary. Read without masking, as
+/// `dispatch::admit` looks first: with masked reads on every spawn and
+/// check, the `scheduler` HIL test measured a cruise pulse 2.03 µs off its
+/// grid (the bar is 2).
 fn others_ready() -> bool {
     !SPAWNED.seems_empty() || READY.with(|r| !r.is_empty())
 }

@@ -37,10 +37,12 @@ pub fn admit<T: TaskId, const N: usize, const P: usize>(
     ready: &mut Ready<T, N, P>,
     task: fn(u8) -> T,
 ) -> bool {
-    let flags = spawned.take();
-    if flags == 0 {
+    // Most calls find nothing: looked at without masking the step
+    // interrupt, taken (masked) only when there is something.
+    if spawned.seems_empty() {
         return false;
     }
+    let flags = spawned.take();
     let (mut bits, mut id) = (flags, 0);
     while bits != 0 {
         if bits & 1 != 0 {
