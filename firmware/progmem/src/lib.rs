@@ -114,7 +114,9 @@ impl<T: Copy> Table<T> {
             let to = out.as_mut_ptr().cast::<u8>();
             for k in 0..core::mem::size_of::<T>() {
                 let b: u8;
-                // SAFETY: as in `get`.
+                // SAFETY: `from + k` lies inside the progmem static
+                // (`from_static`'s contract); `lpm` reads flash and has no
+                // other effect; `to + k` inside `out`.
                 unsafe {
                     core::arch::asm!("lpm {0}, Z", out(reg) b, in("Z") from.wrapping_add(k), options(pure, readonly, nostack));
                     to.add(k).write(b);
@@ -129,27 +131,8 @@ impl<T: Copy> Table<T> {
 
     /// A copy of item `i`, read a byte at a time with `lpm` on the AVR.
     pub fn get(&self, i: usize) -> T {
-        let item = &self.items[i];
-        #[cfg(target_arch = "avr")]
-        {
-            let mut out = core::mem::MaybeUninit::<T>::uninit();
-            let from = (item as *const T).cast::<u8>();
-            let to = out.as_mut_ptr().cast::<u8>();
-            for k in 0..core::mem::size_of::<T>() {
-                let b: u8;
-                // SAFETY: `from + k` lies inside the progmem static
-                // (`from_static`'s contract); `lpm` reads flash and has no
-                // other effect; `to + k` inside `out`.
-                unsafe {
-                    core::arch::asm!("lpm {0}, Z", out(reg) b, in("Z") from.wrapping_add(k), options(pure, readonly, nostack));
-                    to.add(k).write(b);
-                }
-            }
-            // SAFETY: every byte copied from a value of `T`, a `Copy` type.
-            unsafe { out.assume_init() }
-        }
-        #[cfg(not(target_arch = "avr"))]
-        *item
+        let mut out = core::mem::MaybeUninit::uninit();
+        *self.init(i, &mut out)
     }
 }
 
