@@ -6,23 +6,8 @@
 //! addresses, from `llvm-nm -S`), the cycles by instruction in that range.
 use std::path::Path;
 use std::time::Duration;
-use taut_logic::axis::Axis;
-use taut_logic::pinmap::driver;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Sim};
-const AXES3: [Axis; 3] = [Axis::Base, Axis::Radial, Axis::Drill];
-fn boot(elf: &Path) -> Sim {
-    let mut sim = Sim::load(elf).expect("firmware loads");
-    for axis in AXES3 {
-        let d = driver(axis);
-        sim.probe_step_dir(axis.name(), d.step, d.dir, true);
-    }
-    assert_eq!(
-        sim.run_until_uart_contains("reset:", Duration::from_millis(50)),
-        Outcome::Done
-    );
-    sim
-}
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let elf = Path::new(&args[1]);
@@ -30,7 +15,7 @@ fn main() {
     let motion = taut_simavr::elf::function_address(elf, "4taut6motion")
         .unwrap()
         .unwrap();
-    let mut sim = boot(elf);
+    let mut sim = Sim::boot(elf);
     sim.insert_sd(SdImage::from_path(&card).unwrap());
     sim.watch_calls(motion);
     let names = [
@@ -38,24 +23,18 @@ fn main() {
         "4taut3job",
         "4taut5store",
         "4taut6timers",
-        "Trapezoid7advance",
         "Preparer11begin_block",
         "Preparer8ramp_run",
-        "Preparer5brake",
         "Preparer7segment",
         "Preparer3fit",
-        "Preparer8ramp_run",
-        "Trapezoid4time",
         "trapezoid7isqrt32",
         "trapezoid5isqrt",
         "10div_to_u32",
         "__muldi3",
-        "8mul_wide",
         "11round_div32",
         "memcpy",
         "12scaled_speed",
         "Preparer5ahead",
-        "Preparer6cruise",
     ];
     let pcs: Vec<Option<u32>> = names
         .iter()

@@ -120,6 +120,23 @@ impl Sim {
         Ok(sim)
     }
 
+    /// Loads the firmware, probes the string-art axes' STEP and DIR pins
+    /// (`base`, `radial`, `drill`) and runs it to its greeting's `reset:`
+    /// line: how the bench and the examples start. Panics if it cannot.
+    pub fn boot(elf_path: &Path) -> Sim {
+        use taut_logic::axis::Axis;
+        let mut sim = Sim::load(elf_path).expect("firmware loads");
+        for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
+            let d = pinmap::driver(axis);
+            sim.probe_step_dir(axis.name(), d.step, d.dir, true);
+        }
+        assert_eq!(
+            sim.run_until_uart_contains("reset:", Duration::from_millis(50)),
+            Outcome::Done
+        );
+        sim
+    }
+
     /// Loads raw machine code (little-endian 16-bit words) at address 0, for
     /// tests with hand-assembled programs. No statics: the stack may grow
     /// down to the start of SRAM unless `set_ram_limit` says otherwise.

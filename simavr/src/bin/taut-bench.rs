@@ -13,7 +13,6 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
-use taut_logic::pinmap::driver;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
@@ -21,19 +20,6 @@ use taut_simavr::{Outcome, Reply, Sim};
 const STEP_VECTOR: u32 = 0x80;
 const TOLERANCE_US: f64 = 2.0;
 const AXES3: [Axis; 3] = [Axis::Base, Axis::Radial, Axis::Drill];
-
-fn boot(elf: &Path) -> Sim {
-    let mut sim = Sim::load(elf).expect("firmware loads");
-    for axis in AXES3 {
-        let d = driver(axis);
-        sim.probe_step_dir(axis.name(), d.step, d.dir, true);
-    }
-    assert_eq!(
-        sim.run_until_uart_contains("reset:", Duration::from_millis(50)),
-        Outcome::Done
-    );
-    sim
-}
 
 fn send(sim: &mut Sim, line: &str, timeout: Duration) {
     match sim.send_line(line, timeout) {
@@ -91,7 +77,7 @@ fn cruise_timing(r: &[u64], rate: f64) -> Option<(f64, f64)> {
 /// the step interrupt's mean cycles and the worst rate error (ppm), or None
 /// if it could not hold the rate.
 fn cruise(elf: &Path, axes: &[Axis], rate: u32) -> Option<(f64, f64, f64)> {
-    let mut sim = boot(elf);
+    let mut sim = Sim::boot(elf);
     for a in axes {
         send(
             &mut sim,
@@ -184,7 +170,7 @@ fn max_rate(elf: &Path, axes: &[Axis]) -> (u32, f64, f64, f64) {
 /// Worst deviation (µs) of a default-speed `G0 C360` from the exact
 /// trapezoid (a = 500 steps/s², v = 2000 steps/s, from standstill).
 fn default_speed_error_us(elf: &Path) -> (f64, f64, u16) {
-    let mut sim = boot(elf);
+    let mut sim = Sim::boot(elf);
     send(&mut sim, "M17", Duration::from_millis(200));
     send(&mut sim, "G0 C360", Duration::from_millis(200));
     send(&mut sim, "M400", Duration::from_secs(20));
@@ -224,7 +210,7 @@ fn latency_cycles(elf: &Path, card: &Path, task: &str, byte: u8) -> (u64, u64, u
     let entry = taut_simavr::elf::function_address(elf, task)
         .expect("ELF symbols")
         .expect("the task");
-    let mut sim = boot(elf);
+    let mut sim = Sim::boot(elf);
     sim.insert_sd(SdImage::from_path(card).expect("sample card"));
     send(&mut sim, "M17", Duration::from_millis(100));
     send(&mut sim, "G0 X-200", Duration::from_millis(100));
@@ -312,7 +298,7 @@ fn pattern(count: u32) -> String {
 /// `files ok` (param.txt included), by the firmware's own clock.
 fn sd_poradi_parse_ms(elf: &Path) -> u64 {
     let dir = card_dir("poradi", &pattern(3000));
-    let mut sim = boot(elf);
+    let mut sim = Sim::boot(elf);
     sim.insert_sd(SdImage::from_path(&dir).unwrap());
     std::fs::remove_dir_all(&dir).unwrap();
     let end = sim.run_until_uart_contains("files ok", Duration::from_secs(5));
@@ -352,7 +338,7 @@ fn job_figures(elf: &Path, card: &Path) -> (f64, f64, u64) {
     let motion = taut_simavr::elf::function_address(elf, "4taut6motion")
         .expect("ELF symbols")
         .expect("the motion task");
-    let mut sim = boot(elf);
+    let mut sim = Sim::boot(elf);
     sim.insert_sd(SdImage::from_path(card).expect("sample card"));
     sim.watch_calls(motion);
     let mut op = taut_simavr::operator::Operator::confirming();
@@ -433,7 +419,7 @@ fn status_report_latency_us(elf: &Path, card: &Path) -> (f64, f64) {
     let status = taut_simavr::elf::function_address(elf, "8realtime6status")
         .expect("ELF symbols")
         .expect("realtime::status");
-    let mut sim = boot(elf);
+    let mut sim = Sim::boot(elf);
     sim.insert_sd(SdImage::from_path(card).expect("sample card"));
     for line in ["M17", "G0 X-200", "G91"] {
         send(&mut sim, line, Duration::from_millis(100));
@@ -481,7 +467,7 @@ fn status_report_latency_us(elf: &Path, card: &Path) -> (f64, f64) {
 /// lines waiting beside a planner with less than a block free on average
 /// mean the planner is the limit, not the UART or the reading of lines.
 fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64, f64, bool) {
-    let mut sim = boot(elf);
+    let mut sim = Sim::boot(elf);
     for line in ["M17", "G0 X-200", "G91"] {
         send(&mut sim, line, Duration::from_millis(100));
     }
