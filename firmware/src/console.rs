@@ -25,7 +25,9 @@ use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::AXES;
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::config::{MachineConfig, PenConfig};
-use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Line, Parser, Restore, SystemLine};
+use taut_logic::gcode::{
+    CardLine, Error, ErrorKind, Input, Line, Parser, Read, Restore, SystemLine,
+};
 use taut_logic::homing::{self, Homing, HomingError, Leg, Next};
 use taut_logic::interp::{Allowed, Interpreter, Order, Path};
 use taut_logic::kinematics::Kinematics;
@@ -278,15 +280,14 @@ impl Console {
                 }
                 continue;
             }
-            // Copied out by itself: a whole `Pending` is arc-sized.
-            let line = match &self.pending {
+            let jog = match &self.pending {
                 Some(Pending::Path { .. }) => return self.next_piece(m, kin),
                 Some(Pending::Home { .. }) => return self.home(m, cfg),
-                Some(Pending::Line(line)) => Some((*line, false)),
-                Some(Pending::Jog(line)) => Some((*line, true)),
+                Some(Pending::Line(_)) => Some(false),
+                Some(Pending::Jog(_)) => Some(true),
                 None => None,
             };
-            if let Some((line, jog)) = line {
+            if let Some(jog) = jog {
                 // Other lines wait for the jogs to end.
                 if !jog && self.jogging {
                     if !m.is_idle() {
@@ -294,8 +295,7 @@ impl Console {
                     }
                     self.jogging = false;
                 }
-                self.pending = None;
-                if let Some(wait) = self.run_line(&line, jog, m, kin, cfg, owner) {
+                if let Some(wait) = self.run_line(jog, m, kin, cfg, owner) {
                     return wait;
                 }
                 // One line per run: the other tasks get their turn.
@@ -313,14 +313,14 @@ impl Console {
         }
     }
 
-    /// Plan a line (or a jog) read whole, then carry it out and commit it,
-    /// or in check mode only commit it; `Some(wait)` when it must wait
-    /// (kept in `pending`). Out of line: its plan (arc-sized) stays off
-    /// the frame that reads lines and runs `$` commands.
+    /// Plan the line (or the jog) waiting in `pending`, then carry it out
+    /// and commit it, or in check mode only commit it; `Some(wait)` when it
+    /// must wait (it stays in `pending`). The line is read where it waits,
+    /// not copied. Out of line: its plan (arc-sized) stays off the frame
+    /// that reads lines and runs `$` commands.
     #[inline(never)]
     fn run_line(
         &mut self,
-        line: &Line,
         jog: bool,
         m: &mut Motion,
         kin: &impl Kinematics,
@@ -331,34 +331,42 @@ impl Console {
             motion: owner == Owner::Console,
             position_known: m.position_known(),
         };
-        match self.interp.plan(line, kin, cfg, allowed) {
-            Err(kind) => self.error(&Error::new(kind, 0)),
+        let planned = match &self.pending {
+            Some(Pending::Line(line) | Pending::Jog(line)) => {
+                self.interp.plan(line, kin, cfg, allowed)
+            }
+            _ => return None,
+        };
+        let planned = match planned {
+            Err(kind) => {
+                self.pending = None;
+                self.error(&Error::new(kind, 0));
+                return None;
+            }
+            Ok(planned) => planned,
+        };
+        if self.checking {
             // Checked, not carried out; reads are still answered.
-            Ok(planned) if self.checking => {
-                if matches!(planned.order, Order::ReportPosition) {
-                    report_position(m, kin);
-                }
-                self.interp.commit(&planned);
-                self.ok();
+            self.pending = None;
+            if matches!(planned.order, Order::ReportPosition) {
+                report_position(m, kin);
             }
-            Ok(planned) => {
-                if let Some(wait) = self.carry_out(&planned.order, m, kin) {
-                    // Each in place: a `Pending` is arc-sized.
-                    match jog {
-                        true => self.pending = Some(Pending::Jog(*line)),
-                        false => self.pending = Some(Pending::Line(*line)),
-                    }
-                    return Some(wait);
-                }
-                match jog {
-                    true => self.interp.commit_jog(&planned),
-                    false => self.interp.commit(&planned),
-                }
-                self.jogging |= jog;
-                if self.pending.is_none() {
-                    self.ok();
-                }
-            }
+            self.interp.commit(&planned);
+            self.ok();
+            return None;
+        }
+        // A path or homing takes `pending`'s place.
+        if let Some(wait) = self.carry_out(&planned.order, m, kin) {
+            return Some(wait);
+        }
+        match jog {
+            true => self.interp.commit_jog(&planned),
+            false => self.interp.commit(&planned),
+        }
+        self.jogging |= jog;
+        if matches!(self.pending, Some(Pending::Line(_) | Pending::Jog(_))) {
+            self.pending = None;
+            self.ok();
         }
         None
     }
@@ -399,30 +407,35 @@ impl Console {
                     None => return Err(Poll::Idle),
                 },
             };
-            let input = match parse(&mut self.parser, byte) {
-                None | Some(Ok(Input::Realtime(_))) => continue,
-                Some(input) => input,
-            };
-            if self.source == Some(Source::Card) {
-                self.print.line_done();
+            if self.parser.read(byte) == Read::LineEnd {
+                self.line_end(m, cfg, owner);
+                return Ok(());
             }
-            match input {
-                Ok(Input::Realtime(_)) => {}
-                Err(e) => self.error(&e),
-                // While a print runs, the serial line may only look.
-                Ok(Input::Line(_)) if self.printing_from_serial() => {
-                    self.error(&Error::new(ErrorKind::Printing, 0))
-                }
-                Ok(Input::Line(line)) => self.pending = Some(Pending::Line(line)),
-                // Grbl jogs from `Idle` or `Jog` only.
-                Ok(Input::Jog(_)) if self.checking || !(m.is_idle() || self.jogging) => {
-                    self.error(&Error::new(ErrorKind::NotIdle, 0))
-                }
-                Ok(Input::Jog(line)) => self.pending = Some(Pending::Jog(line)),
-                Ok(Input::System(s)) => self.system(s, m, cfg, owner),
-                Ok(Input::Card(c)) => self.card_line(c, m, cfg),
+        }
+    }
+
+    /// A line has ended: its result, acted on. Out of line, so the line
+    /// (~100 B) is on the stack only here, not while bytes are read.
+    #[inline(never)]
+    fn line_end(&mut self, m: &mut Motion, cfg: &mut MachineConfig, owner: Owner) {
+        if self.source == Some(Source::Card) {
+            self.print.line_done();
+        }
+        match self.parser.take_line() {
+            Ok(Input::Realtime(_)) => {}
+            Err(e) => self.error(&e),
+            // While a print runs, the serial line may only look.
+            Ok(Input::Line(_)) if self.printing_from_serial() => {
+                self.error(&Error::new(ErrorKind::Printing, 0))
             }
-            return Ok(());
+            Ok(Input::Line(line)) => self.pending = Some(Pending::Line(line)),
+            // Grbl jogs from `Idle` or `Jog` only.
+            Ok(Input::Jog(_)) if self.checking || !(m.is_idle() || self.jogging) => {
+                self.error(&Error::new(ErrorKind::NotIdle, 0))
+            }
+            Ok(Input::Jog(line)) => self.pending = Some(Pending::Jog(line)),
+            Ok(Input::System(s)) => self.system(s, m, cfg, owner),
+            Ok(Input::Card(c)) => self.card_line(c, m, cfg),
         }
     }
 
@@ -1001,15 +1014,6 @@ fn serial_line_waits() -> bool {
 /// at most), the line end that completes a line up to ~0.5 ms; a 40-byte
 /// line read whole took ~2.4 ms, which a `?` or any task waited behind.
 const READ_PER_RUN: u8 = 6;
-
-/// One byte into the parser. Out of line: its copies of the line being
-/// finished are gone before the line is carried out. Built for size
-/// (3.4 KB less than for speed): bytes wait in the receive ring, and a
-/// stream keeps its pace (`stream_lines_per_s` of `cargo xtask bench`).
-#[inline(never)]
-fn parse(parser: &mut Parser, byte: u8) -> Option<Result<Input, Error>> {
-    parser.push(byte)
-}
 
 /// `M114`: `C:1.000 X:0.000 Z:0.000 Count C:27 X:0 Z:0` (the executed
 /// position).

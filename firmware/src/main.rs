@@ -481,11 +481,18 @@ fn console() {
         signal(Signal::CardRoom);
     }
     if CONSOLE.with(|c| c.take_settings_changed()) {
-        CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
-        settings_changed();
-        // The string-art job runs only on its machine.
-        spawn(Task::Job);
+        console_settings_changed();
     }
+}
+
+/// A `$` line changed the settings. Out of line: the kinematics it makes
+/// stay off the console's frame.
+#[inline(never)]
+fn console_settings_changed() {
+    CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
+    settings_changed();
+    // The string-art job runs only on its machine.
+    spawn(Task::Job);
 }
 
 /// Real-time commands, in the order that makes sense when several came

@@ -182,10 +182,7 @@ impl Motion {
         while room && made < max && self.buffered.queued_us(SEGMENTS.len()) < QUEUED_MAX_US {
             // Taking a block, a part of its profile and a part of a
             // segment each count as one piece of work (each ≤ ~1 ms).
-            let (loaded, took) = PLANNER.with(|p| {
-                let queued = p.queued();
-                (self.prep.load(p), p.queued() < queued)
-            });
+            let (loaded, took) = self.load();
             freed |= took;
             if loaded {
                 made += 1;
@@ -233,6 +230,17 @@ impl Motion {
         let work = !self.prep.is_idle() || !PLANNER.with(|p| p.is_idle());
         let held = self.prep.hold_state() == Hold::Stopped;
         (freed, made == max && work && !held && room)
+    }
+
+    /// [`Prep::load`]: (it did some work, it took a block from the
+    /// planner). Out of line: the block it takes is off the frame that
+    /// cuts segments, the deepest of the motion task.
+    #[inline(never)]
+    fn load(&mut self) -> (bool, bool) {
+        PLANNER.with(|p| {
+            let queued = p.queued();
+            (self.prep.load(p), p.queued() < queued)
+        })
     }
 
     /// Where the last queued move ends, steps.

@@ -422,53 +422,63 @@ fn write_dir(dir: u8, high_positive: u8) {
 /// Take the next segment (and its block); false when the queue is empty.
 #[inline(always)]
 fn load_segment(e: &mut Exec) -> bool {
-    let Some(seg) = SEGMENTS.peek() else {
+    // Both read in place: a copy is a `memcpy` call and stack under the
+    // interrupt's frame.
+    let Some(new_block) = SEGMENTS.peek_with(|seg| seg.flags & NEW_BLOCK != 0) else {
         return false;
     };
-    if seg.flags & NEW_BLOCK != 0 {
-        let Some(block) = BLOCKS.pop() else {
+    if new_block {
+        if BLOCKS.peek_with(|block| begin_block(e, block)).is_none() {
             return false;
-        };
-        e.block_gen = e.block_gen.wrapping_add(1);
-        // The previous block is complete: fold it into the start position.
-        for i in 0..AXES {
-            e.block_start[i] += signed(e.block.steps[i], e.block.dir, i);
         }
-        e.block_left = block.events;
-        if block.dir != e.block.dir || !e.running {
-            e.new_dir = Some(block.dir);
-        }
-        // Field by field, volatile: an aggregate copy becomes a `memcpy`
-        // call, and any call makes the handler save every register.
-        for i in 0..AXES {
-            // SAFETY: plain writes to fields of `e`.
-            unsafe {
-                write_volatile(&mut e.block.steps[i], block.steps[i]);
-                write_volatile(&mut e.counter[i], block.events / 2);
-            }
-        }
-        e.block.events = block.events;
-        e.block.dir = block.dir;
-        let mut always = [0u8; SLOTS];
-        let mut partial = 0;
-        for i in 0..AXES {
-            if block.steps[i] == block.events {
-                always[MAP.slot[i]] |= MAP.bit[i];
-            } else if block.steps[i] != 0 {
-                partial |= 1 << i;
-            }
-        }
-        e.always = always;
-        e.partial = partial;
+        let _ = BLOCKS.pop();
     }
+    SEGMENTS.peek_with(|seg| {
+        e.interval = seg.interval;
+        e.add = seg.add;
+        e.left = seg.count;
+        e.block_left -= seg.count as u32;
+        e.fast_ok = seg.flags & FAST;
+        e.stop = seg.flags & STOP;
+    });
     let _ = SEGMENTS.pop();
-    e.interval = seg.interval;
-    e.add = seg.add;
-    e.left = seg.count;
-    e.block_left -= seg.count as u32;
-    e.fast_ok = seg.flags & FAST;
-    e.stop = seg.flags & STOP;
     true
+}
+
+/// The DDA takes `block` on, the previous one complete.
+#[inline(always)]
+fn begin_block(e: &mut Exec, block: &StepBlock) {
+    e.block_gen = e.block_gen.wrapping_add(1);
+    // The previous block is complete: fold it into the start position.
+    for i in 0..AXES {
+        e.block_start[i] += signed(e.block.steps[i], e.block.dir, i);
+    }
+    e.block_left = block.events;
+    if block.dir != e.block.dir || !e.running {
+        e.new_dir = Some(block.dir);
+    }
+    // Field by field, volatile: an aggregate copy becomes a `memcpy`
+    // call, and any call makes the handler save every register.
+    for i in 0..AXES {
+        // SAFETY: plain writes to fields of `e`.
+        unsafe {
+            write_volatile(&mut e.block.steps[i], block.steps[i]);
+            write_volatile(&mut e.counter[i], block.events / 2);
+        }
+    }
+    e.block.events = block.events;
+    e.block.dir = block.dir;
+    let mut always = [0u8; SLOTS];
+    let mut partial = 0;
+    for i in 0..AXES {
+        if block.steps[i] == block.events {
+            always[MAP.slot[i]] |= MAP.bit[i];
+        } else if block.steps[i] != 0 {
+            partial |= 1 << i;
+        }
+    }
+    e.always = always;
+    e.partial = partial;
 }
 
 /// [`Segment::flags`] bit, set by the motion task: every event of the

@@ -43,6 +43,6 @@ pub use line::{
     AxisWord, CardLine, Command, Distance, Input, Line, Plane, Realtime, Units, AXIS_WORDS,
 };
 pub use number::parse_milli;
-pub use parser::{Parser, MAX_LINE};
+pub use parser::{Parser, Read, MAX_LINE};
 pub use status::{Extra, Overrides, Refresh, State, Status, OVERRIDE_BYTES};
 pub use system::{Restore, SystemLine, SystemText, SYSTEM_TEXT};

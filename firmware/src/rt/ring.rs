@@ -170,7 +170,9 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
         Some(unsafe { (*self.buf.get())[(t & Self::MASK) as usize].assume_init() })
     }
 
-    /// Consumer: `f` of the oldest message, read in place.
+    /// Consumer: `f` of the oldest message, read in place. Inlined, as
+    /// [`Ring::pop`].
+    #[inline(always)]
     pub fn peek_with<R>(&self, f: impl FnOnce(&T) -> R) -> Option<R> {
         let t = self.tail.load(Relaxed);
         if t == self.head.load(Relaxed) {

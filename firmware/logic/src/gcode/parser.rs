@@ -61,6 +61,19 @@ pub struct Parser {
     lexeme: Lexeme,
     checksum: Option<Checksum>,
     statement: Statement,
+    /// A line end was read and its result not yet taken: whether it
+    /// was a `\r`.
+    ended: Option<bool>,
+}
+
+/// What a byte did ([`Parser::read`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Read {
+    /// Part of a line (or the `\n` of a `\r\n`).
+    More,
+    Realtime(Realtime),
+    /// The line ended: take its result with [`Parser::take_line`].
+    LineEnd,
 }
 
 impl Default for Parser {
@@ -78,6 +91,7 @@ impl Parser {
             lexeme: Lexeme::Code,
             checksum: None,
             statement: Statement::Start,
+            ended: None,
         }
     }
 
@@ -88,23 +102,31 @@ impl Parser {
 
     /// Takes one received byte; returns what it completed, if anything.
     pub fn push(&mut self, byte: u8) -> Option<Result<Input, Error>> {
+        match self.read(byte) {
+            Read::More => None,
+            Read::Realtime(r) => Some(Ok(Input::Realtime(r))),
+            Read::LineEnd => Some(self.take_line()),
+        }
+    }
+
+    /// [`Parser::push`] in two steps, for a small stack: the byte, then
+    /// at [`Read::LineEnd`] the line's result ([`Parser::take_line`]).
+    /// Every byte goes through here, so its frame stays a few bytes; the
+    /// line's result (~100 B) is made only where it is used.
+    pub fn read(&mut self, byte: u8) -> Read {
         if let Some(realtime) = Realtime::from_byte(byte) {
             if realtime == Realtime::Reset {
                 // The line so far is dropped; where lines end is not.
-                *self = Parser {
-                    after_cr: self.after_cr,
-                    ..Parser::new()
-                };
+                self.restart(self.after_cr);
             }
-            return Some(Ok(Input::Realtime(realtime)));
+            return Read::Realtime(realtime);
         }
         let after_cr = core::mem::take(&mut self.after_cr);
         match byte {
-            b'\n' if after_cr => None,
+            b'\n' if after_cr => Read::More,
             b'\r' | b'\n' => {
-                let line = core::mem::take(self).finish();
-                self.after_cr = byte == b'\r';
-                Some(line)
+                self.ended = Some(byte == b'\r');
+                Read::LineEnd
             }
             _ => {
                 self.column = self.column.saturating_add(1);
@@ -113,9 +135,26 @@ impl Parser {
                 } else {
                     self.take(byte);
                 }
-                None
+                Read::More
             }
         }
+    }
+
+    /// The result of the line [`Parser::read`] ended; the parser is then
+    /// ready for the next. Without an ended line: an empty line's result.
+    #[inline(never)]
+    pub fn take_line(&mut self) -> Result<Input, Error> {
+        let after_cr = self.ended.take().unwrap_or(false);
+        let line = self.finish();
+        self.restart(after_cr);
+        line
+    }
+
+    fn restart(&mut self, after_cr: bool) {
+        *self = Parser {
+            after_cr,
+            ..Parser::new()
+        };
     }
 
     fn take(&mut self, c: u8) {
@@ -196,7 +235,7 @@ impl Parser {
     /// The result of a complete line. Errors rank: overflow (the line was
     /// cut), then checksum (a corrupted byte explains any other error),
     /// then the first error in the text.
-    fn finish(self) -> Result<Input, Error> {
+    fn finish(&mut self) -> Result<Input, Error> {
         let line_number = match &self.statement {
             Statement::GCode(words) => words.line_number(),
             _ => None,
@@ -204,7 +243,7 @@ impl Parser {
         self.result().map_err(|e| e.with_line_number(line_number))
     }
 
-    fn result(self) -> Result<Input, Error> {
+    fn result(&mut self) -> Result<Input, Error> {
         if self.lexeme == Lexeme::Overflow {
             return Err(Error::new(ErrorKind::LineOverflow, MAX_LINE + 1));
         }
@@ -225,7 +264,7 @@ impl Parser {
             }
             None => None,
         };
-        match self.statement {
+        match &mut self.statement {
             Statement::Start => Ok(Input::Line(Line {
                 checksum,
                 ..Line::empty()

@@ -116,7 +116,7 @@ impl SystemBuilder {
         self.equals && self.value.is_empty() && self.key.eq_ignore_ascii_case("J")
     }
 
-    pub(super) fn finish(self, end: u8) -> Result<SystemLine, Error> {
+    pub(super) fn finish(&mut self, end: u8) -> Result<SystemLine, Error> {
         if let Some(e) = self.error {
             return Err(e);
         }
@@ -133,8 +133,8 @@ impl SystemBuilder {
                 Err(Error::new(ErrorKind::InvalidStatement, end))
             } else {
                 Ok(SystemLine::Set {
-                    key: self.key,
-                    value: self.value,
+                    key: core::mem::take(&mut self.key),
+                    value: core::mem::take(&mut self.value),
                 })
             };
         }

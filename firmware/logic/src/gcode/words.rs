@@ -265,12 +265,12 @@ impl Words {
     }
 
     /// The line, once its last character (before `column`) has been read.
-    pub(super) fn finish(mut self, column: u8) -> Result<Input, Error> {
+    pub(super) fn finish(&mut self, column: u8) -> Result<Input, Error> {
         if let Some(e) = self.error {
             return Err(e);
         }
         self.close(column)?;
-        let line = self.line;
+        let line = &self.line;
         let fail = |kind, column| Err(Error::new(kind, column));
         let has_axes = self.axis_column != 0;
         if let Some(card) = self.card {
@@ -334,7 +334,7 @@ impl Words {
         if self.arc_column != 0 && (!arc || (offsets && line.r.is_some())) {
             return fail(ErrorKind::UnusedValueWords, self.arc_column);
         }
-        Ok(Input::Line(line))
+        Ok(Input::Line(self.line))
     }
 }
 
