@@ -8,14 +8,14 @@ use crate::board::servo::PenServo;
 use crate::drivers::Drivers;
 use crate::queues::{BLOCKS, SEGMENTS, SEGMENTS_CAPACITY};
 use crate::rt::TaskCell;
-use crate::stepper::{fast_segment, Stepper, FAST};
+use crate::stepper::{every_event, fast_segment, Stepper, FAST};
 use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Overrides, Planner};
-use taut_logic::prep::{Hold, Prep};
+use taut_logic::prep::{Cut, Hold, Prep};
+use taut_logic::segment::Buffered;
 use taut_logic::segment::Later;
-use taut_logic::segment::{Buffered, StepBlock};
 use taut_logic::units::Milli;
 
 /// Preparing segments is urgent (the app runs it at the highest software
@@ -61,8 +61,9 @@ pub struct Motion {
     prep: Prep,
     /// How long the queued segments last.
     buffered: Buffered<SEGMENTS_CAPACITY>,
-    /// The block the preparer is cutting (for the fast-path flag).
-    block: StepBlock,
+    /// The block the preparer is cutting steps every axis at every event
+    /// (its segments may take the fast path).
+    every_event: bool,
     /// Blocks in `BLOCKS` after the last refill: fewer now, the step
     /// interrupt has begun one since (what the job waits for to start a
     /// checkpoint's record).
@@ -96,7 +97,7 @@ impl Motion {
         Motion {
             prep: Prep::new(),
             buffered: Buffered::new(),
-            block: StepBlock::default(),
+            every_event: false,
             blocks: 0,
             cancel: false,
             epoch: 0,
@@ -197,18 +198,7 @@ impl Motion {
                     continue;
                 }
             };
-            let mut seg = cut.segment;
-            if let Some(block) = cut.block {
-                // The block goes first: its first segment refers to it.
-                let _ = BLOCKS.push(block);
-                self.block = block;
-                freed = true;
-            }
-            if fast_segment(&seg, &self.block) {
-                seg.flags |= FAST;
-            }
-            let _ = SEGMENTS.push(seg);
-            self.buffered.push(&seg);
+            freed |= self.queue(&cut);
             pushed = true;
             made += 1;
             room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
@@ -241,6 +231,24 @@ impl Motion {
             let queued = p.queued();
             (self.prep.load(p), p.queued() < queued)
         })
+    }
+
+    /// Hand `cut` to the step interrupt; true if it begins a block. Out of
+    /// line, as [`Motion::load`].
+    #[inline(never)]
+    fn queue(&mut self, cut: &Cut) -> bool {
+        let mut seg = cut.segment;
+        if let Some(block) = cut.block {
+            // The block goes first: its first segment refers to it.
+            let _ = BLOCKS.push(block);
+            self.every_event = every_event(&block);
+        }
+        if self.every_event && fast_segment(&seg) {
+            seg.flags |= FAST;
+        }
+        let _ = SEGMENTS.push(seg);
+        self.buffered.push(&seg);
+        cut.block.is_some()
     }
 
     /// Where the last queued move ends, steps.

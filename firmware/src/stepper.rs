@@ -285,7 +285,17 @@ impl Stepper {
     /// turns it on.
     pub fn kick(&mut self) {
         let e = exec();
-        if avr_device::interrupt::free(|_| e.running) || SEGMENTS.is_empty() || !load_segment(e) {
+        if !avr_device::interrupt::free(|_| e.running) && !SEGMENTS.is_empty() {
+            Self::start(e);
+        }
+    }
+
+    /// The interrupt is idle and segments wait: take the first, start the
+    /// timer. Out of line: its locals stay off the motion task's frame,
+    /// under the preparer's calls.
+    #[inline(never)]
+    fn start(e: &mut Exec) {
+        if !load_segment(e) {
             return;
         }
         if let Some(dir) = e.new_dir.take() {
@@ -485,15 +495,19 @@ fn begin_block(e: &mut Exec, block: &StepBlock) {
 /// segment may take the assembly fast path.
 pub const FAST: u8 = 0x80;
 
-/// Whether `seg` of a block with `steps` per axis and `events` events can
-/// take the fast path: no interval needs a split wait (the 24.8 fraction
-/// adds under one tick) and every moving axis steps at every event, so the
-/// DDA has nothing to do. Run by the motion task, not the interrupt.
-pub fn fast_segment(seg: &Segment, block: &StepBlock) -> bool {
-    let every_event = block.steps.iter().all(|&s| s == 0 || s == block.events);
+/// Whether every moving axis of `block` steps at every event: the DDA
+/// then has nothing to do.
+pub fn every_event(block: &StepBlock) -> bool {
+    block.steps.iter().all(|&s| s == 0 || s == block.events)
+}
+
+/// Whether `seg`, of a block that steps [`every_event`], can take the
+/// fast path: no interval needs a split wait (the 24.8 fraction adds
+/// under one tick). Run by the motion task, not the interrupt.
+pub fn fast_segment(seg: &Segment) -> bool {
     let last = seg.interval as i64 + i64::from(seg.add) * i64::from(u16::max(seg.count, 1) - 1);
     let longest = last.max(seg.interval as i64) + 255;
-    every_event && longest < (LONG_WAIT << FRAC_BITS) as i64
+    longest < (LONG_WAIT << FRAC_BITS) as i64
 }
 
 #[inline(never)]

@@ -1,7 +1,9 @@
-//! `stack_trace ELF (--card DIR [SECONDS] | --send FILE)`: the call chain
-//! of a run's deepest stack, innermost first, with each frame's bytes.
-//! With a card, an operator presses green whenever the job asks, for
-//! SECONDS (default 60) of machine time; with a G-code file, its lines are
+//! `stack_trace ELF (--card DIR [SECONDS [FROM]] | --send FILE)`: the call
+//! chain of a run's deepest stack, innermost first, with each frame's
+//! bytes. With a card, an operator presses green whenever the job asks,
+//! for SECONDS (default 60) of machine time, the deepest stack kept from
+//! second FROM on (default 0: a later phase's own peak, past the card's
+//! checks); with a G-code file, its lines are
 //! sent one by one, each after the last one's `ok`. For RAM work (issue
 //! #13's budget), after `cargo xtask build`:
 //! `cargo run --release -p taut-simavr --example stack_trace -- \
@@ -29,8 +31,12 @@ fn main() {
         "--card" => {
             sim.insert_sd(SdImage::from_path(Path::new(&a[3])).unwrap());
             let seconds: u64 = a.get(4).map_or(60, |s| s.parse().unwrap());
+            let from: u64 = a.get(5).map_or(0, |s| s.parse().unwrap());
             let mut op = Operator::confirming();
-            for _ in 0..seconds * 100 {
+            for tick in 0..seconds * 100 {
+                if tick == from * 100 {
+                    sim.reset_peak_stack();
+                }
                 sim.run_for(Duration::from_millis(10));
                 op.step(&mut sim);
             }
@@ -52,7 +58,9 @@ fn main() {
     while at + 3 <= stack.len() {
         let (start, name) = code.function(pc);
         let prologue = at + code.prologue_bytes(start, pc);
-        let isr = name.contains("_compa") || name.contains("__vector_");
+        let isr = ["_compa", "__vector_", "usart0_"]
+            .iter()
+            .any(|v| name.contains(v));
         // An interrupt handler's frame ends at the interrupted code's
         // address (any instruction); a function's at a return site: where
         // its prologue says, or (code the prologue does not describe, e.g.

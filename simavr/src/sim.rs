@@ -449,6 +449,14 @@ impl Sim {
         self.peak_stack.get_or_insert_with(Vec::new);
     }
 
+    /// Forget the deepest stack so far: the next ones are a later phase's.
+    pub fn reset_peak_stack(&mut self) {
+        self.min_sp = RAM_END;
+        if let Some(kept) = &mut self.peak_stack {
+            kept.clear();
+        }
+    }
+
     /// The stack's bytes (from the stack pointer + 1 up to RAMEND) as they
     /// stood at the deepest point, if [`Sim::keep_peak_stack`] was called
     /// before it.
