@@ -48,7 +48,8 @@ pub struct Print {
     state: State,
     /// Numbers the card requests; messages of older ones are dropped.
     ticket: u8,
-    name: Name,
+    // The file's name is the reader's (`card::opened_name`): it reads
+    // one file at a time, and a plotter's card has no other reader.
     size: u32,
     at: Mark,
     /// The start of the line being read: where a lost print goes on.
@@ -74,7 +75,6 @@ impl Print {
         Print {
             state: State::Idle,
             ticket: 0,
-            name: Name::EMPTY,
             size: 0,
             at: Mark { pos: 0, lines: 0 },
             line_start: Mark { pos: 0, lines: 0 },
@@ -147,8 +147,7 @@ impl Print {
         match self.state {
             State::Selected => self.state = State::Running,
             State::Lost => {
-                let name = self.name;
-                self.open(name, true);
+                self.open(crate::card::opened_name(), true);
                 self.skip = self.line_start.pos;
                 self.line_waits = line;
             }
@@ -271,7 +270,6 @@ impl Print {
             return Some(Ok(()));
         }
         let name = crate::card::opened_name();
-        self.name = name;
         self.size = size;
         self.line_start = self.at;
         let mut r = reply::line();
@@ -419,7 +417,7 @@ impl Print {
         let line = self.at.lines + u32::from(self.last != b'\n');
         crate::log::start(Level::Error, crate::__log_module!());
         crate::log::with_line(|r| {
-            let _ = uwrite!(r, "{}:{}:", self.name, line);
+            let _ = uwrite!(r, "{}:{}:", crate::card::opened_name(), line);
             if let Some(c) = e.column() {
                 let _ = uwrite!(r, "{}:", c);
             }

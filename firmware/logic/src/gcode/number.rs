@@ -12,52 +12,56 @@ pub(super) struct Number {
     magnitude: u32,
     /// Largest magnitude accepted.
     limit: u32,
-    /// Fixed-point (sign and point allowed) or a plain unsigned integer.
-    fixed: bool,
-    negative: bool,
-    signed: bool,
-    digits: bool,
-    point: bool,
-    decimals: u8,
+    /// [`FIXED`], [`NEGATIVE`], [`SIGNED`], [`DIGITS`], [`POINT`], and the
+    /// decimals read (saturating at 7) above [`DECIMALS_SHIFT`]: one byte,
+    /// as the parser's statics and frames hold several numbers.
+    flags: u8,
 }
+
+/// Fixed-point (sign and point allowed), else a plain unsigned integer.
+const FIXED: u8 = 1;
+const NEGATIVE: u8 = 2;
+const SIGNED: u8 = 4;
+const DIGITS: u8 = 8;
+const POINT: u8 = 16;
+const DECIMALS_SHIFT: u8 = 5;
 
 impl Number {
     /// A signed value with up to three decimals kept, e.g. `X-2.5`.
     pub(super) const fn fixed() -> Number {
-        Number::new(true, i32::MAX as u32)
+        Number::new(FIXED, i32::MAX as u32)
     }
 
     /// An unsigned integer up to `limit`, e.g. `N` or the checksum.
     pub(super) const fn integer(limit: u32) -> Number {
-        Number::new(false, limit)
+        Number::new(0, limit)
     }
 
-    const fn new(fixed: bool, limit: u32) -> Number {
+    const fn new(flags: u8, limit: u32) -> Number {
         Number {
             magnitude: 0,
             limit,
-            fixed,
-            negative: false,
-            signed: false,
-            digits: false,
-            point: false,
-            decimals: 0,
+            flags,
         }
     }
 
+    fn has(&self, flag: u8) -> bool {
+        self.flags & flag != 0
+    }
+
     pub(super) fn has_digits(&self) -> bool {
-        self.digits
+        self.has(DIGITS)
     }
 
     pub(super) fn push(&mut self, c: u8) -> Result<(), ()> {
+        let fixed = self.has(FIXED);
         match c {
-            b'+' | b'-' if self.fixed && !self.signed && !self.digits && !self.point => {
-                self.signed = true;
-                self.negative = c == b'-';
+            b'+' | b'-' if fixed && !self.has(SIGNED | DIGITS | POINT) => {
+                self.flags |= SIGNED | if c == b'-' { NEGATIVE } else { 0 };
                 Ok(())
             }
-            b'.' if self.fixed && !self.point => {
-                self.point = true;
+            b'.' if fixed && !self.has(POINT) => {
+                self.flags |= POINT;
                 Ok(())
             }
             b'0'..=b'9' => self.digit((c - b'0') as u32),
@@ -66,17 +70,18 @@ impl Number {
     }
 
     fn digit(&mut self, d: u32) -> Result<(), ()> {
-        self.digits = true;
-        let magnitude = if !self.point {
-            let unit = if self.fixed { 1000 } else { 1 };
+        self.flags |= DIGITS;
+        let magnitude = if !self.has(POINT) {
+            let unit = if self.has(FIXED) { 1000 } else { 1 };
             self.magnitude
                 .checked_mul(10)
                 .and_then(|m| m.checked_add(d * unit))
         } else {
-            self.decimals = self.decimals.saturating_add(1);
+            let decimals = (self.flags >> DECIMALS_SHIFT).saturating_add(1).min(7);
+            self.flags = (self.flags & ((1 << DECIMALS_SHIFT) - 1)) | decimals << DECIMALS_SHIFT;
             // Three decimals are kept; the fourth rounds half away from
             // zero (the magnitude rounds up); later ones cannot matter.
-            let add = match self.decimals {
+            let add = match decimals {
                 1 => d * 100,
                 2 => d * 10,
                 3 => d,
@@ -97,13 +102,13 @@ impl Number {
     /// The value of a fixed-point number; `None` without a digit.
     pub(super) fn milli(&self) -> Option<Milli> {
         let m = self.magnitude as i32; // limit is i32::MAX
-        self.digits
-            .then_some(Milli(if self.negative { -m } else { m }))
+        self.has_digits()
+            .then_some(Milli(if self.has(NEGATIVE) { -m } else { m }))
     }
 
     /// The value of an integer; `None` without a digit.
     pub(super) fn value(&self) -> Option<u32> {
-        self.digits.then_some(self.magnitude)
+        self.has_digits().then_some(self.magnitude)
     }
 }
 
