@@ -13,7 +13,7 @@ use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Overrides, Planner};
-use taut_logic::prep::{Cut, Hold, Prep};
+use taut_logic::prep::{Hold, Prep};
 use taut_logic::segment::Buffered;
 use taut_logic::segment::Later;
 use taut_logic::units::Milli;
@@ -183,7 +183,10 @@ impl Motion {
         while room && made < max && self.buffered.queued_us(SEGMENTS.len()) < QUEUED_MAX_US {
             // Taking a block, a part of its profile and a part of a
             // segment each count as one piece of work (each ≤ ~1 ms).
-            let (loaded, took) = self.load();
+            let (loaded, took) = PLANNER.with(|p| {
+                let queued = p.queued();
+                (self.prep.load(p), p.queued() < queued)
+            });
             freed |= took;
             if loaded {
                 made += 1;
@@ -198,7 +201,18 @@ impl Motion {
                     continue;
                 }
             };
-            freed |= self.queue(&cut);
+            let mut seg = cut.segment;
+            if let Some(block) = cut.block {
+                // The block goes first: its first segment refers to it.
+                let _ = BLOCKS.push(block);
+                self.every_event = every_event(&block);
+                freed = true;
+            }
+            if self.every_event && fast_segment(&seg) {
+                seg.flags |= FAST;
+            }
+            let _ = SEGMENTS.push(seg);
+            self.buffered.push(&seg);
             pushed = true;
             made += 1;
             room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
@@ -220,35 +234,6 @@ impl Motion {
         let work = !self.prep.is_idle() || !PLANNER.with(|p| p.is_idle());
         let held = self.prep.hold_state() == Hold::Stopped;
         (freed, made == max && work && !held && room)
-    }
-
-    /// [`Prep::load`]: (it did some work, it took a block from the
-    /// planner). Out of line: the block it takes is off the frame that
-    /// cuts segments, the deepest of the motion task.
-    #[inline(never)]
-    fn load(&mut self) -> (bool, bool) {
-        PLANNER.with(|p| {
-            let queued = p.queued();
-            (self.prep.load(p), p.queued() < queued)
-        })
-    }
-
-    /// Hand `cut` to the step interrupt; true if it begins a block. Out of
-    /// line, as [`Motion::load`].
-    #[inline(never)]
-    fn queue(&mut self, cut: &Cut) -> bool {
-        let mut seg = cut.segment;
-        if let Some(block) = cut.block {
-            // The block goes first: its first segment refers to it.
-            let _ = BLOCKS.push(block);
-            self.every_event = every_event(&block);
-        }
-        if self.every_event && fast_segment(&seg) {
-            seg.flags |= FAST;
-        }
-        let _ = SEGMENTS.push(seg);
-        self.buffered.push(&seg);
-        cut.block.is_some()
     }
 
     /// Where the last queued move ends, steps.

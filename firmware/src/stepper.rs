@@ -294,6 +294,7 @@ impl Stepper {
     /// timer. Out of line: its locals stay off the motion task's frame,
     /// under the preparer's calls.
     #[inline(never)]
+    #[optimize(speed)]
     fn start(e: &mut Exec) {
         if !load_segment(e) {
             return;
@@ -512,6 +513,7 @@ pub fn fast_segment(seg: &Segment) -> bool {
 
 #[inline(never)]
 #[cold]
+#[optimize(speed)]
 fn load_segment_cold(e: &mut Exec) -> bool {
     load_segment(e)
 }
