@@ -105,6 +105,29 @@ pub fn send_ok(sim: &mut sim::Sim, line: &str, timeout: std::time::Duration) {
 /// (issue #11; issue #13's bar is 4.5 KiB).
 pub const RAM_BUDGET: u32 = 6144;
 
+/// With `TAUT_STACK_CHAINS` set, the call chain at the test's deepest
+/// stack goes to `target/hil-stack-chains.txt` (`stack_chain`): the
+/// whole run's deep paths, for RAM work.
+fn record_chain(sim: &sim::Sim) {
+    let chain = sim::stack_chain::deepest(sim, &firmware_elf());
+    if chain.is_empty() {
+        return;
+    }
+    let log = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/hil-stack-chains.txt");
+    if let Ok(mut f) = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(log)
+    {
+        let test = std::thread::current().name().unwrap_or("?").to_string();
+        let mut text = format!("{test} {} B\n", sim.peak_stack_bytes());
+        for frame in chain {
+            text += &format!("  {:>5} {:>4}  {}\n", frame.depth, frame.bytes, frame.at);
+        }
+        let _ = f.write_all(text.as_bytes());
+    }
+}
+
 /// Checked at the end of every HIL test that runs the release image.
 /// Each test's figure is also added to `target/hil-stack-peaks.txt` (test,
 /// stack bytes, where), to find the deepest path of a whole run.
@@ -120,6 +143,7 @@ pub fn assert_ram_budget(sim: &sim::Sim) {
         let test = std::thread::current().name().unwrap_or("?").to_string();
         let _ = writeln!(f, "{test} {stack} {:#x}", sim.peak_stack_pc());
     }
+    record_chain(sim);
     assert!(
         statics + stack < RAM_BUDGET,
         "static {statics} B + stack {stack} B, deepest at {:#x} (avr-addr2line -fe taut.elf; \

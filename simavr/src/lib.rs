@@ -31,6 +31,7 @@ pub mod sdcard;
 pub mod sdimage;
 mod serial;
 mod sim;
+pub mod stack_chain;
 mod traps;
 pub mod uart;
 pub mod vcd;

@@ -219,7 +219,9 @@ impl Sim {
             ram_limit,
             min_sp: RAM_END,
             min_sp_pc: 0,
-            peak_stack: None,
+            // `TAUT_STACK_CHAINS`: every simulation keeps its deepest
+            // chain (`stack_chain`), e.g. for a whole HIL run's.
+            peak_stack: std::env::var_os("TAUT_STACK_CHAINS").map(|_| Vec::new()),
             pc_watches: Vec::new(),
             resets: 0,
             last_avr_cycle: 0,

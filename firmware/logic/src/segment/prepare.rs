@@ -232,7 +232,12 @@ impl Preparer {
         };
         // Standing already: an empty leg (a profile needs an event).
         match n {
-            0 => self.switch(Trapezoid::idle()),
+            0 => {
+                // In place: a profile on the stack is 137 B, deep under a
+                // hold (a feed hold inside a card print's line).
+                self.leave_leg();
+                self.profile.make_idle();
+            }
             n => {
                 let speeds = Speeds {
                     entry_sqr: v_sqr,

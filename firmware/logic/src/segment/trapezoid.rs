@@ -80,6 +80,13 @@ impl Trapezoid {
             k_dec: 0,
         }
     }
+
+    /// [`Trapezoid::idle`] in place. Out of line: any copy it makes is on
+    /// its own frame, which calls nothing.
+    #[inline(never)]
+    pub fn make_idle(&mut self) {
+        *self = Trapezoid::idle();
+    }
 }
 
 /// Speeds² of a profile, events²/s²: where it starts, the most it may
