@@ -72,12 +72,20 @@ pub struct Arc {
     done: u32,
 }
 
-impl Arc {
+/// The circle an arc runs on: its centre in the plane and its radius,
+/// milli-units. Worked out apart from the [`Arc`] (83 B): a caller deep
+/// in the stack holds one arc, not a result and a copy.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Circle {
+    pub centre: [f32; 2],
+    pub radius: f32,
+}
+
+impl Circle {
     /// From the centre's offsets from the start (`I J K` of the plane's
-    /// axes), `clockwise` for `G2`. The end may be the start: a full
-    /// circle.
+    /// axes). The end may be the start: a full circle.
     #[inline(never)]
-    pub fn from_centre(sweep: &Sweep, offset: [Milli; 2]) -> Result<Arc, ArcError> {
+    pub fn from_centre(sweep: &Sweep, offset: [Milli; 2]) -> Result<Circle, ArcError> {
         let Sweep {
             start, end, plane, ..
         } = *sweep;
@@ -90,13 +98,13 @@ impl Arc {
         if off > RADIUS_SLACK && off > RADIUS_SLACK_REL * r {
             return Err(ArcError::EndOffCircle);
         }
-        Ok(Arc::new(sweep, centre, r))
+        Ok(Circle { centre, radius: r })
     }
 
-    /// From the radius `R`: the shorter arc, or the longer one for a
-    /// negative radius (Grbl's rule); `clockwise` for `G2`.
+    /// From the radius `R`: the shorter arc's, or the longer one's for a
+    /// negative radius (Grbl's rule), `clockwise` for `G2`.
     #[inline(never)]
-    pub fn from_radius(sweep: &Sweep, radius: Milli) -> Result<Arc, ArcError> {
+    pub fn from_radius(sweep: &Sweep, radius: Milli) -> Result<Circle, ArcError> {
         let Sweep {
             start,
             end,
@@ -123,10 +131,28 @@ impl Arc {
             h = -h;
         }
         let centre = [x0 + 0.5 * (x - y * h), y0 + 0.5 * (y + x * h)];
-        Ok(Arc::new(sweep, centre, r.abs()))
+        Ok(Circle {
+            centre,
+            radius: r.abs(),
+        })
+    }
+}
+
+impl Arc {
+    /// [`Circle::from_centre`]'s arc.
+    pub fn from_centre(sweep: &Sweep, offset: [Milli; 2]) -> Result<Arc, ArcError> {
+        Ok(Arc::new(sweep, &Circle::from_centre(sweep, offset)?))
     }
 
-    fn new(sweep: &Sweep, centre: [f32; 2], r: f32) -> Arc {
+    /// [`Circle::from_radius`]'s arc.
+    pub fn from_radius(sweep: &Sweep, radius: Milli) -> Result<Arc, ArcError> {
+        Ok(Arc::new(sweep, &Circle::from_radius(sweep, radius)?))
+    }
+
+    /// The arc of `sweep` on `circle`, cut into chords.
+    #[inline(never)]
+    pub fn new(sweep: &Sweep, circle: &Circle) -> Arc {
+        let Circle { centre, radius: r } = *circle;
         let Sweep {
             start,
             end,
@@ -232,26 +258,47 @@ impl Iterator for Arc {
 
     /// The next chord's end.
     fn next(&mut self) -> Option<Position> {
-        if self.done >= self.chords {
+        let (mut done, mut vector) = (self.done, self.vector);
+        let end = self.end_after(&mut done, &mut vector);
+        (self.done, self.vector) = (done, vector);
+        end
+    }
+}
+
+impl Arc {
+    /// The chord ends still to come, without a copy of the arc (83 B): the
+    /// reach check walks them deep in the stack.
+    pub fn ends(&self) -> Ends<'_> {
+        Ends {
+            arc: self,
+            done: self.done,
+            vector: self.vector,
+        }
+    }
+
+    /// The end of chord `done + 1`, `done` and the radius vector taken on
+    /// to it; `None` past the last.
+    fn end_after(&self, done: &mut u32, vector: &mut [f32; 2]) -> Option<Position> {
+        if *done >= self.chords {
             return None;
         }
-        self.done += 1;
-        if self.done == self.chords {
+        *done += 1;
+        if *done == self.chords {
             return Some(self.end);
         }
-        let k = self.done;
+        let k = *done;
         if k.is_multiple_of(EXACT_EVERY) {
             let (sin, cos) = fmath::sin_cos(self.start_angle + k as f32 * self.step);
-            self.vector = [self.radius * cos, self.radius * sin];
+            *vector = [self.radius * cos, self.radius * sin];
         } else {
             let [c, s] = self.rotation;
-            let [x, y] = self.vector;
-            self.vector = [x * c - y * s, x * s + y * c];
+            let [x, y] = *vector;
+            *vector = [x * c - y * s, x * s + y * c];
         }
         let p = &self.plane;
         let mut at: Position = self.start;
-        at[p.axis_0] = Milli(round(self.centre[0] + self.vector[0]));
-        at[p.axis_1] = Milli(round(self.centre[1] + self.vector[1]));
+        at[p.axis_0] = Milli(round(self.centre[0] + vector[0]));
+        at[p.axis_1] = Milli(round(self.centre[1] + vector[1]));
         if let Some(l) = p.linear {
             let span = self.end[l].0 as i64 - self.start[l].0 as i64;
             at[l] = Milli(self.start[l].0 + (span * k as i64 / self.chords as i64) as i32);
@@ -262,6 +309,22 @@ impl Iterator for Arc {
             }
         }
         Some(at)
+    }
+}
+
+/// An arc's chord ends, read from the arc in place ([`Arc::ends`]): the
+/// same as the arc's own iteration.
+pub struct Ends<'a> {
+    arc: &'a Arc,
+    done: u32,
+    vector: [f32; 2],
+}
+
+impl Iterator for Ends<'_> {
+    type Item = Position;
+
+    fn next(&mut self) -> Option<Position> {
+        self.arc.end_after(&mut self.done, &mut self.vector)
     }
 }
 

@@ -15,7 +15,7 @@
 //! and the kinematics' reach — and handed over as an [`Arc`] whose chords
 //! the caller queues one by one.
 
-use crate::arc::{self, Arc, ArcError, Sweep};
+use crate::arc::{self, Arc, ArcError, Circle, Sweep};
 use crate::config::MachineConfig;
 use crate::gcode::{AxisWord, Command, Distance, ErrorKind, Line, Plane, Units, MIN_FEED};
 use crate::kinematics::{Kinematics, Position, Segmenter, Steps};
@@ -391,15 +391,14 @@ impl Interpreter {
     /// Out of line: its pieces stay off the stack of the other moves.
     #[inline(never)]
     fn pieces(&self, feed: Feed, kin: &impl Kinematics, next: Modal) -> Result<Planned, ErrorKind> {
-        let path = Path::Line(Segmenter::new(
-            kin,
-            self.modal.target,
-            &next.target,
-            SEGMENT_UM,
-        ));
-        match reaches(&path, kin) {
+        let line = Segmenter::new(kin, self.modal.target, &next.target, SEGMENT_UM);
+        // Called for the machines that are not linear only.
+        match kin.reaches_line(&line.start(), &line.end()) {
             true => Ok(Planned {
-                order: Order::Path { path, feed },
+                order: Order::Path {
+                    path: Path::Line(line),
+                    feed,
+                },
                 next,
             }),
             false => Err(ErrorKind::InvalidTarget),
@@ -453,11 +452,11 @@ impl Interpreter {
             clockwise: next.motion == Motion::ArcCw,
             tolerance: Milli(cfg.arc_tolerance_um.min(i32::MAX as u32) as i32),
         };
-        let arc = match line.r.get().map(|r| mm(r, next.units)) {
+        let circle = match line.r.get().map(|r| mm(r, next.units)) {
             Some(_) if start[axis_0] == end[axis_0] && start[axis_1] == end[axis_1] => {
                 return Err(ErrorKind::InvalidTarget);
             }
-            Some(r) => Arc::from_radius(&sweep, r),
+            Some(r) => Circle::from_radius(&sweep, r),
             None => {
                 // `I J K` are the offsets along X Y Z.
                 let offset = |w: AxisWord| {
@@ -471,22 +470,26 @@ impl Interpreter {
                     offset(w0).unwrap_or(Milli::ZERO),
                     offset(w1).unwrap_or(Milli::ZERO),
                 ];
-                Arc::from_centre(&sweep, o)
+                Circle::from_centre(&sweep, o)
             }
         }
         .map_err(|e| match e {
             ArcError::EndOffCircle => ErrorKind::InvalidTarget,
             ArcError::RadiusTooSmall => ErrorKind::ArcRadiusInvalid,
         })?;
+        // One arc on this frame, checked in place, then moved out.
+        let arc = Arc::new(&sweep, &circle);
         check_arc(&arc, kin, cfg)?;
-        let path = Path::Arc(arc);
-        match reaches(&path, kin) {
-            true => Ok(Planned {
-                order: Order::Path { path, feed },
-                next,
-            }),
-            false => Err(ErrorKind::InvalidTarget),
+        if !kin.is_linear() && !every_chord_reached(&arc, kin) {
+            return Err(ErrorKind::InvalidTarget);
         }
+        Ok(Planned {
+            order: Order::Path {
+                path: Path::Arc(arc),
+                feed,
+            },
+            next,
+        })
     }
 
     /// Where the axis words of `line` take the commanded position.
@@ -519,30 +522,16 @@ fn check_arc(arc: &Arc, kin: &impl Kinematics, cfg: &MachineConfig) -> Result<()
     }
 }
 
-/// Whether the machine reaches `path`: a linear machine does if it
-/// reaches the path's box (`check_arc`, and a line's target); any other is
-/// asked for every piece.
-fn reaches(path: &Path, kin: &impl Kinematics) -> bool {
-    kin.is_linear() || every_piece_reached(path, kin)
-}
-
-/// Whether every piece of `path` is within reach, by the kinematics'
-/// geometry ([`Kinematics::reaches_line`]): a line at once, an arc chord
-/// by chord. Out of line: its copy of the path stays off the linear
-/// machines' stack.
+/// Whether the machine reaches every chord of `arc`. Out of line: the
+/// linear machines never need it.
 #[inline(never)]
-fn every_piece_reached(path: &Path, kin: &impl Kinematics) -> bool {
-    match path {
-        Path::Line(line) => kin.reaches_line(&line.start(), &line.end()),
-        Path::Arc(arc) => {
-            let mut from = arc.start();
-            { *arc }.all(|to| {
-                let ok = kin.reaches_line(&from, &to);
-                from = to;
-                ok
-            })
-        }
-    }
+fn every_chord_reached(arc: &Arc, kin: &impl Kinematics) -> bool {
+    let mut from = arc.start();
+    arc.ends().all(|to| {
+        let ok = kin.reaches_line(&from, &to);
+        from = to;
+        ok
+    })
 }
 
 /// Refuses a path whose box `lo..=hi` leaves an axis's soft limits.

@@ -130,6 +130,12 @@ proptest! {
         let (start, end) = (p(a0), p(a1));
         let offset = [Milli(cx - start[1].0), Milli(cy - start[2].0)];
         let arc = Arc::from_centre(&sweep(start, end, clockwise, TOL), offset).unwrap();
+        // Read in place, from the start and part-way, the ends are the
+        // arc's own.
+        prop_assert_eq!(arc.ends().collect::<Vec<_>>(), arc.collect::<Vec<_>>());
+        let mut part_way = arc;
+        let _ = part_way.nth(arc.chords() as usize / 3);
+        prop_assert_eq!(part_way.ends().collect::<Vec<_>>(), part_way.collect::<Vec<_>>());
         check(arc, start, end, (cx as f64, cy as f64), r as f64);
     }
 }
