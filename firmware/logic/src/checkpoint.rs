@@ -243,6 +243,8 @@ fn newer(a: u16, b: u16) -> bool {
 }
 
 /// Reads the checkpoint through `read` (an EEPROM byte by address).
+// Out of line, as `settings::image::decode_into`.
+#[inline(never)]
 pub fn scan(mut read: impl FnMut(u16) -> u8) -> Found {
     let slots: [Option<Header>; 2] =
         [0, 1].map(|i| Header::decode(&read_n(&mut read, START + i * HEADER_BYTES)));

@@ -148,14 +148,18 @@ impl AnyKinematics {
     /// The kinematics of the configured machine; an error when its
     /// geometry cannot be (arms of no length, a drawing above the motors).
     pub fn of(cfg: &MachineConfig) -> Result<AnyKinematics, KinError> {
-        let scale = ChannelScale::from_config(cfg);
+        // Each machine's made on its own: one kinematics on the stack at a
+        // time (this runs under the settings' checks, deep at boot).
+        let scale = || ChannelScale::from_config(cfg);
         let g = &cfg.geometry;
-        Ok(match cfg.machine {
-            Machine::StringArt => AnyKinematics::Linear(Linear::cylindrical(cfg)),
-            Machine::Drum | Machine::Flatbed => AnyKinematics::Linear(Linear::cartesian(scale)),
-            Machine::Whiteboard => AnyKinematics::Polargraph(Polargraph::new(&scale, g)?),
-            Machine::Scara => AnyKinematics::Scara(Scara::new(&scale, g)?),
-        })
+        match cfg.machine {
+            Machine::StringArt => Ok(AnyKinematics::Linear(Linear::cylindrical(cfg))),
+            Machine::Drum | Machine::Flatbed => {
+                Ok(AnyKinematics::Linear(Linear::cartesian(scale())))
+            }
+            Machine::Whiteboard => Polargraph::new(&scale(), g).map(AnyKinematics::Polargraph),
+            Machine::Scara => Scara::new(&scale(), g).map(AnyKinematics::Scara),
+        }
     }
 }
 

@@ -196,6 +196,9 @@ pub fn decode(read: impl Fn(usize) -> u8, base: &MachineConfig) -> Result<Machin
 /// any is taken, so on an error `cfg` is unchanged, except after
 /// [`Unusable::Inconsistent`] (each value fine, the set not): the caller
 /// loads the defaults again.
+// Out of line: at boot its locals would sit under the checkpoint's
+// scan and the kinematics' check (the boot's stack peak).
+#[inline(never)]
 pub fn decode_into(read: impl Fn(usize) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
     if (0..HEADER).all(|i| read(i) == 0xFF) {
         return Err(Unusable::Blank);
