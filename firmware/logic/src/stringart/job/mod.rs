@@ -86,7 +86,8 @@ struct Plan {
     scale: StepScale,
     /// The drilling's own figures: its planner is made when it starts.
     depths: Depths,
-    winder: Option<BlendWinder>,
+    /// The winding phase's steps use it in place ([`PhaseSteps::next`]).
+    winder: BlendWinder,
 }
 
 pub struct Job {
@@ -178,7 +179,8 @@ impl Job {
         if !self.state.is_running() && !finishing {
             return None;
         }
-        self.steps.as_mut()?.next()
+        let winder = &mut self.plan.as_mut()?.winder;
+        self.steps.as_mut()?.next(winder)
     }
 
     /// The record of the last [`MachineStep::Mark`] handed out.
@@ -458,7 +460,7 @@ impl Job {
             board,
             scale: StepScale::from_config(config),
             depths: Depths::blended(config),
-            winder: Some(winder),
+            winder,
         });
         true
     }
@@ -568,10 +570,7 @@ impl Job {
                 self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
             }
             _ => {
-                let Some(winder) = plan.winder.take() else {
-                    return;
-                };
-                self.steps = Some(PhaseSteps::wind(winder, plan.count, Some(s.last), now_ms));
+                self.steps = Some(PhaseSteps::wind(plan.count, Some(s.last), now_ms));
                 self.open_pattern(s.done(), o);
                 // The resume entry switches the drill's driver off itself.
                 self.go(State::Winding, MACHINE_DRIVERS, o, now_ms);
@@ -603,10 +602,7 @@ impl Job {
 
     fn start_winding(&mut self, o: &mut Out, now_ms: u32) {
         let Some(plan) = &mut self.plan else { return };
-        let Some(winder) = plan.winder.take() else {
-            return;
-        };
-        let mut steps = PhaseSteps::wind(winder, plan.count, None, now_ms);
+        let mut steps = PhaseSteps::wind(plan.count, None, now_ms);
         let first = steps.reporter.first(now_ms);
         self.steps = Some(steps);
         self.enter(State::Winding, o);

@@ -24,8 +24,9 @@ enum Work {
         /// The retract, held back behind the hole's record.
         retract: Option<MachineStep>,
     },
+    /// Winding with the plan's winder, lent to each call
+    /// ([`PhaseSteps::next`]): one winder in RAM, not two.
     Wind {
-        winder: BlendWinder,
         /// The entry's next step, until it has been handed out.
         entry: Option<u8>,
         /// The entry after a power cut goes in through the gap after
@@ -95,16 +96,10 @@ impl PhaseSteps {
 
     /// Winding a new job's pattern (`resume: None`), or on from a
     /// checkpoint's record (`Some(None)`: none written yet).
-    pub fn wind(
-        winder: BlendWinder,
-        count: u32,
-        resume: Option<Option<Record>>,
-        now_ms: u32,
-    ) -> Self {
+    pub fn wind(count: u32, resume: Option<Option<Record>>, now_ms: u32) -> Self {
         let last = resume.flatten();
         let done = last.map_or(0, |r| r.n / 2);
         let work = Work::Wind {
-            winder,
             entry: Some(0),
             resume_gap: last.map(|r| r.gap),
             wrap: None,
@@ -145,13 +140,14 @@ impl PhaseSteps {
         self.started && !self.hold && !self.exhausted
     }
 
-    pub fn next(&mut self) -> Option<MachineStep> {
-        let step = self.step();
+    /// The next step; `winder` is the plan's (only winding uses it).
+    pub fn next(&mut self, winder: &mut BlendWinder) -> Option<MachineStep> {
+        let step = self.step(winder);
         self.started |= step.is_some();
         step
     }
 
-    fn step(&mut self) -> Option<MachineStep> {
+    fn step(&mut self, winder: &mut BlendWinder) -> Option<MachineStep> {
         if self.hold || self.exhausted {
             return None;
         }
@@ -183,7 +179,6 @@ impl PhaseSteps {
                 Some(step)
             }
             Work::Wind {
-                winder,
                 entry,
                 resume_gap,
                 wrap,
@@ -255,9 +250,9 @@ impl PhaseSteps {
     }
 
     /// The base's position after the steps handed out (0 while drilling).
-    pub fn base(&self) -> i32 {
+    pub fn base(&self, winder: &BlendWinder) -> i32 {
         match &self.work {
-            Work::Wind { winder, .. } => winder.base(),
+            Work::Wind { .. } => winder.base(),
             Work::Drill { .. } => 0,
         }
     }

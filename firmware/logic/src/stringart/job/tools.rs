@@ -105,13 +105,13 @@ impl Job {
                 return o.push(Action::Log(Msg::ToolRange));
             }
             Tool::Jump(k) if k > count => return o.push(Action::Log(Msg::ToolRange)),
-            Tool::WrapTest(k) if waiting && plan.winder.is_some() => Run::WrapTest {
+            Tool::WrapTest(k) if waiting => Run::WrapTest {
                 k,
                 i: 0,
                 wrap: None,
             },
             Tool::Drift(nail) if waiting || winding_paused => {
-                let back = self.steps.as_ref().map_or(0, |s| s.base());
+                let back = self.steps.as_ref().map_or(0, |s| s.base(&plan.winder));
                 let scale = plan.scale;
                 let there = scale.shorter_rotation(back, plan.board.nail(nail).angle);
                 Run::Drift {
@@ -145,7 +145,7 @@ impl Job {
         let plan = self.plan.as_mut()?;
         match self.run.as_mut()? {
             Run::WrapTest { k, i, wrap } => {
-                let winder = plan.winder.as_mut()?;
+                let winder = &mut plan.winder;
                 let nails = plan.board.nails();
                 let step = match *i {
                     // In through the gap before nail k, from the zero pose.
