@@ -13,7 +13,7 @@ use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Overrides, Planner};
-use taut_logic::prep::{Hold, Prep};
+use taut_logic::prep::{Cut, Hold, Prep};
 use taut_logic::segment::Buffered;
 use taut_logic::segment::Later;
 use taut_logic::units::Milli;
@@ -201,18 +201,7 @@ impl Motion {
                     continue;
                 }
             };
-            let mut seg = cut.segment;
-            if let Some(block) = cut.block {
-                // The block goes first: its first segment refers to it.
-                let _ = BLOCKS.push(block);
-                self.every_event = every_event(&block);
-                freed = true;
-            }
-            if self.every_event && fast_segment(&seg) {
-                seg.flags |= FAST;
-            }
-            let _ = SEGMENTS.push(seg);
-            self.buffered.push(&seg);
+            freed |= self.queue(&cut);
             pushed = true;
             made += 1;
             room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
@@ -234,6 +223,25 @@ impl Motion {
         let work = !self.prep.is_idle() || !PLANNER.with(|p| p.is_idle());
         let held = self.prep.hold_state() == Hold::Stopped;
         (freed, made == max && work && !held && room)
+    }
+
+    /// Hand `cut` to the step interrupt; true if it begins a block. Out of
+    /// line: its copies stay off the frame under the preparer's calls.
+    #[inline(never)]
+    #[optimize(speed)]
+    fn queue(&mut self, cut: &Cut) -> bool {
+        let mut seg = cut.segment;
+        if let Some(block) = &cut.block {
+            // The block goes first: its first segment refers to it.
+            let _ = BLOCKS.push(*block);
+            self.every_event = every_event(block);
+        }
+        if self.every_event && fast_segment(&seg) {
+            seg.flags |= FAST;
+        }
+        let _ = SEGMENTS.push(seg);
+        self.buffered.push(&seg);
+        cut.block.is_some()
     }
 
     /// Where the last queued move ends, steps.
