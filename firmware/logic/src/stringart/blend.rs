@@ -136,11 +136,17 @@ fn to(base: i32, radial: i32) -> MachineStep {
 
 impl BlendWinder {
     /// From the winding zero pose: nail 0 under the needle, needle at the
-    /// board's edge.
-    // Out of line: inlined into the job's event handling, its nails
-    // would sit in the frame under every job event (the stack's peak).
-    #[inline(never)]
+    /// board's edge; every gap checked ([`BlendWinder::check_gaps`]).
     pub fn new(board: Board, config: &MachineConfig) -> Result<Self, WindError> {
+        let w = BlendWinder::unchecked(board, config)?;
+        w.check_gaps()?;
+        Ok(w)
+    }
+
+    /// [`BlendWinder::new`] before its gaps are checked: a caller deep in
+    /// the stack keeps the winder where it stays, then checks it there.
+    #[inline(never)]
+    pub fn unchecked(board: Board, config: &MachineConfig) -> Result<Self, WindError> {
         let clearance = Clearance::of(config);
         let inner_mm = board.min_nail_radius() - clearance.mm;
         if inner_mm <= 0.0 {
@@ -148,24 +154,29 @@ impl BlendWinder {
         }
         let scale = StepScale::from_config(config);
         let inner = libm::floorf((inner_mm - board.radius()) * scale.radial.as_f32() - EPS);
-        let w = BlendWinder {
+        Ok(BlendWinder {
             board,
             scale,
             clearance,
             inner: inner as i32,
             base: 0,
-        };
-        // Every gap once, at reading time: a board too dense for the
-        // needle is refused before anything moves, and no wrap can fail
-        // for it later. Each nail is worked out once (a polygon's costs
-        // trigonometry): the job task's run stays well inside the step
-        // queue's 30 ms.
+        })
+    }
+
+    /// Every gap once, at reading time: a board too dense for the needle
+    /// is refused before anything moves, and no wrap can fail for it
+    /// later. Each nail is worked out once (a polygon's costs
+    /// trigonometry): the job task's run stays well inside the step
+    /// queue's 30 ms. Out of line: the deepest of the job's calls.
+    #[inline(never)]
+    pub fn check_gaps(&self) -> Result<(), WindError> {
+        let (board, scale, clearance) = (&self.board, &self.scale, &self.clearance);
         let (n, turn) = (board.nails(), scale.steps_per_turn as f32);
-        let first = clearance.blocked(&board, &scale, 0);
+        let first = clearance.blocked(board, scale, 0);
         let mut below = first;
         for g in 0..n {
             let mut above = match g + 1 {
-                next if next < n => clearance.blocked(&board, &scale, next),
+                next if next < n => clearance.blocked(board, scale, next),
                 _ => first,
             };
             if above.at <= below.at {
@@ -177,7 +188,7 @@ impl BlendWinder {
                 below.at -= turn;
             }
         }
-        Ok(w)
+        Ok(())
     }
 
     /// The window of the gap after nail `g`, in the turn nearest `near`

@@ -394,7 +394,14 @@ impl Job {
     ) {
         if self.state == State::Reading {
             o.push(Action::Configure);
-            match self.plan(params, count, id, config) {
+            // The gaps are checked on the plan in place, from this frame:
+            // no winder or plan on the stack under their trigonometry.
+            let planned = self.plan(params, count, id, config)
+                && self.plan.as_ref().is_some_and(|p| p.winder.check_gaps().is_ok());
+            if !planned {
+                self.plan = None;
+            }
+            match planned {
                 true => {
                     self.card = Card::Present;
                     if let Some(s) = self.saved {
@@ -440,9 +447,10 @@ impl Job {
         }
     }
 
-    /// The job's plan, put together after the winder's checks of every
-    /// gap (on the stack it would sit under them); false when the board
-    /// cannot be made, and then there is none.
+    /// The job's plan, its winder's gaps not yet checked; false when the
+    /// board cannot be made. Out of line: the plan it builds is not on the
+    /// stack under the checks.
+    #[inline(never)]
     fn plan(&mut self, params: Params, count: u32, id: CardId, config: &MachineConfig) -> bool {
         self.plan = None;
         let Ok(radius) = i32::try_from(params.radius_um) else {
@@ -451,7 +459,7 @@ impl Job {
         let Ok(board) = Board::new(params.shape, params.nails, Milli(radius)) else {
             return false;
         };
-        let Ok(winder) = BlendWinder::new(board, config) else {
+        let Ok(winder) = BlendWinder::unchecked(board, config) else {
             return false;
         };
         self.plan = Some(Plan {
