@@ -302,6 +302,14 @@ impl BlendWinder {
         })
     }
 
+    pub fn board(&self) -> &Board {
+        &self.board
+    }
+
+    pub fn scale(&self) -> &StepScale {
+        &self.scale
+    }
+
     /// The base's position after the moves handed out so far.
     pub fn base(&self) -> i32 {
         self.base

@@ -82,12 +82,21 @@ enum Card {
 struct Plan {
     count: u32,
     id: CardId,
-    board: Board,
-    scale: StepScale,
     /// The drilling's own figures: its planner is made when it starts.
     depths: Depths,
-    /// The winding phase's steps use it in place ([`PhaseSteps::next`]).
+    /// The winding phase's steps use it in place ([`PhaseSteps::next`]);
+    /// it keeps the board and the step scale for the whole plan.
     winder: BlendWinder,
+}
+
+impl Plan {
+    fn board(&self) -> Board {
+        *self.winder.board()
+    }
+
+    fn scale(&self) -> StepScale {
+        *self.winder.scale()
+    }
 }
 
 pub struct Job {
@@ -156,7 +165,7 @@ impl Job {
     /// connections, the card's identity.
     pub fn card(&self) -> Option<(u16, u32, CardId)> {
         let p = self.plan.as_ref()?;
-        Some((p.board.nails(), p.count, p.id))
+        Some((p.board().nails(), p.count, p.id))
     }
 
     pub fn state(&self) -> State {
@@ -301,7 +310,7 @@ impl Job {
             State::Offer => {
                 if let (Some(s), Some(p)) = (self.saved, &self.plan) {
                     let total = match s.phase() {
-                        Phase::Drilling => p.board.nails() as u32,
+                        Phase::Drilling => p.board().nails() as u32,
                         Phase::Winding => p.count,
                     };
                     o.push(Action::Offer {
@@ -397,7 +406,10 @@ impl Job {
             // The gaps are checked on the plan in place, from this frame:
             // no winder or plan on the stack under their trigonometry.
             let planned = self.plan(params, count, id, config)
-                && self.plan.as_ref().is_some_and(|p| p.winder.check_gaps().is_ok());
+                && self
+                    .plan
+                    .as_ref()
+                    .is_some_and(|p| p.winder.check_gaps().is_ok());
             if !planned {
                 self.plan = None;
             }
@@ -465,8 +477,6 @@ impl Job {
         self.plan = Some(Plan {
             count,
             id,
-            board,
-            scale: StepScale::from_config(config),
             depths: Depths::blended(config),
             winder,
         });
@@ -572,9 +582,15 @@ impl Job {
         };
         match s.phase() {
             Phase::Drilling => {
-                let hole = s.n().min(plan.board.nails() as u32);
-                let d = Drilling::on(plan.board, plan.scale, plan.depths).from_hole(hole as u16);
-                self.steps = Some(PhaseSteps::drill(d, plan.board.nails(), Some(hole), now_ms));
+                let hole = s.n().min(plan.board().nails() as u32);
+                let d =
+                    Drilling::on(plan.board(), plan.scale(), plan.depths).from_hole(hole as u16);
+                self.steps = Some(PhaseSteps::drill(
+                    d,
+                    plan.board().nails(),
+                    Some(hole),
+                    now_ms,
+                ));
                 self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
             }
             _ => {
@@ -600,8 +616,8 @@ impl Job {
     fn start_drilling(&mut self, o: &mut Out, now_ms: u32) {
         let Some(plan) = &self.plan else { return };
         self.steps = Some(PhaseSteps::drill(
-            Drilling::on(plan.board, plan.scale, plan.depths),
-            plan.board.nails(),
+            Drilling::on(plan.board(), plan.scale(), plan.depths),
+            plan.board().nails(),
             None,
             now_ms,
         ));
@@ -726,7 +742,7 @@ impl Job {
         if !self.wants_nail() {
             return;
         }
-        let in_range = self.plan.as_ref().is_some_and(|p| j < p.board.nails());
+        let in_range = self.plan.as_ref().is_some_and(|p| j < p.board().nails());
         if !in_range {
             // The check pass accepted this file: the card has changed.
             self.card = Card::Absent;

@@ -90,7 +90,7 @@ impl Job {
         let Some(plan) = &self.plan else {
             return o.push(Action::Log(Msg::ToolNotNow));
         };
-        let (nails, count) = (plan.board.nails(), plan.count);
+        let (nails, count) = (plan.board().nails(), plan.count);
         let winding_paused = self.state == State::Paused(Phase::Winding) && !self.lost;
         let waiting = self.state == State::WaitingForNails && self.loose == 0;
         let t = match t {
@@ -112,8 +112,8 @@ impl Job {
             },
             Tool::Drift(nail) if waiting || winding_paused => {
                 let back = self.steps.as_ref().map_or(0, |s| s.base(&plan.winder));
-                let scale = plan.scale;
-                let there = scale.shorter_rotation(back, plan.board.nail(nail).angle);
+                let scale = plan.scale();
+                let there = scale.shorter_rotation(back, plan.board().nail(nail).angle);
                 Run::Drift {
                     nail,
                     there,
@@ -145,8 +145,8 @@ impl Job {
         let plan = self.plan.as_mut()?;
         match self.run.as_mut()? {
             Run::WrapTest { k, i, wrap } => {
+                let nails = plan.board().nails();
                 let winder = &mut plan.winder;
-                let nails = plan.board.nails();
                 let step = match *i {
                     // In through the gap before nail k, from the zero pose.
                     0..=2 => winder.entry_step(Some((*k + nails - 1) % nails), *i),
@@ -160,7 +160,8 @@ impl Job {
                     // Out at the board's edge (above), and back to nail 0.
                     4 => {
                         let at = wrap.as_ref().map_or(0, |w| w.end_base());
-                        let home = plan.scale.shorter_rotation(at, plan.board.nail(0).angle);
+                        let (scale, board) = (winder.scale(), winder.board());
+                        let home = scale.shorter_rotation(at, board.nail(0).angle);
                         Some(MachineStep::to(Axis::Base, home))
                     }
                     _ => None,
