@@ -105,14 +105,17 @@ pub fn send_ok(sim: &mut sim::Sim, line: &str, timeout: std::time::Duration) {
 /// (issue #11; issue #13's bar is 4.5 KiB).
 pub const RAM_BUDGET: u32 = 6144;
 
-/// With `TAUT_STACK_CHAINS` set, the call chain at the test's deepest
+/// With `TAUT_STACK_CHAINS` set (`cargo xtask test` sets it), the call chain at the test's deepest
 /// stack goes to `target/hil-stack-chains.txt` (`stack_chain`): the
 /// whole run's deep paths, for RAM work.
 fn record_chain(sim: &sim::Sim) {
-    let chain = sim::stack_chain::deepest(sim, &firmware_elf());
-    if chain.is_empty() {
+    // The release image's code, read once per test binary.
+    static CODE: std::sync::OnceLock<sim::stack_chain::Code> = std::sync::OnceLock::new();
+    let Some(stack) = sim.peak_stack() else {
         return;
-    }
+    };
+    let code = CODE.get_or_init(|| sim::stack_chain::Code::read(&firmware_elf()));
+    let chain = code.chain(stack, sim.peak_stack_pc());
     let log = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/hil-stack-chains.txt");
     if let Ok(mut f) = std::fs::OpenOptions::new()
         .create(true)

@@ -28,6 +28,8 @@ pub fn deepest(sim: &Sim, elf: &Path) -> Vec<Frame> {
     Code::read(elf).chain(stack, sim.peak_stack_pc())
 }
 
+/// A firmware image's code as `avr-objdump -d` lists it: what a chain is
+/// read from (read once, then any number of chains).
 pub struct Code {
     /// Instructions by byte address: (mnemonic, operands).
     text: BTreeMap<u32, (String, String)>,

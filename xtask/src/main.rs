@@ -115,7 +115,8 @@ fn simtest() -> Result<()> {
     let peaks = root().join("target/hil-stack-peaks.txt");
     let _ = std::fs::remove_file(&peaks);
     let _ = std::fs::remove_file(root().join("target/hil-stack-chains.txt"));
-    cargo(&["test", "-p", "hil-tests"], &root())?;
+    let mut test = run::cargo_cmd(&["test", "-p", "hil-tests"], &root());
+    run::status(test.env("TAUT_STACK_CHAINS", "1"))?;
     print_ram(&img, &peaks);
     Ok(())
 }
@@ -135,7 +136,8 @@ fn print_ram(img: &firmware::Image, peaks: &std::path::Path) {
         .max();
     if let Some((stack, test)) = deepest {
         println!(
-            "== RAM: static {} B + deepest stack {stack} B ({test}) = {} B of 8192",
+            "== RAM: static {} B + deepest stack {stack} B ({test}) = {} B of 8192 \
+             (each test's call chain: target/hil-stack-chains.txt)",
             img.ram_static_bytes,
             img.ram_static_bytes + stack
         );
