@@ -105,28 +105,33 @@ pub fn send_ok(sim: &mut sim::Sim, line: &str, timeout: std::time::Duration) {
 /// (issue #11; issue #13's bar is 4.5 KiB).
 pub const RAM_BUDGET: u32 = 6144;
 
-/// With `TAUT_STACK_CHAINS` set (`cargo xtask test` sets it), the call chain at the test's deepest
-/// stack goes to `target/hil-stack-chains.txt` (`stack_chain`): the
-/// whole run's deep paths, for RAM work.
-fn record_chain(sim: &sim::Sim) {
+/// With `TAUT_STACK_CHAINS` set (`cargo xtask test` sets it), the call
+/// chain at the test's deepest stack goes to `target/hil-stack-chains.txt`
+/// (`stack_chain`): the whole run's deep paths, for RAM work.
+fn record_chain(sim: &sim::Sim, test: &str) {
     // The release image's code, read once per test binary.
     static CODE: std::sync::OnceLock<sim::stack_chain::Code> = std::sync::OnceLock::new();
     let Some(stack) = sim.peak_stack() else {
         return;
     };
     let code = CODE.get_or_init(|| sim::stack_chain::Code::read(&firmware_elf()));
-    let chain = code.chain(stack, sim.peak_stack_pc());
-    let log = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/hil-stack-chains.txt");
+    let mut text = format!("{test} {} B\n", sim.peak_stack_bytes());
+    for frame in code.chain(stack, sim.peak_stack_pc()) {
+        text += &format!("  {:>5} {:>4}  {}\n", frame.depth, frame.bytes, frame.at);
+    }
+    append("hil-stack-chains.txt", &text);
+}
+
+/// Adds `text` to `target/NAME`, the whole run's record.
+fn append(name: &str, text: &str) {
+    let log = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../target")
+        .join(name);
     if let Ok(mut f) = std::fs::OpenOptions::new()
         .create(true)
         .append(true)
         .open(log)
     {
-        let test = std::thread::current().name().unwrap_or("?").to_string();
-        let mut text = format!("{test} {} B\n", sim.peak_stack_bytes());
-        for frame in chain {
-            text += &format!("  {:>5} {:>4}  {}\n", frame.depth, frame.bytes, frame.at);
-        }
         let _ = f.write_all(text.as_bytes());
     }
 }
@@ -137,20 +142,14 @@ fn record_chain(sim: &sim::Sim) {
 pub fn assert_ram_budget(sim: &sim::Sim) {
     let statics = sim.elf().unwrap().ram_static_bytes();
     let stack = sim.peak_stack_bytes() as u32;
-    let log = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/hil-stack-peaks.txt");
-    if let Ok(mut f) = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(log)
-    {
-        let test = std::thread::current().name().unwrap_or("?").to_string();
-        let _ = writeln!(f, "{test} {stack} {:#x}", sim.peak_stack_pc());
-    }
-    record_chain(sim);
+    let test = std::thread::current().name().unwrap_or("?").to_string();
+    let peak = format!("{test} {stack} {:#x}\n", sim.peak_stack_pc());
+    append("hil-stack-peaks.txt", &peak);
+    record_chain(sim, &test);
     assert!(
         statics + stack < RAM_BUDGET,
         "static {statics} B + stack {stack} B, deepest at {:#x} (avr-addr2line -fe taut.elf; \
-         the call chain: simavr/examples/stack_trace.rs)",
+         the call chain: target/hil-stack-chains.txt)",
         sim.peak_stack_pc()
     );
 }
