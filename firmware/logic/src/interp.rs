@@ -444,16 +444,21 @@ impl Interpreter {
             axis_1,
             linear: index(w2),
         };
-        let (start, end) = (self.modal.target, next.target);
+        // Built in place: copies of the ends beside it would be 32 B more
+        // under the arc's checks.
         let sweep = Sweep {
-            start,
-            end,
+            start: self.modal.target,
+            end: next.target,
             plane,
             clockwise: next.motion == Motion::ArcCw,
             tolerance: Milli(cfg.arc_tolerance_um.min(i32::MAX as u32) as i32),
         };
         let circle = match line.r.get().map(|r| mm(r, next.units)) {
-            Some(_) if start[axis_0] == end[axis_0] && start[axis_1] == end[axis_1] => {
+            Some(_)
+                if [axis_0, axis_1]
+                    .iter()
+                    .all(|&a| sweep.start[a] == sweep.end[a]) =>
+            {
                 return Err(ErrorKind::InvalidTarget);
             }
             Some(r) => Circle::from_radius(&sweep, r),
