@@ -14,8 +14,7 @@ use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::planner::{Feed, Full, Overrides, Planner};
 use taut_logic::prep::{Cut, Hold, Prep};
-use taut_logic::segment::Buffered;
-use taut_logic::segment::Later;
+use taut_logic::segment::{Buffered, Later};
 use taut_logic::units::Milli;
 
 /// Preparing segments is urgent (the app runs it at the highest software

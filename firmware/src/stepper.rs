@@ -433,25 +433,26 @@ fn write_dir(dir: u8, high_positive: u8) {
 /// Take the next segment (and its block); false when the queue is empty.
 #[inline(always)]
 fn load_segment(e: &mut Exec) -> bool {
-    // Both read in place: a copy is a `memcpy` call and stack under the
-    // interrupt's frame.
-    let Some(new_block) = SEGMENTS.peek_with(|seg| seg.flags & NEW_BLOCK != 0) else {
-        return false;
-    };
-    if new_block {
-        if BLOCKS.peek_with(|block| begin_block(e, block)).is_none() {
-            return false;
+    // Segment and block read in place: a copy is a `memcpy` call and
+    // stack under the interrupt's frame.
+    let loaded = SEGMENTS.peek_with(|seg| {
+        if seg.flags & NEW_BLOCK != 0 {
+            if BLOCKS.peek_with(|block| begin_block(e, block)).is_none() {
+                return false;
+            }
+            let _ = BLOCKS.pop();
         }
-        let _ = BLOCKS.pop();
-    }
-    SEGMENTS.peek_with(|seg| {
         e.interval = seg.interval;
         e.add = seg.add;
         e.left = seg.count;
         e.block_left -= seg.count as u32;
         e.fast_ok = seg.flags & FAST;
         e.stop = seg.flags & STOP;
+        true
     });
+    if loaded != Some(true) {
+        return false;
+    }
     let _ = SEGMENTS.pop();
     true
 }

@@ -61,9 +61,6 @@ pub struct Parser {
     lexeme: Lexeme,
     checksum: Option<Checksum>,
     statement: Statement,
-    /// A line end was read and its result not yet taken: whether it
-    /// was a `\r`.
-    ended: Option<bool>,
 }
 
 /// What a byte did ([`Parser::read`]).
@@ -91,7 +88,6 @@ impl Parser {
             lexeme: Lexeme::Code,
             checksum: None,
             statement: Statement::Start,
-            ended: None,
         }
     }
 
@@ -125,7 +121,8 @@ impl Parser {
         match byte {
             b'\n' if after_cr => Read::More,
             b'\r' | b'\n' => {
-                self.ended = Some(byte == b'\r');
+                // Kept across `take_line`, which starts the next line.
+                self.after_cr = byte == b'\r';
                 Read::LineEnd
             }
             _ => {
@@ -141,12 +138,11 @@ impl Parser {
     }
 
     /// The result of the line [`Parser::read`] ended; the parser is then
-    /// ready for the next. Without an ended line: an empty line's result.
+    /// ready for the next.
     #[inline(never)]
     pub fn take_line(&mut self) -> Result<Input, Error> {
-        let after_cr = self.ended.take().unwrap_or(false);
         let line = self.finish();
-        self.restart(after_cr);
+        self.restart(self.after_cr);
         line
     }
 

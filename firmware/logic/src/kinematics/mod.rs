@@ -79,8 +79,7 @@ pub struct ChannelScale(pub PerAxis<StepsPerUnit>);
 
 impl ChannelScale {
     pub fn from_config(config: &MachineConfig) -> Self {
-        // Read in place: `axes.map` copies all the axes (108 B) first.
-        ChannelScale(core::array::from_fn(|i| config.axes[i].steps_per_unit))
+        ChannelScale(config.axes.map(|a| a.steps_per_unit))
     }
 
     /// Steps of one coordinate, rounded once from the absolute target.
