@@ -28,12 +28,7 @@ fn main() -> ! {
         let kin = AnyKinematics::of(&cfg).unwrap();
         led(true);
         for i in 0..N {
-            let p = [
-                Milli(50_000 + i * 100),
-                Milli(120_000 - i * 50),
-                Milli(0),
-                Milli(0),
-            ];
+            let p = [Milli(50_000 + i * 100), Milli(120_000 - i * 50), Milli(0)];
             let _ = black_box(kin.inverse(black_box(&p)));
         }
         led(false);
@@ -41,7 +36,7 @@ fn main() -> ! {
     let cfg = MachineConfig::defaults(Machine::Flatbed);
     let kin = AnyKinematics::of(&cfg).unwrap();
     let mut planner = Planner::new(&cfg);
-    let start = [Milli(11_000), Milli(10_000), Milli(0), Milli(0)];
+    let start = [Milli(11_000), Milli(10_000), Milli(0)];
     let sweep = Sweep {
         start,
         end: start,

@@ -18,7 +18,7 @@ use crate::endstop;
 use crate::motion::Motion;
 use crate::print::Print;
 use crate::queues::{Signal, BUTTONS, JOB_CLAIMS_TX, RX};
-use crate::reply::{self, REPORTED_AXES};
+use crate::reply;
 use crate::rt::{stack, Poll};
 use crate::{flash_str, info};
 use core::sync::atomic::Ordering::Relaxed;
@@ -1023,11 +1023,11 @@ fn report_position(m: &Motion, kin: &impl Kinematics) {
     let pos = kin.forward(&steps);
     let words = kin.words();
     let mut r = reply::line();
-    for i in 0..REPORTED_AXES {
+    for i in 0..AXES {
         let _ = uwrite!(r, "{}:{} ", words[i] as char, Decimal(pos[i].0, 3));
     }
     let _ = uwrite!(r, "{}", flash_str!("Count"));
-    for i in 0..REPORTED_AXES {
+    for i in 0..AXES {
         let _ = uwrite!(r, " {}:{}", words[i] as char, steps[i]);
     }
     r.send();

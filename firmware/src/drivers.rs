@@ -10,17 +10,16 @@ use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::config::MachineConfig;
 use taut_logic::pinmap::DRIVERS;
 
-/// RAMPS X/Y/Z/E0 ENABLE pins (see `taut_logic::pinmap::DRIVERS`).
+/// RAMPS X/Y/Z ENABLE pins (see `taut_logic::pinmap::DRIVERS`).
 pub struct EnablePins {
     pub base: Pin<38, Output>,
     pub radial: Pin<56, Output>,
     pub drill: Pin<62, Output>,
-    pub aux: Pin<24, Output>,
 }
 
 const _: () = {
     assert!(DRIVERS[0].enable == 38 && DRIVERS[1].enable == 56);
-    assert!(DRIVERS[2].enable == 62 && DRIVERS[3].enable == 24);
+    assert!(DRIVERS[2].enable == 62);
 };
 
 pub struct Drivers {
@@ -64,8 +63,7 @@ impl Drivers {
             let _ = match i {
                 0 => self.pins.base.set_state(level.into()),
                 1 => self.pins.radial.set_state(level.into()),
-                2 => self.pins.drill.set_state(level.into()),
-                _ => self.pins.aux.set_state(level.into()),
+                _ => self.pins.drill.set_state(level.into()),
             };
             if on {
                 self.on |= 1 << i;

@@ -15,7 +15,6 @@ const MIN_INPUT: [u8; AXES] = [
     1 << Button::ZeroBase as u8,
     1 << Button::ZeroRadial as u8,
     1 << Button::ZeroDrill as u8,
-    0,
 ];
 
 /// The switch bits watched (0: none).

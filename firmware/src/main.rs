@@ -260,7 +260,6 @@ fn init() -> Watchdog {
         base: pins.d38.into_output(),
         radial: pins.a2.into_output(),
         drill: pins.a8.into_output(),
-        aux: pins.d24.into_output(),
     };
     let drivers = CONFIG.with(|c| Drivers::new(enable, c));
     let step_dir = StepDirPins {
@@ -270,8 +269,6 @@ fn init() -> Watchdog {
         radial_dir: pins.a7.into_output_at(false),
         drill_step: pins.d46.into_output_at(false),
         drill_dir: pins.d48.into_output_at(false),
-        aux_step: pins.d26.into_output_at(false),
-        aux_dir: pins.d28.into_output_at(false),
     };
     let stepper = CONFIG.with(|c| Stepper::new(step_dir, StepTimer::start(dp.TC3), c));
     // The pen starts up, whatever the machine (SERVO0 is unused on the

@@ -15,10 +15,6 @@ use ufmt::{uWrite, uwrite};
 /// its `error:<code>` line.
 pub const ROOM: usize = crate::log::LINE + "error:255\n".len();
 
-/// Axes in position reports: the machine's three (the aux channel is
-/// not reported).
-pub const REPORTED_AXES: usize = 3;
-
 /// A reply line being assembled (the log's line type: see `Line::bare`).
 pub type Reply = Line;
 

@@ -49,8 +49,10 @@ const LONG_WAIT: u32 = 0x6000;
 const WAIT_PART: u32 = 0x4000;
 
 /// The ports that carry STEP pins ("slots"), and each axis's slot and bit,
-/// worked out from the pin map at compile time.
-const SLOTS: usize = 4;
+/// worked out from the pin map at compile time. RAMPS puts the X, Y and Z
+/// STEP pins on two ports (PF, PL); a pin map needing more stops the
+/// compiler in `step_map`.
+const SLOTS: usize = 2;
 pub(crate) struct StepMap {
     #[doc(hidden)]
     pub(crate) ports: [Option<Port>; SLOTS],
@@ -114,7 +116,6 @@ const DIR: [PinReg; AXES] = [
     reg(DRIVERS[0].dir),
     reg(DRIVERS[1].dir),
     reg(DRIVERS[2].dir),
-    reg(DRIVERS[3].dir),
 ];
 
 /// State owned by the interrupt once motion runs. `repr(C)`: the assembly
@@ -225,7 +226,7 @@ pub fn take_refill() -> bool {
     avr_device::interrupt::free(|_| core::mem::take(&mut exec().refill) != 0)
 }
 
-/// RAMPS X/Y/Z/E0 STEP and DIR pins, low outputs. The interrupt writes
+/// RAMPS X/Y/Z STEP and DIR pins, low outputs. The interrupt writes
 /// them through the register addresses worked out from
 /// `taut_logic::pinmap::DRIVERS` (one store per port); these tokens prove
 /// that those pins are outputs and the stepper's alone.
@@ -236,15 +237,12 @@ pub struct StepDirPins {
     pub radial_dir: Pin<61, Output>,
     pub drill_step: Pin<46, Output>,
     pub drill_dir: Pin<48, Output>,
-    pub aux_step: Pin<26, Output>,
-    pub aux_dir: Pin<28, Output>,
 }
 
 const _: () = {
     assert!(DRIVERS[0].step == 54 && DRIVERS[0].dir == 55);
     assert!(DRIVERS[1].step == 60 && DRIVERS[1].dir == 61);
     assert!(DRIVERS[2].step == 46 && DRIVERS[2].dir == 48);
-    assert!(DRIVERS[3].step == 26 && DRIVERS[3].dir == 28);
 };
 
 /// Owner of the STEP and DIR pins and of Timer3.
@@ -547,7 +545,6 @@ fn dda_partial(e: &mut Exec, m: &mut [u8; SLOTS]) {
     dda_axis!(e, m, 0);
     dda_axis!(e, m, 1);
     dda_axis!(e, m, 2);
-    dda_axis!(e, m, 3);
 }
 
 /// Time, DDA and compare register of the next event.
@@ -603,12 +600,6 @@ unsafe fn toggle_steps(m: &[u8; SLOTS]) {
     }
     if !slot_pin(1).is_null() {
         write_volatile(slot_pin(1), m[1]);
-    }
-    if !slot_pin(2).is_null() {
-        write_volatile(slot_pin(2), m[2]);
-    }
-    if !slot_pin(3).is_null() {
-        write_volatile(slot_pin(3), m[3]);
     }
 }
 

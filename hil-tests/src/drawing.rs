@@ -155,7 +155,7 @@ pub fn home(machine: Machine) -> [f64; 2] {
 
 fn position(machine: Machine, steps: [i64; 3]) -> [f64; 2] {
     let kin = AnyKinematics::of(&MachineConfig::defaults(machine)).unwrap();
-    let p = kin.forward(&[steps[0] as i32, steps[1] as i32, steps[2] as i32, 0]);
+    let p = kin.forward(&[steps[0] as i32, steps[1] as i32, steps[2] as i32]);
     [p[0].0 as f64 / 1000.0, p[1].0 as f64 / 1000.0]
 }
 

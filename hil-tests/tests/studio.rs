@@ -119,7 +119,7 @@ fn a_generated_card_is_wound_as_its_preview_shows() {
 
 /// The pen's point at `steps` on `machine`, mm.
 fn at(kin: &AnyKinematics, steps: [i64; 3]) -> [f64; 2] {
-    let p = kin.forward(&[steps[0] as i32, steps[1] as i32, steps[2] as i32, 0]);
+    let p = kin.forward(&[steps[0] as i32, steps[1] as i32, steps[2] as i32]);
     [f64::from(p[0].0) / 1000.0, f64::from(p[1].0) / 1000.0]
 }
 

@@ -1,7 +1,9 @@
-//! The four stepper channels of a RAMPS 1.4 board and what they drive.
+//! The three stepper channels of a RAMPS 1.4 board the machines drive.
 
-/// Number of stepper channels the firmware drives (RAMPS X, Y, Z, E0).
-pub const AXES: usize = 4;
+/// Number of stepper channels the firmware drives (RAMPS X, Y, Z): every
+/// machine has at most three motors, and each channel costs RAM in every
+/// position, block and setting.
+pub const AXES: usize = 3;
 
 /// A stepper channel. The names are the string-art machine's; plotter
 /// kinematics use the same channels for X, Y and the pen.
@@ -14,12 +16,10 @@ pub enum Axis {
     Radial = 1,
     /// Drill / needle along the tilted tool axis (RAMPS Z driver). Word `Z`, mm.
     Drill = 2,
-    /// Spare channel (RAMPS E0 driver). Word `A`.
-    Aux = 3,
 }
 
 impl Axis {
-    pub const ALL: [Axis; AXES] = [Axis::Base, Axis::Radial, Axis::Drill, Axis::Aux];
+    pub const ALL: [Axis; AXES] = [Axis::Base, Axis::Radial, Axis::Drill];
 
     pub const fn index(self) -> usize {
         self as usize
@@ -31,7 +31,6 @@ impl Axis {
             Axis::Base => "base",
             Axis::Radial => "radial",
             Axis::Drill => "drill",
-            Axis::Aux => "aux",
         }
     }
 }

@@ -329,11 +329,11 @@ const fn axis(
 }
 
 /// Two drawing axes; the third channel is a spare Z (the pen is a
-/// servo), the fourth the spare E0 driver.
+/// servo).
 const fn plotter(machine: Machine, xy: [AxisConfig; 2]) -> MachineConfig {
     let spare = axis(StepsPerUnit::new(80, 1), 2000, 500, None);
     MachineConfig {
-        axes: [xy[0], xy[1], spare, spare],
+        axes: [xy[0], xy[1], spare],
         pulse: TB6600,
         junction_deviation_um: 10,
         arc_tolerance_um: 10,

@@ -7,9 +7,9 @@ use crate::axis::{Axis, AXES};
 use taut_progmem::{text, Text};
 
 /// The string-art machine's words: base `C`, radial `X`, drill `Z`.
-pub const CYLINDRICAL: [u8; AXES] = *b"CXZA";
+pub const CYLINDRICAL: [u8; AXES] = *b"CXZ";
 /// A plotter's or an arm's words.
-pub const CARTESIAN: [u8; AXES] = *b"XYZA";
+pub const CARTESIAN: [u8; AXES] = *b"XYZ";
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Machine {
@@ -63,7 +63,6 @@ impl Machine {
     pub fn channel(self, axis: Axis) -> Text {
         // A table in flash by machine, then axis: a `match` on the pair
         // cost 176 B of code. Texts named once, not a copy per row.
-        const AUX: Text = text!("aux");
         const Z: Text = text!("z");
         const X: Text = text!("x");
         const Y: Text = text!("y");
@@ -75,14 +74,14 @@ impl Machine {
                 m += 1;
             }
             assert!(Axis::Base as usize == 0 && Axis::Radial as usize == 1);
-            assert!(Axis::Drill as usize == 2 && Axis::Aux as usize == 3 && AXES == 4);
+            assert!(Axis::Drill as usize == 2 && AXES == 3);
         };
         let names = taut_progmem::table!(Text; N; [
-            text!("base"), text!("radial"), text!("drill"), AUX, // StringArt
-            X, Y, Z, AUX, // Drum
-            X, Y, Z, AUX, // Flatbed
-            text!("left"), text!("right"), Z, AUX, // Whiteboard
-            text!("shoulder"), text!("elbow"), Z, AUX, // Scara
+            text!("base"), text!("radial"), text!("drill"), // StringArt
+            X, Y, Z, // Drum
+            X, Y, Z, // Flatbed
+            text!("left"), text!("right"), Z, // Whiteboard
+            text!("shoulder"), text!("elbow"), Z, // Scara
         ]);
         names.get(self as usize * AXES + axis as usize)
     }

@@ -7,7 +7,6 @@
 //! | base STEP / DIR / ENABLE | X | D54 (A0) / D55 (A1) / D38 | PF0 / PF1 / PD7 |
 //! | radial STEP / DIR / ENABLE | Y | D60 (A6) / D61 (A7) / D56 (A2) | PF6 / PF7 / PF2 |
 //! | drill STEP / DIR / ENABLE | Z | D46 / D48 / D62 (A8) | PL3 / PL1 / PK0 |
-//! | aux STEP / DIR / ENABLE | E0 | D26 / D28 / D24 | PA4 / PA6 / PA2 |
 //! | green `confirm` button | X_MAX | D2 | PE4 |
 //! | white `zero_base` button | X_MIN | D3 | PE5 |
 //! | white `zero_radial` button | Y_MIN | D14 | PJ1 |
@@ -101,7 +100,7 @@ pub struct DriverPins {
     pub enable: u8,
 }
 
-/// RAMPS 1.4 X, Y, Z and E0 drivers, in [`Axis`] order.
+/// RAMPS 1.4 X, Y and Z drivers, in [`Axis`] order (E0 and E1 stay free).
 pub const DRIVERS: PerAxis<DriverPins> = [
     DriverPins {
         step: 54,
@@ -117,11 +116,6 @@ pub const DRIVERS: PerAxis<DriverPins> = [
         step: 46,
         dir: 48,
         enable: 62,
-    },
-    DriverPins {
-        step: 26,
-        dir: 28,
-        enable: 24,
     },
 ];
 

@@ -696,22 +696,22 @@ mod tests {
         assert_eq!(lines[15], "radial_travel_min = -450.000");
         assert_eq!(lines[16], "radial_travel_max = 30.000");
         assert_eq!(lines[17], "drill_steps_per_unit = 1600/12");
-        assert_eq!(lines[28], "aux_dir_invert = 0");
-        assert_eq!(lines[29], "aux_enable_active_high = 1");
-        assert_eq!(lines[33], "step_pulse_us = 5");
-        assert_eq!(lines[36], "junction_deviation_um = 10");
-        assert_eq!(lines[37], "arc_tolerance_um = 10");
-        assert_eq!(lines[38], "length_1 = 0.000");
-        assert_eq!(lines[42], "crosstalk = 0");
+        assert_eq!(lines[20], "drill_dir_invert = 0");
+        assert_eq!(lines[21], "drill_enable_active_high = 1");
+        assert_eq!(lines[25], "step_pulse_us = 5");
+        assert_eq!(lines[28], "junction_deviation_um = 10");
+        assert_eq!(lines[29], "arc_tolerance_um = 10");
+        assert_eq!(lines[30], "length_1 = 0.000");
+        assert_eq!(lines[34], "crosstalk = 0");
         // Another machine names its channels its own way.
         let scara = listing(&MachineConfig::defaults(Machine::Scara));
         assert_eq!(scara[0], "machine = scara");
         assert_eq!(scara[1], "shoulder_steps_per_unit = 9600/360");
         assert_eq!(scara[9], "elbow_steps_per_unit = 9600/360");
-        assert_eq!(scara[38], "length_1 = 150.000");
-        assert_eq!(scara[40], "origin_x = 100.000");
-        assert_eq!(scara[41], "origin_y = -56.000");
-        assert_eq!(scara[42], "crosstalk = 3");
+        assert_eq!(scara[30], "length_1 = 150.000");
+        assert_eq!(scara[32], "origin_x = 100.000");
+        assert_eq!(scara[33], "origin_y = -56.000");
+        assert_eq!(scara[34], "crosstalk = 3");
         for (i, s) in all().enumerate() {
             assert_eq!(s.index(), i);
             assert_eq!(Setting::at(i), Some(s));
@@ -738,7 +738,7 @@ mod tests {
         set(&mut cfg, "DRILL_STEPS_PER_UNIT", "1600 / 12").unwrap();
         set(&mut cfg, "radial_steps_per_unit", "26.5").unwrap();
         set(&mut cfg, "radial_dir_invert", "1").unwrap();
-        set(&mut cfg, "aux_enable_active_high", "0").unwrap();
+        set(&mut cfg, "drill_enable_active_high", "0").unwrap();
         set(&mut cfg, "base_accel", " 750 ").unwrap();
         set(&mut cfg, "enable_setup_us", "0").unwrap();
         set(&mut cfg, "junction_deviation_um", "20").unwrap();
@@ -746,7 +746,7 @@ mod tests {
         assert_eq!(cfg.axes[2].steps_per_unit, StepsPerUnit::new(1600, 12));
         assert_eq!(cfg.axes[1].steps_per_unit, StepsPerUnit::new(53, 2));
         assert!(!cfg.axes[1].dir_high_is_positive);
-        assert!(!cfg.axes[3].enable_active_high);
+        assert!(!cfg.axes[2].enable_active_high);
         assert_eq!(cfg.axes[0].accel, 750);
         assert_eq!(cfg.pulse.enable_setup_us, 0);
         assert_eq!(cfg.junction_deviation_um, 20);

@@ -68,19 +68,17 @@ pub const LEAD: u16 = MIN_LEAD;
 pub const fn pin(s: usize) -> u16 {
     match MAP.ports[s] {
         Some(p) => p.pin_register(),
-        None => panic!("the fast path expects three STEP ports (RAMPS)"),
+        None => panic!("the fast path expects two STEP ports (RAMPS)"),
     }
 }
 
-// The fast path writes exactly three STEP ports; a pin map with more or
-// fewer must adapt the assembly (the compiler stops here).
-const _: () = assert!(MAP.ports[3].is_none());
+// The fast path writes exactly two STEP ports; a pin map with another
+// number must adapt the assembly (the compiler stops here).
+const _: () = assert!(MAP.ports.len() == 2);
 #[doc(hidden)]
 pub const PIN0: u16 = pin(0);
 #[doc(hidden)]
 pub const PIN1: u16 = pin(1);
-#[doc(hidden)]
-pub const PIN2: u16 = pin(2);
 
 /// Defines `__vector_32` (TIMER3_COMPA): the fast path, falling back to the
 /// `extern "avr-interrupt"` handler `$slow` for any other event.
@@ -106,7 +104,6 @@ macro_rules! step_vector {
                 // pulse comes at the same delay after the compare match.
                 "lds r24, {e}+{masks}+0", "sts {pin0}, r24",
                 "lds r24, {e}+{masks}+1", "sts {pin1}, r24",
-                "lds r24, {e}+{masks}+2", "sts {pin2}, r24",
                 "lds r24, 0x94", "sts {e}+{raised}, r24",
                 "lds r24, 0x95", "sts {e}+{raised}+1, r24",
                 "lds r24, {e}+{fast_ok}",
@@ -208,7 +205,6 @@ macro_rules! step_vector {
                 // Drop the STEP pins.
                 "lds r24, {e}+{masks}+0", "sts {pin0}, r24",
                 "lds r24, {e}+{masks}+1", "sts {pin1}, r24",
-                "lds r24, {e}+{masks}+2", "sts {pin2}, r24",
                 "pop r31", "pop r30", "pop r27", "pop r26", "pop r25",
                 "pop r23", "pop r22", "pop r21", "pop r20", "pop r19", "pop r18",
                 "pop r24",
@@ -247,7 +243,6 @@ macro_rules! step_vector {
                 lead = const $crate::stepper::fast::LEAD,
                 pin0 = const $crate::stepper::fast::PIN0,
                 pin1 = const $crate::stepper::fast::PIN1,
-                pin2 = const $crate::stepper::fast::PIN2,
             );
         }
     };

@@ -106,7 +106,6 @@ fn cruise(elf: &Path, axes: &[Axis], rate: u32) -> Option<(f64, f64, f64)> {
                 Axis::Base => ("C", 9600.0 / 360.0),
                 Axis::Radial => ("X", 32.0),
                 Axis::Drill => ("Z", 1600.0 / 12.0),
-                Axis::Aux => ("A", 80.0),
             };
             format!("{letter}{:.3}", events as f64 / per_unit)
         })

@@ -8,7 +8,7 @@ use crate::vcd::Signal;
 use serde::Serialize;
 use std::io;
 use std::path::Path;
-use taut_logic::axis::Axis;
+use taut_logic::axis::{Axis, AXES};
 use taut_logic::config::MachineConfig;
 use taut_logic::kinematics::{AnyKinematics, Kinematics};
 
@@ -89,9 +89,9 @@ pub fn plot_points(
         let i = widths.partition_point(|w| w.0 <= t);
         i > 0 && (widths[i - 1].1 - f64::from(cfg.pen.down_deg)).abs() < 1.0
     };
-    let mut steps = [origin[0], origin[1], 0, 0];
+    let mut steps = [origin[0], origin[1], 0];
     let mut points = Vec::with_capacity(events.len() + 1);
-    let at = |s: &[i32; 4]| {
+    let at = |s: &[i32; AXES]| {
         let p = kin.forward(s);
         (p[0].0 as f64 / 1000.0, p[1].0 as f64 / 1000.0)
     };

@@ -1,4 +1,5 @@
 use super::*;
+use crate::axis::AXES;
 use crate::gcode::{Input, Parser};
 use crate::kinematics::Linear;
 use std::vec::Vec;
@@ -89,7 +90,7 @@ fn planned_twice_committed_once_is_one_move() {
 fn relative_moves_never_drift() {
     let mut i = Interpreter::new();
     run(&mut i, "G91 G1 F60000", FREE).unwrap();
-    let mut last = [0; 4];
+    let mut last = [0; AXES];
     for _ in 0..360 {
         last = steps(run(&mut i, "C1", FREE));
     }
@@ -109,7 +110,7 @@ fn soft_limits_refuse_before_anything_and_keep_the_target() {
         run(&mut i, "G0 Z-30.001", FREE),
         Err(ErrorKind::TravelExceeded)
     );
-    assert_eq!(i.target(), [Milli::ZERO; 4]);
+    assert_eq!(i.target(), [Milli::ZERO; AXES]);
     // The base turns freely.
     assert_eq!(steps(run(&mut i, "G0 C7200", FREE))[0], 192_000);
     // G92 moves the zero the limits count from.
@@ -230,7 +231,7 @@ fn arcs_are_refused_whole_before_anything_moves() {
         assert_eq!(
             run(&mut i, "X1", FREE),
             Ok(Order::Move {
-                steps: [0, 32, 0, 0],
+                steps: [0, 32, 0],
                 feed: Feed::Rapid
             }),
             "after {text}"
@@ -330,7 +331,7 @@ fn the_pen_of_a_plotter_answers_m3_m5_m300_and_z() {
     assert_eq!(
         plan("G0 X1"),
         Ok(Order::Move {
-            steps: [40, 0, 0, 0],
+            steps: [40, 0, 0],
             feed: Feed::Rapid
         })
     );
@@ -349,17 +350,17 @@ fn the_string_art_machine_has_no_pen_and_dwells_in_seconds() {
     );
     assert_eq!(run(&mut i, "G4 P1.5", FREE), Ok(Order::Dwell { ms: 1500 }));
     // Z is the drill there.
-    assert_eq!(steps(run(&mut i, "G0 Z1.5", FREE)), [0, 0, 200, 0]);
+    assert_eq!(steps(run(&mut i, "G0 Z1.5", FREE)), [0, 0, 200]);
 }
 
 #[test]
 fn inches_are_converted_once_and_angles_stay_degrees() {
     let mut i = Interpreter::new();
     // 1 in = 25.4 mm = 812.8 → 813 radial steps; C stays 90°.
-    assert_eq!(steps(run(&mut i, "G20 G0 X1 C90", FREE)), [2400, 813, 0, 0]);
+    assert_eq!(steps(run(&mut i, "G20 G0 X1 C90", FREE)), [2400, 813, 0]);
     // Modal: the next line is in inches too, from the absolute target.
-    assert_eq!(steps(run(&mut i, "G91 X-0.5", FREE)), [2400, 406, 0, 0]);
-    assert_eq!(steps(run(&mut i, "G21 X-12.7", FREE)), [2400, 0, 0, 0]);
+    assert_eq!(steps(run(&mut i, "G91 X-0.5", FREE)), [2400, 406, 0]);
+    assert_eq!(steps(run(&mut i, "G21 X-12.7", FREE)), [2400, 0, 0]);
     // F in inches per minute: 0.3 in/min = 7.62 mm/min, below the least.
     assert_eq!(
         run(&mut i, "G20 G1 X1 F0.3", FREE),
@@ -413,7 +414,7 @@ fn a_jog_moves_and_keeps_the_modal_state_but_the_position() {
         planned.order,
         Order::Move {
             // 35.4 mm at 32 steps/mm: 1132.8 steps, rounded once.
-            steps: [0, -1133, 0, 0],
+            steps: [0, -1133, 0],
             feed: Feed::PerMinute(Milli(254_000)),
         }
     );

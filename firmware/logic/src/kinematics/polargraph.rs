@@ -86,7 +86,7 @@ impl Kinematics for Polargraph {
     }
 
     fn words(&self) -> [u8; AXES] {
-        *b"XYZA"
+        *b"XYZ"
     }
 }
 
@@ -109,7 +109,7 @@ pub(crate) mod tests {
     /// turn of a 40 mm sprocket: 50 steps/mm (20 µm per step).
     fn kin() -> Polargraph {
         let s = StepsPerUnit::new(50, 1);
-        let scale = ChannelScale([s, s, s, s]);
+        let scale = ChannelScale([s, s, s]);
         Polargraph::new(&scale, &geometry(1_200_000, [600_000, -600_000])).unwrap()
     }
 
@@ -127,7 +127,7 @@ pub(crate) mod tests {
         // √(300²+800²) = 854.400 mm and √(900²+800²) = 1204.159 mm; at the
         // origin both are √(600²+600²) = 848.528 mm.
         let s = k
-            .inverse(&[Milli(-300_000), Milli(-200_000), Milli(0), Milli(0)])
+            .inverse(&[Milli(-300_000), Milli(-200_000), Milli(0)])
             .unwrap();
         assert!((s[0] - 294).abs() <= 1, "{}", s[0]); // 5.872 mm × 50
         assert!((s[1] - 17782).abs() <= 1, "{}", s[1]); // 355.631 mm × 50
@@ -137,11 +137,11 @@ pub(crate) mod tests {
     fn above_the_motors_is_unreachable() {
         let k = kin();
         assert_eq!(
-            k.inverse(&[Milli(0), Milli(600_000), Milli(0), Milli(0)]),
+            k.inverse(&[Milli(0), Milli(600_000), Milli(0)]),
             Err(KinError::Unreachable)
         );
         let s = StepsPerUnit::new(50, 1);
-        assert!(Polargraph::new(&ChannelScale([s; 4]), &geometry(1_000_000, [0, 10])).is_err());
+        assert!(Polargraph::new(&ChannelScale([s; AXES]), &geometry(1_000_000, [0, 10])).is_err());
     }
 
     proptest! {
@@ -151,7 +151,7 @@ pub(crate) mod tests {
         #[test]
         fn forward_of_inverse_within_a_step(x in -550_000i32..550_000, y in -500_000i32..300_000) {
             let k = kin();
-            let pos = [Milli(x), Milli(y), Milli(0), Milli(0)];
+            let pos = [Milli(x), Milli(y), Milli(0)];
             let back = k.forward(&k.inverse(&pos).unwrap());
             let err = libm::hypotf((back[0].0 - x) as f32, (back[1].0 - y) as f32);
             prop_assert!(err <= 25.0, "{:?} -> {:?}", pos, back);
@@ -160,7 +160,7 @@ pub(crate) mod tests {
         #[test]
         fn inverse_of_forward_within_a_step(x in -550_000i32..550_000, y in -500_000i32..300_000) {
             let k = kin();
-            let s = k.inverse(&[Milli(x), Milli(y), Milli(0), Milli(0)]).unwrap();
+            let s = k.inverse(&[Milli(x), Milli(y), Milli(0)]).unwrap();
             let again = k.inverse(&k.forward(&s)).unwrap();
             prop_assert!((again[0] - s[0]).abs() <= 1 && (again[1] - s[1]).abs() <= 1, "{:?} {:?}", s, again);
         }

@@ -123,7 +123,7 @@ impl Kinematics for Scara {
     }
 
     fn words(&self) -> [u8; AXES] {
-        *b"XYZA"
+        *b"XYZ"
     }
 }
 
@@ -138,7 +138,7 @@ mod tests {
     /// (12 800 steps per 360°: 0.028° a step), ECR 3, shoulder at (10, 20).
     fn kin() -> Scara {
         let s = StepsPerUnit::new(12_800, 360);
-        let scale = ChannelScale([s, s, StepsPerUnit::new(100, 1), s]);
+        let scale = ChannelScale([s, s, StepsPerUnit::new(100, 1)]);
         let g = Geometry {
             lengths: [Milli(150_000), Milli(120_000)],
             origin: [Milli(10_000), Milli(20_000)],
@@ -151,7 +151,7 @@ mod tests {
     fn a_line_through_the_hole_round_the_shoulder_is_out_of_reach() {
         // Arms 150 and 120: nothing within 30 mm of the shoulder (10, 20).
         let k = kin();
-        let at = |x: i32, y: i32| [Milli(x), Milli(y), Milli(0), Milli(0)];
+        let at = |x: i32, y: i32| [Milli(x), Milli(y), Milli(0)];
         assert!(k.reaches_line(&at(-90_000, 20_000), &at(-90_000, 120_000)));
         assert!(!k.reaches_line(&at(-90_000, 20_000), &at(110_000, 20_000)));
         assert!(k.reaches_line(&at(-90_000, 60_000), &at(110_000, 60_000)));
@@ -170,7 +170,7 @@ mod tests {
         // L2 to −x: (10 − 120, 20 + 150).
         let k = kin();
         let steps = k
-            .inverse(&[Milli(-110_000), Milli(170_000), Milli(0), Milli(0)])
+            .inverse(&[Milli(-110_000), Milli(170_000), Milli(0)])
             .unwrap();
         assert!(
             steps[0].abs() <= 1 && (steps[1] - 3200).abs() <= 1,
@@ -184,7 +184,7 @@ mod tests {
             libm::cosf(s) * 150.0 + libm::cosf(s + PI / 2.0) * 120.0 + 20.0,
         ];
         let steps = k
-            .inverse(&[milli(tip[0]), milli(tip[1]), Milli(0), Milli(0)])
+            .inverse(&[milli(tip[0]), milli(tip[1]), Milli(0)])
             .unwrap();
         assert!(
             (steps[0] - 1067).abs() <= 1 && (steps[1] - 3556).abs() <= 1,
@@ -196,8 +196,8 @@ mod tests {
     #[test]
     fn out_of_reach() {
         let k = kin();
-        let far = [Milli(10_000), Milli(300_000), Milli(0), Milli(0)];
-        let near = [Milli(20_000), Milli(20_000), Milli(0), Milli(0)];
+        let far = [Milli(10_000), Milli(300_000), Milli(0)];
+        let near = [Milli(20_000), Milli(20_000), Milli(0)];
         assert_eq!(k.inverse(&far), Err(KinError::Unreachable));
         assert_eq!(k.inverse(&near), Err(KinError::Unreachable));
     }
@@ -219,7 +219,7 @@ mod tests {
         #[test]
         fn forward_of_inverse_within_a_step((x, y) in reachable()) {
             let k = kin();
-            let pos = [Milli(x), Milli(y), Milli(0), Milli(0)];
+            let pos = [Milli(x), Milli(y), Milli(0)];
             let back = k.forward(&k.inverse(&pos).unwrap());
             let err = libm::hypotf((back[0].0 - x) as f32, (back[1].0 - y) as f32);
             prop_assert!(err <= 132.0, "{:?} -> {:?}", pos, back);
@@ -231,7 +231,7 @@ mod tests {
         fn inverse_of_forward_within_a_step(a in -3000i32..3000, bend in 400i32..6000) {
             let k = kin();
             // Elbow motor = bend + shoulder/ECR, as the arm is built.
-            let s = [a, bend + a / 3, 0, 0];
+            let s = [a, bend + a / 3, 0];
             let again = k.inverse(&k.forward(&s)).unwrap();
             prop_assert!((again[0] - s[0]).abs() <= 1 && (again[1] - s[1]).abs() <= 1, "{:?} {:?}", s, again);
         }

@@ -5,7 +5,7 @@ use crate::units::Milli;
 use std::string::ToString;
 
 fn at(x: i32, y: i32) -> Position {
-    [Milli(x), Milli(y), Milli(0), Milli(0)]
+    [Milli(x), Milli(y), Milli(0)]
 }
 
 #[test]
@@ -24,7 +24,7 @@ fn names_round_trip_and_channels_are_named_by_the_machine() {
     );
     assert_eq!(Machine::Whiteboard.channel(Axis::Base).to_string(), "left");
     assert_eq!(Machine::Scara.channel(Axis::Radial).to_string(), "elbow");
-    assert_eq!(Machine::Drum.words(), *b"XYZA");
+    assert_eq!(Machine::Drum.words(), *b"XYZ");
 }
 
 #[test]

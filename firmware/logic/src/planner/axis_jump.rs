@@ -80,7 +80,7 @@ mod tests {
             let c = MachineConfig::STRING_ART;
             let mut p = Planner::new(&c);
             for &(b, r) in &points {
-                p.push([b, r, 0, 0], Feed::Rapid).unwrap();
+                p.push([b, r, 0], Feed::Rapid).unwrap();
             }
             let mut last: Option<[f64; 2]> = None;
             while let Some(t) = p.take_speeds() {
@@ -110,12 +110,12 @@ mod tests {
         let j = AxisJumps::new(&MachineConfig::STRING_ART);
         // Base 1° = 26.67 steps, radial 1 mm = 32 steps: √8000 steps/s is
         // 3354 mdeg/s of the base and 2795 µm/s of the carriage.
-        let (base, radial) = ([1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]);
+        let (base, radial) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
         let v = (j.limit_sqr(&base, &radial) as f32).sqrt();
         assert!((v - 2795.1).abs() < 1.0, "{v}");
         // Straight on: no bound; a reversal of the base: half its jump.
         assert_eq!(j.limit_sqr(&base, &base), u64::MAX);
-        let back = [-1.0, 0.0, 0.0, 0.0];
+        let back = [-1.0, 0.0, 0.0];
         let v = (j.limit_sqr(&base, &back) as f32).sqrt();
         assert!((v - 3354.1 / 2.0).abs() < 1.0, "{v}");
     }

@@ -28,7 +28,7 @@ fn speeds_of_a_fast_machine_are_kept_shifted() {
     let mut p = Planner::new(&c);
     assert_eq!(p.shift, 17);
     for k in 1..=3 {
-        p.push([k * 200_000, 0, 0, 0], Feed::Rapid).unwrap();
+        p.push([k * 200_000, 0, 0], Feed::Rapid).unwrap();
     }
     let e = entries(&p);
     let full = 1e14;
@@ -50,7 +50,7 @@ fn speeds_of_a_fast_machine_are_kept_shifted() {
 fn straight_on_keeps_full_speed() {
     let mut p = Planner::new(&square());
     for k in 1..=3 {
-        p.push([k * 20_000, 0, 0, 0], Feed::Rapid).unwrap();
+        p.push([k * 20_000, 0, 0], Feed::Rapid).unwrap();
     }
     let e = entries(&p);
     assert_eq!(e[0], 0);
@@ -62,8 +62,8 @@ fn straight_on_keeps_full_speed() {
 #[test]
 fn right_angle_takes_the_lower_of_grbl_and_the_axis_jumps() {
     let mut p = Planner::new(&square());
-    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
-    p.push([20_000, 20_000, 0, 0], Feed::Rapid).unwrap();
+    p.push([20_000, 0, 0], Feed::Rapid).unwrap();
+    p.push([20_000, 20_000, 0], Feed::Rapid).unwrap();
     // Grbl: a = 1000 steps/s² = 10 000 milli/s² per axis, limited along the
     // velocity change (-1, 1)/√2 → a·√2; sin(θ/2) = √½.
     let a = 10_000.0 * 2f64.sqrt();
@@ -86,17 +86,17 @@ fn right_angle_takes_the_lower_of_grbl_and_the_axis_jumps() {
 #[test]
 fn reversal_stops() {
     let mut p = Planner::new(&square());
-    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
-    p.push([0, 0, 0, 0], Feed::Rapid).unwrap();
-    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
+    p.push([20_000, 0, 0], Feed::Rapid).unwrap();
+    p.push([0, 0, 0], Feed::Rapid).unwrap();
+    p.push([20_000, 0, 0], Feed::Rapid).unwrap();
     assert_eq!(entries(&p), [0, 0, 0]);
 }
 
 #[test]
 fn gentle_corner_does_not_stop() {
     let mut p = Planner::new(&MachineConfig::STRING_ART);
-    p.push([9600, 320, 0, 0], Feed::Rapid).unwrap();
-    p.push([19_200, 680, 0, 0], Feed::Rapid).unwrap();
+    p.push([9600, 320, 0], Feed::Rapid).unwrap();
+    p.push([19_200, 680, 0], Feed::Rapid).unwrap();
     let e = entries(&p)[1];
     assert!(e > 0, "{e}");
 }
@@ -105,11 +105,11 @@ fn gentle_corner_does_not_stop() {
 fn full_queue_pushes_back() {
     let mut p = Planner::new(&square());
     for k in 1..=PLANNER_BLOCKS as i32 {
-        p.push([k * 100, 0, 0, 0], Feed::Rapid).unwrap();
+        p.push([k * 100, 0, 0], Feed::Rapid).unwrap();
     }
-    assert_eq!(p.push([0, 0, 0, 0], Feed::Rapid), Err(Full));
+    assert_eq!(p.push([0, 0, 0], Feed::Rapid), Err(Full));
     assert!(p.take().is_some());
-    assert_eq!(p.push([0, 0, 0, 0], Feed::Rapid), Ok(()));
+    assert_eq!(p.push([0, 0, 0], Feed::Rapid), Ok(()));
     assert_eq!(p.position(), [0; AXES]);
 }
 
@@ -117,9 +117,9 @@ fn full_queue_pushes_back() {
 fn a_staged_move_is_planned_in_parts_and_queued_by_the_last() {
     let mut p = Planner::new(&square());
     let mut whole = Planner::new(&square());
-    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
-    whole.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
-    let second = ([20_000, 20_000, 0, 0], Feed::PerMinute(Milli(600_000)));
+    p.push([20_000, 0, 0], Feed::Rapid).unwrap();
+    whole.push([20_000, 0, 0], Feed::Rapid).unwrap();
+    let second = ([20_000, 20_000, 0], Feed::PerMinute(Milli(600_000)));
     p.stage(second.0, second.1).unwrap();
     whole.push(second.0, second.1).unwrap();
     assert_eq!(p.position(), second.0);
@@ -144,8 +144,8 @@ fn a_staged_move_is_planned_in_parts_and_queued_by_the_last() {
 #[test]
 fn a_block_taken_while_the_next_is_planned_stops_at_its_end() {
     let mut p = Planner::new(&square());
-    p.push([20_000, 0, 0, 0], Feed::Rapid).unwrap();
-    p.stage([40_000, 0, 0, 0], Feed::Rapid).unwrap();
+    p.push([20_000, 0, 0], Feed::Rapid).unwrap();
+    p.stage([40_000, 0, 0], Feed::Rapid).unwrap();
     assert!(p.plan_part());
     let t = p.take_speeds().unwrap();
     assert_eq!((t.block.steps[0], t.speeds.exit_sqr), (20_000, 0));
@@ -213,8 +213,8 @@ fn speed_and_accel(times: &[u64], w: usize) -> (f64, f64) {
 #[test]
 fn string_art_turn_profile() {
     let c = MachineConfig::STRING_ART;
-    let (events, _, segs) = run(&c, &[([9600, 0, 0, 0], Feed::Rapid)]);
-    assert_eq!(travel(&events), [9600, 0, 0, 0]);
+    let (events, _, segs) = run(&c, &[([9600, 0, 0], Feed::Rapid)]);
+    assert_eq!(travel(&events), [9600, 0, 0]);
     let times: Vec<u64> = events.iter().map(|e| e.tick).collect();
     let (v, a) = speed_and_accel(&times, 128);
     assert!(v <= 2000.0 * 1.001 && v > 1990.0, "{v}");
@@ -227,7 +227,7 @@ fn moves() -> impl Strategy<Value = Vec<(PerAxis<i32>, Feed)>> {
         Just(Feed::Rapid),
         (1_000i32..200_000).prop_map(|f| Feed::PerMinute(Milli(f * 100)))
     ];
-    proptest::collection::vec((proptest::array::uniform4(-3000i32..3000), feed), 1..40)
+    proptest::collection::vec((proptest::array::uniform3(-3000i32..3000), feed), 1..40)
 }
 
 proptest! {
@@ -258,7 +258,7 @@ proptest! {
         let mut pos = 0;
         let moves: Vec<_> = lengths.iter().zip(&feeds).map(|(&l, &f)| {
             pos += l;
-            ([pos, 0, 0, 0], Feed::PerMinute(Milli(f * 100)))
+            ([pos, 0, 0], Feed::PerMinute(Milli(f * 100)))
         }).collect();
         let (events, _, _) = run(&MachineConfig::STRING_ART, &moves);
         prop_assert_eq!(travel(&events)[0], pos);
@@ -282,10 +282,10 @@ fn overrides_scale_the_moves_not_yet_taken() {
     let mut p = Planner::new(&square());
     // F1200 on an axis of 100 steps/unit: 2000 steps/s; rapids 4000.
     for k in 1..=4 {
-        p.push([k * 20_000, 0, 0, 0], Feed::PerMinute(Milli(1_200_000)))
+        p.push([k * 20_000, 0, 0], Feed::PerMinute(Milli(1_200_000)))
             .unwrap();
     }
-    p.push([100_000, 0, 0, 0], Feed::Rapid).unwrap();
+    p.push([100_000, 0, 0], Feed::Rapid).unwrap();
     assert!((cruise(&mut p) - 2000.0).abs() < 1.0);
     p.set_overrides(Overrides {
         feed: 50,
@@ -311,7 +311,7 @@ fn overrides_scale_the_moves_not_yet_taken() {
         rapid: 100,
     });
     for k in 6..=8 {
-        p.push([k * 20_000, 0, 0, 0], Feed::PerMinute(Milli(1_200_000)))
+        p.push([k * 20_000, 0, 0], Feed::PerMinute(Milli(1_200_000)))
             .unwrap();
     }
     // 200 steps/s at 100 steps a unit: 2 000 milli-units/s.

@@ -63,7 +63,7 @@ fn bounded_calls(prep: &mut Prep, moves: &[PerAxis<i32>]) -> usize {
 /// cleared preparer (a stop at once) still yields.
 #[test]
 fn a_waiting_task_ends_a_call_before_the_fit() {
-    let moves: Vec<PerAxis<i32>> = (1..=3).map(|k| [k * 2000, k * 700, 0, 0]).collect();
+    let moves: Vec<PerAxis<i32>> = (1..=3).map(|k| [k * 2000, k * 700, 0]).collect();
     let mut prep = Prep::new();
     prep.yield_to(others_wait);
     let alone = bounded_calls(&mut prep, &moves);
@@ -173,7 +173,7 @@ fn speeds(events: &[Event]) -> Vec<f64> {
 
 #[test]
 fn a_hold_mid_cruise_brakes_to_a_stop_and_resume_ends_on_target() {
-    let target = [40_000, 0, 0, 0];
+    let target = [40_000, 0, 0];
     let r = run(&[target], 20_000, false);
     assert_eq!(travel(&r.events), target);
     let (held, stood) = (r.held_at.unwrap(), r.stood_at.unwrap());
@@ -189,16 +189,16 @@ fn a_hold_mid_cruise_brakes_to_a_stop_and_resume_ends_on_target() {
 #[test]
 fn a_hold_near_the_end_of_a_short_block_brakes_on_into_the_next() {
     // Blocks of 2000 steps straight on: the stop (8000 events) spans four.
-    let moves: Vec<PerAxis<i32>> = (1..=8).map(|k| [k * 2000, k * 2000, 0, 0]).collect();
+    let moves: Vec<PerAxis<i32>> = (1..=8).map(|k| [k * 2000, k * 2000, 0]).collect();
     let r = run(&moves, 9_000, false);
-    assert_eq!(travel(&r.events), [16_000, 16_000, 0, 0]);
+    assert_eq!(travel(&r.events), [16_000, 16_000, 0]);
     let (held, stood) = (r.held_at.unwrap(), r.stood_at.unwrap());
     assert!(stood > held + 2000, "braked across blocks: {held}..{stood}");
 }
 
 #[test]
 fn resume_while_braking_goes_on_from_the_stop() {
-    let target = [0, 30_000, 0, 0];
+    let target = [0, 30_000, 0];
     let r = run(&[target], 15_000, true);
     assert_eq!(travel(&r.events), target);
     assert!(r.stood_at.is_none(), "resumed at once: no stop reported");
@@ -211,7 +211,7 @@ fn a_hold_with_nothing_moving_is_a_stop_at_once() {
     prep.hold();
     assert_eq!(prep.next(&mut planner), None);
     assert_eq!(prep.hold_state(), Hold::Stopped);
-    planner.push([100, 0, 0, 0], Feed::Rapid).unwrap();
+    planner.push([100, 0, 0], Feed::Rapid).unwrap();
     assert_eq!(prep.next(&mut planner), None, "held: nothing starts");
     assert!(prep.resume(&mut planner));
     assert!(prep.next(&mut planner).is_some_and(|c| c.block.is_some()));
@@ -289,7 +289,7 @@ proptest! {
 /// braking starts from the block's entry speed; every step still made.
 #[test]
 fn a_hold_while_a_profile_is_made_brakes_from_its_entry() {
-    let moves: Vec<PerAxis<i32>> = (1..=6).map(|k| [k * 3000, 0, 0, 0]).collect();
+    let moves: Vec<PerAxis<i32>> = (1..=6).map(|k| [k * 3000, 0, 0]).collect();
     let mut planner = Planner::new(&square());
     for m in &moves {
         planner.push(*m, Feed::Rapid).unwrap();
@@ -324,7 +324,7 @@ fn a_hold_while_a_profile_is_made_brakes_from_its_entry() {
         }
     }
     let events: Vec<Event> = expand(segs, blocks).collect();
-    assert_eq!(travel(&events), [18_000, 0, 0, 0]);
+    assert_eq!(travel(&events), [18_000, 0, 0]);
 }
 
 /// A block half loaded is work still to do: the motion task must run on
@@ -332,7 +332,7 @@ fn a_hold_while_a_profile_is_made_brakes_from_its_entry() {
 #[test]
 fn a_half_loaded_block_is_not_idle() {
     let mut planner = Planner::new(&square());
-    planner.push([9600, 0, 0, 0], Feed::Rapid).unwrap();
+    planner.push([9600, 0, 0], Feed::Rapid).unwrap();
     let mut prep = Prep::new();
     assert!(prep.is_idle());
     assert!(prep.load(&mut planner));

@@ -1,5 +1,6 @@
 use super::trapezoid::{cbrt_floor_approx, isqrt, per_speed};
 use super::*;
+use crate::axis::AXES;
 use proptest::prelude::*;
 use std::vec::Vec;
 
@@ -84,7 +85,7 @@ fn prepare(ramps: &[Ramp]) -> (Vec<Segment>, Vec<StepBlock>) {
     for r in ramps {
         prep.start(r.trapezoid());
         blocks.push(StepBlock {
-            steps: [r.events, 0, 0, 0],
+            steps: [r.events, 0, 0],
             events: r.events,
             dir: 1,
         });
@@ -274,12 +275,12 @@ proptest! {
     }
 
     #[test]
-    fn dda_steps_exact_totals(steps in proptest::array::uniform4(0u32..3000)) {
+    fn dda_steps_exact_totals(steps in proptest::array::uniform3(0u32..3000)) {
         let events = *steps.iter().max().unwrap();
         prop_assume!(events > 0);
         let block = StepBlock { steps, events, dir: 0 };
         let seg = Segment { interval: 1000, count: events as u16, add: 0, flags: NEW_BLOCK };
-        let mut totals = [0u32; 4];
+        let mut totals = [0u32; AXES];
         for e in expand([seg], [block]) {
             for (i, t) in totals.iter_mut().enumerate() {
                 *t += (e.axes >> i & 1) as u32;

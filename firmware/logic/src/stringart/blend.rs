@@ -131,7 +131,7 @@ impl Iterator for BlendWrap {
 
 /// Base and carriage together to `(base, radial)`.
 fn to(base: i32, radial: i32) -> MachineStep {
-    MachineStep::Move([Some(base), Some(radial), None, None])
+    MachineStep::Move([Some(base), Some(radial), None])
 }
 
 impl BlendWinder {

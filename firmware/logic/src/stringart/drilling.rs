@@ -179,7 +179,7 @@ mod tests {
     use std::vec::Vec;
 
     fn mv(base: i32, radial: i32) -> MachineStep {
-        MachineStep::Move([Some(base), Some(radial), None, None])
+        MachineStep::Move([Some(base), Some(radial), None])
     }
 
     #[test]

@@ -378,6 +378,7 @@ impl Iterator for Nails<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::axis::AXES;
     use crate::stringart::job::FEED;
     use crate::stringart::MachineStep;
     use std::vec::Vec;
@@ -441,7 +442,7 @@ mod tests {
     /// The moves with a wrap's halves joined: a turn of the base alone
     /// on from one the same way is one move.
     fn whole_moves(steps: impl Iterator<Item = MachineStep>) -> Vec<MachineStep> {
-        let (mut out, mut at, mut turning) = (Vec::new(), [0i32; 4], 0);
+        let (mut out, mut at, mut turning) = (Vec::new(), [0i32; AXES], 0);
         for step in steps {
             let MachineStep::Move(t) = step else {
                 out.push(step);

@@ -72,7 +72,7 @@ fn nail_past_the_last_is_an_error() {
 struct Replay {
     board: Board,
     scale: StepScale,
-    pos: [i32; 4],
+    pos: [i32; AXES],
     /// The nails passed over from outside the ring, in order.
     wrapped: Vec<u16>,
 }
@@ -83,7 +83,7 @@ impl Replay {
         Replay {
             board,
             scale,
-            pos: [0; 4],
+            pos: [0; AXES],
             wrapped: Vec::new(),
         }
     }
@@ -193,7 +193,7 @@ fn trapezoid_times_by_hand() {
     // 2000 steps never reach 2000 steps/s: 2·√(2000/500) = 4 s. 10 000
     // steps: 5 s at full rate + 4 s of ramps = 9 s.
     let steps = [
-        MachineStep::Move([Some(10_000), Some(2000), None, None]),
+        MachineStep::Move([Some(10_000), Some(2000), None]),
         MachineStep::Dwell(250),
         MachineStep::to(Axis::Base, 12_000),
     ];

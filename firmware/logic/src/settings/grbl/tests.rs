@@ -94,7 +94,7 @@ fn writes_in_grbl_s_units_land_in_the_named_settings() {
     // Bits in X, Y, Z order: the radial carriage and the drill.
     set(&mut cfg, "3", "5").unwrap();
     let inverted = cfg.axes.map(|a| !a.dir_high_is_positive);
-    assert_eq!(inverted, [false, true, true, false]);
+    assert_eq!(inverted, [false, true, true]);
     // The travel keeps its upper end.
     set(&mut cfg, "130", "400").unwrap();
     assert_eq!(cfg.axes[1].travel, (Milli(-370_000), Milli(30_000)));
@@ -115,7 +115,7 @@ fn writes_in_grbl_s_units_land_in_the_named_settings() {
     set(&mut cfg, "20", "0").unwrap();
     assert!(cfg.axes.iter().all(|a| !a.soft_limits));
     set(&mut cfg, "20", "1").unwrap();
-    assert_eq!(cfg.axes.map(|a| a.soft_limits), [false, true, true, false]);
+    assert_eq!(cfg.axes.map(|a| a.soft_limits), [false, true, true]);
     // What cannot change here accepts only its value.
     set(&mut cfg, "1", "255").unwrap();
     set(&mut cfg, "21", "0").unwrap();

@@ -2,6 +2,7 @@
 //! actions the way the firmware does.
 
 use super::*;
+use crate::axis::AXES;
 use crate::stringart::{Save, Winding};
 use std::vec::Vec;
 
@@ -83,7 +84,7 @@ struct Bench {
     actions: Vec<Action>,
     pulling: bool,
     drivers: u8,
-    pos: [i32; 4],
+    pos: [i32; AXES],
 }
 
 impl Bench {
@@ -99,7 +100,7 @@ impl Bench {
             actions: Vec::new(),
             pulling: false,
             drivers: 0,
-            pos: [0; 4],
+            pos: [0; AXES],
         }
     }
 

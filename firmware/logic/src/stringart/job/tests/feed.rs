@@ -5,13 +5,14 @@
 
 use super::*;
 use crate::axis::PerAxis;
+use crate::axis::AXES;
 use std::collections::VecDeque;
 use std::vec;
 
 /// What the machine was asked to do, and whether it stood then.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Did {
-    Push([i32; 4]),
+    Push([i32; AXES]),
     Drivers {
         idle: bool,
     },
@@ -31,8 +32,8 @@ enum Did {
 /// A planner of two blocks; a `Motion` wait runs the oldest to its end.
 #[derive(Default)]
 struct Cramped {
-    target: [i32; 4],
-    queue: VecDeque<[i32; 4]>,
+    target: [i32; AXES],
+    queue: VecDeque<[i32; AXES]>,
     /// Looks left before the checkpoint being written is done.
     saving: u8,
     did: Vec<Did>,
@@ -97,8 +98,8 @@ fn drilling() -> Job {
 }
 
 /// The moves of the job's next batch, merged into whole targets.
-fn batch_targets(job: &mut Job) -> Vec<[i32; 4]> {
-    let mut at = [0; 4];
+fn batch_targets(job: &mut Job) -> Vec<[i32; AXES]> {
+    let mut at = [0; AXES];
     let mut out = Vec::new();
     while let Some(step) = job.next_step() {
         if let MachineStep::Move(t) = step {

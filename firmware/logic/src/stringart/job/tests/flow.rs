@@ -7,6 +7,7 @@
 
 use super::*;
 use crate::axis::PerAxis;
+use crate::axis::AXES;
 use crate::checkpoint::Record;
 use std::collections::VecDeque;
 
@@ -14,12 +15,12 @@ use std::collections::VecDeque;
 struct Timeline {
     ticks: u32,
     write: u32,
-    target: [i32; 4],
+    target: [i32; AXES],
     /// Where the last block begun ends.
-    end: [i32; 4],
-    planned: VecDeque<[i32; 4]>,
+    end: [i32; AXES],
+    planned: VecDeque<[i32; AXES]>,
     /// The block running (its start, end) and the ticks it has left.
-    running: Option<([i32; 4], [i32; 4], u32)>,
+    running: Option<([i32; AXES], [i32; AXES], u32)>,
     saving: u32,
     /// Crossings of the band handed over and done (after the entry's).
     crossings: Vec<bool>,
@@ -30,7 +31,7 @@ struct Timeline {
 }
 
 impl Timeline {
-    fn new(ticks: u32, write: u32, at: [i32; 4]) -> Self {
+    fn new(ticks: u32, write: u32, at: [i32; AXES]) -> Self {
         Timeline {
             ticks,
             write,
@@ -45,7 +46,7 @@ impl Timeline {
         }
     }
 
-    fn crossing(from: [i32; 4], to: [i32; 4]) -> bool {
+    fn crossing(from: [i32; AXES], to: [i32; AXES]) -> bool {
         from[1] != to[1]
     }
 
@@ -181,7 +182,7 @@ fn wind(m: &mut Timeline) {
 
 #[test]
 fn records_in_time_let_every_crossing_blend_in() {
-    let mut m = Timeline::new(40, 3, [0; 4]);
+    let mut m = Timeline::new(40, 3, [0; AXES]);
     wind(&mut m);
     assert_eq!(m.records, (1..=10).collect::<Vec<_>>());
     // The halves of this pattern's rotations and moves over the nails:
@@ -196,7 +197,7 @@ fn records_in_time_let_every_crossing_blend_in() {
 #[test]
 fn a_late_record_stops_the_machine_at_its_vertex() {
     // Blocks run faster than a record is written.
-    let mut m = Timeline::new(1, 6, [0; 4]);
+    let mut m = Timeline::new(1, 6, [0; AXES]);
     wind(&mut m);
     assert_eq!(m.records, (1..=10).collect::<Vec<_>>());
     assert!(m.blended.iter().all(|b| !*b), "{:?}", m.blended);

@@ -2,6 +2,7 @@
 //! each of them on a fresh boot — nothing lost, nothing done twice.
 
 use super::*;
+use crate::axis::AXES;
 use crate::checkpoint::{Header, Record, Saved};
 use crate::geometry::StepScale;
 
@@ -28,7 +29,7 @@ pub(super) fn saved(params: Params, count: u32, phase: Phase, n: u32, gap: u16) 
 }
 
 /// A whole job, recording the checkpoints and the pose at each.
-fn whole_job(b: &mut Bench) -> Vec<(Save, [i32; 4])> {
+fn whole_job(b: &mut Bench) -> Vec<(Save, [i32; AXES])> {
     b.ready();
     b.green();
     let mut saves = Vec::new();
@@ -305,11 +306,11 @@ fn winding_resumes_through_the_gap_of_the_record() {
                 on: false
             }
         );
-        let MachineStep::Move([Some(at), None, None, None]) = b.steps[1] else {
+        let MachineStep::Move([Some(at), None, None]) = b.steps[1] else {
             panic!("{:?}", b.steps[1])
         };
         assert!(in_gap(&scale, &board, at, r.gap), "{at} for {r:?}");
-        let MachineStep::Move([Some(at), Some(inner), None, None]) = b.steps[2] else {
+        let MachineStep::Move([Some(at), Some(inner), None]) = b.steps[2] else {
             panic!("{:?}", b.steps[2])
         };
         assert!(in_gap(&scale, &board, at, r.gap) && inner < 0);

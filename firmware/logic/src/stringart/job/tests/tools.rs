@@ -56,7 +56,7 @@ fn wrap_test_wraps_one_nail_from_the_zero_pose_and_back() {
     let n = expect.len();
     assert_eq!(b.steps[..n], expect[..]);
     assert_eq!(b.steps[n + 1..], []);
-    let MachineStep::Move([Some(home), None, None, None]) = b.steps[n] else {
+    let MachineStep::Move([Some(home), None, None]) = b.steps[n] else {
         panic!("{:?}", b.steps[n])
     };
     assert_eq!(home.rem_euclid(9600), 0);
@@ -115,7 +115,7 @@ fn crossings(steps: &[MachineStep]) -> usize {
     let mut radial = None;
     let mut n = 0;
     for s in steps {
-        if let MachineStep::Move([_, Some(r), None, None]) = *s {
+        if let MachineStep::Move([_, Some(r), None]) = *s {
             n += radial.is_some_and(|was| was != r) as usize;
             radial = Some(r);
         }
