@@ -266,6 +266,15 @@ impl Interpreter {
         if moves && !allowed.motion {
             return Err(ErrorKind::JobOwnsMotion);
         }
+        // A word of no channel of this machine (`Y` on the string-art
+        // machine) is refused as Grbl refuses a letter it does not know.
+        let words = kin.words();
+        if AxisWord::ALL
+            .iter()
+            .any(|w| line.axis(*w).is_some() && !words.contains(&w.letter()))
+        {
+            return Err(ErrorKind::UnsupportedCommand);
+        }
         if let Some(u) = line.units {
             next.units = u;
         }
@@ -552,14 +561,14 @@ fn check_travel(cfg: &MachineConfig, lo: &Position, hi: &Position) -> Result<(),
 }
 
 /// The value of the axis word named `letter`, if the line has one, in mm
-/// (or degrees: `C` and `A` are angles in either unit).
+/// (or degrees: `C` is an angle in either unit).
 fn value(line: &Line, letter: u8, units: Units) -> Option<Milli> {
     let v = AxisWord::ALL
         .iter()
         .find(|w| w.letter() == letter)
         .and_then(|w| line.axis(*w))?;
     Some(match letter {
-        b'C' | b'A' => v,
+        b'C' => v,
         _ => mm(v, units),
     })
 }

@@ -14,20 +14,13 @@ pub enum AxisWord {
     X = 1,
     Y = 2,
     Z = 3,
-    A = 4,
 }
 
 /// Number of axis letters.
-pub const AXIS_WORDS: usize = 5;
+pub const AXIS_WORDS: usize = 4;
 
 impl AxisWord {
-    pub const ALL: [AxisWord; AXIS_WORDS] = [
-        AxisWord::C,
-        AxisWord::X,
-        AxisWord::Y,
-        AxisWord::Z,
-        AxisWord::A,
-    ];
+    pub const ALL: [AxisWord; AXIS_WORDS] = [AxisWord::C, AxisWord::X, AxisWord::Y, AxisWord::Z];
 
     pub const fn index(self) -> usize {
         self as usize
@@ -40,7 +33,6 @@ impl AxisWord {
             AxisWord::X => b'X',
             AxisWord::Y => b'Y',
             AxisWord::Z => b'Z',
-            AxisWord::A => b'A',
         }
     }
 

@@ -72,6 +72,18 @@ fn a_refused_line_changes_no_modal_state() {
 }
 
 #[test]
+fn a_word_of_no_channel_of_the_machine_is_refused() {
+    let mut i = Interpreter::new();
+    // The string-art machine's words are C, X and Z: a Y is no channel.
+    assert_eq!(
+        run(&mut i, "G91 G1 X1 Y2 F600", FREE),
+        Err(ErrorKind::UnsupportedCommand)
+    );
+    // Nothing of the refused line was taken: still G90 G0.
+    assert_eq!(steps(run(&mut i, "X1", FREE))[1], 32);
+}
+
+#[test]
 fn planned_twice_committed_once_is_one_move() {
     // A line waiting for planner room is planned again: only the commit
     // moves the commanded position.

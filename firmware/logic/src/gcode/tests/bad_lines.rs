@@ -38,6 +38,7 @@ const BAD: &[(&str, u8, u8)] = &[
     ("G1 M24", 21, 4),
     ("M25 G1", 21, 5),
     ("G1 Q5", 20, 4),
+    ("G1 X1 A5", 20, 7),
     // Grbl's jogging.md: "Only the following G-codes are valid ... G20,
     // G21 ... G90, G91 ... G53"; "F - Feed rate value" and at least one
     // axis word are required.

@@ -1,6 +1,6 @@
 use super::*;
 use std::format;
-use AxisWord::{A, C, X, Y, Z};
+use AxisWord::{C, X, Y, Z};
 
 #[test]
 fn good_lines() {
@@ -20,7 +20,7 @@ fn good_lines() {
             line(Linear).at(X, 1_500).at(C, -90_000).f(60_000),
         ),
         ("G01 Z.5", line(Linear).at(Z, 500)),
-        ("G1.0 A-.25", line(Linear).at(A, -250)),
+        ("G1.0 Y-.25", line(Linear).at(Y, -250)),
         ("G1 X5.", line(Linear).at(X, 5_000)),
         ("G1 X00010.500", line(Linear).at(X, 10_500)),
         ("G1 X+3", line(Linear).at(X, 3_000)),

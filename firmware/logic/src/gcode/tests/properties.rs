@@ -26,7 +26,7 @@ fn any_line() -> impl Strategy<Value = Line> {
         Just(Distance::Absolute),
         Just(Distance::Relative)
     ]);
-    let axes = prop::array::uniform5(prop::option::weighted(0.4, milli()));
+    let axes = prop::array::uniform4(prop::option::weighted(0.4, milli()));
     let positive = (0..=i32::MAX).prop_map(Milli);
     (
         command(),
