@@ -2,6 +2,7 @@
 //! value is kept as its magnitude in thousandths, so `-2.5` becomes
 //! `Milli(-2500)` with one multiply-add per digit.
 
+use crate::text::num::times_ten_plus;
 use crate::units::Milli;
 
 /// A number being read. A `push` error means the character cannot belong
@@ -73,9 +74,7 @@ impl Number {
         self.flags |= DIGITS;
         let magnitude = if !self.has(POINT) {
             let unit = if self.has(FIXED) { 1000 } else { 1 };
-            self.magnitude
-                .checked_mul(10)
-                .and_then(|m| m.checked_add(d * unit))
+            times_ten_plus(self.magnitude, d * unit)
         } else {
             let decimals = (self.flags >> DECIMALS_SHIFT).saturating_add(1).min(7);
             self.flags = (self.flags & ((1 << DECIMALS_SHIFT) - 1)) | decimals << DECIMALS_SHIFT;

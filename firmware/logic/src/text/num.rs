@@ -33,7 +33,18 @@ pub fn trim(s: &[u8]) -> (usize, &[u8]) {
 
 /// Appends one decimal digit; `None` when `u32` overflows.
 pub fn push_digit(value: u32, digit: u8) -> Option<u32> {
-    value.checked_mul(10)?.checked_add((digit - b'0') as u32)
+    times_ten_plus(value, (digit - b'0') as u32)
+}
+
+/// `value × 10 + add`; `None` when `u32` overflows. One copy, out of
+/// line, with the overflow tested before the multiply: on the AVR a
+/// `checked_mul` is two 32-bit multiplies and a test at every use.
+#[inline(never)]
+pub fn times_ten_plus(value: u32, add: u32) -> Option<u32> {
+    if value > u32::MAX / 10 {
+        return None;
+    }
+    (value * 10).checked_add(add)
 }
 
 /// A whole non-negative number: digits only.
@@ -80,7 +91,7 @@ pub fn parse_fixed(s: &[u8], decimals: u32) -> Result<u32, NumError> {
         return Err(not_a_number(0));
     }
     for _ in frac_digits.unwrap_or(0).min(decimals)..decimals {
-        value = value.checked_mul(10).ok_or(TOO_BIG)?;
+        value = times_ten_plus(value, 0).ok_or(TOO_BIG)?;
     }
     value.checked_add(round_up as u32).ok_or(TOO_BIG)
 }
