@@ -260,11 +260,12 @@ impl Parser {
             }
             None => None,
         };
+        // A line of only spaces and comments is an empty G-code line:
+        // one way to make a line's result, not two.
+        if let Statement::Start = self.statement {
+            self.start_words(false);
+        }
         match &mut self.statement {
-            Statement::Start => Ok(Input::Line(Line {
-                checksum,
-                ..Line::empty()
-            })),
             Statement::GCode(words) => {
                 let jog = words.is_jog();
                 if let Some(e) = words.jog_error() {
@@ -278,6 +279,8 @@ impl Parser {
                 }
             }
             Statement::System(system) => system.finish(end).map(Input::System),
+            // Made G-code above.
+            Statement::Start => unreachable!(),
         }
     }
 }
