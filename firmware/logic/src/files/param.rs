@@ -120,10 +120,18 @@ impl ParamFile {
         if !seen.lines {
             return Err(FileError::whole(FILE, ErrorKind::Empty));
         }
-        let missing = |key: usize| FileError::whole(FILE, ErrorKind::MissingKey(key_names(key)[2]));
-        let shape = seen.shape.ok_or(missing(0))?;
-        let nails = seen.nails.ok_or(missing(1))?;
-        let (radius_um, line, col) = seen.radius.ok_or(missing(2))?;
+        // One error for the three keys: each built its own on the AVR.
+        let (Some(shape), Some(nails), Some((radius_um, line, col))) =
+            (seen.shape, seen.nails, seen.radius)
+        else {
+            let missing = match (seen.shape, seen.nails) {
+                (None, _) => 0,
+                (_, None) => 1,
+                _ => 2,
+            };
+            let kind = ErrorKind::MissingKey(key_names(missing)[2]);
+            return Err(FileError::whole(FILE, kind));
+        };
         let above_um = radius_limit_um(shape);
         if radius_um <= above_um {
             let kind = ErrorKind::RadiusTooSmall { above_um };
