@@ -10,7 +10,7 @@
 
 use crate::files::error::{FileError, FileName};
 use crate::files::kv::{Item, KvReader};
-use crate::text::num::{parse_fixed, parse_u32, NumError};
+use crate::text::num::{parse_fixed, parse_u32};
 use crate::text::ErrorKind;
 use taut_progmem::{text, Text};
 
@@ -149,12 +149,12 @@ impl Seen {
     fn take(&mut self, item: Item<'_>) -> Result<(), FileError> {
         self.lines = true;
         let at = |col, kind| FileError::at(FILE, item.line, col, kind);
-        let key = (0..KEYS)
-            .find(|&k| {
-                let [name, alias, _] = key_names(k);
-                name.eq_ignore_ascii_case(item.key) || alias.eq_ignore_ascii_case(item.key)
-            })
-            .ok_or(at(item.key_col, ErrorKind::UnknownKey))?;
+        let Some(key) = (0..KEYS).find(|&k| {
+            let [name, alias, _] = key_names(k);
+            name.eq_ignore_ascii_case(item.key) || alias.eq_ignore_ascii_case(item.key)
+        }) else {
+            return Err(at(item.key_col, ErrorKind::UnknownKey));
+        };
         let already = match key {
             0 => self.shape.is_some(),
             1 => self.nails.is_some(),
@@ -163,11 +163,16 @@ impl Seen {
         if already {
             return Err(at(item.key_col, ErrorKind::DuplicateKey));
         }
-        let number_error = |e: NumError| at(item.value_col + e.at as u32, e.kind);
+        // One number read for the three keys: each of its error paths
+        // builds a whole `FileError` on the AVR.
+        let n = match key {
+            2 => parse_fixed(item.value, 4),
+            _ => parse_u32(item.value),
+        };
+        let n = n.map_err(|e| at(item.value_col + e.at as u32, e.kind))?;
         let out_of_range = |kind| at(item.value_col, kind);
         match key {
             0 => {
-                let n = parse_u32(item.value).map_err(number_error)?;
                 if n == 1 || n == 2 || n > MAX_SHAPE as u32 {
                     return Err(out_of_range(ErrorKind::Shape {
                         max: MAX_SHAPE as u32,
@@ -176,7 +181,6 @@ impl Seen {
                 self.shape = Some(n as u16);
             }
             1 => {
-                let n = parse_u32(item.value).map_err(number_error)?;
                 if !(3..=MAX_NAILS as u32).contains(&n) {
                     // Built here: through the closure it would be a
                     // constant in SRAM.
@@ -193,11 +197,10 @@ impl Seen {
                 self.nails = Some(n as u16);
             }
             _ => {
-                let um = parse_fixed(item.value, 4).map_err(number_error)?;
-                if um > MAX_RADIUS_UM {
+                if n > MAX_RADIUS_UM {
                     return Err(out_of_range(ErrorKind::TooBig));
                 }
-                self.radius = Some((um, item.line, item.value_col));
+                self.radius = Some((n, item.line, item.value_col));
             }
         }
         Ok(())
