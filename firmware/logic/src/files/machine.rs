@@ -20,12 +20,12 @@ const FILE: FileName = FileName::Machine;
 pub struct MachineFile {
     kv: KvReader,
     cfg: MachineConfig,
-    /// Settings already given, by [`Setting::index`].
-    seen: u64,
+    /// Settings already given, a bit each by [`Setting::index`]: bytes,
+    /// as a `u64`'s shifts and tests are long on the AVR.
+    seen: [u8; SEEN],
 }
 
-// One bit per setting in `seen`.
-const _: () = assert!(COUNT <= 64);
+const SEEN: usize = COUNT.div_ceil(8);
 
 impl MachineFile {
     /// Starts from `base`, the configuration in force.
@@ -33,7 +33,7 @@ impl MachineFile {
         MachineFile {
             kv: KvReader::new(FILE),
             cfg: base,
-            seen: 0,
+            seen: [0; SEEN],
         }
     }
 
@@ -69,20 +69,22 @@ impl MachineFile {
     }
 }
 
-fn apply(cfg: &mut MachineConfig, seen: &mut u64, item: Item<'_>) -> Result<(), FileError> {
+fn apply(cfg: &mut MachineConfig, seen: &mut [u8; SEEN], item: Item<'_>) -> Result<(), FileError> {
     let at_key = |kind| FileError::at(FILE, item.line, item.key_col, kind);
-    let setting = Setting::parse(item.key, cfg.machine).ok_or(at_key(ErrorKind::UnknownKey))?;
-    let bit = 1u64 << setting.index();
-    if *seen & bit != 0 {
+    let Some(setting) = Setting::parse(item.key, cfg.machine) else {
+        return Err(at_key(ErrorKind::UnknownKey));
+    };
+    let (byte, bit) = (setting.index() / 8, 1 << (setting.index() % 8));
+    if seen[byte] & bit != 0 {
         return Err(at_key(ErrorKind::DuplicateKey));
     }
     // The machine loads its defaults whole: it would undo the lines above.
-    if setting == Setting::Global(GlobalField::Machine) && *seen != 0 {
+    if setting == Setting::Global(GlobalField::Machine) && seen.iter().any(|&b| b != 0) {
         return Err(at_key(ErrorKind::Invalid(taut_progmem::text!(
             "machine: the first key"
         ))));
     }
-    *seen |= bit;
+    seen[byte] |= bit;
     // Values are trimmed ASCII up to any error, so bytes are columns.
     setting.set(cfg, item.value).map_err(|e: SettingError| {
         FileError::at(FILE, item.line, item.value_col + e.at as u32, e.kind)
