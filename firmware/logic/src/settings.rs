@@ -335,6 +335,46 @@ pub fn set(cfg: &mut MachineConfig, key: &str, value: &str) -> Result<(), Settin
     setting.set(cfg, value.as_bytes())
 }
 
+/// What a setting holds, as [`Spec`] tells it.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Kind {
+    /// A whole number within `min..=max`.
+    Number,
+    /// Thousandths within `min..=max` (as `i32`), else invalid.
+    Milli,
+    /// Thousandths, any.
+    Length,
+    /// `num/den`: `num` at least `min`, `den` from 1 to `max`, else invalid.
+    Ratio,
+    Machine,
+}
+
+/// A setting's kind and bounds, read from a flash table by
+/// [`Setting::spec`]: one generic parse and check, not an arm per field.
+#[derive(Clone, Copy, Debug)]
+struct Spec {
+    kind: Kind,
+    /// Every lower bound is small (0, 1, or 100 µm).
+    min: u8,
+    max: u32,
+}
+
+const fn spec(kind: Kind, min: u8, max: u32) -> Spec {
+    Spec { kind, min, max }
+}
+
+const fn number(min: u8, max: u32) -> Spec {
+    spec(Kind::Number, min, max)
+}
+
+// The string-art needle's and nails' diameters, µm.
+const MIN_UM: u8 = WindingConfig::MIN_UM as u8;
+const MAX_UM: u32 = WindingConfig::MAX_UM as u32;
+const _: () = assert!(MIN_UM as u16 == WindingConfig::MIN_UM);
+
+const SWITCH: Spec = number(0, 1);
+const LENGTH: Spec = spec(Kind::Length, 0, 0);
+
 impl Setting {
     /// The setting named `key`, in any case, on `machine`.
     pub fn parse(key: &[u8], machine: Machine) -> Option<Setting> {
@@ -426,27 +466,6 @@ impl Setting {
         })
     }
 
-    /// Whole numbers this setting accepts.
-    const fn range(self) -> (u32, u32) {
-        match self {
-            Setting::Axis(_, AxisField::MaxRate) => (1, 200_000),
-            Setting::Axis(_, AxisField::Accel) => (1, 10_000_000),
-            Setting::Axis(_, _) => (0, 1),
-            Setting::Global(GlobalField::StepPulseUs) => (1, 255),
-            Setting::Global(GlobalField::JunctionDeviationUm) => (0, 100_000),
-            Setting::Global(GlobalField::ArcToleranceUm) => (1, 100_000),
-            Setting::Global(GlobalField::PenUp | GlobalField::PenDown) => (0, 180),
-            Setting::Global(GlobalField::PenSettleMs) => (0, 5000),
-            Setting::Global(
-                GlobalField::DwellPMs | GlobalField::HomingAtStart | GlobalField::ReportInches,
-            ) => (0, 1),
-            Setting::Global(GlobalField::StatusReport) => (0, 3),
-            Setting::Global(GlobalField::HomingAxes) => (0, (1 << AXES) - 1),
-            Setting::Global(GlobalField::HomingSeek | GlobalField::HomingLocate) => (1, 65_535),
-            Setting::Global(_) => (0, 255),
-        }
-    }
-
     /// Sets this setting from its text and checks the whole configuration
     /// ([`MachineConfig::validate`]); nothing changes on an error.
     pub fn set(self, cfg: &mut MachineConfig, text: &[u8]) -> Result<(), SettingError> {
@@ -459,11 +478,64 @@ impl Setting {
             .map_err(|kind| NumError { at: lead, kind })
     }
 
+    /// The kind and bounds: the axis fields' first, then the global ones,
+    /// each in order of discriminant.
+    fn spec(self) -> Spec {
+        use Kind::*;
+        let specs = taut_progmem::table!(Spec; AXIS_FIELDS.len() + GLOBAL_FIELDS.len(); [
+            // Axis fields.
+            spec(Ratio, 1, MAX_DEN),
+            number(1, 200_000),
+            number(1, 10_000_000),
+            SWITCH,
+            SWITCH,
+            SWITCH,
+            LENGTH,
+            LENGTH,
+            // Global fields.
+            spec(Machine, 0, 0),
+            number(1, 255),
+            number(0, 255),
+            number(0, 255),
+            number(0, 100_000),
+            number(1, 100_000),
+            LENGTH,
+            LENGTH,
+            LENGTH,
+            LENGTH,
+            spec(Ratio, 0, u32::MAX),
+            number(0, 180),
+            number(0, 180),
+            number(0, 5000),
+            SWITCH,
+            number(0, (1 << AXES) - 1),
+            SWITCH,
+            number(1, 65_535),
+            number(1, 65_535),
+            spec(Milli, 0, 65_535),
+            number(0, 3),
+            SWITCH,
+            spec(Milli, MIN_UM, MAX_UM),
+            spec(Milli, MIN_UM, MAX_UM),
+        ]);
+        specs.get(match self {
+            Setting::Axis(_, f) => f as usize,
+            Setting::Global(g) => AXIS_FIELDS.len() + g as usize,
+        })
+    }
+
+    /// The field's name, without the axis.
+    fn field_name(self) -> Text {
+        match self {
+            Setting::Axis(_, f) => f.name(),
+            Setting::Global(g) => g.name(),
+        }
+    }
+
     /// The value `text` (trimmed) gives this setting, in the setting's kind.
     fn parse_value(self, text: &[u8]) -> Result<Value, SettingError> {
-        use GlobalField::*;
-        Ok(match self {
-            Setting::Global(Machine) => match crate::machine::Machine::parse(text) {
+        Ok(match self.spec().kind {
+            Kind::Machine => match crate::machine::Machine::parse(text) {
                 Some(m) => Value::Machine(m),
                 None => {
                     return Err(NumError {
@@ -472,16 +544,9 @@ impl Setting {
                     })
                 }
             },
-            Setting::Global(
-                Length1 | Length2 | OriginX | OriginY | HomingPullOff | NailDiameter
-                | NeedleDiameter,
-            ) => Value::Milli(parse_milli(text)?),
-            Setting::Global(Crosstalk) => Value::Ratio(parse_ratio(text)?),
-            Setting::Axis(_, AxisField::StepsPerUnit) => Value::Ratio(parse_ratio(text)?),
-            Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax) => {
-                Value::Milli(parse_milli(text)?)
-            }
-            _ => Value::Number(parse_u32(text)?),
+            Kind::Milli | Kind::Length => Value::Milli(parse_milli(text)?),
+            Kind::Ratio => Value::Ratio(parse_ratio(text)?),
+            Kind::Number => Value::Number(parse_u32(text)?),
         })
     }
 
@@ -504,55 +569,23 @@ impl Setting {
 
     /// Whether `value` is of this setting's kind and in its range.
     pub fn check(self, value: Value) -> Result<(), ErrorKind> {
-        use GlobalField::*;
-        match (self, value) {
-            (Setting::Global(Machine), Value::Machine(_)) => Ok(()),
-            (Setting::Global(Length1 | Length2 | OriginX | OriginY), Value::Milli(_)) => Ok(()),
-            (Setting::Global(HomingPullOff), Value::Milli(m)) => {
-                match (0..=65_535).contains(&m.0) {
-                    true => Ok(()),
-                    false => Err(ErrorKind::Invalid(HomingPullOff.name())),
-                }
-            }
-            (Setting::Global(f @ (NailDiameter | NeedleDiameter)), Value::Milli(m)) => {
-                let (min, max) = (WindingConfig::MIN_UM, WindingConfig::MAX_UM);
-                match (i32::from(min)..=i32::from(max)).contains(&m.0) {
-                    true => Ok(()),
-                    false => Err(ErrorKind::Invalid(f.name())),
-                }
-            }
-            (Setting::Global(Crosstalk), Value::Ratio(r)) => match r.den != 0 {
-                true => Ok(()),
-                false => Err(ErrorKind::Invalid(Crosstalk.name())),
-            },
-            (
-                Setting::Global(
-                    Machine | Length1 | Length2 | OriginX | OriginY | Crosstalk | HomingPullOff
-                    | NailDiameter | NeedleDiameter,
-                ),
-                _,
-            ) => Err(ErrorKind::NotANumber),
-            (Setting::Axis(_, AxisField::StepsPerUnit), Value::Ratio(r)) => {
-                match r.num != 0 && r.den != 0 && r.den <= MAX_DEN {
-                    true => Ok(()),
-                    false => Err(ErrorKind::Invalid(AxisField::StepsPerUnit.name())),
-                }
-            }
-            (Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax), Value::Milli(_)) => {
-                Ok(())
-            }
-            (Setting::Axis(_, AxisField::StepsPerUnit), _)
-            | (Setting::Axis(_, AxisField::TravelMin | AxisField::TravelMax), _) => {
-                Err(ErrorKind::NotANumber)
-            }
-            (_, Value::Number(n)) => {
-                let (min, max) = self.range();
-                match (min..=max).contains(&n) {
+        let Spec { kind, min, max } = self.spec();
+        let within = match (kind, value) {
+            (Kind::Number, Value::Number(n)) => {
+                let min = min as u32;
+                return match (min..=max).contains(&n) {
                     true => Ok(()),
                     false => Err(ErrorKind::Range { min, max }),
-                }
+                };
             }
-            _ => Err(ErrorKind::NotANumber),
+            (Kind::Length, Value::Milli(_)) | (Kind::Machine, Value::Machine(_)) => return Ok(()),
+            (Kind::Milli, Value::Milli(m)) => (min as i32..=max as i32).contains(&m.0),
+            (Kind::Ratio, Value::Ratio(r)) => r.num >= min as u32 && r.den != 0 && r.den <= max,
+            _ => return Err(ErrorKind::NotANumber),
+        };
+        match within {
+            true => Ok(()),
+            false => Err(ErrorKind::Invalid(self.field_name())),
         }
     }
 
@@ -847,9 +880,9 @@ mod tests {
                 }
                 Err(e) => {
                     // Out of the setting's range, or at odds with the others.
-                    let (min, max) = s.range();
+                    let Spec { min, max, .. } = s.spec();
                     let at_odds = matches!(e.kind, ErrorKind::PulseTooLong { .. } | ErrorKind::Invalid(_));
-                    prop_assert!(!(min..=max).contains(&n) || at_odds, "{:?}", e);
+                    prop_assert!(!(min as u32..=max).contains(&n) || at_odds, "{:?}", e);
                     prop_assert_eq!(cfg, MachineConfig::STRING_ART);
                 }
             }
