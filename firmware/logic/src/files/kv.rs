@@ -86,18 +86,21 @@ impl KvReader {
             self.ended = Some(line);
             return Ok(());
         }
-        let too_long = FileError::at(self.file, line, col, ErrorKind::LineTooLong);
-        if col as usize > MAX_LINE {
-            return Err(too_long);
+        // Only multi-byte characters can fill the buffer before the column
+        // limit.
+        let kept = !self.in_comment && b != b'#';
+        let slot = match kept {
+            true => self.buf.get_mut(self.len as usize),
+            false => None,
+        };
+        if col as usize > MAX_LINE || kept && slot.is_none() {
+            return Err(FileError::at(self.file, line, col, ErrorKind::LineTooLong));
         }
-        if b == b'#' {
-            self.in_comment = true;
-        }
-        if !self.in_comment {
-            // Only multi-byte characters can fill the buffer before the column limit.
-            *self.buf.get_mut(self.len as usize).ok_or(too_long)? = b;
+        if let Some(slot) = slot {
+            *slot = b;
             self.len += 1;
         }
+        self.in_comment |= b == b'#';
         Ok(())
     }
 
@@ -109,11 +112,12 @@ impl KvReader {
         if content.is_empty() {
             return Ok(None);
         }
-        let bad = |offset| FileError::at(self.file, line, col(offset), ErrorKind::ExpectedKeyValue);
-        let eq = content.iter().position(|&b| b == b'=').ok_or(bad(start))?;
+        // No `=` reads as an empty key: one error built, only when it is one.
+        let eq = content.iter().position(|&b| b == b'=').unwrap_or(0);
         let (key_start, key) = trim(&content[..eq]);
         if key.is_empty() {
-            return Err(bad(start + eq));
+            let kind = ErrorKind::ExpectedKeyValue;
+            return Err(FileError::at(self.file, line, col(start + eq), kind));
         }
         let (value_start, value) = trim(&content[eq + 1..]);
         Ok(Some(Item {

@@ -33,35 +33,29 @@ impl Sequence {
 
     /// Takes a number of the list; returns it if it is a nail index.
     fn take(&mut self, n: Number) -> Result<Option<u16>, FileError> {
-        // No closure: called, its error would be a constant in SRAM.
-        if self.declared.is_none() {
-            if !(1..=MAX_CONNECTIONS).contains(&n.value) {
-                return Err(FileError::at(
-                    FILE,
-                    n.line,
-                    n.col,
-                    ErrorKind::Range {
-                        min: 1,
-                        max: MAX_CONNECTIONS,
-                    },
-                ));
+        // No closure: called, its error would be a constant in SRAM. One
+        // error built, for either case.
+        let kind = match self.declared {
+            None if (1..=MAX_CONNECTIONS).contains(&n.value) => {
+                self.declared = Some(n);
+                return Ok(None);
             }
-            self.declared = Some(n);
-            return Ok(None);
-        }
-        self.found += 1;
-        if n.value >= self.nails as u32 {
-            return Err(FileError::at(
-                FILE,
-                n.line,
-                n.col,
+            None => ErrorKind::Range {
+                min: 1,
+                max: MAX_CONNECTIONS,
+            },
+            Some(_) => {
+                self.found += 1;
+                if n.value < self.nails as u32 {
+                    return Ok(Some(n.value as u16));
+                }
                 ErrorKind::Nail {
                     index: n.value,
                     nails: self.nails,
-                },
-            ));
-        }
-        Ok(Some(n.value as u16))
+                }
+            }
+        };
+        Err(FileError::at(FILE, n.line, n.col, kind))
     }
 
     fn push(&mut self, b: u8) -> Result<Option<u16>, FileError> {
@@ -78,18 +72,17 @@ impl Sequence {
             Some(n) => self.take(n)?,
             None => None,
         };
-        // A list that is not empty has a first number, the count.
-        let Some(declared) = self.declared else {
-            return Err(FileError::whole(FILE, ErrorKind::Empty));
+        // A list that is not empty has a first number, the count. One
+        // error built, for either case.
+        let (line, col, kind) = match self.declared {
+            None => (0, 0, ErrorKind::Empty),
+            Some(d) if self.found != d.value => {
+                let (declared, found) = (d.value, self.found);
+                (d.line, d.col, ErrorKind::Count { declared, found })
+            }
+            Some(_) => return Ok(last),
         };
-        if self.found != declared.value {
-            let kind = ErrorKind::Count {
-                declared: declared.value,
-                found: self.found,
-            };
-            return Err(FileError::at(FILE, declared.line, declared.col, kind));
-        }
-        Ok(last)
+        Err(FileError::at(FILE, line, col, kind))
     }
 }
 
