@@ -69,72 +69,101 @@ pub enum ErrorKind {
     },
 }
 
+impl ErrorKind {
+    /// The variant's number, in order of declaration: its message's lead
+    /// in [`ErrorKind::lead`].
+    fn index(&self) -> usize {
+        use ErrorKind::*;
+        match self {
+            NotFound => 0,
+            Empty => 1,
+            LineTooLong => 2,
+            ExpectedKeyValue => 3,
+            UnknownKey => 4,
+            UnknownMachine => 5,
+            DuplicateKey => 6,
+            MissingKey(_) => 7,
+            NotANumber => 8,
+            TooBig => 9,
+            Range { .. } => 10,
+            Shape { .. } => 11,
+            RadiusTooSmall { .. } => 12,
+            ExpectedComma => 13,
+            Nail { .. } => 14,
+            Count { .. } => 15,
+            Invalid(_) => 16,
+            Utf16 => 17,
+            NotText { .. } => 18,
+            PulseTooLong { .. } => 19,
+        }
+    }
+
+    /// The message's text up to its figures (the whole of it for most): a
+    /// flash table, not a `match` of texts (~15 bytes of code an arm).
+    fn lead(&self) -> Text {
+        taut_progmem::table!(Text; 20; [
+            text!("file not found"),
+            text!("empty file"),
+            text!("line too long (max 64)"),
+            text!("expected key = value"),
+            text!("unknown key"),
+            text!("unknown machine"),
+            text!("duplicate key"),
+            text!("missing key "),
+            text!("expected a number"),
+            text!("number too big"),
+            text!("expected "),
+            text!("expected 0 or 3 to "),
+            text!("expected more than "),
+            text!("expected ','"),
+            text!("nail "),
+            text!("declared "),
+            text!("invalid "),
+            text!("UTF-16 text: save it as UTF-8 or ASCII"),
+            text!("not a text file (byte "),
+            text!("pulse over half a step at "),
+        ])
+        .get(self.index())
+    }
+}
+
 // Every literal through `text!`: kept in flash on the AVR.
 impl uDisplay for ErrorKind {
     fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
-        let t = |f: &mut Formatter<'_, W>, t: Text| t.fmt(f);
+        self.lead().fmt(f)?;
         match *self {
-            ErrorKind::NotFound => t(f, text!("file not found")),
-            ErrorKind::Empty => t(f, text!("empty file")),
-            ErrorKind::LineTooLong => t(f, text!("line too long (max 64)")),
-            ErrorKind::ExpectedKeyValue => t(f, text!("expected key = value")),
-            ErrorKind::UnknownKey => t(f, text!("unknown key")),
-            ErrorKind::UnknownMachine => t(f, text!("unknown machine")),
-            ErrorKind::DuplicateKey => t(f, text!("duplicate key")),
-            ErrorKind::MissingKey(key) => uwrite!(f, "{}{}", text!("missing key "), key),
-            ErrorKind::NotANumber => t(f, text!("expected a number")),
-            ErrorKind::TooBig => t(f, text!("number too big")),
-            ErrorKind::Range { min, max } => {
-                uwrite!(f, "{}{}{}{}", text!("expected "), min, text!(" to "), max)
-            }
-            ErrorKind::Shape { max } => uwrite!(f, "{}{}", text!("expected 0 or 3 to "), max),
+            ErrorKind::MissingKey(name) | ErrorKind::Invalid(name) => name.fmt(f),
+            ErrorKind::Range { min, max } => uwrite!(f, "{}{}{}", min, text!(" to "), max),
+            ErrorKind::Shape { max } => uwrite!(f, "{}", max),
             ErrorKind::RadiusTooSmall { above_um } => {
-                t(f, text!("expected more than "))?;
                 write_um_as_cm(f, above_um)?;
-                t(f, text!(" cm"))
+                text!(" cm").fmt(f)
             }
-            ErrorKind::ExpectedComma => t(f, text!("expected ','")),
             ErrorKind::Nail { index, nails } => uwrite!(
                 f,
-                "{}{}{}{}{}",
-                text!("nail "),
+                "{}{}{}{}",
                 index,
                 text!(" out of range (nails: "),
                 nails,
                 text!(")")
             ),
-            ErrorKind::Count { declared, found } => uwrite!(
-                f,
-                "{}{}{}{}",
-                text!("declared "),
-                declared,
-                text!(" connections, found "),
-                found
-            ),
-            ErrorKind::Invalid(field) => uwrite!(f, "{}{}", text!("invalid "), field),
-            ErrorKind::Utf16 => t(f, text!("UTF-16 text: save it as UTF-8 or ASCII")),
-            ErrorKind::NotText { byte } => {
-                uwrite!(
-                    f,
-                    "{}{}{}",
-                    text!("not a text file (byte "),
-                    byte,
-                    text!(")")
-                )
+            ErrorKind::Count { declared, found } => {
+                uwrite!(f, "{}{}{}", declared, text!(" connections, found "), found)
             }
+            ErrorKind::NotText { byte } => uwrite!(f, "{}{}", byte, text!(")")),
             ErrorKind::PulseTooLong {
                 axis,
                 machine,
                 max_us,
             } => uwrite!(
                 f,
-                "{}{}{}{}{}",
-                text!("pulse over half a step at "),
+                "{}{}{}{}",
                 machine.channel(axis),
                 text!("_max_rate: "),
                 max_us,
                 text!(" us at most")
             ),
+            _ => Ok(()),
         }
     }
 }
@@ -175,6 +204,59 @@ pub(crate) mod tests {
         let mut t = Text(String::new());
         uwrite!(t, "{}", value).unwrap();
         t.0
+    }
+
+    #[test]
+    fn every_kind_has_its_message() {
+        use crate::axis::Axis;
+        use crate::machine::Machine;
+        use ErrorKind::*;
+        let name = text!("shape");
+        let cases = [
+            (NotFound, "file not found"),
+            (Empty, "empty file"),
+            (LineTooLong, "line too long (max 64)"),
+            (ExpectedKeyValue, "expected key = value"),
+            (UnknownKey, "unknown key"),
+            (UnknownMachine, "unknown machine"),
+            (DuplicateKey, "duplicate key"),
+            (MissingKey(name), "missing key shape"),
+            (NotANumber, "expected a number"),
+            (TooBig, "number too big"),
+            (Range { min: 1, max: 9 }, "expected 1 to 9"),
+            (Shape { max: 8 }, "expected 0 or 3 to 8"),
+            (
+                RadiusTooSmall { above_um: 35_000 },
+                "expected more than 3.5 cm",
+            ),
+            (ExpectedComma, "expected ','"),
+            (
+                Nail { index: 7, nails: 5 },
+                "nail 7 out of range (nails: 5)",
+            ),
+            (
+                Count {
+                    declared: 3,
+                    found: 2,
+                },
+                "declared 3 connections, found 2",
+            ),
+            (Invalid(name), "invalid shape"),
+            (Utf16, "UTF-16 text: save it as UTF-8 or ASCII"),
+            (NotText { byte: 0 }, "not a text file (byte 0)"),
+            (
+                PulseTooLong {
+                    axis: Axis::Base,
+                    machine: Machine::StringArt,
+                    max_us: 4,
+                },
+                "pulse over half a step at base_max_rate: 4 us at most",
+            ),
+        ];
+        for (i, (kind, message)) in cases.iter().enumerate() {
+            assert_eq!(kind.index(), i);
+            assert_eq!(show(kind), *message);
+        }
     }
 
     #[test]
