@@ -133,30 +133,34 @@ impl Words {
         let Some(w) = self.word.take() else {
             return Ok(());
         };
-        let bad = Error::new(ErrorKind::BadNumberFormat, column);
-        if w.letter == b'N' {
-            let n = w.number.value().ok_or(bad)?;
-            self.set_line_number(n, w.column)
-        } else {
-            let value = w.number.milli().ok_or(bad)?;
-            self.apply(w.letter, w.column, value)
-        }
+        let applied = match w.letter {
+            b'N' => w.number.value().map(|n| self.set_line_number(n)),
+            letter => w.number.milli().map(|v| self.apply(letter, w.column, v)),
+        };
+        // One error built, wherever it came from.
+        let (kind, at) = match applied {
+            Some(Ok(())) => return Ok(()),
+            Some(Err(kind)) => (kind, w.column),
+            None => (ErrorKind::BadNumberFormat, column),
+        };
+        Err(Error::new(kind, at))
     }
 
-    fn set_line_number(&mut self, n: u32, column: u8) -> Result<(), Error> {
+    fn set_line_number(&mut self, n: u32) -> Result<(), ErrorKind> {
         if self.line.n.is_some() {
-            return Err(Error::new(ErrorKind::RepeatedWord, column));
+            return Err(ErrorKind::RepeatedWord);
         }
         self.line.n = Some(n);
         Ok(())
     }
 
-    fn apply(&mut self, letter: u8, column: u8, value: Milli) -> Result<(), Error> {
-        let error = |kind| Err(Error::new(kind, column));
+    /// Takes the word `letter` of `value` at `column`; the error's kind
+    /// (at the word's column).
+    fn apply(&mut self, letter: u8, column: u8, value: Milli) -> Result<(), ErrorKind> {
         if let Some(word) = AxisWord::from_letter(letter) {
             let slot = &mut self.line.axes[word.index()];
             if slot.is_some() {
-                return error(ErrorKind::RepeatedWord);
+                return Err(ErrorKind::RepeatedWord);
             }
             *slot = MaybeMilli::new(Some(value));
             if self.axis_column == 0 {
@@ -170,7 +174,7 @@ impl Words {
                     90_000 => Distance::Absolute,
                     _ => Distance::Relative,
                 };
-                modal(&mut self.line.distance, d, column)
+                modal(&mut self.line.distance, d)
             }
             // Machine coordinates: taut keeps no work offsets, so every
             // position is one already.
@@ -181,14 +185,14 @@ impl Words {
                     18_000 => Plane::Zx,
                     _ => Plane::Yz,
                 };
-                modal(&mut self.line.plane, p, column)
+                modal(&mut self.line.plane, p)
             }
             b'G' if value.0 == 20_000 || value.0 == 21_000 => {
                 let u = match value.0 {
                     20_000 => Units::Inch,
                     _ => Units::Mm,
                 };
-                modal(&mut self.line.units, u, column)
+                modal(&mut self.line.units, u)
             }
             b'I' | b'J' | b'K' | b'R' => {
                 let slot = match letter {
@@ -198,7 +202,7 @@ impl Words {
                     _ => &mut self.line.offsets[2],
                 };
                 if slot.is_some() {
-                    return error(ErrorKind::RepeatedWord);
+                    return Err(ErrorKind::RepeatedWord);
                 }
                 *slot = MaybeMilli::new(Some(value));
                 if self.arc_column == 0 {
@@ -208,7 +212,7 @@ impl Words {
             }
             b'M' if CardLine::from_number(value).is_some() => {
                 if self.command_column != 0 {
-                    return error(ErrorKind::ModalGroupViolation);
+                    return Err(ErrorKind::ModalGroupViolation);
                 }
                 self.command_column = column;
                 self.card = CardLine::from_number(value);
@@ -216,10 +220,10 @@ impl Words {
             }
             b'G' | b'M' => {
                 if self.card.is_some() {
-                    return error(ErrorKind::ModalGroupViolation);
+                    return Err(ErrorKind::ModalGroupViolation);
                 }
                 let Some(command) = Command::from_word(letter, value) else {
-                    return error(ErrorKind::UnsupportedCommand);
+                    return Err(ErrorKind::UnsupportedCommand);
                 };
                 if self.command_column != 0 {
                     // G92 with G0/G1: different groups, but both want the
@@ -229,7 +233,7 @@ impl Words {
                     let axis_conflict = command.uses_axes()
                         && previous.uses_axes()
                         && set_position(command) != set_position(previous);
-                    return error(if axis_conflict {
+                    return Err(if axis_conflict {
                         ErrorKind::AxisWordConflict
                     } else {
                         ErrorKind::ModalGroupViolation
@@ -252,15 +256,15 @@ impl Words {
                     }
                 };
                 if slot.is_some() {
-                    return error(ErrorKind::RepeatedWord);
+                    return Err(ErrorKind::RepeatedWord);
                 }
                 if value.0 < 0 {
-                    return error(ErrorKind::NegativeValue);
+                    return Err(ErrorKind::NegativeValue);
                 }
                 *slot = MaybeMilli::new(Some(value));
                 Ok(())
             }
-            _ => error(ErrorKind::UnsupportedCommand),
+            _ => Err(ErrorKind::UnsupportedCommand),
         }
     }
 
@@ -383,9 +387,9 @@ pub(super) fn jog_line(line: Line, end: u8) -> Result<Line, Error> {
 
 /// A modal word (`G90`, `G17`, `G20`…): one of its group per line (Grbl's
 /// error 21).
-fn modal<T>(slot: &mut Option<T>, value: T, column: u8) -> Result<(), Error> {
+fn modal<T>(slot: &mut Option<T>, value: T) -> Result<(), ErrorKind> {
     if slot.is_some() {
-        return Err(Error::new(ErrorKind::ModalGroupViolation, column));
+        return Err(ErrorKind::ModalGroupViolation);
     }
     *slot = Some(value);
     Ok(())
