@@ -154,7 +154,7 @@ impl Numbered {
             Numbered::HomingPullOff => (global(GlobalField::HomingPullOff), Unit::Same),
             Numbered::JunctionDeviation => (global(GlobalField::JunctionDeviationUm), Unit::Micro),
             Numbered::ArcTolerance => (global(GlobalField::ArcToleranceUm), Unit::Micro),
-            Numbered::StepsPerUnit(p) => (axis(p, AxisField::StepsPerUnit), Unit::Same),
+            Numbered::StepsPerUnit(p) => (axis(p, AxisField::StepsPerUnit), Unit::Ratio),
             Numbered::MaxRate(p) => (axis(p, AxisField::MaxRate), Unit::PerMinute),
             Numbered::Accel(p) => (axis(p, AxisField::Accel), Unit::PerSecond),
             Numbered::MaxTravel(p) => (axis(p, AxisField::TravelMin), Unit::Span),
@@ -166,36 +166,41 @@ impl Numbered {
     /// three decimals for lengths and rates.
     #[inline(never)]
     pub fn get(self, cfg: &MachineConfig) -> Value {
-        let mut mask = [0u32; 2];
-        for (p, axis) in report_axes(cfg.machine).iter().enumerate() {
-            let a = &cfg.axes[axis.index()];
-            mask[0] |= (!a.dir_high_is_positive as u32) << p;
-            mask[1] |= (a.soft_limits as u32) << p;
-        }
         let Some((setting, unit)) = self.behind(cfg.machine) else {
-            return Value::Number(match self {
-                Numbered::DirInvert => mask[0],
-                Numbered::SoftLimits => (mask[1] != 0) as u32,
-                Numbered::Homing => (cfg.homing.axes != 0) as u32,
-                Numbered::IdleDelay => 255,
-                _ => 0,
-            });
+            return Value::Number(self.over_places(cfg));
         };
         let a = axis_of(setting, cfg);
         let StepsPerUnit { num, den } = a.steps_per_unit;
-        let milli = |v| Value::Milli(Milli(v));
-        match (setting.get(cfg), unit) {
-            (Value::Ratio(r), _) => milli(per(&[r.num as u64, 1000, r.den as u64])),
-            (Value::Number(n), Unit::Micro) => milli(n as i32),
-            (Value::Number(n), Unit::PerSecond) => {
-                milli(per(&[n as u64, den as u64 * 1000, num as u64]))
-            }
-            (Value::Number(n), Unit::PerMinute) => {
-                milli(per(&[n as u64, den as u64 * 60_000, num as u64]))
-            }
-            (_, Unit::Span) => milli(a.travel.1 .0.wrapping_sub(a.travel.0 .0)),
-            (value, _) => value,
+        let value = setting.get(cfg);
+        let n = match value {
+            Value::Number(n) => n,
+            _ => 0,
+        };
+        Value::Milli(Milli(match unit {
+            Unit::Same => return value,
+            Unit::Ratio => per(&[num, 1, den], 1000, 1),
+            Unit::Micro => n as i32,
+            Unit::PerSecond | Unit::PerMinute => per(&[n, den, num], unit.scale(), 1),
+            Unit::Span => a.travel.1 .0.wrapping_sub(a.travel.0 .0),
+        }))
+    }
+
+    /// The value of a switch or mask over the report places.
+    fn over_places(self, cfg: &MachineConfig) -> u32 {
+        // Bytes: a `u32`'s shifts are four times as long on the AVR.
+        let mut mask = [0u8; 2];
+        for (p, axis) in report_axes(cfg.machine).iter().enumerate() {
+            let a = &cfg.axes[axis.index()];
+            mask[0] |= (!a.dir_high_is_positive as u8) << p;
+            mask[1] |= (a.soft_limits as u8) << p;
         }
+        (match self {
+            Numbered::DirInvert => mask[0],
+            Numbered::SoftLimits => (mask[1] != 0) as u8,
+            Numbered::Homing => (cfg.homing.axes != 0) as u8,
+            Numbered::IdleDelay => 255,
+            _ => 0,
+        }) as u32
     }
 
     /// Sets the settings behind this one from `text` (Grbl's units),
@@ -212,7 +217,6 @@ impl Numbered {
 
     fn put(self, cfg: &mut MachineConfig, text: &[u8]) -> Result<(), NumError> {
         let error = |kind| NumError { at: 0, kind };
-        let range = |min, max| Err(error(ErrorKind::Range { min, max }));
         // The value listed now keeps the exact figure behind it (a sender
         // writes back what `$$` showed: `$101=26.667` stays 9600/360).
         let listed = self.get(cfg);
@@ -226,64 +230,71 @@ impl Numbered {
         if same {
             return Ok(());
         }
-        let places = report_axes(cfg.machine);
         let Some((setting, unit)) = self.behind(cfg.machine) else {
-            let n = whole?;
-            // Switches and masks over the places: no figure at odds.
-            for (p, axis) in places.iter().enumerate() {
-                let a = &mut cfg.axes[axis.index()];
-                match (self, n) {
-                    (Numbered::DirInvert, 0..=7) => a.dir_high_is_positive = n >> p & 1 == 0,
-                    // On only where a travel is set: the base turns freely.
-                    (Numbered::SoftLimits, 0..=1) => {
-                        a.soft_limits = n == 1 && a.travel.0 < a.travel.1
-                    }
-                    (Numbered::DirInvert, _) => return range(0, 7),
-                    // Off, or on with the axes `homing_axes` names, which
-                    // `$22=1` cannot guess.
-                    (Numbered::Homing, 0) => cfg.homing.axes = 0,
-                    (Numbered::Homing, 1) => {
-                        return Err(error(ErrorKind::Invalid(GlobalField::HomingAxes.name())))
-                    }
-                    (Numbered::SoftLimits | Numbered::Homing, _) => return range(0, 1),
-                    // Another value than the one listed (checked above).
-                    (Numbered::IdleDelay, _) => return range(255, 255),
-                    _ => return range(0, 0),
-                }
-            }
-            return Ok(());
+            return self.put_over_places(cfg, whole?).map_err(error);
         };
         let a = axis_of(setting, cfg);
         // Lengths and rates are never below zero.
         let milli = milli.map(|m| m.0.max(0));
         let StepsPerUnit { num, den } = a.steps_per_unit;
-        // Units per second or minute as steps: the divisor's scale, then
-        // one product in place (a closure taking the `u64` scale got it as
-        // garbage on the AVR once it was not inlined, at `opt-level = "z"`).
-        let scale: u64 = match unit {
-            Unit::PerSecond => 1000,
-            _ => 60_000,
-        };
-        let value = match (setting.get(cfg), unit) {
-            (Value::Ratio(_), _) => Value::Ratio(parse_ratio(text)?),
-            (Value::Milli(_), Unit::Same) => Value::Milli(Milli(milli?)),
-            (Value::Number(_), Unit::Micro) => Value::Number(milli? as u32),
-            (Value::Number(_), Unit::PerSecond | Unit::PerMinute) => {
-                Value::Number(per(&[milli? as u64, num as u64, den as u64 * scale]) as u32)
+        let value = match unit {
+            Unit::Ratio => Value::Ratio(parse_ratio(text)?),
+            Unit::Same => match listed {
+                Value::Milli(_) => Value::Milli(Milli(milli?)),
+                _ => Value::Number(whole?),
+            },
+            Unit::Micro => Value::Number(milli? as u32),
+            Unit::PerSecond | Unit::PerMinute => {
+                Value::Number(per(&[milli? as u32, num, den], 1, unit.scale()) as u32)
             }
             // The travel keeps its upper end.
-            (_, Unit::Span) => Value::Milli(Milli(a.travel.1 .0.saturating_sub(milli?))),
-            (_, _) => Value::Number(whole?),
+            Unit::Span => Value::Milli(Milli(a.travel.1 .0.saturating_sub(milli?))),
         };
         setting.put(cfg, value).map_err(error)
+    }
+
+    /// Sets a switch or mask over the report places to `n`: no figure at
+    /// odds, only its range.
+    fn put_over_places(self, cfg: &mut MachineConfig, n: u32) -> Result<(), ErrorKind> {
+        let max = match self {
+            Numbered::DirInvert => 7,
+            Numbered::SoftLimits | Numbered::Homing => 1,
+            // Another value than the one listed (checked first).
+            Numbered::IdleDelay => return Err(ErrorKind::Range { min: 255, max: 255 }),
+            _ => 0,
+        };
+        if n > max {
+            return Err(ErrorKind::Range { min: 0, max });
+        }
+        match self {
+            // Off, or on with the axes `homing_axes` names, which `$22=1`
+            // cannot guess.
+            Numbered::Homing if n == 1 => {
+                return Err(ErrorKind::Invalid(GlobalField::HomingAxes.name()))
+            }
+            Numbered::Homing => cfg.homing.axes = 0,
+            _ => {
+                for (p, axis) in report_axes(cfg.machine).iter().enumerate() {
+                    let a = &mut cfg.axes[axis.index()];
+                    match self {
+                        Numbered::DirInvert => a.dir_high_is_positive = n >> p & 1 == 0,
+                        // On only where a travel is set: the base turns freely.
+                        _ => a.soft_limits = n == 1 && a.travel.0 < a.travel.1,
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 }
 
 /// How Grbl counts a setting against ours.
 #[derive(Clone, Copy)]
 enum Unit {
-    /// As ours (steps per unit with three decimals).
+    /// As ours: a whole number, or thousandths.
     Same,
+    /// Steps per unit, with three decimals.
+    Ratio,
     /// µm as mm.
     Micro,
     /// Steps/s as units/min (`$110`).
@@ -294,6 +305,16 @@ enum Unit {
     Span,
 }
 
+impl Unit {
+    /// Thousandths of a unit per minute or per second.
+    fn scale(self) -> u32 {
+        match self {
+            Unit::PerMinute => 60_000,
+            _ => 1000,
+        }
+    }
+}
+
 /// The axis of a per-axis setting (the first for the others).
 fn axis_of(setting: Setting, cfg: &MachineConfig) -> &AxisConfig {
     match setting {
@@ -302,14 +323,16 @@ fn axis_of(setting: Setting, cfg: &MachineConfig) -> &AxisConfig {
     }
 }
 
-/// `a × b / c`, rounded, as an `i32` (the settings' figures are far
-/// within it): `b` and `c` are up to a steps-per-unit part
-/// ([`MAX_DEN`](super::MAX_DEN)) times 60 000, so `a × b` fits. Out of
-/// line, one copy of the 64-bit maths; its figures by reference (on the
-/// AVR, `u64` arguments past the registers arrived as garbage).
+/// `a × (b × scale_b) / (c × scale_c)`, rounded, as an `i32` (the
+/// settings' figures are far within it): the products are up to a
+/// steps-per-unit part ([`MAX_DEN`](super::MAX_DEN)) times 60 000, so
+/// they fit in 64 bits. Out of line, one copy of the 64-bit maths; its
+/// figures by reference (on the AVR, arguments past the registers arrived
+/// as garbage).
 #[inline(never)]
-fn per(&[a, b, c]: &[u64; 3]) -> i32 {
-    let v = (a * b + c / 2) / c.max(1);
+fn per(&[a, b, c]: &[u32; 3], scale_b: u32, scale_c: u32) -> i32 {
+    let c = c as u64 * scale_c as u64;
+    let v = (a as u64 * (b as u64 * scale_b as u64) + c / 2) / c.max(1);
     v.min(i32::MAX as u64) as i32
 }
 
