@@ -22,6 +22,7 @@ fn an_image_reads_back_as_the_settings_it_was_made_of() {
     set(&mut cfg, "step_pulse_us", "7").unwrap();
     let img = image(&cfg);
     assert_eq!(img.len(), len());
+    assert_eq!(len(), HEADER + all().map(width).sum::<usize>() + 2);
     assert_eq!(&img[..4], b"taut");
     assert_eq!(read(&img), Ok(cfg));
     assert_eq!(read(&image(&BASE)), Ok(BASE));
