@@ -271,17 +271,10 @@ impl GlobalField {
 }
 
 /// Every setting in `$$` order: the machine, per axis, then the other
-/// machine-wide ones.
+/// machine-wide ones. By index ([`Setting::at`]): chained iterators over
+/// the axes and the fields were hundreds of bytes more on the AVR.
 pub fn all() -> impl Iterator<Item = Setting> {
-    let per_axis = Axis::ALL
-        .into_iter()
-        .flat_map(|a| axis_fields().map(move |f| Setting::Axis(a, f)));
-    let globals = global_fields().map(Setting::Global);
-    globals
-        .clone()
-        .take(1)
-        .chain(per_axis)
-        .chain(globals.skip(1))
+    (0..COUNT).filter_map(Setting::at)
 }
 
 /// Calls `f` with every setting and its value, in `$$` order.
