@@ -205,16 +205,6 @@ impl AxisField {
     }
 }
 
-/// Every global field, in order.
-fn global_fields() -> impl Iterator<Item = GlobalField> + Clone {
-    (0..GLOBAL_FIELDS.len()).filter_map(GlobalField::at)
-}
-
-/// Every axis field, in order.
-fn axis_fields() -> impl Iterator<Item = AxisField> + Clone {
-    (0..AXIS_FIELDS.len()).map(AxisField::at)
-}
-
 /// Largest denominator of steps per unit (nine decimals): Grbl's units
 /// of `$110` and `$120` are then worked out in 64 bits.
 pub const MAX_DEN: u32 = 1_000_000_000;
@@ -371,19 +361,22 @@ const LENGTH: Spec = spec(Kind::Length, 0, 0);
 impl Setting {
     /// The setting named `key`, in any case, on `machine`.
     pub fn parse(key: &[u8], machine: Machine) -> Option<Setting> {
-        for axis in Axis::ALL {
-            let prefix = machine.channel(axis);
-            let named =
-                key.len() > prefix.len() && prefix.is_prefix_of(key) && key[prefix.len()] == b'_';
-            if named {
-                let rest = &key[prefix.len() + 1..];
-                let field = axis_fields().find(|f| f.name().eq_ignore_ascii_case(rest))?;
-                return Some(Setting::Axis(axis, field));
+        all().find(|s| s.is_named(key, machine))
+    }
+
+    /// Whether `key` spells this setting's name on `machine`, in any case.
+    fn is_named(self, key: &[u8], machine: Machine) -> bool {
+        match self {
+            Setting::Axis(axis, field) => {
+                let prefix = machine.channel(axis);
+                let n = prefix.len();
+                key.len() > n
+                    && prefix.is_prefix_of(key)
+                    && key[n] == b'_'
+                    && field.name().eq_ignore_ascii_case(&key[n + 1..])
             }
+            Setting::Global(g) => g.name().eq_ignore_ascii_case(key),
         }
-        global_fields()
-            .find(|f| f.name().eq_ignore_ascii_case(key))
-            .map(Setting::Global)
     }
 
     /// The setting at `index` in [`all`]. Worked out rather than looked
