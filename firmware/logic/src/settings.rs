@@ -456,12 +456,18 @@ impl Setting {
     /// ([`MachineConfig::validate`]); nothing changes on an error.
     pub fn set(self, cfg: &mut MachineConfig, text: &[u8]) -> Result<(), SettingError> {
         let (lead, trimmed) = trim(text);
-        let value = self.parse_value(trimmed).map_err(|e| NumError {
+        // One error built, the value's or the setting's.
+        let e = match self.parse_value(trimmed) {
+            Ok(value) => match self.put(cfg, value) {
+                Ok(()) => return Ok(()),
+                Err(kind) => NumError { at: 0, kind },
+            },
+            Err(e) => e,
+        };
+        Err(NumError {
             at: lead + e.at,
             kind: e.kind,
-        })?;
-        self.put(cfg, value)
-            .map_err(|kind| NumError { at: lead, kind })
+        })
     }
 
     /// The kind and bounds: the axis fields' first, then the global ones,
