@@ -148,12 +148,21 @@ impl ParamFile {
 impl Seen {
     fn take(&mut self, item: Item<'_>) -> Result<(), FileError> {
         self.lines = true;
-        let at = |col, kind| FileError::at(FILE, item.line, col, kind);
+        // One error built, wherever it came from.
+        let (col, kind) = match self.take_value(&item) {
+            Ok(()) => return Ok(()),
+            Err(e) => e,
+        };
+        Err(FileError::at(FILE, item.line, col, kind))
+    }
+
+    /// Takes the line's value; on an error its column and kind.
+    fn take_value(&mut self, item: &Item<'_>) -> Result<(), (u32, ErrorKind)> {
         let Some(key) = (0..KEYS).find(|&k| {
             let [name, alias, _] = key_names(k);
             name.eq_ignore_ascii_case(item.key) || alias.eq_ignore_ascii_case(item.key)
         }) else {
-            return Err(at(item.key_col, ErrorKind::UnknownKey));
+            return Err((item.key_col, ErrorKind::UnknownKey));
         };
         let already = match key {
             0 => self.shape.is_some(),
@@ -161,46 +170,35 @@ impl Seen {
             _ => self.radius.is_some(),
         };
         if already {
-            return Err(at(item.key_col, ErrorKind::DuplicateKey));
+            return Err((item.key_col, ErrorKind::DuplicateKey));
         }
-        // One number read for the three keys: each of its error paths
-        // builds a whole `FileError` on the AVR.
+        // One number read for the three keys.
         let n = match key {
             2 => parse_fixed(item.value, 4),
             _ => parse_u32(item.value),
         };
-        let n = n.map_err(|e| at(item.value_col + e.at as u32, e.kind))?;
-        let out_of_range = |kind| at(item.value_col, kind);
+        let n = n.map_err(|e| (item.value_col + e.at as u32, e.kind))?;
+        let col = item.value_col;
         match key {
             0 => {
                 if n == 1 || n == 2 || n > MAX_SHAPE as u32 {
-                    return Err(out_of_range(ErrorKind::Shape {
-                        max: MAX_SHAPE as u32,
-                    }));
+                    let max = MAX_SHAPE as u32;
+                    return Err((col, ErrorKind::Shape { max }));
                 }
                 self.shape = Some(n as u16);
             }
             1 => {
                 if !(3..=MAX_NAILS as u32).contains(&n) {
-                    // Built here: through the closure it would be a
-                    // constant in SRAM.
-                    return Err(FileError::at(
-                        FILE,
-                        item.line,
-                        item.value_col,
-                        ErrorKind::Range {
-                            min: 3,
-                            max: MAX_NAILS as u32,
-                        },
-                    ));
+                    let (min, max) = (3, MAX_NAILS as u32);
+                    return Err((col, ErrorKind::Range { min, max }));
                 }
                 self.nails = Some(n as u16);
             }
             _ => {
                 if n > MAX_RADIUS_UM {
-                    return Err(out_of_range(ErrorKind::TooBig));
+                    return Err((col, ErrorKind::TooBig));
                 }
-                self.radius = Some((n, item.line, item.value_col));
+                self.radius = Some((n, item.line, col));
             }
         }
         Ok(())
