@@ -77,39 +77,39 @@ impl List {
 
     fn byte(&mut self, b: u8) -> Result<Option<Number>, FileError> {
         let (line, col) = self.cursor.advance(b);
-        let fail = |kind| Err(FileError::at(self.file, line, col, kind));
-        match (self.state, b) {
+        // One error built, only when it is one (a digit's was built
+        // eagerly for every digit).
+        let (line, col, kind) = match (self.state, b) {
             (State::In(n), b' ' | b'\t' | b'\r' | b'\n') => {
                 self.state = State::After;
-                Ok(Some(n))
+                return Ok(Some(n));
             }
-            (_, b' ' | b'\t' | b'\r' | b'\n') => Ok(None),
+            (_, b' ' | b'\t' | b'\r' | b'\n') => return Ok(None),
             (State::Before, b'0'..=b'9') => {
                 self.any = true;
                 let value = (b - b'0') as u32;
                 self.state = State::In(Number { value, line, col });
-                Ok(None)
+                return Ok(None);
             }
-            (State::In(mut n), b'0'..=b'9') => {
-                n.value = push_digit(n.value, b).ok_or(FileError::at(
-                    self.file,
-                    n.line,
-                    n.col,
-                    ErrorKind::TooBig,
-                ))?;
-                self.state = State::In(n);
-                Ok(None)
-            }
+            (State::In(mut n), b'0'..=b'9') => match push_digit(n.value, b) {
+                Some(value) => {
+                    n.value = value;
+                    self.state = State::In(n);
+                    return Ok(None);
+                }
+                None => (n.line, n.col, ErrorKind::TooBig),
+            },
             (State::In(n), b',') => {
                 self.state = State::Before;
-                Ok(Some(n))
+                return Ok(Some(n));
             }
             (State::After, b',') => {
                 self.state = State::Before;
-                Ok(None)
+                return Ok(None);
             }
-            (State::Before, _) => fail(ErrorKind::NotANumber),
-            (_, _) => fail(ErrorKind::ExpectedComma),
-        }
+            (State::Before, _) => (line, col, ErrorKind::NotANumber),
+            (_, _) => (line, col, ErrorKind::ExpectedComma),
+        };
+        Err(FileError::at(self.file, line, col, kind))
     }
 }
