@@ -224,18 +224,20 @@ impl Files {
     /// `param.txt` on a plotter's card.
     #[inline(never)]
     pub fn missing(&mut self, base: &MachineConfig) -> Result<Next, FileError> {
-        match self.stage {
+        // One error built, for either file.
+        let file = match self.stage {
             Stage::Param(_) => {
                 self.stage = Stage::Plotter(MachineFile::new(*base));
-                Ok(Next::Open(FileName::Machine))
+                return Ok(Next::Open(FileName::Machine));
             }
-            Stage::Plotter(_) => Err(FileError::whole(FileName::Param, ErrorKind::NotFound)),
+            Stage::Plotter(_) => FileName::Param,
             Stage::Machine(params, _) => {
                 self.stage = Stage::Poradi(params, *base, PoradiCheck::new(params.nails));
-                Ok(Next::Open(FileName::Poradi))
+                return Ok(Next::Open(FileName::Poradi));
             }
-            _ => Err(FileError::whole(self.file(), ErrorKind::NotFound)),
-        }
+            _ => self.file(),
+        };
+        Err(FileError::whole(file, ErrorKind::NotFound))
     }
 }
 

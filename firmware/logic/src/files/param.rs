@@ -117,31 +117,30 @@ impl ParamFile {
             self.seen.take(item)?;
         }
         let seen = core::mem::take(&mut self.seen);
-        if !seen.lines {
-            return Err(FileError::whole(FILE, ErrorKind::Empty));
-        }
-        // One error for the three keys: each built its own on the AVR.
-        let (Some(shape), Some(nails), Some((radius_um, line, col))) =
-            (seen.shape, seen.nails, seen.radius)
-        else {
-            let missing = match (seen.shape, seen.nails) {
-                (None, _) => 0,
-                (_, None) => 1,
-                _ => 2,
-            };
-            let kind = ErrorKind::MissingKey(key_names(missing)[2]);
-            return Err(FileError::whole(FILE, kind));
+        // One error built, whichever it is.
+        let (line, col, kind) = match (seen.shape, seen.nails, seen.radius) {
+            _ if !seen.lines => (0, 0, ErrorKind::Empty),
+            (Some(shape), Some(nails), Some((radius_um, line, col))) => {
+                let above_um = radius_limit_um(shape);
+                if radius_um > above_um {
+                    return Ok(Params {
+                        shape,
+                        nails,
+                        radius_um,
+                    });
+                }
+                (line, col, ErrorKind::RadiusTooSmall { above_um })
+            }
+            (shape, nails, _) => {
+                let missing = match (shape, nails) {
+                    (None, _) => 0,
+                    (_, None) => 1,
+                    _ => 2,
+                };
+                (0, 0, ErrorKind::MissingKey(key_names(missing)[2]))
+            }
         };
-        let above_um = radius_limit_um(shape);
-        if radius_um <= above_um {
-            let kind = ErrorKind::RadiusTooSmall { above_um };
-            return Err(FileError::at(FILE, line, col, kind));
-        }
-        Ok(Params {
-            shape,
-            nails,
-            radius_um,
-        })
+        Err(FileError::at(FILE, line, col, kind))
     }
 }
 
