@@ -3,6 +3,7 @@
 //! (at most [`MAX_LINE`] bytes). Accepts `#` comments, blank lines, LF, CR
 //! or CRLF line ends, blanks around `=` and a byte-order mark at the start.
 
+use crate::config::MachineConfig;
 use crate::files::cursor::{Cursor, Feed};
 use crate::files::error::{FileError, FileName};
 use crate::text::num::trim;
@@ -19,6 +20,15 @@ pub struct Item<'a> {
     pub line: u32,
     pub key_col: u32,
     pub value_col: u32,
+}
+
+/// What takes the items of a file: `param.txt`'s values or
+/// `machine.txt`'s settings. An enum, not a generic: one copy of the
+/// reading loop ([`KvReader::push_chunk`]) for both files (two cost
+/// ~300 bytes more on the AVR).
+pub(super) enum Taker<'a> {
+    Param(&'a mut super::param::Seen),
+    Machine(&'a mut MachineConfig, &'a mut [u8; super::machine::SEEN]),
 }
 
 pub struct KvReader {
@@ -64,6 +74,23 @@ impl KvReader {
             Some(line) => self.item(line),
             None => Ok(None),
         }
+    }
+
+    /// Feeds `chunk`, each line's item to `taker`.
+    pub(super) fn push_chunk(
+        &mut self,
+        chunk: &[u8],
+        mut taker: Taker<'_>,
+    ) -> Result<(), FileError> {
+        for &b in chunk {
+            if let Some(item) = self.push(b)? {
+                match &mut taker {
+                    Taker::Param(seen) => seen.take(item)?,
+                    Taker::Machine(cfg, seen) => super::machine::apply(cfg, seen, item)?,
+                }
+            }
+        }
+        Ok(())
     }
 
     /// End of file: the item of a last line without a newline, if any.

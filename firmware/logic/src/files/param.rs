@@ -9,7 +9,7 @@
 //! `nails`, `radius_cm`), in any case. Each must appear exactly once.
 
 use crate::files::error::{FileError, FileName};
-use crate::files::kv::{Item, KvReader};
+use crate::files::kv::{Item, KvReader, Taker};
 use crate::text::num::{parse_fixed, parse_u32};
 use crate::text::ErrorKind;
 use taut_progmem::{text, Text};
@@ -73,7 +73,7 @@ const KEYS: usize = 3;
 
 /// Values seen so far, by the index of their key in [`KEYS`].
 #[derive(Default)]
-struct Seen {
+pub(super) struct Seen {
     shape: Option<u16>,
     nails: Option<u16>,
     /// The radius is checked at the end (its limit depends on the shape),
@@ -103,12 +103,7 @@ impl ParamFile {
     }
 
     pub fn push(&mut self, chunk: &[u8]) -> Result<(), FileError> {
-        for &b in chunk {
-            if let Some(item) = self.kv.push(b)? {
-                self.seen.take(item)?;
-            }
-        }
-        Ok(())
+        self.kv.push_chunk(chunk, Taker::Param(&mut self.seen))
     }
 
     /// The file ended: its values, checked as a whole.
@@ -145,7 +140,7 @@ impl ParamFile {
 }
 
 impl Seen {
-    fn take(&mut self, item: Item<'_>) -> Result<(), FileError> {
+    pub(super) fn take(&mut self, item: Item<'_>) -> Result<(), FileError> {
         self.lines = true;
         // One error built, wherever it came from.
         let (col, kind) = match self.take_value(&item) {
