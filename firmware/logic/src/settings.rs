@@ -319,7 +319,7 @@ pub fn set(cfg: &mut MachineConfig, key: &str, value: &str) -> Result<(), Settin
 }
 
 /// What a setting holds, as [`Spec`] tells it.
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+#[derive(Clone, Copy, Debug)]
 enum Kind {
     /// A whole number within `min..=max`.
     Number,
@@ -697,6 +697,21 @@ mod tests {
         assert_eq!(GlobalField::at(GLOBAL_FIELDS.len()), None);
         for (i, a) in AXIS_FIELDS.iter().enumerate() {
             assert_eq!(AxisField::at(i), *a);
+        }
+    }
+
+    #[test]
+    fn each_spec_is_of_its_setting_s_kind() {
+        let cfg = MachineConfig::STRING_ART;
+        for s in all() {
+            let kind = s.spec().kind;
+            let same = match s.get(&cfg) {
+                Value::Number(_) => matches!(kind, Kind::Number),
+                Value::Milli(_) => matches!(kind, Kind::Milli | Kind::Length),
+                Value::Ratio(_) => matches!(kind, Kind::Ratio),
+                Value::Machine(_) => matches!(kind, Kind::Machine),
+            };
+            assert!(same, "{s:?}: {kind:?}");
         }
     }
 
