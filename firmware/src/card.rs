@@ -380,15 +380,9 @@ impl CardReader {
                 Self::send(What::Opened { size: e.size }, ticket);
             }
             Err(FatError::NotFound) => Self::send(What::Missing, ticket),
+            // Reading the directory failed: the job asks again.
             Err(FatError::Device(e)) => {
-                let lba = dev.lba;
-                match failure(&e) {
-                    // Reading the directory failed: the job asks again.
-                    Failure::Block(what) => {
-                        let _ = self.bad_block(lba, what, ticket);
-                    }
-                    Failure::Gone => self.removed(ticket),
-                }
+                let _ = self.read_failed(&e, dev.lba, ticket);
             }
             Err(_) => Self::send(What::Failed, ticket),
         }
@@ -427,17 +421,9 @@ impl CardReader {
             match BUF.with(|b| volume.read_dir(&mut l.dir, &mut dev, b)) {
                 Ok(true) => l.at = 0,
                 Ok(false) => return self.listed(l.ticket),
-                Err(FatError::Device(e)) => {
-                    let lba = dev.lba;
-                    return match failure(&e) {
-                        // Read again: the walk moved on only past good blocks.
-                        Failure::Block(what) => self.bad_block(lba, what, l.ticket),
-                        Failure::Gone => {
-                            self.removed(l.ticket);
-                            Poll::Idle
-                        }
-                    };
-                }
+                // A bad block is read again: the walk moved on only past
+                // good blocks.
+                Err(FatError::Device(e)) => return self.read_failed(&e, dev.lba, l.ticket),
                 Err(_) => return self.listed(l.ticket),
             }
         }
@@ -510,20 +496,24 @@ impl CardReader {
                 self.len = n as u16;
                 Poll::Again
             }
-            Err(FatError::Device(e)) => {
-                let lba = dev.lba;
-                match failure(&e) {
-                    Failure::Block(what) => self.bad_block(lba, what, ticket),
-                    Failure::Gone => {
-                        self.removed(ticket);
-                        Poll::Idle
-                    }
-                }
-            }
+            Err(FatError::Device(e)) => self.read_failed(&e, dev.lba, ticket),
             Err(_) => {
                 warn!("card: broken cluster chain");
                 self.reading = Reading::Nothing;
                 Self::send(What::Failed, ticket);
+                Poll::Idle
+            }
+        }
+    }
+
+    /// Block `lba` of the file or directory with `ticket` did not read:
+    /// a bad block, or no card. One copy for the three readers.
+    #[inline(never)]
+    fn read_failed(&mut self, e: &SdCardError, lba: u32, ticket: u8) -> Poll<Signal> {
+        match failure(e) {
+            Failure::Block(what) => self.bad_block(lba, what, ticket),
+            Failure::Gone => {
+                self.removed(ticket);
                 Poll::Idle
             }
         }
