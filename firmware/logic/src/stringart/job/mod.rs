@@ -242,10 +242,13 @@ impl Job {
         let mut out = Out(actions);
         let o = &mut out;
         match event {
-            Event::PowerOn => {
+            // One copy of the fresh job for both.
+            Event::PowerOn | Event::OtherMachine => {
                 *self = Job::new();
-                o.push(Action::DriversOff(MACHINE_DRIVERS));
-                self.enter(State::WaitingForCard, o);
+                if matches!(event, Event::PowerOn) {
+                    o.push(Action::DriversOff(MACHINE_DRIVERS));
+                    self.enter(State::WaitingForCard, o);
+                }
             }
             Event::CardInserted => self.card_inserted(o),
             Event::CardRemoved => self.card_removed(o, now_ms),
@@ -273,7 +276,6 @@ impl Job {
             Event::Resume => self.resume(o, now_ms),
             Event::Abort => self.abort(o),
             Event::Nail(j) => self.nail(j, o, now_ms),
-            Event::OtherMachine => *self = Job::new(),
             Event::Saved(s) => self.saved = Some(s),
             Event::Tool(t) => self.tool(t, o, now_ms),
             Event::PatternLost => {
@@ -551,7 +553,7 @@ impl Job {
             State::PrepDrill | State::WaitingForNails if self.loose != 0 => {
                 o.push(Action::Log(Msg::ZeroPending));
             }
-            State::PrepDrill => self.start_drilling(o, now_ms),
+            State::PrepDrill => self.start_drilling(None, o, now_ms),
             State::WaitingForNails if self.card != Card::Present => {
                 o.push(Action::Log(Msg::NoCard));
                 o.push(Action::Prompt(Prompt::InsertCard));
@@ -581,18 +583,7 @@ impl Job {
             return;
         };
         match s.phase() {
-            Phase::Drilling => {
-                let hole = s.n().min(plan.board().nails() as u32);
-                let d =
-                    Drilling::on(plan.board(), plan.scale(), plan.depths).from_hole(hole as u16);
-                self.steps = Some(PhaseSteps::drill(
-                    d,
-                    plan.board().nails(),
-                    Some(hole),
-                    now_ms,
-                ));
-                self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
-            }
+            Phase::Drilling => self.start_drilling(Some(s.n()), o, now_ms),
             _ => {
                 self.steps = Some(PhaseSteps::wind(plan.count, Some(s.last), now_ms));
                 self.open_pattern(s.done(), o);
@@ -613,12 +604,17 @@ impl Job {
         self.next_moves(o);
     }
 
-    fn start_drilling(&mut self, o: &mut Out, now_ms: u32) {
+    /// Drilling from the first hole, or from the checkpoint's `resume`:
+    /// one copy of the steps' setup for both.
+    fn start_drilling(&mut self, resume: Option<u32>, o: &mut Out, now_ms: u32) {
         let Some(plan) = &self.plan else { return };
+        let nails = plan.board().nails();
+        let resume = resume.map(|n| n.min(u32::from(nails)));
+        let hole = resume.unwrap_or(0) as u16;
         self.steps = Some(PhaseSteps::drill(
-            Drilling::on(plan.board(), plan.scale(), plan.depths),
-            plan.board().nails(),
-            None,
+            Drilling::on(plan.board(), plan.scale(), plan.depths).from_hole(hole),
+            nails,
+            resume,
             now_ms,
         ));
         self.go(State::Drilling, MACHINE_DRIVERS, o, now_ms);
