@@ -359,7 +359,8 @@ impl JobTask {
         for i in 0..text.len() {
             let _ = name.push(text.byte(i));
         }
-        while CARD_IN.push(Request::Open(name, self.ticket)).is_err() {
+        let request = Request::Open(name, self.ticket);
+        while CARD_IN.push(request).is_err() {
             let _ = CARD_IN.pop();
         }
     }

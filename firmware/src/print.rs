@@ -369,11 +369,10 @@ impl Print {
                 self.taken = 0;
                 let _ = CARD_OUT.pop();
             }
-            if self.at.pos < self.skip {
-                self.at.pos += 1;
+            self.at.pos += 1;
+            if self.at.pos <= self.skip {
                 continue;
             }
-            self.at.pos += 1;
             return Some(self.took(byte));
         }
     }
