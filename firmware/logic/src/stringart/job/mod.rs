@@ -141,6 +141,19 @@ impl Out<'_> {
         let pushed = self.0.push(a);
         debug_assert!(pushed.is_ok(), "too many actions");
     }
+
+    /// `push(Action::Log(m))` in 8 B a call, not 20: the action is built
+    /// here, not at each call.
+    #[inline(never)]
+    fn log(&mut self, m: Msg) {
+        self.push(Action::Log(m));
+    }
+
+    /// `push(Action::Prompt(p))`, as [`Out::log`].
+    #[inline(never)]
+    fn prompt(&mut self, p: Prompt) {
+        self.push(Action::Prompt(p));
+    }
 }
 
 impl Job {
@@ -325,7 +338,7 @@ impl Job {
             }
             State::Reading | State::Drilling | State::Winding => return,
         };
-        o.push(Action::Prompt(prompt));
+        o.prompt(prompt);
     }
 
     /// Back to the start: the job and its files are dropped.
@@ -361,34 +374,33 @@ impl Job {
 
     fn card_removed(&mut self, o: &mut Out, now_ms: u32) {
         self.card = Card::Absent;
-        match self.state {
-            State::WaitingForCard => {}
-            State::Reading | State::BadFiles => {
-                o.push(Action::Log(Msg::CardRemoved));
-                self.restart(o);
-            }
-            State::PrepDrill | State::Offer | State::PrepResume(_) => {
-                // Nothing done yet (a checkpoint is kept): start over, with the drivers off as
-                // whenever the job waits for a card.
-                o.push(Action::Log(Msg::CardRemoved));
-                o.push(Action::StopMotion);
-                o.push(Action::DriversOff(MACHINE_DRIVERS));
-                self.restart(o);
-            }
-            _ if self.phase() == Some(Phase::Winding) => self.lose_pattern(o, now_ms),
+        let stops = match self.state {
+            State::WaitingForCard => return,
+            _ if self.phase() == Some(Phase::Winding) => return self.lose_pattern(o, now_ms),
+            State::Reading | State::BadFiles => false,
+            // Nothing done yet (a checkpoint is kept): start over, with the drivers off as
+            // whenever the job waits for a card.
+            State::PrepDrill | State::Offer | State::PrepResume(_) => true,
             // Drilling needs no card; winding will ask for it.
-            _ => o.push(Action::Log(Msg::CardRemoved)),
+            _ => return o.log(Msg::CardRemoved),
+        };
+        // One copy of what every start over does.
+        o.log(Msg::CardRemoved);
+        if stops {
+            o.push(Action::StopMotion);
+            o.push(Action::DriversOff(MACHINE_DRIVERS));
         }
+        self.restart(o);
     }
 
     /// Winding without its pattern: paused until the card is back.
     fn lose_pattern(&mut self, o: &mut Out, now_ms: u32) {
         self.lost = true;
-        o.push(Action::Log(Msg::PatternLost));
+        o.log(Msg::PatternLost);
         if self.state == State::Winding {
             self.pause(o, now_ms);
         } else {
-            o.push(Action::Prompt(Prompt::InsertCard));
+            o.prompt(Prompt::InsertCard);
         }
     }
 
@@ -425,14 +437,14 @@ impl Job {
                             return;
                         }
                         self.saved = None;
-                        o.push(Action::Log(Msg::SavedOtherCard));
+                        o.log(Msg::SavedOtherCard);
                         o.push(Action::Forget);
                     }
                     o.push(Action::DriversOn(MACHINE_DRIVERS));
                     self.enter(State::PrepDrill, o);
                 }
                 false => {
-                    o.push(Action::Log(Msg::BadBoard));
+                    o.log(Msg::BadBoard);
                     self.card = Card::Present;
                     self.enter(State::BadFiles, o);
                 }
@@ -445,18 +457,18 @@ impl Job {
         let same = self.plan.as_ref().is_some_and(|p| p.id == id);
         if !same {
             self.card = Card::Absent;
-            o.push(Action::Log(Msg::OtherCard));
+            o.log(Msg::OtherCard);
             return;
         }
         self.card = Card::Present;
-        o.push(Action::Log(Msg::CardOk));
+        o.log(Msg::CardOk);
         if self.lost {
             self.lost = false;
             self.open_pattern(self.steps.as_ref().map_or(0, PhaseSteps::fed), o);
         }
         match self.state {
-            State::WaitingForNails => o.push(Action::Prompt(Prompt::StartWinding)),
-            State::Paused(_) => o.push(Action::Prompt(Prompt::Resume)),
+            State::WaitingForNails => o.prompt(Prompt::StartWinding),
+            State::Paused(_) => o.prompt(Prompt::Resume),
             _ => {}
         }
     }
@@ -491,7 +503,7 @@ impl Job {
             self.enter(State::BadFiles, o);
         } else if self.card == Card::Checking {
             self.card = Card::Absent;
-            o.push(Action::Log(Msg::OtherCard));
+            o.log(Msg::OtherCard);
         }
     }
 
@@ -520,7 +532,7 @@ impl Job {
             ButtonEvent::LongPress(Button::Confirm) if self.state == State::Offer => {
                 self.saved = None;
                 o.push(Action::Forget);
-                o.push(Action::Log(Msg::SavedDiscarded));
+                o.log(Msg::SavedDiscarded);
                 o.push(Action::DriversOn(MACHINE_DRIVERS));
                 self.enter(State::PrepDrill, o);
             }
@@ -537,13 +549,13 @@ impl Job {
         if self.loose & b == 0 {
             self.loose |= b;
             o.push(Action::DriversOff(b));
-            o.push(Action::Log(Msg::Loose(axis)));
+            o.log(Msg::Loose(axis));
         } else {
             self.loose &= !b;
             self.zeroed |= b;
             o.push(Action::SetZero(axis));
             o.push(Action::DriversOn(b));
-            o.push(Action::Log(Msg::Zeroed(axis)));
+            o.log(Msg::Zeroed(axis));
         }
     }
 
@@ -551,12 +563,12 @@ impl Job {
     fn confirm(&mut self, o: &mut Out, now_ms: u32) {
         match self.state {
             State::PrepDrill | State::WaitingForNails if self.loose != 0 => {
-                o.push(Action::Log(Msg::ZeroPending));
+                o.log(Msg::ZeroPending);
             }
             State::PrepDrill => self.start_drilling(None, o, now_ms),
             State::WaitingForNails if self.card != Card::Present => {
-                o.push(Action::Log(Msg::NoCard));
-                o.push(Action::Prompt(Prompt::InsertCard));
+                o.log(Msg::NoCard);
+                o.prompt(Prompt::InsertCard);
             }
             State::WaitingForNails => self.start_winding(o, now_ms),
             State::Paused(_) => self.resume(o, now_ms),
@@ -568,9 +580,9 @@ impl Job {
                 let phase = self.saved.map_or(Phase::Drilling, |s| s.phase());
                 self.enter(State::PrepResume(phase), o);
             }
-            State::PrepResume(_) if self.loose != 0 => o.push(Action::Log(Msg::ZeroPending)),
+            State::PrepResume(_) if self.loose != 0 => o.log(Msg::ZeroPending),
             State::PrepResume(_) if self.zeroed != MACHINE_DRIVERS => {
-                o.push(Action::Log(Msg::ZeroAll));
+                o.log(Msg::ZeroAll);
             }
             State::PrepResume(_) => self.start_resumed(o, now_ms),
             _ => {}
@@ -697,14 +709,14 @@ impl Job {
             return;
         };
         if self.lost {
-            o.push(Action::Log(Msg::NoCard));
-            o.push(Action::Prompt(Prompt::InsertCard));
+            o.log(Msg::NoCard);
+            o.prompt(Prompt::InsertCard);
             return;
         }
         if let Some(m) = &mut self.steps {
             m.reporter.resume(now_ms);
         }
-        o.push(Action::Log(Msg::Resumed));
+        o.log(Msg::Resumed);
         self.enter(
             match phase {
                 Phase::Drilling => State::Drilling,
@@ -729,7 +741,7 @@ impl Job {
         self.steps = None;
         self.moving = false;
         self.lost = false;
-        o.push(Action::Log(Msg::Aborted));
+        o.log(Msg::Aborted);
         o.push(Action::Forget);
         self.enter(State::End, o);
     }

@@ -85,26 +85,26 @@ pub(super) enum Run {
 impl Job {
     pub(in crate::stringart::job) fn tool(&mut self, t: Tool, o: &mut Out, now_ms: u32) {
         if self.state.is_running() || self.moving || self.run.is_some() {
-            return o.push(Action::Log(Msg::ToolMoving));
+            return o.log(Msg::ToolMoving);
         }
         let Some(plan) = &self.plan else {
-            return o.push(Action::Log(Msg::ToolNotNow));
+            return o.log(Msg::ToolNotNow);
         };
         let (nails, count) = (plan.board().nails(), plan.count);
         let winding_paused = self.state == State::Paused(Phase::Winding) && !self.lost;
         let waiting = self.state == State::WaitingForNails && self.loose == 0;
         let t = match t {
             Tool::Back if winding_paused => match self.steps.as_ref().map_or(0, |s| s.done) {
-                0 => return o.push(Action::Log(Msg::ToolRange)),
+                0 => return o.log(Msg::ToolRange),
                 done => Tool::Jump(done - 1),
             },
             t => t,
         };
         let run = match t {
             Tool::WrapTest(k) | Tool::Drift(k) if k >= nails => {
-                return o.push(Action::Log(Msg::ToolRange));
+                return o.log(Msg::ToolRange);
             }
-            Tool::Jump(k) if k > count => return o.push(Action::Log(Msg::ToolRange)),
+            Tool::Jump(k) if k > count => return o.log(Msg::ToolRange),
             Tool::WrapTest(k) if waiting => Run::WrapTest {
                 k,
                 i: 0,
@@ -131,7 +131,7 @@ impl Job {
                 self.open_pattern(k, o);
                 Run::Jump(record)
             }
-            _ => return o.push(Action::Log(Msg::ToolNotNow)),
+            _ => return o.log(Msg::ToolNotNow),
         };
         self.run = Some(run);
         if matches!(t, Tool::WrapTest(_)) {
@@ -200,7 +200,7 @@ impl Job {
                     Run::Jump(_) => Msg::Jumped,
                 };
                 self.run = None;
-                o.push(Action::Log(msg));
+                o.log(msg);
                 let state = self.state;
                 self.enter(state, o);
             }
