@@ -149,6 +149,15 @@ impl Out<'_> {
         self.push(Action::Log(m));
     }
 
+    /// `push(Action::DriversOn(mask))` or `DriversOff`, as [`Out::log`].
+    #[inline(never)]
+    fn drivers(&mut self, mask: u8, on: bool) {
+        self.push(match on {
+            true => Action::DriversOn(mask),
+            false => Action::DriversOff(mask),
+        });
+    }
+
     /// `push(Action::Prompt(p))`, as [`Out::log`].
     #[inline(never)]
     fn prompt(&mut self, p: Prompt) {
@@ -259,7 +268,7 @@ impl Job {
             Event::PowerOn | Event::OtherMachine => {
                 *self = Job::new();
                 if matches!(event, Event::PowerOn) {
-                    o.push(Action::DriversOff(MACHINE_DRIVERS));
+                    o.drivers(MACHINE_DRIVERS, false);
                     self.enter(State::WaitingForCard, o);
                 }
             }
@@ -388,7 +397,7 @@ impl Job {
         o.log(Msg::CardRemoved);
         if stops {
             o.push(Action::StopMotion);
-            o.push(Action::DriversOff(MACHINE_DRIVERS));
+            o.drivers(MACHINE_DRIVERS, false);
         }
         self.restart(o);
     }
@@ -440,7 +449,7 @@ impl Job {
                         o.log(Msg::SavedOtherCard);
                         o.push(Action::Forget);
                     }
-                    o.push(Action::DriversOn(MACHINE_DRIVERS));
+                    o.drivers(MACHINE_DRIVERS, true);
                     self.enter(State::PrepDrill, o);
                 }
                 false => {
@@ -533,7 +542,7 @@ impl Job {
                 self.saved = None;
                 o.push(Action::Forget);
                 o.log(Msg::SavedDiscarded);
-                o.push(Action::DriversOn(MACHINE_DRIVERS));
+                o.drivers(MACHINE_DRIVERS, true);
                 self.enter(State::PrepDrill, o);
             }
             ButtonEvent::LongPress(Button::Confirm) => self.pause(o, now_ms),
@@ -548,13 +557,13 @@ impl Job {
         let b = bit(axis);
         if self.loose & b == 0 {
             self.loose |= b;
-            o.push(Action::DriversOff(b));
+            o.drivers(b, false);
             o.log(Msg::Loose(axis));
         } else {
             self.loose &= !b;
             self.zeroed |= b;
             o.push(Action::SetZero(axis));
-            o.push(Action::DriversOn(b));
+            o.drivers(b, true);
             o.log(Msg::Zeroed(axis));
         }
     }
@@ -576,7 +585,7 @@ impl Job {
             State::Offer => {
                 self.loose = 0;
                 self.zeroed = 0;
-                o.push(Action::DriversOn(MACHINE_DRIVERS));
+                o.drivers(MACHINE_DRIVERS, true);
                 let phase = self.saved.map_or(Phase::Drilling, |s| s.phase());
                 self.enter(State::PrepResume(phase), o);
             }
@@ -611,7 +620,7 @@ impl Job {
         let Some(steps) = &mut self.steps else { return };
         let first = steps.reporter.first(now_ms);
         self.enter(state, o);
-        o.push(Action::DriversOn(drivers));
+        o.drivers(drivers, true);
         o.push(Action::Progress(first));
         self.next_moves(o);
     }
@@ -643,7 +652,7 @@ impl Job {
         // would unwind those turns.
         o.push(Action::SetZero(Axis::Base));
         // The winder's entry switches the drill's driver off itself.
-        o.push(Action::DriversOn(bit(Axis::Base) | bit(Axis::Radial)));
+        o.drivers(bit(Axis::Base) | bit(Axis::Radial), true);
         self.open_pattern(0, o);
         o.push(Action::Progress(first));
         self.next_moves(o);

@@ -135,7 +135,7 @@ impl Job {
         };
         self.run = Some(run);
         if matches!(t, Tool::WrapTest(_)) {
-            o.push(Action::DriversOn(bit(Axis::Base) | bit(Axis::Radial)));
+            o.drivers(bit(Axis::Base) | bit(Axis::Radial), true);
         }
         self.next_moves(o);
     }
