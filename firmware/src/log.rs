@@ -220,6 +220,16 @@ pub fn text(s: FlashStr) {
     });
 }
 
+/// A log line of one text from flash (`log!` of a lone literal): one
+/// call at each of its sites, not three.
+#[doc(hidden)]
+#[inline(never)]
+pub fn just(level: Level, module: FlashStr, s: FlashStr) {
+    start(level, module);
+    text(s);
+    finish();
+}
+
 /// Append a value to the log line: one function per type.
 #[doc(hidden)]
 #[inline(never)]
@@ -284,6 +294,11 @@ macro_rules! __log_parts {
 
 #[macro_export]
 macro_rules! log {
+    ($level:expr, $s:literal $(,)?) => {
+        if $level <= $crate::log::MAX_LEVEL {
+            $crate::log::just($level, $crate::__log_module!(), $crate::flash_str!($s));
+        }
+    };
     ($level:expr, $($parts:tt)*) => {
         if $level <= $crate::log::MAX_LEVEL {
             $crate::log::start($level, $crate::__log_module!());
