@@ -420,6 +420,25 @@ fn jogs_move_report_jog_and_cancel_with_a_controlled_stop() {
     refused(&mut sim, "$J=X0 F100", 8);
 }
 
+/// A word of no channel of the machine (`Y` and `A` on the string-art
+/// machine) is refused as Grbl refuses a letter it does not know (error
+/// 20), nothing moves and nothing of the line is taken: still `G90 G0`.
+#[test]
+fn a_word_of_no_channel_is_error_20_and_nothing_of_its_line_is_taken() {
+    let mut sim = boot_machine();
+    send(&mut sim, "M17");
+    refused(&mut sim, "G91 G1 X1 Y2 F600", 20);
+    refused(&mut sim, "G0 A5", 20);
+    sim.run_for(Duration::from_millis(300));
+    assert_eq!(hil_tests::steps_on_pins(&sim), [0, 0, 0], "nothing moved");
+    // Absolute: the second `X1` stays where the first went (32 steps/mm).
+    for _ in 0..2 {
+        send_ok(&mut sim, "X1", Duration::from_secs(2));
+    }
+    send_ok(&mut sim, "M400", Duration::from_secs(5));
+    assert_eq!(hil_tests::steps_on_pins(&sim), [0, 32, 0]);
+}
+
 /// `$C` (commands.md): lines are parsed and checked, nothing moves;
 /// `Check` in reports; errors still come; `$C` again leaves it with a
 /// soft reset (`[MSG:Disabled]`, the greeting) and the modal state is
