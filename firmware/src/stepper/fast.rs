@@ -72,9 +72,9 @@ pub const fn pin(s: usize) -> u16 {
     }
 }
 
-// The fast path writes exactly two STEP ports; a pin map with another
-// number must adapt the assembly (the compiler stops here).
-const _: () = assert!(MAP.ports.len() == 2);
+// The fast path writes exactly two STEP ports, `MAP`'s two slots: a pin
+// map needing a third stops the compiler in `step_map`, one using a
+// single port stops it at `PIN1` (`pin` panics on an unused slot).
 #[doc(hidden)]
 pub const PIN0: u16 = pin(0);
 #[doc(hidden)]
