@@ -18,9 +18,11 @@ use core::f32::consts::{FRAC_PI_2, TAU};
 pub const EXACT_EVERY: u32 = 12;
 
 /// An end further than this from the circle through the start is a bad
-/// target (Grbl's 0.005 mm and 0.1 %).
+/// target (Grbl's rule, `gcode.c` line 826: over 0.005 mm and 0.1 % of
+/// the radius, or over 0.5 mm).
 const RADIUS_SLACK: f32 = 5.0;
 const RADIUS_SLACK_REL: f32 = 0.001;
+const RADIUS_SLACK_MAX: f32 = 500.0;
 
 /// Why an arc cannot be made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,7 +97,7 @@ impl Circle {
         let (x1, y1) = (end[plane.axis_0].0 as f32, end[plane.axis_1].0 as f32);
         let r_end = fmath::sqrt(sq(x1 - centre[0]) + sq(y1 - centre[1]));
         let off = (r - r_end).abs();
-        if off > RADIUS_SLACK && off > RADIUS_SLACK_REL * r {
+        if off > RADIUS_SLACK && (off > RADIUS_SLACK_MAX || off > RADIUS_SLACK_REL * r) {
             return Err(ArcError::EndOffCircle);
         }
         Ok(Circle { centre, radius: r })
@@ -201,6 +203,21 @@ impl Arc {
     /// Chords in all.
     pub fn chords(&self) -> u32 {
         self.chords
+    }
+
+    /// Chords not yet taken.
+    pub fn remaining(&self) -> u32 {
+        self.chords - self.done
+    }
+
+    /// Length along the circle (and the helix's axis), thousandths.
+    pub fn length(&self) -> f32 {
+        let turn = (self.step * self.chords as f32 * self.radius).abs();
+        let rise = match self.plane.linear {
+            Some(i) => (self.end[i].0 - self.start[i].0) as f32,
+            None => 0.0,
+        };
+        fmath::sqrt(turn * turn + rise * rise)
     }
 
     pub fn start(&self) -> Position {

@@ -1,34 +1,38 @@
-//! The serial command line: a streaming G-code parser, Grbl's dialect with
-//! Marlin's line numbers and checksums.
+//! The serial command line: a streaming G-code parser, Grbl 1.1's dialect
+//! (`protocol.c` and the first steps of `gcode.c`) with Marlin's line
+//! checksums.
 //!
 //! [`Parser::push`] takes one received byte at a time and holds no line
-//! buffer: a line is parsed as it arrives, so the only cost of a long line
-//! is the [`MAX_LINE`] limit. No heap, no floats: numbers become
-//! [`Milli`](crate::units::Milli) digit by digit.
+//! buffer: a line is gathered word by word as it arrives. No heap, no
+//! floats: numbers keep their digits and become nanometres or thousandths
+//! once, when their word ends.
 //!
-//! The dialect:
-//! - A line ends at `\n`; `\r` is ignored. Longer than [`MAX_LINE`]
-//!   characters → error 11, and the rest is dropped up to the newline.
-//! - Letters are case-insensitive. Spaces may stand between words and
-//!   between a letter and its number (`G1X10 Y-2.5F600`, `X 10`), but end a
-//!   number (`X1 0` is an error, unlike Grbl). `;` to the end of the line
-//!   and `( … )` are comments and also end a number.
-//! - Numbers: optional sign, digits, optional point; three decimals kept,
-//!   the fourth rounds half away from zero; beyond ±2147483.647 → error 2.
-//! - `N` (0..=9 999 999) may stand anywhere. `*<0..=255>` is Marlin's
-//!   checksum, the XOR of every byte before it; after it only spaces and a
-//!   `;` comment may follow.
-//! - G/M numbers are matched exactly in thousandths: `G1` = `G01` =
-//!   `G1.0`; `G38.2` and other unknown numbers → error 20.
-//! - One command per line, plus `G90`/`G91` (see [`Line`]).
-//! - A line whose first character is `$` is a [`SystemLine`].
+//! The dialect, as Grbl reads it:
+//! - A line ends at `\n`, `\r` or `\r\n`. Comments `( … )` and `;` to
+//!   the end of the line are thrown away as they come, of any length; so
+//!   are spaces, control bytes and `/` (Grbl's block delete, not
+//!   supported: the line runs). More than [`MAX_LINE`] characters kept →
+//!   error 11, after the line's end. A UTF-8 byte-order mark before a
+//!   line's first character is skipped.
+//! - Letters are case-insensitive; spaces count for nothing (`X1 0` is
+//!   `X10`). A word is a letter and a number: an optional sign, digits,
+//!   one point. `%` is no letter (error 1, as Grbl answers it).
+//! - Words are gathered into a [`Block`] with Grbl's checks in the
+//!   line's order: supported commands (20), whole numbers (23), two axis
+//!   commands (24), modal groups (21), repeated words (25), negative
+//!   `F N P S T` (4), `T` ≤ 255 (38), `N` ≤ 10 000 000 (27). The checks
+//!   that need the modal state are the executor's
+//!   ([`crate::interp`]).
+//! - `*<0..=255>` is Marlin's checksum, the XOR of every byte before it;
+//!   after it only spaces and a `;` comment may follow.
+//! - A line whose first character is `$` is a [`SystemLine`]; `$J=` a jog.
 //! - `?`, `!`, `~` and Ctrl-X are [`Realtime`] wherever they appear.
 //!
-//! Errors carry Grbl's numbers (see [`ErrorKind`]) and the column of the
-//! offending character.
+//! Errors carry Grbl's numbers (see [`ErrorKind`]) and, where the parser
+//! finds them, the column of the offending character.
 
+mod block;
 mod error;
-mod line;
 mod number;
 mod parser;
 mod status;
@@ -39,10 +43,11 @@ mod words;
 mod tests;
 
 pub use error::{Error, ErrorKind, MIN_FEED};
-pub use line::{
-    AxisWord, CardLine, Command, Distance, Input, Line, Plane, Realtime, Units, AXIS_WORDS,
+pub use block::{
+    group, word, AxisCommand, AxisWord, Block, CardLine, Coolant, Distance, FeedMode, Flow, Input,
+    MotionMode, NonModal, Plane, Realtime, Spindle, TautCode, ToolLength, Units, AXIS_WORDS,
 };
-pub use number::parse_milli;
+pub use number::{parse_milli, NANO_LIMIT};
 pub use parser::{Parser, Read, MAX_LINE};
 pub use status::{Extra, Overrides, Refresh, State, Status, OVERRIDE_BYTES};
 pub use system::{Restore, SystemLine, SystemText, SYSTEM_TEXT};

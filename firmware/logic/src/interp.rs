@@ -1,70 +1,218 @@
-//! The G-code interpreter, Grbl's `gc_execute_line`: the modal state
-//! (distance mode, motion mode, feed rate, the commanded position) and what
-//! a parsed [`Line`] asks of the machine.
+//! The G-code executor, Grbl's `gc_execute_line` after the words are
+//! gathered: step 3 checks a [`Block`] against the modal state in
+//! `gcode.c`'s order (`gcode.c` lines 347–845), step 4 takes the new state
+//! and leaves the line's actions — pen, dwell, moves, program flow — in
+//! its order (lines 846–1113), which [`Interpreter::run`] then carries
+//! out against a [`MachineIo`], waiting where the machine must: for room
+//! in the planner, for the motion before to end, for a dwell's time.
+//! The firmware's console and the host's job-time estimate drive the same
+//! executor, so there is one set of rules.
 //!
-//! Pure and two-step: [`Interpreter::plan`] checks a line against the modal
-//! state, the machine's figures and what the machine allows now, and
-//! returns the [`Order`] with the modal state it leaves; the caller carries
-//! the order out and only then [`Interpreter::commit`]s. So a line that
-//! fails — or waits for planner room and is planned again — changes no
-//! modal state: `G91 G1 X1` without a feed rate is refused and leaves the
-//! interpreter in `G90`/`G0` as it was.
+//! A line is checked whole before anything happens: a refused line
+//! changes neither the modal state nor the position. Positions are
+//! machine coordinates kept exactly ([`Exact`]: the words as written,
+//! added up), offsets the work coordinate systems `G54`–`G59` (kept by
+//! the machine, [`MachineIo::coord`]), `G92` and `G43.1`; soft limits and
+//! reach are checked on the machine position, so no offset moves the
+//! travel. Steps are rounded once, from the absolute target.
 //!
-//! Arcs (`G2`/`G3`) are checked whole before anything moves — the end on
-//! the circle, a radius that reaches, the whole path inside the soft limits
-//! and the kinematics' reach — and handed over as an [`Arc`] whose chords
-//! the caller queues one by one.
+//! Where taut differs from Grbl, and why, is in `docs/console.md`.
+
+pub mod coords;
+pub mod estimate;
+mod run;
+mod state;
+
+#[cfg(test)]
+mod tests;
+
+pub use coords::{CoordTable, Exact, COORD_SETS, G28, G30};
+pub use state::ParserState;
 
 use crate::arc::{self, Arc, ArcError, Circle, Sweep};
+use crate::axis::AXES;
 use crate::config::MachineConfig;
-use crate::gcode::{AxisWord, Command, Distance, ErrorKind, Line, Plane, Units, MIN_FEED};
+use crate::gcode::{
+    group, word, AxisCommand, AxisWord, Block, Distance, ErrorKind, FeedMode, Flow, MotionMode,
+    NonModal, Plane, Spindle, TautCode, ToolLength, Units, MIN_FEED,
+};
 use crate::kinematics::{Kinematics, Position, Segmenter, Steps};
 use crate::planner::Feed;
-use crate::units::Milli;
+use crate::units::{div_round, Milli};
 
-/// What a line asks of the machine.
+/// What the machine allows the console now.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Allowed {
+    /// No job owns the motion: moves, drivers, offsets and the pen may
+    /// change.
+    pub motion: bool,
+    /// `$C`: lines are checked and their state taken; nothing moves.
+    pub checking: bool,
+}
+
+impl Allowed {
+    /// Everything (the host's tools).
+    pub const ALL: Allowed = Allowed {
+        motion: true,
+        checking: false,
+    };
+}
+
+/// What a line's checks and actions need to know of the machine. Passed
+/// by reference (the AVR backend garbles arguments passed on the stack).
+pub struct Env<'a, K: Kinematics> {
+    pub kin: &'a K,
+    pub cfg: &'a MachineConfig,
+    pub allowed: Allowed,
+}
+
+/// What the executor waits for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wait {
+    /// Room in the planner, or the motion before to end.
+    Motion,
+    /// This many milliseconds (a dwell, the pen settling, pacing).
+    Ms(u16),
+    /// Nothing: a piece of a path was queued, the next comes at the
+    /// next call (other tasks run between).
+    Again,
+}
+
+/// How far [`Interpreter::run`] got.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Progress {
+    /// The line's actions are all done or queued: answer `ok`.
+    Done,
+    Wait(Wait),
+}
+
+/// The machine the executor drives: the firmware's motion, pen and
+/// drivers, or the host's planner and clock.
+pub trait MachineIo {
+    /// Grbl's coordinate data (`settings_read_coord_data`): `G54`…`G59`
+    /// as 0…5, then [`G28`] and [`G30`]; machine coordinates.
+    fn coord(&self, index: u8) -> Exact;
+    /// Keeps coordinate data (`settings_write_coord_data`).
+    fn set_coord(&mut self, index: u8, value: &Exact);
+    /// Whether a move may be queued now (`piece`: one piece of a path):
+    /// `None`, or what to wait for.
+    fn room(&mut self, piece: bool) -> Option<Wait>;
+    /// Queue a move to the absolute motor `steps`; false when the planner
+    /// is full.
+    fn queue(&mut self, steps: &Steps, feed: Feed) -> bool;
+    /// Every queued move is done.
+    fn idle(&mut self) -> bool;
+    /// The pen servo to `deg`; true if it moves (motion then waits for it
+    /// to settle).
+    fn pen(&mut self, deg: u8) -> bool;
+    /// Every driver on or off.
+    fn drivers(&mut self, on: bool);
+    /// `M0`: hold until `~` (or the green button).
+    fn pause(&mut self);
+    /// `M114`: the executed position.
+    fn report_position(&mut self);
+    /// `M2`/`M30` done: `[MSG:Pgm End]`.
+    fn program_end(&mut self);
+    /// A millisecond clock (wrapping).
+    fn millis(&self) -> u32;
+}
+
+/// The modal state (Grbl's `gc_modal_t`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Modal {
+    motion: MotionMode,
+    plane: Plane,
+    distance: Distance,
+    feed_mode: FeedMode,
+    units: Units,
+    /// `G54`…`G59` as 0…5.
+    coord: u8,
+    spindle: Spindle,
+    /// [`MIST`] and [`FLOOD`]: `M7`, `M8`, both, or none (`M9`).
+    coolant: u8,
+    tool_length: ToolLength,
+}
+
+const MIST: u8 = 1;
+const FLOOD: u8 = 2;
+
+impl Modal {
+    /// Grbl's power-on modes: `G0 G54 G17 G21 G90 G94 M5 M9`.
+    const fn new() -> Modal {
+        Modal {
+            motion: MotionMode::Seek,
+            plane: Plane::Xy,
+            distance: Distance::Absolute,
+            feed_mode: FeedMode::PerMinute,
+            units: Units::Mm,
+            coord: 0,
+            spindle: Spindle::Off,
+            coolant: 0,
+            tool_length: ToolLength::Cancel,
+        }
+    }
+}
+
+/// The actions of an accepted line still to do, in Grbl's order (bits
+/// of [`Run::todo`]).
+mod todo {
+    /// The pen from `M3`/`M4`/`M5` or `M300` (Grbl's spindle, `[7]`).
+    pub const PEN: u16 = 1 << 0;
+    /// `M17`.
+    pub const DRIVERS_ON: u16 = 1 << 1;
+    /// `G4` (`[10]`).
+    pub const DWELL: u16 = 1 << 2;
+    /// A plotter's pen from a `Z` word, before the line's moves.
+    pub const PEN_Z: u16 = 1 << 3;
+    /// Straight moves to `legs[0]`, `legs[1]` (`[19]` `G28`/`G30`, `[20]`).
+    pub const LEG_0: u16 = 1 << 4;
+    pub const LEG_1: u16 = 1 << 5;
+    /// The pieces of `path` (an arc, or a leg on a machine that is not
+    /// linear).
+    pub const PATH: u16 = 1 << 6;
+    /// `M0` (`[21]`).
+    pub const PAUSE: u16 = 1 << 7;
+    /// `M2`, `M30` (`[21]`).
+    pub const END: u16 = 1 << 8;
+    /// `M18`, `M84`.
+    pub const DRIVERS_OFF: u16 = 1 << 9;
+    /// `M400`.
+    pub const WAIT: u16 = 1 << 10;
+    /// `M114`.
+    pub const REPORT: u16 = 1 << 11;
+}
+
+/// An accepted line's actions.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Order {
-    /// Nothing but modal state (`G91`, `F100`, a blank line).
-    None,
-    /// Move to these absolute motor steps.
-    Move {
-        steps: Steps,
-        feed: Feed,
-    },
-    /// Move along these pieces (positions in G-code coordinates, each
-    /// converted with [`Kinematics::inverse`], which cannot fail for them).
-    Path {
-        path: Path,
-        feed: Feed,
-    },
-    /// Wait this long once motion is done.
-    Dwell {
-        ms: u32,
-    },
-    /// The pen servo to this angle, degrees, once motion is done; motion
-    /// then waits `ms` for it to get there.
-    Pen {
-        deg: u8,
-        ms: u16,
-    },
-    /// Hold once motion is done, until `~` or the green button (`M0`).
-    Pause,
-    /// Home these axes (bits) once motion is done.
-    Home {
-        axes: u8,
-    },
-    /// Take these steps as the position (once motion is done).
-    SetPosition {
-        steps: Steps,
-    },
-    /// Switch every driver on or off (off once motion is done).
-    Drivers {
-        on: bool,
-    },
-    /// Answer once motion is done.
-    WaitIdle,
-    ReportPosition,
+struct Run {
+    todo: u16,
+    /// Angles of `PEN` and `PEN_Z`.
+    pen: u8,
+    pen_z: u8,
+    dwell_ms: u32,
+    /// Where the moves go (machine coordinates), and from where the next
+    /// one starts.
+    legs: [Exact; 2],
+    from: Exact,
+    feed: Feed,
+    /// The line's path piece by piece: an arc (its last piece on the
+    /// exact target of the last leg), or a straight leg's pieces.
+    path: Option<Path>,
+}
+
+impl Run {
+    const fn new() -> Run {
+        Run {
+            todo: 0,
+            pen: 0,
+            pen_z: 0,
+            dwell_ms: 0,
+            legs: [[0; AXES]; 2],
+            from: [0; AXES],
+            feed: Feed::Rapid,
+            path: None,
+        }
+    }
 }
 
 /// Longest piece of a straight move on a machine whose kinematics are
@@ -91,81 +239,29 @@ impl Iterator for Path {
     }
 }
 
-/// What the machine allows the console now.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Allowed {
-    /// No job owns the motion: moves, drivers and `G92` may run.
-    pub motion: bool,
-    /// The position is known (not lost by a stop at once during motion).
-    pub position_known: bool,
-}
-
-/// The motion mode: what a line of bare axis words does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Motion {
-    Rapid,
-    Linear,
-    ArcCw,
-    ArcCcw,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Modal {
-    distance: Distance,
-    units: Units,
-    motion: Motion,
-    plane: Plane,
-    feed: Option<Milli>,
-    /// Commanded position in milli-units (G-code coordinates).
-    target: Position,
-}
-
-/// The modal state as `$G` reports it: `[GC:` this `]`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ParserState {
-    motion: u8,
-    plane: u8,
-    units: u8,
-    distance: u8,
-    spindle: u8,
-    /// Whole units per minute.
-    feed: i32,
-}
-
-impl ufmt::uDisplay for ParserState {
-    fn fmt<W: ufmt::uWrite + ?Sized>(
-        &self,
-        f: &mut ufmt::Formatter<'_, W>,
-    ) -> Result<(), W::Error> {
-        // The fixed words as flash text: literals would sit in the AVR's SRAM.
-        ufmt::uwrite!(
-            f,
-            "G{}{}{}{}{}{}{}{}{}{}{}",
-            self.motion,
-            taut_progmem::text!(" G54 G"),
-            self.plane,
-            taut_progmem::text!(" G"),
-            self.units,
-            taut_progmem::text!(" G"),
-            self.distance,
-            taut_progmem::text!(" G94 M"),
-            self.spindle,
-            taut_progmem::text!(" M9 T0 F"),
-            self.feed
-        )?;
-        ufmt::uwrite!(f, "{}", taut_progmem::text!(" S0"))
-    }
-}
-
-/// A line checked and ready to carry out, with the modal state it leaves.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Planned {
-    pub order: Order,
-    next: Modal,
-}
-
+/// Grbl's parser state (`gc_state`) and the line being carried out.
 pub struct Interpreter {
     modal: Modal,
+    /// mm (or degrees) per minute; in `G93` the line's 1 / minutes; 0:
+    /// none yet.
+    feed: Milli,
+    /// `S`.
+    speed: Milli,
+    /// `T`.
+    tool: u8,
+    /// The programmed position, machine coordinates.
+    position: Exact,
+    /// The active work system's offset (`G54`…`G59`).
+    coord_system: Exact,
+    /// `G92`'s offset.
+    coord_offset: Exact,
+    /// `G43.1`'s offset of the `Z` channel.
+    tlo: i64,
+    run: Run,
+    /// The end of a dwell or of the pen's settling.
+    dwell_until: Option<u32>,
+    /// The work offset changed since the status report last asked.
+    wco_changed: bool,
 }
 
 impl Default for Interpreter {
@@ -174,362 +270,722 @@ impl Default for Interpreter {
     }
 }
 
+/// The channel the axis word `w` names on this machine.
+fn channel(words: &[u8; AXES], w: AxisWord) -> Option<usize> {
+    words.iter().position(|&l| l == w.letter())
+}
+
+/// The index of the `I J K` word of a plane axis `X Y Z`.
+fn ijk(w: AxisWord) -> usize {
+    w.index() - AxisWord::X.index()
+}
+
+/// The channel of a plotter's pen (its `Z`), or of the string-art
+/// machine's drill: where `G43.1` applies.
+const Z: usize = 2;
+
+/// A length in `units` as mm, rounded once (inches are exact to the
+/// nanometre up to five decimals).
+fn mm_exact(v: i64, units: Units) -> i64 {
+    match units {
+        Units::Mm => v,
+        Units::Inch => div_round(v.saturating_mul(254), 10),
+    }
+}
+
+/// A feed or length in thousandths of `units` as thousandths of a mm.
+fn mm_milli(v: Milli, units: Units) -> Milli {
+    match units {
+        Units::Mm => v,
+        Units::Inch => {
+            Milli(div_round(v.0 as i64 * 254, 10).clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+        }
+    }
+}
+
 impl Interpreter {
-    /// Grbl's power-on state: `G90 G0 G17`, no feed rate, at zero.
+    /// Grbl's power-on state: `G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0`,
+    /// at zero, no offsets; [`Interpreter::reset`] then loads `G54`.
     pub const fn new() -> Self {
         Interpreter {
-            modal: Modal {
-                distance: Distance::Absolute,
-                units: Units::Mm,
-                motion: Motion::Rapid,
-                plane: Plane::Xy,
-                feed: None,
-                target: [Milli::ZERO; crate::axis::AXES],
-            },
+            modal: Modal::new(),
+            feed: Milli::ZERO,
+            speed: Milli::ZERO,
+            tool: 0,
+            position: [0; AXES],
+            coord_system: [0; AXES],
+            coord_offset: [0; AXES],
+            tlo: 0,
+            run: Run::new(),
+            dwell_until: None,
+            wco_changed: true,
         }
     }
 
-    /// Grbl's `$G` report of the modal state, `pen_down` standing for the
-    /// spindle: `G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0` (no work offsets,
-    /// feed per minute, in the line's units).
-    pub fn parser_state(&self, pen_down: bool) -> ParserState {
-        let m = &self.modal;
-        ParserState {
-            motion: match m.motion {
-                Motion::Rapid => 0,
-                Motion::Linear => 1,
-                Motion::ArcCw => 2,
-                Motion::ArcCcw => 3,
-            },
-            plane: match m.plane {
-                Plane::Xy => 17,
-                Plane::Zx => 18,
-                Plane::Yz => 19,
-            },
-            units: match m.units {
-                Units::Inch => 20,
-                Units::Mm => 21,
-            },
-            distance: match m.distance {
-                Distance::Absolute => 90,
-                Distance::Relative => 91,
-            },
-            spindle: if pen_down { 3 } else { 5 },
-            // Kept in mm: whole units per minute of the line's unit.
-            feed: m.feed.map_or(0, |f| match m.units {
-                Units::Mm => f.0 / 1000,
-                Units::Inch => f.0 / 25_400,
-            }),
-        }
-    }
-
-    /// The commanded position.
-    pub fn target(&self) -> Position {
-        self.modal.target
-    }
-
-    /// The machine was moved or stopped by someone else (a job, a stop
-    /// that dropped queued moves): it is commanded where it is.
-    pub fn resync(&mut self, target: Position) {
-        self.modal.target = target;
-    }
-
-    /// Ctrl-X: the modal state back to its power-on values; the position
-    /// stays.
-    pub fn reset(&mut self) {
-        let target = self.modal.target;
+    /// Grbl's `gc_init` (power-on, Ctrl-X, leaving `$C`): the power-on
+    /// modes, `G54`'s offset loaded, `G92` and `G43.1` cleared, the line
+    /// being carried out dropped; the position stays.
+    pub fn reset(&mut self, io: &impl MachineIo) {
+        let position = self.position;
         *self = Interpreter::new();
-        self.modal.target = target;
+        self.position = position;
+        self.coord_system = io.coord(0);
     }
 
-    /// Check `line` and work out its order; the modal state is unchanged
-    /// until [`Interpreter::commit`]. Never inlined: its temporaries (an
-    /// arc's) stay out of the caller's frame on the AVR's small stack.
+    /// The programmed position (machine coordinates, thousandths).
+    pub fn target(&self) -> Position {
+        coords::milli(&self.position)
+    }
+
+    /// The programmed position, exactly.
+    pub fn position(&self) -> Exact {
+        self.position
+    }
+
+    /// The machine was moved or stopped by someone else (homing, a job, a
+    /// stop that dropped queued moves): it is programmed where it stands,
+    /// on the channels in `channels` (bits; a plotter's pen channel keeps
+    /// its programmed `Z`). The line being carried out is dropped.
+    pub fn resync(&mut self, at: &Position, channels: u8) {
+        let at = coords::exact(at);
+        for (i, p) in self.position.iter_mut().enumerate() {
+            if channels >> i & 1 != 0 {
+                *p = at[i];
+            }
+        }
+        self.run = Run::new();
+        self.dwell_until = None;
+    }
+
+    /// The work coordinate offset of each channel (Grbl's `WCO`: the work
+    /// system's, `G92`'s and the tool length's), thousandths.
+    pub fn wco(&self) -> Position {
+        let mut wco = [0; AXES];
+        for (i, w) in wco.iter_mut().enumerate() {
+            *w = self.coord_system[i] + self.coord_offset[i] + if i == Z { self.tlo } else { 0 };
+        }
+        coords::milli(&wco)
+    }
+
+    /// Whether the work offset changed since the last call (Grbl's
+    /// `system_flag_wco_change`: the next status report carries `WCO:`).
+    pub fn take_wco_changed(&mut self) -> bool {
+        core::mem::take(&mut self.wco_changed)
+    }
+
+    /// `G92`'s offset and the tool length offset, for `$#`.
+    pub fn offsets(&self) -> (Position, Milli) {
+        let tlo = coords::milli(&[self.tlo, 0, 0])[0];
+        (coords::milli(&self.coord_offset), tlo)
+    }
+
+    /// Whether the accepted line still has actions to carry out.
+    pub fn busy(&self) -> bool {
+        self.run.todo != 0
+    }
+
+    /// The accepted line's motion was dropped (a jog cancel, a pulled
+    /// card): its other actions too.
+    pub fn drop_line(&mut self) {
+        self.run = Run::new();
+        self.dwell_until = None;
+    }
+
+    /// Checks `block` (a jog's if `jog`) against the modal state in
+    /// Grbl's order and, if it passes, takes the state it leaves and its
+    /// actions (carried out by [`Interpreter::run`]). A refused line
+    /// changes nothing. Never inlined: its temporaries (an arc's) stay
+    /// out of the caller's frame on the AVR's small stack.
     #[inline(never)]
-    pub fn plan(
-        &self,
-        line: &Line,
-        kin: &impl Kinematics,
-        cfg: &MachineConfig,
-        allowed: Allowed,
-    ) -> Result<Planned, ErrorKind> {
-        let mut next = self.modal;
-        let has_axes = line.has_axes();
-        let moves = has_axes
-            || matches!(
-                line.command,
-                Command::EnableDrivers
-                    | Command::DisableDrivers
-                    | Command::SetPosition
-                    | Command::Home
-            );
-        if moves && !allowed.motion {
+    pub fn accept<K: Kinematics>(
+        &mut self,
+        b: &Block,
+        jog: bool,
+        env: &Env<K>,
+        io: &mut impl MachineIo,
+    ) -> Result<(), ErrorKind> {
+        let (kin, cfg) = (env.kin, env.cfg);
+        let plotter = !cfg.machine.is_string_art();
+        let names = kin.words();
+        if !env.allowed.motion && moves(b) {
             return Err(ErrorKind::JobOwnsMotion);
         }
-        // A word of no channel of this machine (`Y` on the string-art
-        // machine) is refused as Grbl refuses a letter it does not know.
-        let words = kin.words();
-        if AxisWord::ALL
-            .iter()
-            .any(|w| line.axis(*w).is_some() && !words.contains(&w.letter()))
+        if b.has(group::TAUT) && b.taut == TautCode::Servo {
+            if !plotter {
+                return Err(ErrorKind::UnsupportedCommand);
+            }
+            if !b.has_word(word::S) {
+                return Err(ErrorKind::ValueWordMissing);
+            }
+        }
+        // The block's modes: the state's, with the line's changes
+        // (`gc_block.modal`).
+        let mut m = self.modal;
+        if jog {
+            m.motion = MotionMode::Linear;
+            m.feed_mode = FeedMode::PerMinute;
+        }
+        if b.has(group::MOTION) {
+            m.motion = b.motion;
+        }
+        if b.has(group::PLANE) {
+            m.plane = b.plane;
+        }
+        if b.has(group::DISTANCE) {
+            m.distance = b.distance;
+        }
+        if b.has(group::FEED_MODE) && !jog {
+            m.feed_mode = b.feed_mode;
+        }
+        if b.has(group::UNITS) {
+            m.units = b.units;
+        }
+        if b.has(group::TOOL_LENGTH) {
+            m.tool_length = b.tool_length;
+        }
+        if b.has(group::COORD) {
+            m.coord = b.coord;
+        }
+        // The axis words by channel, in mm ([12]); a letter of no channel
+        // is one Grbl does not know.
+        let mut axes: Exact = [0; AXES];
+        let mut given = 0u8;
+        for w in AxisWord::ALL {
+            if let Some(v) = b.axis(w) {
+                let Some(i) = channel(&names, w) else {
+                    return Err(ErrorKind::UnsupportedCommand);
+                };
+                axes[i] = match w {
+                    AxisWord::C => v,
+                    _ => mm_exact(v, m.units),
+                };
+                given |= 1 << i;
+            }
+        }
+        // [0] Bare axis words move in the motion mode.
+        let mut axis_command = b.axis_command;
+        if given != 0 && axis_command == AxisCommand::None {
+            axis_command = AxisCommand::Motion;
+        }
+        let mut words = b.words;
+        // [2], [3] The feed rate.
+        let has_f = b.has_word(word::F);
+        let feed = if jog {
+            if !has_f {
+                return Err(ErrorKind::UndefinedFeedRate);
+            }
+            mm_milli(b.f, m.units)
+        } else if m.feed_mode == FeedMode::InverseTime {
+            let feed_move = !matches!(m.motion, MotionMode::None | MotionMode::Seek);
+            if axis_command == AxisCommand::Motion && feed_move && !has_f {
+                return Err(ErrorKind::UndefinedFeedRate);
+            }
+            if has_f {
+                b.f
+            } else {
+                Milli::ZERO
+            }
+        } else if has_f {
+            mm_milli(b.f, m.units)
+        } else if self.modal.feed_mode == FeedMode::PerMinute {
+            self.feed
+        } else {
+            // From G93 to G94: no feed until one is given.
+            Milli::ZERO
+        };
+        // [4], [5] Spindle speed and tool (Grbl takes `T` from every line,
+        // 0 when it has none). `M300`'s `S` is its angle.
+        let servo = b.has(group::TAUT) && b.taut == TautCode::Servo;
+        let speed = match b.has_word(word::S) && !servo {
+            true => b.s,
+            false => self.speed,
+        };
+        // [10] A dwell needs its time.
+        if b.non_modal == NonModal::Dwell {
+            if !b.has_word(word::P) {
+                return Err(ErrorKind::ValueWordMissing);
+            }
+            words &= !(1 << word::P);
+        }
+        // [11] The plane's channels.
+        let [w0, w1, _] = m.plane.axes();
+        let (axis_0, axis_1) = (channel(&names, w0), channel(&names, w1));
+        // [14] G43.1 takes Z alone.
+        if axis_command == AxisCommand::ToolLength
+            && m.tool_length == ToolLength::Dynamic
+            && b.words & word::AXES != AxisWord::Z.bit()
         {
-            return Err(ErrorKind::UnsupportedCommand);
+            return Err(ErrorKind::G43DynamicAxisError);
         }
-        if let Some(u) = line.units {
-            next.units = u;
+        // [15] Another work system's offset.
+        let mut block_coord = self.coord_system;
+        if m.coord != self.modal.coord {
+            block_coord = io.coord(m.coord);
         }
-        let feed = line.f.get().map(|f| mm(f, next.units));
-        if feed.is_some_and(|f| f.0 < MIN_FEED) {
+        // [19] Coordinate data, offsets, and where the axis words go.
+        let mut target = self.position;
+        let mut g10 = None;
+        let mut g92 = None;
+        let mut home = None;
+        let tlo_of = |i: usize| if i == Z { self.tlo } else { 0 };
+        match b.non_modal {
+            NonModal::SetCoordData => {
+                if given == 0 {
+                    return Err(ErrorKind::NoAxisWords);
+                }
+                if !b.has_word(word::P) && !b.has_word(word::L) {
+                    return Err(ErrorKind::ValueWordMissing);
+                }
+                let p = b.p.0 / 1000;
+                if p > 6 {
+                    return Err(ErrorKind::UnsupportedCoordSys);
+                }
+                if b.l != 20 && (b.l != 2 || b.has_word(word::R)) {
+                    return Err(ErrorKind::UnsupportedCommand);
+                }
+                words &= !(1 << word::L | 1 << word::P);
+                let index = match p {
+                    0 => m.coord,
+                    _ => p as u8 - 1,
+                };
+                let mut data = io.coord(index);
+                for i in (0..AXES).filter(|i| given >> i & 1 != 0) {
+                    data[i] = match b.l {
+                        20 => self.position[i] - self.coord_offset[i] - axes[i] - tlo_of(i),
+                        _ => axes[i],
+                    };
+                }
+                g10 = Some((index, data));
+            }
+            NonModal::SetCoordOffset => {
+                if given == 0 {
+                    return Err(ErrorKind::NoAxisWords);
+                }
+                let mut offset = self.coord_offset;
+                for i in (0..AXES).filter(|i| given >> i & 1 != 0) {
+                    offset[i] = self.position[i] - block_coord[i] - axes[i] - tlo_of(i);
+                }
+                g92 = Some(offset);
+            }
+            _ => {
+                if axis_command != AxisCommand::ToolLength {
+                    for i in (0..AXES).filter(|i| given >> i & 1 != 0) {
+                        target[i] = match (b.non_modal, m.distance) {
+                            (NonModal::AbsoluteOverride, _) => axes[i],
+                            (_, Distance::Absolute) => {
+                                axes[i] + block_coord[i] + self.coord_offset[i] + tlo_of(i)
+                            }
+                            (_, Distance::Relative) => axes[i] + self.position[i],
+                        };
+                    }
+                }
+                match b.non_modal {
+                    NonModal::GoHome0 | NonModal::GoHome1 => {
+                        let index = match b.non_modal {
+                            NonModal::GoHome0 => G28,
+                            _ => G30,
+                        };
+                        let mut to = io.coord(index);
+                        if given != 0 {
+                            // Only the named axes go home, the others stay.
+                            for i in (0..AXES).filter(|i| given >> i & 1 == 0) {
+                                to[i] = self.position[i];
+                            }
+                        } else {
+                            axis_command = AxisCommand::None;
+                        }
+                        home = Some(to);
+                    }
+                    NonModal::AbsoluteOverride
+                        if !matches!(m.motion, MotionMode::Seek | MotionMode::Linear) =>
+                    {
+                        return Err(ErrorKind::G53InvalidMotionMode);
+                    }
+                    _ => {}
+                }
+            }
+        }
+        // [20] Motion modes.
+        let mut arc = None;
+        if m.motion == MotionMode::None {
+            if given != 0 {
+                return Err(ErrorKind::AxisWordsExist);
+            }
+        } else if axis_command == AxisCommand::Motion {
+            if m.motion != MotionMode::Seek && feed.0 == 0 {
+                return Err(ErrorKind::UndefinedFeedRate);
+            }
+            match m.motion {
+                MotionMode::CwArc | MotionMode::CcwArc => {
+                    if given == 0 {
+                        return Err(ErrorKind::NoAxisWords);
+                    }
+                    let in_plane = |c: Option<usize>| c.is_some_and(|i| given >> i & 1 != 0);
+                    let (Some(a0), Some(a1)) = (axis_0, axis_1) else {
+                        return Err(ErrorKind::NoAxisWordsInPlane);
+                    };
+                    if !in_plane(axis_0) && !in_plane(axis_1) {
+                        return Err(ErrorKind::NoAxisWordsInPlane);
+                    }
+                    let clockwise = m.motion == MotionMode::CwArc;
+                    let sweep_plane = arc::Plane {
+                        axis_0: a0,
+                        axis_1: a1,
+                        linear: channel(&names, m.plane.axes()[2]),
+                    };
+                    let circle = if b.has_word(word::R) {
+                        words &= !(1 << word::R);
+                        if target == self.position {
+                            return Err(ErrorKind::InvalidTarget);
+                        }
+                        Some(mm_milli(b.r, m.units))
+                    } else {
+                        if !b.has_word(word::I + ijk(w0) as u8) && !b.has_word(word::I + ijk(w1) as u8)
+                        {
+                            return Err(ErrorKind::NoOffsetsInPlane);
+                        }
+                        words &= !word::IJK;
+                        None
+                    };
+                    let offsets = [
+                        mm_milli(b.ijk[ijk(w0)], m.units),
+                        mm_milli(b.ijk[ijk(w1)], m.units),
+                    ];
+                    arc = Some(self.arc(&target, sweep_plane, clockwise, circle, offsets, cfg)?);
+                }
+                MotionMode::Seek | MotionMode::Linear if given == 0 => {
+                    axis_command = AxisCommand::None;
+                }
+                _ => {}
+            }
+        }
+        // [0] Words no command used.
+        words &= match jog {
+            true => !(1 << word::N | 1 << word::F),
+            false => !(1 << word::N | 1 << word::F | 1 << word::S | 1 << word::T),
+        };
+        if axis_command != AxisCommand::None {
+            words &= !word::AXES;
+        }
+        if words != 0 {
+            return Err(ErrorKind::UnusedWords);
+        }
+        if jog {
+            let allowed = group::DISTANCE | group::UNITS | group::NON_MODAL;
+            let override_only = matches!(b.non_modal, NonModal::None | NonModal::AbsoluteOverride);
+            if b.groups & !allowed != 0 || !override_only {
+                return Err(ErrorKind::InvalidJogCommand);
+            }
+            // Grbl's jogging document requires an axis word.
+            if given == 0 {
+                return Err(ErrorKind::NoAxisWords);
+            }
+        }
+        // taut's own checks, after Grbl's: a feed too slow to plan, and
+        // every move inside the travel and the reach, in machine
+        // coordinates.
+        if has_f && m.feed_mode == FeedMode::PerMinute && feed.0 < MIN_FEED && feed.0 != 0 {
             return Err(ErrorKind::FeedTooLow);
         }
-        if let Some(d) = line.distance {
-            next.distance = d;
+        let motors = motor_channels(cfg);
+        let moving = axis_command == AxisCommand::Motion && m.motion != MotionMode::None;
+        let mut legs = [self.position; 2];
+        let mut count = 0;
+        if let Some(h) = home {
+            if axis_command != AxisCommand::None {
+                legs[0] = target;
+                count = 1;
+            }
+            legs[count] = h;
+            count += 1;
+        } else if moving || jog {
+            legs[0] = target;
+            count = 1;
         }
-        if feed.is_some() {
-            next.feed = feed;
+        let mut from = self.position;
+        for leg in &legs[..count] {
+            if let Some(a) = &arc {
+                check_arc(a, motors, kin, cfg)?;
+            } else {
+                check_leg(&from, leg, motors, kin, cfg)?;
+            }
+            from = *leg;
         }
-        let pen = !cfg.machine.is_string_art();
-        if let Some(p) = line.plane {
-            next.plane = p;
-        }
-        let order = match line.command {
-            Command::Rapid
-            | Command::Linear
-            | Command::ArcCw
-            | Command::ArcCcw
-            | Command::Empty => {
-                next.motion = match line.command {
-                    Command::Rapid => Motion::Rapid,
-                    Command::Linear => Motion::Linear,
-                    Command::ArcCw => Motion::ArcCw,
-                    Command::ArcCcw => Motion::ArcCcw,
-                    _ => next.motion,
+
+        // Step 4: the line is good. Its state, then its actions.
+        let mut run = Run::new();
+        let pen_deg = |down: bool| if down { cfg.pen.down_deg } else { cfg.pen.up_deg };
+        if jog {
+            run.feed = Feed::PerMinute(feed);
+        } else {
+            self.feed = feed;
+            self.speed = speed;
+            self.tool = if b.has_word(word::T) { b.t } else { 0 };
+            // [7] The spindle: a plotter's pen.
+            if b.has(group::SPINDLE) {
+                self.modal.spindle = b.spindle;
+                if plotter {
+                    run.pen = pen_deg(b.spindle != Spindle::Off);
+                    run.todo |= todo::PEN;
+                }
+            }
+            if servo {
+                run.pen = (b.s.0.clamp(0, 180_000) / 1000) as u8;
+                run.todo |= todo::PEN;
+            }
+            // [8] Coolant: kept for `$G`.
+            if b.has(group::COOLANT) {
+                self.modal.coolant = match b.coolant {
+                    crate::gcode::Coolant::Mist => self.modal.coolant | MIST,
+                    crate::gcode::Coolant::Flood => self.modal.coolant | FLOOD,
+                    crate::gcode::Coolant::Off => 0,
                 };
-                let arc = matches!(next.motion, Motion::ArcCw | Motion::ArcCcw);
-                // `I J K R` only with an arc that moves (Grbl's error 36).
-                if line.has_arc_words() && !(arc && has_axes) {
-                    return Err(ErrorKind::UnusedValueWords);
+            }
+            if b.non_modal == NonModal::Dwell {
+                run.dwell_ms = dwell_ms(b.p, cfg);
+                run.todo |= todo::DWELL;
+            }
+            self.modal.plane = m.plane;
+            self.modal.units = m.units;
+            self.modal.feed_mode = m.feed_mode;
+            // [14] The tool length offset.
+            if axis_command == AxisCommand::ToolLength {
+                self.modal.tool_length = m.tool_length;
+                let tlo = match m.tool_length {
+                    ToolLength::Dynamic => axes[Z],
+                    ToolLength::Cancel => 0,
+                };
+                self.wco_changed |= tlo != self.tlo;
+                self.tlo = tlo;
+            }
+            // [15] The work system.
+            if m.coord != self.modal.coord {
+                self.modal.coord = m.coord;
+                self.coord_system = block_coord;
+                self.wco_changed = true;
+            }
+            self.modal.distance = m.distance;
+            // [19]
+            if let Some((index, data)) = g10 {
+                io.set_coord(index, &data);
+                if index == self.modal.coord {
+                    self.coord_system = data;
+                    self.wco_changed = true;
                 }
-                if !has_axes {
-                    return Ok(Planned {
-                        order: Order::None,
-                        next,
-                    });
+            }
+            match b.non_modal {
+                NonModal::SetHome0 => io.set_coord(G28, &self.position),
+                NonModal::SetHome1 => io.set_coord(G30, &self.position),
+                NonModal::ResetCoordOffset => {
+                    self.coord_offset = [0; AXES];
+                    self.wco_changed = true;
                 }
-                // A plotter's Z lifts (above 0) or lowers its pen and
-                // drives no motor.
-                if let Some(z) = line.axis(AxisWord::Z).filter(|_| pen) {
-                    let alone = AxisWord::ALL
-                        .iter()
-                        .all(|w| *w == AxisWord::Z || line.axis(*w).is_none());
-                    if !alone {
-                        return Err(ErrorKind::PenWithMove);
+                _ => {}
+            }
+            if let Some(offset) = g92 {
+                self.coord_offset = offset;
+                self.wco_changed = true;
+            }
+            // [20]
+            self.modal.motion = m.motion;
+        }
+        if count > 0 {
+            if !jog {
+                run.feed = match (home.is_some() || m.motion == MotionMode::Seek, m.feed_mode) {
+                    (true, _) => Feed::Rapid,
+                    (false, FeedMode::PerMinute) => Feed::PerMinute(feed),
+                    (false, FeedMode::InverseTime) => {
+                        let length = match &arc {
+                            Some(a) => a.length(),
+                            None => length_um(&self.position, &legs[0]),
+                        };
+                        inverse_time(feed, length)
                     }
-                    let up = z.0 > 0;
-                    return Ok(Planned {
-                        order: pen_order(cfg, if up { cfg.pen.up_deg } else { cfg.pen.down_deg }),
-                        next,
-                    });
-                }
-                let feed = match (next.motion, next.feed) {
-                    (Motion::Rapid, _) => Feed::Rapid,
-                    (_, Some(f)) => Feed::PerMinute(f),
-                    (_, None) => return Err(ErrorKind::UndefinedFeedRate),
                 };
-                if !allowed.position_known {
-                    return Err(ErrorKind::Locked);
-                }
-                next.target = self.destination(line, kin, &next);
-                check_travel(cfg, &next.target, &next.target)?;
-                if arc {
-                    return self.arc(line, kin, cfg, next, feed);
-                }
-                if !kin.is_linear() {
-                    return self.pieces(feed, kin, next);
-                }
-                // Converted once from the absolute target: relative moves
-                // never drift.
-                let steps = kin
-                    .inverse(&next.target)
-                    .map_err(|_| ErrorKind::InvalidTarget)?;
-                Order::Move { steps, feed }
             }
-            // `P` is held in thousandths: of seconds, or of milliseconds.
-            Command::Dwell => Order::Dwell {
-                ms: line.p.get().map_or(0, |p| match cfg.dwell_p_ms {
-                    true => (p.0.max(0) as u32 + 500) / 1000,
-                    false => p.0.max(0) as u32,
-                }),
-            },
-            Command::PenDown | Command::PenUp | Command::Servo if !pen => {
-                return Err(ErrorKind::UnsupportedCommand)
+            // A plotter's Z is its pen, set before the moves.
+            if plotter && given >> Z & 1 != 0 {
+                let work_z = legs[count - 1][Z] - self.work_offset(Z);
+                run.pen_z = pen_deg(work_z <= 0);
+                run.todo |= todo::PEN_Z;
             }
-            Command::PenUp => pen_order(cfg, cfg.pen.up_deg),
-            Command::PenDown | Command::Servo => {
-                let deg = match line.s.get() {
-                    Some(s) => (s.0.clamp(0, 180_000) / 1000) as u8,
-                    None => cfg.pen.down_deg,
-                };
-                pen_order(cfg, deg)
+            run.legs = legs;
+            run.from = self.position;
+            run.todo |= match count {
+                1 => todo::LEG_0,
+                _ => todo::LEG_0 | todo::LEG_1,
+            };
+            if let Some(a) = arc {
+                run.path = Some(Path::Arc(a));
+                run.todo = run.todo & !todo::LEG_0 | todo::PATH;
             }
-            Command::Pause => Order::Pause,
-            Command::Home if cfg.homing.axes == 0 => return Err(ErrorKind::NoHoming),
-            Command::Home => Order::Home {
-                axes: cfg.homing.axes,
-            },
-            Command::SetPosition => {
-                for (i, w) in kin.words().iter().enumerate() {
-                    if let Some(v) = value(line, *w, next.units) {
-                        next.target[i] = v;
+            self.position = legs[count - 1];
+        }
+        if !jog {
+            // [21] Program flow.
+            if b.has(group::STOPPING) {
+                match b.flow {
+                    Flow::Pause => run.todo |= todo::PAUSE,
+                    Flow::OptionalStop => {}
+                    Flow::End | Flow::EndRewind => {
+                        self.program_end(io);
+                        run.todo |= todo::END;
                     }
                 }
-                let steps = kin
-                    .inverse(&next.target)
-                    .map_err(|_| ErrorKind::InvalidTarget)?;
-                Order::SetPosition { steps }
             }
-            Command::EnableDrivers => Order::Drivers { on: true },
-            Command::DisableDrivers => Order::Drivers { on: false },
-            Command::WaitIdle => Order::WaitIdle,
-            Command::ReportPosition => Order::ReportPosition,
-        };
-        Ok(Planned { order, next })
-    }
-
-    /// A straight move cut into pieces, if the machine reaches every one.
-    /// Out of line: its pieces stay off the stack of the other moves.
-    #[inline(never)]
-    fn pieces(&self, feed: Feed, kin: &impl Kinematics, next: Modal) -> Result<Planned, ErrorKind> {
-        let line = Segmenter::new(kin, self.modal.target, &next.target, SEGMENT_UM);
-        // Called for the machines that are not linear only.
-        match kin.reaches_line(&line.start(), &line.end()) {
-            true => Ok(Planned {
-                order: Order::Path {
-                    path: Path::Line(line),
-                    feed,
-                },
-                next,
-            }),
-            false => Err(ErrorKind::InvalidTarget),
+            if b.has(group::TAUT) {
+                run.todo |= match b.taut {
+                    TautCode::EnableDrivers => todo::DRIVERS_ON,
+                    TautCode::DisableDrivers => todo::DRIVERS_OFF,
+                    TautCode::ReportPosition => todo::REPORT,
+                    TautCode::WaitIdle => todo::WAIT,
+                    TautCode::Servo => 0,
+                };
+            }
         }
+        // Checked, not carried out: only reads are answered.
+        if env.allowed.checking {
+            run.todo &= todo::REPORT;
+        }
+        self.run = run;
+        self.dwell_until = None;
+        Ok(())
     }
 
-    /// The order of `planned` was carried out: take the modal state it
-    /// leaves.
-    pub fn commit(&mut self, planned: &Planned) {
-        self.modal = planned.next;
+    /// The work offset of channel `i`, millionths.
+    fn work_offset(&self, i: usize) -> i64 {
+        self.coord_system[i] + self.coord_offset[i] + if i == Z { self.tlo } else { 0 }
     }
 
-    /// A jog's (`$J=`, planned as the `G1` the parser made of it) was
-    /// carried out: its `G20`/`G21`, `G90`/`G91` and feed were its own, so
-    /// only the position is taken (Grbl's jogging.md).
-    pub fn commit_jog(&mut self, planned: &Planned) {
-        self.modal.target = planned.next.target;
+    /// `M2`/`M30`: the modes LinuxCNC resets at a program's end (`gcode.c`
+    /// line 1077): `G1 G17 G90 G94 G54 M5 M9`; `F`, `S`, units and
+    /// offsets stay.
+    fn program_end(&mut self, io: &impl MachineIo) {
+        let m = &mut self.modal;
+        m.motion = MotionMode::Linear;
+        m.plane = Plane::Xy;
+        m.distance = Distance::Absolute;
+        m.feed_mode = FeedMode::PerMinute;
+        m.coord = 0;
+        m.spindle = Spindle::Off;
+        m.coolant = 0;
+        self.coord_system = io.coord(0);
+        self.wco_changed = true;
     }
 
-    /// The arc `line` asks for, from the commanded position to
-    /// `next.target` in `next.plane`, checked whole. Out of line, and
-    /// returning the whole order: the arc is built once, where the caller
-    /// takes it (the AVR's stack is small).
+    /// The arc from the programmed position to `target`, checked: `R`'s
+    /// circle (`radius`) or the centre's `offsets`. Out of line: the arc
+    /// is built once, where the caller keeps it (the AVR's stack is
+    /// small).
     #[inline(never)]
     fn arc(
         &self,
-        line: &Line,
-        kin: &impl Kinematics,
+        target: &Exact,
+        plane: arc::Plane,
+        clockwise: bool,
+        radius: Option<Milli>,
+        offsets: [Milli; 2],
         cfg: &MachineConfig,
-        next: Modal,
-        feed: Feed,
-    ) -> Result<Planned, ErrorKind> {
-        let [w0, w1, w2] = next.plane.axes();
-        let index = |w: AxisWord| kin.words().iter().position(|l| *l == w.letter());
-        let (Some(axis_0), Some(axis_1)) = (index(w0), index(w1)) else {
-            return Err(ErrorKind::ArcNoAxisInPlane);
-        };
-        if line.axis(w0).is_none() && line.axis(w1).is_none() {
-            return Err(ErrorKind::ArcNoAxisInPlane);
-        }
-        let plane = arc::Plane {
-            axis_0,
-            axis_1,
-            linear: index(w2),
-        };
-        // Built in place: copies of the ends beside it would be 32 B more
-        // under the arc's checks.
+    ) -> Result<Arc, ErrorKind> {
         let sweep = Sweep {
-            start: self.modal.target,
-            end: next.target,
+            start: coords::milli(&self.position),
+            end: coords::milli(target),
             plane,
-            clockwise: next.motion == Motion::ArcCw,
+            clockwise,
             tolerance: Milli(cfg.arc_tolerance_um.min(i32::MAX as u32) as i32),
         };
-        let circle = match line.r.get().map(|r| mm(r, next.units)) {
-            Some(_)
-                if [axis_0, axis_1]
-                    .iter()
-                    .all(|&a| sweep.start[a] == sweep.end[a]) =>
-            {
-                return Err(ErrorKind::InvalidTarget);
-            }
+        let circle = match radius {
             Some(r) => Circle::from_radius(&sweep, r),
-            None => {
-                // `I J K` are the offsets along X Y Z.
-                let offset = |w: AxisWord| {
-                    let o = line.offsets[w.index() - AxisWord::X.index()].get();
-                    o.map(|o| mm(o, next.units))
-                };
-                if offset(w0).is_none() && offset(w1).is_none() {
-                    return Err(ErrorKind::ArcNoOffsetInPlane);
-                }
-                let o = [
-                    offset(w0).unwrap_or(Milli::ZERO),
-                    offset(w1).unwrap_or(Milli::ZERO),
-                ];
-                Circle::from_centre(&sweep, o)
-            }
+            None => Circle::from_centre(&sweep, offsets),
         }
         .map_err(|e| match e {
             ArcError::EndOffCircle => ErrorKind::InvalidTarget,
-            ArcError::RadiusTooSmall => ErrorKind::ArcRadiusInvalid,
+            ArcError::RadiusTooSmall => ErrorKind::ArcRadiusError,
         })?;
-        // One arc on this frame, checked in place, then moved out.
-        let arc = Arc::new(&sweep, &circle);
-        check_arc(&arc, kin, cfg)?;
-        if !kin.is_linear() && !every_chord_reached(&arc, kin) {
-            return Err(ErrorKind::InvalidTarget);
-        }
-        Ok(Planned {
-            order: Order::Path {
-                path: Path::Arc(arc),
-                feed,
-            },
-            next,
-        })
+        Ok(Arc::new(&sweep, &circle))
     }
+}
 
-    /// Where the axis words of `line` take the commanded position.
-    fn destination(&self, line: &Line, kin: &impl Kinematics, next: &Modal) -> Position {
-        let mut target = self.modal.target;
-        for (i, w) in kin.words().iter().enumerate() {
-            if let Some(v) = value(line, *w, next.units) {
-                target[i] = match next.distance {
-                    Distance::Absolute => v,
-                    Distance::Relative => Milli(target[i].0.saturating_add(v.0)),
-                };
-            }
-        }
-        target
+/// Whether the line would move the machine or change what a job owns
+/// (refused while a string-art job runs).
+fn moves(b: &Block) -> bool {
+    b.has_axes()
+        || b.has(group::TAUT)
+            && matches!(b.taut, TautCode::EnableDrivers | TautCode::DisableDrivers | TautCode::Servo)
+        || b.has(group::SPINDLE)
+        || b.has(group::STOPPING) && b.flow != Flow::OptionalStop
+        || !matches!(b.non_modal, NonModal::None | NonModal::Dwell)
+}
+
+/// The channels motors drive (bits): a plotter's `Z` is its pen.
+pub fn motor_channels(cfg: &MachineConfig) -> u8 {
+    match cfg.machine.is_string_art() {
+        true => 0b111,
+        false => 0b011,
+    }
+}
+
+/// `G4 P`: seconds (Grbl), or milliseconds where `dwell_p_ms` says so
+/// (the plotters: Marlin's and the unicorn extension's `G4 P150`).
+fn dwell_ms(p: Milli, cfg: &MachineConfig) -> u32 {
+    let p = p.0.max(0) as u32;
+    match cfg.dwell_p_ms {
+        true => (p + 500) / 1000,
+        false => p,
+    }
+}
+
+/// The straight length from `a` to `b`, thousandths.
+fn length_um(a: &Exact, b: &Exact) -> f32 {
+    let d = coords::milli(&core::array::from_fn(|i| b[i] - a[i]));
+    let sq: f32 = d.iter().map(|v| v.0 as f32 * v.0 as f32).sum();
+    crate::fmath::sqrt(sq)
+}
+
+/// `G93`'s feed: `F` moves a line in 1 / F minutes, so its speed is its
+/// length times `F` (never below what the planner takes).
+fn inverse_time(f: Milli, length_um: f32) -> Feed {
+    let per_min = f.0 as f32 / 1000.0 * length_um;
+    Feed::PerMinute(Milli((per_min as i32).max(MIN_FEED)))
+}
+
+/// Refuses a straight move from `from` to `to` that leaves the soft
+/// limits or the machine's reach.
+fn check_leg(
+    from: &Exact,
+    to: &Exact,
+    motors: u8,
+    kin: &impl Kinematics,
+    cfg: &MachineConfig,
+) -> Result<(), ErrorKind> {
+    check_travel(cfg, to, to, motors)?;
+    if kin.is_linear() {
+        return motor_steps(to, motors, kin, cfg).map(drop);
+    }
+    let (a, b) = (motor_milli(from, motors), motor_milli(to, motors));
+    match kin.reaches_line(&a, &b) {
+        true => Ok(()),
+        false => Err(ErrorKind::InvalidTarget),
     }
 }
 
 /// Refuses an arc that leaves the soft limits or the machine's reach.
 /// Out of line: the AVR's stack is small, the arc's caller deep.
 #[inline(never)]
-fn check_arc(arc: &Arc, kin: &impl Kinematics, cfg: &MachineConfig) -> Result<(), ErrorKind> {
+fn check_arc(
+    arc: &Arc,
+    motors: u8,
+    kin: &impl Kinematics,
+    cfg: &MachineConfig,
+) -> Result<(), ErrorKind> {
     let (lo, hi) = arc.bounds();
-    check_travel(cfg, &lo, &hi)?;
-    // A linear kinematics reaches the whole box if it reaches its
-    // corners; any other is asked for every chord end by the caller.
-    let reached = !kin.is_linear() || (kin.inverse(&lo).is_ok() && kin.inverse(&hi).is_ok());
+    check_travel(cfg, &coords::exact(&lo), &coords::exact(&hi), motors)?;
+    let reached = match kin.is_linear() {
+        // A linear kinematics reaches the whole box if it reaches its
+        // corners.
+        true => kin.inverse(&lo).is_ok() && kin.inverse(&hi).is_ok(),
+        false => every_chord_reached(arc, kin),
+    };
     match reached {
         true => Ok(()),
         false => Err(ErrorKind::InvalidTarget),
@@ -548,11 +1004,21 @@ fn every_chord_reached(arc: &Arc, kin: &impl Kinematics) -> bool {
     })
 }
 
-/// Refuses a path whose box `lo..=hi` leaves an axis's soft limits.
-fn check_travel(cfg: &MachineConfig, lo: &Position, hi: &Position) -> Result<(), ErrorKind> {
-    let outside = cfg.axes.iter().zip(lo.iter().zip(hi)).any(|(a, (l, h))| {
+/// Refuses a path whose box `lo..=hi` (machine coordinates) leaves a
+/// motor channel's soft limits.
+fn check_travel(
+    cfg: &MachineConfig,
+    lo: &Exact,
+    hi: &Exact,
+    motors: u8,
+) -> Result<(), ErrorKind> {
+    let outside = (0..AXES).any(|i| {
+        let a = &cfg.axes[i];
         let (min, max) = a.travel;
-        a.soft_limits && (*l < min || *h > max)
+        let milli = 1000;
+        motors >> i & 1 != 0
+            && a.soft_limits
+            && (lo[i] < min.0 as i64 * milli || hi[i] > max.0 as i64 * milli)
     });
     match outside {
         true => Err(ErrorKind::TravelExceeded),
@@ -560,36 +1026,39 @@ fn check_travel(cfg: &MachineConfig, lo: &Position, hi: &Position) -> Result<(),
     }
 }
 
-/// The value of the axis word named `letter`, if the line has one, in mm
-/// (or degrees: `C` is an angle in either unit).
-fn value(line: &Line, letter: u8, units: Units) -> Option<Milli> {
-    let v = AxisWord::ALL
-        .iter()
-        .find(|w| w.letter() == letter)
-        .and_then(|w| line.axis(*w))?;
-    Some(match letter {
-        b'C' => v,
-        _ => mm(v, units),
-    })
-}
-
-/// A length in `units` as mm, rounded once.
-fn mm(v: Milli, units: Units) -> Milli {
-    match units {
-        Units::Mm => v,
-        Units::Inch => Milli(crate::units::div_round(v.0 as i64 * 254, 10) as i32),
+/// `pos` in thousandths, the channels without a motor at 0.
+fn motor_milli(pos: &Exact, motors: u8) -> Position {
+    let mut p = coords::milli(pos);
+    for (i, v) in p.iter_mut().enumerate() {
+        if motors >> i & 1 == 0 {
+            *v = Milli::ZERO;
+        }
     }
+    p
 }
 
-/// The pen to `deg`, then its settle time.
-fn pen_order(cfg: &MachineConfig, deg: u8) -> Order {
-    Order::Pen {
-        deg,
-        ms: cfg.pen.settle_ms,
+/// The motors' steps for `pos`, rounded once: on a linear machine from
+/// the exact position, channel by channel; on the others through the
+/// kinematics (whose floats are far coarser than a µm).
+fn motor_steps(
+    pos: &Exact,
+    motors: u8,
+    kin: &impl Kinematics,
+    cfg: &MachineConfig,
+) -> Result<Steps, ErrorKind> {
+    if !kin.is_linear() {
+        return kin
+            .inverse(&motor_milli(pos, motors))
+            .map_err(|_| ErrorKind::InvalidTarget);
     }
+    let mut steps = [0; AXES];
+    for (i, s) in steps.iter_mut().enumerate() {
+        if motors >> i & 1 != 0 {
+            *s = cfg.axes[i]
+                .steps_per_unit
+                .steps_exact(pos[i])
+                .ok_or(ErrorKind::InvalidTarget)?;
+        }
+    }
+    Ok(steps)
 }
-
-pub mod estimate;
-
-#[cfg(test)]
-mod tests;

@@ -47,7 +47,7 @@ mod tests {
             let mut lines = 0;
             for b in t.bytes() {
                 match parser.push(b) {
-                    Some(Ok(Input::Line(_))) => lines += 1,
+                    Some(Ok(Input::Block(_))) => lines += 1,
                     Some(other) => panic!("$T{n}: {other:?}"),
                     None => {}
                 }

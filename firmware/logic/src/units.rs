@@ -82,6 +82,15 @@ impl StepsPerUnit {
         div_round(n, d) as i32
     }
 
+    /// The same from a target in millionths of the unit (nanometres),
+    /// as the programmed position keeps it: rounded once, half away from
+    /// zero; `None` when the count does not fit an `i32`.
+    pub fn steps_exact(self, target: i64) -> Option<i32> {
+        let n = target.checked_mul(self.num as i64)?;
+        let d = self.den as i64 * 1_000_000;
+        i32::try_from(div_round(n, d)).ok()
+    }
+
     /// The position of a step count, rounded to the nearest milli-unit.
     pub fn milli(self, steps: i32) -> Milli {
         let n = steps as i64 * self.den as i64 * Milli::SCALE as i64;

@@ -4,59 +4,74 @@
 
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
-/// What went wrong. The discriminant is the number printed after `error:`.
+/// What went wrong. The discriminant is the number printed after `error:`:
+/// Grbl's own (`doc/csv/error_codes_en_US.csv`) up to 38, taut's from 60.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum ErrorKind {
-    /// A word must start with a letter (`10`, `#`).
+    /// A word must start with a letter (`10`, `#`, `%`).
     ExpectedCommandLetter = 1,
-    /// A letter without a number, a stray sign or point, or an overflow.
+    /// A letter without a number, or a stray sign or point.
     BadNumberFormat = 2,
     /// A `$` line taut does not know.
     InvalidStatement = 3,
-    /// `F` or `P` below zero.
+    /// `F N P S T` below zero.
     NegativeValue = 4,
-    /// More than [`MAX_LINE`](super::MAX_LINE) characters.
+    /// `$H` on a machine with no axis set to home (Grbl's "setting
+    /// disabled").
+    NoHoming = 5,
+    /// A setting or a jog while the machine is not idle.
+    NotIdle = 8,
+    /// G-code while the position is unknown (alarm) or a jog runs:
+    /// Grbl's "G-code lock", lifted by `$X`, `$H` or the jog's end.
+    Locked = 9,
+    /// More than 79 characters kept (comments and spaces do not count).
     LineOverflow = 11,
-    /// A G/M number or a letter taut does not implement.
-    UnsupportedCommand = 20,
-    /// Two commands of one group (`G0 G1`, `G90 G91`, two M words, …).
-    ModalGroupViolation = 21,
-    /// `G1` before any `F`: raised by the interpreter, which knows the
-    /// modal feed rate; the parser never does.
-    UndefinedFeedRate = 22,
-    /// Two commands that both take the axis words (`G1 G92 X0`).
-    AxisWordConflict = 24,
-    /// A letter given twice (`X1 X2`).
-    RepeatedWord = 25,
-    /// `G92` without an axis word.
-    NoAxisWords = 26,
+    /// A target outside an axis's soft limits (the line is refused before
+    /// anything moves, as Grbl refuses a jog).
+    TravelExceeded = 15,
     /// `$J=` with a command or word a jog cannot take.
     InvalidJogCommand = 16,
-    /// `N` negative, fractional or above 9 999 999.
+    /// A G/M number or a letter taut does not implement.
+    UnsupportedCommand = 20,
+    /// Two commands of one modal group (`G90 G91`, `M3 M5`, …).
+    ModalGroupViolation = 21,
+    /// A feed move before any `F` (or without `F` in `G93`).
+    UndefinedFeedRate = 22,
+    /// A G/M number that is not whole (`G1.5`).
+    CommandValueNotInteger = 23,
+    /// Two commands that both take the axis words (`G0 G92 X0`).
+    AxisCommandConflict = 24,
+    /// A word given twice (`X1 X2`).
+    RepeatedWord = 25,
+    /// A command that needs axis words has none (`G92`, `G10`, `G2`).
+    NoAxisWords = 26,
+    /// `N` above 10 000 000.
     InvalidLineNumber = 27,
-    /// `G4` without `P`.
+    /// A command without its value word (`G4` without `P`, `G10`
+    /// without `L` or `P`).
     ValueWordMissing = 28,
-    /// Axis words on a command that takes none (`G4`, `M17`, …).
-    UnusedAxisWords = 31,
-    /// `P` on a command other than `G4`.
-    UnusedValueWords = 36,
-    /// A setting or a `G92` while motion is under way (interpreter).
-    NotIdle = 8,
-    /// Motion while the position is unknown (a stop at once during
-    /// motion): Grbl's alarm lock, lifted by `G92` or `$X`.
-    Locked = 9,
-    /// A target outside an axis's soft limits (interpreter).
-    TravelExceeded = 15,
-    /// An arc without an axis word of its plane (interpreter).
-    ArcNoAxisInPlane = 32,
-    /// A target the kinematics cannot reach or the step counter cannot
-    /// hold, or an arc's end off its circle (interpreter).
+    /// `G10 P` above 6.
+    UnsupportedCoordSys = 29,
+    /// `G53` in a motion mode other than `G0` or `G1`.
+    G53InvalidMotionMode = 30,
+    /// Axis words no command uses (`G80 X1`, `G4 P1 X1`).
+    AxisWordsExist = 31,
+    /// An arc without an axis word of its plane.
+    NoAxisWordsInPlane = 32,
+    /// A target the machine cannot reach or hold, or an arc's end off its
+    /// circle.
     InvalidTarget = 33,
-    /// No circle of the arc's `R` joins its ends (interpreter).
-    ArcRadiusInvalid = 34,
-    /// An arc with neither `R` nor an offset of its plane (interpreter).
-    ArcNoOffsetInPlane = 35,
+    /// No circle of the arc's `R` joins its ends.
+    ArcRadiusError = 34,
+    /// An arc with neither `R` nor an offset of its plane.
+    NoOffsetsInPlane = 35,
+    /// Value words no command uses (`P` without `G4`, `I` without an arc).
+    UnusedWords = 36,
+    /// `G43.1` with another axis word than `Z`.
+    G43DynamicAxisError = 37,
+    /// `T` above 255.
+    MaxValueExceeded = 38,
     /// `M20`, `M23`…: no card in the slot, or none with a FAT volume
     /// (numbered as FluidNC's SD errors).
     NoCard = 60,
@@ -66,19 +81,14 @@ pub enum ErrorKind {
     FileNotFound = 65,
     /// A card print is running: `M25` pauses it, `M524` aborts it.
     Printing = 67,
-    /// `M24` with no file selected by `M23` (taut's).
-    NoFileSelected = 76,
     /// `*` checksum wrong, malformed, or followed by more words.
     BadChecksum = 70,
     /// Motion, drivers or settings while a string-art job runs (taut's).
     JobOwnsMotion = 71,
     /// `F` below [`MIN_FEED`] (taut's: Grbl creeps instead).
     FeedTooLow = 72,
-    /// A plotter's `Z` (its pen) with other axis words (taut's).
-    PenWithMove = 73,
-    /// `G28`/`$H` on a machine with no axis set to home (Grbl's "setting
-    /// disabled").
-    NoHoming = 5,
+    /// `M24` with no file selected by `M23` (taut's).
+    NoFileSelected = 76,
 }
 
 /// The slowest feed rate accepted, thousandths of a unit per minute.
@@ -91,25 +101,32 @@ impl ErrorKind {
             ErrorKind::ExpectedCommandLetter => "Expected command letter",
             ErrorKind::BadNumberFormat => "Bad number format",
             ErrorKind::InvalidStatement => "Invalid statement",
-            ErrorKind::NegativeValue => "Negative value",
+            ErrorKind::NegativeValue => "Value < 0",
+            ErrorKind::NoHoming => "Setting disabled (homing_axes)",
+            ErrorKind::NotIdle => "Not idle",
+            ErrorKind::Locked => "G-code lock",
             ErrorKind::LineOverflow => "Line overflow",
+            ErrorKind::TravelExceeded => "Travel exceeded (soft limit)",
+            ErrorKind::InvalidJogCommand => "Invalid jog command",
             ErrorKind::UnsupportedCommand => "Unsupported command",
             ErrorKind::ModalGroupViolation => "Modal group violation",
             ErrorKind::UndefinedFeedRate => "Undefined feed rate",
-            ErrorKind::AxisWordConflict => "Two commands use axis words",
+            ErrorKind::CommandValueNotInteger => "Command value not integer",
+            ErrorKind::AxisCommandConflict => "Two commands use axis words",
             ErrorKind::RepeatedWord => "Repeated word",
             ErrorKind::NoAxisWords => "No axis words",
             ErrorKind::InvalidLineNumber => "Invalid line number",
             ErrorKind::ValueWordMissing => "Value word missing",
-            ErrorKind::UnusedAxisWords => "Unused axis words",
-            ErrorKind::UnusedValueWords => "Unused value words",
-            ErrorKind::NotIdle => "Not idle",
-            ErrorKind::Locked => "Position unknown: G92 or $X first",
-            ErrorKind::TravelExceeded => "Travel exceeded (soft limit)",
+            ErrorKind::UnsupportedCoordSys => "Unsupported coordinate system",
+            ErrorKind::G53InvalidMotionMode => "G53 only with G0 or G1",
+            ErrorKind::AxisWordsExist => "Unused axis words",
+            ErrorKind::NoAxisWordsInPlane => "Arc without an axis word of its plane",
             ErrorKind::InvalidTarget => "Invalid target",
-            ErrorKind::ArcNoAxisInPlane => "Arc without an axis of its plane",
-            ErrorKind::ArcRadiusInvalid => "Arc radius invalid",
-            ErrorKind::ArcNoOffsetInPlane => "Arc without R or an offset of its plane",
+            ErrorKind::ArcRadiusError => "Arc radius invalid",
+            ErrorKind::NoOffsetsInPlane => "Arc without an offset of its plane",
+            ErrorKind::UnusedWords => "Unused value words",
+            ErrorKind::G43DynamicAxisError => "G43.1 takes Z only",
+            ErrorKind::MaxValueExceeded => "Tool number above 255",
             ErrorKind::NoCard => "No card",
             ErrorKind::CardFailed => "Card read failed",
             ErrorKind::FileNotFound => "File not found",
@@ -118,9 +135,6 @@ impl ErrorKind {
             ErrorKind::BadChecksum => "Bad checksum",
             ErrorKind::JobOwnsMotion => "A job is running",
             ErrorKind::FeedTooLow => "Feed rate below 10/min",
-            ErrorKind::PenWithMove => "Pen Z with X/Y: one line each",
-            ErrorKind::NoHoming => "Homing not enabled (homing_axes)",
-            ErrorKind::InvalidJogCommand => "Invalid jog command",
         }
     }
 }

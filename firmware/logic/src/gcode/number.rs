@@ -1,48 +1,57 @@
-//! Numbers read one character at a time, without floats: a fixed-point
-//! value is kept as its magnitude in thousandths, so `-2.5` becomes
-//! `Milli(-2500)` with one multiply-add per digit.
+//! Numbers read one character at a time, without floats, as Grbl's
+//! `read_float` reads them (an optional sign, digits, one point; no
+//! exponent) but exact: the digits are kept as an integer significand
+//! and a power of ten, and converted once, when the word ends, to what
+//! the word needs — nanometres for an axis word, thousandths for a feed,
+//! a whole number and hundredths for a `G`/`M` number. So a move of
+//! `X0.0125` or `X0.00049` (inches) is taken as written, not rounded to
+//! a µm or a thousandth of an inch.
 
-use crate::text::num::times_ten_plus;
 use crate::units::Milli;
 
 /// A number being read. A `push` error means the character cannot belong
-/// to this number (a second point, a late sign, too large).
+/// to this number (a second point, a late sign).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct Number {
-    /// Magnitude so far: thousandths for fixed-point numbers, else units.
-    magnitude: u32,
-    /// Largest magnitude accepted.
-    limit: u32,
-    /// [`FIXED`], [`NEGATIVE`], [`SIGNED`], [`DIGITS`], [`POINT`], and the
-    /// decimals read (saturating at 7) above [`DECIMALS_SHIFT`]: one byte,
-    /// as the parser's statics and frames hold several numbers.
+    /// The first [`DIGITS_KEPT`] significant digits.
+    sig: u32,
+    /// Value = `sig` × 10^`exp`: decimals make it negative, integer digits
+    /// past the kept ones positive.
+    exp: i8,
+    /// [`NEGATIVE`], [`SIGNED`], [`DIGITS`], [`POINT`], [`ROUNDED`]: one
+    /// byte, as the parser's statics hold several numbers.
     flags: u8,
 }
 
-/// Fixed-point (sign and point allowed), else a plain unsigned integer.
-const FIXED: u8 = 1;
-const NEGATIVE: u8 = 2;
-const SIGNED: u8 = 4;
-const DIGITS: u8 = 8;
-const POINT: u8 = 16;
-const DECIMALS_SHIFT: u8 = 5;
+const NEGATIVE: u8 = 1;
+const SIGNED: u8 = 2;
+const DIGITS: u8 = 4;
+const POINT: u8 = 8;
+/// The first digit past the kept ones has rounded `sig`; later ones
+/// cannot matter.
+const ROUNDED: u8 = 16;
+
+/// Significant digits kept: 9 (`999 999 999` fits a `u32`), one more than
+/// Grbl's `read_float` and beyond what its `float` holds.
+const DIGITS_KEPT: u32 = 100_000_000;
+/// Decimal exponents stop here: a value of 10^-60 is nothing, one of
+/// 10^60 saturates every conversion.
+const EXP_LIMIT: i8 = 60;
+
+/// Whole units and hundredths of a `G`/`M` number, as Grbl splits it:
+/// `G38.2` is (38, 20), `G1.005` (1, 1), `G1.001` (1, 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Code {
+    pub int: u32,
+    pub hundredths: u8,
+}
 
 impl Number {
-    /// A signed value with up to three decimals kept, e.g. `X-2.5`.
-    pub(super) const fn fixed() -> Number {
-        Number::new(FIXED, i32::MAX as u32)
-    }
-
-    /// An unsigned integer up to `limit`, e.g. `N` or the checksum.
-    pub(super) const fn integer(limit: u32) -> Number {
-        Number::new(0, limit)
-    }
-
-    const fn new(flags: u8, limit: u32) -> Number {
+    pub(super) const fn new() -> Number {
         Number {
-            magnitude: 0,
-            limit,
-            flags,
+            sig: 0,
+            exp: 0,
+            flags: 0,
         }
     }
 
@@ -54,69 +63,175 @@ impl Number {
         self.has(DIGITS)
     }
 
+    pub(super) fn is_negative(&self) -> bool {
+        self.has(NEGATIVE) && self.sig != 0
+    }
+
+    /// One character of the number; per byte, so no division and no
+    /// 64-bit arithmetic.
     pub(super) fn push(&mut self, c: u8) -> Result<(), ()> {
-        let fixed = self.has(FIXED);
         match c {
-            b'+' | b'-' if fixed && !self.has(SIGNED | DIGITS | POINT) => {
+            b'+' | b'-' if !self.has(SIGNED | DIGITS | POINT) => {
                 self.flags |= SIGNED | if c == b'-' { NEGATIVE } else { 0 };
                 Ok(())
             }
-            b'.' if fixed && !self.has(POINT) => {
+            b'.' if !self.has(POINT) => {
                 self.flags |= POINT;
                 Ok(())
             }
-            b'0'..=b'9' => self.digit((c - b'0') as u32),
-            _ => Err(()),
-        }
-    }
-
-    fn digit(&mut self, d: u32) -> Result<(), ()> {
-        self.flags |= DIGITS;
-        let magnitude = if !self.has(POINT) {
-            let unit = if self.has(FIXED) { 1000 } else { 1 };
-            times_ten_plus(self.magnitude, d * unit)
-        } else {
-            let decimals = (self.flags >> DECIMALS_SHIFT).saturating_add(1).min(7);
-            self.flags = (self.flags & ((1 << DECIMALS_SHIFT) - 1)) | decimals << DECIMALS_SHIFT;
-            // Three decimals are kept; the fourth rounds half away from
-            // zero (the magnitude rounds up); later ones cannot matter.
-            let add = match decimals {
-                1 => d * 100,
-                2 => d * 10,
-                3 => d,
-                4 => (d >= 5) as u32,
-                _ => 0,
-            };
-            self.magnitude.checked_add(add)
-        };
-        match magnitude {
-            Some(m) if m <= self.limit => {
-                self.magnitude = m;
+            b'0'..=b'9' => {
+                self.digit(c - b'0');
                 Ok(())
             }
             _ => Err(()),
         }
     }
 
-    /// The value of a fixed-point number; `None` without a digit.
-    pub(super) fn milli(&self) -> Option<Milli> {
-        let m = self.magnitude as i32; // limit is i32::MAX
-        self.has_digits()
-            .then_some(Milli(if self.has(NEGATIVE) { -m } else { m }))
+    fn digit(&mut self, d: u8) {
+        self.flags |= DIGITS;
+        let point = self.has(POINT);
+        if self.sig < DIGITS_KEPT {
+            // Leading zeros cost nothing: `sig` stays 0.
+            self.sig = self.sig * 10 + d as u32;
+            if point && self.exp > -EXP_LIMIT {
+                self.exp -= 1;
+            }
+        } else if !point {
+            // An integer digit past the kept ones: the value grows tenfold.
+            self.exp = (self.exp + 1).min(EXP_LIMIT);
+        } else if !self.has(ROUNDED) {
+            // The first decimal past the kept ones rounds half away from
+            // zero; `sig` may become 10^9, which still fits.
+            self.flags |= ROUNDED;
+            self.sig += (d >= 5) as u32;
+        }
     }
 
-    /// The value of an integer; `None` without a digit.
-    pub(super) fn value(&self) -> Option<u32> {
-        self.has_digits().then_some(self.magnitude)
+    /// `value × 10^shift`, rounded half away from zero to an integer and
+    /// saturated to `limit`; per word, not per byte.
+    fn scaled(&self, shift: i8, limit: u64) -> u64 {
+        let exp = self.exp as i16 + shift as i16;
+        let mut v = self.sig as u64;
+        if exp >= 0 {
+            for _ in 0..exp {
+                v = v.saturating_mul(10);
+                if v >= limit {
+                    return limit;
+                }
+            }
+        } else {
+            // At most 9 significant digits: past 10 decimals it is 0.
+            let down = (-exp).min(11) as u32;
+            let p = 10u64.pow(down);
+            v = (v + p / 2) / p;
+        }
+        v.min(limit)
+    }
+
+    /// The value in millionths (nanometres of a mm), saturated at
+    /// ±[`NANO_LIMIT`]; `None` without a digit.
+    pub(super) fn nano(&self) -> Option<i64> {
+        let v = self.scaled(6, NANO_LIMIT as u64) as i64;
+        self.has_digits()
+            .then_some(if self.has(NEGATIVE) { -v } else { v })
+    }
+
+    /// The value in thousandths, rounded once and saturated at
+    /// ±`i32::MAX`; `None` without a digit.
+    pub(super) fn milli(&self) -> Option<Milli> {
+        let v = self.scaled(3, i32::MAX as u64) as i32;
+        self.has_digits()
+            .then_some(Milli(if self.has(NEGATIVE) { -v } else { v }))
+    }
+
+    /// The whole part (truncated, saturated) and the hundredths (rounded)
+    /// of a non-negative number, as Grbl's `int_value` and `mantissa`.
+    pub(super) fn code(&self) -> Code {
+        let int = self.whole();
+        let all = self.scaled(2, u32::MAX as u64);
+        Code {
+            int,
+            hundredths: all.saturating_sub(int as u64 * 100).min(100) as u8,
+        }
+    }
+
+    /// The whole part, truncated and saturated (Grbl's `trunc(value)` of
+    /// `N`, `T`, `L`).
+    pub(super) fn whole(&self) -> u32 {
+        let exp = self.exp as i16;
+        if exp >= 0 {
+            return self.scaled(0, u32::MAX as u64) as u32;
+        }
+        let down = (-exp).min(10) as u32;
+        (self.sig as u64 / 10u64.pow(down)) as u32
     }
 }
+
+/// Largest axis value in nanometres: ±9.2 × 10^15, far past any machine
+/// and still summable without overflow.
+pub const NANO_LIMIT: i64 = i64::MAX >> 10;
 
 /// Reads a whole fixed-point number such as a `$` setting's value
 /// (`"-2.5"` → `Milli(-2500)`); `None` if it is not one.
 pub fn parse_milli(text: &str) -> Option<Milli> {
-    let mut number = Number::fixed();
+    let mut number = Number::new();
     for &c in text.as_bytes() {
         number.push(c).ok()?;
     }
     number.milli()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(text: &str) -> Number {
+        let mut n = Number::new();
+        for &c in text.as_bytes() {
+            n.push(c).unwrap();
+        }
+        n
+    }
+
+    #[test]
+    fn exact_in_nanometres_and_rounded_once_in_thousandths() {
+        assert_eq!(read("0.0125").nano(), Some(12_500));
+        assert_eq!(read("0.00049").nano(), Some(490));
+        assert_eq!(read("-2.5").nano(), Some(-2_500_000));
+        assert_eq!(read("0.0125").milli(), Some(Milli(13)));
+        assert_eq!(read("-0.0125").milli(), Some(Milli(-13)));
+        // Nine significant digits are kept, the tenth rounds.
+        assert_eq!(read("123456.789012").nano(), Some(123_456_789_000));
+        assert_eq!(read("123456.789512").nano(), Some(123_456_790_000));
+        assert_eq!(read(".5").nano(), Some(500_000));
+        assert_eq!(read("5.").nano(), Some(5_000_000));
+        assert_eq!(read("+7").milli(), Some(Milli(7000)));
+        assert_eq!(read("-").nano(), None);
+        assert_eq!(read(".").milli(), None);
+    }
+
+    #[test]
+    fn digits_past_nine_round_once_and_big_numbers_saturate() {
+        // 1234.56789 kept; the 6 rounds the last kept digit up.
+        assert_eq!(read("1234.567896").nano(), Some(1_234_567_900));
+        assert_eq!(read("0.0000004").nano(), Some(0));
+        assert_eq!(read("0.0000005").nano(), Some(1));
+        assert_eq!(read("99999999999999999999999").milli(), Some(Milli(i32::MAX)));
+        assert_eq!(read("-99999999999999999999999").nano(), Some(-NANO_LIMIT));
+        assert_eq!(read("0.00000000000000000000000000001").nano(), Some(0));
+    }
+
+    #[test]
+    fn codes_split_as_grbl_splits_them() {
+        assert_eq!(read("38.2").code(), Code { int: 38, hundredths: 20 });
+        assert_eq!(read("01").code(), Code { int: 1, hundredths: 0 });
+        assert_eq!(read("1.001").code(), Code { int: 1, hundredths: 0 });
+        assert_eq!(read("1.005").code(), Code { int: 1, hundredths: 1 });
+        // Grbl's `trunc` then `round`: 0.996 is G0 with 100 hundredths.
+        assert_eq!(read("0.996").code(), Code { int: 0, hundredths: 100 });
+        assert_eq!(read("92.1").code(), Code { int: 92, hundredths: 10 });
+        assert_eq!(read("1.5").whole(), 1);
+        assert_eq!(read("12345678901").whole(), u32::MAX);
+        assert_eq!(read("255.9").whole(), 255);
+    }
 }

@@ -1,16 +1,24 @@
-//! The byte-level stage: realtime bytes, line ends, the length limit,
-//! comments and the `*` checksum. What remains of the line goes, one
-//! character at a time, to the statement (G-code words or a `$` line), so
-//! nothing is buffered.
+//! The byte-level stage, Grbl's `protocol_main_loop` filter (`protocol.c`
+//! lines 76–149): real-time bytes, line ends, comments `( … )` and `;`
+//! thrown away as they come, whitespace and control bytes and Grbl's
+//! ignored block delete `/` dropped, the length limit on what is kept,
+//! a UTF-8 byte-order mark before a line's first character skipped, and
+//! taut's `*` checksum. What remains of the line goes, one character at a
+//! time, to the statement (G-code words or a `$` line), so nothing is
+//! buffered.
 
+use super::block::{Input, Realtime};
 use super::error::{Error, ErrorKind};
-use super::line::{Input, Line, Realtime};
-use super::number::Number;
 use super::system::SystemBuilder;
-use super::words::{jog_line, Words};
+use super::words::Words;
 
-/// Longest line, characters (without its line end and realtime bytes).
-pub const MAX_LINE: u8 = 80;
+/// Most characters a line keeps (Grbl's `LINE_BUFFER_SIZE` of 80 with its
+/// terminator): comments, spaces and control bytes do not count, so a
+/// comment may be of any length.
+pub const MAX_LINE: u8 = 79;
+
+/// The UTF-8 byte-order mark an editor may put before a file's first line.
+const BOM: [u8; 3] = [0xEF, 0xBB, 0xBF];
 
 /// Where in the line the next byte falls.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,7 +40,9 @@ enum Lexeme {
 #[derive(Clone, Copy, Debug)]
 struct Checksum {
     column: u8,
-    number: Number,
+    /// Its digits' value (above 255 it cannot match), 0x100 past it.
+    value: u16,
+    digits: bool,
     /// Column of a character that spoils it; 0 = none.
     bad: u8,
 }
@@ -56,6 +66,13 @@ pub struct Parser {
     after_cr: bool,
     /// Characters of this line so far = column of the last one.
     column: u8,
+    /// Characters kept (Grbl's `char_counter`); the column where the
+    /// limit was passed once it is.
+    kept: u8,
+    /// Bytes of a byte-order mark matched before the line's first.
+    bom: u8,
+    /// Axis letters the machine has (a bit per [`AxisWord`](super::AxisWord)).
+    letters: u8,
     /// XOR of the bytes before `*`.
     xor: u8,
     lexeme: Lexeme,
@@ -84,6 +101,9 @@ impl Parser {
         Parser {
             after_cr: false,
             column: 0,
+            kept: 0,
+            bom: 0,
+            letters: 0b1111,
             xor: 0,
             lexeme: Lexeme::Code,
             checksum: None,
@@ -94,6 +114,13 @@ impl Parser {
     /// Some of a line has been read, not yet its end.
     pub fn mid_line(&self) -> bool {
         self.column != 0
+    }
+
+    /// The axis letters the machine has (a bit per
+    /// [`AxisWord`](super::AxisWord)): another is a letter Grbl does not
+    /// know (20), in the line's order.
+    pub fn set_axis_letters(&mut self, letters: u8) {
+        self.letters = letters;
     }
 
     /// Takes one received byte; returns what it completed, if anything.
@@ -125,11 +152,13 @@ impl Parser {
                 self.after_cr = byte == b'\r';
                 Read::LineEnd
             }
+            _ if self.column == 0 && BOM.get(self.bom as usize) == Some(&byte) => {
+                self.bom = (self.bom + 1) % 3;
+                Read::More
+            }
             _ => {
                 self.column = self.column.saturating_add(1);
-                if self.column > MAX_LINE {
-                    self.lexeme = Lexeme::Overflow;
-                } else {
+                if self.lexeme != Lexeme::Overflow {
                     self.take(byte);
                 }
                 Read::More
@@ -149,6 +178,7 @@ impl Parser {
     fn restart(&mut self, after_cr: bool) {
         *self = Parser {
             after_cr,
+            letters: self.letters,
             ..Parser::new()
         };
     }
@@ -163,31 +193,39 @@ impl Parser {
             self.xor ^= c;
         }
         match (self.lexeme, c) {
-            (Lexeme::Code, b'(') => {
-                self.lexeme = Lexeme::Comment;
-                self.feed(b' ', column);
-            }
-            (Lexeme::Code, b';') => {
-                self.lexeme = Lexeme::LineComment;
-                self.feed(b' ', column);
-            }
+            (Lexeme::Code, b'(') => self.lexeme = Lexeme::Comment,
+            (Lexeme::Code, b';') => self.lexeme = Lexeme::LineComment,
+            // Whitespace and control bytes are dropped (a space still
+            // reaches `M23`'s file name); `/` too (Grbl has no block
+            // delete switch: the line runs).
+            (Lexeme::Code, ..=b' ') => self.feed(b' ', column),
+            (Lexeme::Code, b'/') => {}
             (Lexeme::Checksum | Lexeme::AfterChecksum, b';') => self.lexeme = Lexeme::LineComment,
             (Lexeme::Code, b'*') if star => {
                 self.lexeme = Lexeme::Checksum;
                 self.checksum = Some(Checksum {
                     column,
-                    number: Number::integer(u8::MAX as u32),
+                    value: 0,
+                    digits: false,
                     bad: 0,
                 });
             }
-            (Lexeme::Code, _) => self.feed(c, column),
+            (Lexeme::Code, _) if self.kept >= MAX_LINE => self.lexeme = Lexeme::Overflow,
+            (Lexeme::Code, _) => {
+                self.kept += 1;
+                self.feed(c, column)
+            }
             (Lexeme::Comment, b')') => self.lexeme = Lexeme::Code,
             (Lexeme::Checksum, b' ' | b'\t') | (Lexeme::AfterChecksum, b' ' | b'\t') => {
                 self.lexeme = Lexeme::AfterChecksum
             }
             (Lexeme::Checksum, _) | (Lexeme::AfterChecksum, _) => {
                 if let Some(ck) = &mut self.checksum {
-                    let spoilt = self.lexeme == Lexeme::AfterChecksum || ck.number.push(c).is_err();
+                    let spoilt = self.lexeme == Lexeme::AfterChecksum || !c.is_ascii_digit();
+                    if !spoilt {
+                        ck.value = (ck.value * 10 + (c - b'0') as u16).min(0x100);
+                        ck.digits = true;
+                    }
                     if spoilt && ck.bad == 0 {
                         ck.bad = column;
                     }
@@ -206,9 +244,7 @@ impl Parser {
                 b'$' => self.statement = Statement::System(SystemBuilder::new(column)),
                 _ => {
                     self.start_words(false);
-                    if let Statement::GCode(words) = &mut self.statement {
-                        words.feed(c, column);
-                    }
+                    self.feed(c, column);
                 }
             },
             Statement::GCode(words) => words.feed(c, column),
@@ -225,7 +261,7 @@ impl Parser {
     /// the words it makes stay off the frame that reads every byte.
     #[inline(never)]
     fn start_words(&mut self, jog: bool) {
-        self.statement = Statement::GCode(Words::new(jog));
+        self.statement = Statement::GCode(Words::new(jog, self.letters));
     }
 
     /// The result of a complete line. Errors rank: overflow (the line was
@@ -241,11 +277,11 @@ impl Parser {
 
     fn result(&mut self) -> Result<Input, Error> {
         if self.lexeme == Lexeme::Overflow {
-            return Err(Error::new(ErrorKind::LineOverflow, MAX_LINE + 1));
+            return Err(Error::new(ErrorKind::LineOverflow, 0));
         }
         let end = match self.checksum {
             Some(ck) => ck.column,
-            None => self.column + 1,
+            None => self.column.saturating_add(1),
         };
         let checksum = match self.checksum {
             Some(ck) => {
@@ -253,8 +289,8 @@ impl Parser {
                 if ck.bad != 0 {
                     return bad(ck.bad);
                 }
-                match ck.number.value() {
-                    Some(v) if v == self.xor as u32 => Some(self.xor),
+                match ck.digits.then_some(ck.value) {
+                    Some(v) if v == self.xor as u16 => Some(self.xor),
                     _ => return bad(ck.column),
                 }
             }
@@ -268,13 +304,13 @@ impl Parser {
         match &mut self.statement {
             Statement::GCode(words) => {
                 let jog = words.is_jog();
-                if let Some(e) = words.jog_error() {
-                    return Err(e);
-                }
                 match words.finish(end)? {
-                    Input::Line(line) if jog => jog_line(line, end).map(Input::Jog),
+                    Input::Block(block) if jog => Ok(Input::Jog(block)),
                     _ if jog => Err(Error::new(ErrorKind::InvalidJogCommand, end)),
-                    Input::Line(line) => Ok(Input::Line(Line { checksum, ..line })),
+                    Input::Block(mut block) => {
+                        block.checksum = checksum;
+                        Ok(Input::Block(block))
+                    }
                     other => Ok(other),
                 }
             }

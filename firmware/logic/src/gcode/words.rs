@@ -1,15 +1,21 @@
-//! The words of a G-code line: letters with their numbers, collected into a
-//! [`Line`] with Grbl's checks (repeated words, modal groups, words the
-//! command cannot use). The first error is kept; the rest of the line is
-//! then only skipped.
+//! The words of a G-code line gathered into a [`Block`] as Grbl's
+//! `gc_execute_line` gathers them (its step 2, `gcode.c` lines 116–345):
+//! each word as it ends, in the order of the text, with the checks that
+//! need nothing but the line — a supported command (20), a whole command
+//! number (23), two axis commands (24), one command per modal group (21),
+//! a word given once (25), no negative `F N P S T` (4), `T` ≤ 255 (38).
+//! The first error is kept and the rest of the line skipped. Whatever
+//! needs the modal state (step 3) is the executor's.
 
+use super::block::{
+    group, word, AxisCommand, AxisWord, Block, CardLine, Coolant, Distance, FeedMode, Flow,
+    Input, MotionMode, NonModal, Plane, Spindle, TautCode, ToolLength, Units,
+};
 use super::error::{Error, ErrorKind};
-use super::line::{AxisWord, CardLine, Command, Distance, Input, Line, Plane, Units};
 use super::number::Number;
-use crate::units::{MaybeMilli, Milli};
 
-/// Largest line number, as in Grbl.
-const MAX_LINE_NUMBER: u32 = 9_999_999;
+/// Largest line number, as Grbl's `MAX_LINE_NUMBER`.
+const MAX_LINE_NUMBER: u32 = 10_000_000;
 
 /// A letter whose number is being read.
 #[derive(Clone, Copy, Debug)]
@@ -21,17 +27,13 @@ struct Word {
 
 #[derive(Clone, Debug)]
 pub(super) struct Words {
-    line: Line,
+    block: Block,
     word: Option<Word>,
     error: Option<Error>,
-    // Columns of words checked once the line is complete; 0 = absent.
-    command_column: u8,
-    axis_column: u8,
-    p_column: u8,
-    s_column: u8,
-    /// The first `I J K R`.
-    arc_column: u8,
-    /// A card command (`M20`…) in place of the line's command; `M23`
+    /// Axis letters (bits [`AxisWord::bit`] >> [`word::C`]) the machine
+    /// has: another is a letter Grbl does not know (20).
+    letters: u8,
+    /// A card command (`M20`…) in place of the line's commands; `M23`
     /// collects the rest of the line as its file name.
     card: Option<CardLine>,
     /// A jog's words (after `$J=`).
@@ -39,16 +41,17 @@ pub(super) struct Words {
 }
 
 impl Words {
-    pub(super) const fn new(jog: bool) -> Words {
+    pub(super) const fn new(jog: bool, letters: u8) -> Words {
+        let mut block = Block::empty();
+        if jog {
+            // Grbl reads a jog as a `G1` in `G94` (`gcode.c` line 89).
+            block.motion = MotionMode::Linear;
+        }
         Words {
-            line: Line::empty(),
+            block,
             word: None,
             error: None,
-            command_column: 0,
-            axis_column: 0,
-            p_column: 0,
-            s_column: 0,
-            arc_column: 0,
+            letters,
             card: None,
             jog,
         }
@@ -59,10 +62,11 @@ impl Words {
     }
 
     pub(super) fn line_number(&self) -> Option<u32> {
-        self.line.n
+        self.block.line_number()
     }
 
-    /// One character outside comments; a comment arrives as a space.
+    /// One character outside comments, upper case; spaces are passed
+    /// only for `M23`'s file name (Grbl drops them: `X1 0` is `X10`).
     pub(super) fn feed(&mut self, c: u8, column: u8) {
         if self.error.is_none() {
             if let Err(e) = self.take(c, column) {
@@ -75,39 +79,30 @@ impl Words {
         if self.naming() {
             return self.name_char(c, column);
         }
-        match c {
-            // A space ends a number but may sit between letter and number.
-            b' ' | b'\t' => match self.word {
-                Some(w) if w.number.has_digits() => self.close(column),
-                _ => Ok(()),
-            },
-            b'a'..=b'z' | b'A'..=b'Z' => {
-                self.close(column)?;
-                if self.naming() {
-                    return self.name_char(c, column);
-                }
-                let letter = c.to_ascii_uppercase();
-                let number = match letter {
-                    b'N' => Number::integer(MAX_LINE_NUMBER),
-                    _ => Number::fixed(),
-                };
+        if c == b' ' {
+            return Ok(());
+        }
+        if let Some(w) = &mut self.word {
+            if w.number.push(c).is_ok() {
+                return Ok(());
+            }
+            // Not the number's: the word ends here (Grbl's `read_float`
+            // stops), and a letter must follow.
+            self.close(column)?;
+            if self.naming() {
+                return self.name_char(c, column);
+            }
+        }
+        match c.to_ascii_uppercase() {
+            letter @ b'A'..=b'Z' => {
                 self.word = Some(Word {
                     letter,
                     column,
-                    number,
+                    number: Number::new(),
                 });
                 Ok(())
             }
-            _ => match &mut self.word {
-                Some(w) => w.number.push(c).map_err(|()| {
-                    let kind = match w.letter {
-                        b'N' => ErrorKind::InvalidLineNumber,
-                        _ => ErrorKind::BadNumberFormat,
-                    };
-                    Error::new(kind, column)
-                }),
-                None => Err(Error::new(ErrorKind::ExpectedCommandLetter, column)),
-            },
+            _ => Err(Error::new(ErrorKind::ExpectedCommandLetter, column)),
         }
     }
 
@@ -128,144 +123,249 @@ impl Words {
             .map_err(|_| Error::new(ErrorKind::FileNotFound, column))
     }
 
-    /// Ends the word being read at the character in `column`.
+    /// Ends the word being read at `column`: its number needs a digit (2).
     fn close(&mut self, column: u8) -> Result<(), Error> {
         let Some(w) = self.word.take() else {
             return Ok(());
         };
-        let applied = match w.letter {
-            b'N' => w.number.value().map(|n| self.set_line_number(n)),
-            letter => w.number.milli().map(|v| self.apply(letter, w.column, v)),
-        };
-        // One error built, wherever it came from.
-        let (kind, at) = match applied {
-            Some(Ok(())) => return Ok(()),
-            Some(Err(kind)) => (kind, w.column),
-            None => (ErrorKind::BadNumberFormat, column),
-        };
-        Err(Error::new(kind, at))
+        if !w.number.has_digits() {
+            return Err(Error::new(ErrorKind::BadNumberFormat, column));
+        }
+        self.apply(w.letter, &w.number)
+            .map_err(|kind| Error::new(kind, w.column))
     }
 
-    fn set_line_number(&mut self, n: u32) -> Result<(), ErrorKind> {
-        if self.line.n.is_some() {
-            return Err(ErrorKind::RepeatedWord);
+    /// Takes the word `letter` of `n` (`gcode.c` lines 143–345).
+    fn apply(&mut self, letter: u8, n: &Number) -> Result<(), ErrorKind> {
+        match letter {
+            b'G' | b'M' => self.command(letter, n),
+            _ => self.value(letter, n),
         }
-        self.line.n = Some(n);
+    }
+
+    /// A `G` or `M` word: its group and meaning.
+    fn command(&mut self, letter: u8, n: &Number) -> Result<(), ErrorKind> {
+        let b = &mut self.block;
+        let code = n.code();
+        if n.is_negative() {
+            return Err(ErrorKind::UnsupportedCommand);
+        }
+        let mut hundredths = code.hundredths;
+        let bit = if letter == b'G' {
+            let bit = match code.int {
+                10 | 28 | 30 | 92 | 4 | 53 => {
+                    if matches!(code.int, 10 | 28 | 30 | 92) && hundredths == 0 {
+                        axis_command(b, AxisCommand::NonModal)?;
+                    }
+                    b.non_modal = match (code.int, hundredths) {
+                        (4, _) => NonModal::Dwell,
+                        (10, _) => NonModal::SetCoordData,
+                        (53, _) => NonModal::AbsoluteOverride,
+                        (28, 0) => NonModal::GoHome0,
+                        (28, 10) => NonModal::SetHome0,
+                        (30, 0) => NonModal::GoHome1,
+                        (30, 10) => NonModal::SetHome1,
+                        (92, 0) => NonModal::SetCoordOffset,
+                        (92, 10) => NonModal::ResetCoordOffset,
+                        _ => return Err(ErrorKind::UnsupportedCommand),
+                    };
+                    if matches!(code.int, 28 | 30 | 92) {
+                        hundredths = 0;
+                    }
+                    group::NON_MODAL
+                }
+                0..=3 | 38 | 80 => {
+                    if code.int != 80 {
+                        axis_command(b, AxisCommand::Motion)?;
+                    }
+                    b.motion = match code.int {
+                        0 => MotionMode::Seek,
+                        1 => MotionMode::Linear,
+                        2 => MotionMode::CwArc,
+                        3 => MotionMode::CcwArc,
+                        80 => MotionMode::None,
+                        // G38.x probing: taut has no probe input.
+                        _ => return Err(ErrorKind::UnsupportedCommand),
+                    };
+                    group::MOTION
+                }
+                17..=19 => {
+                    b.plane = match code.int {
+                        17 => Plane::Xy,
+                        18 => Plane::Zx,
+                        _ => Plane::Yz,
+                    };
+                    group::PLANE
+                }
+                90 | 91 if hundredths == 0 => {
+                    b.distance = match code.int {
+                        90 => Distance::Absolute,
+                        _ => Distance::Relative,
+                    };
+                    group::DISTANCE
+                }
+                90 | 91 => {
+                    // G91.1: arc offsets relative, Grbl's only mode.
+                    if hundredths != 10 || code.int == 90 {
+                        return Err(ErrorKind::UnsupportedCommand);
+                    }
+                    hundredths = 0;
+                    group::ARC_DISTANCE
+                }
+                93 | 94 => {
+                    b.feed_mode = match code.int {
+                        93 => FeedMode::InverseTime,
+                        _ => FeedMode::PerMinute,
+                    };
+                    group::FEED_MODE
+                }
+                20 | 21 => {
+                    b.units = match code.int {
+                        20 => Units::Inch,
+                        _ => Units::Mm,
+                    };
+                    group::UNITS
+                }
+                40 => group::CUTTER,
+                43 | 49 => {
+                    axis_command(b, AxisCommand::ToolLength)?;
+                    b.tool_length = match (code.int, hundredths) {
+                        (49, _) => ToolLength::Cancel,
+                        (_, 10) => ToolLength::Dynamic,
+                        _ => return Err(ErrorKind::UnsupportedCommand),
+                    };
+                    hundredths = 0;
+                    group::TOOL_LENGTH
+                }
+                54..=59 => {
+                    b.coord = (code.int - 54) as u8;
+                    group::COORD
+                }
+                61 if hundredths != 0 => return Err(ErrorKind::UnsupportedCommand),
+                61 => group::CONTROL,
+                _ => return Err(ErrorKind::UnsupportedCommand),
+            };
+            if hundredths > 0 {
+                return Err(ErrorKind::CommandValueNotInteger);
+            }
+            bit
+        } else {
+            if hundredths > 0 {
+                return Err(ErrorKind::CommandValueNotInteger);
+            }
+            if let Some(card) = CardLine::from_number(code.int) {
+                if b.groups != 0 || self.card.is_some() {
+                    return Err(ErrorKind::ModalGroupViolation);
+                }
+                self.card = Some(card);
+                return Ok(());
+            }
+            match code.int {
+                0 | 1 | 2 | 30 => {
+                    b.flow = match code.int {
+                        0 => Flow::Pause,
+                        1 => Flow::OptionalStop,
+                        2 => Flow::End,
+                        _ => Flow::EndRewind,
+                    };
+                    group::STOPPING
+                }
+                3..=5 => {
+                    b.spindle = match code.int {
+                        3 => Spindle::Cw,
+                        4 => Spindle::Ccw,
+                        _ => Spindle::Off,
+                    };
+                    group::SPINDLE
+                }
+                7..=9 => {
+                    b.coolant = match code.int {
+                        7 => Coolant::Mist,
+                        8 => Coolant::Flood,
+                        _ => Coolant::Off,
+                    };
+                    group::COOLANT
+                }
+                17 | 18 | 84 | 114 | 300 | 400 => {
+                    b.taut = match code.int {
+                        17 => TautCode::EnableDrivers,
+                        114 => TautCode::ReportPosition,
+                        300 => TautCode::Servo,
+                        400 => TautCode::WaitIdle,
+                        _ => TautCode::DisableDrivers,
+                    };
+                    group::TAUT
+                }
+                _ => return Err(ErrorKind::UnsupportedCommand),
+            }
+        };
+        if b.groups & bit != 0 || self.card.is_some() {
+            return Err(ErrorKind::ModalGroupViolation);
+        }
+        b.groups |= bit;
         Ok(())
     }
 
-    /// Takes the word `letter` of `value` at `column`; the error's kind
-    /// (at the word's column).
-    fn apply(&mut self, letter: u8, column: u8, value: Milli) -> Result<(), ErrorKind> {
-        if let Some(word) = AxisWord::from_letter(letter) {
-            let slot = &mut self.line.axes[word.index()];
-            if slot.is_some() {
-                return Err(ErrorKind::RepeatedWord);
+    /// A value or axis word (`gcode.c` lines 305–343).
+    fn value(&mut self, letter: u8, n: &Number) -> Result<(), ErrorKind> {
+        let b = &mut self.block;
+        let milli = || n.milli().unwrap_or_default();
+        let bit = match letter {
+            b'F' => {
+                b.f = milli();
+                word::F
             }
-            *slot = MaybeMilli::new(Some(value));
-            if self.axis_column == 0 {
-                self.axis_column = column;
+            b'I' | b'J' | b'K' => {
+                b.ijk[(letter - b'I') as usize] = milli();
+                word::I + (letter - b'I')
             }
-            return Ok(());
+            b'L' => {
+                b.l = n.whole().min(u8::MAX as u32) as u8;
+                word::L
+            }
+            b'N' => {
+                b.n = n.whole();
+                word::N
+            }
+            b'P' => {
+                b.p = milli();
+                word::P
+            }
+            b'R' => {
+                b.r = milli();
+                word::R
+            }
+            b'S' => {
+                b.s = milli();
+                word::S
+            }
+            b'T' => {
+                // Grbl compares the value, fraction and all, with 255.
+                let whole = n.whole();
+                if !n.is_negative() && (whole > 255 || (whole == 255 && n.code().hundredths > 0)) {
+                    return Err(ErrorKind::MaxValueExceeded);
+                }
+                b.t = whole.min(255) as u8;
+                word::T
+            }
+            _ => match AxisWord::from_letter(letter) {
+                Some(w) if self.letters >> w.index() & 1 != 0 => {
+                    b.axes[w.index()] = n.nano().unwrap_or_default();
+                    word::C + w.index() as u8
+                }
+                _ => return Err(ErrorKind::UnsupportedCommand),
+            },
+        };
+        if b.words >> bit & 1 != 0 {
+            return Err(ErrorKind::RepeatedWord);
         }
-        match letter {
-            b'G' if value.0 == 90_000 || value.0 == 91_000 => {
-                let d = match value.0 {
-                    90_000 => Distance::Absolute,
-                    _ => Distance::Relative,
-                };
-                modal(&mut self.line.distance, d)
-            }
-            // Machine coordinates: taut keeps no work offsets, so every
-            // position is one already.
-            b'G' if value.0 == 53_000 => Ok(()),
-            b'G' if matches!(value.0, 17_000..=19_000) && value.0 % 1000 == 0 => {
-                let p = match value.0 {
-                    17_000 => Plane::Xy,
-                    18_000 => Plane::Zx,
-                    _ => Plane::Yz,
-                };
-                modal(&mut self.line.plane, p)
-            }
-            b'G' if value.0 == 20_000 || value.0 == 21_000 => {
-                let u = match value.0 {
-                    20_000 => Units::Inch,
-                    _ => Units::Mm,
-                };
-                modal(&mut self.line.units, u)
-            }
-            b'I' | b'J' | b'K' | b'R' => {
-                let slot = match letter {
-                    b'R' => &mut self.line.r,
-                    b'I' => &mut self.line.offsets[0],
-                    b'J' => &mut self.line.offsets[1],
-                    _ => &mut self.line.offsets[2],
-                };
-                if slot.is_some() {
-                    return Err(ErrorKind::RepeatedWord);
-                }
-                *slot = MaybeMilli::new(Some(value));
-                if self.arc_column == 0 {
-                    self.arc_column = column;
-                }
-                Ok(())
-            }
-            b'M' if CardLine::from_number(value).is_some() => {
-                if self.command_column != 0 {
-                    return Err(ErrorKind::ModalGroupViolation);
-                }
-                self.command_column = column;
-                self.card = CardLine::from_number(value);
-                Ok(())
-            }
-            b'G' | b'M' => {
-                if self.card.is_some() {
-                    return Err(ErrorKind::ModalGroupViolation);
-                }
-                let Some(command) = Command::from_word(letter, value) else {
-                    return Err(ErrorKind::UnsupportedCommand);
-                };
-                if self.command_column != 0 {
-                    // G92 with G0/G1: different groups, but both want the
-                    // axis words. Anything else is one group here.
-                    let previous = self.line.command;
-                    let set_position = |c| c == Command::SetPosition;
-                    let axis_conflict = command.uses_axes()
-                        && previous.uses_axes()
-                        && set_position(command) != set_position(previous);
-                    return Err(if axis_conflict {
-                        ErrorKind::AxisWordConflict
-                    } else {
-                        ErrorKind::ModalGroupViolation
-                    });
-                }
-                self.command_column = column;
-                self.line.command = command;
-                Ok(())
-            }
-            b'F' | b'P' | b'S' => {
-                let slot = match letter {
-                    b'F' => &mut self.line.f,
-                    b'P' => {
-                        self.p_column = column;
-                        &mut self.line.p
-                    }
-                    _ => {
-                        self.s_column = column;
-                        &mut self.line.s
-                    }
-                };
-                if slot.is_some() {
-                    return Err(ErrorKind::RepeatedWord);
-                }
-                if value.0 < 0 {
-                    return Err(ErrorKind::NegativeValue);
-                }
-                *slot = MaybeMilli::new(Some(value));
-                Ok(())
-            }
-            _ => Err(ErrorKind::UnsupportedCommand),
+        const UNSIGNED: u16 =
+            1 << word::F | 1 << word::N | 1 << word::P | 1 << word::S | 1 << word::T;
+        if UNSIGNED >> bit & 1 != 0 && n.is_negative() {
+            return Err(ErrorKind::NegativeValue);
         }
+        b.words |= 1 << bit;
+        Ok(())
     }
 
     /// The line, once its last character (before `column`) has been read.
@@ -274,123 +374,35 @@ impl Words {
             return Err(e);
         }
         self.close(column)?;
-        let line = &self.line;
-        let fail = |kind, column| Err(Error::new(kind, column));
-        let has_axes = self.axis_column != 0;
-        if let Some(card) = self.card {
-            let value_column = [self.p_column, self.s_column, self.arc_column]
-                .into_iter()
-                .find(|&c| c != 0);
-            return match card {
-                _ if has_axes => fail(ErrorKind::UnusedAxisWords, self.axis_column),
-                _ if value_column.is_some() || line.f.is_some() => fail(
-                    ErrorKind::UnusedValueWords,
-                    value_column.unwrap_or(self.command_column),
-                ),
-                CardLine::Select(name) if name.is_empty() => {
-                    fail(ErrorKind::ValueWordMissing, self.command_column)
-                }
-                CardLine::Select(name) => Ok(Input::Card(CardLine::Select(name.trimmed()))),
-                _ => Ok(Input::Card(card)),
-            };
+        let b = &self.block;
+        // The first of step 3's checks (`gcode.c` line 362), needing no
+        // modal state.
+        if b.has_word(word::N) && b.n > MAX_LINE_NUMBER {
+            return Err(Error::new(ErrorKind::InvalidLineNumber, 0));
         }
-        match line.command {
-            Command::Dwell if has_axes => {
-                return fail(ErrorKind::UnusedAxisWords, self.axis_column)
-            }
-            Command::Dwell if !line.p.is_some() => {
-                return fail(ErrorKind::ValueWordMissing, self.command_column)
-            }
-            Command::SetPosition if !has_axes => {
-                return fail(ErrorKind::NoAxisWords, self.command_column)
-            }
-            Command::Servo if line.s.get().is_none() => {
-                return fail(ErrorKind::ValueWordMissing, self.command_column)
-            }
-            Command::EnableDrivers
-            | Command::DisableDrivers
-            | Command::ReportPosition
-            | Command::WaitIdle
-            | Command::Home
-            | Command::Pause
-            | Command::PenDown
-            | Command::PenUp
-            | Command::Servo
-                if has_axes =>
-            {
-                return fail(ErrorKind::UnusedAxisWords, self.axis_column)
-            }
-            _ => {}
-        }
-        if line.p.is_some() && line.command != Command::Dwell {
-            return fail(ErrorKind::UnusedValueWords, self.p_column);
-        }
-        if line.s.is_some() && !matches!(line.command, Command::PenDown | Command::Servo) {
-            return fail(ErrorKind::UnusedValueWords, self.s_column);
-        }
-        // Arc words only with an arc (or axis words in an arc's modal
-        // mode: the interpreter decides), and `R` or `I J K`, not both.
-        let arc = matches!(
-            line.command,
-            Command::ArcCw | Command::ArcCcw | Command::Empty
-        );
-        let offsets = line.offsets.iter().any(|o| o.is_some());
-        if self.arc_column != 0 && (!arc || (offsets && line.r.is_some())) {
-            return fail(ErrorKind::UnusedValueWords, self.arc_column);
-        }
-        Ok(Input::Line(self.line))
-    }
-}
-
-impl Words {
-    /// Why a jog's words (after `$J=`) are no jog, before the line ends:
-    /// a command, a plane or a value word other than `F` and `N` (Grbl's
-    /// error 16). Its own errors come first.
-    pub(super) fn jog_error(&self) -> Option<Error> {
-        if !self.jog || self.error.is_some() {
-            return None;
-        }
-        let open = self.word.map_or(0, |w| match w.letter {
-            b'M' | b'P' | b'S' | b'I' | b'J' | b'K' | b'R' => w.column,
-            _ => 0,
-        });
-        let commands = self.line.command != Command::Empty || self.card.is_some();
-        let column = match commands || self.line.plane.is_some() {
-            true => self.command_column.max(1),
-            false => [self.p_column, self.s_column, self.arc_column, open]
-                .into_iter()
-                .find(|&c| c != 0)?,
+        let Some(card) = self.card else {
+            return Ok(Input::Block(self.block));
         };
-        Some(Error::new(ErrorKind::InvalidJogCommand, column))
+        // A card command takes no other word (Marlin's lines stand alone).
+        match card {
+            _ if b.words & !(1 << word::N) != 0 => {
+                Err(Error::new(ErrorKind::UnusedWords, column))
+            }
+            CardLine::Select(name) if name.is_empty() => {
+                Err(Error::new(ErrorKind::ValueWordMissing, column))
+            }
+            CardLine::Select(name) => Ok(Input::Card(CardLine::Select(name.trimmed()))),
+            _ => Ok(Input::Card(card)),
+        }
     }
 }
 
-/// A jog's line once read whole: a `G1` to its axis words at its `F`
-/// (Grbl's error 16 for a command or plane its last word brought, 26
-/// without an axis word, 22 without `F`); `end` is the line's end.
-pub(super) fn jog_line(line: Line, end: u8) -> Result<Line, Error> {
-    let fail = |kind| Err(Error::new(kind, end));
-    if line.command != Command::Empty || line.plane.is_some() || line.has_arc_words() {
-        return fail(ErrorKind::InvalidJogCommand);
+/// Grbl's `axis_command` for a command that takes the axis words: a
+/// second one on the line is error 24.
+fn axis_command(b: &mut Block, what: AxisCommand) -> Result<(), ErrorKind> {
+    if b.axis_command != AxisCommand::None {
+        return Err(ErrorKind::AxisCommandConflict);
     }
-    if !line.has_axes() {
-        return fail(ErrorKind::NoAxisWords);
-    }
-    if line.f.get().is_none() {
-        return fail(ErrorKind::UndefinedFeedRate);
-    }
-    Ok(Line {
-        command: Command::Linear,
-        ..line
-    })
-}
-
-/// A modal word (`G90`, `G17`, `G20`…): one of its group per line (Grbl's
-/// error 21).
-fn modal<T>(slot: &mut Option<T>, value: T) -> Result<(), ErrorKind> {
-    if slot.is_some() {
-        return Err(ErrorKind::ModalGroupViolation);
-    }
-    *slot = Some(value);
+    b.axis_command = what;
     Ok(())
 }

@@ -1,120 +1,43 @@
 //! Machine time of a G-code stream worked out on the host, with the
-//! firmware's own parser, interpreter, kinematics and planner: what a
-//! sender needs for an honest ETA. Each line's moves go into the planner
-//! as the console queues them (a path piece by piece); a block's time is
-//! counted when the planner hands it on, with the exit speed the lines
-//! after it allow, so a line's time is final once later lines are in.
-//! Dwells, the pen's settle time and a homing cycle wait for the machine
-//! to stand (homing's own moves are not counted: where the switch is, is
-//! the machine's secret).
+//! firmware's own parser, executor, kinematics and planner: what a
+//! sender needs for an honest ETA. The executor carries each line out
+//! against a [`MachineIo`] whose planner is the firmware's and whose
+//! clock counts the planned blocks' time: a block's time is counted when
+//! the planner hands it on (when it is full, or when a line waits for the
+//! motion to end), with the exit speed the lines after it allow. Dwells
+//! and the pen's settle time count once the machine stands.
 
-use super::{Allowed, Interpreter, Order};
+use super::{Allowed, CoordTable, Env, Exact, Interpreter, MachineIo, Progress, Wait};
 use crate::config::MachineConfig;
 use crate::gcode::{Input, Parser};
-use crate::kinematics::{AnyKinematics, Kinematics};
+use crate::kinematics::{AnyKinematics, Steps};
 use crate::planner::{Feed, Planner};
 use crate::segment::SUBTICKS_PER_S;
 
-/// Runs a stream of G-code through the firmware's planner.
+/// Runs a stream of G-code through the firmware's parser, executor and
+/// planner.
 pub struct GcodeTime {
     parser: Parser,
     interp: Interpreter,
     kin: AnyKinematics,
     config: MachineConfig,
-    planner: Planner,
-    /// Sub-ticks of motion and waiting counted so far.
-    subticks: u64,
+    machine: Timed,
     /// Lines read, and lines refused (they move nothing, as on the machine).
     pub lines: u32,
     pub refused: u32,
 }
 
-impl GcodeTime {
-    /// `None` when the configuration's kinematics cannot be made.
-    pub fn new(config: &MachineConfig) -> Option<Self> {
-        Some(GcodeTime {
-            parser: Parser::new(),
-            interp: Interpreter::new(),
-            kin: AnyKinematics::of(config).ok()?,
-            config: *config,
-            planner: Planner::new(config),
-            subticks: 0,
-            lines: 0,
-            refused: 0,
-        })
-    }
+/// The machine as the estimate sees it: the planner, a clock of
+/// sub-ticks, the pen's angle, the coordinate data.
+struct Timed {
+    planner: Planner,
+    /// Sub-ticks of motion and waiting counted so far.
+    subticks: u64,
+    pen: Option<u8>,
+    coords: CoordTable,
+}
 
-    /// Feeds the stream's bytes; each line is carried out when it ends.
-    pub fn push(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            match self.parser.push(b) {
-                Some(Ok(Input::Line(line))) => {
-                    self.lines += 1;
-                    let allowed = Allowed {
-                        motion: true,
-                        position_known: true,
-                    };
-                    match self.interp.plan(&line, &self.kin, &self.config, allowed) {
-                        Ok(planned) => {
-                            self.interp.commit(&planned);
-                            self.carry_out(planned.order);
-                        }
-                        Err(_) => self.refused += 1,
-                    }
-                }
-                Some(Ok(_)) => self.lines += 1,
-                Some(Err(_)) => {
-                    self.lines += 1;
-                    self.refused += 1;
-                }
-                None => {}
-            }
-        }
-    }
-
-    /// Seconds counted so far: the blocks the planner has handed on.
-    pub fn seconds(&self) -> f64 {
-        self.subticks as f64 / SUBTICKS_PER_S as f64
-    }
-
-    /// The whole stream's time: every block still planned run out.
-    pub fn finish(mut self) -> f64 {
-        self.settle();
-        self.seconds()
-    }
-
-    fn carry_out(&mut self, order: Order) {
-        match order {
-            Order::Move { steps, feed } => self.push_move(steps, feed),
-            Order::Path { path, feed } => {
-                for piece in path {
-                    // Pieces were checked to be within reach with the line.
-                    if let Ok(steps) = self.kin.inverse(&piece) {
-                        self.push_move(steps, feed);
-                    }
-                }
-            }
-            Order::Dwell { ms } => self.wait_ms(ms),
-            Order::Pen { ms, .. } => self.wait_ms(ms as u32),
-            Order::SetPosition { steps } => {
-                self.settle();
-                self.planner.set_position(steps);
-            }
-            Order::Home { .. } | Order::Pause | Order::WaitIdle | Order::Drivers { .. } => {
-                self.settle()
-            }
-            Order::None | Order::ReportPosition => {}
-        }
-    }
-
-    fn push_move(&mut self, steps: crate::kinematics::Steps, feed: Feed) {
-        if self.planner.is_full() {
-            self.take();
-        }
-        // Not full: cannot fail.
-        let _ = self.planner.push(steps, feed);
-    }
-
+impl Timed {
     fn take(&mut self) {
         if let Some(p) = self.planner.take() {
             self.subticks += p.profile.time(p.profile.events());
@@ -126,10 +49,119 @@ impl GcodeTime {
             self.take();
         }
     }
+}
 
-    fn wait_ms(&mut self, ms: u32) {
+impl MachineIo for Timed {
+    fn coord(&self, index: u8) -> Exact {
+        self.coords.get(index)
+    }
+
+    fn set_coord(&mut self, index: u8, value: &Exact) {
+        self.coords.set(index, value);
+    }
+
+    fn room(&mut self, _piece: bool) -> Option<Wait> {
+        // A full planner hands its oldest block on (its time counted).
+        if self.planner.is_full() {
+            self.take();
+        }
+        None
+    }
+
+    fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
+        self.planner.push(*steps, feed).is_ok()
+    }
+
+    fn idle(&mut self) -> bool {
         self.settle();
-        self.subticks += ms as u64 * SUBTICKS_PER_S / 1000;
+        true
+    }
+
+    fn pen(&mut self, deg: u8) -> bool {
+        self.pen.replace(deg) != Some(deg)
+    }
+
+    fn drivers(&mut self, _on: bool) {}
+
+    fn pause(&mut self) {}
+
+    fn report_position(&mut self) {}
+
+    fn program_end(&mut self) {}
+
+    fn millis(&self) -> u32 {
+        (self.subticks * 1000 / SUBTICKS_PER_S) as u32
+    }
+}
+
+impl GcodeTime {
+    /// `None` when the configuration's kinematics cannot be made.
+    pub fn new(config: &MachineConfig) -> Option<Self> {
+        Some(GcodeTime {
+            parser: Parser::new(),
+            interp: Interpreter::new(),
+            kin: AnyKinematics::of(config).ok()?,
+            config: *config,
+            machine: Timed {
+                planner: Planner::new(config),
+                subticks: 0,
+                pen: None,
+                coords: CoordTable::new(),
+            },
+            lines: 0,
+            refused: 0,
+        })
+    }
+
+    /// Feeds the stream's bytes; each line is carried out when it ends.
+    pub fn push(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            let (block, jog) = match self.parser.push(b) {
+                None => continue,
+                Some(Ok(Input::Block(block))) => (block, false),
+                Some(Ok(Input::Jog(block))) => (block, true),
+                Some(Ok(_)) => {
+                    self.lines += 1;
+                    continue;
+                }
+                Some(Err(_)) => {
+                    self.lines += 1;
+                    self.refused += 1;
+                    continue;
+                }
+            };
+            self.lines += 1;
+            let env = Env {
+                kin: &self.kin,
+                cfg: &self.config,
+                allowed: Allowed::ALL,
+            };
+            if self.interp.accept(&block, jog, &env, &mut self.machine).is_err() {
+                self.refused += 1;
+                continue;
+            }
+            loop {
+                match self.interp.run(&env, &mut self.machine) {
+                    Progress::Done => break,
+                    Progress::Wait(Wait::Ms(ms)) => {
+                        self.machine.subticks += ms as u64 * SUBTICKS_PER_S / 1000
+                    }
+                    // The machine's `idle` and `room` make their own way.
+                    Progress::Wait(_) => {}
+                }
+            }
+        }
+    }
+
+    /// Seconds counted so far: the blocks the planner has handed on.
+    pub fn seconds(&self) -> f64 {
+        self.machine.subticks as f64 / SUBTICKS_PER_S as f64
+    }
+
+    /// The whole stream's time: every block still planned run out.
+    pub fn finish(mut self) -> f64 {
+        self.machine.settle();
+        self.seconds()
     }
 }
 

@@ -1,449 +1,537 @@
+//! Host tests of the executor against a recording machine: Grbl's
+//! step-3 errors in `gcode.c`'s order, work coordinates and offsets,
+//! soft limits in machine coordinates, the exact programmed position,
+//! the pen from spindle and `Z` words, program end, `$G`.
+
 use super::*;
-use crate::axis::AXES;
 use crate::gcode::{Input, Parser};
-use crate::kinematics::Linear;
-use std::vec::Vec;
+use crate::kinematics::AnyKinematics;
+use crate::machine::Machine;
+use proptest::prelude::*;
+use std::{format, string::String, string::ToString, vec::Vec};
 
-const CFG: MachineConfig = MachineConfig::STRING_ART;
-const FREE: Allowed = Allowed {
-    motion: true,
-    position_known: true,
-};
+/// What the executor asked of the machine, in order.
+#[derive(Clone, Debug, PartialEq)]
+enum Did {
+    Move(Steps, Feed),
+    Pen(u8),
+    Drivers(bool),
+    Pause,
+    Report,
+    End,
+}
 
-fn line(text: &str) -> Line {
-    let mut p = Parser::new();
-    let out: Vec<_> = text
-        .bytes()
-        .chain([b'\n'])
-        .filter_map(|b| p.push(b))
-        .collect();
-    match out.as_slice() {
-        [Ok(Input::Line(l))] => *l,
-        other => panic!("{text:?}: {other:?}"),
+/// A machine that does at once what it is asked and writes it down.
+struct Recorder {
+    did: Vec<Did>,
+    coords: CoordTable,
+    clock: u32,
+    pen: Option<u8>,
+}
+
+impl MachineIo for Recorder {
+    fn coord(&self, index: u8) -> Exact {
+        self.coords.get(index)
+    }
+    fn set_coord(&mut self, index: u8, value: &Exact) {
+        self.coords.set(index, value)
+    }
+    fn room(&mut self, _piece: bool) -> Option<Wait> {
+        None
+    }
+    fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
+        self.did.push(Did::Move(*steps, feed));
+        true
+    }
+    fn idle(&mut self) -> bool {
+        true
+    }
+    fn pen(&mut self, deg: u8) -> bool {
+        self.did.push(Did::Pen(deg));
+        self.pen.replace(deg) != Some(deg)
+    }
+    fn drivers(&mut self, on: bool) {
+        self.did.push(Did::Drivers(on))
+    }
+    fn pause(&mut self) {
+        self.did.push(Did::Pause)
+    }
+    fn report_position(&mut self) {
+        self.did.push(Did::Report)
+    }
+    fn program_end(&mut self) {
+        self.did.push(Did::End)
+    }
+    fn millis(&self) -> u32 {
+        self.clock
     }
 }
 
-/// Plans `text` with `allowed` and commits it when it is good.
-fn run(i: &mut Interpreter, text: &str, allowed: Allowed) -> Result<Order, ErrorKind> {
-    let kin = Linear::cylindrical(&CFG);
-    let planned = i.plan(&line(text), &kin, &CFG, allowed)?;
-    i.commit(&planned);
-    Ok(planned.order)
+/// A machine with its executor.
+struct Bench {
+    interp: Interpreter,
+    kin: AnyKinematics,
+    cfg: MachineConfig,
+    io: Recorder,
 }
 
-fn steps(order: Result<Order, ErrorKind>) -> Steps {
-    match order {
-        Ok(Order::Move { steps, .. }) | Ok(Order::SetPosition { steps }) => steps,
-        other => panic!("{other:?}"),
+impl Bench {
+    fn new(machine: Machine) -> Bench {
+        let cfg = MachineConfig::defaults(machine);
+        let io = Recorder {
+            did: Vec::new(),
+            coords: CoordTable::new(),
+            clock: 0,
+            pen: None,
+        };
+        let mut interp = Interpreter::new();
+        interp.reset(&io);
+        Bench {
+            interp,
+            kin: AnyKinematics::of(&cfg).unwrap(),
+            cfg,
+            io,
+        }
     }
-}
 
-#[test]
-fn a_refused_line_changes_no_modal_state() {
-    let mut i = Interpreter::new();
-    assert_eq!(
-        run(&mut i, "G91 G1 X1", FREE),
-        Err(ErrorKind::UndefinedFeedRate)
-    );
-    // Still G90 G0: an absolute rapid move.
-    let order = run(&mut i, "X5", FREE);
-    assert_eq!(
-        order.map(|o| matches!(
-            o,
-            Order::Move {
-                feed: Feed::Rapid,
-                ..
+    /// A flatbed standing at `x`, `y` (machine mm).
+    fn flatbed_at(x: i32, y: i32) -> Bench {
+        let mut b = Bench::new(Machine::Flatbed);
+        b.interp.resync(&[Milli(x * 1000), Milli(y * 1000), Milli(0)], 0b111);
+        b
+    }
+
+    /// Sends `text` (one line) and carries it out whole; Grbl's error
+    /// code if refused.
+    fn send(&mut self, text: &str) -> Result<(), u8> {
+        let mut p = Parser::new();
+        let mut out: Vec<_> = text.bytes().chain([b'\n']).filter_map(|b| p.push(b)).collect();
+        assert_eq!(out.len(), 1, "{text:?}");
+        let (block, jog) = match out.remove(0) {
+            Ok(Input::Block(b)) => (b, false),
+            Ok(Input::Jog(b)) => (b, true),
+            Ok(other) => panic!("{text:?}: {other:?}"),
+            Err(e) => return Err(e.code()),
+        };
+        let env = Env {
+            kin: &self.kin,
+            cfg: &self.cfg,
+            allowed: Allowed::ALL,
+        };
+        self.interp
+            .accept(&block, jog, &env, &mut self.io)
+            .map_err(|e| e as u8)?;
+        loop {
+            match self.interp.run(&env, &mut self.io) {
+                Progress::Done => return Ok(()),
+                Progress::Wait(Wait::Ms(ms)) => self.io.clock += ms as u32,
+                Progress::Wait(_) => {}
             }
-        )),
-        Ok(true)
-    );
-    assert_eq!(steps(Ok(order.unwrap()))[1], 160);
-    // A feed below the minimum is refused and the old one stays.
-    run(&mut i, "G1 F600", FREE).unwrap();
-    assert_eq!(run(&mut i, "G1 X1 F5", FREE), Err(ErrorKind::FeedTooLow));
-    let order = run(&mut i, "X6", FREE).unwrap();
-    assert!(matches!(
-        order,
-        Order::Move {
-            feed: Feed::PerMinute(Milli(600_000)),
-            ..
         }
-    ));
-}
-
-#[test]
-fn a_word_of_no_channel_of_the_machine_is_refused() {
-    let mut i = Interpreter::new();
-    // The string-art machine's words are C, X and Z: a Y is no channel.
-    assert_eq!(
-        run(&mut i, "G91 G1 X1 Y2 F600", FREE),
-        Err(ErrorKind::UnsupportedCommand)
-    );
-    // Nothing of the refused line was taken: still G90 G0.
-    assert_eq!(steps(run(&mut i, "X1", FREE))[1], 32);
-}
-
-#[test]
-fn planned_twice_committed_once_is_one_move() {
-    // A line waiting for planner room is planned again: only the commit
-    // moves the commanded position.
-    let kin = Linear::cylindrical(&CFG);
-    let mut i = Interpreter::new();
-    run(&mut i, "G91", FREE).unwrap();
-    let l = line("G0 C10");
-    let first = i.plan(&l, &kin, &CFG, FREE).unwrap();
-    let again = i.plan(&l, &kin, &CFG, FREE).unwrap();
-    assert_eq!(first, again);
-    i.commit(&again);
-    assert_eq!(i.target()[0], Milli(10_000));
-}
-
-#[test]
-fn relative_moves_never_drift() {
-    let mut i = Interpreter::new();
-    run(&mut i, "G91 G1 F60000", FREE).unwrap();
-    let mut last = [0; AXES];
-    for _ in 0..360 {
-        last = steps(run(&mut i, "C1", FREE));
     }
-    assert_eq!(last[0], 9600, "a whole turn, to the step");
-    // 1000 × 0.001 mm on the radial axis (32 steps/mm): 32 steps exactly.
-    for _ in 0..1000 {
-        last = steps(run(&mut i, "X0.001", FREE));
-    }
-    assert_eq!(last[1], 32);
-}
 
-#[test]
-fn soft_limits_refuse_before_anything_and_keep_the_target() {
-    let mut i = Interpreter::new();
-    assert_eq!(run(&mut i, "G0 X31", FREE), Err(ErrorKind::TravelExceeded));
-    assert_eq!(
-        run(&mut i, "G0 Z-30.001", FREE),
-        Err(ErrorKind::TravelExceeded)
-    );
-    assert_eq!(i.target(), [Milli::ZERO; AXES]);
-    // The base turns freely.
-    assert_eq!(steps(run(&mut i, "G0 C7200", FREE))[0], 192_000);
-    // G92 moves the zero the limits count from.
-    run(&mut i, "G92 X-440", FREE).unwrap();
-    assert_eq!(steps(run(&mut i, "G0 X30", FREE))[1], 960);
-}
-
-#[test]
-fn a_job_or_a_lost_position_refuses_what_would_move() {
-    let mut i = Interpreter::new();
-    let job = Allowed {
-        motion: false,
-        ..FREE
-    };
-    for text in ["G0 C1", "X1", "M17", "M18", "G92 C0"] {
-        assert_eq!(
-            run(&mut i, text, job),
-            Err(ErrorKind::JobOwnsMotion),
-            "{text}"
-        );
-    }
-    assert_eq!(run(&mut i, "M114", job), Ok(Order::ReportPosition));
-    assert_eq!(run(&mut i, "M400", job), Ok(Order::WaitIdle));
-    let lost = Allowed {
-        position_known: false,
-        ..FREE
-    };
-    assert_eq!(run(&mut i, "G0 C1", lost), Err(ErrorKind::Locked));
-    assert!(matches!(
-        run(&mut i, "G92 C0", lost),
-        Ok(Order::SetPosition { .. })
-    ));
-}
-
-#[test]
-fn reset_restores_the_modes_and_keeps_the_position() {
-    let mut i = Interpreter::new();
-    run(&mut i, "G91 G1 F100 C5", FREE).unwrap();
-    i.reset();
-    assert_eq!(i.target()[0], Milli(5_000));
-    // G90 G0 again: an absolute rapid.
-    assert!(matches!(
-        run(&mut i, "C1", FREE),
-        Ok(Order::Move { feed: Feed::Rapid, steps }) if steps[0] == 27
-    ));
-}
-
-#[test]
-fn dwell_and_drivers() {
-    let mut i = Interpreter::new();
-    assert_eq!(run(&mut i, "G4 P1.5", FREE), Ok(Order::Dwell { ms: 1500 }));
-    assert_eq!(run(&mut i, "M17", FREE), Ok(Order::Drivers { on: true }));
-    assert_eq!(run(&mut i, "M84", FREE), Ok(Order::Drivers { on: false }));
-    assert_eq!(run(&mut i, "G91", FREE), Ok(Order::None));
-}
-
-/// The chord ends of an arc order, in milli-units of X and Z.
-fn chords(order: Result<Order, ErrorKind>) -> Vec<(i32, i32)> {
-    match order {
-        Ok(Order::Path {
-            path: Path::Arc(arc),
-            feed,
-        }) => {
-            assert_eq!(feed, Feed::PerMinute(Milli(100_000)));
-            arc.map(|p| (p[1].0, p[2].0)).collect()
+    #[track_caller]
+    fn ok(&mut self, text: &str) {
+        if let Err(code) = self.send(text) {
+            panic!("{text:?}: error:{code}");
         }
-        other => panic!("{other:?}"),
+    }
+
+    fn err(&mut self, text: &str) -> u8 {
+        self.send(text).err().unwrap_or(0)
+    }
+
+    /// The last move's steps.
+    fn steps(&self) -> Steps {
+        self.io
+            .did
+            .iter()
+            .rev()
+            .find_map(|d| match d {
+                Did::Move(s, _) => Some(*s),
+                _ => None,
+            })
+            .expect("no move")
+    }
+
+    fn moves(&self) -> usize {
+        self.io.did.iter().filter(|d| matches!(d, Did::Move(..))).count()
+    }
+
+    /// `$G` as the console prints it.
+    fn gc(&self) -> String {
+        show(&self.interp.parser_state(false))
+    }
+
+    /// Machine position, mm (µm rounded).
+    fn mpos(&self) -> [i32; 3] {
+        self.interp.target().map(|m| m.0)
+    }
+
+    fn wco(&self) -> [i32; 3] {
+        self.interp.wco().map(|m| m.0)
+    }
+}
+
+fn show(d: &impl ufmt::uDisplay) -> String {
+    crate::text::error::tests::show(d)
+}
+
+/// (setup lines, line, Grbl's error, gcode.c line): step 3's checks on
+/// the flatbed (words X Y and the pen's Z), in Grbl's order.
+const STEP_3: &[(&str, &str, u8, &str)] = &[
+    ("", "G1 X1", 22, "665: no feed rate yet"),
+    ("", "G2 X1 I1", 22, "665"),
+    ("G93", "G1 X1", 22, "401: G93 needs F on every feed move"),
+    ("G93 G1 X1 F10", "X2", 22, "401"),
+    ("G1 F100 G93", "G94 G1 X1", 22, "423: from G93 no feed is kept"),
+    ("", "G4", 28, "456: dwell without P"),
+    ("", "G10 L20 X0", 28, "not reached: L without P is fine"),
+    ("", "G10 X0", 28, "533: neither L nor P"),
+    ("", "G10 L20 P1", 26, "532: no axis words"),
+    ("", "G10 L2 P7 X0", 29, "535: P above 6"),
+    ("", "G10 L3 P1 X0", 20, "539: L other than 2 or 20"),
+    ("", "G10 L2 P1 R1 X0", 20, "538: G10 L2 with R"),
+    ("", "G92", 26, "563"),
+    ("", "G53 G2 X1 I1 F100", 30, "630: G53 only with G0 or G1"),
+    ("G80", "X1", 31, "640: axis words in G80"),
+    ("", "G80 G28 X1", 31, "640: even non-modal commands"),
+    ("", "G4 P1 X1", 31, "never: bare axis words move in G0"),
+    ("", "G2 F100", 26, "678: an explicit G2 needs axis words"),
+    ("G1 F100", "G1", 0, "not an error: G1 alone changes the mode"),
+    ("", "G2 X1 F100", 35, "846: no offset in the plane"),
+    ("", "G2 Z1 I1 F100", 32, "688: no axis word of the plane"),
+    ("", "G2 X70 Y0 R5 F100", 33, "694: R with the end at the start"),
+    ("", "G2 X20 R5 F100", 34, "769: radius too small"),
+    ("", "G2 X10 I3 F100", 33, "826: end off the circle by over 0.5 mm"),
+    ("", "G1 X1 I1 F100", 36, "859: I without an arc"),
+    ("", "G1 X1 P1 F100", 36, "859: P without G4 or G10"),
+    ("", "G0 X1 L2", 36, "859"),
+    ("", "G2 X72 I1 R1 F100", 36, "859: I left over in radius form"),
+    ("", "G43.1 X1", 37, "491: G43.1 takes Z only"),
+    ("", "G43.1 Z1 X1", 37, "491"),
+    ("", "$J=X1", 22, "396: a jog needs F"),
+    ("", "$J=G1 X1 F100", 16, "856: a jog takes no motion command"),
+    ("", "$J=G17 X1 F100", 16, "856"),
+    ("", "$J=G28 X1 F100", 16, "857"),
+    ("", "$J=X1 S1 F100", 36, "859: S unused in a jog"),
+    ("", "$J=F100", 26, "jogging.md: an axis word is required"),
+    ("", "G0 X141", 15, "taut: out of the 0…140 mm travel"),
+    ("", "G1 X1 F5", 72, "taut: a feed below 10 mm/min"),
+];
+
+#[test]
+fn grbl_s_step_3_errors_in_gcode_c_s_order() {
+    for (setup, line, code, why) in STEP_3 {
+        let mut b = Bench::flatbed_at(70, 0);
+        for l in setup.split('\n').filter(|l| !l.is_empty()) {
+            b.ok(l);
+        }
+        let got = b.send(line).err();
+        let expected = match why.starts_with("not") || why.starts_with("never") {
+            true => None,
+            false => Some(*code),
+        };
+        assert_eq!(got, expected, "{setup:?} then {line:?} (gcode.c {why})");
     }
 }
 
 #[test]
-fn arcs_in_the_zx_plane_end_exactly_and_stay_on_the_circle() {
-    let mut i = Interpreter::new();
-    // G18: Z then X, offsets K then I. Centre X5 Z0, radius 5, half a turn.
-    let ends = chords(run(&mut i, "G18 G2 X10 I5 F100", FREE));
-    assert_eq!(*ends.last().unwrap(), (10_000, 0));
-    assert!(ends.len() > 10, "{} chords", ends.len());
-    for (x, z) in &ends {
-        let d = (((x - 5_000) as f64).powi(2) + (*z as f64).powi(2)).sqrt();
-        assert!((d - 5_000.0).abs() <= 1.5, "{x} {z}");
+fn a_refused_line_changes_nothing() {
+    let mut b = Bench::flatbed_at(70, 0);
+    let gc = b.gc();
+    assert_eq!(b.err("G91 G21 G55 G1 X1"), 22);
+    assert_eq!(b.gc(), gc);
+    assert_eq!(b.err("G92 X0 G4"), 21);
+    assert_eq!(b.err("G10 L2 P9 X1"), 29);
+    assert_eq!(b.wco(), [0; 3]);
+    assert_eq!(b.moves(), 0);
+}
+
+/// The sender's "zero" button: homed, at the middle of the bed, `G10 L20
+/// P1 X0 Y0` makes it the work zero; `G0 X0 Y0` goes back to it; the
+/// machine position never changes by an offset.
+#[test]
+fn work_zero_with_g10_l20_and_moves_in_work_coordinates() {
+    let mut b = Bench::flatbed_at(70, 100);
+    b.ok("G10 L20 P1 X0 Y0");
+    assert_eq!(b.wco(), [70_000, 100_000, 0]);
+    assert_eq!(b.mpos(), [70_000, 100_000, 0]);
+    assert_eq!(b.io.coords.get(0), [70_000_000, 100_000_000, 0]);
+    b.ok("G0 X-20 Y5");
+    assert_eq!(b.mpos(), [50_000, 105_000, 0]);
+    assert_eq!(b.steps(), [2000, 4200, 0]);
+    // G53: machine coordinates for one line.
+    b.ok("G53 G0 X10");
+    assert_eq!(b.mpos(), [10_000, 105_000, 0]);
+    b.ok("G0 X0 Y0");
+    assert_eq!(b.mpos(), [70_000, 100_000, 0]);
+    // G55 has no offset: its zero is the machine's.
+    b.ok("G55 G0 X0");
+    assert_eq!(b.mpos(), [0, 100_000, 0]);
+    assert_eq!(b.gc(), "G0 G55 G17 G21 G90 G94 M5 M9 T0 F0 S0");
+    b.ok("G10 L2 P2 X5");
+    assert_eq!(b.wco(), [5_000, 0, 0]);
+    b.ok("G10 L2 P0 Y7");
+    assert_eq!(b.io.coords.get(1), [5_000_000, 7_000_000, 0]);
+    b.ok("G54");
+    assert_eq!(b.wco(), [70_000, 100_000, 0]);
+}
+
+/// `G92` is an offset, never a new machine position: the travel stays
+/// where the machine has it (the safety hole this closes: at X20, `G92
+/// X0` then `G0 X139` went 19 mm past the 140 mm travel).
+#[test]
+fn g92_is_an_offset_and_the_travel_stays_in_machine_coordinates() {
+    let mut b = Bench::flatbed_at(20, 0);
+    b.ok("G92 X0");
+    assert_eq!(b.wco(), [20_000, 0, 0]);
+    assert_eq!(b.mpos(), [20_000, 0, 0]);
+    assert_eq!(b.err("G0 X139"), 15);
+    assert_eq!(b.err("G0 X-21"), 15);
+    b.ok("G0 X120");
+    assert_eq!(b.mpos(), [140_000, 0, 0]);
+    b.ok("G0 X-20");
+    assert_eq!(b.steps()[0], 0);
+    // G10 L20 counts the G92 offset (WCS = MPos − G92 − WPos).
+    b.ok("G10 L20 P1 X5");
+    assert_eq!(b.io.coords.get(0)[0], -25_000_000);
+    assert_eq!(b.wco(), [-5_000, 0, 0]);
+    b.ok("G92.1");
+    assert_eq!(b.wco(), [-25_000, 0, 0]);
+    // A jog is refused past the travel too (Grbl's error 15).
+    assert_eq!(b.err("$J=G53 X150 F1000"), 15);
+    b.ok("$J=G91 X10 F1000");
+    assert_eq!(b.mpos()[0], 10_000);
+}
+
+#[test]
+fn g28_and_g30_go_to_their_stored_positions() {
+    let mut b = Bench::flatbed_at(30, 40);
+    b.ok("G28.1");
+    b.ok("G0 X50 Y60");
+    b.ok("G30.1");
+    b.ok("G0 X10 Y10");
+    b.ok("G28");
+    assert_eq!(b.mpos(), [30_000, 40_000, 0]);
+    assert_eq!(b.moves(), 3);
+    // Through a point, then only the named axis goes home.
+    b.ok("G30 X20");
+    assert_eq!(b.mpos(), [50_000, 40_000, 0]);
+    let n = b.io.did.len();
+    assert_eq!(b.io.did[n - 2], Did::Move([800, 1600, 0], Feed::Rapid));
+    assert_eq!(b.io.did[n - 1], Did::Move([2000, 1600, 0], Feed::Rapid));
+}
+
+/// Grbl keeps the programmed position unrounded and rounds the absolute
+/// target to steps once: 2 000 × `G91 G1 X0.0125` is 25 mm exactly, 2 000
+/// × `X0.00049` inch is 24.892 mm (996 steps of 0.025 mm).
+#[test]
+fn relative_moves_add_up_exactly() {
+    let mut b = Bench::flatbed_at(0, 0);
+    b.ok("G91 G1 F1000");
+    for _ in 0..2000 {
+        b.ok("X0.0125");
     }
-    // G2 in ZX (Z right, X up) is clockwise: from X0 through Z-5.
-    assert!(ends.iter().all(|(_, z)| *z <= 0));
-    assert_eq!(i.target()[1], Milli(10_000));
-    // Modal: bare axis words continue the arc, here relative and back.
-    run(&mut i, "G91", FREE).unwrap();
-    let back = chords(run(&mut i, "X-10 R5", FREE));
-    assert_eq!(*back.last().unwrap(), (0, 0));
-    assert!(
-        back.iter().all(|(_, z)| *z >= 0),
-        "clockwise, the other half"
-    );
-}
-
-#[test]
-fn arcs_are_refused_whole_before_anything_moves() {
-    let mut i = Interpreter::new();
-    let refused = [
-        // The circle passes X40, beyond the radial's travel (30).
-        ("G18 G2 X0 I20 F100", ErrorKind::TravelExceeded),
-        // A whole turn of radius 12.5 reaches Z+12.5, past the drill's
-        // travel (12), though both its ends are inside.
-        ("G18 G3 X0 I12.5 F100", ErrorKind::TravelExceeded),
-        // The string-art machine has no Y: no arc in XY.
-        ("G17 G2 X10 I5 F100", ErrorKind::ArcNoAxisInPlane),
-        ("G18 G2 C10 I5 F100", ErrorKind::ArcNoAxisInPlane),
-        ("G18 G2 X10 J5 F100", ErrorKind::ArcNoOffsetInPlane),
-        ("G18 G2 X10 I4 F100", ErrorKind::InvalidTarget),
-        ("G18 G2 X10 R4 F100", ErrorKind::ArcRadiusInvalid),
-        ("G18 G2 X0 R4 F100", ErrorKind::InvalidTarget),
-        ("G18 G2 X10 I5", ErrorKind::UndefinedFeedRate),
-        ("I5 X10", ErrorKind::UnusedValueWords),
-        ("G18 G2 I5 F100", ErrorKind::UnusedValueWords),
-    ];
-    for (text, kind) in refused {
-        assert_eq!(run(&mut i, text, FREE).err(), Some(kind), "{text}");
-        // No mode changed: a bare X is still an absolute rapid.
-        assert_eq!(
-            run(&mut i, "X1", FREE),
-            Ok(Order::Move {
-                steps: [0, 32, 0],
-                feed: Feed::Rapid
-            }),
-            "after {text}"
-        );
-        run(&mut i, "X0", FREE).unwrap();
+    assert_eq!(b.mpos()[0], 25_000);
+    assert_eq!(b.steps()[0], 1000);
+    b.ok("G20");
+    for _ in 0..2000 {
+        b.ok("Y0.00049");
     }
-    let job = Allowed {
-        motion: false,
-        ..FREE
-    };
-    let lost = Allowed {
-        position_known: false,
-        ..FREE
-    };
+    assert_eq!(b.interp.position()[1], 24_892_000);
+    assert_eq!(b.steps()[1], 996);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+
+    /// 10 000 relative moves of any size: the steps are the sum of the
+    /// words rounded once.
+    #[test]
+    fn ten_thousand_relative_moves_are_their_sum(
+        words in prop::collection::vec((-30_000i64..30_000, 2u32..=6), 10_000),
+        inch in any::<bool>(),
+    ) {
+        let mut b = Bench::new(Machine::Drum);
+        b.cfg.axes[0].soft_limits = false;
+        b.ok(if inch { "G20 G91 G1 F100" } else { "G21 G91 G1 F100" });
+        let mut sum: i128 = 0;
+        for (w, places) in &words {
+            // w / 10^places units, written with `places` decimals.
+            let sign = if *w < 0 { "-" } else { "" };
+            let p = 10i64.pow(*places);
+            let text = match places {
+                0 => format!("X{sign}{}", w.abs()),
+                _ => format!("X{sign}{}.{:0n$}", w.abs() / p, w.abs() % p, n = *places as usize),
+            };
+            b.ok(&text);
+            sum += *w as i128 * 10i128.pow(6 - places);
+        }
+        // In nanometres; an inch is 25.4 mm.
+        let nm = if inch { sum * 254 / 10 } else { sum };
+        let spu = b.cfg.axes[0].steps_per_unit;
+        let n = nm * spu.num as i128;
+        let d = spu.den as i128 * 1_000_000;
+        let expected = if n >= 0 { (n + d / 2) / d } else { -((-n + d / 2) / d) };
+        if inch {
+            // Inch words of 6 decimals round to the nanometre each.
+            prop_assume!(words.iter().all(|(_, p)| *p <= 5));
+        }
+        prop_assert_eq!(b.steps()[0] as i128, expected);
+        prop_assert_eq!(b.interp.position()[0] as i128, nm);
+    }
+}
+
+/// On a plotter `M3`/`M4` with any `S` lower the pen to `pen_down`, `M5`
+/// raises it, `M300 S` sets its angle; a line with X/Y and a pen `Z`
+/// (gcodetools' `G01 X… Y… Z-0.1 F400`) sets the pen first, then moves.
+#[test]
+fn the_pen_from_spindle_words_and_z() {
+    let mut b = Bench::flatbed_at(70, 0);
+    let (up, down) = (b.cfg.pen.up_deg, b.cfg.pen.down_deg);
+    b.ok("M3 S1000");
+    assert_eq!(b.io.did, [Did::Pen(down)]);
+    assert_eq!(b.gc(), "G0 G54 G17 G21 G90 G94 M3 M9 T0 F0 S1000");
+    b.ok("M5");
+    b.ok("M4 S12");
+    b.ok("M300 S42");
+    assert_eq!(b.io.did[1..], [Did::Pen(up), Did::Pen(down), Did::Pen(42)]);
+    assert_eq!(b.gc(), "G0 G54 G17 G21 G90 G94 M4 M9 T0 F0 S12");
+    b.io.did.clear();
+    b.ok("G01 X10 Y20 Z-0.1 F400");
     assert_eq!(
-        run(&mut i, "G18 G2 X10 I5 F100", job).err(),
-        Some(ErrorKind::JobOwnsMotion)
+        b.io.did,
+        [
+            Did::Pen(down),
+            Did::Move([400, 800, 0], Feed::PerMinute(Milli(400_000)))
+        ]
     );
-    assert_eq!(
-        run(&mut i, "G18 G2 X10 I5 F100", lost).err(),
-        Some(ErrorKind::Locked)
-    );
+    b.io.did.clear();
+    b.ok("G00 Z5");
+    assert_eq!(b.io.did, [Did::Pen(up), Did::Move([400, 800, 0], Feed::Rapid)]);
+    // The pen follows the work Z, not the machine's.
+    b.ok("G10 L20 P1 Z0");
+    b.ok("G0 Z-1");
+    assert_eq!(b.io.pen, Some(down));
+    // The string-art machine has no pen: M3 is kept for $G, M300 refused.
+    let mut s = Bench::new(Machine::StringArt);
+    s.ok("M3 S100");
+    assert!(s.io.did.is_empty());
+    assert_eq!(s.err("M300 S30"), 20);
+    assert_eq!(b.err("M300"), 28);
+}
+
+/// `M2`/`M30`: once the motion is done, Grbl's program end (`gcode.c`
+/// line 1077): `G1 G17 G90 G94 G54 M5 M9`, the pen up, `[MSG:Pgm End]`.
+#[test]
+fn program_end_resets_what_grbl_resets() {
+    let mut b = Bench::flatbed_at(70, 0);
+    b.ok("G10 L2 P2 X1");
+    b.ok("G55 G91 G18 G20 G93 M3 M8 S100 T2");
+    b.ok("M30");
+    assert_eq!(b.gc(), "G1 G54 G17 G20 G90 G94 M5 M9 T0 F0 S100");
+    let n = b.io.did.len();
+    assert_eq!(b.io.did[n - 2..], [Did::Pen(b.cfg.pen.up_deg), Did::End]);
+    // M1: no optional-stop switch, so nothing; M0 holds.
+    b.io.did.clear();
+    b.ok("M1");
+    assert!(b.io.did.is_empty());
+    b.ok("M0");
+    assert_eq!(b.io.did, [Did::Pause]);
 }
 
 #[test]
-fn a_full_circle_and_the_long_way_round() {
-    let mut i = Interpreter::new();
-    let circle = chords(run(&mut i, "G18 G3 X0 I5 F100", FREE));
-    assert_eq!(*circle.last().unwrap(), (0, 0));
-    let (min, max) = circle.iter().fold((i32::MAX, i32::MIN), |(a, b), (x, _)| {
-        (a.min(*x), b.max(*x))
-    });
-    assert!((min, max) == (0, 10_000), "a whole turn: X {min}..{max}");
-    // R negative: more than half a turn, so the path reaches past the
-    // chord's far side.
-    let short = chords(run(&mut i, "G2 X6 R5", FREE));
-    run(&mut i, "G0 X0", FREE).unwrap();
-    let long = chords(run(&mut i, "G2 X6 R-5", FREE));
-    assert!(long.len() > short.len());
-    assert!(long.iter().any(|(x, _)| *x > 6_000) && short.iter().all(|(x, _)| *x <= 6_000));
+fn g_shows_grbl_s_modes_feed_in_mm_per_minute() {
+    let mut b = Bench::flatbed_at(70, 0);
+    assert_eq!(b.gc(), "G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0");
+    b.ok("G20 G1 F10");
+    // Grbl keeps and shows the feed in mm/min.
+    assert_eq!(b.gc(), "G1 G54 G17 G20 G90 G94 M5 M9 T0 F254 S0");
+    assert_eq!(show(&b.interp.parser_state(true)), "G1 G54 G17 G20 G90 G94 M5 M9 T0 F10.0 S0");
+    b.ok("M7");
+    b.ok("M8 T7");
+    assert_eq!(b.gc(), "G1 G54 G17 G20 G90 G94 M5 M7 M8 T7 F254 S0");
+    b.ok("G80 G91.1 G40 G49 G61 M9");
+    assert_eq!(b.gc(), "G80 G54 G17 G20 G90 G94 M5 M9 T0 F254 S0");
+    // A jog changes no mode.
+    b.ok("G0");
+    b.ok("$J=G91 G21 X1 F500");
+    assert_eq!(b.gc(), "G0 G54 G17 G20 G90 G94 M5 M9 T0 F254 S0");
 }
 
 #[test]
-fn straight_moves_of_an_arm_are_cut_into_pieces_that_it_reaches() {
-    use crate::kinematics::AnyKinematics;
-    use crate::machine::Machine;
-    let cfg = MachineConfig::defaults(Machine::Scara);
-    let kin = AnyKinematics::of(&cfg).unwrap();
-    let mut i = Interpreter::new();
-    i.resync(kin.forward(&[0; crate::axis::AXES]));
-    let plan = |i: &mut Interpreter, text| {
-        let planned = i.plan(&line(text), &kin, &cfg, FREE)?;
-        i.commit(&planned);
-        Ok::<_, ErrorKind>(planned.order)
+fn tool_length_offset_moves_the_work_z() {
+    let mut b = Bench::new(Machine::StringArt);
+    b.ok("G43.1 Z2");
+    assert_eq!(b.wco(), [0, 0, 2_000]);
+    b.ok("G0 Z1");
+    assert_eq!(b.mpos()[2], 3_000);
+    b.ok("G49");
+    assert_eq!(b.wco(), [0; 3]);
+}
+
+#[test]
+fn arcs_end_on_the_exact_target() {
+    let mut b = Bench::flatbed_at(70, 50);
+    b.ok("G10 L20 P1 X0 Y0");
+    b.ok("G2 X10.0125 Y0 I5.00625 J0 F600");
+    assert!(b.moves() > 10);
+    // 80.0125 mm at 40 steps/mm: 3200.5 → 3201, rounded once.
+    assert_eq!(b.steps(), [3201, 2000, 0]);
+}
+
+#[test]
+fn lines_wait_for_the_machine_and_check_mode_moves_nothing() {
+    let mut b = Bench::flatbed_at(70, 0);
+    let env_check = Allowed {
+        motion: true,
+        checking: true,
     };
-    plan(&mut i, "G0 X100 Y150").unwrap();
-    let ends: Vec<Position> = match plan(&mut i, "G1 X130 Y110 F600") {
-        Ok(Order::Path {
-            path: Path::Line(line),
-            ..
-        }) => line.collect(),
-        other => panic!("{other:?}"),
-    };
-    // 50 mm in pieces of at most 1 mm, on the line, the last one exact.
-    assert_eq!(ends.len(), 50);
-    assert_eq!(ends[24][..2], [Milli(115_000), Milli(130_000)]);
-    assert_eq!(ends[49][..2], [Milli(130_000), Milli(110_000)]);
-    // Out of the arms' reach (300 mm from the shoulder at 100, −56): refused
-    // whole, nothing changes.
-    assert_eq!(plan(&mut i, "G1 X100 Y250"), Err(ErrorKind::InvalidTarget));
-    assert_eq!(i.target()[..2], [Milli(130_000), Milli(110_000)]);
-}
-
-#[test]
-fn the_pen_of_a_plotter_answers_m3_m5_m300_and_z() {
-    use crate::machine::Machine;
-    let cfg = MachineConfig::defaults(Machine::Flatbed);
-    let kin = crate::kinematics::AnyKinematics::of(&cfg).unwrap();
-    let mut i = Interpreter::new();
-    let mut plan = |text| {
-        let planned = i.plan(&line(text), &kin, &cfg, FREE)?;
-        i.commit(&planned);
-        Ok::<_, ErrorKind>(planned.order)
-    };
-    let pen = |deg| Ok(Order::Pen { deg, ms: 150 });
-    assert_eq!(plan("M3"), pen(30));
-    assert_eq!(plan("M5"), pen(50));
-    assert_eq!(plan("M300 S30"), pen(30));
-    assert_eq!(plan("M300 S50"), pen(50));
-    assert_eq!(plan("M3 S12.7"), pen(12));
-    // Seed 002 and gcodetools: Z above 0 is up, 0 or below is down.
-    assert_eq!(plan("G0 Z1"), pen(50));
-    assert_eq!(plan("G1 Z-0.5 F100"), pen(30));
-    assert_eq!(plan("G0 Z0"), pen(30));
-    assert_eq!(plan("G1 X10 Z1"), Err(ErrorKind::PenWithMove));
-    // Z drives no motor: X alone moves only X.
-    assert_eq!(
-        plan("G0 X1"),
-        Ok(Order::Move {
-            steps: [40, 0, 0],
-            feed: Feed::Rapid
-        })
-    );
-    assert_eq!(plan("M0"), Ok(Order::Pause));
-    // The unicorn's `G4 P150` is 150 ms on a plotter.
-    assert_eq!(plan("G4 P150"), Ok(Order::Dwell { ms: 150 }));
-}
-
-#[test]
-fn the_string_art_machine_has_no_pen_and_dwells_in_seconds() {
-    let mut i = Interpreter::new();
-    assert_eq!(run(&mut i, "M3", FREE), Err(ErrorKind::UnsupportedCommand));
-    assert_eq!(
-        run(&mut i, "M300 S30", FREE),
-        Err(ErrorKind::UnsupportedCommand)
-    );
-    assert_eq!(run(&mut i, "G4 P1.5", FREE), Ok(Order::Dwell { ms: 1500 }));
-    // Z is the drill there.
-    assert_eq!(steps(run(&mut i, "G0 Z1.5", FREE)), [0, 0, 200]);
-}
-
-#[test]
-fn inches_are_converted_once_and_angles_stay_degrees() {
-    let mut i = Interpreter::new();
-    // 1 in = 25.4 mm = 812.8 → 813 radial steps; C stays 90°.
-    assert_eq!(steps(run(&mut i, "G20 G0 X1 C90", FREE)), [2400, 813, 0]);
-    // Modal: the next line is in inches too, from the absolute target.
-    assert_eq!(steps(run(&mut i, "G91 X-0.5", FREE)), [2400, 406, 0]);
-    assert_eq!(steps(run(&mut i, "G21 X-12.7", FREE)), [2400, 0, 0]);
-    // F in inches per minute: 0.3 in/min = 7.62 mm/min, below the least.
-    assert_eq!(
-        run(&mut i, "G20 G1 X1 F0.3", FREE),
-        Err(ErrorKind::FeedTooLow)
-    );
-}
-
-/// `$G` in Grbl 1.1's words, after the lines that set each mode; a line
-/// that fails changes none of it.
-#[test]
-fn parser_state_reports_the_modal_state_as_grbl() {
-    let show = |i: &Interpreter, pen| crate::text::error::tests::show(&i.parser_state(pen));
-    let mut i = Interpreter::new();
-    assert_eq!(show(&i, false), "G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0");
-    run(&mut i, "G91 G18 G1 X1 F500", FREE).unwrap();
-    assert_eq!(show(&i, true), "G1 G54 G18 G21 G91 G94 M3 M9 T0 F500 S0");
-    assert!(run(&mut i, "G90 G2 X5 I1", FREE).is_err());
-    run(&mut i, "G20 G90", FREE).unwrap();
-    // 500 mm/min is 19.7 inches a minute.
-    assert_eq!(show(&i, false), "G1 G54 G18 G20 G90 G94 M5 M9 T0 F19 S0");
-}
-
-fn jog(text: &str) -> Line {
     let mut p = Parser::new();
-    let out: Vec<_> = text
-        .bytes()
-        .chain([b'\n'])
-        .filter_map(|b| p.push(b))
-        .collect();
-    match out.as_slice() {
-        [Ok(Input::Jog(l))] => *l,
-        other => panic!("{text:?}: {other:?}"),
+    let block = match p.push_all_test(b"G1 X10 F100 M114\n") {
+        Some(Ok(Input::Block(b))) => b,
+        other => panic!("{other:?}"),
+    };
+    let env = Env {
+        kin: &b.kin,
+        cfg: &b.cfg,
+        allowed: env_check,
+    };
+    b.interp.accept(&block, false, &env, &mut b.io).unwrap();
+    assert_eq!(b.interp.run(&env, &mut b.io), Progress::Done);
+    assert_eq!(b.io.did, [Did::Report]);
+    // The state is taken: the next line starts at X10.
+    assert_eq!(b.mpos()[0], 10_000);
+}
+
+impl Parser {
+    fn push_all_test(&mut self, bytes: &[u8]) -> Option<Result<Input, crate::gcode::Error>> {
+        bytes.iter().filter_map(|&b| self.push(b)).last()
     }
 }
 
-/// jogging.md: "The jog command ... G20, G21, G90, G91 ... only apply to
-/// the jog and do not alter the g-code parser state"; "if soft limits
-/// are enabled, jog commands beyond the travel are rejected with an
-/// error" (15).
+/// A job owns the motion: reads are answered, anything that moves is
+/// refused (taut's 71).
 #[test]
-fn a_jog_moves_and_keeps_the_modal_state_but_the_position() {
-    let kin = Linear::cylindrical(&CFG);
-    let mut i = Interpreter::new();
-    run(&mut i, "G1 X-10 F300", FREE).unwrap();
-    let before = i.parser_state(false);
-    let planned = i
-        .plan(&jog("$J=G91 G20 X-1 F10"), &kin, &CFG, FREE)
-        .unwrap();
-    // One inch further out at 10 in/min: 254 mm/min.
-    assert_eq!(
-        planned.order,
-        Order::Move {
-            // 35.4 mm at 32 steps/mm: 1132.8 steps, rounded once.
-            steps: [0, -1133, 0],
-            feed: Feed::PerMinute(Milli(254_000)),
-        }
-    );
-    i.commit_jog(&planned);
-    assert_eq!(i.parser_state(false), before, "G90 G21 G1 F300 stay");
-    assert_eq!(i.target()[1], Milli(-35_400));
-    // Beyond the radial travel (−450 mm): refused, nothing changes.
-    assert_eq!(
-        i.plan(&jog("$J=X-451 F100"), &kin, &CFG, FREE),
-        Err(ErrorKind::TravelExceeded)
-    );
-    let locked = Allowed {
-        position_known: false,
-        ..FREE
-    };
-    assert_eq!(
-        i.plan(&jog("$J=X-1 F100"), &kin, &CFG, locked),
-        Err(ErrorKind::Locked)
-    );
+fn a_job_owns_the_motion() {
+    let mut b = Bench::new(Machine::StringArt);
+    let mut p = Parser::new();
+    for (text, refused) in [("G0 X1", true), ("G92 X0", true), ("M17", true), ("G91", false), ("M114", false)] {
+        let block = match p.push_all_test(format!("{text}\n").as_bytes()) {
+            Some(Ok(Input::Block(b))) => b,
+            other => panic!("{other:?}"),
+        };
+        let env = Env {
+            kin: &b.kin,
+            cfg: &b.cfg,
+            allowed: Allowed {
+                motion: false,
+                checking: false,
+            },
+        };
+        let r = b.interp.accept(&block, false, &env, &mut b.io);
+        assert_eq!(r.is_err(), refused, "{text}: {r:?}");
+    }
+    let _ = "".to_string();
 }

@@ -1,0 +1,166 @@
+//! Carrying out an accepted line's actions (Grbl's step 4 in order):
+//! each waits where Grbl's `protocol_buffer_synchronize` or a full
+//! planner would, and goes on at the next call.
+
+use super::{coords, motor_channels, motor_steps, todo, Env, Interpreter, MachineIo, Path,
+    Progress, Wait, SEGMENT_UM};
+use crate::kinematics::{Kinematics, Segmenter};
+
+impl Interpreter {
+    /// Carry out what is left of the accepted line, as far as the
+    /// machine lets it now. Never inlined: a path's piece is worked out
+    /// in its frame, off the caller's.
+    #[inline(never)]
+    pub fn run<K: Kinematics>(&mut self, env: &Env<K>, io: &mut impl MachineIo) -> Progress {
+        loop {
+            let todo = self.run.todo;
+            // The first action left, lowest bit first.
+            let next = todo & todo.wrapping_neg();
+            if next == 0 {
+                return Progress::Done;
+            }
+            let waits = match next {
+                todo::PEN => self.pen(self.run.pen, env, io),
+                todo::PEN_Z => self.pen(self.run.pen_z, env, io),
+                todo::DRIVERS_ON => {
+                    io.drivers(true);
+                    None
+                }
+                todo::DWELL => self.after_motion(io).or_else(|| self.wait_ms(self.run.dwell_ms, io)),
+                todo::LEG_0 | todo::LEG_1 => self.leg(next == todo::LEG_1, env, io),
+                todo::PATH => self.piece(env, io),
+                todo::PAUSE => self.after_motion(io).or_else(|| {
+                    io.pause();
+                    None
+                }),
+                todo::END => self.after_motion(io).or_else(|| {
+                    // M5: a plotter's pen goes up; then Grbl's message.
+                    let up = env.cfg.pen.up_deg;
+                    let pen = match env.cfg.machine.is_string_art() {
+                        true => None,
+                        false => self.pen(up, env, io),
+                    };
+                    if pen.is_none() {
+                        io.program_end();
+                    }
+                    pen
+                }),
+                todo::DRIVERS_OFF => self.after_motion(io).or_else(|| {
+                    io.drivers(false);
+                    None
+                }),
+                todo::WAIT => self.after_motion(io),
+                _ => {
+                    io.report_position();
+                    None
+                }
+            };
+            if let Some(wait) = waits {
+                return Progress::Wait(wait);
+            }
+            // Done: an action that takes its own bit off (a leg that became
+            // a path) has already.
+            self.run.todo &= !next;
+        }
+    }
+
+    /// Waits for the motion before to end.
+    fn after_motion(&self, io: &mut impl MachineIo) -> Option<Wait> {
+        match io.idle() {
+            true => None,
+            false => Some(Wait::Motion),
+        }
+    }
+
+    /// Waits `ms` from the first call.
+    fn wait_ms(&mut self, ms: u32, io: &mut impl MachineIo) -> Option<Wait> {
+        let now = io.millis();
+        let until = *self.dwell_until.get_or_insert(now.wrapping_add(ms));
+        let left = until.wrapping_sub(now) as i32;
+        if left > 0 {
+            return Some(Wait::Ms(left.min(u16::MAX as i32) as u16));
+        }
+        self.dwell_until = None;
+        None
+    }
+
+    /// The pen to `deg` once the motion before is done, then its settle
+    /// time if it moved.
+    fn pen<K: Kinematics>(&mut self, deg: u8, env: &Env<K>, io: &mut impl MachineIo) -> Option<Wait> {
+        if self.dwell_until.is_none() {
+            if let Some(wait) = self.after_motion(io) {
+                return Some(wait);
+            }
+            if !io.pen(deg) {
+                return None;
+            }
+        }
+        self.wait_ms(u32::from(env.cfg.pen.settle_ms), io)
+    }
+
+    /// A straight leg: one move on a linear machine, from the exact
+    /// target; on the others, pieces (then the leg's bit is off and the
+    /// path's on).
+    fn leg<K: Kinematics>(&mut self, second: bool, env: &Env<K>, io: &mut impl MachineIo) -> Option<Wait> {
+        let to = self.run.legs[second as usize];
+        let motors = motor_channels(env.cfg);
+        if !env.kin.is_linear() {
+            let from = super::motor_milli(&self.run.from, motors);
+            let end = super::motor_milli(&to, motors);
+            self.run.path = Some(Path::Line(Segmenter::new(env.kin, from, &end, SEGMENT_UM)));
+            self.run.from = to;
+            let bit = if second { todo::LEG_1 } else { todo::LEG_0 };
+            self.run.todo = self.run.todo & !bit | todo::PATH;
+            // Its pieces next, from this same call.
+            return self.piece(env, io);
+        }
+        if let Some(wait) = io.room(false) {
+            return Some(wait);
+        }
+        // Checked when the line was accepted.
+        let steps = motor_steps(&to, motors, env.kin, env.cfg).unwrap_or_default();
+        if !io.queue(&steps, self.run.feed) {
+            return Some(Wait::Motion);
+        }
+        self.run.from = to;
+        None
+    }
+
+    /// The path's next piece; `None` once its last is queued.
+    fn piece<K: Kinematics>(&mut self, env: &Env<K>, io: &mut impl MachineIo) -> Option<Wait> {
+        let Some(path) = self.run.path.as_mut() else {
+            return None;
+        };
+        if let Some(wait) = io.room(true) {
+            return Some(wait);
+        }
+        let before = *path;
+        let motors = motor_channels(env.cfg);
+        let steps = match path.next() {
+            None => {
+                self.run.path = None;
+                return None;
+            }
+            // An arc's last chord ends on the exact target (a linear
+            // machine's steps from it, rounded once).
+            Some(_) if matches!(path, Path::Arc(a) if a.remaining() == 0) && env.kin.is_linear() => {
+                motor_steps(&self.run.legs[0], motors, env.kin, env.cfg)
+            }
+            Some(p) => {
+                let p = super::motor_milli(&coords::exact(&p), motors);
+                env.kin
+                    .inverse(&p)
+                    .map_err(|_| crate::gcode::ErrorKind::InvalidTarget)
+            }
+        };
+        // Every piece was checked when the line was accepted.
+        let steps = steps.unwrap_or_default();
+        if !io.queue(&steps, self.run.feed) {
+            self.run.path = Some(before);
+            return Some(Wait::Motion);
+        }
+        // The next piece in a run of its own: working one out takes up
+        // to ms on the arm.
+        Some(Wait::Again)
+    }
+}
