@@ -323,13 +323,14 @@ impl Interpreter {
     }
 
     /// Grbl's `gc_init` (power-on, Ctrl-X, leaving `$C`): the power-on
-    /// modes, `G54`'s offset loaded, `G92` and `G43.1` cleared, the line
-    /// being carried out dropped; the position stays.
-    pub fn reset(&mut self, io: &impl MachineIo) {
+    /// modes, `G54`'s offset (`g54`, the coordinate data's first) loaded,
+    /// `G92` and `G43.1` cleared, the line being carried out dropped; the
+    /// position stays.
+    pub fn reset(&mut self, g54: &Exact) {
         let position = self.position;
         *self = Interpreter::new();
         self.position = position;
-        self.coord_system = io.coord(0);
+        self.coord_system = *g54;
     }
 
     /// The programmed position (machine coordinates, thousandths).

@@ -123,6 +123,12 @@ impl Refresh {
         self.ov = 0;
     }
 
+    /// The work offset changed (Grbl's `system_flag_wco_change`): in the
+    /// next report.
+    pub fn wco_changed(&mut self) {
+        self.wco = 0;
+    }
+
     /// What the next report carries; `busy`: the machine moves or holds.
     pub fn next(&mut self, busy: bool) -> Extra {
         let mut extra = Extra::None;
@@ -153,7 +159,11 @@ impl Refresh {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Status {
     pub state: State,
+    /// The machine position.
     pub position: [Milli; 3],
+    /// The work coordinate offset (`WCO`): the work position is the
+    /// machine position less it.
+    pub wco: [Milli; 3],
     /// Places (bits) whose position is an angle: never in inches.
     pub angles: u8,
     /// Along the path, thousandths of a unit per minute.
@@ -170,41 +180,54 @@ pub struct Status {
     pub inches: bool,
 }
 
-impl Status {
-    /// `v` thousandths of mm in the report's unit: mm with three
-    /// decimals, or inches with four.
-    fn length(&self, v: Milli, angle: bool) -> Decimal {
-        match self.inches && !angle {
-            true => Decimal(div_round(v.0 as i64 * 100, 254) as i32, 4),
-            false => Decimal(v.0, 3),
-        }
-    }
+/// Three report places' values as Grbl prints positions and offsets
+/// (`$#`, `?`): comma-separated, mm with three decimals or, with `$13`,
+/// inches with four; an angle (a bit of `angles`) in degrees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Places {
+    pub values: [Milli; 3],
+    pub angles: u8,
+    pub inches: bool,
+}
 
-    /// The three places of `values`, comma-separated.
-    fn axes<W: uWrite + ?Sized>(
-        &self,
-        f: &mut Formatter<'_, W>,
-        values: &[Milli; 3],
-    ) -> Result<(), W::Error> {
-        for (p, v) in values.iter().enumerate() {
+impl uDisplay for Places {
+    fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
+        for (p, v) in self.values.iter().enumerate() {
             if p > 0 {
                 f.write_char(',')?;
             }
-            uwrite!(f, "{}", self.length(*v, self.angles >> p & 1 != 0))?;
+            let value = match self.inches && self.angles >> p & 1 == 0 {
+                true => Decimal(div_round(v.0 as i64 * 100, 254) as i32, 4),
+                false => Decimal(v.0, 3),
+            };
+            uwrite!(f, "{}", value)?;
         }
         Ok(())
     }
 }
 
+impl Status {
+    fn places(&self, values: [Milli; 3]) -> Places {
+        Places {
+            values,
+            angles: self.angles,
+            inches: self.inches,
+        }
+    }
+}
+
 impl uDisplay for Status {
     fn fmt<W: uWrite + ?Sized>(&self, f: &mut Formatter<'_, W>) -> Result<(), W::Error> {
-        // No work offsets: the work position is the machine position.
-        let position = match self.fields & 1 {
-            1 => text!("|MPos:"),
-            _ => text!("|WPos:"),
+        // `$10` bit 0: the machine position, else the work position
+        // (report.c line 510).
+        let (label, position) = match self.fields & 1 {
+            1 => (text!("|MPos:"), self.position),
+            _ => (
+                text!("|WPos:"),
+                core::array::from_fn(|i| Milli(self.position[i].0 - self.wco[i].0)),
+            ),
         };
-        uwrite!(f, "<{}{}", self.state, position)?;
-        self.axes(f, &self.position)?;
+        uwrite!(f, "<{}{}{}", self.state, label, self.places(position))?;
         if self.fields & 2 != 0 {
             uwrite!(f, "{}{},{}", text!("|Bf:"), self.buffer.0, self.buffer.1)?;
         }
@@ -225,10 +248,7 @@ impl uDisplay for Status {
         }
         match self.extra {
             Extra::None => {}
-            Extra::Wco => {
-                text!("|WCO:").fmt(f)?;
-                self.axes(f, &[Milli::ZERO; 3])?;
-            }
+            Extra::Wco => uwrite!(f, "{}{}", text!("|WCO:"), self.places(self.wco))?,
             Extra::Ov => {
                 let o = self.overrides;
                 uwrite!(

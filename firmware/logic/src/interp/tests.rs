@@ -85,7 +85,7 @@ impl Bench {
             pen: None,
         };
         let mut interp = Interpreter::new();
-        interp.reset(&io);
+        interp.reset(&io.coord(0));
         Bench {
             interp,
             kin: AnyKinematics::of(&cfg).unwrap(),

@@ -10,6 +10,7 @@ fn idle() -> Status {
     Status {
         state: State::Idle,
         position: [Milli::ZERO; 3],
+        wco: [Milli::ZERO; 3],
         angles: 0,
         feed: Milli::ZERO,
         buffer: (15, 128),
@@ -198,4 +199,39 @@ fn override_bytes_step_and_clamp_as_grbl_s() {
             rapid: 100
         }
     );
+}
+
+/// report.c line 510: `WPos` is the machine position less the work
+/// offset (`WCO` = the work system's + `G92`'s + the tool length's); the
+/// `WCO:` field carries the offset itself, in the report's units.
+#[test]
+fn the_work_position_is_the_machine_position_less_the_offset() {
+    let s = Status {
+        position: [Milli(70_000), Milli(100_000), Milli(0)],
+        wco: [Milli(70_000), Milli(90_000), Milli(-1_500)],
+        fields: 0,
+        extra: Extra::Wco,
+        ..idle()
+    };
+    assert_eq!(
+        show(&s),
+        "<Idle|WPos:0.000,10.000,1.500|FS:0,0|WCO:70.000,90.000,-1.500>"
+    );
+    assert_eq!(
+        show(&Status { fields: 1, ..s }),
+        "<Idle|MPos:70.000,100.000,0.000|FS:0,0|WCO:70.000,90.000,-1.500>"
+    );
+}
+
+/// `Refresh::wco_changed`: the next report carries `WCO:` (Grbl's
+/// `system_flag_wco_change` sets its counter to 0).
+#[test]
+fn a_changed_work_offset_is_in_the_next_report() {
+    let mut r = Refresh::new();
+    assert_eq!(r.next(false), Extra::Wco);
+    for _ in 0..5 {
+        assert_ne!(r.next(true), Extra::Wco);
+    }
+    r.wco_changed();
+    assert_eq!(r.next(true), Extra::Wco);
 }

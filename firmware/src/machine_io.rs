@@ -1,0 +1,105 @@
+//! The executor's machine (`taut_logic::interp::MachineIo`) on the board:
+//! moves into the motion task's planner, the pen servo, the drivers, the
+//! clock, and the work coordinate data (in RAM until the EEPROM keeps
+//! them).
+#![deny(unsafe_code)]
+
+use crate::board::clock;
+use crate::motion::{self, Motion};
+use crate::{flash_str, reply};
+use taut_logic::axis::AXES;
+use taut_logic::config::PenConfig;
+use taut_logic::interp::{CoordTable, Exact, MachineIo, Wait};
+use taut_logic::kinematics::{Kinematics, Steps};
+use taut_logic::planner::Feed;
+use taut_logic::units::Decimal;
+use ufmt::uwrite;
+
+pub struct Io<'a, K: Kinematics> {
+    pub m: &'a mut Motion,
+    pub kin: &'a K,
+    pub coords: &'a mut CoordTable,
+    /// `M114` is answered (not from the card).
+    pub replies: bool,
+}
+
+impl<K: Kinematics> MachineIo for Io<'_, K> {
+    fn coord(&self, index: u8) -> Exact {
+        self.coords.get(index)
+    }
+
+    fn set_coord(&mut self, index: u8, value: &Exact) {
+        self.coords.set(index, value);
+    }
+
+    fn room(&mut self, piece: bool) -> Option<Wait> {
+        if !self.m.has_room() {
+            return Some(Wait::Motion);
+        }
+        // A piece is not cut while the step queue runs short with pieces
+        // planned ahead: planning one takes a few ms, which the
+        // segments' refill needs first (with none ahead the planner
+        // would run dry instead).
+        if piece && motion::urgent() && self.m.planned() >= 2 {
+            return Some(Wait::Ms(1));
+        }
+        None
+    }
+
+    fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
+        self.m.stage(*steps, feed).is_ok()
+    }
+
+    fn idle(&mut self) -> bool {
+        self.m.is_idle()
+    }
+
+    fn pen(&mut self, deg: u8) -> bool {
+        let us = PenConfig::pulse_us(deg);
+        let moves = self.m.pen.pulse_us() != us;
+        self.m.pen.set_pulse_us(us);
+        moves
+    }
+
+    fn drivers(&mut self, on: bool) {
+        self.m.drivers.set(0xFF, on);
+    }
+
+    fn pause(&mut self) {
+        self.m.hold();
+    }
+
+    fn report_position(&mut self) {
+        if self.replies {
+            report_position(self.m, self.kin);
+        }
+    }
+
+    fn program_end(&mut self) {
+        let mut r = reply::line();
+        let _ = uwrite!(r, "{}", flash_str!("[MSG:Pgm End]"));
+        r.send();
+    }
+
+    fn millis(&self) -> u32 {
+        clock::millis()
+    }
+}
+
+/// `M114`: `C:1.000 X:0.000 Z:0.000 Count C:27 X:0 Z:0` (the executed
+/// position, machine coordinates).
+#[inline(never)]
+pub fn report_position(m: &Motion, kin: &impl Kinematics) {
+    let steps = m.stepper.position();
+    let pos = kin.forward(&steps);
+    let words = kin.words();
+    let mut r = reply::line();
+    for i in 0..AXES {
+        let _ = uwrite!(r, "{}:{} ", words[i] as char, Decimal(pos[i].0, 3));
+    }
+    let _ = uwrite!(r, "{}", flash_str!("Count"));
+    for i in 0..AXES {
+        let _ = uwrite!(r, " {}:{}", words[i] as char, steps[i]);
+    }
+    r.send();
+}
