@@ -1,56 +1,65 @@
 //! The serial console: G-code lines in, `ok` / `error:<code>` out, Grbl
-//! style — the I/O around the interpreter. The parser (`taut_logic::gcode`)
-//! turns bytes into lines, the interpreter (`taut_logic::interp`, both
-//! host-tested) turns a line into an order with the modal state it leaves;
-//! this file carries the order out against the motion task's state and
-//! only then commits the line. Real-time commands never get here
-//! (`realtime`). An arc, or a straight move of a machine whose kinematics
-//! are not linear, is queued piece by piece, a piece a run, and answered
-//! `ok` once its last piece is queued, as Grbl does.
+//! style — the I/O around the executor. The parser (`taut_logic::gcode`)
+//! gathers a line's words as its bytes come; the executor
+//! (`taut_logic::interp`, both host-tested) checks the line against the
+//! modal state and carries its actions out against the machine
+//! (`machine_io`), waiting where Grbl waits; this file reads bytes,
+//! hands whole lines on in Grbl's order (`protocol.c`: overflow, empty,
+//! `$`, the G-code lock, G-code) and answers. Real-time commands never
+//! get here (`realtime`). A line is answered `ok` once its last move is
+//! queued, as Grbl does.
 //!
 //! The console owns the machine's motion only while no string-art job
-//! does: during a job the interpreter refuses motion, drivers and `G92`,
-//! and settings are refused here; reads are answered.
+//! does: during a job the executor refuses motion, drivers, offsets and
+//! the pen, and settings are refused here; reads are answered.
 #![deny(unsafe_code)]
 
-use crate::board::clock;
-use crate::endstop;
+mod homing;
+
+use crate::machine_io::Io;
 use crate::motion::Motion;
 use crate::print::Print;
 use crate::queues::{Signal, BUTTONS, JOB_CLAIMS_TX, RX};
 use crate::reply;
 use crate::rt::{stack, Poll};
-use crate::{flash_str, info};
+use crate::flash_str;
 use core::sync::atomic::Ordering::Relaxed;
+use homing::HomingRun;
 use taut_logic::axis::AXES;
 use taut_logic::buttons::ButtonEvent;
-use taut_logic::config::{MachineConfig, PenConfig};
+use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{
-    CardLine, Error, ErrorKind, Input, Line, Parser, Read, Restore, SystemLine,
+    coord_value, CardLine, Error, ErrorKind, Input, Parser, Places, Read, Restore, SystemLine,
 };
-use taut_logic::homing::{self, Homing, HomingError, Leg, Next};
-use taut_logic::interp::{Allowed, Interpreter, Order, Path};
-use taut_logic::kinematics::Kinematics;
+use taut_logic::interp::{
+    axis_letters, motor_channels, Allowed, CoordTable, Env, Interpreter, Progress, Wait, G28, G30,
+};
+use taut_logic::kinematics::{Kinematics, Position};
 use taut_logic::patterns;
 use taut_logic::pinmap::Button;
-use taut_logic::planner::Feed;
 use taut_logic::settings;
-use taut_logic::units::{Decimal, Milli};
+use taut_logic::settings::grbl::{report_angles, report_axes};
+use taut_logic::units::Milli;
 use taut_progmem::{text, Text};
 use ufmt::uwrite;
 
 pub struct Console {
     parser: Parser,
-    /// The line being carried out while it waits for room.
-    pending: Option<Pending>,
+    /// The parser holds a line read whole: it is taken in the next run
+    /// (reading a line and checking it each take up to ~3 ms).
+    line_ready: bool,
+    /// The line being carried out is answered `ok` when it is done (not a
+    /// card's or a pattern's).
+    owed: bool,
     /// A test pattern (`$T5`) read in place of the line, and how far: its
     /// lines are answered once, at its end.
     pattern: Option<(Text, u16)>,
-    dwell_until: Option<u32>,
     /// `$$` or `$Q` in progress: its next line.
     listing: Option<Listing>,
     interp: Interpreter,
-    /// The motion epoch the interpreter's position agrees with: a stop that
+    /// The work coordinate data (`G54`–`G59`, `G28`, `G30`).
+    coords: CoordTable,
+    /// The motion epoch the executor's position agrees with: a stop that
     /// dropped queued moves starts a new one, and the position is then
     /// read back.
     epoch: u8,
@@ -61,12 +70,14 @@ pub struct Console {
     /// Where the line being read comes from, `None` between lines: while
     /// a print runs, a serial line is read whenever one has arrived whole.
     source: Option<Source>,
-    /// The motion queued is jogs (`$J=`): a jog cancel stops it, other
-    /// lines wait for it to end.
+    /// The motion queued is jogs (`$J=`): a jog cancel stops it, and
+    /// G-code is locked out until it ends (Grbl's `Jog` state).
     jogging: bool,
     /// `$C`: lines are checked and answered, nothing moves.
     checking: bool,
     sleep: Sleep,
+    /// Homing (`$H`, at power-on).
+    homing: Option<HomingRun>,
 }
 
 /// `$SLP`: until a reset.
@@ -82,22 +93,6 @@ enum Sleep {
 enum Source {
     Serial,
     Card,
-}
-
-enum Pending {
-    /// Read but not yet carried out (back-pressure).
-    Line(Line),
-    /// A jog (`$J=`) the same way.
-    Jog(Line),
-    /// A path whose line was taken, its pieces not all queued yet.
-    Path { path: Path, feed: Feed },
-    /// Homing (`G28`, `$H`, at power-on), a leg moving or not; `reply`:
-    /// answer `ok` at the end (a line asked for it).
-    Home {
-        homing: Homing,
-        moving: bool,
-        reply: bool,
-    },
 }
 
 #[derive(Clone, Copy)]
@@ -128,15 +123,28 @@ pub enum Owner {
     Job,
 }
 
+/// What the status report takes from the console: where the work
+/// coordinates are.
+pub struct Frame {
+    /// The work coordinate offset of each channel (`WCO`).
+    pub wco: Position,
+    /// The programmed position: a plotter's pen channel reports it (no
+    /// motor counts its `Z`).
+    pub programmed: Position,
+    /// The offset changed since the last report (Grbl's WCO refresh).
+    pub changed: bool,
+}
+
 impl Console {
     pub const fn new() -> Console {
         Console {
             parser: Parser::new(),
-            pending: None,
+            line_ready: false,
+            owed: false,
             pattern: None,
-            dwell_until: None,
             listing: None,
             interp: Interpreter::new(),
+            coords: CoordTable::new(),
             // Unlike the motion's: the first run reads the position through
             // the kinematics (zero steps are not (0, 0) on an arm).
             epoch: u8::MAX,
@@ -146,6 +154,7 @@ impl Console {
             jogging: false,
             checking: false,
             sleep: Sleep::Awake,
+            homing: None,
         }
     }
 
@@ -155,27 +164,38 @@ impl Console {
         core::mem::take(&mut self.settings_changed)
     }
 
-    /// Ctrl-X: the line in progress, a waiting line and a listing are
-    /// dropped with the bytes not yet read; modal state is Grbl's default.
+    /// Ctrl-X: the line in progress, the line being carried out and a
+    /// listing are dropped with the bytes not yet read; the modes are
+    /// Grbl's power-on ones, `G92` cleared (Grbl's `gc_init`).
     pub fn reset(&mut self) {
         self.parser = Parser::new();
-        self.pending = None;
+        self.line_ready = false;
+        self.owed = false;
         self.pattern = None;
-        self.dwell_until = None;
         self.listing = None;
-        self.interp.reset();
+        self.interp.reset(&self.coords.get(0));
         self.print.abort();
         self.source = None;
         self.jogging = false;
         self.checking = false;
         self.sleep = Sleep::Awake;
+        self.homing = None;
         RX.clear();
     }
 
+    /// The work coordinates for the status report.
+    pub fn frame(&mut self) -> Frame {
+        Frame {
+            wco: self.interp.wco(),
+            programmed: self.interp.target(),
+            changed: self.interp.take_wco_changed(),
+        }
+    }
+
     /// A jog cancel (0x85, or `!` or the safety door while jogging): brake
-    /// to a stop and drop the jogs queued; the jogs read and not yet
-    /// queued are answered `ok` and dropped on the next run (Grbl answered
-    /// them when it took them). False when no jog moves.
+    /// to a stop and drop the jogs queued; the jog being queued is
+    /// answered `ok` and dropped on the next run (Grbl answered it when
+    /// it took it). False when no jog moves.
     pub fn cancel_jog(&mut self, m: &mut Motion) -> bool {
         if !self.jogging || m.is_idle() {
             return false;
@@ -184,29 +204,14 @@ impl Console {
         true
     }
 
-    /// The safety door while homing: stop at once, not homed (Grbl's alarm
-    /// 7); the line that asked is answered `ok`, as Grbl's.
-    pub fn abort_homing(&mut self, m: &mut Motion) {
-        let Some(Pending::Home { reply, .. }) = self.pending else {
-            return;
-        };
-        endstop::disarm();
-        m.stop_now();
-        m.lose_position();
-        self.pending = None;
-        self.resync_next_run(m);
-        reply::alarm(7);
-        if reply {
-            self.ok();
-        }
-    }
-
-    /// Drop a jog that waited to be queued or was being queued piece by
-    /// piece (a jog cancel), answering it.
-    fn drop_jog(&mut self) {
-        if self.jogging && matches!(self.pending, Some(Pending::Jog(_) | Pending::Path { .. })) {
-            self.pending = None;
-            self.ok();
+    /// The line being carried out was cut short by a stop: dropped, and
+    /// answered if it is owed an answer.
+    fn drop_line(&mut self) {
+        if self.interp.busy() {
+            self.interp.drop_line();
+            if core::mem::take(&mut self.owed) {
+                reply::ok();
+            }
         }
     }
 
@@ -219,18 +224,14 @@ impl Console {
         cfg: &mut MachineConfig,
         owner: Owner,
     ) -> Poll<Signal> {
-        if self.epoch != m.epoch() {
+        if self.epoch != m.epoch() && reply::room() {
             self.epoch = m.epoch();
-            // Queued pieces were dropped with the motion (homing goes on:
-            // its own stops bump the epoch too; Ctrl-X resets it); a
-            // cancelled jog's are answered.
-            if reply::room() {
-                self.drop_jog();
-            }
-            if let Some(Pending::Path { .. }) = self.pending {
-                self.pending = None;
-            }
-            self.interp.resync(kin.forward(&m.target()));
+            // Queued moves were dropped with the motion (homing goes on:
+            // its own stops take the epoch; Ctrl-X resets): the line they
+            // were part of ends, and the executor reads the position back.
+            self.drop_line();
+            self.interp
+                .resync(&kin.forward(&m.target()), motor_channels(cfg));
         }
         loop {
             // A move staged by the last run is planned a part a run, each
@@ -243,7 +244,6 @@ impl Console {
             }
             // A jog cancel or `$SLP` is braking: nothing new until it stands.
             if m.is_cancelling() {
-                self.drop_jog();
                 return Poll::Wait(Signal::Motion);
             }
             match self.sleep {
@@ -271,126 +271,91 @@ impl Console {
             // A serial line (`M25`, `M27`, `?`-like reads) goes by while
             // the card's line waits for the planner: a held print must
             // still hear `M24`.
-            if self.pending.is_some() && self.source == Some(Source::Card) && serial_line_waits() {
+            if self.interp.busy() && self.source == Some(Source::Card) && serial_line_waits() {
                 self.source = Some(Source::Serial);
-                let read = self.read(m, cfg, owner);
+                let read = self.read();
+                if read == Ok(true) {
+                    self.take(m, kin, cfg, owner);
+                }
                 self.source = Some(Source::Card);
                 if let Err(wait) = read {
                     return wait;
                 }
                 continue;
             }
-            let jog = match &self.pending {
-                Some(Pending::Path { .. }) => return self.next_piece(m, kin),
-                Some(Pending::Home { .. }) => return self.home(m, cfg),
-                Some(Pending::Line(_)) => Some(false),
-                Some(Pending::Jog(_)) => Some(true),
-                None => None,
-            };
-            if let Some(jog) = jog {
-                // Other lines wait for the jogs to end.
-                if !jog && self.jogging {
-                    if !m.is_idle() {
-                        return Poll::Wait(Signal::Motion);
-                    }
-                    self.jogging = false;
-                }
-                if let Some(wait) = self.run_line(jog, m, kin, cfg, owner) {
-                    return wait;
-                }
+            if self.homing.is_some() {
+                return self.home(m, cfg);
+            }
+            if self.interp.busy() {
+                return self.carry_on(m, kin, cfg, owner);
+            }
+            if core::mem::take(&mut self.line_ready) {
+                self.take(m, kin, cfg, owner);
                 // One line per run: the other tasks get their turn.
                 return Poll::Again;
             }
-            if let Err(wait) = self.read(m, cfg, owner) {
-                return wait;
-            }
-            // A line read whole is carried out in a run of its own: reading
-            // and planning one each take up to ~3 ms, and `?` waits for
-            // the run in progress.
-            if matches!(self.pending, Some(Pending::Line(_) | Pending::Jog(_))) {
-                return Poll::Again;
+            match self.read() {
+                Err(wait) => return wait,
+                // A line read whole is taken in a run of its own.
+                Ok(true) => {
+                    self.line_ready = true;
+                    return Poll::Again;
+                }
+                Ok(false) => {}
             }
         }
     }
 
-    /// Plan the line (or the jog) waiting in `pending`, then carry it out
-    /// and commit it, or in check mode only commit it; `Some(wait)` when it
-    /// must wait (it stays in `pending`). The line is read where it waits,
-    /// not copied. Out of line: its plan (arc-sized) stays off the frame
-    /// that reads lines and runs `$` commands.
+    /// The executor's view of the machine now.
+    fn env<'a, K: Kinematics>(&self, kin: &'a K, cfg: &'a MachineConfig, owner: Owner) -> Env<'a, K> {
+        Env {
+            kin,
+            cfg,
+            allowed: Allowed {
+                motion: owner == Owner::Console,
+                checking: self.checking,
+            },
+        }
+    }
+
+    /// Carry out what is left of the accepted line; `ok` once it is done.
+    /// Out of line: a path's piece is worked out in its frame.
     #[inline(never)]
-    fn run_line(
+    #[optimize(speed)]
+    fn carry_on(
         &mut self,
-        jog: bool,
         m: &mut Motion,
         kin: &impl Kinematics,
         cfg: &MachineConfig,
         owner: Owner,
-    ) -> Option<Poll<Signal>> {
-        let allowed = Allowed {
-            motion: owner == Owner::Console,
-            position_known: m.position_known(),
+    ) -> Poll<Signal> {
+        let env = self.env(kin, cfg, owner);
+        let mut io = Io {
+            m,
+            kin,
+            coords: &mut self.coords,
+            replies: self.owed,
         };
-        let planned = match &self.pending {
-            Some(Pending::Line(line) | Pending::Jog(line)) => {
-                self.interp.plan(line, kin, cfg, allowed)
+        match self.interp.run(&env, &mut io) {
+            Progress::Done => {
+                if core::mem::take(&mut self.owed) {
+                    reply::ok();
+                }
+                Poll::Again
             }
-            _ => return None,
-        };
-        let planned = match planned {
-            Err(kind) => {
-                self.pending = None;
-                self.error(&Error::new(kind, 0));
-                return None;
-            }
-            Ok(planned) => planned,
-        };
-        if self.checking {
-            // Checked, not carried out; reads are still answered.
-            self.pending = None;
-            if matches!(planned.order, Order::ReportPosition) {
-                report_position(m, kin);
-            }
-            self.interp.commit(&planned);
-            self.ok();
-            return None;
+            Progress::Wait(Wait::Motion) => Poll::Wait(Signal::Motion),
+            Progress::Wait(Wait::Ms(ms)) => Poll::After(ms),
+            Progress::Wait(Wait::Again) => Poll::Again,
         }
-        // A path or homing takes `pending`'s place.
-        if let Some(wait) = self.carry_out(&planned.order, m, kin) {
-            return Some(wait);
-        }
-        match jog {
-            true => self.interp.commit_jog(&planned),
-            false => self.interp.commit(&planned),
-        }
-        self.jogging |= jog;
-        if matches!(self.pending, Some(Pending::Line(_) | Pending::Jog(_))) {
-            self.pending = None;
-            self.ok();
-        }
-        None
     }
 
-    /// Read bytes until an input is complete, and take it: a G-code line
-    /// waits in `pending`, the others are carried out. `Err` when the
-    /// bytes ran out. Out of line: the parser's copies of a line stay off
-    /// the frame that plans and cuts moves.
+    /// Read bytes until a line is complete (`Ok(true)`) or a run's share
+    /// is read; `Err` when the bytes ran out. Out of line: the parser's
+    /// frame stays off the one that carries lines out.
     #[inline(never)]
     #[optimize(speed)]
-    fn read(
-        &mut self,
-        m: &mut Motion,
-        cfg: &mut MachineConfig,
-        owner: Owner,
-    ) -> Result<(), Poll<Signal>> {
-        let mut budget = READ_PER_RUN;
-        loop {
-            // The rest of a long line in the next run: every task waits
-            // behind this one.
-            if budget == 0 {
-                return Err(Poll::Again);
-            }
-            budget -= 1;
+    fn read(&mut self) -> Result<bool, Poll<Signal>> {
+        for _ in 0..READ_PER_RUN {
             let byte = match self.pattern.as_mut() {
                 Some((text, at)) if usize::from(*at) < text.len() => {
                     *at += 1;
@@ -400,7 +365,7 @@ impl Console {
                 Some(_) => {
                     self.pattern = None;
                     reply::ok();
-                    return Ok(());
+                    return Ok(false);
                 }
                 None => match self.next_byte() {
                     Some(byte) => byte,
@@ -408,34 +373,97 @@ impl Console {
                 },
             };
             if self.parser.read(byte) == Read::LineEnd {
-                self.line_end(m, cfg, owner);
-                return Ok(());
+                if self.source == Some(Source::Card) {
+                    self.print.line_done();
+                }
+                return Ok(true);
+            }
+        }
+        // The rest of a long line in the next run: every task waits
+        // behind this one.
+        Err(Poll::Again)
+    }
+
+    /// A line read whole, taken in Grbl's order (`protocol.c` lines
+    /// 88–102): overflow, empty, `$`, the G-code lock (alarm or jog),
+    /// G-code. Out of line: the line (~100 B) is on the stack only here.
+    #[inline(never)]
+    fn take(&mut self, m: &mut Motion, kin: &impl Kinematics, cfg: &mut MachineConfig, owner: Owner) {
+        // The next line's words are the machine's (`$machine=` may change them).
+        self.parser.set_axis_letters(axis_letters(&kin.words()));
+        let first = self.parser.first_char();
+        let card = self.source == Some(Source::Card);
+        let jog_state = self.jogging && !m.is_idle();
+        match self.parser.take_line() {
+            Ok(Input::Realtime(_)) => {}
+            Err(e) if e.kind() == ErrorKind::LineOverflow => self.error(&e),
+            // Empty or comment only: for syncing, `ok`.
+            _ if first == 0 => self.ok(),
+            Ok(Input::System(s)) => self.system(s, m, cfg, owner),
+            Ok(Input::Jog(b)) if self.checking || !m.position_known() || !(m.is_idle() || jog_state) => {
+                let _ = b;
+                self.error(&Error::new(ErrorKind::NotIdle, 0))
+            }
+            Ok(Input::Jog(_)) if self.printing_from_serial() => {
+                self.error(&Error::new(ErrorKind::Printing, 0))
+            }
+            Ok(Input::Jog(b)) => {
+                if self.accept(&b, true, m, kin, cfg, owner) {
+                    self.jogging = true;
+                }
+            }
+            // `$` lines and jogs that did not parse.
+            Err(e) if first == b'$' => self.error(&e),
+            // A program's `%` delimiters in a file: passed over (Grbl
+            // answers a sender error 1).
+            _ if card && first == b'%' => {}
+            Ok(Input::Card(c)) => self.card_line(c, m, cfg),
+            // Grbl's G-code lock: in alarm (the position lost) or while
+            // jogs run.
+            _ if !m.position_known() || jog_state => {
+                self.error(&Error::new(ErrorKind::Locked, 0))
+            }
+            Err(e) => self.error(&e),
+            // While a print runs, the serial line may only look.
+            Ok(Input::Block(_)) if self.printing_from_serial() => {
+                self.error(&Error::new(ErrorKind::Printing, 0))
+            }
+            Ok(Input::Block(b)) => {
+                self.jogging = false;
+                self.accept(&b, false, m, kin, cfg, owner);
             }
         }
     }
 
-    /// A line has ended: its result, acted on. Out of line, so the line
-    /// (~100 B) is on the stack only here, not while bytes are read.
+    /// Hand a block to the executor; its error is the answer, else it is
+    /// carried out from the next run. True if accepted.
     #[inline(never)]
-    fn line_end(&mut self, m: &mut Motion, cfg: &mut MachineConfig, owner: Owner) {
-        if self.source == Some(Source::Card) {
-            self.print.line_done();
-        }
-        match self.parser.take_line() {
-            Ok(Input::Realtime(_)) => {}
-            Err(e) => self.error(&e),
-            // While a print runs, the serial line may only look.
-            Ok(Input::Line(_)) if self.printing_from_serial() => {
-                self.error(&Error::new(ErrorKind::Printing, 0))
+    fn accept(
+        &mut self,
+        b: &taut_logic::gcode::Block,
+        jog: bool,
+        m: &mut Motion,
+        kin: &impl Kinematics,
+        cfg: &MachineConfig,
+        owner: Owner,
+    ) -> bool {
+        let owed = self.pattern.is_none() && self.source != Some(Source::Card);
+        let env = self.env(kin, cfg, owner);
+        let mut io = Io {
+            m,
+            kin,
+            coords: &mut self.coords,
+            replies: owed,
+        };
+        match self.interp.accept(b, jog, &env, &mut io) {
+            Ok(()) => {
+                self.owed = owed;
+                true
             }
-            Ok(Input::Line(line)) => self.pending = Some(Pending::Line(line)),
-            // Grbl jogs from `Idle` or `Jog` only.
-            Ok(Input::Jog(_)) if self.checking || !(m.is_idle() || self.jogging) => {
-                self.error(&Error::new(ErrorKind::NotIdle, 0))
+            Err(kind) => {
+                self.error(&Error::new(kind, 0));
+                false
             }
-            Ok(Input::Jog(line)) => self.pending = Some(Pending::Jog(line)),
-            Ok(Input::System(s)) => self.system(s, m, cfg, owner),
-            Ok(Input::Card(c)) => self.card_line(c, m, cfg),
         }
     }
 
@@ -537,149 +565,15 @@ impl Console {
         }
     }
 
-    /// Carry out an order; `Some(wait)` when it cannot run yet.
-    #[optimize(speed)]
-    fn carry_out(
-        &mut self,
-        order: &Order,
-        m: &mut Motion,
-        kin: &impl Kinematics,
-    ) -> Option<Poll<Signal>> {
-        let after_motion = matches!(
-            order,
-            Order::Dwell { .. }
-                | Order::Pen { .. }
-                | Order::Pause
-                | Order::SetPosition { .. }
-                | Order::Drivers { on: false }
-                | Order::WaitIdle
-        );
-        if after_motion && !m.is_idle() {
-            return Some(Poll::Wait(Signal::Motion));
-        }
-        match order {
-            Order::None | Order::WaitIdle => {}
-            Order::Move { steps, feed } => {
-                if m.stage(*steps, *feed).is_err() {
-                    return Some(Poll::Wait(Signal::Motion));
-                }
-            }
-            Order::Dwell { ms } => return self.dwell(*ms),
-            Order::Pen { deg, ms } => {
-                // Set once, then its settle time like a dwell.
-                if self.dwell_until.is_none() {
-                    m.pen.set_pulse_us(PenConfig::pulse_us(*deg));
-                }
-                return self.dwell(u32::from(*ms));
-            }
-            // Held like `!`: `~` or the green button goes on.
-            Order::Pause => m.hold(),
-            Order::Home { axes } => self.start_homing(*axes, m, true),
-            Order::Path { path, feed } => {
-                self.pending = Some(Pending::Path {
-                    path: *path,
-                    feed: *feed,
-                })
-            }
-            Order::SetPosition { steps } => m.set_position(*steps),
-            Order::Drivers { on } => m.drivers.set(0xFF, *on),
-            Order::ReportPosition => report_position(m, kin),
-        }
-        None
-    }
-
     /// What the console is doing.
     pub fn activity(&self) -> Activity {
-        match self.pending {
+        match self.homing {
             _ if self.sleep != Sleep::Awake => Activity::Sleeping,
-            Some(Pending::Home { .. }) => Activity::Homing,
+            Some(_) => Activity::Homing,
             _ if self.checking => Activity::Checking,
             _ if self.jogging => Activity::Jogging,
             _ => Activity::Lines,
         }
-    }
-
-    /// Home `axes` (bits), their drivers on; `reply`: answer the line
-    /// that asked at the end.
-    pub fn start_homing(&mut self, axes: u8, m: &mut Motion, reply: bool) {
-        m.drivers.set(axes, true);
-        self.pending = Some(Pending::Home {
-            homing: Homing::new(axes),
-            moving: false,
-            reply,
-        });
-    }
-
-    /// One step of homing: wait for the leg to end (done, or stopped at
-    /// its switch), then the next leg, the zero, or the end. Out of line:
-    /// the console's frame stays small.
-    #[inline(never)]
-    fn home(&mut self, m: &mut Motion, cfg: &MachineConfig) -> Poll<Signal> {
-        let Some(Pending::Home {
-            homing,
-            moving,
-            reply,
-        }) = self.pending.as_mut()
-        else {
-            return Poll::Again;
-        };
-        // Looked at every 10 ms while a leg moves (the tick wakes it at
-        // once when the switch stops the steps).
-        if *moving && !endstop::hit() && !m.is_idle() {
-            return Poll::After(LEG_POLL_MS);
-        }
-        let hit = endstop::disarm();
-        if hit {
-            // The steps stopped at the switch: drop the rest of the leg
-            // (a stop of our own: homing goes on).
-            m.stop_now();
-            self.epoch = m.epoch();
-        }
-        *moving = false;
-        match homing.next(cfg, hit, endstop::closed(homing.axis())) {
-            Next::Move(leg) => {
-                if leg.until_closed {
-                    endstop::watch(leg.axis);
-                }
-                let to = homing::target(m.target(), &leg);
-                // The machine stands: the planner has room.
-                let _ = m.push(to, leg_feed(cfg, &leg));
-                *moving = true;
-                return Poll::After(LEG_POLL_MS);
-            }
-            Next::Zero { axis, steps } => {
-                let mut at = m.target();
-                at[axis] = steps;
-                m.set_position(at);
-            }
-            Next::Done => {
-                let reply = *reply;
-                self.pending = None;
-                self.resync_next_run(m);
-                match reply {
-                    true => self.ok(),
-                    false => info!("homed"),
-                }
-            }
-            // Grbl's alarms 8 (the switch stayed closed after the pull-off)
-            // and 9 (no switch within the travel); the line that asked is
-            // then answered `ok`, as Grbl's. Motion waits for `$H`, `G92`
-            // or `$X`.
-            Next::Failed(e) => {
-                let reply = *reply;
-                self.pending = None;
-                self.resync_next_run(m);
-                m.lose_position();
-                reply::alarm(match e {
-                    HomingError::Stuck => 8,
-                    HomingError::NotFound => 9,
-                });
-                if reply {
-                    self.ok();
-                }
-            }
-        }
-        Poll::Again
     }
 
     /// `ok` to a line, unless it is a pattern's (answered at its end) or
@@ -704,62 +598,10 @@ impl Console {
         }
     }
 
-    /// Read the commanded position back through the kinematics on the
+    /// Read the programmed position back through the kinematics on the
     /// next run (the machine moved, or is another one), as after a stop.
     fn resync_next_run(&mut self, m: &Motion) {
         self.epoch = m.epoch().wrapping_add(1);
-    }
-
-    /// Wait `ms` from the first call (motion done): `Some(wait)` until then.
-    fn dwell(&mut self, ms: u32) -> Option<Poll<Signal>> {
-        let now = clock::millis();
-        let until = *self.dwell_until.get_or_insert(now.wrapping_add(ms));
-        let left = until.wrapping_sub(now) as i32;
-        if left > 0 {
-            return Some(Poll::After(left.min(u16::MAX as i32) as u16));
-        }
-        self.dwell_until = None;
-        None
-    }
-
-    /// Queue the path's next piece; `ok` once the last one is queued. Out
-    /// of line: its copy of the path stays off the console's frame.
-    #[inline(never)]
-    #[optimize(speed)]
-    fn next_piece(&mut self, m: &mut Motion, kin: &impl Kinematics) -> Poll<Signal> {
-        let Some(Pending::Path { path, feed }) = self.pending.as_mut() else {
-            return Poll::Again;
-        };
-        // Cut a piece only when the planner can take it.
-        if !m.has_room() {
-            return Poll::Wait(Signal::Motion);
-        }
-        // And not while the step queue runs short with pieces planned
-        // ahead: planning one takes a few ms, which the segments' refill
-        // needs first (with none ahead the planner would run dry instead).
-        if crate::motion::urgent() && m.planned() >= 2 {
-            return Poll::After(1);
-        }
-        let before = *path;
-        match path.next().map(|p| kin.inverse(&p)) {
-            Some(Ok(steps)) => {
-                if m.stage(steps, *feed).is_err() {
-                    *path = before;
-                    return Poll::Wait(Signal::Motion);
-                }
-            }
-            None => {
-                self.pending = None;
-                self.ok();
-            }
-            // The interpreter checked every chord: not reached.
-            Some(Err(_)) => {
-                self.pending = None;
-                self.interp.resync(kin.forward(&m.target()));
-                self.error(&Error::new(ErrorKind::InvalidTarget, 0));
-            }
-        }
-        Poll::Again
     }
 
     #[inline(never)]
@@ -834,9 +676,8 @@ impl Console {
             }
             SystemLine::BuildInfo => build_info(cfg),
             SystemLine::ParserState => {
-                let pen_down = m.pen.pulse_us() == PenConfig::pulse_us(cfg.pen.down_deg);
                 let mut r = reply::line();
-                let _ = uwrite!(r, "[GC:{}]", self.interp.parser_state(pen_down));
+                let _ = uwrite!(r, "[GC:{}]", self.interp.parser_state(cfg.report_inches));
                 r.send();
             }
             SystemLine::Offsets => {
@@ -865,17 +706,21 @@ impl Console {
                     // Another machine: where it stands is its zero, and its
                     // modal state starts afresh.
                     m.set_position([0; AXES]);
-                    self.interp = Interpreter::new();
+                    self.interp.reset(&self.coords.get(0));
                     self.resync_next_run(m);
                 }
                 self.settings_changed = true;
             }
-            // The machine's defaults; taut keeps no offsets to clear.
+            // The machine's defaults, the work coordinate data, or both.
             SystemLine::Restore(what) => {
                 if what != Restore::Offsets {
                     restore_defaults(cfg);
                     m.configure(cfg);
                     self.settings_changed = true;
+                }
+                if what != Restore::Settings {
+                    self.coords.clear();
+                    self.interp.reset(&self.coords.get(0));
                 }
                 message(text!("Restoring defaults"));
             }
@@ -898,7 +743,7 @@ impl Console {
                 self.checking = false;
                 message(text!("Disabled"));
                 self.ok();
-                self.interp.reset();
+                self.interp.reset(&self.coords.get(0));
                 self.resync_next_run(m);
                 return reply::banner();
             }
@@ -926,11 +771,52 @@ impl Console {
             Listing::Queues(line) => {
                 crate::report::queue_line(line).then_some(Listing::Queues(line + 1))
             }
-            Listing::Offsets(line) => offsets_line(line).then_some(Listing::Offsets(line + 1)),
+            Listing::Offsets(line) => self
+                .offsets_line(line, cfg)
+                .then_some(Listing::Offsets(line + 1)),
         };
         if self.listing.is_none() {
             reply::ok();
         }
+    }
+
+    /// Line `line` of `$#` (`report_ngc_parameters`): `G54`…`G59`, `G28`,
+    /// `G30` from the coordinate data, `G92` and `TLO` from the executor,
+    /// `PRB` (taut has no probe: zero, not taken); `false` past the last.
+    #[inline(never)]
+    #[optimize(size)]
+    fn offsets_line(&self, line: u8, cfg: &MachineConfig) -> bool {
+        let (g92, tlo) = self.interp.offsets();
+        let places = |p: Position| Places {
+            values: report_axes(cfg.machine).map(|a| p[a.index()]),
+            angles: report_angles(cfg.machine),
+            inches: cfg.report_inches,
+        };
+        let mut r = reply::line();
+        let _ = match line {
+            0..=5 => uwrite!(r, "{}{}:", flash_str!("[G"), 54 + line),
+            6 | 7 => uwrite!(r, "{}{}:", flash_str!("[G"), if line == 6 { 28 } else { 30 }),
+            8 => uwrite!(r, "{}", flash_str!("[G92:")),
+            9 => uwrite!(r, "{}", flash_str!("[TLO:")),
+            10 => uwrite!(r, "{}", flash_str!("[PRB:")),
+            _ => return false,
+        };
+        let _ = match line {
+            0..=7 => {
+                let index = match line {
+                    6 => G28,
+                    7 => G30,
+                    n => n,
+                };
+                let data = taut_logic::interp::coords::milli(&self.coords.get(index));
+                uwrite!(r, "{}]", places(data))
+            }
+            8 => uwrite!(r, "{}]", places(g92)),
+            9 => uwrite!(r, "{}]", coord_value(tlo, cfg.report_inches)),
+            _ => uwrite!(r, "{}{}", places([Milli::ZERO; 3]), flash_str!(":0]")),
+        };
+        r.send();
+        true
     }
 }
 
@@ -963,40 +849,6 @@ fn build_info(cfg: &MachineConfig) {
     r.send();
 }
 
-/// Line `line` of `$#`; `false` past the last. taut keeps no work
-/// offsets, tool length or probe: every one is zero, in Grbl's format.
-fn offsets_line(line: u8) -> bool {
-    use taut_progmem::text;
-    // A table in flash: a `match` costs ~15 B of code an arm.
-    const NAMES: usize = 11;
-    let names = taut_progmem::table!(taut_progmem::Text; NAMES; [
-        text!("G54"),
-        text!("G55"),
-        text!("G56"),
-        text!("G57"),
-        text!("G58"),
-        text!("G59"),
-        text!("G28"),
-        text!("G30"),
-        text!("G92"),
-        text!("TLO"),
-        text!("PRB"),
-    ]);
-    if line as usize >= NAMES {
-        return false;
-    }
-    let name = names.get(line as usize);
-    let zeros = match line {
-        9 => flash_str!(":0.000]"),
-        10 => flash_str!(":0.000,0.000,0.000:0]"),
-        _ => flash_str!(":0.000,0.000,0.000]"),
-    };
-    let mut r = reply::line();
-    let _ = uwrite!(r, "[{}{}", name, zeros);
-    r.send();
-    true
-}
-
 /// The machine's defaults in place of `cfg`.
 fn restore_defaults(cfg: &mut MachineConfig) {
     cfg.load_defaults(cfg.machine);
@@ -1018,32 +870,3 @@ fn serial_line_waits() -> bool {
 /// at most), the line end that completes a line up to ~0.5 ms; a 40-byte
 /// line read whole took ~2.4 ms, which a `?` or any task waited behind.
 const READ_PER_RUN: u8 = 6;
-
-/// `M114`: `C:1.000 X:0.000 Z:0.000 Count C:27 X:0 Z:0` (the executed
-/// position).
-#[inline(never)]
-fn report_position(m: &Motion, kin: &impl Kinematics) {
-    let steps = m.stepper.position();
-    let pos = kin.forward(&steps);
-    let words = kin.words();
-    let mut r = reply::line();
-    for i in 0..AXES {
-        let _ = uwrite!(r, "{}:{} ", words[i] as char, Decimal(pos[i].0, 3));
-    }
-    let _ = uwrite!(r, "{}", flash_str!("Count"));
-    for i in 0..AXES {
-        let _ = uwrite!(r, " {}:{}", words[i] as char, steps[i]);
-    }
-    r.send();
-}
-
-/// How often homing looks whether a leg has ended, ms.
-const LEG_POLL_MS: u16 = 10;
-
-/// The feed that moves `leg`'s axis at its rate: units per minute.
-fn leg_feed(cfg: &MachineConfig, leg: &Leg) -> Feed {
-    let spu = cfg.axes[leg.axis].steps_per_unit;
-    let milli_per_min =
-        u64::from(leg.rate) * 60_000 * u64::from(spu.den) / u64::from(spu.num.max(1));
-    Feed::PerMinute(Milli(milli_per_min.min(i32::MAX as u64) as i32))
-}

@@ -14,6 +14,7 @@ pub mod drivers;
 pub mod endstop;
 pub mod job;
 pub mod log;
+pub mod machine_io;
 pub mod motion;
 pub mod print;
 pub mod queues;

@@ -540,10 +540,11 @@ fn realtime() {
         }
         if r.status() {
             if reply::room() {
+                let frame = CONSOLE.with(|c| c.frame());
                 KIN.with(|kin| {
                     CONFIG.with(|cfg| {
                         STANDING.with(|rt| {
-                            realtime::status(m, kin.as_ref().unwrap(), cfg, activity, rt)
+                            realtime::status(m, kin.as_ref().unwrap(), cfg, activity, &frame, rt)
                         })
                     })
                 });

@@ -6,7 +6,7 @@
 //! (formatted by `taut_logic::gcode::Status`).
 #![deny(unsafe_code)]
 
-use crate::console::Activity;
+use crate::console::{Activity, Frame};
 use crate::endstop;
 use crate::motion::{self, Motion};
 use crate::queues::{FEED_PRESSES, REALTIME, RX};
@@ -16,6 +16,7 @@ use crate::stepper;
 use crate::{flash_str, info, warn};
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Overrides, Realtime, Refresh, State, Status, OVERRIDE_BYTES};
+use taut_logic::interp::motor_channels;
 use taut_logic::kinematics::Kinematics;
 use taut_logic::planner::PLANNER_BLOCKS;
 use taut_logic::settings::grbl::{report_angles, report_axes};
@@ -150,7 +151,7 @@ pub fn after_reset(m: &mut Motion, homing: bool, moving: bool) {
             let mut r = reply::line();
             let _ = uwrite!(r, "{}", flash_str!("[MSG:'$H'|'$X' to unlock]"));
             r.send();
-            warn!("position unknown until $H, G92, $X or zeroing");
+            warn!("position unknown until $H, $X or zeroing");
         }
     }
 }
@@ -193,9 +194,11 @@ impl Standing {
 }
 
 /// Grbl 1.1's status report: `<Run|MPos:0.000,12.500,-3.000|Bf:12,100|FS:600,0>`,
-/// the position as the pulses left it in the report's X, Y, Z places,
-/// the fields `$10` chooses, in `$13`'s unit. Out of line: the task's
-/// frame stays small when no report is asked for.
+/// the position as the pulses left it in the report's X, Y, Z places
+/// (a plotter's pen channel as programmed: no motor counts its `Z`),
+/// the machine's or the work's as `$10` says, in `$13`'s unit, and the
+/// work offset every so often and after it changed. Out of line: the
+/// task's frame stays small when no report is asked for.
 #[inline(never)]
 #[optimize(speed)]
 pub fn status(
@@ -203,6 +206,7 @@ pub fn status(
     kin: &impl Kinematics,
     cfg: &MachineConfig,
     activity: Activity,
+    frame: &Frame,
     rt: &mut Standing,
 ) {
     let state = match (activity, m.state()) {
@@ -221,7 +225,16 @@ pub fn status(
         State::Idle | State::Alarm | State::Check | State::Sleep
     );
     let places = report_axes(cfg.machine);
-    let at = kin.forward(&m.stepper.position());
+    let mut at = kin.forward(&m.stepper.position());
+    let motors = motor_channels(cfg);
+    for (i, a) in at.iter_mut().enumerate() {
+        if motors >> i & 1 == 0 {
+            *a = frame.programmed[i];
+        }
+    }
+    if frame.changed {
+        rt.refresh.wco_changed();
+    }
     // A plotter's MIN inputs are its limit switches (the string-art
     // machine's are buttons).
     let mut pins = 0;
@@ -233,6 +246,7 @@ pub fn status(
     let report = Status {
         state,
         position: places.map(|a| at[a.index()]),
+        wco: places.map(|a| frame.wco[a.index()]),
         angles: report_angles(cfg.machine),
         feed: m.feed(),
         buffer: ((PLANNER_BLOCKS - m.planned()) as u8, RX.free() as u8),

@@ -49,5 +49,5 @@ pub use block::{
 };
 pub use number::{parse_milli, NANO_LIMIT};
 pub use parser::{Parser, Read, MAX_LINE};
-pub use status::{Extra, Overrides, Refresh, State, Status, OVERRIDE_BYTES};
+pub use status::{coord_value, Extra, Overrides, Places, Refresh, State, Status, OVERRIDE_BYTES};
 pub use system::{Restore, SystemLine, SystemText, SYSTEM_TEXT};

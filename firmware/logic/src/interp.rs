@@ -918,6 +918,15 @@ fn moves(b: &Block) -> bool {
         || !matches!(b.non_modal, NonModal::None | NonModal::Dwell)
 }
 
+/// The axis letters a machine with these channel `words` has, a bit per
+/// [`AxisWord`] (the parser's [`set_axis_letters`](crate::gcode::Parser::set_axis_letters)).
+pub fn axis_letters(words: &[u8; AXES]) -> u8 {
+    AxisWord::ALL
+        .iter()
+        .filter(|w| words.contains(&w.letter()))
+        .fold(0, |bits, w| bits | 1 << w.index())
+}
+
 /// The channels motors drive (bits): a plotter's `Z` is its pen.
 pub fn motor_channels(cfg: &MachineConfig) -> u8 {
     match cfg.machine.is_string_art() {

@@ -73,6 +73,8 @@ pub struct Parser {
     bom: u8,
     /// Axis letters the machine has (a bit per [`AxisWord`](super::AxisWord)).
     letters: u8,
+    /// The line's first character kept (0: none yet).
+    first: u8,
     /// XOR of the bytes before `*`.
     xor: u8,
     lexeme: Lexeme,
@@ -104,6 +106,7 @@ impl Parser {
             kept: 0,
             bom: 0,
             letters: 0b1111,
+            first: 0,
             xor: 0,
             lexeme: Lexeme::Code,
             checksum: None,
@@ -114,6 +117,13 @@ impl Parser {
     /// Some of a line has been read, not yet its end.
     pub fn mid_line(&self) -> bool {
         self.column != 0
+    }
+
+    /// The first character the line kept (0 for an empty or comment-only
+    /// line, `$` for a system line, `%` for a program delimiter); read
+    /// before [`Parser::take_line`], which starts the next line.
+    pub fn first_char(&self) -> u8 {
+        self.first
     }
 
     /// The axis letters the machine has (a bit per
@@ -241,6 +251,10 @@ impl Parser {
         match &mut self.statement {
             Statement::Start => match c {
                 b' ' | b'\t' => {}
+                _ if self.first == 0 => {
+                    self.first = c;
+                    self.feed(c, column)
+                }
                 b'$' => self.statement = Statement::System(SystemBuilder::new(column)),
                 _ => {
                     self.start_words(false);

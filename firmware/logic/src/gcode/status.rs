@@ -196,13 +196,19 @@ impl uDisplay for Places {
             if p > 0 {
                 f.write_char(',')?;
             }
-            let value = match self.inches && self.angles >> p & 1 == 0 {
-                true => Decimal(div_round(v.0 as i64 * 100, 254) as i32, 4),
-                false => Decimal(v.0, 3),
-            };
-            uwrite!(f, "{}", value)?;
+            let inches = self.inches && self.angles >> p & 1 == 0;
+            uwrite!(f, "{}", coord_value(*v, inches))?;
         }
         Ok(())
+    }
+}
+
+/// A length as Grbl prints a coordinate (`printFloat_CoordValue`): mm
+/// with three decimals, or inches with four.
+pub fn coord_value(v: Milli, inches: bool) -> Decimal {
+    match inches {
+        true => Decimal(div_round(v.0 as i64 * 100, 254) as i32, 4),
+        false => Decimal(v.0, 3),
     }
 }
 
