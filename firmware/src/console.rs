@@ -286,7 +286,9 @@ impl Console {
             if self.homing.is_some() {
                 return self.home(m, cfg);
             }
-            if self.interp.busy() {
+            // A line accepted and not yet answered (one with nothing to do
+            // is answered here too).
+            if self.interp.busy() || self.owed {
                 return self.carry_on(m, kin, cfg, owner);
             }
             if core::mem::take(&mut self.line_ready) {

@@ -1,22 +1,107 @@
-//! Arbitrary bytes into the G-code parser: it must never panic, must answer
-//! every line end (`\n`, `\r`, `\r\n`) exactly once, and must parse a good line after any input.
+//! Arbitrary bytes into the G-code parser and the executor: neither may
+//! panic (overflow checks are on) or loop; every line end (`\n`, `\r`,
+//! `\r\n`) is answered exactly once; an error has a message; every block
+//! is carried out against a machine that takes anything, to its end;
+//! and a good line parses after any input.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use taut_logic::gcode::{Command, Input, Parser, Realtime};
+use taut_logic::config::MachineConfig;
+use taut_logic::gcode::{Input, Parser, Realtime};
+use taut_logic::interp::{
+    Allowed, CoordTable, Env, Exact, Interpreter, MachineIo, Progress, Wait,
+};
+use taut_logic::kinematics::{AnyKinematics, Steps};
+use taut_logic::machine::Machine;
+use taut_logic::planner::Feed;
+
+/// A machine that does at once whatever it is asked.
+struct Yes {
+    coords: CoordTable,
+    clock: u32,
+}
+
+impl MachineIo for Yes {
+    fn coord(&self, index: u8) -> Exact {
+        self.coords.get(index)
+    }
+    fn set_coord(&mut self, index: u8, value: &Exact) {
+        self.coords.set(index, value)
+    }
+    fn room(&mut self, _piece: bool) -> Option<Wait> {
+        None
+    }
+    fn queue(&mut self, _steps: &Steps, _feed: Feed) -> bool {
+        true
+    }
+    fn idle(&mut self) -> bool {
+        true
+    }
+    fn pen(&mut self, _deg: u8) -> bool {
+        true
+    }
+    fn drivers(&mut self, _on: bool) {}
+    fn pause(&mut self) {}
+    fn report_position(&mut self) {}
+    fn program_end(&mut self) {}
+    fn millis(&self) -> u32 {
+        self.clock
+    }
+}
 
 fuzz_target!(|data: &[u8]| {
+    // The first byte picks the machine: linear, hanging or an arm.
+    let machine = match data.first().map(|b| b % 3) {
+        Some(1) => Machine::Whiteboard,
+        Some(2) => Machine::Scara,
+        _ => Machine::Flatbed,
+    };
+    let cfg = MachineConfig::defaults(machine);
+    let kin = AnyKinematics::of(&cfg).unwrap();
+    let env = Env {
+        kin: &kin,
+        cfg: &cfg,
+        allowed: Allowed::ALL,
+    };
+    let mut io = Yes {
+        coords: CoordTable::new(),
+        clock: 0,
+    };
+    let mut interp = Interpreter::new();
     let mut parser = Parser::new();
-    for &b in data {
-        match parser.push(b) {
-            Some(Ok(Input::Realtime(r))) => assert_eq!(Realtime::from_byte(b), Some(r)),
+    for &b in data.iter().skip(1) {
+        let (block, jog) = match parser.push(b) {
+            Some(Ok(Input::Realtime(r))) => {
+                assert_eq!(Realtime::from_byte(b), Some(r));
+                continue;
+            }
+            None => {
+                assert!(Realtime::from_byte(b).is_none());
+                continue;
+            }
             Some(result) => {
                 assert!(b == b'\n' || b == b'\r');
-                if let Err(e) = result {
-                    assert!(e.column().is_some() && !e.message().is_empty());
+                match result {
+                    Err(e) => {
+                        assert!(!e.message().is_empty());
+                        continue;
+                    }
+                    Ok(Input::Block(block)) => (block, false),
+                    Ok(Input::Jog(block)) => (block, true),
+                    Ok(_) => continue,
                 }
             }
-            None => assert!(Realtime::from_byte(b).is_none()),
+        };
+        if interp.accept(&block, jog, &env, &mut io).is_ok() {
+            // Every action ends: a path has a bounded number of pieces.
+            for _ in 0..1_000_000 {
+                match interp.run(&env, &mut io) {
+                    Progress::Done => break,
+                    Progress::Wait(Wait::Ms(ms)) => io.clock = io.clock.wrapping_add(ms.into()),
+                    Progress::Wait(_) => {}
+                }
+            }
+            interp.drop_line();
         }
     }
     let mut last = None;
@@ -24,7 +109,9 @@ fuzz_target!(|data: &[u8]| {
         last = parser.push(b).or(last);
     }
     match last {
-        Some(Ok(Input::Line(line))) => assert_eq!(line.command, Command::WaitIdle),
+        Some(Ok(Input::Block(block))) => {
+            assert_eq!(block.taut, taut_logic::gcode::TautCode::WaitIdle)
+        }
         other => panic!("no clean line after the input: {other:?}"),
     }
 });

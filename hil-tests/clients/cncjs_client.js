@@ -23,6 +23,12 @@
 //   cncjs: done <why>              all went as planned (exit 0)
 //   cncjs: fail <why>              it did not (exit 1; the server's log follows on stderr)
 //
+// With FILE `buttons:LINE|LINE|…` it streams no job: once ready it sends
+// those lines as CNCjs's buttons do (`command('gcode', line)`: the jog
+// arrows' `G91`, `G0 X10`, `G90`, "Zero Out Work Offsets"' `G10 L20 P1 X0
+// Y0 Z0`, "Go To Work Zero"'s `G0 X0 Y0 Z0`), waits for each `ok` and for
+// Idle, and ends (`cncjs: done buttons`).
+//
 // usage: node cncjs_client.js PORT CNCJS_PREFIX FILE TIMEOUT_S HOLD_S
 
 'use strict';
@@ -42,8 +48,9 @@ const say = (what) => process.stdout.write(`cncjs: ${((Date.now() - started) / 1
 const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'taut-cncjs-'));
 const watch = path.join(tmp, 'watch');
 fs.mkdirSync(watch);
+const buttons = file.startsWith('buttons:') ? file.slice('buttons:'.length).split('|') : null;
 const name = path.basename(file);
-fs.copyFileSync(file, path.join(watch, name));
+if (!buttons) fs.copyFileSync(file, path.join(watch, name));
 const config = path.join(tmp, 'cncrc.json');
 fs.writeFileSync(
   config,
@@ -121,6 +128,10 @@ async function connect() {
     if (line === 'ok' && lastRead.startsWith('$')) {
       settingsRead = true;
       onState(activeState, true);
+    } else if (step === 'buttons' && (line === 'ok' || line.startsWith('error'))) {
+      if (line.startsWith('error')) finish(1, `${line} to a button's line`);
+      answered += 1;
+      check();
     }
     lastRead = line;
     if (step === 'reset' && line.startsWith('Grbl ')) {
@@ -148,6 +159,8 @@ let total = 0;
 
 let lastRead = '';
 let settingsRead = false;
+// Buttons' lines answered.
+let answered = 0;
 
 function onState(s, again = false) {
   if (!s || (s === activeState && !again)) return;
@@ -156,7 +169,10 @@ function onState(s, again = false) {
     say(`state ${s}`);
   }
   if (s === 'Alarm') finish(1, 'the machine reports Alarm');
-  if (step === 'connecting' && s === 'Idle' && settingsRead) {
+  if (step === 'connecting' && s === 'Idle' && settingsRead && buttons) {
+    step = 'buttons';
+    for (const line of buttons) command('gcode', line);
+  } else if (step === 'connecting' && s === 'Idle' && settingsRead) {
     // Ready: CNCjs has seen the banner or a status report.
     step = 'loading';
     socket.emit('command', port, 'watchdir:load', name, (err, sender) => {
@@ -211,7 +227,9 @@ function onVersion(v) {
 }
 
 function check() {
-  if (step === 'ended' && activeState === 'Idle') {
+  if (step === 'buttons' && answered === buttons.length && activeState === 'Idle') {
+    finish(0, 'buttons');
+  } else if (step === 'ended' && activeState === 'Idle') {
     job = `${total} lines in ${((Date.now() - started) / 1000).toFixed(1)} s`;
     step = 'reset';
     command('reset');

@@ -276,3 +276,52 @@ fn cncjs_streams_a_job_holds_and_resumes_it_and_the_pulses_follow() {
         installed.as_secs_f64()
     );
 }
+
+/// CNCjs's own buttons against the flatbed, as its Axes widget sends
+/// them (CNCjs 1.11.5): a jog arrow (`G91`, `G0 X10 Y5`, `G90`), "Zero
+/// Out Work Offsets" (`G10 L20 P1 X0 Y0 Z0`), another jog (`G91`, `G0
+/// X-4`, `G90`), "Go To Work Zero" (`G0 X0 Y0 Z0`). The pulses go where
+/// those say, from the middle of the bed, and `$#` and `?` keep the work
+/// zero where it was set; the machine position never jumps.
+#[test]
+fn cncjs_zero_and_jog_buttons_move_the_machine_and_set_the_work_zero() {
+    use hil_tests::steps_on_pins;
+    let prefix = cncjs_prefix();
+    let mut sim = boot_machine();
+    for line in ["$machine=flatbed", "$homing_at_start=0", "M17", "G0 X70 Y30"] {
+        send_ok(&mut sim, line, Duration::from_secs(2));
+    }
+    settle(&mut sim);
+    // 40 steps a mm on both axes.
+    assert_eq!(steps_on_pins(&sim)[..2], [2800, 1200]);
+    let from = sim.cycles();
+    let buttons = "buttons:G91|G0 X10 Y5|G90|G10 L20 P1 X0 Y0 Z0|G91|G0 X-4|G90|G0 X0 Y0 Z0";
+    let mut client = Command::new("node");
+    client.arg(client_script("cncjs_client.js"));
+    let args = [prefix.to_str().unwrap(), buttons, "60", "0"];
+    let out = serve(&mut sim, &mut client, &args, Duration::from_secs(60), |_, _, _| {});
+    let said = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{said}\n{}", hil_tests::log_tail(&sim));
+    assert!(said.contains("done buttons"), "{said}");
+    settle(&mut sim);
+    // Jogged to (80, 35), zeroed there, jogged to (76, 35), back to zero.
+    assert_eq!(steps_on_pins(&sim)[..2], [3200, 1400]);
+    let path: Vec<[i64; 3]> = track(&sim)
+        .into_iter()
+        .filter(|(c, _)| *c > from)
+        .map(|(_, s)| s)
+        .collect();
+    let passes = |x: i64, y: i64| path.iter().any(|s| s[0] == x && s[1] == y);
+    assert!(passes(3200, 1400) && passes(3040, 1400), "the jogs' ends");
+    assert!(path.iter().all(|s| s[1] >= 1200 && s[1] <= 1400 && s[0] >= 2800 && s[0] <= 3200));
+    let start = sim.uart_bytes().len();
+    send_ok(&mut sim, "$#", Duration::from_secs(2));
+    let text = sim.uart_text_from(start);
+    assert!(text.contains("[G54:80.000,35.000,0.000]\n"), "{text}");
+    assert!(text.contains("[G92:0.000,0.000,0.000]\n"), "{text}");
+    let start = sim.uart_bytes().len();
+    sim.uart_send(b"?");
+    sim.run_for(Duration::from_millis(50));
+    let report = sim.uart_text_from(start);
+    assert!(report.contains("MPos:80.000,35.000,0.000"), "{report}");
+}

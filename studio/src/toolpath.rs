@@ -6,9 +6,12 @@
 
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Input, Parser};
-use taut_logic::interp::{Allowed, Interpreter, Order};
-use taut_logic::kinematics::{AnyKinematics, Kinematics, Position};
+use taut_logic::interp::{
+    Allowed, CoordTable, Env, Exact, Interpreter, MachineIo, Progress, Wait,
+};
+use taut_logic::kinematics::{AnyKinematics, Kinematics, Steps};
 use taut_logic::machine::Machine;
+use taut_logic::planner::Feed;
 use taut_simavr::vcd::Signal;
 
 /// A straight piece of the path, mm in the G-code's frame (y up).
@@ -61,26 +64,76 @@ impl Toolpath {
     }
 }
 
-fn mm(p: &Position) -> [f64; 2] {
-    [f64::from(p[0].0) / 1000.0, f64::from(p[1].0) / 1000.0]
+/// The machine as the preview sees it: every move the executor queues
+/// (through the forward kinematics) and the pen's angle.
+struct Drawing<'a> {
+    kin: &'a AnyKinematics,
+    cfg: &'a MachineConfig,
+    coords: CoordTable,
+    path: Toolpath,
+    at: [f64; 2],
+    down: bool,
+}
+
+impl MachineIo for Drawing<'_> {
+    fn coord(&self, index: u8) -> Exact {
+        self.coords.get(index)
+    }
+    fn set_coord(&mut self, index: u8, value: &Exact) {
+        self.coords.set(index, value)
+    }
+    fn room(&mut self, _piece: bool) -> Option<Wait> {
+        None
+    }
+    fn queue(&mut self, steps: &Steps, _feed: Feed) -> bool {
+        let p = self.kin.forward(steps);
+        let to = [f64::from(p[0].0) / 1000.0, f64::from(p[1].0) / 1000.0];
+        self.path.push(self.at, to, self.down);
+        self.at = to;
+        true
+    }
+    fn idle(&mut self) -> bool {
+        true
+    }
+    fn pen(&mut self, deg: u8) -> bool {
+        self.down = deg == self.cfg.pen.down_deg;
+        false
+    }
+    fn drivers(&mut self, _on: bool) {}
+    fn pause(&mut self) {}
+    fn report_position(&mut self) {}
+    fn program_end(&mut self) {}
+    fn millis(&self) -> u32 {
+        0
+    }
 }
 
 /// The toolpath of a G-code program on `machine` (its default settings),
-/// from the origin with the pen up. An error names the line and the
+/// from the origin with the pen up, read and carried out by the
+/// firmware's parser and executor. An error names the line and the
 /// firmware's `error:` code and message.
 pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
     let cfg = MachineConfig::defaults(machine);
     let kin = AnyKinematics::of(&cfg).map_err(|e| e.message().to_string())?;
-    let allowed = Allowed {
-        motion: true,
-        position_known: true,
+    let env = Env {
+        kin: &kin,
+        cfg: &cfg,
+        allowed: Allowed::ALL,
     };
     let (mut parser, mut interp) = (Parser::new(), Interpreter::new());
-    let mut path = Toolpath::default();
-    let (mut at, mut down, mut line_no) = ([0.0; 2], false, 1);
+    let mut io = Drawing {
+        kin: &kin,
+        cfg: &cfg,
+        coords: CoordTable::new(),
+        path: Toolpath::default(),
+        at: [0.0; 2],
+        down: false,
+    };
+    let mut line_no = 1;
     let mut bytes: Vec<u8> = text.bytes().collect();
     bytes.push(b'\n');
     for b in bytes {
+        let first = parser.first_char();
         let Some(result) = parser.push(b) else {
             continue;
         };
@@ -89,39 +142,23 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
             line_no += 1;
         }
         let fail = |code: u8, message: &str| format!("line {here}: error:{code} {message}");
-        let line = match result {
-            Ok(Input::Line(line)) => line,
+        let (block, jog) = match result {
+            Ok(Input::Block(block)) => (block, false),
+            Ok(Input::Jog(block)) => (block, true),
             Ok(Input::Realtime(r)) => {
                 return Err(format!("line {here}: a real-time byte ({r:?}) in the file"))
             }
+            // A program's `%` delimiters, as a card print passes them over.
+            Err(_) if first == b'%' => continue,
             Ok(_) => return Err(format!("line {here}: a $ or card command is not a drawing")),
             Err(e) => return Err(fail(e.code(), e.message())),
         };
-        let planned = interp
-            .plan(&line, &kin, &cfg, allowed)
+        interp
+            .accept(&block, jog, &env, &mut io)
             .map_err(|e| fail(e as u8, e.message()))?;
-        match planned.order {
-            Order::Move { steps, .. } | Order::SetPosition { steps } => {
-                let to = mm(&kin.forward(&steps));
-                if matches!(planned.order, Order::Move { .. }) {
-                    path.push(at, to, down);
-                }
-                at = to;
-            }
-            Order::Path { path: pieces, .. } => {
-                for p in pieces {
-                    let to = mm(&p);
-                    path.push(at, to, down);
-                    at = to;
-                }
-            }
-            Order::Pen { deg, .. } => down = deg == cfg.pen.down_deg,
-            Order::Home { .. } => return Err(fail(0, "homing (G28) cannot be previewed")),
-            _ => {}
-        }
-        interp.commit(&planned);
+        while interp.run(&env, &mut io) != Progress::Done {}
     }
-    Ok(path)
+    Ok(io.path)
 }
 
 /// The toolpath a plotter's pulses drew (`taut-sim --vcd`): its two drawing
@@ -168,8 +205,9 @@ mod tests {
         assert_eq!(e, "line 2: error:15 Travel exceeded (soft limit)");
         let e = from_gcode("G1 X10\n", Machine::Drum).unwrap_err();
         assert!(e.starts_with("line 1: error:22"), "{e}");
-        let e = from_gcode("G0 X1 Z1\n", Machine::Flatbed).unwrap_err();
-        assert!(e.starts_with("line 1: error:73"), "{e}");
+        // A move with the pen's Z: the pen first, then the move.
+        let p = from_gcode("G0 Z1\nG1 X1 Z-1 F100\n", Machine::Flatbed).unwrap();
+        assert_eq!(p.moves.iter().map(|m| m.down).collect::<Vec<_>>(), [true]);
         let e = from_gcode("G0 X900 Y0\n", Machine::Scara).unwrap_err();
         assert!(e.starts_with("line 1: error:"), "{e}");
     }

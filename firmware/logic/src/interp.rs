@@ -262,6 +262,9 @@ pub struct Interpreter {
     dwell_until: Option<u32>,
     /// The work offset changed since the status report last asked.
     wco_changed: bool,
+    /// `M300 S255`: the unicorn extension's "servo off": `Z` words leave
+    /// the pen alone until `M3`/`M4`/`M5` or `M300` gives it an angle.
+    servo_off: bool,
 }
 
 impl Default for Interpreter {
@@ -319,6 +322,7 @@ impl Interpreter {
             run: Run::new(),
             dwell_until: None,
             wco_changed: true,
+            servo_off: false,
         }
     }
 
@@ -728,11 +732,16 @@ impl Interpreter {
                 if plotter {
                     run.pen = pen_deg(b.spindle != Spindle::Off);
                     run.todo |= todo::PEN;
+                    self.servo_off = false;
                 }
             }
+            // `M300 S` over 180: the servo off (the pen stays).
             if servo {
-                run.pen = (b.s.0.clamp(0, 180_000) / 1000) as u8;
-                run.todo |= todo::PEN;
+                self.servo_off = b.s.0 > 180_000;
+                if !self.servo_off {
+                    run.pen = (b.s.0 / 1000) as u8;
+                    run.todo |= todo::PEN;
+                }
             }
             // [8] Coolant: kept for `$G`.
             if b.has(group::COOLANT) {
@@ -805,7 +814,7 @@ impl Interpreter {
                 };
             }
             // A plotter's Z is its pen, set before the moves.
-            if plotter && given >> Z & 1 != 0 {
+            if plotter && given >> Z & 1 != 0 && !self.servo_off {
                 let work_z = legs[count - 1][Z] - self.work_offset(Z);
                 run.pen_z = pen_deg(work_z <= 0);
                 run.todo |= todo::PEN_Z;
