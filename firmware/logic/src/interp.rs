@@ -656,7 +656,13 @@ impl Interpreter {
                         mm_milli(b.ijk[ijk(w0)], m.units),
                         mm_milli(b.ijk[ijk(w1)], m.units),
                     ];
-                    arc = Some(self.arc(&target, sweep_plane, clockwise, circle, offsets, cfg)?);
+                    let ask = ArcAsk {
+                        plane: sweep_plane,
+                        clockwise,
+                        radius: circle,
+                        offsets,
+                    };
+                    arc = Some(self.arc(&target, &ask, cfg)?);
                 }
                 MotionMode::Seek | MotionMode::Linear if given == 0 => {
                     axis_command = AxisCommand::None;
@@ -888,25 +894,17 @@ impl Interpreter {
     /// is built once, where the caller keeps it (the AVR's stack is
     /// small).
     #[inline(never)]
-    fn arc(
-        &self,
-        target: &Exact,
-        plane: arc::Plane,
-        clockwise: bool,
-        radius: Option<Milli>,
-        offsets: [Milli; 2],
-        cfg: &MachineConfig,
-    ) -> Result<Arc, ErrorKind> {
+    fn arc(&self, target: &Exact, ask: &ArcAsk, cfg: &MachineConfig) -> Result<Arc, ErrorKind> {
         let sweep = Sweep {
             start: coords::milli(&self.position),
             end: coords::milli(target),
-            plane,
-            clockwise,
+            plane: ask.plane,
+            clockwise: ask.clockwise,
             tolerance: Milli(cfg.arc_tolerance_um.min(i32::MAX as u32) as i32),
         };
-        let circle = match radius {
+        let circle = match ask.radius {
             Some(r) => Circle::from_radius(&sweep, r),
-            None => Circle::from_centre(&sweep, offsets),
+            None => Circle::from_centre(&sweep, ask.offsets),
         }
         .map_err(|e| match e {
             ArcError::EndOffCircle => ErrorKind::InvalidTarget,
@@ -914,6 +912,17 @@ impl Interpreter {
         })?;
         Ok(Arc::new(&sweep, &circle))
     }
+}
+
+/// An arc's figures besides its ends: by reference, as the AVR backend
+/// garbles arguments passed on the stack (an arc's offsets came as
+/// garbage, `error:33`).
+struct ArcAsk {
+    plane: arc::Plane,
+    clockwise: bool,
+    /// `R` (mm), or the centre's offsets from the start in the plane.
+    radius: Option<Milli>,
+    offsets: [Milli; 2],
 }
 
 /// Whether the line would move the machine or change what a job owns

@@ -535,3 +535,4 @@ fn a_job_owns_the_motion() {
     }
     let _ = "".to_string();
 }
+
