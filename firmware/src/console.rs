@@ -15,31 +15,26 @@
 #![deny(unsafe_code)]
 
 mod homing;
+mod offsets;
 
+use crate::flash_str;
 use crate::machine_io::Io;
 use crate::motion::Motion;
 use crate::print::Print;
 use crate::queues::{Signal, BUTTONS, JOB_CLAIMS_TX, RX};
 use crate::reply;
 use crate::rt::{stack, Poll};
-use crate::flash_str;
 use core::sync::atomic::Ordering::Relaxed;
 use homing::HomingRun;
 use taut_logic::axis::AXES;
-use taut_logic::buttons::ButtonEvent;
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{
-    coord_value, CardLine, Error, ErrorKind, Input, Parser, Places, Read, Restore, SystemLine,
-};
+use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Parser, Read, Restore, SystemLine};
 use taut_logic::interp::{
-    axis_letters, motor_channels, Allowed, CoordTable, Env, Interpreter, Progress, Wait, G28, G30,
+    axis_letters, motor_channels, Allowed, CoordTable, Env, Interpreter, Progress, Wait,
 };
 use taut_logic::kinematics::{Kinematics, Position};
 use taut_logic::patterns;
-use taut_logic::pinmap::Button;
 use taut_logic::settings;
-use taut_logic::settings::grbl::{report_angles, report_axes};
-use taut_logic::units::Milli;
 use taut_progmem::{text, Text};
 use ufmt::uwrite;
 
@@ -309,7 +304,12 @@ impl Console {
     }
 
     /// The executor's view of the machine now.
-    fn env<'a, K: Kinematics>(&self, kin: &'a K, cfg: &'a MachineConfig, owner: Owner) -> Env<'a, K> {
+    fn env<'a, K: Kinematics>(
+        &self,
+        kin: &'a K,
+        cfg: &'a MachineConfig,
+        owner: Owner,
+    ) -> Env<'a, K> {
         Env {
             kin,
             cfg,
@@ -390,7 +390,13 @@ impl Console {
     /// 88–102): overflow, empty, `$`, the G-code lock (alarm or jog),
     /// G-code. Out of line: the line (~100 B) is on the stack only here.
     #[inline(never)]
-    fn take(&mut self, m: &mut Motion, kin: &impl Kinematics, cfg: &mut MachineConfig, owner: Owner) {
+    fn take(
+        &mut self,
+        m: &mut Motion,
+        kin: &impl Kinematics,
+        cfg: &mut MachineConfig,
+        owner: Owner,
+    ) {
         // The next line's words are the machine's (`$machine=` may change them).
         self.parser.set_axis_letters(axis_letters(&kin.words()));
         let first = self.parser.first_char();
@@ -402,7 +408,9 @@ impl Console {
             // Empty or comment only: for syncing, `ok`.
             _ if first == 0 => self.ok(),
             Ok(Input::System(s)) => self.system(s, m, cfg, owner),
-            Ok(Input::Jog(b)) if self.checking || !m.position_known() || !(m.is_idle() || jog_state) => {
+            Ok(Input::Jog(b))
+                if self.checking || !m.position_known() || !(m.is_idle() || jog_state) =>
+            {
                 let _ = b;
                 self.error(&Error::new(ErrorKind::NotIdle, 0))
             }
@@ -422,9 +430,7 @@ impl Console {
             Ok(Input::Card(c)) => self.card_line(c, m, cfg),
             // Grbl's G-code lock: in alarm (the position lost) or while
             // jogs run.
-            _ if !m.position_known() || jog_state => {
-                self.error(&Error::new(ErrorKind::Locked, 0))
-            }
+            _ if !m.position_known() || jog_state => self.error(&Error::new(ErrorKind::Locked, 0)),
             Err(e) => self.error(&e),
             // While a print runs, the serial line may only look.
             Ok(Input::Block(_)) if self.printing_from_serial() => {
@@ -505,7 +511,9 @@ impl Console {
     /// still waits for the reader.
     #[inline(never)]
     fn card_news(&mut self, m: &mut Motion) -> bool {
-        self.green_button(m);
+        while let Some(event) = BUTTONS.pop() {
+            self.print.button(event, m);
+        }
         let waited = self.print.waiting();
         match self.print.take_messages() {
             Some(Ok(())) => self.ok(),
@@ -515,51 +523,14 @@ impl Console {
         false
     }
 
-    /// The green button on a plotter: go on after a hold or `M0`, else
-    /// start the selected file, go on with a lost one, or start the
-    /// card's first G-code file.
-    #[inline(never)]
-    fn green_button(&mut self, m: &mut Motion) {
-        while let Some(event) = BUTTONS.pop() {
-            if event == ButtonEvent::Pressed(Button::Confirm)
-                && !m.resume()
-                && self.print.start(false).is_err()
-            {
-                self.print.start_first();
-            }
-        }
-    }
-
     /// `M20`, `M23`…: a plotter's card print (the string-art job owns the
     /// card on its machine; a file cannot run card commands).
     #[inline(never)]
-    #[optimize(size)]
     fn card_line(&mut self, c: CardLine, m: &mut Motion, cfg: &MachineConfig) {
         if cfg.machine.is_string_art() || self.source == Some(Source::Card) {
             return self.error(&Error::new(ErrorKind::UnsupportedCommand, 1));
         }
-        let done = match c {
-            CardLine::List => self.print.list(),
-            CardLine::Mount => Ok(()),
-            CardLine::Select(name) => self.print.select(name),
-            CardLine::Start if m.resume() => Ok(()),
-            CardLine::Start => self.print.start(true),
-            CardLine::Pause => {
-                if self.print.running() {
-                    m.hold();
-                }
-                Ok(())
-            }
-            CardLine::Progress => {
-                self.print.progress();
-                Ok(())
-            }
-            CardLine::Abort => {
-                self.print.abort();
-                Ok(())
-            }
-        };
-        match done {
+        match self.print.command(c, m) {
             Err(kind) => self.error(&Error::new(kind, 0)),
             // Answered when the reader has.
             Ok(()) if self.print.waiting() => {}
@@ -780,45 +751,6 @@ impl Console {
         if self.listing.is_none() {
             reply::ok();
         }
-    }
-
-    /// Line `line` of `$#` (`report_ngc_parameters`): `G54`…`G59`, `G28`,
-    /// `G30` from the coordinate data, `G92` and `TLO` from the executor,
-    /// `PRB` (taut has no probe: zero, not taken); `false` past the last.
-    #[inline(never)]
-    #[optimize(size)]
-    fn offsets_line(&self, line: u8, cfg: &MachineConfig) -> bool {
-        let (g92, tlo) = self.interp.offsets();
-        let places = |p: Position| Places {
-            values: report_axes(cfg.machine).map(|a| p[a.index()]),
-            angles: report_angles(cfg.machine),
-            inches: cfg.report_inches,
-        };
-        let mut r = reply::line();
-        let _ = match line {
-            0..=5 => uwrite!(r, "{}{}:", flash_str!("[G"), 54 + line),
-            6 | 7 => uwrite!(r, "{}{}:", flash_str!("[G"), if line == 6 { 28 } else { 30 }),
-            8 => uwrite!(r, "{}", flash_str!("[G92:")),
-            9 => uwrite!(r, "{}", flash_str!("[TLO:")),
-            10 => uwrite!(r, "{}", flash_str!("[PRB:")),
-            _ => return false,
-        };
-        let _ = match line {
-            0..=7 => {
-                let index = match line {
-                    6 => G28,
-                    7 => G30,
-                    n => n,
-                };
-                let data = taut_logic::interp::coords::milli(&self.coords.get(index));
-                uwrite!(r, "{}]", places(data))
-            }
-            8 => uwrite!(r, "{}]", places(g92)),
-            9 => uwrite!(r, "{}]", coord_value(tlo, cfg.report_inches)),
-            _ => uwrite!(r, "{}{}", places([Milli::ZERO; 3]), flash_str!(":0]")),
-        };
-        r.send();
-        true
     }
 }
 

@@ -13,11 +13,14 @@
 
 use crate::board::flash::FlashStr;
 use crate::log::Level;
+use crate::motion::Motion;
 use crate::queues::{CardMsg, Request, What, CARD_IN, CARD_OUT};
 use crate::reply;
 use crate::{flash_str, info, warn};
+use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
-use taut_logic::gcode::{Error, ErrorKind};
+use taut_logic::gcode::{CardLine, Error, ErrorKind};
+use taut_logic::pinmap::Button;
 use ufmt::uwrite;
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -108,6 +111,47 @@ impl Print {
         let r = request(self.ticket);
         while CARD_IN.push(r).is_err() {
             let _ = CARD_IN.pop();
+        }
+    }
+
+    /// A card command from the console (`M20`, `M23`…); answered `ok`
+    /// now, or once the reader has when [`Print::waiting`].
+    #[inline(never)]
+    #[optimize(size)]
+    pub fn command(&mut self, c: CardLine, m: &mut Motion) -> Result<(), ErrorKind> {
+        match c {
+            CardLine::List => self.list(),
+            CardLine::Mount => Ok(()),
+            CardLine::Select(name) => self.select(name),
+            CardLine::Start if m.resume() => Ok(()),
+            CardLine::Start => self.start(true),
+            CardLine::Pause => {
+                if self.running() {
+                    m.hold();
+                }
+                Ok(())
+            }
+            CardLine::Progress => {
+                self.progress();
+                Ok(())
+            }
+            CardLine::Abort => {
+                self.abort();
+                Ok(())
+            }
+        }
+    }
+
+    /// The green button on a plotter: go on after a hold or `M0`, else
+    /// start the selected file, go on with a lost one, or start the
+    /// card's first G-code file.
+    #[inline(never)]
+    pub fn button(&mut self, event: ButtonEvent, m: &mut Motion) {
+        if event == ButtonEvent::Pressed(Button::Confirm)
+            && !m.resume()
+            && self.start(false).is_err()
+        {
+            self.start_first();
         }
     }
 

@@ -206,7 +206,10 @@ impl Reader {
         if r < 0.0 {
             h = -h;
         }
-        [self.at[0] + 0.5 * (x - y * h), self.at[1] + 0.5 * (y + x * h)]
+        [
+            self.at[0] + 0.5 * (x - y * h),
+            self.at[1] + 0.5 * (y + x * h),
+        ]
     }
 
     fn pen(&mut self, down: bool) {

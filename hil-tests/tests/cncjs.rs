@@ -288,7 +288,12 @@ fn cncjs_zero_and_jog_buttons_move_the_machine_and_set_the_work_zero() {
     use hil_tests::steps_on_pins;
     let prefix = cncjs_prefix();
     let mut sim = boot_machine();
-    for line in ["$machine=flatbed", "$homing_at_start=0", "M17", "G0 X70 Y30"] {
+    for line in [
+        "$machine=flatbed",
+        "$homing_at_start=0",
+        "M17",
+        "G0 X70 Y30",
+    ] {
         send_ok(&mut sim, line, Duration::from_secs(2));
     }
     settle(&mut sim);
@@ -299,9 +304,20 @@ fn cncjs_zero_and_jog_buttons_move_the_machine_and_set_the_work_zero() {
     let mut client = Command::new("node");
     client.arg(client_script("cncjs_client.js"));
     let args = [prefix.to_str().unwrap(), buttons, "60", "0"];
-    let out = serve(&mut sim, &mut client, &args, Duration::from_secs(60), |_, _, _| {});
-    let said = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{said}\n{}", hil_tests::log_tail(&sim));
+    let out = serve(
+        &mut sim,
+        &mut client,
+        &args,
+        Duration::from_secs(60),
+        |_, _, _| {},
+    );
+    let said =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success(),
+        "{said}\n{}",
+        hil_tests::log_tail(&sim)
+    );
     assert!(said.contains("done buttons"), "{said}");
     settle(&mut sim);
     // Jogged to (80, 35), zeroed there, jogged to (76, 35), back to zero.
@@ -313,7 +329,9 @@ fn cncjs_zero_and_jog_buttons_move_the_machine_and_set_the_work_zero() {
         .collect();
     let passes = |x: i64, y: i64| path.iter().any(|s| s[0] == x && s[1] == y);
     assert!(passes(3200, 1400) && passes(3040, 1400), "the jogs' ends");
-    assert!(path.iter().all(|s| s[1] >= 1200 && s[1] <= 1400 && s[0] >= 2800 && s[0] <= 3200));
+    assert!(path
+        .iter()
+        .all(|s| s[1] >= 1200 && s[1] <= 1400 && s[0] >= 2800 && s[0] <= 3200));
     let start = sim.uart_bytes().len();
     send_ok(&mut sim, "$#", Duration::from_secs(2));
     let text = sim.uart_text_from(start);

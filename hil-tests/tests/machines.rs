@@ -53,7 +53,8 @@ fn the_scara_arm_draws_its_toolpath() {
 }
 
 /// `M0` holds once the motion before it is done, until the green button or
-/// `~`; `G20` takes inches, converted once.
+/// `~`; `M1` is ignored (no optional-stop switch, as Grbl); `G20` takes
+/// inches, converted once.
 #[test]
 fn a_plotter_pauses_at_m0_and_takes_inches() {
     use hil_tests::{press, steps_on_pins};
@@ -61,8 +62,7 @@ fn a_plotter_pauses_at_m0_and_takes_inches() {
     let mut sim = boot_machine();
     send(&mut sim, "$machine=flatbed");
     send(&mut sim, "M17");
-    // Sent ahead, as a streaming sender does: `M1` is answered only
-    // once the motion before it is done, after the first pause.
+    // Sent ahead, as a streaming sender does.
     sim.uart_send(b"G0 X10\nM0\nG0 X20\nM1\nG20 G0 X1\n");
     let status = |sim: &mut Sim| {
         let start = sim.uart_bytes().len();
@@ -74,26 +74,22 @@ fn a_plotter_pauses_at_m0_and_takes_inches() {
     assert!(status(&mut sim).contains("<Hold:0|"), "{}", log_tail(&sim));
     assert_eq!(steps_on_pins(&sim)[0], 400, "stopped at X10 (40 steps/mm)");
     press(&mut sim, Button::Confirm, 100);
-    sim.run_for(Duration::from_secs(2));
+    sim.run_for(Duration::from_secs(3));
+    // 1 in = 25.4 mm = 1016 steps: M1 did not stop it at X20.
     assert_eq!(
         steps_on_pins(&sim)[0],
-        800,
-        "the green button went on to X20"
+        1016,
+        "the green button went on, past M1"
     );
-    assert!(status(&mut sim).contains("<Hold:0|"));
-    sim.uart_send(b"~");
-    sim.run_for(Duration::from_secs(2));
-    // 1 in = 25.4 mm = 1016 steps.
-    assert_eq!(steps_on_pins(&sim)[0], 1016, "~ went on to X1 in");
     assert!(status(&mut sim).contains("<Idle|"));
 }
 
 /// The flatbed homes X against its MIN switch (X_MIN, D3) at power-on and
-/// on `G28`: seek, pull off, locate slowly, pull off 1 mm, and X is then
-/// 1.000. The harness closes the switch 3 mm (120 steps) below where X
+/// on `$H`: seek, pull off, locate slowly, pull off 1 mm, and X is then
+/// 1.000 (`G28` goes to the stored G28 position, not home). The harness closes the switch 3 mm (120 steps) below where X
 /// stood at power-on.
 #[test]
-fn the_flatbed_homes_x_against_its_switch_at_power_on_and_on_g28() {
+fn the_flatbed_homes_x_against_its_switch_at_power_on_and_on_dollar_h() {
     use hil_tests::{machine, steps_on_pins, wait_for};
     use taut_logic::axis::Axis;
     use taut_logic::pinmap::{driver, Button};
@@ -126,14 +122,14 @@ fn the_flatbed_homes_x_against_its_switch_at_power_on_and_on_g28() {
     }
     sim.run_for(Duration::from_millis(300));
     assert_eq!(steps_on_pins(&sim), before);
-    send(&mut sim, "G28");
+    send(&mut sim, "$H");
     assert_eq!(steps_on_pins(&sim)[0], -80);
     assert_ram_budget(&sim);
 }
 
 /// Without its switch, homing fails with Grbl's alarm 9 ("could not find
-/// limit switch"), the line answered `ok` as Grbl's, and motion waits for
-/// `G28`, `G92` or `$X`; a machine with no homing axes answers Grbl's
+/// limit switch"), the line answered `ok` as Grbl's, and G-code waits for
+/// `$H` or `$X` (Grbl's lock, error 9); a machine with no homing axes answers Grbl's
 /// error 5 (setting disabled).
 #[test]
 fn homing_without_a_switch_fails_and_locks_motion() {
@@ -145,7 +141,7 @@ fn homing_without_a_switch_fails_and_locks_motion() {
     send(&mut sim, "$machine=flatbed");
     send(&mut sim, "$homing_seek=4000");
     let from = sim.uart_bytes().len();
-    send_ok(&mut sim, "G28", Duration::from_secs(20));
+    send_ok(&mut sim, "$H", Duration::from_secs(20));
     let text = sim.uart_text_from(from);
     assert!(text.ends_with("ALARM:9\nok\n"), "{text}");
     match sim.send_line("G0 X1", Duration::from_secs(2)) {
@@ -156,7 +152,7 @@ fn homing_without_a_switch_fails_and_locks_motion() {
 
 /// What plotter tools emit that taut does not do (`M117` messages, tool
 /// changes) is answered with an error, moves nothing, and the stream goes
-/// on.
+/// on; a tool number alone (`T1`) is kept, as Grbl keeps it.
 #[test]
 fn unknown_but_harmless_codes_are_refused_and_the_stream_goes_on() {
     use hil_tests::steps_on_pins;
@@ -165,7 +161,6 @@ fn unknown_but_harmless_codes_are_refused_and_the_stream_goes_on() {
     send(&mut sim, "M17");
     for (line, code) in [
         ("M117 Drawing...", "error:20 "),
-        ("T1", "error:20 "),
         ("M6", "error:20 "),
         ("M106 S255", "error:20 "),
     ] {

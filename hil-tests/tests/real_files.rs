@@ -26,7 +26,9 @@ const WITHIN: f64 = 0.046;
 const ZERO: [f64; 2] = [70.0, 100.0];
 
 fn fixture(name: &str) -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("files").join(name);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("files")
+        .join(name);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
@@ -67,7 +69,8 @@ fn send_file(sim: &mut Sim, text: &str) {
     for line in text.lines() {
         match sim.send_line(line, Duration::from_secs(60)) {
             Ok(hil_tests::sim::Reply::Ok) => {}
-            Ok(hil_tests::sim::Reply::Error(e)) if line.trim() == "%" && e.starts_with("error:1 ") => {}
+            Ok(hil_tests::sim::Reply::Error(e))
+                if line.trim() == "%" && e.starts_with("error:1 ") => {}
             other => panic!("{line:?}: {other:?}\n{}", log_tail(sim)),
         }
     }
@@ -88,7 +91,12 @@ fn assert_drawn(sim: &Sim, begins: u64, strokes: &Strokes) {
     // where it stood (the switch at -120 steps, the pull-off 1 mm).
     let all = track(sim);
     let offset = {
-        let homed_x = all.iter().rev().find(|(c, _)| *c <= begins).map(|(_, s)| s[0]).unwrap_or(0);
+        let homed_x = all
+            .iter()
+            .rev()
+            .find(|(c, _)| *c <= begins)
+            .map(|(_, s)| s[0])
+            .unwrap_or(0);
         // At `begins` the machine stands at ZERO.
         (ZERO[0] * 40.0).round() as i64 - homed_x
     };
@@ -122,7 +130,10 @@ fn assert_drawn(sim: &Sim, begins: u64, strokes: &Strokes) {
     }
     let end = points.last().unwrap().1;
     let e = strokes.end;
-    assert!((end[0] - e[0]).hypot(end[1] - e[1]) <= WITHIN, "ended at {end:?}, not {e:?}");
+    assert!(
+        (end[0] - e[0]).hypot(end[1] - e[1]) <= WITHIN,
+        "ended at {end:?}, not {e:?}"
+    );
     eprintln!(
         "{} pulses ({down} with the pen down), worst {worst:.3} mm off; {} strokes, {} corners",
         points.len(),

@@ -120,7 +120,8 @@ fn feed_hold_brakes_and_resume_ends_on_the_exact_target() {
 }
 
 /// Ctrl-X mid-move: the pulses stop at once, the position is what they
-/// made (`M114`), and motion waits for `G92` or `$X`; drivers stay on.
+/// made (`M114`), and G-code waits for `$X` (Grbl's lock, error 9);
+/// drivers stay on.
 #[test]
 fn ctrl_x_stops_at_once_and_locks_motion_until_the_position_is_set() {
     let mut sim = enabled();
@@ -198,15 +199,17 @@ fn soft_limits_and_slow_feeds_are_refused_with_zero_steps() {
     refused(&mut sim, "G0 Z-31", 15);
     refused(&mut sim, "G0 X2147483.647", 15);
     refused(&mut sim, "G1 X1 F5", 72);
-    refused(&mut sim, "G1 X1 F0", 72);
+    // Grbl's: F0 is no feed rate.
+    refused(&mut sim, "G1 X1 F0", 22);
     sim.run_for(Duration::from_millis(500));
     assert_eq!(steps_on_pins(&sim), [0, 0, 0], "nothing moved");
-    // Limits count from the zero: G92 moves them with it.
+    // Limits are machine coordinates: a G92 offset never moves them.
     send(&mut sim, "G92 X-440");
-    send(&mut sim, "G0 X29");
+    refused(&mut sim, "G0 X29", 15);
+    send(&mut sim, "G0 X-411");
     send(&mut sim, "G0 C720");
     send_ok(&mut sim, "M400", Duration::from_secs(60));
-    assert_eq!(steps_on_pins(&sim), [19200, 469 * 32, 0]);
+    assert_eq!(steps_on_pins(&sim), [19200, 29 * 32, 0]);
 }
 
 /// The sample job's card in, green pressed: drilling.
@@ -303,13 +306,19 @@ fn refused_settings_say_why_and_long_replies_are_whole() {
     assert!(e.contains("travel_min above travel_max"), "{e}");
     send(&mut sim, "$step_pulse_us=200");
     send(&mut sim, "$step_pulse_us=5");
-    // The longest M114 line: every axis far out.
-    send(&mut sim, "G92 C-999999 X-999999 Z-999999");
+    // Offsets far out, each line of `$#` whole.
+    send(&mut sim, "G10 L2 P1 C-999999 X-999999 Z-999999");
+    // G92 = MPos - WCS - WPos.
+    send(&mut sim, "G92 C1 X1 Z1");
     let start = sim.uart_bytes().len();
-    send(&mut sim, "M114");
+    send(&mut sim, "$#");
     let text = sim.uart_text_from(start);
     assert!(
-        text.starts_with("C:-999999.000 X:-999999.000 Z:-999999.000 Count C:-26666640 X:-31999968 Z:-133333200\nok\n"),
+        text.starts_with("[G54:-999999.000,-999999.000,-999999.000]\n"),
+        "{text:?}"
+    );
+    assert!(
+        text.contains("\n[G92:999998.000,999998.000,999998.000]\n"),
         "{text:?}"
     );
 }

@@ -6,9 +6,7 @@
 
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Input, Parser};
-use taut_logic::interp::{
-    Allowed, CoordTable, Env, Exact, Interpreter, MachineIo, Progress, Wait,
-};
+use taut_logic::interp::{Allowed, CoordTable, Env, Exact, Interpreter, MachineIo, Progress, Wait};
 use taut_logic::kinematics::{AnyKinematics, Kinematics, Steps};
 use taut_logic::machine::Machine;
 use taut_logic::planner::Feed;

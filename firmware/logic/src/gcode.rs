@@ -42,11 +42,11 @@ mod words;
 #[cfg(test)]
 mod tests;
 
-pub use error::{Error, ErrorKind, MIN_FEED};
 pub use block::{
     group, word, AxisCommand, AxisWord, Block, CardLine, Coolant, Distance, FeedMode, Flow, Input,
     MotionMode, NonModal, Plane, Realtime, Spindle, TautCode, ToolLength, Units, AXIS_WORDS,
 };
+pub use error::{Error, ErrorKind, MIN_FEED};
 pub use number::{parse_milli, NANO_LIMIT};
 pub use parser::{Parser, Read, MAX_LINE};
 pub use status::{coord_value, Extra, Overrides, Places, Refresh, State, Status, OVERRIDE_BYTES};

@@ -283,12 +283,26 @@ fn ijk(w: AxisWord) -> usize {
     w.index() - AxisWord::X.index()
 }
 
+/// `a + b` (or `a - b` with `sign` below 0), channel by channel. Out of
+/// line: the channels' 64-bit sums are one loop, not one inlined per use.
+#[inline(never)]
+fn sum(a: &Exact, b: &Exact, sign: i8) -> Exact {
+    core::array::from_fn(|i| if sign < 0 { a[i] - b[i] } else { a[i] + b[i] })
+}
+
+/// `new` on the channels in `mask` (bits), `old` on the others.
+#[inline(never)]
+fn pick(old: &Exact, new: &Exact, mask: u8) -> Exact {
+    core::array::from_fn(|i| if mask >> i & 1 != 0 { new[i] } else { old[i] })
+}
+
 /// The channel of a plotter's pen (its `Z`), or of the string-art
 /// machine's drill: where `G43.1` applies.
 const Z: usize = 2;
 
 /// A length in `units` as mm, rounded once (inches are exact to the
 /// nanometre up to five decimals).
+#[inline(never)]
 fn mm_exact(v: i64, units: Units) -> i64 {
     match units {
         Units::Mm => v,
@@ -297,6 +311,7 @@ fn mm_exact(v: i64, units: Units) -> i64 {
 }
 
 /// A feed or length in thousandths of `units` as thousandths of a mm.
+#[inline(never)]
 fn mm_milli(v: Milli, units: Units) -> Milli {
     match units {
         Units::Mm => v,
@@ -532,7 +547,7 @@ impl Interpreter {
         let mut g10 = None;
         let mut g92 = None;
         let mut home = None;
-        let tlo_of = |i: usize| if i == Z { self.tlo } else { 0 };
+        let tlo: Exact = [0, 0, self.tlo];
         match b.non_modal {
             NonModal::SetCoordData => {
                 if given == 0 {
@@ -553,36 +568,35 @@ impl Interpreter {
                     0 => m.coord,
                     _ => p as u8 - 1,
                 };
-                let mut data = io.coord(index);
-                for i in (0..AXES).filter(|i| given >> i & 1 != 0) {
-                    data[i] = match b.l {
-                        20 => self.position[i] - self.coord_offset[i] - axes[i] - tlo_of(i),
-                        _ => axes[i],
-                    };
-                }
-                g10 = Some((index, data));
+                // L20: WCS = MPos - G92 - TLO - WPos; L2: the words.
+                let base = match b.l {
+                    20 => sum(&self.position, &sum(&self.coord_offset, &tlo, 1), -1),
+                    _ => [0; AXES],
+                };
+                let sign = if b.l == 20 { -1 } else { 1 };
+                g10 = Some((
+                    index,
+                    pick(&io.coord(index), &sum(&base, &axes, sign), given),
+                ));
             }
             NonModal::SetCoordOffset => {
                 if given == 0 {
                     return Err(ErrorKind::NoAxisWords);
                 }
-                let mut offset = self.coord_offset;
-                for i in (0..AXES).filter(|i| given >> i & 1 != 0) {
-                    offset[i] = self.position[i] - block_coord[i] - axes[i] - tlo_of(i);
-                }
-                g92 = Some(offset);
+                // G92 = MPos - WCS - TLO - WPos.
+                let base = sum(&self.position, &sum(&block_coord, &tlo, 1), -1);
+                g92 = Some(pick(&self.coord_offset, &sum(&base, &axes, -1), given));
             }
             _ => {
                 if axis_command != AxisCommand::ToolLength {
-                    for i in (0..AXES).filter(|i| given >> i & 1 != 0) {
-                        target[i] = match (b.non_modal, m.distance) {
-                            (NonModal::AbsoluteOverride, _) => axes[i],
-                            (_, Distance::Absolute) => {
-                                axes[i] + block_coord[i] + self.coord_offset[i] + tlo_of(i)
-                            }
-                            (_, Distance::Relative) => axes[i] + self.position[i],
-                        };
-                    }
+                    let from = match (b.non_modal, m.distance) {
+                        (NonModal::AbsoluteOverride, _) => [0; AXES],
+                        (_, Distance::Absolute) => {
+                            sum(&block_coord, &sum(&self.coord_offset, &tlo, 1), 1)
+                        }
+                        (_, Distance::Relative) => self.position,
+                    };
+                    target = pick(&self.position, &sum(&from, &axes, 1), given);
                 }
                 match b.non_modal {
                     NonModal::GoHome0 | NonModal::GoHome1 => {
@@ -590,16 +604,13 @@ impl Interpreter {
                             NonModal::GoHome0 => G28,
                             _ => G30,
                         };
-                        let mut to = io.coord(index);
-                        if given != 0 {
-                            // Only the named axes go home, the others stay.
-                            for i in (0..AXES).filter(|i| given >> i & 1 == 0) {
-                                to[i] = self.position[i];
-                            }
-                        } else {
+                        // Only the named axes go home, the others stay;
+                        // with none, all go.
+                        if given == 0 {
                             axis_command = AxisCommand::None;
                         }
-                        home = Some(to);
+                        let mask = if given == 0 { 0b111 } else { given };
+                        home = Some(pick(&self.position, &io.coord(index), mask));
                     }
                     NonModal::AbsoluteOverride
                         if !matches!(m.motion, MotionMode::Seek | MotionMode::Linear) =>
@@ -645,7 +656,8 @@ impl Interpreter {
                         }
                         Some(mm_milli(b.r, m.units))
                     } else {
-                        if !b.has_word(word::I + ijk(w0) as u8) && !b.has_word(word::I + ijk(w1) as u8)
+                        if !b.has_word(word::I + ijk(w0) as u8)
+                            && !b.has_word(word::I + ijk(w1) as u8)
                         {
                             return Err(ErrorKind::NoOffsetsInPlane);
                         }
@@ -725,7 +737,13 @@ impl Interpreter {
 
         // Step 4: the line is good. Its state, then its actions.
         let mut run = Run::new();
-        let pen_deg = |down: bool| if down { cfg.pen.down_deg } else { cfg.pen.up_deg };
+        let pen_deg = |down: bool| {
+            if down {
+                cfg.pen.down_deg
+            } else {
+                cfg.pen.up_deg
+            }
+        };
         if jog {
             run.feed = Feed::PerMinute(feed);
         } else {
@@ -876,6 +894,7 @@ impl Interpreter {
     /// `M2`/`M30`: the modes LinuxCNC resets at a program's end (`gcode.c`
     /// line 1077): `G1 G17 G90 G94 G54 M5 M9`; `F`, `S`, units and
     /// offsets stay.
+    #[inline(never)]
     fn program_end(&mut self, io: &impl MachineIo) {
         let m = &mut self.modal;
         m.motion = MotionMode::Linear;
@@ -930,7 +949,10 @@ struct ArcAsk {
 fn moves(b: &Block) -> bool {
     b.has_axes()
         || b.has(group::TAUT)
-            && matches!(b.taut, TautCode::EnableDrivers | TautCode::DisableDrivers | TautCode::Servo)
+            && matches!(
+                b.taut,
+                TautCode::EnableDrivers | TautCode::DisableDrivers | TautCode::Servo
+            )
         || b.has(group::SPINDLE)
         || b.has(group::STOPPING) && b.flow != Flow::OptionalStop
         || !matches!(b.non_modal, NonModal::None | NonModal::Dwell)
@@ -979,6 +1001,7 @@ fn inverse_time(f: Milli, length_um: f32) -> Feed {
 
 /// Refuses a straight move from `from` to `to` that leaves the soft
 /// limits or the machine's reach.
+#[inline(never)]
 fn check_leg(
     from: &Exact,
     to: &Exact,
@@ -1034,12 +1057,7 @@ fn every_chord_reached(arc: &Arc, kin: &impl Kinematics) -> bool {
 
 /// Refuses a path whose box `lo..=hi` (machine coordinates) leaves a
 /// motor channel's soft limits.
-fn check_travel(
-    cfg: &MachineConfig,
-    lo: &Exact,
-    hi: &Exact,
-    motors: u8,
-) -> Result<(), ErrorKind> {
+fn check_travel(cfg: &MachineConfig, lo: &Exact, hi: &Exact, motors: u8) -> Result<(), ErrorKind> {
     let outside = (0..AXES).any(|i| {
         let a = &cfg.axes[i];
         let (min, max) = a.travel;

@@ -4,11 +4,11 @@
 
 use super::Console;
 use crate::endstop;
+use crate::info;
 use crate::motion::Motion;
 use crate::queues::Signal;
 use crate::reply;
 use crate::rt::Poll;
-use crate::info;
 use taut_logic::config::MachineConfig;
 use taut_logic::homing::{self, Homing, HomingError, Leg, Next};
 use taut_logic::planner::Feed;

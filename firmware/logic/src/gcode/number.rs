@@ -216,20 +216,59 @@ mod tests {
         assert_eq!(read("1234.567896").nano(), Some(1_234_567_900));
         assert_eq!(read("0.0000004").nano(), Some(0));
         assert_eq!(read("0.0000005").nano(), Some(1));
-        assert_eq!(read("99999999999999999999999").milli(), Some(Milli(i32::MAX)));
+        assert_eq!(
+            read("99999999999999999999999").milli(),
+            Some(Milli(i32::MAX))
+        );
         assert_eq!(read("-99999999999999999999999").nano(), Some(-NANO_LIMIT));
         assert_eq!(read("0.00000000000000000000000000001").nano(), Some(0));
     }
 
     #[test]
     fn codes_split_as_grbl_splits_them() {
-        assert_eq!(read("38.2").code(), Code { int: 38, hundredths: 20 });
-        assert_eq!(read("01").code(), Code { int: 1, hundredths: 0 });
-        assert_eq!(read("1.001").code(), Code { int: 1, hundredths: 0 });
-        assert_eq!(read("1.005").code(), Code { int: 1, hundredths: 1 });
+        assert_eq!(
+            read("38.2").code(),
+            Code {
+                int: 38,
+                hundredths: 20
+            }
+        );
+        assert_eq!(
+            read("01").code(),
+            Code {
+                int: 1,
+                hundredths: 0
+            }
+        );
+        assert_eq!(
+            read("1.001").code(),
+            Code {
+                int: 1,
+                hundredths: 0
+            }
+        );
+        assert_eq!(
+            read("1.005").code(),
+            Code {
+                int: 1,
+                hundredths: 1
+            }
+        );
         // Grbl's `trunc` then `round`: 0.996 is G0 with 100 hundredths.
-        assert_eq!(read("0.996").code(), Code { int: 0, hundredths: 100 });
-        assert_eq!(read("92.1").code(), Code { int: 92, hundredths: 10 });
+        assert_eq!(
+            read("0.996").code(),
+            Code {
+                int: 0,
+                hundredths: 100
+            }
+        );
+        assert_eq!(
+            read("92.1").code(),
+            Code {
+                int: 92,
+                hundredths: 10
+            }
+        );
         assert_eq!(read("1.5").whole(), 1);
         assert_eq!(read("12345678901").whole(), u32::MAX);
         assert_eq!(read("255.9").whole(), 255);

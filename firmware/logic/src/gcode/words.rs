@@ -8,8 +8,8 @@
 //! needs the modal state (step 3) is the executor's.
 
 use super::block::{
-    group, word, AxisCommand, AxisWord, Block, CardLine, Coolant, Distance, FeedMode, Flow,
-    Input, MotionMode, NonModal, Plane, Spindle, TautCode, ToolLength, Units,
+    group, word, AxisCommand, AxisWord, Block, CardLine, Coolant, Distance, FeedMode, Flow, Input,
+    MotionMode, NonModal, Plane, Spindle, TautCode, ToolLength, Units,
 };
 use super::error::{Error, ErrorKind};
 use super::number::Number;
@@ -385,9 +385,7 @@ impl Words {
         };
         // A card command takes no other word (Marlin's lines stand alone).
         match card {
-            _ if b.words & !(1 << word::N) != 0 => {
-                Err(Error::new(ErrorKind::UnusedWords, column))
-            }
+            _ if b.words & !(1 << word::N) != 0 => Err(Error::new(ErrorKind::UnusedWords, column)),
             CardLine::Select(name) if name.is_empty() => {
                 Err(Error::new(ErrorKind::ValueWordMissing, column))
             }

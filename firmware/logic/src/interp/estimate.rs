@@ -136,7 +136,11 @@ impl GcodeTime {
                 cfg: &self.config,
                 allowed: Allowed::ALL,
             };
-            if self.interp.accept(&block, jog, &env, &mut self.machine).is_err() {
+            if self
+                .interp
+                .accept(&block, jog, &env, &mut self.machine)
+                .is_err()
+            {
                 self.refused += 1;
                 continue;
             }

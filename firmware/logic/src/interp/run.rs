@@ -2,8 +2,10 @@
 //! each waits where Grbl's `protocol_buffer_synchronize` or a full
 //! planner would, and goes on at the next call.
 
-use super::{coords, motor_channels, motor_steps, todo, Env, Interpreter, MachineIo, Path,
-    Progress, Wait, SEGMENT_UM};
+use super::{
+    coords, motor_channels, motor_steps, todo, Env, Interpreter, MachineIo, Path, Progress, Wait,
+    SEGMENT_UM,
+};
 use crate::kinematics::{Kinematics, Segmenter};
 
 impl Interpreter {
@@ -26,7 +28,9 @@ impl Interpreter {
                     io.drivers(true);
                     None
                 }
-                todo::DWELL => self.after_motion(io).or_else(|| self.wait_ms(self.run.dwell_ms, io)),
+                todo::DWELL => self
+                    .after_motion(io)
+                    .or_else(|| self.wait_ms(self.run.dwell_ms, io)),
                 todo::LEG_0 | todo::LEG_1 => self.leg(next == todo::LEG_1, env, io),
                 todo::PATH => self.piece(env, io),
                 todo::PAUSE => self.after_motion(io).or_else(|| {
@@ -86,7 +90,12 @@ impl Interpreter {
 
     /// The pen to `deg` once the motion before is done, then its settle
     /// time if it moved.
-    fn pen<K: Kinematics>(&mut self, deg: u8, env: &Env<K>, io: &mut impl MachineIo) -> Option<Wait> {
+    fn pen<K: Kinematics>(
+        &mut self,
+        deg: u8,
+        env: &Env<K>,
+        io: &mut impl MachineIo,
+    ) -> Option<Wait> {
         if self.dwell_until.is_none() {
             if let Some(wait) = self.after_motion(io) {
                 return Some(wait);
@@ -101,7 +110,12 @@ impl Interpreter {
     /// A straight leg: one move on a linear machine, from the exact
     /// target; on the others, pieces (then the leg's bit is off and the
     /// path's on).
-    fn leg<K: Kinematics>(&mut self, second: bool, env: &Env<K>, io: &mut impl MachineIo) -> Option<Wait> {
+    fn leg<K: Kinematics>(
+        &mut self,
+        second: bool,
+        env: &Env<K>,
+        io: &mut impl MachineIo,
+    ) -> Option<Wait> {
         let to = self.run.legs[second as usize];
         let motors = motor_channels(env.cfg);
         if !env.kin.is_linear() {
@@ -143,7 +157,9 @@ impl Interpreter {
             }
             // An arc's last chord ends on the exact target (a linear
             // machine's steps from it, rounded once).
-            Some(_) if matches!(path, Path::Arc(a) if a.remaining() == 0) && env.kin.is_linear() => {
+            Some(_)
+                if matches!(path, Path::Arc(a) if a.remaining() == 0) && env.kin.is_linear() =>
+            {
                 motor_steps(&self.run.legs[0], motors, env.kin, env.cfg)
             }
             Some(p) => {

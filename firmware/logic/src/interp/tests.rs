@@ -97,7 +97,8 @@ impl Bench {
     /// A flatbed standing at `x`, `y` (machine mm).
     fn flatbed_at(x: i32, y: i32) -> Bench {
         let mut b = Bench::new(Machine::Flatbed);
-        b.interp.resync(&[Milli(x * 1000), Milli(y * 1000), Milli(0)], 0b111);
+        b.interp
+            .resync(&[Milli(x * 1000), Milli(y * 1000), Milli(0)], 0b111);
         b
     }
 
@@ -105,7 +106,11 @@ impl Bench {
     /// code if refused.
     fn send(&mut self, text: &str) -> Result<(), u8> {
         let mut p = Parser::new();
-        let mut out: Vec<_> = text.bytes().chain([b'\n']).filter_map(|b| p.push(b)).collect();
+        let mut out: Vec<_> = text
+            .bytes()
+            .chain([b'\n'])
+            .filter_map(|b| p.push(b))
+            .collect();
         assert_eq!(out.len(), 1, "{text:?}");
         let (block, jog) = match out.remove(0) {
             Ok(Input::Block(b)) => (b, false),
@@ -155,7 +160,11 @@ impl Bench {
     }
 
     fn moves(&self) -> usize {
-        self.io.did.iter().filter(|d| matches!(d, Did::Move(..))).count()
+        self.io
+            .did
+            .iter()
+            .filter(|d| matches!(d, Did::Move(..)))
+            .count()
     }
 
     /// `$G` as the console prints it.
@@ -184,7 +193,12 @@ const STEP_3: &[(&str, &str, u8, &str)] = &[
     ("", "G2 X1 I1", 22, "665"),
     ("G93", "G1 X1", 22, "401: G93 needs F on every feed move"),
     ("G93 G1 X1 F10", "X2", 22, "401"),
-    ("G1 F100 G93", "G94 G1 X1", 22, "423: from G93 no feed is kept"),
+    (
+        "G1 F100 G93",
+        "G94 G1 X1",
+        22,
+        "423: from G93 no feed is kept",
+    ),
     ("", "G4", 28, "456: dwell without P"),
     ("", "G10 L20 X0", 28, "not reached: L without P is fine"),
     ("", "G10 X0", 28, "533: neither L nor P"),
@@ -198,20 +212,45 @@ const STEP_3: &[(&str, &str, u8, &str)] = &[
     ("", "G80 G28 X1", 31, "640: even non-modal commands"),
     ("", "G4 P1 X1", 31, "never: bare axis words move in G0"),
     ("", "G2 F100", 26, "678: an explicit G2 needs axis words"),
-    ("G1 F100", "G1", 0, "not an error: G1 alone changes the mode"),
+    (
+        "G1 F100",
+        "G1",
+        0,
+        "not an error: G1 alone changes the mode",
+    ),
     ("", "G2 X1 F100", 35, "846: no offset in the plane"),
     ("", "G2 Z1 I1 F100", 32, "688: no axis word of the plane"),
-    ("", "G2 X70 Y0 R5 F100", 33, "694: R with the end at the start"),
+    (
+        "",
+        "G2 X70 Y0 R5 F100",
+        33,
+        "694: R with the end at the start",
+    ),
     ("", "G2 X20 R5 F100", 34, "769: radius too small"),
-    ("", "G2 X10 I3 F100", 33, "826: end off the circle by over 0.5 mm"),
+    (
+        "",
+        "G2 X10 I3 F100",
+        33,
+        "826: end off the circle by over 0.5 mm",
+    ),
     ("", "G1 X1 I1 F100", 36, "859: I without an arc"),
     ("", "G1 X1 P1 F100", 36, "859: P without G4 or G10"),
     ("", "G0 X1 L2", 36, "859"),
-    ("", "G2 X72 I1 R1 F100", 36, "859: I left over in radius form"),
+    (
+        "",
+        "G2 X72 I1 R1 F100",
+        36,
+        "859: I left over in radius form",
+    ),
     ("", "G43.1 X1", 37, "491: G43.1 takes Z only"),
     ("", "G43.1 Z1 X1", 37, "491"),
     ("", "$J=X1", 22, "396: a jog needs F"),
-    ("", "$J=G1 X1 F100", 16, "856: a jog takes no motion command"),
+    (
+        "",
+        "$J=G1 X1 F100",
+        16,
+        "856: a jog takes no motion command",
+    ),
     ("", "$J=G17 X1 F100", 16, "856"),
     ("", "$J=G28 X1 F100", 16, "857"),
     ("", "$J=X1 S1 F100", 36, "859: S unused in a jog"),
@@ -409,7 +448,10 @@ fn the_pen_from_spindle_words_and_z() {
     );
     b.io.did.clear();
     b.ok("G00 Z5");
-    assert_eq!(b.io.did, [Did::Pen(up), Did::Move([400, 800, 0], Feed::Rapid)]);
+    assert_eq!(
+        b.io.did,
+        [Did::Pen(up), Did::Move([400, 800, 0], Feed::Rapid)]
+    );
     // The pen follows the work Z, not the machine's.
     b.ok("G10 L20 P1 Z0");
     b.ok("G0 Z-1");
@@ -448,7 +490,10 @@ fn g_shows_grbl_s_modes_feed_in_mm_per_minute() {
     b.ok("G20 G1 F10");
     // Grbl keeps and shows the feed in mm/min.
     assert_eq!(b.gc(), "G1 G54 G17 G20 G90 G94 M5 M9 T0 F254 S0");
-    assert_eq!(show(&b.interp.parser_state(true)), "G1 G54 G17 G20 G90 G94 M5 M9 T0 F10.0 S0");
+    assert_eq!(
+        show(&b.interp.parser_state(true)),
+        "G1 G54 G17 G20 G90 G94 M5 M9 T0 F10.0 S0"
+    );
     b.ok("M7");
     b.ok("M8 T7");
     assert_eq!(b.gc(), "G1 G54 G17 G20 G90 G94 M5 M7 M8 T7 F254 S0");
@@ -517,7 +562,13 @@ impl Parser {
 fn a_job_owns_the_motion() {
     let mut b = Bench::new(Machine::StringArt);
     let mut p = Parser::new();
-    for (text, refused) in [("G0 X1", true), ("G92 X0", true), ("M17", true), ("G91", false), ("M114", false)] {
+    for (text, refused) in [
+        ("G0 X1", true),
+        ("G92 X0", true),
+        ("M17", true),
+        ("G91", false),
+        ("M114", false),
+    ] {
         let block = match p.push_all_test(format!("{text}\n").as_bytes()) {
             Some(Ok(Input::Block(b))) => b,
             other => panic!("{other:?}"),
@@ -535,4 +586,3 @@ fn a_job_owns_the_motion() {
     }
     let _ = "".to_string();
 }
-
