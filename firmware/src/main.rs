@@ -310,8 +310,9 @@ fn init() -> Watchdog {
     if homing.at_start && enabled {
         info!("homing");
         MOTION.with(|m| CONSOLE.with(|c| c.start_homing(homing.axes, m.as_mut().unwrap(), false)));
-        spawn(Task::Console);
     }
+    // The startup lines (after the homing, if any).
+    spawn(Task::Console);
     // Last: the blinks are timed from here, the dispatcher's start.
     LED.with(|l| *l = Some((status_led, clock::millis())));
     spawn(Task::Led);
@@ -516,6 +517,8 @@ fn realtime() {
             m.set_overrides(Overrides::NONE);
             control_job(Control::Abort);
             realtime::after_reset(m, activity == Activity::Homing, moving);
+            // Its startup lines.
+            spawn(Task::Console);
         }
         // `!` while jogging cancels the jog; while homing only the door
         // stops (Grbl's alarm 7).

@@ -28,8 +28,7 @@ use taut_logic::machine::Machine;
 use taut_logic::settings::grbl::Extras;
 use taut_logic::settings::image::{self, legacy, Unusable};
 use taut_logic::settings::record::{
-    self, text_part, Area, Layout, Loaded, Part, Step, Writer, COORDS, INFO, LINES, MARKER,
-    SETTINGS, TEXT,
+    self, area, marker_byte, text_part, Layout, Loaded, Part, Step, Writer, MARKER, TEXT,
 };
 use taut_logic::stringart::job::Phase;
 use taut_logic::units::Milli;
@@ -38,22 +37,13 @@ use taut_logic::units::Milli;
 /// short, as every task waits behind it.
 const PARTS_PER_RUN: u8 = 4;
 
-/// The records, by index: a bit each in [`Store::due`].
-const RECORDS: usize = 5;
+/// The records, by index ([`record::area`]): a bit each in
+/// [`Store::due`].
+const RECORDS: usize = record::RECORDS;
 const SETTINGS_I: u8 = 0;
 const COORDS_I: u8 = 1;
 /// The layout marker: written last on a new or upgraded chip.
 const MARKER_BIT: u8 = 1 << RECORDS;
-
-fn area(i: u8) -> Area {
-    match i {
-        SETTINGS_I => SETTINGS,
-        COORDS_I => COORDS,
-        2 => LINES[0],
-        3 => LINES[1],
-        _ => INFO,
-    }
-}
 
 /// Byte `i` of the stored text at `at` ([`Store::text_addr`]), 0 past its
 /// end. Read while a byte write is under way, it waits for it (≤ 3.4 ms).
@@ -133,7 +123,11 @@ impl Store {
             loaded: [Loaded::Blank; RECORDS],
             writer: None,
             upgrading: false,
-            extras: Extras::DEFAULT,
+            extras: Extras {
+                bytes: [0; 5],
+                spindle: [0; 2],
+                typed: [0; taut_logic::settings::grbl::TYPED],
+            },
             coords: CoordData::ZERO,
             text: [0; TEXT as usize],
             text_len: 0,
@@ -157,16 +151,19 @@ impl Store {
         let layout = record::layout(&read);
         let current = layout == Layout::Current;
         self.upgrading = !current;
-        let mut extras = Extras::DEFAULT;
-        let settings = record::load(&SETTINGS, &read, |c| {
+        let mut extras = self.extras;
+        extras.reset();
+        let settings_area = area(SETTINGS_I);
+        let settings = record::load(settings_area, &read, |c| {
             cfg.load_defaults(Machine::StringArt);
-            extras = Extras::DEFAULT;
-            image::decode_into(|i| SETTINGS.payload_byte(c, i, &read), cfg, &mut extras).is_ok()
+            extras.reset();
+            image::decode_into(|i| settings_area.payload_byte(c, i, &read), cfg, &mut extras)
+                .is_ok()
         });
         let mut notes = [None; 2];
         if !matches!(settings, Loaded::Taken { .. }) {
             cfg.load_defaults(Machine::StringArt);
-            extras = Extras::DEFAULT;
+            extras.reset();
             let why = match (layout, settings) {
                 (Layout::Legacy, _) => match legacy::decode_into(read, cfg) {
                     Ok(()) => None,
@@ -185,7 +182,7 @@ impl Store {
         let mut loaded = [settings; RECORDS];
         for i in COORDS_I..RECORDS as u8 {
             let a = area(i);
-            loaded[i as usize] = record::load(&a, &read, |c| {
+            loaded[i as usize] = record::load(a, &read, |c| {
                 if i == COORDS_I {
                     coords = CoordData::decode(|k| a.payload_byte(c, k, &read));
                 }
@@ -331,7 +328,7 @@ impl Store {
 
     /// `$RST=*`'s rest: the texts empty, the extras Grbl's defaults.
     pub fn wipe(&mut self) {
-        self.extras = Extras::DEFAULT;
+        self.extras.reset();
         for t in [Text::Startup(0), Text::Startup(1), Text::Info] {
             self.clear_text(t);
         }
@@ -420,7 +417,9 @@ impl Store {
         warn!(what, ": EEPROM ", why, ": ", instead);
     }
 
-    /// Payload part `k` of record `r`.
+    /// Payload part `k` of record `r`. Out of line: the settings' parts
+    /// alone are hundreds of bytes.
+    #[inline(never)]
     fn part(&self, r: u8, cfg: &MachineConfig, k: u8) -> Option<Part> {
         match r {
             SETTINGS_I => image::part(cfg, &self.extras, k),
@@ -501,7 +500,8 @@ impl Store {
     /// Every record written: the layout marker, if due.
     fn marker(&mut self) -> Poll<Signal> {
         if self.due & MARKER_BIT != 0 {
-            for (i, &b) in MARKER.iter().enumerate() {
+            for i in 0..MARKER.len() {
+                let b = marker_byte(i);
                 if self.eeprom.read(i as u16) != b {
                     self.eeprom.start_write(i as u16, b);
                     return Poll::After(4);

@@ -121,8 +121,10 @@ fn campaign(name: &str, before: Option<&[u8]>, line: Option<&str>, sample: usize
     let mut rng = Rng::new(seed);
     let picked: Vec<&Cut> = match soak_or(true, false) {
         true => cuts.iter().collect(),
+        // The last cuts too: the commit byte's write.
         false => (0..sample)
             .map(|_| &cuts[rng.below(cuts.len() as u64) as usize])
+            .chain(cuts.iter().rev().take(2))
             .collect(),
     };
     let (mut olds, mut news) = (0, 0);

@@ -17,7 +17,7 @@ use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::gcode::{Error, ErrorKind, Input, Read, Restore, SystemLine};
 use taut_logic::interp::Interpreter;
 use taut_logic::settings::grbl::{Numbered, SetError};
-use taut_logic::settings::{self, grbl};
+use taut_logic::settings;
 use taut_progmem::text;
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
@@ -200,12 +200,12 @@ impl Console {
         }
         m.configure(cfg);
         if cfg.machine != machine {
-            // Another machine: where it stands is its zero, its modal
-            // state starts afresh, offsets in the other's frame are gone.
+            // Another machine: where it stands is its zero, and its modal
+            // state starts afresh. The work coordinate data stays (one
+            // record written, whole or not at all; `$RST=#` clears it).
             m.set_position([0; AXES]);
             self.interp = Interpreter::new();
             self.resync_next_run(m);
-            store.clear_coords();
         }
         self.settings_changed = true;
         store.settings_changed();
@@ -223,7 +223,7 @@ impl Console {
         if what != Restore::Offsets {
             cfg.load_defaults(cfg.machine);
             m.configure(cfg);
-            *store.extras_mut() = grbl::Extras::DEFAULT;
+            store.extras_mut().reset();
             store.settings_changed();
             self.settings_changed = true;
         }

@@ -91,33 +91,33 @@ const SMALL: usize = 22;
 /// every machine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Extras {
-    /// `$1`: how long the drivers stay on after motion, ms; 255: always.
-    pub idle_delay_ms: u8,
-    /// `$2`: STEP pulses inverted, a bit per place.
-    pub step_invert: u8,
-    /// `$5`, `$6`, `$21`, `$22` (off), `$32`: the `FLAG_` bits.
-    pub flags: u8,
-    /// `$23`: homing towards the other end, a bit per place.
-    pub homing_dir_invert: u8,
-    /// `$26`: ms a homing switch must settle.
-    pub homing_debounce_ms: u8,
+    /// `$1` step idle delay (ms; 255: the drivers always on), `$2` step
+    /// invert mask, the `FLAG_` bits (`$5`, `$6`, `$21`, `$22` off,
+    /// `$32`), `$23` homing direction invert mask, `$26` homing debounce
+    /// (ms): by the `BYTE_` indices.
+    pub bytes: [u8; 5],
     /// `$30`, `$31`: rpm at the spindle output's top and bottom.
-    pub spindle_max: u32,
-    pub spindle_min: u32,
-    pub typed: Typed,
+    pub spindle: [u32; 2],
+    /// The rates as last typed in Grbl's units, thousandths of a unit per
+    /// minute (`$110`…, `$24`, `$25`) or per second² (`$120`…), by the
+    /// `TYPED_` indices (per channel for the axes'); 0: never typed so.
+    /// Listed while the steps figure is still the one they make: a rate
+    /// set by name since shows as its steps make it.
+    pub typed: [u32; TYPED],
 }
 
-/// The rates as last typed in Grbl's units, thousandths of a unit per
-/// minute (`$110`, `$24`, `$25`) or per second² (`$120`); 0: never typed
-/// so. By channel. Listed while the steps figure is still the one they
-/// make: a rate set by name since shows as its steps make it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Typed {
-    pub max_rate: [u32; AXES],
-    pub accel: [u32; AXES],
-    pub homing_feed: u32,
-    pub homing_seek: u32,
-}
+pub const BYTE_IDLE_DELAY: usize = 0;
+pub const BYTE_STEP_INVERT: usize = 1;
+pub const BYTE_FLAGS: usize = 2;
+pub const BYTE_HOMING_DIR: usize = 3;
+pub const BYTE_DEBOUNCE: usize = 4;
+
+/// `typed[TYPED_MAX_RATE + channel]`, `typed[TYPED_ACCEL + channel]`.
+pub const TYPED_MAX_RATE: usize = 0;
+pub const TYPED_ACCEL: usize = AXES;
+pub const TYPED_HOMING_FEED: usize = 2 * AXES;
+pub const TYPED_HOMING_SEEK: usize = 2 * AXES + 1;
+pub const TYPED: usize = 2 * AXES + 2;
 
 /// `$5`: the limit switches read inverted.
 pub const FLAG_LIMIT_INVERT: u8 = 1;
@@ -131,82 +131,69 @@ pub const FLAG_HOMING_OFF: u8 = 8;
 pub const FLAG_LASER: u8 = 16;
 
 /// Bytes of [`Extras`] in EEPROM.
-pub const EXTRAS_BYTES: u16 = 5 + 2 * 4 + (2 * AXES as u16 + 2) * 4;
+pub const EXTRAS_BYTES: u16 = 5 + 2 * 4 + TYPED as u16 * 4;
 
 impl Extras {
     /// Grbl's defaults (`defaults.h`), but `$1`: taut's drivers hold the
     /// machine still between moves.
     pub const DEFAULT: Extras = Extras {
-        idle_delay_ms: 255,
-        step_invert: 0,
-        flags: 0,
-        homing_dir_invert: 0,
-        homing_debounce_ms: 250,
-        spindle_max: 1000,
-        spindle_min: 0,
-        typed: Typed {
-            max_rate: [0; AXES],
-            accel: [0; AXES],
-            homing_feed: 0,
-            homing_seek: 0,
-        },
+        bytes: [255, 0, 0, 0, 250],
+        spindle: [1000, 0],
+        typed: [0; TYPED],
     };
+
+    /// [`Extras::DEFAULT`] in place, a field at a time: a copy of the
+    /// constant would sit in the AVR's SRAM.
+    pub fn reset(&mut self) {
+        self.bytes = [0; 5];
+        self.bytes[BYTE_IDLE_DELAY] = 255;
+        self.bytes[BYTE_DEBOUNCE] = 250;
+        self.spindle = [0; 2];
+        self.spindle[0] = 1000;
+        self.typed = [0; TYPED];
+    }
+
+    /// `$1`: ms the drivers stay on after motion; 255: always.
+    pub fn idle_delay_ms(&self) -> u8 {
+        self.bytes[BYTE_IDLE_DELAY]
+    }
+
+    pub fn flags(&self) -> u8 {
+        self.bytes[BYTE_FLAGS]
+    }
 
     /// Whether `$H` may home: `$22` on and a channel to home.
     pub fn homing_enabled(&self, cfg: &MachineConfig) -> bool {
-        self.flags & FLAG_HOMING_OFF == 0 && cfg.homing.axes != 0
+        self.flags() & FLAG_HOMING_OFF == 0 && cfg.homing.axes != 0
     }
 
     /// Part `k` of the EEPROM bytes: the bytes, then the two rpm figures,
     /// then the typed rates, little-endian.
     pub fn part(&self, k: u8) -> Option<Part> {
-        let t = &self.typed;
-        let pair = |a: u32, b: u32| {
-            let (a, b) = (a.to_le_bytes(), b.to_le_bytes());
-            ([a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]], 8)
+        let k = k as usize;
+        if k == 0 {
+            let b = self.bytes;
+            return Some(([b[0], b[1], b[2], b[3], b[4], 0, 0, 0], 5));
+        }
+        let word = |i: usize| match i {
+            0 | 1 => self.spindle.get(i).copied(),
+            _ => self.typed.get(i - 2).copied(),
         };
-        Some(match k {
-            0 => (
-                [
-                    self.idle_delay_ms,
-                    self.step_invert,
-                    self.flags,
-                    self.homing_dir_invert,
-                    self.homing_debounce_ms,
-                    0,
-                    0,
-                    0,
-                ],
-                5,
-            ),
-            1 => pair(self.spindle_max, self.spindle_min),
-            2 => pair(t.max_rate[0], t.max_rate[1]),
-            3 => pair(t.max_rate[2], t.accel[0]),
-            4 => pair(t.accel[1], t.accel[2]),
-            5 => pair(t.homing_feed, t.homing_seek),
-            _ => return None,
-        })
+        let (a, b) = (word(2 * k - 2)?.to_le_bytes(), word(2 * k - 1)?.to_le_bytes());
+        Some(([a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]], 8))
     }
 
     /// The extras from their bytes through `byte(i)`. Any value is taken:
     /// none is refused by the machine.
     pub fn decode(byte: impl Fn(u16) -> u8) -> Extras {
-        let word = |i: u16| u32::from_le_bytes([byte(i), byte(i + 1), byte(i + 2), byte(i + 3)]);
-        let w = |n: u16| word(5 + 4 * n);
+        let word = |n: usize| {
+            let i = 5 + 4 * n as u16;
+            u32::from_le_bytes([byte(i), byte(i + 1), byte(i + 2), byte(i + 3)])
+        };
         Extras {
-            idle_delay_ms: byte(0),
-            step_invert: byte(1),
-            flags: byte(2),
-            homing_dir_invert: byte(3),
-            homing_debounce_ms: byte(4),
-            spindle_max: w(0),
-            spindle_min: w(1),
-            typed: Typed {
-                max_rate: [w(2), w(3), w(4)],
-                accel: [w(5), w(6), w(7)],
-                homing_feed: w(8),
-                homing_seek: w(9),
-            },
+            bytes: core::array::from_fn(|i| byte(i as u16)),
+            spindle: [word(0), word(1)],
+            typed: core::array::from_fn(|i| word(i + 2)),
         }
     }
 }
@@ -216,6 +203,8 @@ impl Default for Extras {
         Extras::DEFAULT
     }
 }
+
+const _: () = assert!(Extras::DEFAULT.bytes[BYTE_IDLE_DELAY] == 255);
 
 /// The channel in each of Grbl's X, Y, Z places: a plotter's X Y Z
 /// channels in order; on the string-art machine the radial carriage
@@ -366,14 +355,45 @@ impl Numbered {
         }
     }
 
-    /// A flag of [`Extras::flags`] this setting is.
-    fn flag(self) -> u8 {
+    /// Where this setting's value lives on `cfg`'s machine.
+    fn held(self, cfg: &MachineConfig) -> Held {
+        use Numbered::*;
+        let places = report_axes(cfg.machine);
+        let global = |g| Setting::Global(g);
+        let axis = |p: u8| places[p as usize];
         match self {
-            Numbered::LimitInvert => FLAG_LIMIT_INVERT,
-            Numbered::ProbeInvert => FLAG_PROBE_INVERT,
-            Numbered::HardLimits => FLAG_HARD_LIMITS,
-            Numbered::LaserMode => FLAG_LASER,
-            _ => 0,
+            IdleDelay => Held::Byte(BYTE_IDLE_DELAY),
+            StepInvert => Held::Byte(BYTE_STEP_INVERT),
+            HomingDirInvert => Held::Byte(BYTE_HOMING_DIR),
+            HomingDebounce => Held::Byte(BYTE_DEBOUNCE),
+            SpindleMax => Held::Rpm(0),
+            SpindleMin => Held::Rpm(1),
+            LimitInvert => Held::Flag(FLAG_LIMIT_INVERT),
+            ProbeInvert => Held::Flag(FLAG_PROBE_INVERT),
+            HardLimits => Held::Flag(FLAG_HARD_LIMITS),
+            LaserMode => Held::Flag(FLAG_LASER),
+            Homing => Held::HomingOn,
+            DirInvert | EnableInvert | SoftLimits => Held::Places,
+            StepPulse => Held::Named(global(GlobalField::StepPulseUs)),
+            StatusReport => Held::Named(global(GlobalField::StatusReport)),
+            ReportInches => Held::Named(global(GlobalField::ReportInches)),
+            JunctionDeviation => Held::Micro(global(GlobalField::JunctionDeviationUm)),
+            ArcTolerance => Held::Micro(global(GlobalField::ArcToleranceUm)),
+            HomingPullOff => Held::Named(global(GlobalField::HomingPullOff)),
+            HomingFeed => Held::Rate(TYPED_HOMING_FEED, global(GlobalField::HomingLocate), axis(0)),
+            HomingSeek => Held::Rate(TYPED_HOMING_SEEK, global(GlobalField::HomingSeek), axis(0)),
+            MaxRate(p) => Held::Rate(
+                TYPED_MAX_RATE + axis(p).index(),
+                Setting::Axis(axis(p), AxisField::MaxRate),
+                axis(p),
+            ),
+            Accel(p) => Held::Rate(
+                TYPED_ACCEL + axis(p).index(),
+                Setting::Axis(axis(p), AxisField::Accel),
+                axis(p),
+            ),
+            StepsPerUnit(p) => Held::StepsPerUnit(axis(p), p),
+            MaxTravel(p) => Held::Travel(axis(p)),
         }
     }
 
@@ -381,65 +401,42 @@ impl Numbered {
     /// and rpm, three decimals for lengths and rates.
     #[inline(never)]
     pub fn get(self, cfg: &MachineConfig, ex: &Extras) -> Value {
-        use Numbered::*;
-        let places = report_axes(cfg.machine);
-        let axis = |p: u8| &cfg.axes[places[p as usize].index()];
-        let typed = &ex.typed;
         let milli = |m: i32| Value::Milli(Milli(m));
         let n = |v: u32| Value::Number(v);
-        match self {
-            StepPulse => n(cfg.pulse.step_pulse_us as u32),
-            IdleDelay => n(ex.idle_delay_ms as u32),
-            StepInvert => n(ex.step_invert as u32),
-            HomingDirInvert => n(ex.homing_dir_invert as u32),
-            HomingDebounce => n(ex.homing_debounce_ms as u32),
-            SpindleMax => n(ex.spindle_max),
-            SpindleMin => n(ex.spindle_min),
-            LimitInvert | ProbeInvert | HardLimits | LaserMode => {
-                n((ex.flags & self.flag() != 0) as u32)
+        match self.held(cfg) {
+            Held::Byte(i) => n(ex.bytes[i] as u32),
+            Held::Flag(f) => n((ex.flags() & f != 0) as u32),
+            Held::Rpm(i) => n(ex.spindle[i]),
+            Held::HomingOn => n(ex.homing_enabled(cfg) as u32),
+            Held::Places => n(self.over_places(cfg) as u32),
+            Held::Named(s) => s.get(cfg),
+            Held::Micro(s) => match s.get(cfg) {
+                Value::Number(um) => milli(um as i32),
+                v => v,
+            },
+            Held::Rate(t, s, axis) => {
+                let steps = match s.get(cfg) {
+                    Value::Number(v) => v,
+                    _ => 0,
+                };
+                milli(shown(ex.typed[t], steps, &cfg.axes[axis.index()], self.scale()))
             }
-            Homing => n(ex.homing_enabled(cfg) as u32),
-            DirInvert | EnableInvert | SoftLimits => n(self.over_places(cfg) as u32),
-            StatusReport => n(cfg.status_report as u32),
-            ReportInches => n(cfg.report_inches as u32),
-            JunctionDeviation => milli(cfg.junction_deviation_um as i32),
-            ArcTolerance => milli(cfg.arc_tolerance_um as i32),
-            HomingPullOff => milli(cfg.homing.pull_off_um as i32),
-            HomingFeed => milli(shown(
-                typed.homing_feed,
-                cfg.homing.locate as u32,
-                axis(0),
-                PER_MIN,
-            )),
-            HomingSeek => milli(shown(
-                typed.homing_seek,
-                cfg.homing.seek as u32,
-                axis(0),
-                PER_MIN,
-            )),
-            StepsPerUnit(p) => {
-                let Ratio { num, den } = axis(p).steps_per_unit;
+            Held::StepsPerUnit(axis, _) => {
+                let Ratio { num, den } = cfg.axes[axis.index()].steps_per_unit;
                 milli(per(&[num, 1, den], 1000, 1))
             }
-            MaxRate(p) => {
-                let a = axis(p);
-                milli(shown(
-                    typed.max_rate[places[p as usize].index()],
-                    a.max_rate,
-                    a,
-                    PER_MIN,
-                ))
+            Held::Travel(axis) => {
+                let (lo, hi) = cfg.axes[axis.index()].travel;
+                milli(hi.0.wrapping_sub(lo.0))
             }
-            Accel(p) => {
-                let a = axis(p);
-                milli(shown(
-                    typed.accel[places[p as usize].index()],
-                    a.accel,
-                    a,
-                    PER_S,
-                ))
-            }
-            MaxTravel(p) => milli(axis(p).travel.1 .0.wrapping_sub(axis(p).travel.0 .0)),
+        }
+    }
+
+    /// A rate's thousandths: per minute, or per second² (`$12x`).
+    fn scale(self) -> u32 {
+        match self {
+            Numbered::Accel(_) => PER_S,
+            _ => PER_MIN,
         }
     }
 
@@ -480,9 +477,9 @@ impl Numbered {
     }
 
     fn put(self, cfg: &mut MachineConfig, ex: &mut Extras, text: &[u8]) -> Result<(), SetError> {
-        use Numbered::*;
+        let held = self.held(cfg);
         // `$100` may be a ratio (`1600/12`); anything else a number.
-        let ratio = matches!(self, StepsPerUnit(_)) && text.contains(&b'/');
+        let ratio = matches!(held, Held::StepsPerUnit(..)) && text.contains(&b'/');
         let value = match ratio {
             true => Milli(1),
             false => parse_milli(text)?,
@@ -495,171 +492,162 @@ impl Numbered {
             });
         }
         let milli = value.0 as u32;
+        // Grbl truncates a whole-number setting's value.
+        let whole = milli / 1000;
         // The value listed now keeps the exact figure behind it (a sender
         // writes back what `$$` showed: `$101=26.667` stays 9600/360).
         let same = match self.get(cfg, ex) {
             Value::Milli(m) => m == value,
-            Value::Number(n) => n == milli / 1000,
+            Value::Number(n) => n == whole,
             _ => false,
         };
         if same && !ratio {
             return Ok(());
         }
-        // Grbl truncates a whole-number setting's value.
-        let whole = milli / 1000;
-        let byte = |max: u32| match whole <= max {
+        let byte = |max: u8| match whole <= max as u32 {
             true => Ok(whole as u8),
-            false => Err(SetError::refused(ErrorKind::Range { min: 0, max })),
+            false => Err(SetError::refused(ErrorKind::Range {
+                min: 0,
+                max: max as u32,
+            })),
         };
-        let switch = || byte(1).map(|b| b == 1);
-        let places = report_axes(cfg.machine);
-        let named = |s: GlobalField| Setting::Global(s);
-        match self {
-            IdleDelay => ex.idle_delay_ms = byte(255)?,
-            StepInvert => ex.step_invert = byte(255)?,
-            HomingDirInvert => ex.homing_dir_invert = byte(255)?,
-            HomingDebounce => ex.homing_debounce_ms = byte(255)?,
-            SpindleMax => ex.spindle_max = whole,
-            SpindleMin => ex.spindle_min = whole,
-            LimitInvert | ProbeInvert | HardLimits | LaserMode => {
-                let on = switch()?;
-                ex.flags = (ex.flags & !self.flag()) | if on { self.flag() } else { 0 };
+        match held {
+            Held::Byte(i) => ex.bytes[i] = byte(255)?,
+            Held::Rpm(i) => ex.spindle[i] = whole,
+            Held::Flag(f) => {
+                let on = byte(1)? == 1;
+                let flags = &mut ex.bytes[BYTE_FLAGS];
+                *flags = (*flags & !f) | if on { f } else { 0 };
             }
             // Off, or on with the channels `homing_axes` names, which
             // `$22=1` cannot guess.
-            Homing => match switch()? {
-                false => ex.flags |= FLAG_HOMING_OFF,
-                true if cfg.homing.axes == 0 => {
+            Held::HomingOn => match byte(1)? {
+                0 => ex.bytes[BYTE_FLAGS] |= FLAG_HOMING_OFF,
+                _ if cfg.homing.axes == 0 => {
                     return Err(SetError::refused(ErrorKind::Invalid(
                         GlobalField::HomingAxes.name(),
                     )))
                 }
-                true => ex.flags &= !FLAG_HOMING_OFF,
+                _ => ex.bytes[BYTE_FLAGS] &= !FLAG_HOMING_OFF,
             },
-            DirInvert => {
-                let mask = byte(7)?;
-                for (p, axis) in places.iter().enumerate() {
-                    cfg.axes[axis.index()].dir_high_is_positive = mask >> p & 1 == 0;
-                }
-            }
-            EnableInvert => {
-                let high = switch()?;
-                for axis in places {
-                    cfg.axes[axis.index()].enable_active_high = high;
-                }
-            }
-            SoftLimits => {
-                let on = switch()?;
-                for axis in places {
-                    let a = &mut cfg.axes[axis.index()];
-                    // On only where a travel is set: the base turns freely.
-                    a.soft_limits = on && a.travel.0 < a.travel.1;
-                }
-            }
-            StepPulse => put(cfg, named(GlobalField::StepPulseUs), Value::Number(whole))?,
-            StatusReport => put(cfg, named(GlobalField::StatusReport), Value::Number(whole))?,
-            ReportInches => put(cfg, named(GlobalField::ReportInches), Value::Number(whole))?,
-            JunctionDeviation => put(
-                cfg,
-                named(GlobalField::JunctionDeviationUm),
-                Value::Number(milli),
-            )?,
-            ArcTolerance => put(
-                cfg,
-                named(GlobalField::ArcToleranceUm),
-                Value::Number(milli),
-            )?,
-            HomingPullOff => put(cfg, named(GlobalField::HomingPullOff), Value::Milli(value))?,
-            HomingFeed | HomingSeek => {
-                let spu = cfg.axes[places[0].index()].steps_per_unit;
-                let steps = Value::Number(steps_of(milli, spu, PER_MIN));
-                match self {
-                    HomingFeed => {
-                        put(cfg, named(GlobalField::HomingLocate), steps)?;
-                        ex.typed.homing_feed = milli;
-                    }
-                    _ => {
-                        put(cfg, named(GlobalField::HomingSeek), steps)?;
-                        ex.typed.homing_seek = milli;
-                    }
-                }
-            }
-            MaxRate(p) | Accel(p) => {
-                let axis = places[p as usize];
-                let a = &cfg.axes[axis.index()];
-                let (field, scale) = match self {
-                    MaxRate(_) => (AxisField::MaxRate, PER_MIN),
-                    _ => (AxisField::Accel, PER_S),
+            Held::Places => {
+                let max = match self {
+                    Numbered::DirInvert => 7,
+                    _ => 1,
                 };
-                let steps = Value::Number(steps_of(milli, a.steps_per_unit, scale));
-                put(cfg, Setting::Axis(axis, field), steps)?;
-                match self {
-                    MaxRate(_) => ex.typed.max_rate[axis.index()] = milli,
-                    _ => ex.typed.accel[axis.index()] = milli,
-                }
+                self.put_over_places(cfg, byte(max)?)
+            }
+            Held::Named(s) => {
+                let v = match s.get(cfg) {
+                    Value::Milli(_) => Value::Milli(value),
+                    _ => Value::Number(whole),
+                };
+                put(cfg, s, v)?
+            }
+            Held::Micro(s) => put(cfg, s, Value::Number(milli))?,
+            Held::Rate(t, s, axis) => {
+                let spu = cfg.axes[axis.index()].steps_per_unit;
+                put(cfg, s, Value::Number(steps_of(milli, spu, self.scale())))?;
+                ex.typed[t] = milli;
             }
             // The travel keeps its upper end.
-            MaxTravel(p) => {
-                let axis = places[p as usize];
+            Held::Travel(axis) => {
                 let end = cfg.axes[axis.index()].travel.1 .0;
                 let min = Value::Milli(Milli(end.saturating_sub(value.0)));
                 put(cfg, Setting::Axis(axis, AxisField::TravelMin), min)?;
             }
-            StepsPerUnit(p) => {
+            Held::StepsPerUnit(axis, p) => {
                 // A ratio as typed; a decimal in lowest terms.
                 let spu = match ratio {
                     true => parse_ratio(text)?,
                     false => reduce(Ratio::new(milli, 1000)),
                 };
-                self.put_steps_per_unit(cfg, ex, places[p as usize], spu)?
+                put_steps_per_unit(cfg, ex, axis, p, spu)?
             }
         }
         Ok(())
     }
 
-    /// `$10x`: new steps per unit; `$11x` and `$12x` keep their figures in
-    /// units, as Grbl's do, so their steps change with it. Checked whole;
-    /// nothing changes on an error.
-    fn put_steps_per_unit(
-        self,
-        cfg: &mut MachineConfig,
-        ex: &mut Extras,
-        axis: Axis,
-        spu: StepsPerUnit,
-    ) -> Result<(), SetError> {
-        let Numbered::StepsPerUnit(p) = self else {
-            return Ok(());
-        };
-        let rate = Numbered::MaxRate(p).get(cfg, ex);
-        let accel = Numbered::Accel(p).get(cfg, ex);
-        let milli = |v: Value| match v {
-            Value::Milli(m) => m.0 as u32,
-            _ => 0,
-        };
-        let (rate, accel) = (milli(rate), milli(accel));
-        Setting::Axis(axis, AxisField::StepsPerUnit)
-            .check(Value::Ratio(spu))
-            .map_err(SetError::refused)?;
-        let i = axis.index();
-        let old: AxisConfig = cfg.axes[i];
-        let a = &mut cfg.axes[i];
-        a.steps_per_unit = spu;
-        a.max_rate = steps_of(rate, spu, PER_MIN);
-        a.accel = steps_of(accel, spu, PER_S);
-        let each = [AxisField::MaxRate, AxisField::Accel]
-            .into_iter()
-            .try_for_each(|f| {
-                let s = Setting::Axis(axis, f);
-                s.check(s.get(cfg))
-            });
-        if let Err(e) = each.and_then(|()| check_whole(cfg)) {
-            cfg.axes[i] = old;
-            return Err(SetError::refused(e));
+    /// `$3` (a bit per place), `$4`, `$20` to `n` over the report places.
+    #[inline(never)]
+    fn put_over_places(self, cfg: &mut MachineConfig, n: u8) {
+        for (p, axis) in report_axes(cfg.machine).iter().enumerate() {
+            let a = &mut cfg.axes[axis.index()];
+            match self {
+                Numbered::DirInvert => a.dir_high_is_positive = n >> p & 1 == 0,
+                Numbered::EnableInvert => a.enable_active_high = n == 1,
+                // On only where a travel is set: the base turns freely.
+                _ => a.soft_limits = n == 1 && a.travel.0 < a.travel.1,
+            }
         }
-        ex.typed.max_rate[i] = rate;
-        ex.typed.accel[i] = accel;
-        Ok(())
     }
+}
+
+/// Where a numbered setting's value lives.
+#[derive(Clone, Copy)]
+enum Held {
+    /// [`Extras::bytes`]`[i]`.
+    Byte(usize),
+    /// A bit of the extras' flags.
+    Flag(u8),
+    /// [`Extras::spindle`]`[i]`.
+    Rpm(usize),
+    /// `$22`: the flag and `homing_axes`.
+    HomingOn,
+    /// `$3`, `$4`, `$20`: a field of every report place.
+    Places,
+    /// A named setting in Grbl's unit (a whole number or thousandths).
+    Named(Setting),
+    /// A named setting in µm, which Grbl counts in mm.
+    Micro(Setting),
+    /// A rate in Grbl's units: its typed figure, the named setting of its
+    /// steps, the channel whose steps per unit convert it.
+    Rate(usize, Setting, Axis),
+    /// `$10x`: the channel, its report place.
+    StepsPerUnit(Axis, u8),
+    /// `$13x`: the travel's length.
+    Travel(Axis),
+}
+
+/// `$10x`: new steps per unit; `$11x` and `$12x` keep their figures in
+/// units, as Grbl's do, so their steps change with it. Checked whole;
+/// nothing changes on an error.
+#[inline(never)]
+fn put_steps_per_unit(
+    cfg: &mut MachineConfig,
+    ex: &mut Extras,
+    axis: Axis,
+    p: u8,
+    spu: Ratio,
+) -> Result<(), SetError> {
+    let milli = |v: Value| match v {
+        Value::Milli(m) => m.0 as u32,
+        _ => 0,
+    };
+    let rate = milli(Numbered::MaxRate(p).get(cfg, ex));
+    let accel = milli(Numbered::Accel(p).get(cfg, ex));
+    Setting::Axis(axis, AxisField::StepsPerUnit)
+        .check(Value::Ratio(spu))
+        .map_err(SetError::refused)?;
+    let i = axis.index();
+    let old: AxisConfig = cfg.axes[i];
+    let a = &mut cfg.axes[i];
+    a.steps_per_unit = spu;
+    a.max_rate = steps_of(rate, spu, PER_MIN);
+    a.accel = steps_of(accel, spu, PER_S);
+    let each = [AxisField::MaxRate, AxisField::Accel]
+        .into_iter()
+        .try_for_each(|f| {
+            let s = Setting::Axis(axis, f);
+            s.check(s.get(cfg))
+        });
+    if let Err(e) = each.and_then(|()| check_whole(cfg)) {
+        cfg.axes[i] = old;
+        return Err(SetError::refused(e));
+    }
+    ex.typed[TYPED_MAX_RATE + i] = rate;
+    ex.typed[TYPED_ACCEL + i] = accel;
+    Ok(())
 }
 
 /// A named setting to `value`, checked with the whole configuration.

@@ -53,23 +53,23 @@ pub fn newer(a: u16, b: u16) -> bool {
 }
 
 impl Area {
-    pub const fn copy_len(&self) -> u16 {
+    pub const fn copy_len(self) -> u16 {
         HEAD + self.payload + TAIL
     }
 
     /// Copy `c`'s (0 or 1) first byte.
-    pub const fn copy(&self, c: u8) -> u16 {
+    pub const fn copy(self, c: u8) -> u16 {
         self.start + c as u16 * self.copy_len()
     }
 
     /// The byte after copy 1.
-    pub const fn end(&self) -> u16 {
+    pub const fn end(self) -> u16 {
         self.start + 2 * self.copy_len()
     }
 
     /// Copy `c`'s sequence number, if it is committed whole: its state,
     /// kind, version and CRC right.
-    pub fn check(&self, c: u8, read: &impl Fn(u16) -> u8) -> Option<u16> {
+    pub fn check(self, c: u8, read: &impl Fn(u16) -> u8) -> Option<u16> {
         let at = self.copy(c);
         if read(at) != COMMITTED || read(at + 1) != self.kind || read(at + 2) != self.version {
             return None;
@@ -85,7 +85,7 @@ impl Area {
 
     /// The copies that pass [`Area::check`], newest first: `(copy, seq)`.
     /// The caller takes the first whose payload it accepts.
-    pub fn copies(&self, read: &impl Fn(u16) -> u8) -> [Option<(u8, u16)>; 2] {
+    pub fn copies(self, read: &impl Fn(u16) -> u8) -> [Option<(u8, u16)>; 2] {
         let a = self.check(0, read).map(|s| (0, s));
         let b = self.check(1, read).map(|s| (1, s));
         match (a, b) {
@@ -98,12 +98,12 @@ impl Area {
     /// A copy's state byte says committed. When no copy is taken, this
     /// tells corruption (a committed copy went bad) from a write that
     /// never finished or never began.
-    pub fn any_committed(&self, read: &impl Fn(u16) -> u8) -> bool {
+    pub fn any_committed(self, read: &impl Fn(u16) -> u8) -> bool {
         read(self.copy(0)) == COMMITTED || read(self.copy(1)) == COMMITTED
     }
 
     /// Byte `i` of copy `c`'s payload, as it was given.
-    pub fn payload_byte(&self, c: u8, i: u16, read: &impl Fn(u16) -> u8) -> u8 {
+    pub fn payload_byte(self, c: u8, i: u16, read: &impl Fn(u16) -> u8) -> u8 {
         !read(self.copy(c) + HEAD + i)
     }
 }
@@ -132,7 +132,7 @@ impl Loaded {
 
 /// Reads `area`: its committed copies newest first, each offered to
 /// `take(copy)`, which reads the payload and says whether it takes it.
-pub fn load(area: &Area, read: &impl Fn(u16) -> u8, mut take: impl FnMut(u8) -> bool) -> Loaded {
+pub fn load(area: Area, read: &impl Fn(u16) -> u8, mut take: impl FnMut(u8) -> bool) -> Loaded {
     for (copy, seq) in area.copies(read).into_iter().flatten() {
         if take(copy) {
             return Loaded::Taken { copy, seq };
@@ -158,9 +158,25 @@ pub enum Layout {
     Foreign,
 }
 
+/// Byte `i` of [`MARKER`], read from flash (an array would be copied
+/// into the AVR's SRAM).
+pub fn marker_byte(i: usize) -> u8 {
+    taut_progmem::text!("taut\x07").byte(i)
+}
+
+/// Record `i`: 0 the settings, 1 the coordinates, 2 and 3 the startup
+/// lines, 4 the build info; from a table in flash (each constant would be
+/// copied into the AVR's SRAM where it is taken by reference).
+pub fn area(i: u8) -> Area {
+    taut_progmem::table!(Area; RECORDS; [SETTINGS, COORDS, LINES[0], LINES[1], INFO]).get(i as usize)
+}
+
+/// Records kept.
+pub const RECORDS: usize = 5;
+
 /// The layout byte 0… says.
 pub fn layout(read: &impl Fn(u16) -> u8) -> Layout {
-    if (0..MARKER.len()).all(|i| read(i as u16) == MARKER[i]) {
+    if (0..MARKER.len()).all(|i| read(i as u16) == marker_byte(i)) {
         return Layout::Current;
     }
     if (0..MARKER.len()).all(|i| read(i as u16) == 0xFF) {
@@ -254,7 +270,8 @@ impl Writer {
 
     /// Compares up to `parts` parts of the copy with what `read(address)`
     /// holds; the payload's part `k` is `part(k)` (`None` past the last).
-    #[cfg_attr(target_arch = "avr", optimize(speed))]
+    /// Out of line: one copy, not one in each caller.
+    #[inline(never)]
     pub fn step(
         &mut self,
         read: impl Fn(u16) -> u8,
@@ -462,7 +479,7 @@ pub mod host {
         use crate::settings::image;
         let read = |a: u16| eeprom.get(a as usize).copied().unwrap_or(0xFF);
         let mut out = None;
-        load(&SETTINGS, &read, |c| {
+        load(SETTINGS, &read, |c| {
             let (mut cfg, mut ex) = (MachineConfig::STRING_ART, Extras::DEFAULT);
             let ok = image::decode_into(|i| SETTINGS.payload_byte(c, i, &read), &mut cfg, &mut ex)
                 .is_ok();
@@ -482,7 +499,7 @@ pub mod host {
     pub fn coords(eeprom: &[u8]) -> Option<CoordData> {
         let read = |a: u16| eeprom.get(a as usize).copied().unwrap_or(0xFF);
         let mut out = None;
-        load(&COORDS, &read, |c| {
+        load(COORDS, &read, |c| {
             out = Some(CoordData::decode(|i| COORDS.payload_byte(c, i, &read)));
             true
         });

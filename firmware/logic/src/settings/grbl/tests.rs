@@ -193,14 +193,14 @@ fn writes_in_grbl_s_units_land_in_the_named_settings() {
     ] {
         set(&mut cfg, &mut ex, k, v).unwrap();
     }
-    assert_eq!(ex.idle_delay_ms, 25);
-    assert_eq!(ex.step_invert, 5);
+    assert_eq!(ex.idle_delay_ms(), 25);
+    assert_eq!(ex.bytes[BYTE_STEP_INVERT], 5);
     assert_eq!(
-        ex.flags,
+        ex.flags(),
         FLAG_LIMIT_INVERT | FLAG_PROBE_INVERT | FLAG_HARD_LIMITS | FLAG_LASER
     );
-    assert_eq!((ex.homing_dir_invert, ex.homing_debounce_ms), (3, 100));
-    assert_eq!((ex.spindle_max, ex.spindle_min), (24000, 100));
+    assert_eq!((ex.bytes[BYTE_HOMING_DIR], ex.bytes[BYTE_DEBOUNCE]), (3, 100));
+    assert_eq!(ex.spindle, [24000, 100]);
     let lines = listing(&cfg, &ex);
     for l in ["$1=25", "$2=5", "$21=1", "$30=24000", "$31=100", "$32=1"] {
         assert!(lines.contains(&l.into()), "{l} in {lines:?}");
@@ -290,14 +290,24 @@ fn every_listed_number_reads_back() {
 #[test]
 fn extras_read_back_from_their_bytes() {
     let mut ex = Extras::DEFAULT;
-    ex.flags = 0x1F;
-    ex.spindle_max = 123_456;
-    ex.typed.accel[2] = 7;
-    ex.typed.homing_seek = 99;
+    ex.bytes[BYTE_FLAGS] = 0x1F;
+    ex.spindle[0] = 123_456;
+    ex.typed[TYPED_ACCEL + 2] = 7;
+    ex.typed[TYPED_HOMING_SEEK] = 99;
     let bytes: Vec<u8> = (0..)
         .map_while(|k| ex.part(k))
         .flat_map(|(b, n)| b.into_iter().take(n as usize))
         .collect();
     assert_eq!(bytes.len(), EXTRAS_BYTES as usize);
     assert_eq!(Extras::decode(|i| bytes[i as usize]), ex);
+}
+
+#[test]
+fn reset_is_the_default() {
+    let mut ex = Extras::DEFAULT;
+    ex.bytes = [1; 5];
+    ex.spindle = [7, 7];
+    ex.typed = [9; TYPED];
+    ex.reset();
+    assert_eq!(ex, Extras::DEFAULT);
 }

@@ -19,7 +19,7 @@ fn blank() -> Vec<u8> {
 fn settings_of(ee: &[u8]) -> (Loaded, Option<Settings>) {
     let read = |a: u16| ee[a as usize];
     let mut out = None;
-    let loaded = load(&SETTINGS, &read, |c| {
+    let loaded = load(SETTINGS, &read, |c| {
         let mut cfg = MachineConfig::STRING_ART;
         let mut ex = Extras::DEFAULT;
         let ok =
@@ -35,7 +35,7 @@ fn settings_of(ee: &[u8]) -> (Loaded, Option<Settings>) {
 fn coords_of(ee: &[u8]) -> (Loaded, Option<CoordData>) {
     let read = |a: u16| ee[a as usize];
     let mut out = None;
-    let loaded = load(&COORDS, &read, |c| {
+    let loaded = load(COORDS, &read, |c| {
         out = Some(CoordData::decode(|i| COORDS.payload_byte(c, i, &read)));
         true
     });
@@ -203,6 +203,14 @@ fn a_committed_copy_gone_bad_is_corruption_the_other_copy_holds() {
     both[SETTINGS.copy(1) as usize + 20] ^= 1;
     assert_eq!(settings_of(&both), (Loaded::Corrupt, None));
     assert_eq!(settings_of(&blank()), (Loaded::Blank, None));
+}
+
+#[test]
+fn the_marker_and_the_areas_in_flash_are_the_constants() {
+    for i in 0..MARKER.len() {
+        assert_eq!(marker_byte(i), MARKER[i]);
+    }
+    assert_eq!([area(0), area(1), area(2), area(3), area(4)], [SETTINGS, COORDS, LINES[0], LINES[1], INFO]);
 }
 
 #[test]
