@@ -312,7 +312,9 @@ fn init() -> Watchdog {
         MOTION.with(|m| CONSOLE.with(|c| c.start_homing(homing.axes, m.as_mut().unwrap(), false)));
     }
     // The startup lines (after the homing, if any).
-    spawn(Task::Console);
+    if homing.at_start && enabled || startup_lines() {
+        spawn(Task::Console);
+    }
     // Last: the blinks are timed from here, the dispatcher's start.
     LED.with(|l| *l = Some((status_led, clock::millis())));
     spawn(Task::Led);
@@ -518,7 +520,9 @@ fn realtime() {
             control_job(Control::Abort);
             realtime::after_reset(m, activity == Activity::Homing, moving);
             // Its startup lines.
-            spawn(Task::Console);
+            if startup_lines() {
+                spawn(Task::Console);
+            }
         }
         // `!` while jogging cancels the jog; while homing only the door
         // stops (Grbl's alarm 7).
@@ -568,6 +572,11 @@ fn realtime() {
     // frees the planner for whoever waits.
     spawn(Task::Refill);
     signal(Signal::Motion);
+}
+
+/// A startup line is kept: the console runs it.
+fn startup_lines() -> bool {
+    STORE.with(|s| s.as_ref().unwrap().has_startup_lines())
 }
 
 fn control_job(c: Control) {

@@ -273,6 +273,14 @@ impl Store {
         }
     }
 
+    /// A startup line is kept (not empty).
+    pub fn has_startup_lines(&self) -> bool {
+        (0..2).any(|n| {
+            self.text_addr(Text::Startup(n))
+                .is_some_and(|at| stored_text(at, 0) != 0)
+        })
+    }
+
     /// A byte write is under way: reads would wait for it.
     pub fn busy(&self) -> bool {
         self.eeprom.busy()
