@@ -35,7 +35,7 @@ use taut_logic::units::Milli;
 
 /// Parts compared per run (up to 8 bytes each, ~0.04 ms): the run stays
 /// short, as every task waits behind it.
-const PARTS_PER_RUN: u8 = 4;
+const PARTS_PER_RUN: u8 = 2;
 
 /// The records, by index ([`record::area`]): a bit each in
 /// [`Store::due`].
@@ -450,6 +450,8 @@ impl Store {
             }
             self.notes = [self.notes[1], None];
             Self::say(note);
+            // A line is a run's worth.
+            return Poll::Again;
         }
         if self.eeprom.busy() {
             return Poll::After(4);

@@ -20,6 +20,12 @@ use taut_logic::settings::grbl::{Extras, Numbered};
 use taut_logic::settings::record::host;
 use taut_logic::units::Milli;
 
+/// The store task's longest run (0.5 ms at 16 MHz): it compares a few
+/// parts of a record a run and starts at most one byte's write. One run
+/// may print the boot's warning line instead (a log line: 0.72 ms).
+const STORE_RUN_CYCLES: u64 = 8_000;
+const LOG_LINE_CYCLES: u64 = 12_000;
+
 /// What a cut at one millisecond leaves.
 struct Cut {
     at_ms: u32,
@@ -40,6 +46,12 @@ fn cuts_of(before: Option<&[u8]>, line: Option<&str>, seed: u64) -> (Vec<Cut>, V
         sim.set_eeprom(e);
     }
     sim.watch_eeprom();
+    // The store task: every task waits behind each of its runs.
+    let elf = hil_tests::firmware_elf();
+    let store = taut_simavr::elf::function_address(&elf, "4taut5store")
+        .unwrap()
+        .unwrap();
+    sim.watch_calls(store);
     if line.is_some() {
         wait_for(&mut sim, "reset:", Duration::from_millis(50));
         sim.run_for(Duration::from_millis(200));
@@ -83,6 +95,17 @@ fn cuts_of(before: Option<&[u8]>, line: Option<&str>, seed: u64) -> (Vec<Cut>, V
     for c in &cuts {
         assert!(c.writes >= 1 && (c.writes < total || c.torn.is_some()));
     }
+    let (runs, longest, _) = sim.call_summary(store).unwrap();
+    let long: Vec<u64> = sim
+        .call_runs(store)
+        .iter()
+        .map(|r| r.1)
+        .filter(|&c| c >= STORE_RUN_CYCLES)
+        .collect();
+    assert!(
+        long.len() <= 1 && longest < LOG_LINE_CYCLES,
+        "store runs of {long:?} cycles ({runs} runs)"
+    );
     assert_ram_budget(&sim);
     (cuts, sim.eeprom())
 }
