@@ -483,7 +483,7 @@ impl Console {
                 self.error(&Error::new(ErrorKind::NotIdle, 0))
             }
             Ok(Input::Jog(line)) => self.pending = Some(Pending::Jog(line)),
-            Ok(Input::System(s)) => self.system(s, m, cfg, owner, store),
+            Ok(Input::System(ref s)) => self.system(s, m, cfg, owner, store),
             Ok(Input::Card(c)) => self.card_line(c, m, cfg),
         }
     }

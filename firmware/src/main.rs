@@ -343,15 +343,17 @@ fn init_cells() {
 #[inline(never)]
 #[optimize(size)]
 fn load_store(eeprom: Eeprom) -> (bool, Found) {
-    let mut store = Store::new(eeprom);
-    // CONFIG starts as the defaults, read from flash (a starting value in
-    // `.data` would be a second copy of them in flash), in place: a copy
-    // would sit on init's stack.
+    // The store made in its cell (~300 B: not on init's stack), CONFIG
+    // as the defaults, read from flash (a starting value in `.data` would
+    // be a second copy of them in flash), in place: a copy would sit on
+    // init's stack.
+    STORE.with(|s| *s = Some(Store::new(eeprom)));
     CONFIG.init_with(|c| MachineConfig::init_defaults(Machine::StringArt, c));
-    let store_now = CONFIG.with(|c| store.load(c));
-    let found = store.load_checkpoint();
-    STORE.with(|s| *s = Some(store));
-    (store_now, found)
+    STORE.with(|s| {
+        let store = s.as_mut().unwrap();
+        let store_now = CONFIG.with(|c| store.load(c));
+        (store_now, store.load_checkpoint())
+    })
 }
 
 #[inline(never)]

@@ -146,26 +146,43 @@ impl Store {
     /// first runs say why, a line each. True when the task must run.
     #[inline(never)]
     pub fn load(&mut self, cfg: &mut MachineConfig) -> bool {
-        let eeprom = &self.eeprom;
+        // Into the fields in place: copies on the stack would be the
+        // boot's stack peak.
+        let Store {
+            eeprom,
+            notes,
+            due,
+            loaded,
+            upgrading,
+            extras,
+            coords,
+            ..
+        } = self;
         let read = |a: u16| eeprom.read(a);
+        // A payload's bytes from `at` on, stored inverted or not: one
+        // closure type, so the settings' reading is one copy in flash for
+        // the records and the version-6 image.
+        let from = |at: u16, inverted: bool| {
+            move |i: u16| read(at + i) ^ if inverted { 0xFF } else { 0 }
+        };
         let layout = record::layout(&read);
         let current = layout == Layout::Current;
-        self.upgrading = !current;
-        let mut extras = self.extras;
+        *upgrading = !current;
         extras.reset();
         let settings_area = area(SETTINGS_I);
-        let settings = record::load(settings_area, &read, |c| {
+        loaded[0] = record::load(settings_area, &read, |c| {
             cfg.load_defaults(Machine::StringArt);
             extras.reset();
-            image::decode_into(|i| settings_area.payload_byte(c, i, &read), cfg, &mut extras)
-                .is_ok()
+            let payload = settings_area.copy(c) + record::HEAD;
+            image::decode_into(from(payload, true), cfg, extras).is_ok()
         });
-        let mut notes = [None; 2];
-        if !matches!(settings, Loaded::Taken { .. }) {
+        if !matches!(loaded[0], Loaded::Taken { .. }) {
             cfg.load_defaults(Machine::StringArt);
             extras.reset();
-            let why = match (layout, settings) {
-                (Layout::Legacy, _) => match legacy::decode_into(read, cfg) {
+            let why = match (layout, loaded[0]) {
+                (Layout::Legacy, _) => match legacy::check(&read)
+                    .and_then(|()| image::take_named(&from(legacy::BODY, false), cfg))
+                {
                     Ok(()) => None,
                     Err(why) => {
                         cfg.load_defaults(Machine::StringArt);
@@ -178,13 +195,11 @@ impl Store {
             };
             notes[0] = Some(why.map_or(Note::Migrated, Note::Settings));
         }
-        let mut coords = CoordData::ZERO;
-        let mut loaded = [settings; RECORDS];
         for i in COORDS_I..RECORDS as u8 {
             let a = area(i);
             loaded[i as usize] = record::load(a, &read, |c| {
                 if i == COORDS_I {
-                    coords = CoordData::decode(|k| a.payload_byte(c, k, &read));
+                    coords.decode_into(|k| a.payload_byte(c, k, &read));
                 }
                 true
             });
@@ -192,19 +207,15 @@ impl Store {
                 notes[1] = Some(Note::Corrupt(i));
             }
         }
-        self.extras = extras;
-        self.coords = coords;
-        self.loaded = loaded;
-        self.notes = notes;
         for (i, l) in loaded.iter().enumerate() {
             if !matches!(l, Loaded::Taken { .. }) {
-                self.due |= 1 << i;
+                *due |= 1 << i;
             }
         }
         if !current {
-            self.due |= MARKER_BIT;
+            *due |= MARKER_BIT;
         }
-        self.due != 0
+        *due != 0
     }
 
     /// The job's checkpoint as the last power-off left it. A corrupt one

@@ -110,7 +110,13 @@ impl CoordData {
     /// un-inverted). Every value is taken: a position needs no check.
     pub fn decode(byte: impl Fn(u16) -> u8) -> CoordData {
         let mut data = CoordData::ZERO;
-        for (s, slot) in data.values.iter_mut().enumerate() {
+        data.decode_into(byte);
+        data
+    }
+
+    /// [`CoordData::decode`] in place (no copy on the AVR's stack).
+    pub fn decode_into(&mut self, byte: impl Fn(u16) -> u8) {
+        for (s, slot) in self.values.iter_mut().enumerate() {
             for (a, v) in slot.iter_mut().enumerate() {
                 let at = ((s * AXES + a) * 4) as u16;
                 *v = Milli(i32::from_le_bytes([
@@ -121,7 +127,6 @@ impl CoordData {
                 ]));
             }
         }
-        data
     }
 }
 

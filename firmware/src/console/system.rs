@@ -29,7 +29,7 @@ impl Console {
     #[optimize(size)]
     pub(super) fn system(
         &mut self,
-        s: SystemLine,
+        s: &SystemLine,
         m: &mut Motion,
         cfg: &mut MachineConfig,
         owner: Owner,
@@ -70,7 +70,7 @@ impl Console {
             }
             // The job's tools: it answers them itself, in its log (and
             // refuses them while it moves).
-            SystemLine::Set { ref key, ref value } if tools::is_tool(key) => {
+            SystemLine::Set { key, value } if tools::is_tool(key) => {
                 if let Err(col) = tools::send(key, value) {
                     return self.error(&Error::new(ErrorKind::InvalidStatement, col));
                 }
@@ -136,16 +136,16 @@ impl Console {
             SystemLine::Home => return self.start_homing(cfg.homing.axes, m, true),
             // Answered at its end.
             SystemLine::Pattern(n) => {
-                self.pattern = taut_logic::patterns::pattern(n).map(|t| (t, 0));
+                self.pattern = taut_logic::patterns::pattern(*n).map(|t| (t, 0));
                 return;
             }
             SystemLine::Set { key, value } => {
-                if let Some(t) = text_key(&key) {
+                if let Some(t) = text_key(key) {
                     return self.keep_text(t, value.as_bytes(), m, store);
                 }
-                return self.set(&key, &value, m, cfg, store);
+                return self.set(key, value, m, cfg, store);
             }
-            SystemLine::Restore(what) => return self.restore(what, m, cfg, store),
+            SystemLine::Restore(what) => return self.restore(*what, m, cfg, store),
             // Asleep once it stands (`poll`).
             SystemLine::Sleep => {
                 m.cancel();

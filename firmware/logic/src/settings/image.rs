@@ -98,9 +98,9 @@ pub fn decode_into(
     Ok(())
 }
 
-/// The named settings from bytes 0… of `byte`, each checked, then the
-/// set.
-fn take_named(byte: &impl Fn(u16) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
+/// The named settings from bytes 0… of `byte` (a version-6 image's from
+/// its byte 5), each checked, then the set.
+pub fn take_named(byte: &impl Fn(u16) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
     for take in [false, true] {
         let mut at = 0;
         for s in all() {
@@ -174,11 +174,11 @@ pub mod legacy {
         })
     }
 
-    /// The settings of a version-6 image onto `cfg` (the defaults on
-    /// entry), as [`super::decode_into`].
-    #[inline(never)]
-    pub fn decode_into(read: impl Fn(u16) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
-        match version(&read) {
+    /// Whether `read` (byte `i` of the EEPROM) holds a whole version-6
+    /// image; its settings are then [`super::take_named`] from byte
+    /// [`BODY`].
+    pub fn check(read: &impl Fn(u16) -> u8) -> Result<(), Unusable> {
+        match version(read) {
             Some(VERSION) => {}
             Some(v) => return Err(Unusable::OtherVersion(v)),
             None if (0..HEADER as u16).all(|i| read(i) == 0xFF) => return Err(Unusable::Blank),
@@ -187,10 +187,20 @@ pub mod legacy {
         let n = len() as u16;
         let mut sum = Fletcher::new();
         (0..n - 2).for_each(|i| sum.add(read(i)));
-        if u16::from_le_bytes([read(n - 2), read(n - 1)]) != sum.value() {
-            return Err(Unusable::Checksum);
+        match u16::from_le_bytes([read(n - 2), read(n - 1)]) == sum.value() {
+            true => Ok(()),
+            false => Err(Unusable::Checksum),
         }
-        take_named(&|i| read(HEADER as u16 + i), cfg)
+    }
+
+    /// Where a version-6 image's settings begin.
+    pub const BODY: u16 = HEADER as u16;
+
+    /// The settings of a version-6 image onto `cfg` (the defaults on
+    /// entry), as [`super::decode_into`].
+    pub fn decode_into(read: impl Fn(u16) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
+        check(&read)?;
+        take_named(&|i| read(BODY + i), cfg)
     }
 
     /// Fletcher-16: two running sums mod 255.
