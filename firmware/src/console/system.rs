@@ -170,6 +170,7 @@ impl Console {
     }
 
     /// `$<n>=` or `$<name>=`: the setting, then the machine reconfigured.
+    #[inline(never)]
     fn set(
         &mut self,
         key: &str,
@@ -213,6 +214,7 @@ impl Console {
     }
 
     /// `$RST=`: Grbl's `settings_restore`, then its soft reset.
+    #[inline(never)]
     fn restore(
         &mut self,
         what: Restore,
@@ -249,6 +251,7 @@ impl Console {
     /// `$N0=`, `$N1=` (a G-code line, checked first as Grbl's
     /// `gc_execute_line` does; carried out at the next boot, not now) and
     /// `$I=` (any text): kept, then answered once written.
+    #[inline(never)]
     fn keep_text(&mut self, t: Text, value: &[u8], m: &Motion, store: &mut Store) {
         // Grbl stores startup lines only when idle, not in alarm.
         if matches!(t, Text::Startup(_)) && !m.position_known() {
