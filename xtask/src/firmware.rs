@@ -10,6 +10,7 @@ pub struct Image {
     pub flash_bytes: u64,
     pub ram_static_bytes: u64,
     pub data_bytes: u64,
+    pub map: crate::flashmap::FlashMap,
 }
 
 pub fn dir() -> PathBuf {
@@ -33,8 +34,10 @@ pub fn build_release() -> Result<Image> {
     )?;
     let sizes = section_sizes(&elf)?;
     let get = |n: &str| sizes.iter().find(|(s, _)| s == n).map_or(0, |(_, v)| *v);
+    let map = crate::flashmap::check(&elf)?;
     Ok(Image {
-        flash_bytes: get(".text") + get(".data"),
+        flash_bytes: get(".text") + get(".hightext") + get(".data") + get(".endmark"),
+        map,
         ram_static_bytes: get(".data") + get(".bss") + get(".noinit"),
         data_bytes: get(".data"),
         elf,
@@ -42,16 +45,27 @@ pub fn build_release() -> Result<Image> {
     })
 }
 
-/// The special-purpose images in firmware/examples (crash, hang, …).
+/// The special-purpose images in firmware/examples (crash, hang, …),
+/// each with its flash map checked (the watchdog entry, the end mark).
 pub fn build_examples() -> Result<()> {
     println!("== building the example images");
-    cargo(&["build", "--release", "--examples"], &dir())
+    cargo(&["build", "--release", "--examples"], &dir())?;
+    for e in std::fs::read_dir(release_dir().join("examples"))? {
+        let path = e?.path();
+        if path.extension().is_some_and(|x| x == "elf") {
+            crate::flashmap::check(&path)?;
+        }
+    }
+    Ok(())
 }
 
 pub fn flash() -> Result<()> {
     let img = build_release()?;
     img.print_size();
-    println!("== flashing through ravedude (Mega 2560 on the first serial port it finds)");
+    println!(
+        "== flashing through ravedude (Mega 2560 on the first serial port it finds, \
+         or RAVEDUDE_PORT)"
+    );
     let mut c = cargo_cmd(&["run", "--release"], &dir());
     status(&mut c)
 }
@@ -67,6 +81,7 @@ impl Image {
             self.elf.display(),
             self.hex.display()
         );
+        self.map.print();
     }
 }
 
