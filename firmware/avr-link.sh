@@ -9,12 +9,13 @@
 #   2. read from the map the function sections of `.text` in order, up to
 #      the first one that does not end below 0x20000;
 #   3. link again with the default script changed so that those sections
-#      stay where they were, and an output section at 0x20000 starts with
-#      the watchdog entry and takes every other function after it.
-# The gap between the last low function and 0x20000 (less than one
-# function) is left out of the image: it is never executed.
-# A small image gets the entry alone at 0x20000 (a record of its own in the
-# hex: avrdude writes it and leaves the pages between as they were).
+#      stay where they were, `.text` goes on at 0x20000 with the watchdog
+#      entry, then every other function.
+# The image stays one run of bytes from 0: the gap before 0x20000 (less
+# than one function; all of the rest up to it in a small image) is filled
+# (zeros: `nop`s). That bootloader erases pages in the order it writes
+# them, counting from 0 whatever address it is told: a hole in the hex
+# would make it erase each page after the hole just after writing it.
 # The build's end mark (`.endmark`) goes last, after `.data`'s values: the
 # start-up checks it is there (a write cut short leaves it out).
 set -euo pipefail
@@ -63,15 +64,20 @@ low=$(awk '
 ' "$map")
 
 if [ "$low" = "ALL" ]; then
-    text_rule='    *(.text.*)'
-else
-    text_rule=$low
+    low='    *(.text.*)'
 fi
+text_rule="$low
+    . = 0x20000;
+    KEEP (*(.watchdog_entry))
+    *(.text.*)"
 
 # The default script, its `*(.text.*)` in `.text` replaced by the low
-# sections, and the section at 0x20000 added after `.text`.
+# sections, the entry at 0x20000 and the rest; the end mark after `.data`;
+# `.noinit` not loaded.
 printf '%s\n' "$default" | awk -v rule="$text_rule" '
     /^[ \t]*\.text[ \t]*:/ { in_text = 1 }
+    # Statics of Rust in `.noinit` are PROGBITS (zeros): not for flash.
+    /^[ \t]*\.noinit[ \t]/ { print "  .noinit (NOLOAD) :"; next }
     in_text && /^[ \t]*\*\(\.text\.\*\)/ { print rule; next }
     { print }
     /^[ \t]*}[ \t]*>[ \t]*data[ \t]+AT>[ \t]*text/ {
@@ -80,15 +86,7 @@ printf '%s\n' "$default" | awk -v rule="$text_rule" '
         print "    KEEP (*(.endmark))"
         print "  }  > text"
     }
-    in_text && /^[ \t]*}[ \t]*>[ \t]*text/ {
-        in_text = 0
-        print "  .hightext 0x20000 :"
-        print "  {"
-        print "    KEEP (*(.watchdog_entry))"
-        print "    *(.text.*)"
-        print "    . = ALIGN(2);"
-        print "  }  > text"
-    }
+    in_text && /^[ \t]*}[ \t]*>[ \t]*text/ { in_text = 0 }
 ' > "$script"
 
 # --emit-relocs: the relocations stay in the ELF (not in flash), for

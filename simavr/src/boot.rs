@@ -286,7 +286,7 @@ mod tests {
         // Extended segment 0x3000 (base 0x30000), 2 bytes at 0xE000.
         std::fs::write(
             &path,
-            ":020000023000CC\n:02E00000AABBB9\n:00000001FF\n,
+            ":020000023000CC\n:02E00000AABBB9\n:00000001FF\n",
         )
         .unwrap();
         assert_eq!(read_hex(&path).unwrap(), vec![(0x3_E000, vec![0xAA, 0xBB])]);

@@ -24,7 +24,9 @@
 //! takes its 86.8 µs of simulated time at 115200 baud, and a transfer of
 //! 180 KB takes seconds instead of the line's 16 s each way.
 
+use crate::clock::cycles_in;
 use crate::sim::Sim;
+use crate::Outcome;
 use std::ffi::CStr;
 use std::fs::File;
 use std::io::{self, Read, Write};
@@ -182,8 +184,8 @@ impl Pty {
 
     /// Runs `sim` for `span` of simulated time, in step with the wall
     /// clock: what the client wrote goes to the UART first, what the UART
-    /// sent goes to the client after.
-    pub fn serve(&mut self, sim: &mut Sim, span: Duration) -> io::Result<()> {
+    /// sent goes to the client after. Returns how the last run ended.
+    pub fn serve(&mut self, sim: &mut Sim, span: Duration) -> io::Result<Outcome> {
         if self.opened()? {
             // A closed USB port keeps nothing: what the board said while
             // no one listened is gone (here it waited in the terminal).
@@ -191,46 +193,98 @@ impl Pty {
             unsafe { libc::tcflush(self._slave.as_raw_fd(), libc::TCIFLUSH) };
             sim.reset_external();
         }
-        let (wall, sim_start) = *self.start.get_or_insert((Instant::now(), sim.time_s()));
+        self.start.get_or_insert((Instant::now(), sim.time_s()));
+        if self.pace == Pace::RealTime {
+            self.take_input(sim)?;
+            let outcome = sim.run_for(span);
+            self.give_output(sim)?;
+            self.keep_pace(sim, None);
+            return Ok(outcome);
+        }
+        // Busy link: in 1 ms steps while idle, so the host's next bytes
+        // wait at most that long in simulated time.
+        let end = sim.cycles() + cycles_in(span);
+        let mut outcome = Outcome::Running;
+        while sim.cycles() < end && !outcome.is_fatal() {
+            let busy = self.take_input(sim)? > 0 || sim.uart_pending() > 0;
+            let step = match busy {
+                true => end - sim.cycles(),
+                false => (end - sim.cycles()).min(IDLE_STEP),
+            };
+            outcome = sim.run_cycles(step);
+            let sent = self.give_output(sim)?;
+            if busy || sent > 0 || sim.uart_pending() > 0 {
+                // The wall clock's reference moves to now: the idle time
+                // after is paced afresh.
+                self.start = Some((Instant::now(), sim.time_s()));
+            } else {
+                self.keep_pace(sim, Some(&self.master));
+            }
+        }
+        Ok(outcome)
+    }
+
+    /// What the client wrote, queued for the UART: how many bytes.
+    fn take_input(&mut self, sim: &mut Sim) -> io::Result<usize> {
         let mut buf = [0u8; 256];
-        let mut busy = sim.uart_pending() > 0;
+        let mut got = 0;
         loop {
             match self.master.read(&mut buf) {
-                Ok(0) => break,
+                Ok(0) => return Ok(got),
                 Ok(n) => {
                     sim.uart_send(&buf[..n]);
                     self.received.extend_from_slice(&buf[..n]);
-                    busy = true;
+                    got += n;
                 }
-                Err(e) if e.kind() == io::ErrorKind::WouldBlock => break,
+                Err(e) if e.kind() == io::ErrorKind::WouldBlock => return Ok(got),
                 // No client has the terminal open (Linux reports EIO).
-                Err(e) if e.raw_os_error() == Some(libc::EIO) => break,
+                Err(e) if e.raw_os_error() == Some(libc::EIO) => return Ok(got),
                 Err(e) => return Err(e),
             }
         }
-        sim.run_for(span);
+    }
+
+    /// What the UART sent, to the client: how many bytes.
+    fn give_output(&mut self, sim: &Sim) -> io::Result<usize> {
         let out = &sim.uart_bytes()[self.sent..];
-        busy |= !out.is_empty() || sim.uart_pending() > 0;
-        match self.master.write(out) {
-            Ok(n) => self.sent += n,
-            Err(e) if e.kind() == io::ErrorKind::WouldBlock => {}
-            Err(e) if e.raw_os_error() == Some(libc::EIO) => self.sent += out.len(),
+        let n = match self.master.write(out) {
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::WouldBlock => 0,
+            Err(e) if e.raw_os_error() == Some(libc::EIO) => out.len(),
             Err(e) => return Err(e),
-        }
-        if self.pace == Pace::BusyLink && busy {
-            // The line is busy: no wait, and the wall clock's reference
-            // moves to now, so the idle time after is paced afresh.
-            self.start = Some((Instant::now(), sim.time_s()));
-            return Ok(());
-        }
-        // Never ahead of the wall clock.
+        };
+        self.sent += n;
+        Ok(n)
+    }
+
+    /// Never ahead of the wall clock: waits until it catches up, or (with
+    /// `wake`) until the client writes.
+    fn keep_pace(&self, sim: &Sim, wake: Option<&File>) {
+        let Some((wall, sim_start)) = self.start else {
+            return;
+        };
         let ahead = (sim.time_s() - sim_start) - wall.elapsed().as_secs_f64();
-        if ahead > 0.0 {
-            std::thread::sleep(Duration::from_secs_f64(ahead));
+        if ahead <= 0.0 {
+            return;
         }
-        Ok(())
+        match wake {
+            None => std::thread::sleep(Duration::from_secs_f64(ahead)),
+            Some(file) => {
+                let mut fd = libc::pollfd {
+                    fd: file.as_raw_fd(),
+                    events: libc::POLLIN,
+                    revents: 0,
+                };
+                let ms = (ahead * 1000.0).ceil() as libc::c_int;
+                // SAFETY: one valid pollfd for the call's length.
+                unsafe { libc::poll(&mut fd, 1, ms) };
+            }
+        }
     }
 }
+
+/// Simulated time run at once while the line is idle (1 ms).
+const IDLE_STEP: u64 = 16_000;
 
 impl Drop for Pty {
     fn drop(&mut self) {

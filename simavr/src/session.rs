@@ -256,10 +256,11 @@ impl<'a> Session<'a> {
             }
             let span = end - now;
             let outcome = match (&mut pty, &text_pending) {
-                (Some(pty), _) => {
-                    pty.serve(self.sim, crate::clock::duration_of(span))?;
-                    Outcome::Running
-                }
+                (Some(pty), _) => match pty.serve(self.sim, crate::clock::duration_of(span))? {
+                    // A watchdog reset, or the awaited text: nothing here.
+                    o if o.is_fatal() => o,
+                    _ => Outcome::Running,
+                },
                 (None, Some(text)) => {
                     let needle = text.as_bytes().to_vec();
                     let mut searched = self.searched;
