@@ -18,11 +18,20 @@ pub const STOCK_BOOTLOADER: &str =
 /// (its `mega2560` board: the `wiring` programmer, 115200 baud, no chip
 /// erase: the bootloader erases each page it writes).
 pub fn avrdude_args(port: &Path) -> Vec<String> {
-    ["-c", "wiring", "-p", "atmega2560", "-b", "115200", "-D", "-P"]
-        .iter()
-        .map(|s| s.to_string())
-        .chain([port.display().to_string()])
-        .collect()
+    [
+        "-c",
+        "wiring",
+        "-p",
+        "atmega2560",
+        "-b",
+        "115200",
+        "-D",
+        "-P",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .chain([port.display().to_string()])
+    .collect()
 }
 
 fn workspace() -> PathBuf {
@@ -174,11 +183,17 @@ impl Terminal {
     /// Sends a line and waits for its `ok`.
     pub fn send_ok(&mut self, line: &str, timeout: Duration) {
         use std::io::Write;
-        let oks = String::from_utf8_lossy(&self.seen).matches("ok\r\n").count();
+        let oks = String::from_utf8_lossy(&self.seen)
+            .matches("ok\r\n")
+            .count();
         self.file.write_all(format!("{line}\n").as_bytes()).unwrap();
         let end = Instant::now() + timeout;
         let mut buf = [0u8; 512];
-        while String::from_utf8_lossy(&self.seen).matches("ok\r\n").count() <= oks {
+        while String::from_utf8_lossy(&self.seen)
+            .matches("ok\r\n")
+            .count()
+            <= oks
+        {
             assert!(
                 Instant::now() < end,
                 "{line}: no ok; got:\n{}",
@@ -216,7 +231,7 @@ pub fn avrdude(port: &Path, ops: &[String]) -> (String, bool, Duration) {
         .args(ops)
         .output()
         .expect("avrdude (Debian package; scripts/setup.sh installs it)");
-    let text = String::from_utf8_lossy(&out.stderr).into_owned()
-        + &String::from_utf8_lossy(&out.stdout);
+    let text =
+        String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout);
     (text, out.status.success(), start.elapsed())
 }

@@ -27,10 +27,19 @@ fn avrdude_writes_taut_through_the_stock_bootloader_and_taut_runs() {
 
     let (out, ok, write_time) = avrdude(&mega.link, &[format!("-Uflash:w:{}:i", hex.display())]);
     assert!(ok, "avrdude write failed:\n{out}");
-    assert!(out.contains("Device signature = 1E 98 01") || out.contains("1e9801"), "{out}");
-    assert!(out.contains("bytes of flash verified"), "the write's own verify:\n{out}");
+    assert!(
+        out.contains("Device signature = 1E 98 01") || out.contains("1e9801"),
+        "{out}"
+    );
+    assert!(
+        out.contains("bytes of flash verified"),
+        "the write's own verify:\n{out}"
+    );
     let (out, ok, verify_time) = avrdude(&mega.link, &[format!("-Uflash:v:{}:i", hex.display())]);
-    assert!(ok && out.contains("bytes of flash verified"), "verify:\n{out}");
+    assert!(
+        ok && out.contains("bytes of flash verified"),
+        "verify:\n{out}"
+    );
     eprintln!(
         "flashing: write + verify {:.1} s, verify alone {:.1} s (wall)",
         write_time.as_secs_f64(),
@@ -54,7 +63,8 @@ fn avrdude_writes_taut_through_the_stock_bootloader_and_taut_runs() {
     // radial axis, at their default steps per unit.
     use taut_logic::units::Milli;
     let cfg = taut_logic::config::MachineConfig::STRING_ART;
-    let steps = |axis: usize, milli: i32| cfg.axes[axis].steps_per_unit.steps(Milli(milli)) as usize;
+    let steps =
+        |axis: usize, milli: i32| cfg.axes[axis].steps_per_unit.steps(Milli(milli)) as usize;
     let want_base = steps(0, 15_000) + (steps(0, 15_000) - steps(0, 7_500));
     let want_radial = steps(1, 5_000);
     let got = (rises(&signals, "base_step"), rises(&signals, "radial_step"));
@@ -70,7 +80,10 @@ fn avrdude_writes_taut_through_the_stock_bootloader_and_taut_runs() {
 #[test]
 fn after_a_watchdog_reset_the_bootloader_hands_back_to_the_firmware() {
     let dir = board::scratch("watchdog");
-    let hex = board::hex_of(&hil_tests::example_elf("stuck_task"), &dir.join("stuck.hex"));
+    let hex = board::hex_of(
+        &hil_tests::example_elf("stuck_task"),
+        &dir.join("stuck.hex"),
+    );
     let mega = Board::power_on(&dir, None, &[]);
     let (out, ok, _) = avrdude(&mega.link, &[format!("-Uflash:w:{}:i", hex.display())]);
     assert!(ok, "{out}");
@@ -104,7 +117,11 @@ fn taut_comes_back_through_the_bootloader_after_a_watchdog_reset() {
     // Power-on: the bootloader waits ~1 s for avrdude, then starts taut.
     let started = sim.run_until_uart_contains("reset:", Duration::from_secs(3));
     assert_eq!(started, Outcome::Done, "{}", sim.uart_text());
-    assert!(sim.uart_text().contains("reset:unknown"), "{}", sim.uart_text());
+    assert!(
+        sim.uart_text().contains("reset:unknown"),
+        "{}",
+        sim.uart_text()
+    );
     sim.run_for(Duration::from_millis(200));
     let abort = hil_tests::sim::elf::symbol_address(&elf, "abort")
         .unwrap()
@@ -155,7 +172,11 @@ fn a_write_cut_half_way_is_finished_by_the_next_avrdude() {
     let mut term = Terminal::open(&mega.link);
     std::thread::sleep(Duration::from_secs(4));
     term.drain();
-    assert!(!term.text().contains("Grbl"), "half an image ran: {}", term.text());
+    assert!(
+        !term.text().contains("Grbl"),
+        "half an image ran: {}",
+        term.text()
+    );
     drop(term);
     let (out, ok, _) = avrdude(&mega.link, &[format!("-Uflash:w:{}:i", hex.display())]);
     assert!(ok, "the second write:\n{out}");
@@ -250,6 +271,9 @@ fn cargo_run_flashes_through_ravedude_and_opens_the_console() {
         "no banner on ravedude's console after {:.0} s\nstdout:\n{console}\nstderr:\n{said}",
         start.elapsed().as_secs_f64()
     );
-    assert!(said.contains("flash verified"), "avrdude under ravedude:\n{said}");
+    assert!(
+        said.contains("flash verified"),
+        "avrdude under ravedude:\n{said}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

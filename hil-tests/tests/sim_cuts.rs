@@ -3,8 +3,8 @@
 //! hundred seeded cut times on the string-art job and on a plotter's print
 //! from the card, and a cut on text comes however long its delay.
 
-use hil_tests::sim::session::{Cut, Ending, Plan, Session};
 use hil_tests::sim::sdcard::{SdCard, SdImage};
+use hil_tests::sim::session::{Cut, Ending, Plan, Session};
 use hil_tests::sim::Sim;
 use hil_tests::{send_ok, soak_or, Rng};
 use std::sync::atomic::AtomicBool;
@@ -29,7 +29,9 @@ fn assert_cut_at(sim: &Sim, ending: &Ending, cycle: u64, what: &str) {
         stopped >= cycle && stopped - cycle <= LONGEST_INSTRUCTION,
         "{what}: asked for cycle {cycle}, stopped at {stopped}"
     );
-    assert!(ending.words().starts_with(&format!("power cut at cycle {cycle}")));
+    assert!(ending
+        .words()
+        .starts_with(&format!("power cut at cycle {cycle}")));
 }
 
 fn string_art() -> Sim {

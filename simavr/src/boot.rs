@@ -258,7 +258,10 @@ impl Sim {
     /// `len` bytes of flash from byte address `at` (as avrdude would read
     /// them back).
     pub fn flash(&self, at: u32, len: usize) -> Vec<u8> {
-        assert!(at as usize + len <= FLASH_BYTES as usize, "past the end of flash");
+        assert!(
+            at as usize + len <= FLASH_BYTES as usize,
+            "past the end of flash"
+        );
         let avr = self.avr_raw();
         // SAFETY: `flash` holds `flashend + 1` = FLASH_BYTES bytes.
         unsafe { std::slice::from_raw_parts((*avr).flash.add(at as usize), len).to_vec() }
@@ -275,7 +278,11 @@ mod tests {
         assert_eq!(f.boot_start(), 0x3_E000);
         assert!(f.reset_into_boot());
         assert!(f.boot_section_locked());
-        let unlocked = Fuses { lock: 0x3F, high: 0xD9, ..f };
+        let unlocked = Fuses {
+            lock: 0x3F,
+            high: 0xD9,
+            ..f
+        };
         assert!(!unlocked.reset_into_boot() && !unlocked.boot_section_locked());
         assert_eq!(Fuses { high: 0xDE, ..f }.boot_start(), 0x3_FC00);
     }
@@ -284,11 +291,7 @@ mod tests {
     fn hex_records_land_at_their_addresses() {
         let path = std::env::temp_dir().join(format!("taut-hex-{}.hex", std::process::id()));
         // Extended segment 0x3000 (base 0x30000), 2 bytes at 0xE000.
-        std::fs::write(
-            &path,
-            ":020000023000CC\n:02E00000AABBB9\n:00000001FF\n",
-        )
-        .unwrap();
+        std::fs::write(&path, ":020000023000CC\n:02E00000AABBB9\n:00000001FF\n").unwrap();
         assert_eq!(read_hex(&path).unwrap(), vec![(0x3_E000, vec![0xAA, 0xBB])]);
         std::fs::write(&path, ":02E00000AABBBA\n:00000001FF\n").unwrap();
         assert!(read_hex(&path).is_err(), "bad checksum");

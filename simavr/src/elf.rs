@@ -44,9 +44,9 @@ pub fn read(path: &Path) -> Result<ElfInfo, Error> {
     let bad = |e: object::Error| Error::Elf(format!("{}: {e}", path.display()));
     let file = object::File::parse(&*bytes).map_err(bad)?;
     let size = |name: &str| file.section_by_name(name).map_or(0, |s| s.size() as u32);
-    // `.hightext`: the code from 0x20000 on, `.endmark` the build's mark
-    // after `.data`'s values (firmware/avr-link.sh).
-    let text_bytes = size(".text") + size(".hightext") + size(".endmark");
+    // `.endmark`: the build's mark after `.data`'s values
+    // (firmware/avr-link.sh).
+    let text_bytes = size(".text") + size(".endmark");
     let data_bytes = size(".data");
     let bss_bytes = size(".bss") + size(".noinit");
     // The linker script marks the end of statics; prefer the most inclusive name.
@@ -101,11 +101,7 @@ pub(crate) fn code_ranges(path: &Path) -> Result<Vec<(u32, u32)>, Error> {
     let file =
         object::File::parse(&*bytes).map_err(|e| Error::Elf(format!("{}: {e}", path.display())))?;
     let mut ranges = Vec::new();
-    // `.hightext`: the code from 0x20000 on (firmware/avr-link.sh).
-    for name in [".text", ".hightext"] {
-        let Some(text) = file.section_by_name(name) else {
-            continue;
-        };
+    if let Some(text) = file.section_by_name(".text") {
         let text_end = (text.address() + text.size()) as u32;
         let mut symbols: Vec<(u32, u32, bool)> = file
             .symbols()

@@ -102,7 +102,8 @@ impl Sim {
         self.clear_deadline();
         // Without traps (a board with a bootloader) nothing is watched.
         let trapped = !self.code.is_empty();
-        if std::mem::take(&mut self.shared_mut().unseen_mask) && trapped && !self.warned_unseen_mask {
+        if std::mem::take(&mut self.shared_mut().unseen_mask) && trapped && !self.warned_unseen_mask
+        {
             self.warned_unseen_mask = true;
             eprintln!(
                 "taut-simavr: interrupts were masked by code outside the ELF's code symbols \

@@ -36,7 +36,7 @@ pub fn build_release() -> Result<Image> {
     let get = |n: &str| sizes.iter().find(|(s, _)| s == n).map_or(0, |(_, v)| *v);
     let map = crate::flashmap::check(&elf)?;
     Ok(Image {
-        flash_bytes: get(".text") + get(".hightext") + get(".data") + get(".endmark"),
+        flash_bytes: get(".text") + get(".data") + get(".endmark"),
         map,
         ram_static_bytes: get(".data") + get(".bss") + get(".noinit"),
         data_bytes: get(".data"),

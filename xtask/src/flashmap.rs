@@ -31,10 +31,8 @@ const DATA: u64 = 0x80_0000;
 pub struct FlashMap {
     /// First byte past everything written to flash.
     pub end: u64,
-    /// End of the code below 128 KiB (`.text`).
+    /// End of the code below the watchdog entry.
     pub low_end: u64,
-    /// `.hightext`: from the watchdog entry on.
-    pub high: Option<(u64, u64)>,
     pub trampolines: usize,
     /// Function pointers checked, and those reached through a trampoline.
     pub pointers: usize,
@@ -45,14 +43,12 @@ impl FlashMap {
     pub fn print(&self) {
         let kib = |b: u64| b as f64 / 1024.0;
         println!(
-            "flash map: code below 128 KiB to {:#07x} ({} B free before the watchdog entry), \
-             watchdog entry at {WATCHDOG_ENTRY:#07x}{}; image ends at {:#07x} = {} B, \
+            "flash map: code below the watchdog entry to {:#07x} ({} B filled before it), \
+             watchdog entry at {WATCHDOG_ENTRY:#07x}; image ends at {:#07x} = {} B, \
              {} B ({:.1} KiB) under the {} B budget, bootloader at {BOOT_START:#07x}; \
              {} function pointers, {} through the {} trampolines",
             self.low_end,
             WATCHDOG_ENTRY.saturating_sub(self.low_end),
-            self.high
-                .map_or(String::new(), |(a, b)| format!(", code {a:#07x}..{b:#07x}")),
             self.end,
             self.end,
             BUDGET.saturating_sub(self.end),
@@ -103,10 +99,13 @@ pub fn check(elf: &Path) -> Result<FlashMap> {
             .find(|s| s.name() == Ok(want))
             .map(|s| s.address())
     };
-    let section = |want: &str| {
-        file.section_by_name(want)
-            .map(|s| (s.address(), s.address() + s.size()))
-    };
+    // The code's end below the entry (a small image: all of it).
+    let low_end = file
+        .symbols()
+        .filter(|s| s.kind() == object::SymbolKind::Text && s.address() < WATCHDOG_ENTRY)
+        .map(|s| s.address() + s.size())
+        .max()
+        .unwrap_or(0);
     let mut problems = Vec::new();
     if end > BUDGET {
         problems.push(format!(
@@ -209,8 +208,7 @@ pub fn check(elf: &Path) -> Result<FlashMap> {
     }
     Ok(FlashMap {
         end,
-        low_end: section(".text").map_or(0, |s| s.1),
-        high: section(".hightext"),
+        low_end,
         trampolines: trampolines.len(),
         pointers,
         through_trampolines: through,

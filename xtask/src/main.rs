@@ -184,7 +184,10 @@ fn soak() -> Result<()> {
 fn sim(args: &[String]) -> Result<()> {
     let img = firmware::build_release()?;
     if args.iter().any(|a| a == "--bootloader") {
-        println!("== a Mega with only its bootloader; flash {}", img.hex.display());
+        println!(
+            "== a Mega with only its bootloader; flash {}",
+            img.hex.display()
+        );
         return run::bin("taut-sim", args);
     }
     run::taut_sim(&img.elf, args)
@@ -203,7 +206,10 @@ mod tests {
             .collect();
         assert!(commands.len() >= 12, "{commands:?}");
         for c in commands {
-            assert!(super::HELP.contains(&format!("\n  {c}")), "{c} missing from the help");
+            assert!(
+                super::HELP.contains(&format!("\n  {c}")),
+                "{c} missing from the help"
+            );
         }
         assert!(super::HELP.contains("demo plotter [MACHINE]"));
         assert!(super::HELP.contains("sdimage DIR -o IMG"));

@@ -12,12 +12,12 @@ use std::time::{Duration, Instant};
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
 use taut_logic::settings::image;
-use taut_simavr::operator::Seen;
 use taut_simavr::clock::{cycles_in, FREQ_HZ};
+use taut_simavr::operator::Seen;
 use taut_simavr::pty::{Pace, Pty};
-use taut_simavr::session::{self, Ending, Plan, Session};
 use taut_simavr::scenario::{self, FaultSpec, TimedBytes};
 use taut_simavr::sdcard::{SdCard, SdImage};
+use taut_simavr::session::{self, Ending, Plan, Session};
 use taut_simavr::{picture, replay};
 use taut_simavr::{Outcome, Reply, Sim};
 
@@ -733,7 +733,11 @@ mod tests {
             })
         );
         let p = plan(&args("fw.elf --power-cut-at 45").unwrap(), 0);
-        assert_eq!(p.limit, Some(80_000_000), "the plain 5 s: the cut outlasts it");
+        assert_eq!(
+            p.limit,
+            Some(80_000_000),
+            "the plain 5 s: the cut outlasts it"
+        );
         let p = plan(&args("fw.elf --sd c --auto-confirm").unwrap(), 0);
         assert_eq!(p.limit, None, "--auto-confirm runs the job to its end");
     }
