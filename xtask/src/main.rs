@@ -3,6 +3,7 @@
 //! the idempotent bootstrap (`scripts/setup.sh`).
 
 mod bench;
+mod bench_page;
 mod demo;
 mod estimate;
 mod firmware;
@@ -29,7 +30,7 @@ usage: cargo xtask <command> [args]
   sdimage DIR -o IMG  build a FAT card image from a folder (dd it to a real card)
   estimate DIR      the machine time of a card folder's job: this firmware's (its
                     own job, planner and trapezoids, on the host) and the original's
-  bench             measure, write target/bench.json, print a table
+  bench             measure, write target/bench.json and docs/benchmarks.md
   flash             flash a Mega 2560 through ravedude
   setup             install what is missing (apt packages, the pinned nightly)
 ";
