@@ -10,11 +10,21 @@ use serde_json::{json, Map, Value};
 use taut_logic::files::FileName;
 use taut_logic::stringart::estimate::{self, CardEstimate};
 
-pub fn run() -> Result<()> {
+pub fn run(args: &[String]) -> Result<()> {
+    let out = root().join("target/bench.json");
+    match args {
+        [] => {}
+        [page] if page == "--page" => return write_page(&out),
+        _ => {
+            return Err(
+                "bench: `bench` or `bench --page` (the page again from target/bench.json)".into(),
+            )
+        }
+    }
+    let host = host_figures();
     let img = firmware::build_release()?;
     firmware::build_examples()?;
     let busy = firmware::release_dir().join("examples/busy.elf");
-    let out = root().join("target/bench.json");
     println!("== benchmarks (simulated ATmega2560, cycle-exact)");
     let args = [
         img.elf.display().to_string(),
@@ -26,6 +36,7 @@ pub fn run() -> Result<()> {
     let ram = ["ram_static_bytes", "stack_peak_bytes"]
         .map(|k| figures.get(k).and_then(Value::as_u64).unwrap_or(0));
     figures.insert("ram_static_plus_stack_bytes".into(), json!(ram[0] + ram[1]));
+    figures.extend(host);
     println!("\n== machine time of the string-art job (host, the firmware's own planner)");
     let demo = crate::estimate::estimate(&root().join("examples/card"))?;
     let seed = seed_size_job()?;
@@ -49,6 +60,23 @@ pub fn run() -> Result<()> {
     println!("\n== string art on the host (taut bench)");
     run::studio(&["bench".into(), "--json".into(), out.display().to_string()])?;
     write_page(&out)
+}
+
+/// The host's cores and load when the bench starts: the wall-clock
+/// figures depend on them.
+fn host_figures() -> Map<String, Value> {
+    let mut m = Map::new();
+    if let Ok(n) = std::thread::available_parallelism() {
+        m.insert("host_cores".into(), json!(n.get()));
+    }
+    let load = std::fs::read_to_string("/proc/loadavg").ok();
+    if let Some(l) = load
+        .as_deref()
+        .and_then(|t| t.split(' ').next()?.parse::<f64>().ok())
+    {
+        m.insert("host_load_average".into(), json!(l));
+    }
+    m
 }
 
 /// docs/benchmarks.md from every figure in `json`; the bars missed are

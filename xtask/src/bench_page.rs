@@ -153,6 +153,8 @@ const SECTIONS: &[(&str, &[Figure])] = &[
             barred("demo_wall_s", "s", "wall seconds that took", Bar::AtMost(15.0)),
             fig("sim_mhz_idle", "MHz", "simulated MHz per wall second, the firmware idle"),
             fig("sim_mhz_busy", "MHz", "the same, an MCU that never sleeps (`firmware/examples/busy.rs`)"),
+            fig("host_cores", "cores", "the host's cores the bench ran on"),
+            fig("host_load_average", "", "the host's 1-minute load average when the bench started: the wall-clock figures shrink as it grows"),
         ],
     ),
 ];
@@ -312,7 +314,10 @@ fn stringart_rows(
             shown.insert(key.clone());
             let bar = match (kind, v.as_f64(), random, plain) {
                 ("rmse", Some(x), Some(r), Some(p)) => Some((
-                    format!("≤ 0.75 × random ({}), < plain", number(0.75 * r)),
+                    format!(
+                        "≤ 0.75 × random ({}), < plain",
+                        number((7500.0 * r).round() / 1e4)
+                    ),
                     x <= 0.75 * r && x < p,
                 )),
                 _ => None,

@@ -30,7 +30,8 @@ usage: cargo xtask <command> [args]
   sdimage DIR -o IMG  build a FAT card image from a folder (dd it to a real card)
   estimate DIR      the machine time of a card folder's job: this firmware's (its
                     own job, planner and trapezoids, on the host) and the original's
-  bench             measure, write target/bench.json and docs/benchmarks.md
+  bench [--page]    measure, write target/bench.json and docs/benchmarks.md
+                    (--page: only the page again, from target/bench.json)
   flash             flash a Mega 2560 through ravedude
   setup             install what is missing (apt packages, the pinned nightly)
 ";
@@ -64,7 +65,7 @@ fn main() -> ExitCode {
             Some("plotter") => demo::plotter(rest.get(1).map_or("flatbed", String::as_str)),
             Some(other) => Err(format!("demo {other}: `demo` or `demo plotter [MACHINE]`").into()),
         }),
-        "bench" => run::setup().and_then(|_| bench::run()),
+        "bench" => run::setup().and_then(|_| bench::run(rest)),
         "estimate" => estimate::run(rest),
         "flash" => run::setup().and_then(|_| firmware::flash()),
         "help" | "--help" | "-h" => {
