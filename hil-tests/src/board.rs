@@ -183,17 +183,18 @@ impl Terminal {
     /// Sends a line and waits for its `ok`.
     pub fn send_ok(&mut self, line: &str, timeout: Duration) {
         use std::io::Write;
-        let oks = String::from_utf8_lossy(&self.seen)
-            .matches("ok\r\n")
-            .count();
+        // `ok` lines, whatever line ends the terminal's settings give.
+        let count = |seen: &[u8]| {
+            String::from_utf8_lossy(seen)
+                .lines()
+                .filter(|l| l.trim() == "ok")
+                .count()
+        };
+        let oks = count(&self.seen);
         self.file.write_all(format!("{line}\n").as_bytes()).unwrap();
         let end = Instant::now() + timeout;
         let mut buf = [0u8; 512];
-        while String::from_utf8_lossy(&self.seen)
-            .matches("ok\r\n")
-            .count()
-            <= oks
-        {
+        while count(&self.seen) <= oks {
             assert!(
                 Instant::now() < end,
                 "{line}: no ok; got:\n{}",

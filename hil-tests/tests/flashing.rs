@@ -235,7 +235,20 @@ fn cargo_run_flashes_through_ravedude_and_opens_the_console() {
         .process_group(0)
         .spawn()
         .unwrap();
+    // ravedude's console, read by a thread (a read blocks until it says
+    // something); the build before it may wait for other builds' locks.
     let mut out = child.stdout.take().unwrap();
+    let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let into = seen.clone();
+    std::thread::spawn(move || {
+        let mut buf = [0u8; 256];
+        while let Ok(n) = out.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            into.lock().unwrap().extend_from_slice(&buf[..n]);
+        }
+    });
     let err = child.stderr.take().unwrap();
     let err = std::thread::spawn(move || {
         let mut text = String::new();
@@ -243,16 +256,9 @@ fn cargo_run_flashes_through_ravedude_and_opens_the_console() {
         text
     });
     let start = std::time::Instant::now();
-    let mut seen = Vec::new();
-    let mut buf = [0u8; 256];
-    while !String::from_utf8_lossy(&seen).contains("Grbl 1.1h") {
-        if start.elapsed() > Duration::from_secs(240) {
-            break;
-        }
-        match out.read(&mut buf) {
-            Ok(0) | Err(_) => break,
-            Ok(n) => seen.extend_from_slice(&buf[..n]),
-        }
+    let banner = |s: &[u8]| String::from_utf8_lossy(s).contains("Grbl 1.1h");
+    while !banner(&seen.lock().unwrap()) && start.elapsed() < Duration::from_secs(900) {
+        std::thread::sleep(Duration::from_millis(50));
     }
     // A signal to the process group this test made, as Ctrl-C would.
     let _ = Command::new("kill")
@@ -261,7 +267,7 @@ fn cargo_run_flashes_through_ravedude_and_opens_the_console() {
     let _ = child.wait();
     let said = err.join().unwrap();
     mega.stop();
-    let console = String::from_utf8_lossy(&seen);
+    let console = String::from_utf8_lossy(&seen.lock().unwrap()).into_owned();
     assert!(
         console.contains("Grbl 1.1h"),
         "no banner on ravedude's console after {:.0} s\nstdout:\n{console}\nstderr:\n{said}",

@@ -48,8 +48,8 @@ fn cuts_during_the_string_art_job_come_at_their_cycle() {
     for k in 0..runs {
         // Whole seconds (where a float once missed) and any cycle.
         let cycle = match k % 4 {
-            0 => 16_000_000 * (1 + rng.below(3)),
-            _ => 320_000 + rng.below(3 * 16_000_000),
+            0 => 16_000_000 * (1 + rng.below(2)),
+            _ => 320_000 + rng.below(2 * 16_000_000),
         };
         let mut sim = string_art();
         let plan = Plan {
@@ -85,12 +85,12 @@ fn cuts_during_a_plotter_print_from_the_card_come_at_their_cycle() {
             0 => Plan {
                 cut: Some(Cut::On {
                     text: "File selected".into(),
-                    delay: rng.below(4 * 16_000_000),
+                    delay: rng.below(2 * 16_000_000),
                 }),
                 ..Plan::default()
             },
             _ => Plan {
-                cut: Some(Cut::At(now + rng.below(4 * 16_000_000))),
+                cut: Some(Cut::At(now + rng.below(2 * 16_000_000))),
                 ..Plan::default()
             },
         };
