@@ -51,7 +51,7 @@ fn avrdude_writes_taut_through_the_stock_bootloader_and_taut_runs() {
     let mut term = Terminal::open(&mega.link);
     term.wait_for("Grbl 1.1h", Duration::from_secs(30));
     term.wait_for("reset:", Duration::from_secs(5));
-    for line in ["G91", "G1 X15 Y5 F3000", "G1 X-7.5 F3000", "M400"] {
+    for line in ["G91", "G1 C15 X5 F3000", "G1 C-7.5 F3000", "M400"] {
         term.send_ok(line, Duration::from_secs(30));
     }
     drop(term);
@@ -59,8 +59,8 @@ fn avrdude_writes_taut_through_the_stock_bootloader_and_taut_runs() {
     assert!(status.success(), "taut-sim: {status}\n{said}");
     assert!(said.contains("ended: stopped by a signal"), "{said}");
     let signals = vcd::parse(&std::fs::read_to_string(dir.join("trace.vcd")).unwrap()).unwrap();
-    // The default machine (the string-art one): X is the base, Y the
-    // radial axis, at their default steps per unit.
+    // The default machine (the string-art one): C turns the base, X moves
+    // the radial carriage, at their default steps per unit.
     use taut_logic::units::Milli;
     let cfg = taut_logic::config::MachineConfig::STRING_ART;
     let steps =
