@@ -144,7 +144,7 @@ pub fn check(elf: &Path) -> Result<FlashMap> {
     // `ldi` immediate: 1110 KKKK dddd KKKK.
     let ldi = |at: u64| {
         let w = word(at);
-        (w & 0xF000 == 0xE000).then(|| ((w >> 4) & 0xF0) as u8 | (w & 0x0F) as u8)
+        (w & 0xF000 == 0xE000).then_some(((w >> 4) & 0xF0) as u8 | (w & 0x0F) as u8)
     };
     let (mut pointers, mut through) = (0, 0);
     for section in file.sections() {
