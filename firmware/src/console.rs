@@ -16,6 +16,7 @@
 
 mod homing;
 mod offsets;
+mod system;
 
 use crate::flash_str;
 use crate::machine_io::Io;
@@ -23,18 +24,15 @@ use crate::motion::Motion;
 use crate::print::Print;
 use crate::queues::{Signal, BUTTONS, JOB_CLAIMS_TX, RX};
 use crate::reply;
-use crate::rt::{stack, Poll};
+use crate::rt::Poll;
+use crate::store::Store;
 use core::sync::atomic::Ordering::Relaxed;
 use homing::HomingRun;
-use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Parser, Read, Restore, SystemLine};
-use taut_logic::interp::{
-    axis_letters, motor_channels, Allowed, CoordTable, Env, Interpreter, Progress, Wait,
-};
+use taut_logic::coords::CoordData;
+use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Parser, Read};
+use taut_logic::interp::{axis_letters, coords, motor_channels, Allowed, Env, Interpreter, Progress, Wait};
 use taut_logic::kinematics::{Kinematics, Position};
-use taut_logic::patterns;
-use taut_logic::settings;
 use taut_progmem::{text, Text};
 use ufmt::uwrite;
 
@@ -52,8 +50,6 @@ pub struct Console {
     /// `$$` or `$Q` in progress: its next line.
     listing: Option<Listing>,
     interp: Interpreter,
-    /// The work coordinate data (`G54`–`G59`, `G28`, `G30`).
-    coords: CoordTable,
     /// The motion epoch the executor's position agrees with: a stop that
     /// dropped queued moves starts a new one, and the position is then
     /// read back.
@@ -73,6 +69,15 @@ pub struct Console {
     sleep: Sleep,
     /// Homing (`$H`, at power-on).
     homing: Option<HomingRun>,
+    /// Startup lines still to run (a bit each): at boot, after a reset,
+    /// after `$H`.
+    startup: u8,
+    /// The startup line being answered: where its text is.
+    echo: u16,
+    /// The line being checked is a `$N0=`'s, to keep if it passes.
+    storing: bool,
+    /// A `$N0=` or `$I=` is being written: answered `ok` once it is.
+    saving: bool,
 }
 
 /// `$SLP`: until a reset.
@@ -88,6 +93,8 @@ enum Sleep {
 enum Source {
     Serial,
     Card,
+    /// A startup line from EEPROM.
+    Startup,
 }
 
 #[derive(Clone, Copy)]
@@ -95,6 +102,7 @@ enum Listing {
     Settings(usize),
     Queues(u8),
     Offsets(u8),
+    Startup(u8),
 }
 
 /// What the console is doing, for the status report.
@@ -139,7 +147,6 @@ impl Console {
             pattern: None,
             listing: None,
             interp: Interpreter::new(),
-            coords: CoordTable::new(),
             // Unlike the motion's: the first run reads the position through
             // the kinematics (zero steps are not (0, 0) on an arm).
             epoch: u8::MAX,
@@ -150,7 +157,16 @@ impl Console {
             checking: false,
             sleep: Sleep::Awake,
             homing: None,
+            startup: system::STARTUP,
+            echo: 0,
+            storing: false,
+            saving: false,
         }
+    }
+
+    /// At power-on: the stored `G54` offset in force.
+    pub fn boot(&mut self, coords: &CoordData) {
+        self.interp.reset(&coords::stored(coords, 0));
     }
 
     /// Whether a `$` setting changed since the last call (the app then has
@@ -161,20 +177,24 @@ impl Console {
 
     /// Ctrl-X: the line in progress, the line being carried out and a
     /// listing are dropped with the bytes not yet read; the modes are
-    /// Grbl's power-on ones, `G92` cleared (Grbl's `gc_init`).
-    pub fn reset(&mut self) {
+    /// Grbl's power-on ones, `G92` cleared, `G54` (from `coords`) in force
+    /// (Grbl's `gc_init`); the startup lines run again.
+    pub fn reset(&mut self, coords: &CoordData) {
         self.parser = Parser::new();
         self.line_ready = false;
         self.owed = false;
         self.pattern = None;
         self.listing = None;
-        self.interp.reset(&self.coords.get(0));
+        self.interp.reset(&coords::stored(coords, 0));
         self.print.abort();
         self.source = None;
         self.jogging = false;
         self.checking = false;
         self.sleep = Sleep::Awake;
         self.homing = None;
+        self.startup = system::STARTUP;
+        self.storing = false;
+        self.saving = false;
         RX.clear();
     }
 
@@ -205,7 +225,7 @@ impl Console {
         if self.interp.busy() {
             self.interp.drop_line();
             if core::mem::take(&mut self.owed) {
-                reply::ok();
+                self.answer_ok();
             }
         }
     }
@@ -218,6 +238,7 @@ impl Console {
         kin: &impl Kinematics,
         cfg: &mut MachineConfig,
         owner: Owner,
+        store: &mut Store,
     ) -> Poll<Signal> {
         if self.epoch != m.epoch() && reply::room() {
             self.epoch = m.epoch();
@@ -256,8 +277,16 @@ impl Console {
                 }
             }
             if let Some(listing) = self.listing {
-                self.list(listing, cfg);
+                self.list(listing, cfg, store);
                 return Poll::Again;
+            }
+            // A kept text is answered once written, as Grbl's.
+            if self.saving {
+                if store.text_saving() {
+                    return Poll::After(4);
+                }
+                self.saving = false;
+                self.ok();
             }
             // A card command waits for the reader.
             if !cfg.machine.is_string_art() && self.card_news(m) {
@@ -270,7 +299,7 @@ impl Console {
                 self.source = Some(Source::Serial);
                 let read = self.read();
                 if read == Ok(true) {
-                    self.take(m, kin, cfg, owner);
+                    self.take(m, kin, cfg, owner, store);
                 }
                 self.source = Some(Source::Card);
                 if let Err(wait) = read {
@@ -284,12 +313,20 @@ impl Console {
             // A line accepted and not yet answered (one with nothing to do
             // is answered here too).
             if self.interp.busy() || self.owed {
-                return self.carry_on(m, kin, cfg, owner);
+                return self.carry_on(m, kin, cfg, owner, store);
             }
             if core::mem::take(&mut self.line_ready) {
-                self.take(m, kin, cfg, owner);
+                self.take(m, kin, cfg, owner, store);
                 // One line per run: the other tasks get their turn.
                 return Poll::Again;
+            }
+            match self.startup_line_ready(m, store) {
+                Err(wait) => return wait,
+                Ok(true) => {
+                    self.line_ready = true;
+                    return Poll::Again;
+                }
+                Ok(false) => {}
             }
             match self.read() {
                 Err(wait) => return wait,
@@ -301,6 +338,18 @@ impl Console {
                 Ok(false) => {}
             }
         }
+    }
+
+    /// The startup lines, each read whole from EEPROM and taken as a line
+    /// (`true`), before any other input.
+    fn startup_line_ready(&mut self, m: &Motion, store: &Store) -> Result<bool, Poll<Signal>> {
+        if self.startup == 0 || self.parser.mid_line() || self.print.busy() {
+            return Ok(false);
+        }
+        if store.busy() {
+            return Err(Poll::After(4));
+        }
+        Ok(self.next_startup_line(m, store))
     }
 
     /// The executor's view of the machine now.
@@ -330,18 +379,19 @@ impl Console {
         kin: &impl Kinematics,
         cfg: &MachineConfig,
         owner: Owner,
+        store: &mut Store,
     ) -> Poll<Signal> {
         let env = self.env(kin, cfg, owner);
         let mut io = Io {
             m,
             kin,
-            coords: &mut self.coords,
+            store,
             replies: self.owed,
         };
         match self.interp.run(&env, &mut io) {
             Progress::Done => {
                 if core::mem::take(&mut self.owed) {
-                    reply::ok();
+                    self.answer_ok();
                 }
                 Poll::Again
             }
@@ -396,18 +446,27 @@ impl Console {
         kin: &impl Kinematics,
         cfg: &mut MachineConfig,
         owner: Owner,
+        store: &mut Store,
     ) {
         // The next line's words are the machine's (`$machine=` may change them).
         self.parser.set_axis_letters(axis_letters(&kin.words()));
         let first = self.parser.first_char();
         let card = self.source == Some(Source::Card);
         let jog_state = self.jogging && !m.is_idle();
-        match self.parser.take_line() {
+        let line = self.parser.take_line();
+        // A `$N0=` line must be G-code.
+        if self.storing && !matches!(line, Ok(Input::Block(_))) {
+            self.stored_checked(false, store);
+            if line.is_ok() {
+                return self.error(&Error::new(ErrorKind::ExpectedCommandLetter, 1));
+            }
+        }
+        match line {
             Ok(Input::Realtime(_)) => {}
             Err(e) if e.kind() == ErrorKind::LineOverflow => self.error(&e),
             // Empty or comment only: for syncing, `ok`.
             _ if first == 0 => self.ok(),
-            Ok(Input::System(s)) => self.system(s, m, cfg, owner),
+            Ok(Input::System(ref s)) => self.system(s, m, cfg, owner, store),
             Ok(Input::Jog(b))
                 if self.checking || !m.position_known() || !(m.is_idle() || jog_state) =>
             {
@@ -418,7 +477,7 @@ impl Console {
                 self.error(&Error::new(ErrorKind::Printing, 0))
             }
             Ok(Input::Jog(b)) => {
-                if self.accept(&b, true, m, kin, cfg, owner) {
+                if self.accept(&b, true, m, kin, cfg, owner, store) {
                     self.jogging = true;
                 }
             }
@@ -438,7 +497,11 @@ impl Console {
             }
             Ok(Input::Block(b)) => {
                 self.jogging = false;
-                self.accept(&b, false, m, kin, cfg, owner);
+                let accepted = self.accept(&b, false, m, kin, cfg, owner, store);
+                // A `$N0=` line: carried out, and kept if it passed.
+                if self.storing {
+                    self.stored_checked(accepted, store);
+                }
             }
         }
     }
@@ -454,13 +517,15 @@ impl Console {
         kin: &impl Kinematics,
         cfg: &MachineConfig,
         owner: Owner,
+        store: &mut Store,
     ) -> bool {
-        let owed = self.pattern.is_none() && self.source != Some(Source::Card);
+        // A `$N0=` line is answered once kept.
+        let owed = self.pattern.is_none() && self.source != Some(Source::Card) && !self.storing;
         let env = self.env(kin, cfg, owner);
         let mut io = Io {
             m,
             kin,
-            coords: &mut self.coords,
+            store,
             replies: owed,
         };
         match self.interp.accept(b, jog, &env, &mut io) {
@@ -553,7 +618,15 @@ impl Console {
     /// the card's.
     fn ok(&self) {
         if self.pattern.is_none() && self.source != Some(Source::Card) {
-            reply::ok();
+            self.answer_ok();
+        }
+    }
+
+    /// `ok`, or a startup line's `>line:ok`.
+    fn answer_ok(&self) {
+        match self.source {
+            Some(Source::Startup) => system::startup_reply(self.echo, None),
+            _ => reply::ok(),
         }
     }
 
@@ -567,6 +640,7 @@ impl Console {
         self.pattern = None;
         match self.source {
             Some(Source::Card) => self.print.line_failed(e, why),
+            Some(Source::Startup) => system::startup_reply(self.echo, Some(e)),
             _ => reply::error_because(e, why),
         }
     }
@@ -576,216 +650,12 @@ impl Console {
     fn resync_next_run(&mut self, m: &Motion) {
         self.epoch = m.epoch().wrapping_add(1);
     }
-
-    #[inline(never)]
-    #[optimize(size)]
-    fn system(&mut self, s: SystemLine, m: &mut Motion, cfg: &mut MachineConfig, owner: Owner) {
-        match s {
-            SystemLine::PrintSettings => {
-                self.listing = Some(Listing::Settings(0));
-                return;
-            }
-            SystemLine::QueueStats => {
-                self.listing = Some(Listing::Queues(0));
-                return;
-            }
-            SystemLine::Stack => {
-                let mut r = reply::line();
-                let _ = uwrite!(
-                    r,
-                    "{}{}{}{}{}",
-                    flash_str!("[stack peak "),
-                    stack::peak(),
-                    flash_str!(" B, headroom "),
-                    stack::headroom(),
-                    flash_str!(" B]")
-                );
-                r.send();
-            }
-            SystemLine::Unlock
-            | SystemLine::Home
-            | SystemLine::Pattern(_)
-            | SystemLine::Set { .. }
-            | SystemLine::Restore(_)
-            | SystemLine::Sleep
-                if self.printing_from_serial() =>
-            {
-                return self.error(&Error::new(ErrorKind::Printing, 0));
-            }
-            // The job's tools: it answers them itself, in its log (and
-            // refuses them while it moves).
-            SystemLine::Set { ref key, ref value } if crate::tools::is_tool(key) => {
-                if let Err(col) = crate::tools::send(key, value) {
-                    return self.error(&Error::new(ErrorKind::InvalidStatement, col));
-                }
-            }
-            // What moves the machine or changes its settings: not while a
-            // job owns it; in check mode Grbl's "not idle".
-            SystemLine::Home
-            | SystemLine::Pattern(_)
-            | SystemLine::Set { .. }
-            | SystemLine::Restore(_)
-            | SystemLine::Sleep
-                if owner == Owner::Job =>
-            {
-                return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
-            }
-            SystemLine::Home
-            | SystemLine::Pattern(_)
-            | SystemLine::Set { .. }
-            | SystemLine::Restore(_)
-            | SystemLine::Sleep
-                if self.checking =>
-            {
-                return self.error(&Error::new(ErrorKind::NotIdle, 0));
-            }
-            // Settings are written with the planner empty, as Grbl's.
-            SystemLine::Home | SystemLine::Set { .. } | SystemLine::Restore(_) if !m.is_idle() => {
-                return self.error(&Error::new(ErrorKind::NotIdle, 0));
-            }
-            SystemLine::Unlock => {
-                m.unlock();
-                message(text!("Caution: Unlocked"));
-            }
-            SystemLine::BuildInfo => build_info(cfg),
-            SystemLine::ParserState => {
-                let mut r = reply::line();
-                let _ = uwrite!(r, "[GC:{}]", self.interp.parser_state(cfg.report_inches));
-                r.send();
-            }
-            SystemLine::Offsets => {
-                self.listing = Some(Listing::Offsets(0));
-                return;
-            }
-            SystemLine::Home if cfg.homing.axes == 0 => {
-                return self.error(&Error::new(ErrorKind::NoHoming, 0));
-            }
-            SystemLine::Home => return self.start_homing(cfg.homing.axes, m, true),
-            // Answered at its end.
-            SystemLine::Pattern(n) => {
-                self.pattern = patterns::pattern(n).map(|t| (t, 0));
-                return;
-            }
-            SystemLine::Set { key, value } => {
-                let machine = cfg.machine;
-                if let Err(e) = settings::set(cfg, &key, &value) {
-                    // `$key=value`: the value starts after `$`, the key, `=`.
-                    let col = (key.len() + 3 + e.at).min(u8::MAX as usize) as u8;
-                    let invalid = Error::new(ErrorKind::InvalidStatement, col);
-                    return self.error_because(&invalid, Some(e.kind));
-                }
-                m.configure(cfg);
-                if cfg.machine != machine {
-                    // Another machine: where it stands is its zero, and its
-                    // modal state starts afresh.
-                    m.set_position([0; AXES]);
-                    self.interp.reset(&self.coords.get(0));
-                    self.resync_next_run(m);
-                }
-                self.settings_changed = true;
-            }
-            // The machine's defaults, the work coordinate data, or both.
-            SystemLine::Restore(what) => {
-                if what != Restore::Offsets {
-                    restore_defaults(cfg);
-                    m.configure(cfg);
-                    self.settings_changed = true;
-                }
-                if what != Restore::Settings {
-                    self.coords.clear();
-                    self.interp.reset(&self.coords.get(0));
-                }
-                message(text!("Restoring defaults"));
-            }
-            // Asleep once it stands (`poll`).
-            SystemLine::Sleep => {
-                m.cancel();
-                self.sleep = Sleep::Falling;
-            }
-            // taut keeps no startup lines: both empty, as a fresh Grbl's.
-            SystemLine::StartupLines => {
-                for n in 0..2 {
-                    let mut r = reply::line();
-                    let _ = uwrite!(r, "{}{}=", flash_str!("$N"), n);
-                    r.send();
-                }
-            }
-            // Grbl leaves check mode with a soft reset: the modal state
-            // afresh, the position read back, the greeting.
-            SystemLine::CheckMode if self.checking => {
-                self.checking = false;
-                message(text!("Disabled"));
-                self.ok();
-                self.interp.reset(&self.coords.get(0));
-                self.resync_next_run(m);
-                return reply::banner();
-            }
-            SystemLine::CheckMode if owner == Owner::Job || !m.is_idle() || !m.position_known() => {
-                return self.error(&Error::new(ErrorKind::NotIdle, 0));
-            }
-            SystemLine::CheckMode => {
-                self.checking = true;
-                message(text!("Enabled"));
-            }
-        }
-        self.ok();
-    }
-
-    /// One line of a listing per call: the TX ring never overflows.
-    #[inline(never)]
-    fn list(&mut self, listing: Listing, cfg: &MachineConfig) {
-        self.listing = match listing {
-            Listing::Settings(next) => settings::listed(next, cfg).map(|line| {
-                let mut r = reply::line();
-                let _ = uwrite!(r, "{}", line);
-                r.send();
-                Listing::Settings(next + 1)
-            }),
-            Listing::Queues(line) => {
-                crate::report::queue_line(line).then_some(Listing::Queues(line + 1))
-            }
-            Listing::Offsets(line) => self
-                .offsets_line(line, cfg)
-                .then_some(Listing::Offsets(line + 1)),
-        };
-        if self.listing.is_none() {
-            reply::ok();
-        }
-    }
 }
 
 impl Default for Console {
     fn default() -> Self {
         Self::new()
     }
-}
-
-/// `$I`: `[VER:1.1h.taut-0.1.0:flatbed]` (UGS wants `[VER:1.1`) and
-/// `[OPT:,<planner blocks>,<receive bytes>]`.
-#[inline(never)]
-fn build_info(cfg: &MachineConfig) {
-    let mut r = reply::line();
-    let _ = uwrite!(
-        r,
-        "{}{}]",
-        flash_str!(concat!("[VER:1.1h.taut-", env!("CARGO_PKG_VERSION"), ":")),
-        cfg.machine.name()
-    );
-    r.send();
-    let mut r = reply::line();
-    let _ = uwrite!(
-        r,
-        "{}{},{}]",
-        flash_str!("[OPT:,"),
-        taut_logic::planner::PLANNER_BLOCKS,
-        RX.capacity()
-    );
-    r.send();
-}
-
-/// The machine's defaults in place of `cfg`.
-fn restore_defaults(cfg: &mut MachineConfig) {
-    cfg.load_defaults(cfg.machine);
 }
 
 /// Grbl's feedback message: `[MSG:<text>]`.

@@ -1,7 +1,6 @@
 //! The executor's machine (`taut_logic::interp::MachineIo`) on the board:
 //! moves into the motion task's planner, the pen servo, the drivers, the
-//! clock, and the work coordinate data (in RAM until the EEPROM keeps
-//! them).
+//! clock, and the work coordinate data (the store's, kept in EEPROM).
 #![deny(unsafe_code)]
 
 use crate::board::clock;
@@ -9,7 +8,9 @@ use crate::motion::{self, Motion};
 use crate::{flash_str, reply};
 use taut_logic::axis::AXES;
 use taut_logic::config::PenConfig;
-use taut_logic::interp::{CoordTable, Exact, MachineIo, Wait};
+use crate::store::Store;
+use taut_logic::coords::Slot;
+use taut_logic::interp::{coords, Exact, MachineIo, Wait};
 use taut_logic::kinematics::{Kinematics, Steps};
 use taut_logic::planner::Feed;
 use taut_logic::units::Decimal;
@@ -18,18 +19,21 @@ use ufmt::uwrite;
 pub struct Io<'a, K: Kinematics> {
     pub m: &'a mut Motion,
     pub kin: &'a K,
-    pub coords: &'a mut CoordTable,
+    pub store: &'a mut Store,
     /// `M114` is answered (not from the card).
     pub replies: bool,
 }
 
 impl<K: Kinematics> MachineIo for Io<'_, K> {
     fn coord(&self, index: u8) -> Exact {
-        self.coords.get(index)
+        coords::stored(self.store.coords(), index)
     }
 
+    /// In force at once, in EEPROM soon (two copies, cut-safe).
     fn set_coord(&mut self, index: u8, value: &Exact) {
-        self.coords.set(index, value);
+        if let Some(slot) = Slot::at(index as usize) {
+            self.store.set_coords(slot, coords::milli(value));
+        }
     }
 
     fn room(&mut self, piece: bool) -> Option<Wait> {

@@ -112,6 +112,7 @@ pub fn error(e: ErrorKind) -> FlashStr {
         NoHoming,
         NotIdle,
         Locked,
+        LineLengthExceeded,
         LineOverflow,
         TravelExceeded,
         InvalidJogCommand,

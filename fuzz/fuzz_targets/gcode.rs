@@ -8,25 +8,24 @@
 use libfuzzer_sys::fuzz_target;
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Input, Parser, Realtime};
-use taut_logic::interp::{
-    Allowed, CoordTable, Env, Exact, Interpreter, MachineIo, Progress, Wait,
-};
+use taut_logic::coords::CoordData;
+use taut_logic::interp::{coords, Allowed, Env, Exact, Interpreter, MachineIo, Progress, Wait};
 use taut_logic::kinematics::{AnyKinematics, Steps};
 use taut_logic::machine::Machine;
 use taut_logic::planner::Feed;
 
 /// A machine that does at once whatever it is asked.
 struct Yes {
-    coords: CoordTable,
+    coords: CoordData,
     clock: u32,
 }
 
 impl MachineIo for Yes {
     fn coord(&self, index: u8) -> Exact {
-        self.coords.get(index)
+        coords::stored(&self.coords, index)
     }
     fn set_coord(&mut self, index: u8, value: &Exact) {
-        self.coords.set(index, value)
+        coords::store(&mut self.coords, index, value)
     }
     fn room(&mut self, _piece: bool) -> Option<Wait> {
         None
@@ -64,7 +63,7 @@ fuzz_target!(|data: &[u8]| {
         allowed: Allowed::ALL,
     };
     let mut io = Yes {
-        coords: CoordTable::new(),
+        coords: CoordData::ZERO,
         clock: 0,
     };
     let mut interp = Interpreter::new();

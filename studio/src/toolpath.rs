@@ -6,11 +6,12 @@
 
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Input, Parser};
-use taut_logic::interp::{Allowed, CoordTable, Env, Exact, Interpreter, MachineIo, Progress, Wait};
+use taut_logic::coords::CoordData;
+use taut_logic::interp::{coords, Allowed, Env, Exact, Interpreter, MachineIo, Progress, Wait};
 use taut_logic::kinematics::{AnyKinematics, Kinematics, Steps};
 use taut_logic::machine::Machine;
 use taut_logic::planner::Feed;
-use taut_simavr::vcd::Signal;
+use taut_trace::vcd::Signal;
 
 /// A straight piece of the path, mm in the G-code's frame (y up).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,7 +68,7 @@ impl Toolpath {
 struct Drawing<'a> {
     kin: &'a AnyKinematics,
     cfg: &'a MachineConfig,
-    coords: CoordTable,
+    coords: CoordData,
     path: Toolpath,
     at: [f64; 2],
     down: bool,
@@ -75,10 +76,10 @@ struct Drawing<'a> {
 
 impl MachineIo for Drawing<'_> {
     fn coord(&self, index: u8) -> Exact {
-        self.coords.get(index)
+        coords::stored(&self.coords, index)
     }
     fn set_coord(&mut self, index: u8, value: &Exact) {
-        self.coords.set(index, value)
+        coords::store(&mut self.coords, index, value)
     }
     fn room(&mut self, _piece: bool) -> Option<Wait> {
         None
@@ -122,7 +123,7 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
     let mut io = Drawing {
         kin: &kin,
         cfg: &cfg,
-        coords: CoordTable::new(),
+        coords: CoordData::ZERO,
         path: Toolpath::default(),
         at: [0.0; 2],
         down: false,
@@ -166,7 +167,7 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
 pub fn from_vcd(signals: &[Signal], machine: Machine) -> Result<Toolpath, String> {
     let cfg = MachineConfig::defaults(machine);
     let points =
-        taut_simavr::picture::plot_points(signals, &cfg, [0, 0]).map_err(|e| e.to_string())?;
+        taut_trace::picture::plot_points(signals, &cfg, [0, 0]).map_err(|e| e.to_string())?;
     let mut path = Toolpath::default();
     for w in points.windows(2) {
         path.push([w[0].0 .0, w[0].0 .1], [w[1].0 .0, w[1].0 .1], w[1].1);

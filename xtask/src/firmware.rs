@@ -17,6 +17,7 @@ pub struct Image {
     pub flash_bytes: u64,
     pub ram_static_bytes: u64,
     pub data_bytes: u64,
+    pub map: crate::flashmap::FlashMap,
 }
 
 pub fn dir() -> PathBuf {
@@ -40,8 +41,10 @@ pub fn build_release() -> Result<Image> {
     )?;
     let sizes = section_sizes(&elf)?;
     let get = |n: &str| sizes.iter().find(|(s, _)| s == n).map_or(0, |(_, v)| *v);
+    let map = crate::flashmap::check(&elf)?;
     let img = Image {
-        flash_bytes: get(".text") + get(".data"),
+        flash_bytes: get(".text") + get(".data") + get(".endmark"),
+        map,
         ram_static_bytes: get(".data") + get(".bss") + get(".noinit"),
         data_bytes: get(".data"),
         elf,
@@ -58,16 +61,27 @@ pub fn build_release() -> Result<Image> {
     Ok(img)
 }
 
-/// The special-purpose images in firmware/examples (crash, hang, …).
+/// The special-purpose images in firmware/examples (crash, hang, …),
+/// each with its flash map checked (the watchdog entry, the end mark).
 pub fn build_examples() -> Result<()> {
     println!("== building the example images");
-    cargo(&["build", "--release", "--examples"], &dir())
+    cargo(&["build", "--release", "--examples"], &dir())?;
+    for e in std::fs::read_dir(release_dir().join("examples"))? {
+        let path = e?.path();
+        if path.extension().is_some_and(|x| x == "elf") {
+            crate::flashmap::check(&path)?;
+        }
+    }
+    Ok(())
 }
 
 pub fn flash() -> Result<()> {
     let img = build_release()?;
     img.print_size();
-    println!("== flashing through ravedude (Mega 2560 on the first serial port it finds)");
+    println!(
+        "== flashing through ravedude (Mega 2560 on the first serial port it finds, \
+         or RAVEDUDE_PORT)"
+    );
     let mut c = cargo_cmd(&["run", "--release"], &dir());
     status(&mut c)
 }
@@ -83,6 +97,7 @@ impl Image {
             self.elf.display(),
             self.hex.display()
         );
+        self.map.print();
     }
 }
 

@@ -26,7 +26,7 @@ mod state;
 #[cfg(test)]
 mod tests;
 
-pub use coords::{CoordTable, Exact, COORD_SETS, G28, G30};
+pub use coords::{Exact, G28, G30};
 pub use state::ParserState;
 
 use crate::arc::{self, Arc, ArcError, Circle, Sweep};

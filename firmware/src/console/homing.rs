@@ -99,6 +99,8 @@ impl Console {
                 let reply = *reply;
                 self.homing = None;
                 self.resync_next_run(m);
+                // Grbl runs the startup lines after a homing cycle.
+                self.startup = super::system::STARTUP;
                 match reply {
                     true => self.ok(),
                     false => info!("homed"),

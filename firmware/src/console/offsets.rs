@@ -4,8 +4,8 @@
 use super::Console;
 use crate::{flash_str, reply};
 use taut_logic::config::MachineConfig;
+use taut_logic::coords::{CoordData, Slot};
 use taut_logic::gcode::{coord_value, Places};
-use taut_logic::interp::{coords, G28, G30};
 use taut_logic::kinematics::Position;
 use taut_logic::settings::grbl::{report_angles, report_axes};
 use taut_logic::units::Milli;
@@ -17,7 +17,7 @@ impl Console {
     /// `PRB` (taut has no probe: zero, not taken); `false` past the last.
     #[inline(never)]
     #[optimize(size)]
-    pub(super) fn offsets_line(&self, line: u8, cfg: &MachineConfig) -> bool {
+    pub(super) fn offsets_line(&self, line: u8, cfg: &MachineConfig, data: &CoordData) -> bool {
         let (g92, tlo) = self.interp.offsets();
         let places = |p: Position| Places {
             values: report_axes(cfg.machine).map(|a| p[a.index()]),
@@ -40,13 +40,8 @@ impl Console {
         };
         let _ = match line {
             0..=7 => {
-                let index = match line {
-                    6 => G28,
-                    7 => G30,
-                    n => n,
-                };
-                let data = coords::milli(&self.coords.get(index));
-                uwrite!(r, "{}]", places(data))
+                let values = Slot::at(line as usize).map_or([Milli::ZERO; 3], |s| data.get(s));
+                uwrite!(r, "{}]", places(values))
             }
             8 => uwrite!(r, "{}]", places(g92)),
             9 => uwrite!(r, "{}]", coord_value(tlo, cfg.report_inches)),

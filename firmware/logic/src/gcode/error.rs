@@ -25,6 +25,9 @@ pub enum ErrorKind {
     /// G-code while the position is unknown (alarm) or a jog runs:
     /// Grbl's "G-code lock", lifted by `$X`, `$H` or the jog's end.
     Locked = 9,
+    /// A startup line or build info line (`$N0=`, `$I=`) longer than is
+    /// kept.
+    LineLengthExceeded = 14,
     /// More than 79 characters kept (comments and spaces do not count).
     LineOverflow = 11,
     /// A target outside an axis's soft limits (the line is refused before
@@ -105,6 +108,7 @@ impl ErrorKind {
             ErrorKind::NoHoming => "Setting disabled (homing_axes)",
             ErrorKind::NotIdle => "Not idle",
             ErrorKind::Locked => "G-code lock",
+            ErrorKind::LineLengthExceeded => "Line length exceeded",
             ErrorKind::LineOverflow => "Line overflow",
             ErrorKind::TravelExceeded => "Travel exceeded (soft limit)",
             ErrorKind::InvalidJogCommand => "Invalid jog command",

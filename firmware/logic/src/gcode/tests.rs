@@ -303,6 +303,77 @@ fn jogs_and_system_lines() {
     assert_eq!(parse("$#"), Ok(Input::System(SystemLine::Offsets)));
 }
 
+/// `$` lines (Grbl's `system.c`): commands, settings and the texts kept.
+#[test]
+fn system_lines() {
+    let set = |key: &str, value: &str| {
+        Ok(Input::System(SystemLine::Set {
+            key: key.try_into().unwrap(),
+            value: value.try_into().unwrap(),
+        }))
+    };
+    assert_eq!(parse(" $Q"), Ok(Input::System(SystemLine::QueueStats)));
+    assert_eq!(parse("$s ; stack"), Ok(Input::System(SystemLine::Stack)));
+    assert_eq!(parse("$X"), Ok(Input::System(SystemLine::Unlock)));
+    assert_eq!(parse("$I"), Ok(Input::System(SystemLine::BuildInfo)));
+    // Grbl's commands.md: `$N` "View startup blocks", `$C` "Check gcode
+    // mode", `$SLP` "Enable Sleep Mode", `$RST=$`, `$RST=#`, `$RST=*`
+    // "Restore Grbl settings and data to defaults".
+    assert_eq!(parse("$N"), Ok(Input::System(SystemLine::StartupLines)));
+    assert_eq!(parse("$C"), Ok(Input::System(SystemLine::CheckMode)));
+    assert_eq!(parse("$SLP"), Ok(Input::System(SystemLine::Sleep)));
+    for (text, what) in [
+        ("$", Restore::Settings),
+        ("#", Restore::Offsets),
+        ("*", Restore::All),
+    ] {
+        let line = format!("$RST={text}");
+        assert_eq!(parse(&line), Ok(Input::System(SystemLine::Restore(what))));
+    }
+    assert_eq!(parse("$N0=G20"), set("N0", "G20"));
+    // Grbl's help, and the texts `$N0=`, `$N1=`, `$I=` cleared.
+    assert_eq!(parse("$"), Ok(Input::System(SystemLine::Help)));
+    assert_eq!(parse("$N0="), set("N0", ""));
+    assert_eq!(parse("$n1="), set("n1", ""));
+    assert_eq!(parse("$I="), set("I", ""));
+    assert_eq!(parse("$N1=G20 (inches) G90"), set("N1", "G20G90"));
+    assert_eq!(parse("$ steps_c = 26.667"), set("steps_c", "26.667"));
+    assert_eq!(parse("$100=80"), set("100", "80"));
+    assert_eq!(parse("$Q=-1"), set("Q", "-1"));
+    assert_eq!(
+        parse("$abcdefghijklmnop=0123456789abcdef"),
+        set("abcdefghijklmnop", "0123456789abcdef")
+    );
+    assert_eq!(
+        parse(&format!("$$*{}", xor("$$"))),
+        Ok(Input::System(SystemLine::PrintSettings))
+    );
+}
+
+/// (line, Grbl's error, column) of `$` lines: all Grbl's 3 (`system.c`),
+/// but a text to keep longer than is kept (14).
+const BAD_SYSTEM: &[(&str, u8, u8)] = &[
+    ("$Y", 3, 1),
+    ("$$$", 3, 3),
+    ("$=5", 3, 2),
+    ("$key=", 3, 6),
+    ("$a-b=1", 3, 3),
+    ("$abcdefghijklmnopqrstuvwxy=1", 3, 26),
+    // `$N0=` and 75 characters kept, then one more.
+    ("$N0=G1X12345678901234567890123456789012345678901234567890123456789012(c)34567890123", 14, 80),
+    ("$N2=", 3, 5),
+];
+
+#[test]
+fn bad_system_lines() {
+    for (text, code, column) in BAD_SYSTEM {
+        match parse(text) {
+            Err(e) => assert_eq!((e.code(), e.column().unwrap_or(0)), (*code, *column), "{text:?}"),
+            ok => panic!("{text:?}: {ok:?}"),
+        }
+    }
+}
+
 #[test]
 fn card_lines() {
     assert_eq!(parse("M20"), Ok(Input::Card(CardLine::List)));

@@ -7,7 +7,8 @@
 //! motion to end), with the exit speed the lines after it allow. Dwells
 //! and the pen's settle time count once the machine stands.
 
-use super::{Allowed, CoordTable, Env, Exact, Interpreter, MachineIo, Progress, Wait};
+use super::{coords, Allowed, Env, Exact, Interpreter, MachineIo, Progress, Wait};
+use crate::coords::CoordData;
 use crate::config::MachineConfig;
 use crate::gcode::{Input, Parser};
 use crate::kinematics::{AnyKinematics, Steps};
@@ -34,7 +35,7 @@ struct Timed {
     /// Sub-ticks of motion and waiting counted so far.
     subticks: u64,
     pen: Option<u8>,
-    coords: CoordTable,
+    coords: CoordData,
 }
 
 impl Timed {
@@ -53,11 +54,11 @@ impl Timed {
 
 impl MachineIo for Timed {
     fn coord(&self, index: u8) -> Exact {
-        self.coords.get(index)
+        coords::stored(&self.coords, index)
     }
 
     fn set_coord(&mut self, index: u8, value: &Exact) {
-        self.coords.set(index, value);
+        coords::store(&mut self.coords, index, value);
     }
 
     fn room(&mut self, _piece: bool) -> Option<Wait> {
@@ -106,7 +107,7 @@ impl GcodeTime {
                 planner: Planner::new(config),
                 subticks: 0,
                 pen: None,
-                coords: CoordTable::new(),
+                coords: CoordData::ZERO,
             },
             lines: 0,
             refused: 0,

@@ -4,6 +4,7 @@
 //! the pen from spindle and `Z` words, program end, `$G`.
 
 use super::*;
+use crate::coords::CoordData;
 use crate::gcode::{Input, Parser};
 use crate::kinematics::AnyKinematics;
 use crate::machine::Machine;
@@ -24,17 +25,17 @@ enum Did {
 /// A machine that does at once what it is asked and writes it down.
 struct Recorder {
     did: Vec<Did>,
-    coords: CoordTable,
+    coords: CoordData,
     clock: u32,
     pen: Option<u8>,
 }
 
 impl MachineIo for Recorder {
     fn coord(&self, index: u8) -> Exact {
-        self.coords.get(index)
+        coords::stored(&self.coords, index)
     }
     fn set_coord(&mut self, index: u8, value: &Exact) {
-        self.coords.set(index, value)
+        coords::store(&mut self.coords, index, value)
     }
     fn room(&mut self, _piece: bool) -> Option<Wait> {
         None
@@ -80,7 +81,7 @@ impl Bench {
         let cfg = MachineConfig::defaults(machine);
         let io = Recorder {
             did: Vec::new(),
-            coords: CoordTable::new(),
+            coords: CoordData::ZERO,
             clock: 0,
             pen: None,
         };
@@ -296,7 +297,7 @@ fn work_zero_with_g10_l20_and_moves_in_work_coordinates() {
     b.ok("G10 L20 P1 X0 Y0");
     assert_eq!(b.wco(), [70_000, 100_000, 0]);
     assert_eq!(b.mpos(), [70_000, 100_000, 0]);
-    assert_eq!(b.io.coords.get(0), [70_000_000, 100_000_000, 0]);
+    assert_eq!(coords::stored(&b.io.coords, 0), [70_000_000, 100_000_000, 0]);
     b.ok("G0 X-20 Y5");
     assert_eq!(b.mpos(), [50_000, 105_000, 0]);
     assert_eq!(b.steps(), [2000, 4200, 0]);
@@ -312,7 +313,7 @@ fn work_zero_with_g10_l20_and_moves_in_work_coordinates() {
     b.ok("G10 L2 P2 X5");
     assert_eq!(b.wco(), [5_000, 0, 0]);
     b.ok("G10 L2 P0 Y7");
-    assert_eq!(b.io.coords.get(1), [5_000_000, 7_000_000, 0]);
+    assert_eq!(coords::stored(&b.io.coords, 1), [5_000_000, 7_000_000, 0]);
     b.ok("G54");
     assert_eq!(b.wco(), [70_000, 100_000, 0]);
 }
@@ -334,7 +335,7 @@ fn g92_is_an_offset_and_the_travel_stays_in_machine_coordinates() {
     assert_eq!(b.steps()[0], 0);
     // G10 L20 counts the G92 offset (WCS = MPos − G92 − WPos).
     b.ok("G10 L20 P1 X5");
-    assert_eq!(b.io.coords.get(0)[0], -25_000_000);
+    assert_eq!(coords::stored(&b.io.coords, 0)[0], -25_000_000);
     assert_eq!(b.wco(), [-5_000, 0, 0]);
     b.ok("G92.1");
     assert_eq!(b.wco(), [-25_000, 0, 0]);
