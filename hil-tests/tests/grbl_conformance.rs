@@ -534,6 +534,79 @@ fn two_thousand_small_relative_moves_add_up_exactly() {
     assert_ram_budget(&sim);
 }
 
+/// 10 000 relative moves of seeded random sizes (1–4 decimals in mm, then
+/// 1–5 in inches, either sign, a random walk about the bed's middle):
+/// `M114` is their exact sum rounded to steps once, on both axes.
+#[test]
+fn ten_thousand_random_relative_moves_end_at_their_sum_rounded_once() {
+    let mut sim = homed_flatbed();
+    send_ok(&mut sim, "G53 G0 X70 Y50", Duration::from_secs(10));
+    send_ok(&mut sim, "G91 G1 F6000", Duration::from_secs(2));
+    let mut seed: u64 = 0x5eed_2710;
+    let mut next = |n: u64| {
+        seed = seed
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (seed >> 33) % n
+    };
+    // Machine position in nanometres, exactly.
+    let mut nm = [70_000_000i128, 50_000_000];
+    let mut lines = Vec::new();
+    for i in 0..10_000 {
+        let inch = i >= 5_000;
+        if i == 5_000 {
+            lines.push("G20".to_string());
+        }
+        let axis = next(2) as usize;
+        let places = 1 + next(if inch { 5 } else { 4 }) as u32;
+        let scale = 10u64.pow(places);
+        // Up to 0.2 mm or 0.008 in, towards the middle when far from it.
+        let most = if inch { 8 * scale / 1000 } else { 2 * scale / 10 };
+        let size = next(most + 1) as i128;
+        let middle = [70_000_000i128, 50_000_000][axis];
+        let negative = match (nm[axis] - middle).abs() > 20_000_000 {
+            true => nm[axis] > middle,
+            false => next(2) == 1,
+        };
+        let w = if negative { -size } else { size };
+        let unit_nm = 10i128.pow(6 - places);
+        nm[axis] += if inch { w * unit_nm * 254 / 10 } else { w * unit_nm };
+        let letter = ['X', 'Y'][axis];
+        let sign = if negative { "-" } else { "" };
+        let s = size as u64;
+        lines.push(format!(
+            "{letter}{sign}{}.{:0p$}",
+            s / scale,
+            s % scale,
+            p = places as usize
+        ));
+    }
+    let refs: Vec<&str> = lines.iter().map(String::as_str).collect();
+    stream(&mut sim, &refs);
+    send_ok(&mut sim, "M400", Duration::from_secs(60));
+    // 40 steps a mm: a step is 25 000 nm, rounded once, half up.
+    let steps = nm.map(|v| ((v + 12_500).div_euclid(25_000)) as i64);
+    let mm = |s: i64| format!("{}.{:03}", s / 40, (s % 40) * 25);
+    let expected = format!(
+        "X:{} Y:{} Z:0.000 Count X:{} Y:{} Z:0",
+        mm(steps[0]),
+        mm(steps[1]),
+        steps[0],
+        steps[1]
+    );
+    let from = sim.uart_bytes().len();
+    send_ok(&mut sim, "M114", Duration::from_secs(2));
+    let text = sim.uart_text_from(from);
+    let m114 = text.lines().find(|l| l.contains("Count")).unwrap_or("");
+    assert_eq!(m114, expected, "{text}");
+    assert_eq!(
+        hil_tests::steps_on_pins(&sim)[..2],
+        [steps[0] - 120, steps[1]],
+        "the pulses (X's switch 120 steps below where it stood at power-on)"
+    );
+    assert_ram_budget(&sim);
+}
+
 /// Streams `lines` by character counting (Grbl's 128-byte receive
 /// buffer), every one answered `ok`.
 fn stream(sim: &mut Sim, lines: &[&str]) {

@@ -331,6 +331,9 @@ fn system_lines() {
         assert_eq!(parse(&line), Ok(Input::System(SystemLine::Restore(what))));
     }
     assert_eq!(parse("$N0=G20"), set("N0", "G20"));
+    // 79 kept, comments and spaces not counted: the longest startup line.
+    let longest = format!("G4P{}", "0".repeat(72));
+    assert_eq!(parse(&format!("$N0= {longest} (a comment)")), set("N0", &longest));
     // Grbl's help, and the texts `$N0=`, `$N1=`, `$I=` cleared.
     assert_eq!(parse("$"), Ok(Input::System(SystemLine::Help)));
     assert_eq!(parse("$N0="), set("N0", ""));
@@ -359,8 +362,9 @@ const BAD_SYSTEM: &[(&str, u8, u8)] = &[
     ("$key=", 3, 6),
     ("$a-b=1", 3, 3),
     ("$abcdefghijklmnopqrstuvwxy=1", 3, 26),
-    // `$N0=` and 75 characters kept, then one more.
-    ("$N0=G1X12345678901234567890123456789012345678901234567890123456789012(c)34567890123", 14, 80),
+    // `$N0=` and 76 characters kept: 80, Grbl's line overflow
+    // (`protocol.c` 141) before `$N0=` would see it.
+    ("$N0=G1X12345678901234567890123456789012345678901234567890123456789012(c)34567890123", 11, 0),
     ("$N2=", 3, 5),
 ];
 
