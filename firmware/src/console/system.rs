@@ -16,8 +16,8 @@ use taut_logic::axis::AXES;
 use taut_logic::config::{MachineConfig, PenConfig};
 use taut_logic::gcode::{Error, ErrorKind, Input, Read, Restore, SystemLine};
 use taut_logic::interp::Interpreter;
-use taut_logic::settings::grbl::{Numbered, SetError};
 use taut_logic::settings;
+use taut_logic::settings::grbl::{Numbered, SetError};
 use taut_progmem::text;
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
