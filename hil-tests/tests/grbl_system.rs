@@ -235,8 +235,7 @@ fn restore_check_mode_and_sleep_reply_as_grbl() {
     assert_eq!(transcript(&mut sim, "G0 X-5"), ["ok"]);
     assert_eq!(transcript(&mut sim, "$C"), ["[MSG:Disabled]", "ok", BANNER]);
     assert_eq!(transcript(&mut sim, "$SLP"), ["ok", "[MSG:Sleeping]"]);
-    match sim.send_line("$$", Duration::from_millis(200)) {
-        Ok(Reply::Ok) => panic!("asleep: lines wait for a reset\n{}", log_tail(&sim)),
-        _ => {}
+    if let Ok(Reply::Ok) = sim.send_line("$$", Duration::from_millis(200)) {
+        panic!("asleep: lines wait for a reset\n{}", log_tail(&sim));
     }
 }

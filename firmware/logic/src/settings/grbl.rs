@@ -491,7 +491,7 @@ impl Numbered {
     fn put(self, cfg: &mut MachineConfig, ex: &mut Extras, text: &[u8]) -> Result<(), SetError> {
         let held = self.held(cfg);
         // `$100` may be a ratio (`1600/12`); anything else a number.
-        let ratio = matches!(held, Held::StepsPerUnit(..)) && text.iter().any(|&b| b == b'/');
+        let ratio = matches!(held, Held::StepsPerUnit(..)) && text.contains(&b'/');
         let value = match ratio {
             true => Milli(1),
             false => parse_milli(text)?,
