@@ -349,7 +349,8 @@ impl Store {
         self.changed(t.record());
     }
 
-    /// A text write is still under way: `$N0=` is answered after it.
+    /// A text write is still under way: `$N0=` is answered after it, and
+    /// the console reads no line until then.
     pub fn text_saving(&self) -> bool {
         self.text_saved
     }

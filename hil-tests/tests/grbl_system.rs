@@ -208,6 +208,31 @@ fn startup_lines_are_listed_stored_and_run_as_grbl_runs_them() {
     send_ok(&mut again, "M400", Duration::from_secs(5));
     assert_eq!(transcript(&mut again, "$N0="), ["ok"]);
     assert_eq!(transcript(&mut again, "$N"), ["$N0=", "$N1=G0X-1", "ok"]);
+    // A Ctrl-X while a kept line is being written: the write goes on
+    // (Grbl's is done before it reads the reset), the startup lines run
+    // once it is kept, and the next `$N1=` waits for it, not refused.
+    again.watch_eeprom();
+    let (from, writes) = (again.uart_bytes().len(), again.eeprom_writes());
+    again.uart_send(b"$N0=G21\n");
+    while again.eeprom_writes() == writes {
+        again.run_for(Duration::from_millis(1));
+        assert!(
+            again.uart_bytes().len() - from < 200,
+            "{}",
+            log_tail(&again)
+        );
+    }
+    // The write began and is not done: no `ok` yet.
+    assert!(!lines(&again.uart_text_from(from)).contains(&"ok".to_string()));
+    again.uart_send(&[0x18]);
+    again.run_for(Duration::from_millis(500));
+    let after = lines(&again.uart_text_from(from));
+    let at = after.iter().position(|l| l == BANNER);
+    let at = at.unwrap_or_else(|| panic!("{}", again.uart_text_from(from)));
+    assert_eq!(after[at + 1..], [">G21:ok", ">G0X-1:ok"], "{after:?}");
+    send_ok(&mut again, "M400", Duration::from_secs(5));
+    assert_eq!(transcript(&mut again, "$N1=G90"), ["ok"]);
+    assert_eq!(transcript(&mut again, "$N"), ["$N0=G21", "$N1=G90", "ok"]);
     assert_ram_budget(&again);
 }
 

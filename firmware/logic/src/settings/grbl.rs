@@ -491,7 +491,10 @@ impl Numbered {
     fn put(self, cfg: &mut MachineConfig, ex: &mut Extras, text: &[u8]) -> Result<(), SetError> {
         let held = self.held(cfg);
         // `$100` may be a ratio (`1600/12`); anything else a number.
-        let ratio = matches!(held, Held::StepsPerUnit(..)) && text.contains(&b'/');
+        // A loop, not `contains`: that brings core's memchr (~480 B of AVR
+        // flash) for a line of a few bytes.
+        #[allow(clippy::manual_contains)]
+        let ratio = matches!(held, Held::StepsPerUnit(..)) && text.iter().any(|&b| b == b'/');
         let value = match ratio {
             true => Milli(1),
             false => parse_milli(text)?,
