@@ -280,11 +280,13 @@ impl Console {
                 self.list(listing, cfg, store);
                 return Poll::Again;
             }
-            // A kept text is answered once written, as Grbl's.
+            // A kept text is answered once written, as Grbl's; lines wait
+            // until then, after a Ctrl-X too (the text being written is
+            // where the store would stage the next one).
+            if store.text_saving() {
+                return Poll::After(4);
+            }
             if self.saving {
-                if store.text_saving() {
-                    return Poll::After(4);
-                }
                 self.saving = false;
                 self.ok();
             }

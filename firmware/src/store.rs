@@ -104,6 +104,9 @@ pub struct Store {
     text: [u8; TEXT as usize],
     text_len: u8,
     text_for: Option<u8>,
+    /// The staged text passed its check and is to be written; until then
+    /// it is only held, and a write of its record writes what was kept.
+    text_saved: bool,
     /// The checkpoint header in force (its number mixes into records).
     seq: u16,
     /// The checkpoint bytes being written: where, how many, how far.
@@ -132,6 +135,7 @@ impl Store {
             text: [0; TEXT as usize],
             text_len: 0,
             text_for: None,
+            text_saved: false,
             seq: 0,
             buf: [0; HEADER_BYTES as usize],
             at: 0,
@@ -162,9 +166,8 @@ impl Store {
         // A payload's bytes from `at` on, stored inverted or not: one
         // closure type, so the settings' reading is one copy in flash for
         // the records and the version-6 image.
-        let from = |at: u16, inverted: bool| {
-            move |i: u16| read(at + i) ^ if inverted { 0xFF } else { 0 }
-        };
+        let from =
+            |at: u16, inverted: bool| move |i: u16| read(at + i) ^ if inverted { 0xFF } else { 0 };
         let layout = record::layout(&read);
         let current = layout == Layout::Current;
         *upgrading = !current;
@@ -298,12 +301,13 @@ impl Store {
     }
 
     /// Hold `text` for `t` (the console checks it before it is written
-    /// with [`Store::save_staged`]). False when it is longer than a text
-    /// is kept (Grbl's error 14).
+    /// with [`Store::save_staged`]; a write of its record under way goes
+    /// on with what was kept before). False when it is longer than a text
+    /// is kept (Grbl's error 14), or while a saved text is still being
+    /// written (its bytes are these).
     /// Capitals, as Grbl's reader leaves every line.
     pub fn stage(&mut self, t: Text, text: &[u8]) -> bool {
-        let writing = self.text_for.is_some_and(|r| self.due & 1 << r != 0);
-        if text.len() > TEXT as usize || writing {
+        if text.len() > TEXT as usize || self.text_saving() {
             return false;
         }
         for (to, b) in self.text.iter_mut().zip(text) {
@@ -311,6 +315,7 @@ impl Store {
         }
         self.text_len = text.len() as u8;
         self.text_for = Some(t.record());
+        self.text_saved = false;
         true
     }
 
@@ -322,27 +327,32 @@ impl Store {
     /// Write the staged text.
     pub fn save_staged(&mut self) {
         if let Some(r) = self.text_for {
+            self.text_saved = true;
             self.changed(r);
         }
     }
 
     /// Drop the staged text (it failed its check).
     pub fn drop_staged(&mut self) {
-        if let Some(r) = self.text_for {
-            if self.due & 1 << r == 0 {
-                self.text_for = None;
-            }
+        if !self.text_saved {
+            self.text_for = None;
         }
     }
 
-    /// Empty a stored text (`$RST=*`).
+    /// Empty a stored text (`$RST=*`): a text still to be written to it
+    /// (a `$N0=` whose answer a Ctrl-X dropped) is dropped too.
     pub fn clear_text(&mut self, t: Text) {
+        if self.text_for == Some(t.record()) {
+            self.text_for = None;
+            self.text_saved = false;
+        }
         self.changed(t.record());
     }
 
-    /// A text write is still under way: `$N0=` is answered after it.
+    /// A text write is still under way: `$N0=` is answered after it, and
+    /// the console reads no line until then.
     pub fn text_saving(&self) -> bool {
-        self.text_for.is_some()
+        self.text_saved
     }
 
     /// `$RST=*`'s rest: the texts empty, the extras Grbl's defaults.
@@ -446,7 +456,9 @@ impl Store {
                 .coords
                 .part(k)
                 .map(|b| ([b[0], b[1], b[2], b[3], 0, 0, 0, 0], 4)),
-            _ if self.text_for == Some(r) => text_part(&self.text[..self.text_len as usize], k),
+            _ if self.text_saved && self.text_for == Some(r) => {
+                text_part(&self.text[..self.text_len as usize], k)
+            }
             _ => text_part(&[], k),
         }
     }
@@ -501,8 +513,9 @@ impl Store {
                     true => self.again &= !bit,
                     false => {
                         self.due &= !bit;
-                        if self.text_for == Some(r) {
+                        if self.text_saved && self.text_for == Some(r) {
                             self.text_for = None;
+                            self.text_saved = false;
                         }
                     }
                 }

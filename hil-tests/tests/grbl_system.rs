@@ -116,7 +116,7 @@ fn settings_errors_are_grbl_s() {
     // settings.c:194: a negative value is error 4.
     assert_eq!(
         transcript(&mut sim, "$110=-5"),
-        ["[MSG:Negative value (col 6)]", "error:4"]
+        ["[MSG:Value < 0 (col 6)]", "error:4"]
     );
     // system.c:264: `read_float` fails, error 2.
     assert_eq!(
@@ -153,8 +153,8 @@ fn settings_errors_are_grbl_s() {
     assert!(listing.contains(&"$32=1".to_string()));
 }
 
-/// `$N` (system.c:239-244, report.c:352 `$N<n>=<line>`), `$N0=` checked
-/// by the G-code parser before it is stored (system.c:260-266), run at
+/// `$N` (system.c:239-244, report.c:352 `$N<n>=<line>`), `$N0=` run to
+/// check it before it is stored (system.c:260-266), run at
 /// boot and after a reset with their answer `>line:ok`
 /// (system.c:98 `system_execute_startup`, report.c:361).
 #[test]
@@ -163,6 +163,9 @@ fn startup_lines_are_listed_stored_and_run_as_grbl_runs_them() {
     assert_eq!(transcript(&mut sim, "$N"), ["$N0=", "$N1=", "ok"]);
     assert_eq!(transcript(&mut sim, "$N0=g21 g91 (relative)"), ["ok"]);
     assert_eq!(transcript(&mut sim, "$N1=G0X-1"), ["ok"]);
+    // Grbl runs the line to check it (system.c:262): it moved; `$N1=`
+    // waits for the machine to stand (error 8 while it moves).
+    send_ok(&mut sim, "M400", Duration::from_secs(5));
     // A line the parser refuses is not stored: its error.
     let bad = transcript(&mut sim, "$N1=G0 X1 X2");
     assert_eq!(bad.last().map(String::as_str), Some("error:25"), "{bad:?}");
@@ -208,6 +211,31 @@ fn startup_lines_are_listed_stored_and_run_as_grbl_runs_them() {
     send_ok(&mut again, "M400", Duration::from_secs(5));
     assert_eq!(transcript(&mut again, "$N0="), ["ok"]);
     assert_eq!(transcript(&mut again, "$N"), ["$N0=", "$N1=G0X-1", "ok"]);
+    // A Ctrl-X while a kept line is being written: the write goes on
+    // (Grbl's is done before it reads the reset), the startup lines run
+    // once it is kept, and the next `$N1=` waits for it, not refused.
+    again.watch_eeprom();
+    let (from, writes) = (again.uart_bytes().len(), again.eeprom_writes());
+    again.uart_send(b"$N0=G21\n");
+    while again.eeprom_writes() == writes {
+        again.run_for(Duration::from_millis(1));
+        assert!(
+            again.uart_bytes().len() - from < 200,
+            "{}",
+            log_tail(&again)
+        );
+    }
+    // The write began and is not done: no `ok` yet.
+    assert!(!lines(&again.uart_text_from(from)).contains(&"ok".to_string()));
+    again.uart_send(&[0x18]);
+    again.run_for(Duration::from_millis(500));
+    let after = lines(&again.uart_text_from(from));
+    let at = after.iter().position(|l| l == BANNER);
+    let at = at.unwrap_or_else(|| panic!("{}", again.uart_text_from(from)));
+    assert_eq!(after[at + 1..], [">G21:ok", ">G0X-1:ok"], "{after:?}");
+    send_ok(&mut again, "M400", Duration::from_secs(5));
+    assert_eq!(transcript(&mut again, "$N1=G90"), ["ok"]);
+    assert_eq!(transcript(&mut again, "$N"), ["$N0=G21", "$N1=G90", "ok"]);
     assert_ram_budget(&again);
 }
 
@@ -235,8 +263,7 @@ fn restore_check_mode_and_sleep_reply_as_grbl() {
     assert_eq!(transcript(&mut sim, "G0 X-5"), ["ok"]);
     assert_eq!(transcript(&mut sim, "$C"), ["[MSG:Disabled]", "ok", BANNER]);
     assert_eq!(transcript(&mut sim, "$SLP"), ["ok", "[MSG:Sleeping]"]);
-    match sim.send_line("$$", Duration::from_millis(200)) {
-        Ok(Reply::Ok) => panic!("asleep: lines wait for a reset\n{}", log_tail(&sim)),
-        _ => {}
+    if let Ok(Reply::Ok) = sim.send_line("$$", Duration::from_millis(200)) {
+        panic!("asleep: lines wait for a reset\n{}", log_tail(&sim));
     }
 }

@@ -1,14 +1,16 @@
 //! Settings and work coordinates survive a power cut at any moment of
 //! their write, on the release image. For a `$n=` change, a `$machine=`
 //! switch, a coordinate write (`$RST=#` zeroes stored offsets: the store's
-//! coordinate record written as a `G10` writes it) and the first boot
-//! on a blank EEPROM, the write is run once with the simulator's EEPROM
-//! watched, and what a cut leaves is taken every millisecond of it (the
-//! bytes written so far, the one being written torn to a seeded value):
-//! a cut at that millisecond would stop the same run there. Each such
-//! EEPROM is then powered on: its `$$`, `$#` and `$N` must be the old
-//! ones or the new ones, exactly, and nothing may be said of corruption.
-//! A seeded sample of the cuts here; every one under `cargo xtask soak`.
+//! coordinate record written as `Store::set_coords` writes it for `G10`)
+//! and the first boot on a blank EEPROM, the write is run once with the
+//! simulator's EEPROM watched, and what a cut leaves is taken every
+//! millisecond of it (the bytes written so far, the one being written
+//! torn to a seeded value): a cut at that millisecond would stop the same
+//! run there. Each such EEPROM is then powered on: its `$$`, `$#` and `$N`
+//! must be the old ones or the new ones, exactly, and nothing may be said
+//! of corruption. The changes are written onto erased bytes and over a
+//! board's older values. A seeded sample of the cuts here; every one
+//! under `cargo xtask soak`.
 
 use hil_tests::sim::Sim;
 use hil_tests::{assert_ram_budget, machine, soak_or, wait_for, Rng};
@@ -17,7 +19,8 @@ use taut_logic::config::MachineConfig;
 use taut_logic::coords::{CoordData, Slot};
 use taut_logic::machine::Machine;
 use taut_logic::settings::grbl::{Extras, Numbered};
-use taut_logic::settings::record::host;
+use taut_logic::settings::image;
+use taut_logic::settings::record::{host, Writer, COORDS, SETTINGS};
 use taut_logic::units::Milli;
 
 /// The store task's longest run (0.5 ms at 16 MHz): it compares a few
@@ -192,8 +195,8 @@ fn diff(got: &[String], old: &[String], new: &[String]) -> String {
         .collect()
 }
 
-/// A board that kept some settings and offsets.
-fn tuned(machine: Machine) -> Vec<u8> {
+/// Some settings and offsets a maker tuned.
+fn tuned_values(machine: Machine) -> (MachineConfig, Extras, CoordData) {
     let (mut cfg, mut ex) = (MachineConfig::defaults(machine), Extras::DEFAULT);
     Numbered::MaxRate(0)
         .set(&mut cfg, &mut ex, b"1875")
@@ -202,14 +205,48 @@ fn tuned(machine: Machine) -> Vec<u8> {
     let mut coords = CoordData::ZERO;
     coords.set(Slot::G54, [Milli(-12_345), Milli(90_000), Milli(-1_500)]);
     coords.set(Slot::G30, [Milli(5_000), Milli(0), Milli(2_000)]);
+    (cfg, ex, coords)
+}
+
+/// A board that kept them once: each record's copy 0 in force, copy 1
+/// blank (a change is written onto erased bytes).
+fn tuned(machine: Machine) -> Vec<u8> {
+    let (cfg, ex, coords) = tuned_values(machine);
     host::eeprom(&cfg, &ex, &coords)
+}
+
+/// A board that kept other values before them: copy 0 holds the older
+/// ones (sequence 1), copy 1 the tuned ones (sequence 2), so a change is
+/// written over stale bytes of copy 0, as on a board in use.
+fn worn(machine: Machine) -> Vec<u8> {
+    let mut older = CoordData::ZERO;
+    older.set(Slot::G54, [Milli(7_000), Milli(-3_250), Milli(40)]);
+    older.set(Slot::G59, [Milli(-1), Milli(2), Milli(-3)]);
+    older.set(Slot::G28, [Milli(100_000), Milli(-100_000), Milli(1)]);
+    let mut e = host::eeprom(
+        &MachineConfig::defaults(Machine::Flatbed),
+        &Extras::DEFAULT,
+        &older,
+    );
+    let (cfg, ex, coords) = tuned_values(machine);
+    host::write(&mut e, Writer::new(SETTINGS, 1, 2), |k| {
+        image::part(&cfg, &ex, k)
+    });
+    host::write(&mut e, Writer::new(COORDS, 1, 2), |k| {
+        coords
+            .part(k)
+            .map(|b| ([b[0], b[1], b[2], b[3], 0, 0, 0, 0], 4))
+    });
+    // The tuned values are in force.
+    assert_eq!(host::settings(&e), Some((cfg, ex)));
+    e
 }
 
 #[test]
 fn a_dollar_number_change_cut_anywhere_leaves_the_old_or_the_new_settings() {
     campaign(
         "$110=2345",
-        Some(&tuned(Machine::StringArt)),
+        Some(&worn(Machine::StringArt)),
         Some("$110=2345"),
         soak_or(0, 6),
     );
@@ -229,7 +266,7 @@ fn a_machine_switch_cut_anywhere_leaves_the_old_or_the_new_machine() {
 fn a_coordinate_write_cut_anywhere_leaves_the_old_or_the_new_offsets() {
     campaign(
         "$RST=#",
-        Some(&tuned(Machine::StringArt)),
+        Some(&worn(Machine::StringArt)),
         Some("$RST=#"),
         soak_or(0, 6),
     );

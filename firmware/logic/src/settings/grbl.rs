@@ -179,7 +179,10 @@ impl Extras {
             0 | 1 => self.spindle.get(i).copied(),
             _ => self.typed.get(i - 2).copied(),
         };
-        let (a, b) = (word(2 * k - 2)?.to_le_bytes(), word(2 * k - 1)?.to_le_bytes());
+        let (a, b) = (
+            word(2 * k - 2)?.to_le_bytes(),
+            word(2 * k - 1)?.to_le_bytes(),
+        );
         Some(([a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]], 8))
     }
 
@@ -380,7 +383,11 @@ impl Numbered {
             JunctionDeviation => Held::Micro(global(GlobalField::JunctionDeviationUm)),
             ArcTolerance => Held::Micro(global(GlobalField::ArcToleranceUm)),
             HomingPullOff => Held::Named(global(GlobalField::HomingPullOff)),
-            HomingFeed => Held::Rate(TYPED_HOMING_FEED, global(GlobalField::HomingLocate), axis(0)),
+            HomingFeed => Held::Rate(
+                TYPED_HOMING_FEED,
+                global(GlobalField::HomingLocate),
+                axis(0),
+            ),
             HomingSeek => Held::Rate(TYPED_HOMING_SEEK, global(GlobalField::HomingSeek), axis(0)),
             MaxRate(p) => Held::Rate(
                 TYPED_MAX_RATE + axis(p).index(),
@@ -419,7 +426,12 @@ impl Numbered {
                     Value::Number(v) => v,
                     _ => 0,
                 };
-                milli(shown(ex.typed[t], steps, &cfg.axes[axis.index()], self.scale()))
+                milli(shown(
+                    ex.typed[t],
+                    steps,
+                    &cfg.axes[axis.index()],
+                    self.scale(),
+                ))
             }
             Held::StepsPerUnit(axis, _) => {
                 let Ratio { num, den } = cfg.axes[axis.index()].steps_per_unit;
@@ -479,6 +491,9 @@ impl Numbered {
     fn put(self, cfg: &mut MachineConfig, ex: &mut Extras, text: &[u8]) -> Result<(), SetError> {
         let held = self.held(cfg);
         // `$100` may be a ratio (`1600/12`); anything else a number.
+        // A loop, not `contains`: that brings core's memchr (~480 B of AVR
+        // flash) for a line of a few bytes.
+        #[allow(clippy::manual_contains)]
         let ratio = matches!(held, Held::StepsPerUnit(..)) && text.iter().any(|&b| b == b'/');
         let value = match ratio {
             true => Milli(1),

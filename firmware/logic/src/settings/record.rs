@@ -168,7 +168,8 @@ pub fn marker_byte(i: usize) -> u8 {
 /// lines, 4 the build info; from a table in flash (each constant would be
 /// copied into the AVR's SRAM where it is taken by reference).
 pub fn area(i: u8) -> Area {
-    taut_progmem::table!(Area; RECORDS; [SETTINGS, COORDS, LINES[0], LINES[1], INFO]).get(i as usize)
+    taut_progmem::table!(Area; RECORDS; [SETTINGS, COORDS, LINES[0], LINES[1], INFO])
+        .get(i as usize)
 }
 
 /// Records kept.

@@ -199,7 +199,10 @@ fn writes_in_grbl_s_units_land_in_the_named_settings() {
         ex.flags(),
         FLAG_LIMIT_INVERT | FLAG_PROBE_INVERT | FLAG_HARD_LIMITS | FLAG_LASER
     );
-    assert_eq!((ex.bytes[BYTE_HOMING_DIR], ex.bytes[BYTE_DEBOUNCE]), (3, 100));
+    assert_eq!(
+        (ex.bytes[BYTE_HOMING_DIR], ex.bytes[BYTE_DEBOUNCE]),
+        (3, 100)
+    );
     assert_eq!(ex.spindle, [24000, 100]);
     let lines = listing(&cfg, &ex);
     for l in ["$1=25", "$2=5", "$21=1", "$30=24000", "$31=100", "$32=1"] {

@@ -210,7 +210,10 @@ fn the_marker_and_the_areas_in_flash_are_the_constants() {
     for i in 0..MARKER.len() {
         assert_eq!(marker_byte(i), MARKER[i]);
     }
-    assert_eq!([area(0), area(1), area(2), area(3), area(4)], [SETTINGS, COORDS, LINES[0], LINES[1], INFO]);
+    assert_eq!(
+        [area(0), area(1), area(2), area(3), area(4)],
+        [SETTINGS, COORDS, LINES[0], LINES[1], INFO]
+    );
 }
 
 #[test]
