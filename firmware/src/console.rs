@@ -31,7 +31,9 @@ use homing::HomingRun;
 use taut_logic::config::MachineConfig;
 use taut_logic::coords::CoordData;
 use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Parser, Read};
-use taut_logic::interp::{axis_letters, coords, motor_channels, Allowed, Env, Interpreter, Progress, Wait};
+use taut_logic::interp::{
+    axis_letters, coords, motor_channels, Allowed, Env, Interpreter, Progress, Wait,
+};
 use taut_logic::kinematics::{Kinematics, Position};
 use taut_progmem::{text, Text};
 use ufmt::uwrite;

@@ -5,10 +5,10 @@
 
 use crate::board::clock;
 use crate::motion::{self, Motion};
+use crate::store::Store;
 use crate::{flash_str, reply};
 use taut_logic::axis::AXES;
 use taut_logic::config::PenConfig;
-use crate::store::Store;
 use taut_logic::coords::Slot;
 use taut_logic::interp::{coords, Exact, MachineIo, Wait};
 use taut_logic::kinematics::{Kinematics, Steps};

@@ -7,8 +7,8 @@
 
 use libfuzzer_sys::fuzz_target;
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{Input, Parser, Realtime};
 use taut_logic::coords::CoordData;
+use taut_logic::gcode::{Input, Parser, Realtime};
 use taut_logic::interp::{coords, Allowed, Env, Exact, Interpreter, MachineIo, Progress, Wait};
 use taut_logic::kinematics::{AnyKinematics, Steps};
 use taut_logic::machine::Machine;

@@ -561,7 +561,11 @@ fn ten_thousand_random_relative_moves_end_at_their_sum_rounded_once() {
         let places = 1 + next(if inch { 5 } else { 4 }) as u32;
         let scale = 10u64.pow(places);
         // Up to 0.2 mm or 0.008 in, towards the middle when far from it.
-        let most = if inch { 8 * scale / 1000 } else { 2 * scale / 10 };
+        let most = if inch {
+            8 * scale / 1000
+        } else {
+            2 * scale / 10
+        };
         let size = next(most + 1) as i128;
         let middle = [70_000_000i128, 50_000_000][axis];
         let negative = match (nm[axis] - middle).abs() > 20_000_000 {
@@ -570,7 +574,11 @@ fn ten_thousand_random_relative_moves_end_at_their_sum_rounded_once() {
         };
         let w = if negative { -size } else { size };
         let unit_nm = 10i128.pow(6 - places);
-        nm[axis] += if inch { w * unit_nm * 254 / 10 } else { w * unit_nm };
+        nm[axis] += if inch {
+            w * unit_nm * 254 / 10
+        } else {
+            w * unit_nm
+        };
         let letter = ['X', 'Y'][axis];
         let sign = if negative { "-" } else { "" };
         let s = size as u64;

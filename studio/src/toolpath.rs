@@ -5,8 +5,8 @@
 //! error here too; or a simulator trace (VCD) through the pulse replay.
 
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{Input, Parser};
 use taut_logic::coords::CoordData;
+use taut_logic::gcode::{Input, Parser};
 use taut_logic::interp::{coords, Allowed, Env, Exact, Interpreter, MachineIo, Progress, Wait};
 use taut_logic::kinematics::{AnyKinematics, Kinematics, Steps};
 use taut_logic::machine::Machine;

@@ -333,7 +333,10 @@ fn system_lines() {
     assert_eq!(parse("$N0=G20"), set("N0", "G20"));
     // 79 kept, comments and spaces not counted: the longest startup line.
     let longest = format!("G4P{}", "0".repeat(72));
-    assert_eq!(parse(&format!("$N0= {longest} (a comment)")), set("N0", &longest));
+    assert_eq!(
+        parse(&format!("$N0= {longest} (a comment)")),
+        set("N0", &longest)
+    );
     // Grbl's help, and the texts `$N0=`, `$N1=`, `$I=` cleared.
     assert_eq!(parse("$"), Ok(Input::System(SystemLine::Help)));
     assert_eq!(parse("$N0="), set("N0", ""));
@@ -364,7 +367,11 @@ const BAD_SYSTEM: &[(&str, u8, u8)] = &[
     ("$abcdefghijklmnopqrstuvwxy=1", 3, 26),
     // `$N0=` and 76 characters kept: 80, Grbl's line overflow
     // (`protocol.c` 141) before `$N0=` would see it.
-    ("$N0=G1X12345678901234567890123456789012345678901234567890123456789012(c)34567890123", 11, 0),
+    (
+        "$N0=G1X12345678901234567890123456789012345678901234567890123456789012(c)34567890123",
+        11,
+        0,
+    ),
     ("$N2=", 3, 5),
 ];
 
@@ -372,7 +379,11 @@ const BAD_SYSTEM: &[(&str, u8, u8)] = &[
 fn bad_system_lines() {
     for (text, code, column) in BAD_SYSTEM {
         match parse(text) {
-            Err(e) => assert_eq!((e.code(), e.column().unwrap_or(0)), (*code, *column), "{text:?}"),
+            Err(e) => assert_eq!(
+                (e.code(), e.column().unwrap_or(0)),
+                (*code, *column),
+                "{text:?}"
+            ),
             ok => panic!("{text:?}: {ok:?}"),
         }
     }

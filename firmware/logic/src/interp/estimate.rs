@@ -8,8 +8,8 @@
 //! and the pen's settle time count once the machine stands.
 
 use super::{coords, Allowed, Env, Exact, Interpreter, MachineIo, Progress, Wait};
-use crate::coords::CoordData;
 use crate::config::MachineConfig;
+use crate::coords::CoordData;
 use crate::gcode::{Input, Parser};
 use crate::kinematics::{AnyKinematics, Steps};
 use crate::planner::{Feed, Planner};

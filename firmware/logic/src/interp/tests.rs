@@ -297,7 +297,10 @@ fn work_zero_with_g10_l20_and_moves_in_work_coordinates() {
     b.ok("G10 L20 P1 X0 Y0");
     assert_eq!(b.wco(), [70_000, 100_000, 0]);
     assert_eq!(b.mpos(), [70_000, 100_000, 0]);
-    assert_eq!(coords::stored(&b.io.coords, 0), [70_000_000, 100_000_000, 0]);
+    assert_eq!(
+        coords::stored(&b.io.coords, 0),
+        [70_000_000, 100_000_000, 0]
+    );
     b.ok("G0 X-20 Y5");
     assert_eq!(b.mpos(), [50_000, 105_000, 0]);
     assert_eq!(b.steps(), [2000, 4200, 0]);
