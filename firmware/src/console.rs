@@ -465,6 +465,7 @@ impl Console {
                 return self.error(&Error::new(ErrorKind::ExpectedCommandLetter, 1));
             }
         }
+        let reads = matches!(&line, Ok(Input::Block(b)) if b.only_reads());
         match line {
             Ok(Input::Realtime(_)) => {}
             Err(e) if e.kind() == ErrorKind::LineOverflow => self.error(&e),
@@ -492,8 +493,10 @@ impl Console {
             _ if card && first == b'%' => {}
             Ok(Input::Card(c)) => self.card_line(c, m, cfg),
             // Grbl's G-code lock: in alarm (the position lost) or while
-            // jogs run.
-            _ if !m.position_known() || jog_state => self.error(&Error::new(ErrorKind::Locked, 0)),
+            // jogs run; `M114` only reads.
+            _ if (!m.position_known() || jog_state) && !reads => {
+                self.error(&Error::new(ErrorKind::Locked, 0))
+            }
             Err(e) => self.error(&e),
             // While a print runs, the serial line may only look.
             Ok(Input::Block(_)) if self.printing_from_serial() => {

@@ -361,6 +361,14 @@ impl Block {
         self.words & word::AXES != 0
     }
 
+    /// `M114` alone (an `N` aside): it only reads, so Grbl's G-code lock
+    /// lets it by.
+    pub const fn only_reads(&self) -> bool {
+        self.groups == group::TAUT
+            && matches!(self.taut, TautCode::ReportPosition)
+            && self.words & !(1 << word::N) == 0
+    }
+
     /// The line's `N`, if it has one.
     pub fn line_number(&self) -> Option<u32> {
         self.has_word(word::N).then_some(self.n)

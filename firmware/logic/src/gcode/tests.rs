@@ -389,6 +389,16 @@ fn bad_system_lines() {
     }
 }
 
+/// `M114` alone only reads: Grbl's G-code lock lets it by.
+#[test]
+fn m114_alone_only_reads() {
+    assert!(block("M114").only_reads());
+    assert!(block("N7 M114").only_reads());
+    for text in ["M114 G0", "M114 X1", "M114 F100", "M400", "G4 P0", ""] {
+        assert!(!block(text).only_reads(), "{text}");
+    }
+}
+
 #[test]
 fn card_lines() {
     assert_eq!(parse("M20"), Ok(Input::Card(CardLine::List)));
