@@ -78,7 +78,11 @@ pub fn serve(
     limit: Duration,
     mut each: impl FnMut(&Sim, &[u8], u64),
 ) -> Output {
-    let link = std::env::temp_dir().join(format!("taut-hil-tty-{}", std::process::id()));
+    // One link a call: tests of one binary run side by side.
+    static SERVED: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let n = SERVED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let name = format!("taut-hil-tty-{}-{n}", std::process::id());
+    let link = std::env::temp_dir().join(name);
     let mut pty = Pty::open(Some(&link)).unwrap();
     let mut child = client
         .arg(&link)
