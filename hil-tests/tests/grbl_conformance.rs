@@ -615,6 +615,39 @@ fn ten_thousand_random_relative_moves_end_at_their_sum_rounded_once() {
     assert_ram_budget(&sim);
 }
 
+/// `G10` offsets and `G28.1` positions are kept in EEPROM (Grbl's
+/// `settings_write_coord_data`): after a power cycle `$#` lists them and
+/// `G54` is in force (`WCO`); `G92` is not kept.
+#[test]
+fn work_offsets_survive_a_power_cycle() {
+    let mut sim = homed_flatbed();
+    expect(
+        &mut sim,
+        &[
+            ("G0 X70 Y50", OK, ""),
+            ("G10 L20 P1 X0 Y0", OK, "gcode.c 549"),
+            ("G10 L2 P3 X1.5 Y-2.25", OK, "gcode.c 553"),
+            ("G53 G0 X30 Y20", OK, ""),
+            ("G28.1", OK, "gcode.c 1017"),
+            ("G92 X7", OK, "not kept"),
+            ("M400", OK, "settings wait for the machine to stand"),
+            ("$homing_at_start=0", OK, "the next boot without its switch"),
+        ],
+    );
+    sim.run_for(Duration::from_secs(1));
+    let eeprom = sim.eeprom();
+    let mut again = hil_tests::machine();
+    again.set_eeprom(&eeprom);
+    wait_for(&mut again, "Grbl 1.1h", Duration::from_secs(5));
+    again.run_for(Duration::from_millis(500));
+    let (offsets, modes) = offsets_and_modes(&mut again);
+    assert_eq!(offsets[0], "[G54:70.000,50.000,0.000]");
+    assert_eq!(offsets[2], "[G56:1.500,-2.250,0.000]");
+    assert_eq!(offsets[6], "[G28:30.000,20.000,0.000]");
+    assert_eq!(offsets[8], "[G92:0.000,0.000,0.000]");
+    assert!(modes.contains(" G54 "), "{modes}");
+}
+
 /// Streams `lines` by character counting (Grbl's 128-byte receive
 /// buffer), every one answered `ok`.
 fn stream(sim: &mut Sim, lines: &[&str]) {
