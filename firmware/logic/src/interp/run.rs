@@ -142,9 +142,7 @@ impl Interpreter {
 
     /// The path's next piece; `None` once its last is queued.
     fn piece<K: Kinematics>(&mut self, env: &Env<K>, io: &mut impl MachineIo) -> Option<Wait> {
-        let Some(path) = self.run.path.as_mut() else {
-            return None;
-        };
+        let path = self.run.path.as_mut()?;
         if let Some(wait) = io.room(true) {
             return Some(wait);
         }
