@@ -136,10 +136,11 @@ fn off_path(path: &Toolpath, p: [f64; 2], down: bool) -> f64 {
 fn a_vectorized_drawing_is_drawn_on_its_toolpath() {
     let wall = Instant::now();
     let mut o = vectorize::Options::new(Machine::Flatbed, 12.0);
-    o.tolerance_mm = 0.05;
+    o.tolerance_mm = Some(0.05);
+    o.mode = vectorize::Mode::Edges;
     // The flatbed's top speed (2000 steps/s, 40 a mm).
     o.feed = 3000.0;
-    let v = vectorize::vectorize(&example("horse.png"), &o, "horse").unwrap();
+    let v = vectorize::vectorize(&vectorize::Source::Picture(example("horse.png")), &o, "horse").unwrap();
     let mut sim = boot_machine();
     send_ok(&mut sim, "$machine=flatbed", Duration::from_secs(5));
     for line in v.gcode.lines() {

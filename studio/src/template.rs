@@ -8,7 +8,6 @@
 //! the numbers go (counter-clockwise, seen from above). A 100 mm bar
 //! checks the printer's scale.
 
-use crate::args::Args;
 use crate::board::nail_mm;
 use crate::stringart::card::Spec;
 use crate::stringart::picture::outline;
@@ -16,7 +15,19 @@ use crate::svg::{num, points, Svg};
 use std::f64::consts::TAU;
 use taut_logic::geometry::Board;
 
-pub const USAGE: &str = "taut template --nails N --shape circle|<n> --radius-cm R -o template.svg";
+/// A 1:1 drilling template of a board (SVG)
+#[derive(clap::Args, Debug)]
+#[command(
+    after_help = "Example:\n  taut template --nails 250 --shape circle --radius-cm 40.2 -o template.svg\n\n\
+Print at 100 % (no fitting to the page); the 100 mm bar checks the scale."
+)]
+pub struct Cli {
+    #[command(flatten)]
+    pub board: crate::stringart::BoardArgs,
+    /// The template (.svg)
+    #[arg(short = 'o', long = "output")]
+    pub output: std::path::PathBuf,
+}
 
 /// Room round the board for the numbers, mm.
 const MARGIN_MM: f64 = 22.0;
@@ -178,12 +189,12 @@ fn numbering_arrow(board: &Board, font: f64) -> String {
 }
 
 /// `taut template …` from the command line.
-pub fn run(mut args: Args) -> Result<(), String> {
-    let spec = crate::stringart::spec_from(&mut args)?;
-    let out = std::path::PathBuf::from(args.required("o")?);
-    args.finish()?;
+pub fn run(cli: Cli) -> Result<(), String> {
+    let spec = cli.board.spec()?;
+    let out = cli.output;
+    crate::output::refuse_overwriting(&[], &[&out])?;
     let doc = template(&spec)?;
-    std::fs::write(&out, doc).map_err(|e| format!("{}: {e}", out.display()))?;
+    crate::output::write(&out, doc.as_bytes())?;
     println!(
         "written: {} (print at 100 %, no fitting to the page)",
         out.display()
