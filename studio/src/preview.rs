@@ -156,11 +156,11 @@ pub fn run(cli: Cli) -> Result<(), String> {
     let (input, out, px, card, thread_mm) =
         (cli.input, cli.output, cli.px, cli.card, cli.thread_mm);
     let machine = Machine::from(cli.machine);
-    extension(&out)?;
     let param_path = card.as_ref().map(|c| c.join("param.txt"));
     let mut inputs = vec![input.as_path()];
     inputs.extend(param_path.as_deref());
     crate::output::refuse_overwriting(&inputs, &[&out])?;
+    extension(&out)?;
     let text = std::fs::read_to_string(&input).map_err(|e| format!("{}: {e}", input.display()))?;
     let is_vcd = input
         .extension()

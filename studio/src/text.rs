@@ -163,8 +163,8 @@ pub fn run(cli: Cli) -> Result<(), String> {
     let preview_path = cli
         .preview
         .unwrap_or_else(|| crate::output::derived(&out, "preview", "png"));
-    preview::extension(&preview_path)?;
     crate::output::refuse_overwriting(&[], &[&out, &preview_path])?;
+    preview::extension(&preview_path)?;
     let placed = strokes(&font, &text, height, wrap, [0.0, 0.0])?;
     let (_, size) = extent(&placed);
     let corner = at.unwrap_or_else(|| plot::default_corner(machine, size));

@@ -635,8 +635,8 @@ pub fn run(cli: Cli) -> Result<(), String> {
     let preview_path = cli
         .preview
         .unwrap_or_else(|| crate::output::derived(&out, "preview", "png"));
-    preview::extension(&preview_path)?;
     crate::output::refuse_overwriting(&[&input], &[&out, &preview_path])?;
+    preview::extension(&preview_path)?;
 
     let source = Source::open(&input)?;
     let title = format!(

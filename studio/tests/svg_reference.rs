@@ -42,7 +42,11 @@ fn reference(svg: &Path) -> Reference {
         .arg("0.05")
         .output()
         .expect("python");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let pt = |p: &serde_json::Value| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()];
     let shapes = v["shapes"]
@@ -82,7 +86,10 @@ impl Grid {
         Grid(g)
     }
     fn cell(p: [f64; 2]) -> (i64, i64) {
-        ((p[0] / WITHIN_MM).floor() as i64, (p[1] / WITHIN_MM).floor() as i64)
+        (
+            (p[0] / WITHIN_MM).floor() as i64,
+            (p[1] / WITHIN_MM).floor() as i64,
+        )
     }
     fn near(&self, p: [f64; 2]) -> bool {
         let (x, y) = Grid::cell(p);

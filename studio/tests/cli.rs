@@ -1,0 +1,415 @@
+//! The `taut` binary as a maker meets it: every subcommand explains
+//! itself, a misspelt flag is refused with a suggestion, no run writes over
+//! its input (or any file it reads), and a run killed at any moment leaves
+//! each output whole — old or new, never half.
+
+use clap::CommandFactory;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::Instant;
+use taut_studio::cli::Cli;
+
+fn taut(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_taut"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("taut-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples")
+        .join(name)
+}
+
+#[test]
+fn every_subcommand_has_help_listing_its_flags() {
+    let cli = Cli::command();
+    let mut seen = 0;
+    for sub in cli.get_subcommands() {
+        let name = sub.get_name();
+        let out = taut(&[name, "--help"]);
+        assert!(out.status.success(), "taut {name} --help: {}", text(&out));
+        let help = text(&out);
+        for arg in sub.get_arguments() {
+            if let Some(long) = arg.get_long() {
+                assert!(
+                    help.contains(&format!("--{long}")),
+                    "taut {name} --help lacks --{long}:\n{help}"
+                );
+            }
+        }
+        // Defaults are shown; the commands that make files give examples.
+        if sub
+            .get_arguments()
+            .any(|a| !a.get_default_values().is_empty())
+        {
+            assert!(
+                help.contains("[default: "),
+                "taut {name} --help shows no default"
+            );
+        }
+        if [
+            "stringart",
+            "template",
+            "vectorize",
+            "text",
+            "preview",
+            "send",
+        ]
+        .contains(&name)
+        {
+            assert!(
+                help.contains("Example"),
+                "taut {name} --help has no example"
+            );
+        }
+        seen += 1;
+    }
+    assert!(seen >= 8, "{seen} subcommands");
+    let top = taut(&["--help"]);
+    assert!(top.status.success() && text(&top).contains("vectorize"));
+    let bash = taut(&["completions", "bash"]);
+    assert!(
+        bash.status.success()
+            && text(&bash).contains("vectorize")
+            && text(&bash).contains("--width-mm")
+    );
+}
+
+#[test]
+fn misspelt_and_missing_flags_are_named() {
+    let out = taut(&["vectorize", "x.svg", "--machin", "flatbed", "-o", "x.gcode"]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = text(&out);
+    assert!(
+        e.contains("unexpected argument '--machin'")
+            && e.contains("tip: a similar argument exists: '--machine'"),
+        "{e}"
+    );
+    let out = taut(&[
+        "template", "--nails", "100", "--shape", "circle", "-o", "t.svg",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out).contains("required arguments were not provided")
+            && text(&out).contains("--radius-cm")
+    );
+    let out = taut(&[
+        "vectorize",
+        "x.svg",
+        "--machine",
+        "plotter",
+        "-o",
+        "x.gcode",
+    ]);
+    assert!(
+        text(&out).contains("possible values: flatbed, drum, whiteboard, scara"),
+        "{}",
+        text(&out)
+    );
+}
+
+/// Runs `args` in `dir` and checks the files named `inputs` are the same
+/// bytes after it.
+fn unchanged(dir: &Path, inputs: &[&str], args: &[&str]) -> Output {
+    let before: Vec<Vec<u8>> = inputs
+        .iter()
+        .map(|f| std::fs::read(dir.join(f)).unwrap())
+        .collect();
+    let out = Command::new(env!("CARGO_BIN_EXE_taut"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    for (f, b) in inputs.iter().zip(before) {
+        assert_eq!(
+            std::fs::read(dir.join(f)).unwrap(),
+            b,
+            "{f} changed by taut {args:?}"
+        );
+    }
+    out
+}
+
+#[test]
+fn no_run_writes_over_its_input() {
+    let d = scratch("inputs");
+    std::fs::copy(example("images/horse.png"), d.join("horse.png")).unwrap();
+    std::fs::copy(example("svg/shapes.svg"), d.join("shapes.svg")).unwrap();
+    let ok = |o: &Output| assert!(o.status.success(), "{}", text(o));
+    // Outputs next to the input, named after it: the preview is
+    // horse.preview.png, not horse.png.
+    let o = unchanged(
+        &d,
+        &["horse.png"],
+        &[
+            "vectorize",
+            "horse.png",
+            "--machine",
+            "flatbed",
+            "--width-mm",
+            "40",
+            "-o",
+            "horse.gcode",
+        ],
+    );
+    ok(&o);
+    assert!(d.join("horse.preview.png").exists() && d.join("horse.gcode").exists());
+    ok(&unchanged(
+        &d,
+        &["shapes.svg"],
+        &[
+            "vectorize",
+            "shapes.svg",
+            "--machine",
+            "flatbed",
+            "-o",
+            "shapes.gcode",
+        ],
+    ));
+    ok(&unchanged(
+        &d,
+        &["horse.gcode"],
+        &[
+            "preview",
+            "horse.gcode",
+            "--machine",
+            "flatbed",
+            "-o",
+            "horse-path.png",
+        ],
+    ));
+    ok(&unchanged(
+        &d,
+        &["horse.png"],
+        &[
+            "stringart",
+            "horse.png",
+            "--nails",
+            "24",
+            "--shape",
+            "circle",
+            "--radius-cm",
+            "10",
+            "--lines",
+            "20",
+            "--resolution",
+            "64",
+            "-o",
+            ".",
+        ],
+    ));
+    ok(&unchanged(
+        &d,
+        &["horse.png", "shapes.svg"],
+        &["text", "Hi", "--height-mm", "5", "-o", "hi.gcode"],
+    ));
+    ok(&unchanged(
+        &d,
+        &["horse.png"],
+        &[
+            "template",
+            "--nails",
+            "24",
+            "--shape",
+            "circle",
+            "--radius-cm",
+            "10",
+            "-o",
+            "template.svg",
+        ],
+    ));
+    // An output that is an input, by any name, is refused before anything
+    // is written.
+    std::fs::create_dir_all(d.join("sub")).unwrap();
+    let refused = [
+        vec![
+            "vectorize",
+            "horse.png",
+            "--machine",
+            "flatbed",
+            "--width-mm",
+            "40",
+            "-o",
+            "sub/../horse.png",
+        ],
+        vec![
+            "vectorize",
+            "horse.png",
+            "--machine",
+            "flatbed",
+            "--width-mm",
+            "40",
+            "-o",
+            "x.gcode",
+            "--preview",
+            "horse.png",
+        ],
+        vec![
+            "vectorize",
+            "shapes.svg",
+            "--machine",
+            "flatbed",
+            "-o",
+            "y.gcode",
+            "--preview",
+            "./shapes.svg",
+        ],
+        vec![
+            "preview",
+            "horse.gcode",
+            "--machine",
+            "flatbed",
+            "-o",
+            "horse.gcode",
+        ],
+        vec![
+            "stringart",
+            "preview.png",
+            "--nails",
+            "24",
+            "--shape",
+            "circle",
+            "--radius-cm",
+            "10",
+            "--lines",
+            "20",
+            "-o",
+            ".",
+        ],
+        vec!["bench", "--json", "horse.png", "--images", "."],
+    ];
+    for args in refused {
+        let names = ["horse.png", "horse.gcode", "preview.png", "shapes.svg"];
+        let o = unchanged(&d, &names, &args);
+        assert!(!o.status.success(), "taut {args:?} ran");
+        assert!(
+            text(&o).contains("is an input of this run"),
+            "taut {args:?}: {}",
+            text(&o)
+        );
+    }
+    assert!(!d.join("x.gcode").exists() && !d.join("y.gcode").exists());
+    // `send` reads its file and writes nothing.
+    let o = unchanged(
+        &d,
+        &["horse.gcode"],
+        &["send", "horse.gcode", "--port", "/nonexistent/tty"],
+    );
+    assert!(!o.status.success());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn a_run_killed_at_a_random_moment_leaves_whole_files() {
+    let d = scratch("killed");
+    std::fs::copy(example("images/horse.png"), d.join("horse.png")).unwrap();
+    let args = [
+        "vectorize",
+        "horse.png",
+        "--machine",
+        "drum",
+        "--width-mm",
+        "120",
+        "--mode",
+        "hatch",
+        "-o",
+        "out.gcode",
+    ];
+    // The whole run once: what a finished run writes, and how long it takes.
+    let start = Instant::now();
+    let o = Command::new(env!("CARGO_BIN_EXE_taut"))
+        .args(args)
+        .current_dir(&d)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let took = start.elapsed();
+    let new = (
+        std::fs::read(d.join("out.gcode")).unwrap(),
+        std::fs::read(d.join("out.preview.png")).unwrap(),
+    );
+    let old = (
+        b"; an older drawing\n".to_vec(),
+        b"an older preview".to_vec(),
+    );
+    // Seeded moments through the run (and a little past it).
+    let mut seed: u64 = 0x5eed_0029;
+    let mut kinds = [0usize; 2];
+    for _ in 0..8 {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let at = took.mul_f64((seed >> 33) as f64 / (1u64 << 31) as f64 * 1.1);
+        std::fs::write(d.join("out.gcode"), &old.0).unwrap();
+        std::fs::write(d.join("out.preview.png"), &old.1).unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_taut"))
+            .args(args)
+            .current_dir(&d)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(at);
+        let _ = child.kill();
+        child.wait().unwrap();
+        let gcode = std::fs::read(d.join("out.gcode")).unwrap();
+        let preview = std::fs::read(d.join("out.preview.png")).unwrap();
+        assert!(
+            gcode == old.0 || gcode == new.0,
+            "out.gcode is neither the old file nor the new one ({} bytes) after a kill at {at:?}",
+            gcode.len()
+        );
+        assert!(
+            preview == old.1 || preview == new.1,
+            "the preview is half written after a kill at {at:?}"
+        );
+        kinds[usize::from(gcode == new.0)] += 1;
+        // What a kill leaves behind is a hidden temporary file, never the output.
+        for e in std::fs::read_dir(&d).unwrap() {
+            let name = e.unwrap().file_name().to_string_lossy().into_owned();
+            if name.starts_with('.') {
+                assert!(name.ends_with(".tmp"), "{name}");
+                std::fs::remove_file(d.join(&name)).unwrap();
+            }
+        }
+    }
+    eprintln!(
+        "killed 8 runs of {took:?}: {} left the old files, {} the new ones",
+        kinds[0], kinds[1]
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn errors_name_the_file_and_exit_1() {
+    let o = taut(&[
+        "vectorize",
+        "/nonexistent/x.svg",
+        "--machine",
+        "flatbed",
+        "-o",
+        &std::env::temp_dir()
+            .join("taut-never.gcode")
+            .display()
+            .to_string(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o).contains("/nonexistent/x.svg"), "{}", text(&o));
+}
