@@ -12,6 +12,7 @@
 
 pub mod baseline;
 pub mod card;
+pub mod framing;
 pub mod greedy;
 pub mod picture;
 mod spread;
@@ -29,8 +30,10 @@ const EXAMPLES: &str = "\
 Examples:
   taut stringart camera.jpg --nails 250 --shape circle --radius-cm 40.2 --lines 3000 -o CARD
   taut stringart face.png --nails 180 --shape 6 --radius-cm 30 --lines 2000 --thread-mm 0.2 -o /media/sd
+  taut stringart group.jpg --zoom 2 --offset 0.1,0.15 --contrast 1.3 --mask faces.png … -o CARD
 
-CARD gets param.txt and poradi.txt (copy them onto the card), preview.png and preview.svg.";
+CARD gets param.txt and poradi.txt (copy them onto the card), preview.png and
+preview.svg (the winding), target.png (the picture as framed and toned for it).";
 
 /// A picture to a string-art card (param.txt, poradi.txt, previews)
 #[derive(clap::Args, Debug)]
@@ -70,6 +73,24 @@ pub struct Cli {
     /// Side of preview.png, pixels
     #[arg(long, default_value_t = 1200)]
     pub preview_px: usize,
+    /// Zoom into the picture: the ring sees its shorter side divided by this
+    #[arg(long, default_value_t = 1.0)]
+    pub zoom: f64,
+    /// Move the ring over the picture X,Y, fractions of its shorter side (x right, y up)
+    #[arg(long, value_parser = crate::cli::pair, default_value = "0,0", allow_hyphen_values = true)]
+    pub offset: [f64; 2],
+    /// Contrast about mid-grey (1: as it is; 2: twice)
+    #[arg(long, default_value_t = 1.0)]
+    pub contrast: f32,
+    /// Gamma of the grey levels (above 1 darkens the midtones)
+    #[arg(long, default_value_t = 1.0)]
+    pub gamma: f32,
+    /// Light thread on a dark board: the picture's tones inverted
+    #[arg(long)]
+    pub invert: bool,
+    /// Importance mask (a picture framed as the image): darkness kept where it is white, halved where black
+    #[arg(long, value_name = "PICTURE")]
+    pub mask: Option<PathBuf>,
 }
 
 /// The board: its shape, nails and size.
@@ -218,7 +239,15 @@ pub struct Card {
 }
 
 /// The files a card gets.
-pub const CARD_FILES: [&str; 4] = ["param.txt", "poradi.txt", "preview.png", "preview.svg"];
+/// (`target.png`, the picture as the generator saw it, is written by the
+/// command beside them.)
+pub const CARD_FILES: [&str; 5] = [
+    "param.txt",
+    "poradi.txt",
+    "preview.png",
+    "preview.svg",
+    "target.png",
+];
 
 /// Writes `param.txt`, `poradi.txt` (both read back through the
 /// firmware's parsers first), `preview.png` and `preview.svg` into `dir`.
@@ -270,14 +299,29 @@ pub fn run(cli: Cli) -> Result<(), String> {
     let (image_path, dir, preview_px) = (cli.image, cli.output, cli.preview_px);
     let outputs: Vec<PathBuf> = CARD_FILES.iter().map(|f| dir.join(f)).collect();
     let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
-    crate::output::refuse_overwriting(&[&image_path], &outputs)?;
+    let mut inputs = vec![image_path.as_path()];
+    inputs.extend(cli.mask.as_deref());
+    crate::output::refuse_overwriting(&inputs, &outputs)?;
+    let framing = framing::Framing {
+        zoom: cli.zoom,
+        offset: cli.offset,
+        contrast: cli.contrast,
+        gamma: cli.gamma,
+        invert: cli.invert,
+    };
+    framing.check()?;
     let board = spec.board()?;
-    let image = Gray::open(&image_path)?;
+    let mask = cli.mask.as_deref().map(Gray::open).transpose()?;
+    let image = framing.apply(&Gray::open(&image_path)?, mask.as_ref());
     let radius_cm = f64::from(spec.radius_um) / 10_000.0;
     let bar = progress::bar("lines", o.lines as u64);
     let w = generate(&image, &o, &bar)?;
     bar.finish_and_clear();
     let card = write_card(&dir, &o, &w.pattern, preview_px)?;
+    crate::output::write(
+        &dir.join("target.png"),
+        &target_png(&image, board, preview_px.min(1200)),
+    )?;
     let random = Target::new(&image, board, o.resolution, o.thread_mm).rmse(&baseline::random(
         spec.nails,
         o.lines,
@@ -311,10 +355,26 @@ pub fn run(cli: Cli) -> Result<(), String> {
         hours(card.winding_s)
     );
     println!(
-        "  written: {}/{{param.txt,poradi.txt,preview.png,preview.svg}}",
+        "  written: {}/{{param.txt,poradi.txt,preview.png,preview.svg,target.png}}",
         dir.display()
     );
     Ok(())
+}
+
+/// The picture as the generator aims at it: framed and toned, inside the
+/// ring of nails (outside it a light grey), `px` across.
+pub fn target_png(image: &Gray, board: taut_logic::geometry::Board, px: usize) -> Vec<u8> {
+    let t = Target::new(image, board, px, 0.3);
+    let grey: Vec<u8> = t
+        .darkness
+        .iter()
+        .zip(&t.frame.mask)
+        .map(|(d, &inside)| match inside {
+            true => ((1.0 - d) * 255.0).round() as u8,
+            false => 200,
+        })
+        .collect();
+    crate::raster::encode_png(px, px, png::ColorType::Grayscale, &grey)
 }
 
 /// `3 h 05 min` or `12 min 30 s`.
