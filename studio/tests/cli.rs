@@ -211,10 +211,18 @@ fn no_run_writes_over_its_input() {
             "20",
             "--resolution",
             "64",
+            "--zoom",
+            "2",
+            "--offset",
+            "-0.1,0.05",
+            "--invert",
+            "--mask",
+            "horse.png",
             "-o",
             ".",
         ],
     ));
+    assert!(d.join("target.png").exists() && d.join("poradi.txt").exists());
     ok(&unchanged(
         &d,
         &["horse.png", "shapes.svg"],
