@@ -54,6 +54,31 @@ pub struct Cli {
     pub machine: Option<AnyMachine>,
 }
 
+/// Whether a line is a program pause (`M0`, `M00`, `M1`), outside its
+/// comments.
+fn is_pause(line: &str) -> bool {
+    let code: String = line
+        .split(['(', ';'])
+        .next()
+        .unwrap_or("")
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect::<String>()
+        .to_ascii_uppercase();
+    let mut rest = code.as_str();
+    while let Some(at) = rest.find('M') {
+        let digits: String = rest[at + 1..]
+            .chars()
+            .take_while(|c| c.is_ascii_digit())
+            .collect();
+        if matches!(digits.trim_start_matches('0'), "" | "1") && !digits.is_empty() {
+            return true;
+        }
+        rest = &rest[at + 1..];
+    }
+    false
+}
+
 /// Grbl 1.1's receive buffer; senders keep one byte of it free, as Grbl's
 /// own stream.py and grbl-streamer do (bytes of lines sent and not yet
 /// answered stay under it).
@@ -396,6 +421,14 @@ fn stream(
                 .answered()
                 .ok_or(format!("a reply with no line sent: {reply}"))?;
             o.answered += 1;
+            // A program pause (M0, as a pen change): the machine holds
+            // there; the line's comment says what to do.
+            if reply == "ok" && is_pause(&lines[i].1) {
+                let (number, text) = &lines[i];
+                p.bar.suspend(|| {
+                    eprintln!("line {number}: paused: {text} — resume with ~ or space")
+                });
+            }
             if reply != "ok" {
                 o.errors += 1;
                 let (number, text) = &lines[i];

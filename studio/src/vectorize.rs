@@ -422,8 +422,9 @@ fn picture(
         }
         Mode::Hatch | Mode::Auto => {
             // Tones over the picture's whole range; a two-toned picture's
-            // levels lie below its ink threshold, and it is outlined.
-            let two_toned = separation >= 0.8;
+            // (Otsu's separation ≥ 0.9) levels lie below its ink threshold,
+            // and it is outlined.
+            let two_toned = separation >= 0.9;
             let stretched = tone::stretch(&smooth);
             let lightest = match (o.threshold, two_toned) {
                 (Some(t), _) => t,
@@ -663,7 +664,7 @@ pub fn run(cli: Cli) -> Result<(), String> {
 
 fn report(input: &Path, v: &Vectorized, machine: Machine) {
     let (down, up) = v.toolpath.lengths();
-    let (lo, hi) = v.toolpath.bounds();
+    let (lo, hi) = bounds(&v.strokes);
     let how = match v.mode {
         Some((m, t)) => format!(" ({} at threshold {t:.2})", format!("{m:?}").to_lowercase()),
         None => String::new(),
