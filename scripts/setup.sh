@@ -82,7 +82,7 @@ if [ ! -d "$PIN_DIR" ]; then
     if ! rustup toolchain install "$PIN" --profile minimal --component rust-src; then
         echo "setup: cannot install $PIN, and no installed toolchain is its commit ${PIN_HASH:-(none named)}." >&2
         echo "setup: installed: $(rustup toolchain list | tr '\n' ' ')" >&2
-        echo "setup: install it where a download works, or move the pin to an installed nightly (README, \"Toolchains\")." >&2
+        echo "setup: install it where a download works, or move the pin to an installed nightly (docs/toolchain.md)." >&2
         exit 1
     fi
     if [ -n "$PIN_HASH" ] && [ "$(commit_of "$PIN_DIR")" != "$PIN_HASH" ]; then
