@@ -23,10 +23,13 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
+/// A filled shape's rings, and whether its rule is even-odd.
+type Fill = (bool, Vec<Vec<[f64; 2]>>);
+
 #[derive(Debug)]
 struct Reference {
-    /// (layer or colour, outline points, fill rings with the even-odd rule)
-    shapes: Vec<(String, Vec<[f64; 2]>, Option<(bool, Vec<Vec<[f64; 2]>>)>)>,
+    /// (layer or colour, outline points, fill)
+    shapes: Vec<(String, Vec<[f64; 2]>, Option<Fill>)>,
 }
 
 /// The drawing as svgelements reads it.
@@ -151,8 +154,7 @@ fn check(file: &str, layers: &[&str]) {
 
     // The pen is on the drawing.
     let outlines = Grid::new(want.shapes.iter().flat_map(|s| s.1.iter().copied()));
-    let fills: Vec<&(bool, Vec<Vec<[f64; 2]>>)> =
-        want.shapes.iter().filter_map(|s| s.2.as_ref()).collect();
+    let fills: Vec<&Fill> = want.shapes.iter().filter_map(|s| s.2.as_ref()).collect();
     let pen = drawn(&v.toolpath, 0.05);
     let off: Vec<&[f64; 2]> = pen
         .iter()
