@@ -145,7 +145,12 @@ fn a_vectorized_drawing_is_drawn_on_its_toolpath() {
     o.mode = vectorize::Mode::Edges;
     // The flatbed's top speed (2000 steps/s, 40 a mm).
     o.feed = 3000.0;
-    let v = vectorize::vectorize(&vectorize::Source::Picture(example("horse.png")), &o, "horse").unwrap();
+    let v = vectorize::vectorize(
+        &vectorize::Source::Picture(example("horse.png")),
+        &o,
+        "horse",
+    )
+    .unwrap();
     let mut sim = boot_machine();
     send_ok(&mut sim, "$machine=flatbed", Duration::from_secs(5));
     for line in v.gcode.lines() {
@@ -203,7 +208,11 @@ fn a_vectorized_drawing_is_drawn_on_its_toolpath() {
 /// every vertex of every stroke reached with the pen down.
 fn drawn_as_planned(v: &vectorize::Vectorized, machine: Machine, within: f64) -> (usize, f64) {
     let mut sim = boot_machine();
-    send_ok(&mut sim, &format!("$machine={}", machine.name()), Duration::from_secs(5));
+    send_ok(
+        &mut sim,
+        &format!("$machine={}", machine.name()),
+        Duration::from_secs(5),
+    );
     for line in v.gcode.lines() {
         send_ok(&mut sim, line, Duration::from_secs(60));
     }
@@ -218,7 +227,12 @@ fn drawn_as_planned(v: &vectorize::Vectorized, machine: Machine, within: f64) ->
         let down = (pen_deg_at(&sim, *cycle).expect("pen pulses") - down_deg).abs() < 1.0;
         down_steps += usize::from(down);
         let off = off_path(&v.toolpath, p, down);
-        assert!(off <= within, "{machine:?}: ({:.3}, {:.3}) is {off:.3} mm off, pen down: {down}", p[0], p[1]);
+        assert!(
+            off <= within,
+            "{machine:?}: ({:.3}, {:.3}) is {off:.3} mm off, pen down: {down}",
+            p[0],
+            p[1]
+        );
     }
     for s in &v.strokes {
         for q in s {
@@ -226,7 +240,10 @@ fn drawn_as_planned(v: &vectorize::Vectorized, machine: Machine, within: f64) ->
                 let p = at(&kin, *st);
                 (p[0] - q[0]).hypot(p[1] - q[1])
             });
-            assert!(near.fold(f64::MAX, f64::min) <= within, "{machine:?}: never at {q:?}");
+            assert!(
+                near.fold(f64::MAX, f64::min) <= within,
+                "{machine:?}: never at {q:?}"
+            );
         }
     }
     assert_ram_budget(&sim);
