@@ -9,6 +9,7 @@ use std::sync::Once;
 
 pub use taut_simavr as sim;
 
+pub mod board;
 pub mod drawing;
 pub mod senders;
 

@@ -15,8 +15,8 @@ use crate::toolpath::{self, Toolpath};
 use std::path::{Path, PathBuf};
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
-use taut_simavr::replay::{board_from_param, JobReplay};
-use taut_simavr::vcd;
+use taut_trace::replay::{board_from_param, JobReplay};
+use taut_trace::vcd;
 
 /// A toolpath (G-code or a simulator trace) as a picture
 #[derive(clap::Args, Debug)]
