@@ -1,8 +1,10 @@
-//! `taut preview FILE.gcode|TRACE.vcd --machine … -o out.png|svg`: a
-//! toolpath as a picture, the pen down solid and its travel dashed.
+//! `taut preview FILE.gcode|DRAWING.svg|TRACE.vcd --machine … -o
+//! out.png|svg`: a toolpath as a picture, the pen down solid and its travel
+//! dashed.
 //!
 //! G-code is read through the firmware's parser and interpreter
-//! (`toolpath::from_gcode`); a simulator trace (`cargo xtask sim --vcd`)
+//! (`toolpath::from_gcode`); an SVG drawing as `taut vectorize` would draw
+//! it with its defaults (its own size, its layers in order); a simulator trace (`cargo xtask sim --vcd`)
 //! through the pulse replay: a plotter's steps and pen pulses, or — with
 //! `--machine string_art --card DIR` — the nails the string-art job wrapped,
 //! drawn as `taut stringart`'s preview draws the card's pattern.
@@ -23,10 +25,12 @@ use taut_trace::vcd;
 #[command(after_help = "\
 Examples:
   taut preview horse.gcode --machine flatbed -o horse.png
+  taut preview drawing.svg --machine flatbed -o drawing.png
   cargo xtask sim --vcd run.vcd …; taut preview run.vcd --machine flatbed -o run.svg
   taut preview job.vcd --machine string_art --card CARD -o wound.png")]
 pub struct Cli {
-    /// The G-code file, or a simulator trace (.vcd)
+    /// The G-code file, an SVG drawing (drawn as `taut vectorize` draws it
+    /// with its defaults), or a simulator trace (.vcd)
     pub input: PathBuf,
     /// The machine the file is for
     #[arg(long, value_enum)]
@@ -161,7 +165,16 @@ pub fn run(cli: Cli) -> Result<(), String> {
     inputs.extend(param_path.as_deref());
     crate::output::refuse_overwriting(&inputs, &[&out])?;
     extension(&out)?;
-    let text = std::fs::read_to_string(&input).map_err(|e| format!("{}: {e}", input.display()))?;
+    let bytes = std::fs::read(&input).map_err(|e| format!("{}: {e}", input.display()))?;
+    if machine != Machine::StringArt && crate::vectorize::is_svg(&bytes) {
+        return svg_drawing(&input, machine, &out, px);
+    }
+    let text = String::from_utf8(bytes).map_err(|_| {
+        format!(
+            "{}: neither G-code, SVG nor a trace (not UTF-8 text)",
+            input.display()
+        )
+    })?;
     let is_vcd = input
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("vcd"));
@@ -198,6 +211,28 @@ pub fn run(cli: Cli) -> Result<(), String> {
     println!(
         "{}: pen down {down:.0} mm, up {up:.0} mm; written {}",
         input.display(),
+        out.display()
+    );
+    Ok(())
+}
+
+/// An SVG drawing as `taut vectorize` draws it with its defaults.
+fn svg_drawing(input: &Path, machine: Machine, out: &Path, px: usize) -> Result<(), String> {
+    use crate::vectorize::{self, Options, Source};
+    let source = Source::open(input)?;
+    let mut o = Options::new(machine, 1.0);
+    o.width_mm = None;
+    let v = vectorize::vectorize(&source, &o, &input.display().to_string())?;
+    for w in &v.warnings {
+        eprintln!("warning: {w}");
+    }
+    save(&v.toolpath, out, px)?;
+    let (down, up) = v.toolpath.lengths();
+    println!(
+        "{}: {} strokes in {} pass(es), pen down {down:.0} mm, up {up:.0} mm; written {}",
+        input.display(),
+        v.strokes.len(),
+        v.layers.len(),
         out.display()
     );
     Ok(())

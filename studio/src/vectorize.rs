@@ -193,11 +193,7 @@ impl Source {
     /// A PNG, JPEG or SVG file, told apart by its bytes.
     pub fn open(path: &Path) -> Result<Source, String> {
         let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let head = String::from_utf8_lossy(&bytes[..bytes.len().min(512)]).to_ascii_lowercase();
-        let is_svg = head.contains("<svg")
-            || (head.trim_start().starts_with("<?xml")
-                && String::from_utf8_lossy(&bytes).contains("<svg"));
-        let source = match is_svg {
+        let source = match is_svg(&bytes) {
             true => svgfile::read(&bytes).map(Source::Svg),
             false => Gray::decode(&bytes)
                 .map(Source::Picture)
@@ -205,6 +201,14 @@ impl Source {
         };
         source.map_err(|e| format!("{}: {e}", path.display()))
     }
+}
+
+/// An SVG document, by its bytes (not its name).
+pub fn is_svg(bytes: &[u8]) -> bool {
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(512)]).to_ascii_lowercase();
+    head.contains("<svg")
+        || (head.trim_start().starts_with("<?xml")
+            && String::from_utf8_lossy(bytes).contains("<svg"))
 }
 
 /// What came out.

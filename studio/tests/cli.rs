@@ -421,3 +421,47 @@ fn errors_name_the_file_and_exit_1() {
     assert_eq!(o.status.code(), Some(1));
     assert!(text(&o).contains("/nonexistent/x.svg"), "{}", text(&o));
 }
+
+#[test]
+fn an_svg_previews_as_vectorize_draws_it() {
+    let d = scratch("svg-preview");
+    let svg = example("svg/inkscape-layers.svg");
+    let svg = svg.to_str().unwrap();
+    let v = taut(&[
+        "vectorize",
+        svg,
+        "--machine",
+        "flatbed",
+        "-o",
+        d.join("layers.gcode").to_str().unwrap(),
+    ]);
+    assert!(v.status.success(), "{}", text(&v));
+    let p = taut(&[
+        "preview",
+        svg,
+        "--machine",
+        "flatbed",
+        "-o",
+        d.join("layers.png").to_str().unwrap(),
+    ]);
+    assert!(p.status.success(), "{}", text(&p));
+    assert!(text(&p).contains("in 3 pass(es)"), "{}", text(&p));
+    let read = |f: &str| std::fs::read(d.join(f)).unwrap();
+    assert_eq!(
+        read("layers.png"),
+        read("layers.preview.png"),
+        "the SVG's preview is the drawing vectorize makes of it"
+    );
+    // And the G-code vectorize wrote previews the same again.
+    let g = taut(&[
+        "preview",
+        d.join("layers.gcode").to_str().unwrap(),
+        "--machine",
+        "flatbed",
+        "-o",
+        d.join("layers-gcode.png").to_str().unwrap(),
+    ]);
+    assert!(g.status.success(), "{}", text(&g));
+    assert_eq!(read("layers-gcode.png"), read("layers.png"));
+    let _ = std::fs::remove_dir_all(&d);
+}

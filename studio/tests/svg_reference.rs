@@ -228,3 +228,13 @@ fn an_inkscape_file_with_layers() {
         &["1 outline black", "2 fill red", "3 title blue"],
     );
 }
+
+#[test]
+fn a_vpype_drawing_with_named_coloured_layers() {
+    check("vpype-generated.svg", &["outline", "ellipses", "title"]);
+}
+
+#[test]
+fn an_inkscape_file_after_a_vpype_pipeline() {
+    check("vpype-processed.svg", &["2", "4"]);
+}
