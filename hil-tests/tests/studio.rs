@@ -254,7 +254,13 @@ fn drawn_as_planned(v: &vectorize::Vectorized, machine: Machine, within: f64) ->
 fn an_inkscape_drawing_is_drawn_on_the_flatbed_and_the_whiteboard() {
     let svg = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/svg/inkscape-layers.svg");
     let source = vectorize::Source::open(&svg).unwrap();
-    for (machine, within) in [(Machine::Flatbed, 0.046), (Machine::Whiteboard, 0.08)] {
+    // A step of each motor off (a move's ends rounded to steps, the DDA's
+    // minor axis within a step between them), or the chord a curve was cut
+    // into: the flatbed 0.025 mm a step; the whiteboard's chain 1143/20000
+    // mm a step, the two chains meeting near a right angle across the
+    // drawing, so √2 steps (0.081 mm) and 5 % for the angle.
+    let chain = 1143.0 / 20000.0 * 2f64.sqrt() * 1.05;
+    for (machine, within) in [(Machine::Flatbed, 0.046), (Machine::Whiteboard, chain)] {
         let wall = Instant::now();
         let mut o = vectorize::Options::new(machine, 30.0);
         // One pass: the pen changes (M0) would wait for a cycle start.

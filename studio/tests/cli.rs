@@ -324,52 +324,65 @@ fn no_run_writes_over_its_input() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
-#[test]
-fn a_run_killed_at_a_random_moment_leaves_whole_files() {
-    let d = scratch("killed");
-    std::fs::copy(example("images/horse.png"), d.join("horse.png")).unwrap();
-    let args = [
-        "vectorize",
-        "horse.png",
-        "--machine",
-        "drum",
-        "--width-mm",
-        "120",
-        "--mode",
-        "hatch",
-        "-o",
-        "out.gcode",
-    ];
+/// Every file under `d` (one folder deep), by its path relative to `d`.
+fn files(d: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(d).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            for f in std::fs::read_dir(&p).unwrap() {
+                out.push(f.unwrap().path().strip_prefix(d).unwrap().to_path_buf());
+            }
+        } else {
+            out.push(p.strip_prefix(d).unwrap().to_path_buf());
+        }
+    }
+    out.sort();
+    out
+}
+
+/// `taut ARGS` in `d` killed at `n` seeded moments through its run (and a
+/// little past it): each of its outputs is then either the older file or
+/// the one a whole run writes, and what a kill leaves besides is a hidden
+/// temporary file. Returns (outputs, kills that left the old files, kills
+/// that left the new ones).
+fn killed_runs(d: &Path, args: &[&str], n: usize, seed: u64) -> (usize, usize, usize) {
     // The whole run once: what a finished run writes, and how long it takes.
+    let before = files(d);
     let start = Instant::now();
     let o = Command::new(env!("CARGO_BIN_EXE_taut"))
         .args(args)
-        .current_dir(&d)
+        .current_dir(d)
         .output()
         .unwrap();
-    assert!(o.status.success(), "{}", text(&o));
+    assert!(o.status.success(), "taut {args:?}: {}", text(&o));
     let took = start.elapsed();
-    let new = (
-        std::fs::read(d.join("out.gcode")).unwrap(),
-        std::fs::read(d.join("out.preview.png")).unwrap(),
-    );
-    let old = (
-        b"; an older drawing\n".to_vec(),
-        b"an older preview".to_vec(),
-    );
-    // Seeded moments through the run (and a little past it).
-    let mut seed: u64 = 0x5eed_0029;
+    let outputs: Vec<PathBuf> = files(d)
+        .into_iter()
+        .filter(|f| !before.contains(f))
+        .collect();
+    assert!(!outputs.is_empty(), "taut {args:?} wrote nothing");
+    let new: Vec<Vec<u8>> = outputs
+        .iter()
+        .map(|f| std::fs::read(d.join(f)).unwrap())
+        .collect();
+    let old: Vec<Vec<u8>> = outputs
+        .iter()
+        .map(|f| format!("an older {}", f.display()).into_bytes())
+        .collect();
+    let mut seed = seed;
     let mut kinds = [0usize; 2];
-    for _ in 0..8 {
+    for _ in 0..n {
         seed = seed
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
         let at = took.mul_f64((seed >> 33) as f64 / (1u64 << 31) as f64 * 1.1);
-        std::fs::write(d.join("out.gcode"), &old.0).unwrap();
-        std::fs::write(d.join("out.preview.png"), &old.1).unwrap();
+        for (f, b) in outputs.iter().zip(&old) {
+            std::fs::write(d.join(f), b).unwrap();
+        }
         let mut child = Command::new(env!("CARGO_BIN_EXE_taut"))
             .args(args)
-            .current_dir(&d)
+            .current_dir(d)
             .stdout(std::process::Stdio::null())
             .stderr(std::process::Stdio::null())
             .spawn()
@@ -377,31 +390,101 @@ fn a_run_killed_at_a_random_moment_leaves_whole_files() {
         std::thread::sleep(at);
         let _ = child.kill();
         child.wait().unwrap();
-        let gcode = std::fs::read(d.join("out.gcode")).unwrap();
-        let preview = std::fs::read(d.join("out.preview.png")).unwrap();
-        assert!(
-            gcode == old.0 || gcode == new.0,
-            "out.gcode is neither the old file nor the new one ({} bytes) after a kill at {at:?}",
-            gcode.len()
-        );
-        assert!(
-            preview == old.1 || preview == new.1,
-            "the preview is half written after a kill at {at:?}"
-        );
-        kinds[usize::from(gcode == new.0)] += 1;
-        // What a kill leaves behind is a hidden temporary file, never the output.
-        for e in std::fs::read_dir(&d).unwrap() {
-            let name = e.unwrap().file_name().to_string_lossy().into_owned();
-            if name.starts_with('.') {
-                assert!(name.ends_with(".tmp"), "{name}");
-                std::fs::remove_file(d.join(&name)).unwrap();
+        let mut all_new = true;
+        for ((f, o), w) in outputs.iter().zip(&old).zip(&new) {
+            let now = std::fs::read(d.join(f)).unwrap();
+            assert!(
+                now == *o || now == *w,
+                "taut {args:?}: {} is neither the old file nor the new one ({} bytes) after a kill at {at:?}",
+                f.display(),
+                now.len()
+            );
+            all_new &= now == *w;
+        }
+        kinds[usize::from(all_new)] += 1;
+        for f in files(d) {
+            if !before.contains(&f) && !outputs.contains(&f) {
+                let name = f.file_name().unwrap().to_string_lossy().into_owned();
+                assert!(
+                    name.starts_with('.') && name.ends_with(".tmp"),
+                    "taut {args:?} left {}",
+                    f.display()
+                );
+                std::fs::remove_file(d.join(&f)).unwrap();
             }
         }
     }
     eprintln!(
-        "killed 8 runs of {took:?}: {} left the old files, {} the new ones",
-        kinds[0], kinds[1]
+        "taut {}: {} outputs, {n} runs of {took:?} killed: {} left old files (some or all), {} all new ones",
+        args[0],
+        outputs.len(),
+        kinds[0],
+        kinds[1]
     );
+    (outputs.len(), kinds[0], kinds[1])
+}
+
+#[test]
+fn a_run_killed_at_a_random_moment_leaves_whole_files() {
+    let d = scratch("killed");
+    std::fs::copy(example("images/horse.png"), d.join("horse.png")).unwrap();
+    let runs: [&[&str]; 4] = [
+        &[
+            "vectorize",
+            "horse.png",
+            "--machine",
+            "drum",
+            "--width-mm",
+            "120",
+            "--mode",
+            "hatch",
+            "-o",
+            "out.gcode",
+        ],
+        &[
+            "stringart",
+            "horse.png",
+            "--nails",
+            "120",
+            "--shape",
+            "circle",
+            "--radius-cm",
+            "20",
+            "--lines",
+            "600",
+            "--resolution",
+            "200",
+            "-o",
+            "card",
+        ],
+        &[
+            "template",
+            "--nails",
+            "250",
+            "--shape",
+            "circle",
+            "--radius-cm",
+            "40.2",
+            "--paper",
+            "A4",
+            "-o",
+            "template.svg",
+        ],
+        &[
+            "text",
+            "Příliš žluťoučký kůň úpěl ďábelské ódy",
+            "--height-mm",
+            "8",
+            "--wrap-mm",
+            "100",
+            "-o",
+            "text.gcode",
+        ],
+    ];
+    for (k, args) in runs.iter().enumerate() {
+        let (outputs, _, _) = killed_runs(&d, args, 8, 0x5eed_0029 + k as u64);
+        assert!(outputs >= 2, "taut {}: {outputs} outputs", args[0]);
+    }
     std::fs::remove_dir_all(&d).unwrap();
 }
 

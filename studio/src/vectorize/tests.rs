@@ -204,6 +204,12 @@ fn line_art_is_drawn_once_along_its_centre_lines() {
     );
     // The crossing lines are not cut at the crossings: a handful of strokes.
     assert!(v.strokes.len() <= 6, "{} strokes", v.strokes.len());
+    eprintln!(
+        "centre-lines: pen down {down:.1} mm for L = {l:.1} mm ({:.3} L), {} strokes, \
+         {shared} of {samples} points near another stroke",
+        down / l,
+        v.strokes.len()
+    );
 }
 
 #[test]
@@ -249,6 +255,7 @@ fn a_grey_ramp_is_hatched_denser_where_it_is_darker() {
             }
         }
         assert!(distinct.len() >= 4, "cross {cross}: {bands:?}");
+        eprintln!("grey ramp, cross {cross}: pen down per 10 mm band {bands:.0?}");
     }
 }
 
