@@ -151,56 +151,20 @@ fn a_vectorized_drawing_is_drawn_on_its_toolpath() {
         "horse",
     )
     .unwrap();
-    let mut sim = boot_machine();
-    send_ok(&mut sim, "$machine=flatbed", Duration::from_secs(5));
-    for line in v.gcode.lines() {
-        send_ok(&mut sim, line, Duration::from_secs(30));
-    }
-    send_ok(&mut sim, "M400", Duration::from_secs(30));
-
     // 0.025 mm a step: a step of each axis off, or the chord between two
     // points of a curve the G-code cut.
-    let within = 0.046;
-    let kin = AnyKinematics::of(&MachineConfig::defaults(Machine::Flatbed)).unwrap();
-    let down_deg = f64::from(MachineConfig::defaults(Machine::Flatbed).pen.down_deg);
-    let points = track(&sim);
-    let mut down_steps = 0;
-    for (cycle, steps) in &points {
-        let p = at(&kin, *steps);
-        let down = (pen_deg_at(&sim, *cycle).expect("pen pulses") - down_deg).abs() < 1.0;
-        down_steps += usize::from(down);
-        let off = off_path(&v.toolpath, p, down);
-        assert!(
-            off <= within,
-            "({:.3}, {:.3}) is {off:.3} mm off, pen down: {down}",
-            p[0],
-            p[1]
-        );
-    }
-    // Every vertex of every stroke is reached with the pen down.
-    for s in &v.strokes {
-        for q in s {
-            let near = points.iter().map(|(_, st)| {
-                let p = at(&kin, *st);
-                (p[0] - q[0]).hypot(p[1] - q[1])
-            });
-            assert!(near.fold(f64::MAX, f64::min) <= within, "never at {q:?}");
-        }
-    }
+    let (down_steps, machine_s) = drawn_as_planned(&v, Machine::Flatbed, 0.046);
     let (drawn, _) = v.toolpath.lengths();
     assert!(
         down_steps as f64 > 0.9 * drawn * 40.0,
         "{down_steps} steps down for {drawn:.1} mm"
     );
     eprintln!(
-        "horse: {} strokes, {} G-code lines, {} steps ({down_steps} pen down), {:.0} s machine time in {:.1} s",
+        "horse: {} strokes, {} G-code lines, {down_steps} pen-down steps, {machine_s:.0} s machine time in {:.1} s",
         v.strokes.len(),
         v.gcode.lines().count(),
-        points.len(),
-        sim.time_s(),
         wall.elapsed().as_secs_f64()
     );
-    assert_ram_budget(&sim);
 }
 
 /// Streams `v`'s G-code to `machine` and checks the pulses drew it: every

@@ -114,7 +114,7 @@ pub fn strokes(
             x += (g.right - g.left) * scale;
         }
     }
-    let (lo, _) = extent(&out);
+    let (lo, _) = crate::vectorize::bounds(&out);
     for p in out.iter_mut().flatten() {
         *p = [p[0] - lo[0] + at[0], p[1] - lo[1] + at[1]];
     }
@@ -166,7 +166,7 @@ pub fn run(cli: Cli) -> Result<(), String> {
     crate::output::refuse_overwriting(&[], &[&out, &preview_path])?;
     preview::extension(&preview_path)?;
     let placed = strokes(&font, &text, height, wrap, [0.0, 0.0])?;
-    let (_, size) = extent(&placed);
+    let (_, size) = crate::vectorize::bounds(&placed);
     let corner = at.unwrap_or_else(|| plot::default_corner(machine, size));
     let shifted = strokes(&font, &text, height, wrap, corner)?;
     let (gcode, path) = plot::plot(&shifted, machine, feed, &format!("taut text {text}"))?;
@@ -176,18 +176,6 @@ pub fn run(cli: Cli) -> Result<(), String> {
     files.commit()?;
     report(&path, &out, &preview_path);
     Ok(())
-}
-
-fn extent(strokes: &[Polyline]) -> ([f64; 2], [f64; 2]) {
-    strokes
-        .iter()
-        .flatten()
-        .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
-            (
-                [lo[0].min(p[0]), lo[1].min(p[1])],
-                [hi[0].max(p[0]), hi[1].max(p[1])],
-            )
-        })
 }
 
 fn report(path: &Toolpath, out: &std::path::Path, preview: &std::path::Path) {
@@ -227,8 +215,9 @@ mod tests {
                 let s = strokes(&font, &c.to_string(), 10.0, None, [0.0; 2]).unwrap();
                 assert_eq!(s.len(), plain.len() + more, "{name} {c}");
             }
-            let (_, top_e) = extent(&plain);
-            let (_, top_acute) = extent(&strokes(&font, "é", 10.0, None, [0.0; 2]).unwrap());
+            let (_, top_e) = crate::vectorize::bounds(&plain);
+            let (_, top_acute) =
+                crate::vectorize::bounds(&strokes(&font, "é", 10.0, None, [0.0; 2]).unwrap());
             assert!(
                 top_acute[1] > top_e[1] + 0.5,
                 "{name}: the acute is above the e"
@@ -284,7 +273,7 @@ mod tests {
     fn capitals_have_the_height_and_glyphs_their_widths() {
         let font = Font::named("futural").unwrap();
         let s = strokes(&font, "HH", 10.0, None, [3.0, 4.0]).unwrap();
-        let (lo, hi) = extent(&s);
+        let (lo, hi) = crate::vectorize::bounds(&s);
         let unit = 10.0 / 21.0;
         assert_eq!(lo, [3.0, 4.0]);
         assert!((hi[1] - lo[1] - 10.0).abs() < 1e-9, "{lo:?} {hi:?}");

@@ -385,38 +385,24 @@ fn picture(
     };
     let mut used = threshold;
     let strokes: Vec<Polyline> = match mode {
-        Mode::Edges => {
-            let [low, high] = o.canny;
-            if !(low >= 0.0 && high >= low) {
-                return Err("--canny LOW,HIGH: 0 ≤ LOW ≤ HIGH".into());
-            }
-            let edge = canny::edges(&image, o.blur, low, high);
-            let lines = trace::chains(&edge, w, h);
+        Mode::Edges | Mode::Outline | Mode::Centerline => {
+            let pixels = match mode {
+                Mode::Edges => {
+                    let [low, high] = o.canny;
+                    if !(low >= 0.0 && high >= low) {
+                        return Err("--canny LOW,HIGH: 0 ≤ LOW ≤ HIGH".into());
+                    }
+                    let edge = canny::edges(&image, o.blur, low, high);
+                    trace::chains(&edge, w, h)
+                }
+                Mode::Outline => contour::iso(&smooth, w, h, threshold),
+                _ => {
+                    let dark: Vec<bool> = smooth.iter().map(|&v| v < threshold).collect();
+                    skeleton::centre_lines(&dark, w, h)
+                }
+            };
             finish(
-                lines
-                    .iter()
-                    .map(|l| l.iter().map(to_mm).collect())
-                    .collect(),
-                tolerance,
-                min_length,
-            )
-        }
-        Mode::Outline => {
-            let rings = contour::iso(&smooth, w, h, threshold);
-            finish(
-                rings
-                    .iter()
-                    .map(|l| l.iter().map(to_mm).collect())
-                    .collect(),
-                tolerance,
-                min_length,
-            )
-        }
-        Mode::Centerline => {
-            let dark: Vec<bool> = smooth.iter().map(|&v| v < threshold).collect();
-            let lines = skeleton::centre_lines(&dark, w, h);
-            finish(
-                lines
+                pixels
                     .iter()
                     .map(|l| l.iter().map(to_mm).collect())
                     .collect(),
