@@ -7,11 +7,12 @@
 //! parser and interpreter, kinematics and machine-time estimate, so what
 //! the tools predict is what the machine does.
 
-pub mod args;
 pub mod bench;
 pub mod board;
+pub mod cli;
 pub mod gray;
 pub mod hershey;
+pub mod output;
 pub mod plot;
 pub mod preview;
 pub mod progress;
