@@ -268,9 +268,15 @@ impl Print {
         let is_data = |m: &CardMsg| (m.ticket, matches!(m.what, What::Data { .. }));
         while let Some((ticket, data)) = CARD_OUT.peek_with(is_data) {
             let ours = ticket == self.ticket;
-            // Bytes wait in the queue until a line wants them.
+            // Bytes wait in the queue until a line wants them, unless the
+            // card went out behind them: the print stops at its last whole
+            // line now (the line being carried out may wait on a long move).
             if data && ours && self.state != State::Idle {
-                return None;
+                if !CARD_OUT.any(|m| matches!(m.what, What::Removed)) {
+                    return None;
+                }
+                self.lost();
+                continue;
             }
             let msg = CARD_OUT.pop()?;
             match msg.what {
