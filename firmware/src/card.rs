@@ -30,7 +30,8 @@ use ufmt::uwrite;
 
 /// Free slots the reader waits for before a step of work: the most one
 /// step sends (the last chunk of a block and `End`, or `Failed` and
-/// `Removed`). The job wakes the reader when there are this many.
+/// `Removed`). A file's bytes leave this many free, so the readers (the
+/// job, the console) wake the reader when there are more.
 pub const ROOM: usize = 2;
 
 /// Reads of one block before the card counts as faulty.
@@ -324,10 +325,13 @@ impl CardReader {
             lba: 0,
         };
         let volume = match BUF.with(|b| Volume::mount(&mut dev, b)) {
+            Ok(v) if v.end() > blocks => past_end(v.end() - 1, blocks),
             Ok(v) => {
                 log_mounted(blocks, v.is_fat32());
                 Some(v)
             }
+            // The partition's boot sector lies past the card's end.
+            Err(FatError::Device(_)) if dev.lba >= blocks => past_end(dev.lba, blocks),
             Err(FatError::Device(e)) => {
                 let lba = dev.lba;
                 return match failure(&e) {
@@ -346,7 +350,13 @@ impl CardReader {
         };
         self.failures = 0;
         self.slot = Slot::Mounted(volume);
-        Self::send(What::Inserted, 0);
+        // A card with no usable volume is in the slot all the same: said
+        // once (above), not probed for again, and not asked for files.
+        let what = match volume {
+            Some(_) => What::Inserted,
+            None => What::Unusable,
+        };
+        Self::send(what, 0);
         Poll::Idle
     }
 
@@ -465,7 +475,11 @@ impl CardReader {
             return Poll::Idle;
         };
         while self.at < self.len {
-            if CARD_OUT.free() == 0 {
+            // `ROOM` slots stay free for the presence check's news: a
+            // reader of the file that leaves its bytes waiting (winding
+            // between nails, a print behind a long move) still hears of
+            // a pull within the next check.
+            if CARD_OUT.free() <= ROOM {
                 return Poll::Wait(Signal::CardRoom);
             }
             let n = (self.len - self.at).min(CHUNK as u16);
@@ -556,11 +570,19 @@ impl CardReader {
         Poll::Idle
     }
 
-    /// Is the card still in the slot? Asks for its CSD; a removal is
+    /// Is the card still in the slot? Asks for its CSD, a second time
+    /// after a CRC error (a glitch on the bus is not a pull); a removal is
     /// reported.
     fn still_there(&mut self) -> bool {
-        if self.sd.num_bytes().is_ok() {
-            return true;
+        match self.sd.num_bytes() {
+            Ok(_) => return true,
+            Err(SdCardError::CrcError(..)) => {
+                warn!("card: CSD CRC error, asking again");
+                if self.sd.num_bytes().is_ok() {
+                    return true;
+                }
+            }
+            Err(_) => {}
         }
         let ticket = match self.reading {
             Reading::File(_, t) => t,
@@ -596,6 +618,17 @@ fn log_mounted(blocks: u32, fat32: bool) {
         false => flash_str!("16"),
     };
     info!("card: ", blocks / 2048, " MiB FAT", fat);
+}
+
+/// A volume whose block `lba` lies past the card's last (`blocks` of
+/// them): a partition made for a bigger card. No volume.
+#[inline(never)]
+fn past_end(lba: u32, blocks: u32) -> Option<Volume> {
+    error!(
+        "card: partition past the end (block ",
+        lba, " of ", blocks, "): format the card"
+    );
+    None
 }
 
 /// Does a card answer CMD0 (GO_IDLE_STATE)? A few bytes on the bus: an

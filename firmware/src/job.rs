@@ -208,10 +208,12 @@ impl JobTask {
             if self.stream.checking() && !room_for_a_line() {
                 return false;
             }
-            // Pattern bytes wait in the queue until winding wants them.
+            // Pattern bytes wait in the queue until winding wants them,
+            // unless the card went out behind them: they are dropped (the
+            // pattern is read again from its start once it is back).
             let winding = matches!(self.stream, Stream::Pattern(_));
             if matches!(msg.what, What::Data { .. }) && winding && msg.ticket == self.ticket {
-                return false;
+                return CARD_OUT.any(|m| matches!(m.what, What::Removed));
             }
             self.card(msg, m, config, now);
             true
@@ -226,6 +228,7 @@ impl JobTask {
     fn card(&mut self, msg: &CardMsg, m: &mut Motion, config: &mut MachineConfig, now: u32) {
         match msg.what {
             What::Inserted => return self.event(Event::CardInserted, now),
+            What::Unusable => return self.event(Event::CardUnusable, now),
             What::Removed => {
                 if self.stream.checking() {
                     self.stream = Stream::None;

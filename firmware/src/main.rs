@@ -490,7 +490,7 @@ fn console() {
     if !CARD_IN.is_empty() {
         spawn(Task::Card);
     }
-    if CARD_OUT.free() >= card::ROOM {
+    if CARD_OUT.free() > card::ROOM {
         signal(Signal::CardRoom);
     }
     if CONSOLE.with(|c| c.take_settings_changed()) {
@@ -636,7 +636,7 @@ fn job() {
     if !CARD_IN.is_empty() {
         spawn(Task::Card);
     }
-    if CARD_OUT.free() >= card::ROOM {
+    if CARD_OUT.free() > card::ROOM {
         signal(Signal::CardRoom);
     }
 }

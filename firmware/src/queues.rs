@@ -47,8 +47,10 @@ pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
 /// Job → card reader: one request (the reader takes them first), its
 /// one slot usable.
 pub static CARD_IN: Ring<Request, 1, true> = Ring::new();
-/// Card reader → job. Full: the reader keeps its block and waits.
-pub static CARD_OUT: Ring<CardMsg, 4> = Ring::new();
+/// Card reader → job or console, its four slots usable. Full: the reader
+/// keeps its block and waits. A file's bytes take at most two
+/// (`card::ROOM` stay free for a removal's news).
+pub static CARD_OUT: Ring<CardMsg, 4, true> = Ring::new();
 /// File bytes per message at most.
 pub const CHUNK: usize = 32;
 
@@ -86,6 +88,9 @@ pub struct CardMsg {
 #[derive(Clone, Copy)]
 pub enum What {
     Inserted,
+    /// A card is in the slot, but without a volume to read (no FAT, or a
+    /// partition past its end): the reason is logged.
+    Unusable,
     Removed,
     /// The file asked for is open (its name: `card::opened_name`); its
     /// bytes follow.
@@ -104,7 +109,7 @@ pub enum What {
     End,
     /// No such file on the card.
     Missing,
-    /// The card failed mid-file (a `Removed` follows), or holds no FAT volume.
+    /// The card failed mid-file (a `Removed` follows), or holds no volume.
     Failed,
 }
 

@@ -292,3 +292,150 @@ fn an_oversized_pattern_is_refused_once_then_quiet() {
         assert_eq!(pulses(&sim, axis), 0, "{axis:?} moved");
     }
 }
+
+/// An MBR whose first partition (FAT32, LBA) starts at `start`, `size`
+/// blocks long.
+fn mbr(start: u32, size: u32) -> [u8; 512] {
+    let mut b = [0u8; 512];
+    b[446 + 4] = 0x0C;
+    b[446 + 8..446 + 12].copy_from_slice(&start.to_le_bytes());
+    b[446 + 12..446 + 16].copy_from_slice(&size.to_le_bytes());
+    b[510] = 0x55;
+    b[511] = 0xAA;
+    b
+}
+
+/// A card whose partition lies past its end (an image made for a bigger
+/// card, a bad partition table): one line saying so and what to do, the
+/// card taken as bad (never `insert card` while it is in), no retry
+/// every second; whether the partition starts past the end or only ends
+/// there. A good card then reads.
+#[test]
+fn a_partition_past_the_cards_end_is_said_once() {
+    let files = card(&[("param.txt", PARAM), ("poradi.txt", b"3,0,7,13")]);
+    // The volume alone, without the image's MBR if it has one.
+    let first = files.block(0);
+    let start = match first[0] {
+        0xEB | 0xE9 => 0,
+        _ => u32::from_le_bytes(first[454..458].try_into().unwrap()) as usize,
+    };
+    let volume = files.bytes()[start * 512..].to_vec();
+    let blocks = (volume.len() / 512) as u32;
+    // Starts past the end of a 4 MiB card.
+    let mut starts_past = SdImage::blank(8192);
+    starts_past.write_block(0, &mbr(8192 + 2048, blocks));
+    // At block 2048 of a card that holds half of it.
+    let mut bytes = mbr(2048, blocks).to_vec();
+    bytes.resize(2048 * 512, 0);
+    bytes.extend_from_slice(&volume[..volume.len() / 2]);
+    let ends_past = SdImage::from_bytes(bytes);
+    for (image, block) in [(starts_past, 8192 + 2048), (ends_past, 2048 + blocks - 1)] {
+        let cap = image.blocks();
+        let mut sim = boot_machine();
+        wait_for(&mut sim, ">>> insert card", Duration::from_secs(1));
+        let from = sim.uart_bytes().len();
+        sim.insert_sd(image);
+        let said =
+            format!("card: partition past the end (block {block} of {cap}): format the card");
+        wait_for(&mut sim, &said, Duration::from_secs(3));
+        wait_for(
+            &mut sim,
+            ">>> bad files: replace card",
+            Duration::from_secs(1),
+        );
+        sim.run_for(Duration::from_secs(10));
+        let log = sim.uart_text_from(from);
+        assert_eq!(log.matches(&said).count(), 1, "{log}");
+        assert!(!log.contains("read failed"), "{log}");
+        assert!(!log.contains("insert card"), "{log}");
+        assert_eq!(sim.watchdog_resets(), 0);
+        let _ = sim.remove_sd();
+        wait_for(&mut sim, "card out", Duration::from_millis(1500));
+        sim.insert_sd(files.clone());
+        wait_for(&mut sim, "files ok:", Duration::from_millis(1500));
+        assert_ram_budget(&sim);
+    }
+}
+
+/// One CRC error on the once-a-second presence check (its CSD) is asked
+/// again, not taken for a pull.
+#[test]
+fn a_crc_glitch_on_the_presence_check_is_not_a_removal() {
+    let mut sim = boot_machine();
+    sim.insert_sd(card(&[("param.txt", PARAM), ("poradi.txt", b"3,0,7,13")]));
+    wait_for(&mut sim, "press green to drill", Duration::from_secs(3));
+    let from = sim.uart_bytes().len();
+    // Standing in prep drill, no file open: the next block the card
+    // sends is the next check's CSD (CMD9).
+    let at = Duration::from_secs_f64(sim.time_s() + 0.2);
+    sim.sd_fault_at(at, CardFault::CrcNext);
+    sim.run_for(Duration::from_millis(100));
+    let csds = sim.sd_stats().unwrap().cmd(9);
+    wait_for(
+        &mut sim,
+        "card: CSD CRC error, asking again",
+        Duration::from_secs(2),
+    );
+    // The glitch happened, and the CSD was asked for again at once.
+    assert_eq!(sim.sd_stats().unwrap().cmd(9), csds + 2);
+    sim.run_for(Duration::from_secs(3));
+    let log = sim.uart_text_from(from);
+    assert!(!log.contains("card out"), "{log}");
+    assert!(!log.contains("state:"), "{log}");
+    // A real pull is still one.
+    let _ = sim.remove_sd();
+    wait_for(&mut sim, "card out", Duration::from_millis(2000));
+    assert_ram_budget(&sim);
+}
+
+/// The card pulled at seeded moments while winding (the pattern's next
+/// bytes waiting for their wraps in the reader's queue) is noticed within
+/// 2 s each time; put back, the job goes on and winds every wrap once.
+#[test]
+fn a_card_pulled_mid_winding_is_noticed_within_2_s() {
+    let text = pattern(40, 6);
+    let image = card(&[
+        ("param.txt", b"shape = 0\nnails = 6\nradius_cm = 20\n"),
+        ("machine.txt", hil_tests::QUICK_MACHINE_TXT.as_bytes()),
+        ("poradi.txt", &text),
+    ]);
+    let mut sim = boot_machine();
+    sim.insert_sd(image.clone());
+    let mut op = Operator::confirming();
+    run(
+        &mut sim,
+        &mut op,
+        &|_, op| matches!(&op.progress, Some((p, done, _)) if p == "wind" && *done >= 2),
+    );
+    let mut rng = hil_tests::Rng::new(28);
+    for pull in 0..3 {
+        let until = sim.time_s() + rng.between(0.1, 4.0);
+        run(&mut sim, &mut op, &|s, _| s.time_s() >= until);
+        let from = sim.uart_bytes().len();
+        let pulled = sim.time_s();
+        let _ = sim.remove_sd();
+        let out = sim.run_until(
+            |s| s.uart_text_from(from).contains("pattern lost"),
+            Duration::from_secs(5),
+        );
+        assert_eq!(out, Outcome::Done, "pull {pull}: {}", log_tail(&sim));
+        let took = sim.time_s() - pulled;
+        assert!(took <= 2.0, "pull {pull}: noticed after {took:.2} s");
+        sim.run_for(Duration::from_secs(2));
+        sim.insert_sd(image.clone());
+        wait_for(&mut sim, "card ok", Duration::from_secs(2));
+    }
+    run(&mut sim, &mut op, &|_, op: &Operator| op.finished);
+    assert!(sim.uart_text().contains("wind 40/40"), "{}", log_tail(&sim));
+    assert_eq!(sim.watchdog_resets(), 0);
+    assert_ram_budget(&sim);
+}
+
+/// The operator at work until `until` holds (at most 900 s of machine time).
+fn run(sim: &mut Sim, op: &mut Operator, until: &dyn Fn(&Sim, &Operator) -> bool) {
+    while !until(sim, op) {
+        assert_eq!(sim.run_for(Duration::from_millis(10)), Outcome::Running);
+        op.step(sim);
+        assert!(sim.time_s() < 900.0, "{}", log_tail(sim));
+    }
+}

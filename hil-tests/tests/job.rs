@@ -238,3 +238,52 @@ fn a_thicker_needle_from_machine_txt_keeps_its_clearance() {
     );
     assert_ram_budget(&sim);
 }
+
+/// A job ends with its card left in the slot: green starts the next job
+/// from it (read and checked again, `>>> insert card` never said), and
+/// that job runs to its end too: no pulling the card and putting it back.
+#[test]
+fn green_at_the_end_starts_the_next_job_from_the_card_left_in() {
+    let card = hil_tests::card(&[
+        ("param.txt", b"shape = 0\nnails = 6\nradius_cm = 20\n"),
+        ("machine.txt", hil_tests::QUICK_MACHINE_TXT.as_bytes()),
+        ("poradi.txt", b"3,0,3,1"),
+    ]);
+    let mut sim = boot_machine();
+    sim.insert_sd(card);
+    let mut holes = Vec::new();
+    let mut op = Operator::confirming();
+    for job in 0..2 {
+        let from = sim.uart_bytes().len();
+        if job > 0 {
+            // `>>> done: press green`, answered.
+            op.finished = false;
+            hil_tests::press(&mut sim, taut_logic::pinmap::Button::Confirm, 150);
+        }
+        while !op.finished {
+            assert_eq!(sim.run_for(Duration::from_millis(10)), Outcome::Running);
+            op.step(&mut sim);
+            assert!(sim.time_s() < 600.0, "job {job}:\n{}", sim.uart_text());
+        }
+        let log = sim.uart_text_from(from);
+        assert!(
+            log.contains("files ok: shape 0 nails 6"),
+            "job {job}:\n{log}"
+        );
+        assert!(log.contains("wind 3/3"), "job {job}:\n{log}");
+        // (Before the first, the power-on prompt.)
+        assert!(
+            job == 0 || !log.contains("insert card"),
+            "job {job}:\n{log}"
+        );
+        assert!(!log.contains("card out"), "job {job}:\n{log}");
+        holes.push(hil_tests::pulses(&sim, taut_logic::axis::Axis::Drill));
+    }
+    // The second job moved the drill as the first did.
+    let second = holes[1] - holes[0];
+    assert!(
+        holes[0] > 0 && second.abs_diff(holes[0]) * 10 <= holes[0],
+        "{holes:?}"
+    );
+    assert_ram_budget(&sim);
+}

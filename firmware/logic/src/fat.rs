@@ -161,6 +161,13 @@ impl Volume {
         self.fat32
     }
 
+    /// The block after the volume's last cluster: a card with fewer blocks
+    /// holds a partition made for a bigger one (an image written to a
+    /// smaller card), whose files may lie past its end.
+    pub fn end(&self) -> u32 {
+        self.data_start + (self.clusters << self.cluster_shift)
+    }
+
     fn cluster_lba(&self, cluster: u32) -> u32 {
         self.data_start + ((cluster - 2) << self.cluster_shift)
     }
@@ -428,6 +435,18 @@ mod tests {
         ] {
             assert_eq!(short_name(bad), None, "{:?}", bad);
         }
+    }
+
+    #[test]
+    fn a_volume_ends_after_its_last_cluster() {
+        let mut disk = Disk::default();
+        format(&mut disk, 0, &FAT16);
+        let v = Volume::mount(&mut disk, &mut [0; BLOCK]).unwrap();
+        assert_eq!(v.end(), FAT16_ROOT + 2 + 5000 * 4);
+        let mut disk = Disk::default();
+        format(&mut disk, 0, &FAT32);
+        let v = Volume::mount(&mut disk, &mut [0; BLOCK]).unwrap();
+        assert_eq!(v.end(), FAT32_DATA + 70_000);
     }
 
     #[test]

@@ -65,6 +65,9 @@ pub enum Event<'c> {
     /// Once at start-up.
     PowerOn,
     CardInserted,
+    /// A card went in that cannot be read at all (no FAT volume, a
+    /// partition past its end); the firmware logged why.
+    CardUnusable,
     CardRemoved,
     /// The answer to [`Action::ReadFiles`]: `param.txt` and `machine.txt`
     /// read, `poradi.txt` checked completely ([`crate::files::poradi::PoradiCheck`]).

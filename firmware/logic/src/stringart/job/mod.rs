@@ -73,7 +73,8 @@ enum Card {
     Checking,
     /// In, and (once a job is on) holding the job's files.
     Present,
-    /// Inserted at the end of a job: read when the next job starts.
+    /// Inserted at the end of a job: read when the next job starts (as
+    /// a card left in is).
     Fresh,
 }
 
@@ -273,6 +274,7 @@ impl Job {
                 }
             }
             Event::CardInserted => self.card_inserted(o),
+            Event::CardUnusable => self.card_unusable(o),
             Event::CardRemoved => self.card_removed(o, now_ms),
             Event::FilesValid {
                 params,
@@ -350,14 +352,16 @@ impl Job {
         o.prompt(prompt);
     }
 
-    /// Back to the start: the job and its files are dropped.
+    /// Back to the start: the job and its files are dropped; a card in
+    /// the slot (the last job's, left in, or another put in at the end)
+    /// is read for the next job at once, else the job waits for one.
     fn restart(&mut self, o: &mut Out) {
         self.plan = None;
         self.steps = None;
         self.loose = 0;
-        self.enter(State::WaitingForCard, o);
-        if self.card == Card::Fresh {
-            self.read(o);
+        match self.card {
+            Card::Fresh | Card::Present => self.read(o),
+            _ => self.enter(State::WaitingForCard, o),
         }
     }
 
@@ -381,10 +385,27 @@ impl Job {
         }
     }
 
+    /// A card in the slot that has nothing to read: as bad files, never
+    /// `insert card` while it is in; mid-job, not the job's card.
+    fn card_unusable(&mut self, o: &mut Out) {
+        match self.state {
+            State::WaitingForCard | State::BadFiles => {
+                self.card = Card::Present;
+                self.enter(State::BadFiles, o);
+            }
+            // Read (and refused) when the next job starts.
+            State::End => self.card = Card::Fresh,
+            _ if self.card == Card::Absent && self.plan.is_some() => o.log(Msg::OtherCard),
+            _ => {}
+        }
+    }
+
     fn card_removed(&mut self, o: &mut Out, now_ms: u32) {
         self.card = Card::Absent;
         let stops = match self.state {
             State::WaitingForCard => return,
+            // Said once: the pattern's stream may have failed first.
+            _ if self.phase() == Some(Phase::Winding) && self.lost => return,
             _ if self.phase() == Some(Phase::Winding) => return self.lose_pattern(o, now_ms),
             State::Reading | State::BadFiles => false,
             // Nothing done yet (a checkpoint is kept): start over, with the drivers off as

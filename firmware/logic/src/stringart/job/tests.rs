@@ -298,20 +298,13 @@ fn a_whole_hexagon_job() {
         .map(|p| (p.done, p.total))
         .collect();
     assert_eq!(wind, [(0, 5), (1, 5), (2, 5), (3, 5), (4, 5), (5, 5)]);
+    // The card left in: green reads it for the next job.
     assert_eq!(
         b.green(),
-        [
-            Action::Enter(State::WaitingForCard),
-            Action::Prompt(Prompt::InsertCard)
-        ]
-    );
-    // The same card again only after it is taken out and put back.
-    assert_eq!(b.green(), []);
-    b.send(Event::CardRemoved);
-    assert_eq!(
-        b.send(Event::CardInserted),
         [Action::Enter(State::Reading), Action::ReadFiles]
     );
+    b.send(valid(HEX, 5));
+    assert_eq!(b.job.state(), State::PrepDrill);
 }
 
 #[test]
@@ -329,12 +322,7 @@ fn a_card_changed_at_the_end_is_read_on_green() {
     );
     assert_eq!(
         b.green(),
-        [
-            Action::Enter(State::WaitingForCard),
-            Action::Prompt(Prompt::InsertCard),
-            Action::Enter(State::Reading),
-            Action::ReadFiles
-        ]
+        [Action::Enter(State::Reading), Action::ReadFiles]
     );
     b.send(valid(HEX, 5));
     assert_eq!(b.job.state(), State::PrepDrill);
@@ -534,8 +522,11 @@ fn ctrl_x_ends_the_job_where_it_is_with_the_drivers_holding() {
     assert_eq!(b.job.next_step(), None, "no step after the stop");
     assert_eq!(b.drivers, ALL, "the drivers keep holding");
     assert_eq!(b.send(Event::MotionDone), []);
-    // Green starts over: a new job from a card.
-    assert_eq!(b.green()[0], Action::Enter(State::WaitingForCard));
+    // Green starts over: a new job from the card in the slot.
+    assert_eq!(
+        b.green(),
+        [Action::Enter(State::Reading), Action::ReadFiles]
+    );
 }
 
 #[test]
@@ -600,6 +591,29 @@ fn bad_files_wait_without_moving() {
         a,
         Action::NextMoves | Action::DriversOn(_) | Action::SetZero(_)
     )));
+}
+
+#[test]
+fn a_card_with_nothing_to_read_is_bad_files_until_replaced() {
+    let mut b = Bench::new(HEX, &PATTERN);
+    b.send(Event::PowerOn);
+    assert_eq!(
+        b.send(Event::CardUnusable),
+        [
+            Action::Enter(State::BadFiles),
+            Action::Prompt(Prompt::ReplaceCard)
+        ]
+    );
+    assert_eq!(b.green(), []);
+    let out = b.sends(&[Event::CardRemoved, Event::CardInserted]);
+    assert_eq!(out.last(), Some(&Action::ReadFiles));
+    b.send(valid(HEX, 5));
+    assert_eq!(b.job.state(), State::PrepDrill);
+    // Mid-job it is not the job's card.
+    b.green();
+    b.batch();
+    b.send(Event::CardRemoved);
+    assert_eq!(b.send(Event::CardUnusable), [Action::Log(Msg::OtherCard)]);
 }
 
 #[test]

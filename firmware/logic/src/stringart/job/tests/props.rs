@@ -34,6 +34,7 @@ fn event(k: usize, nail: u16) -> Event<'static> {
         9 => Event::Nail(nail),
         10 => Event::PatternLost,
         27 => Event::Abort,
+        29 => Event::CardUnusable,
         28 => Event::Saved(super::resume::saved(
             SMALL,
             3,
@@ -58,7 +59,7 @@ fn event(k: usize, nail: u16) -> Event<'static> {
 /// resets are rare, green and the motion loop common.
 fn ops() -> impl Strategy<Value = Vec<(Op, u16)>> {
     let op = prop_oneof![
-        1 => (0usize..29).prop_map(Op::Send),
+        1 => (0usize..30).prop_map(Op::Send),
         2 => Just(Op::Send(1)),
         2 => Just(Op::Send(3)),
         4 => Just(Op::Send(15)),
