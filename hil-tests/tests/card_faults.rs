@@ -229,6 +229,26 @@ fn a_10000_connection_pattern_is_checked_and_wound() {
     assert_eq!(&job.wrapped_nails()[..wraps], &indices[..wraps]);
     assert!(job.crossings_outside_gaps().is_empty());
     assert!(job.moves_while_plunged().is_empty());
+    // 1 % is 100 wraps: a progress line at least every 10 s all the same,
+    // give or take the wrap that ends the ten seconds. (ms, wraps done.)
+    let lines: Vec<(u64, u64)> = sim
+        .uart_text()
+        .lines()
+        .filter_map(|l| {
+            let (_, rest) = l.split_once("job: wind ")?;
+            let ms = l.split(' ').nth(1)?.parse().ok()?;
+            Some((ms, rest.split('/').next()?.parse().ok()?))
+        })
+        .collect();
+    assert!(lines.len() >= 4, "{lines:?}");
+    let (first, last) = (lines[1], lines[lines.len() - 1]);
+    let wrap_ms = (last.0 - first.0) / (last.1 - first.1).max(1);
+    assert!(
+        lines[1..]
+            .windows(2)
+            .all(|w| w[1].0 - w[0].0 <= 10_000 + 2 * wrap_ms),
+        "a wrap {wrap_ms} ms: {lines:?}"
+    );
     assert_ram_budget(&sim);
 }
 

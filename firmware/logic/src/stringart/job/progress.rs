@@ -1,5 +1,5 @@
-//! Progress of a phase: a line at its start and end and whenever another
-//! 5 % is done, with the time left estimated proportionally from the time
+//! Progress of a phase: a line at its start and end, whenever another
+//! 1 % is done, and after 10 s without one while units get done, with the time left estimated proportionally from the time
 //! spent so far (pauses excluded). Integer maths, a division or two per
 //! line, never per step.
 
@@ -51,7 +51,14 @@ pub(super) struct Reporter {
     next: u32,
     /// The last line said the total.
     said_total: bool,
+    /// The last line: when, and the units it said.
+    last_ms: u32,
+    last_done: u32,
 }
+
+/// Longest time between lines while units get done, ms: a job of a
+/// million wraps is not silent for hours between its 1 % lines.
+pub const EVERY_MS: u32 = 10_000;
 
 impl Reporter {
     /// A phase started with `from` units done (0, or a resumed phase's).
@@ -66,12 +73,14 @@ impl Reporter {
             pause_from: None,
             next: (from / every + 1) * every,
             said_total: false,
+            last_ms: now_ms,
+            last_done: from,
         }
     }
 
-    /// Units between lines: 5 % of the total, at least one.
+    /// Units between lines: 1 % of the total, at least one.
     fn every(total: u32) -> u32 {
-        (total / 20).max(1)
+        (total / 100).max(1)
     }
 
     pub fn pause(&mut self, now_ms: u32) {
@@ -86,6 +95,8 @@ impl Reporter {
 
     fn line(&mut self, done: u32, now_ms: u32) -> Progress {
         self.said_total = done == self.total;
+        self.last_ms = now_ms;
+        self.last_done = done;
         let elapsed = now_ms
             .wrapping_sub(self.started_ms)
             .wrapping_sub(self.paused_ms);
@@ -106,9 +117,11 @@ impl Reporter {
         self.line(self.from, now_ms)
     }
 
-    /// A line if another 5 % is done.
+    /// A line if another 1 % is done, or units were done in the
+    /// [`EVERY_MS`] since the last line.
     pub fn update(&mut self, done: u32, now_ms: u32) -> Option<Progress> {
-        if done < self.next {
+        let late = done > self.last_done && now_ms.wrapping_sub(self.last_ms) >= EVERY_MS;
+        if done < self.next && !late {
             return None;
         }
         let every = Self::every(self.total);
@@ -169,15 +182,15 @@ mod tests {
     }
 
     #[test]
-    fn a_line_every_5_percent_and_one_at_the_end() {
+    fn a_line_every_1_percent_and_one_at_the_end() {
         let mut r = Reporter::start_at(Phase::Winding, 3000, 0, 0);
         let lines: std::vec::Vec<u32> = (1..=3000)
             .filter_map(|d| r.update(d, d))
             .map(|p| p.done)
             .collect();
-        assert_eq!(lines.len(), 20);
-        assert_eq!(lines[0], 150);
-        assert!(lines.windows(2).all(|w| w[1] - w[0] == 150));
+        assert_eq!(lines.len(), 100);
+        assert_eq!(lines[0], 30);
+        assert!(lines.windows(2).all(|w| w[1] - w[0] == 30));
         assert_eq!(r.finish(3000), None, "3000/3000 was the last line");
         // Small totals: a line per unit; jumps of several units report once.
         let mut r = Reporter::start_at(Phase::Drilling, 7, 0, 0);
@@ -191,10 +204,29 @@ mod tests {
     fn a_resumed_phase_counts_from_where_it_went_on() {
         let mut r = Reporter::start_at(Phase::Winding, 3000, 1234, 0);
         assert_eq!(r.first(0).done, 1234);
-        // The next line at the next multiple of 150, estimated from the
-        // units done since the resume only: 116 in 116 s, 1650 left.
-        assert!(r.update(1349, 115_000).is_none());
-        let p = r.update(1350, 116_000).unwrap();
-        assert_eq!(p.left_s, Some(1650));
+        // The next line at the next multiple of 30, estimated from the
+        // units done since the resume only: 26 in 2.6 s, 1740 left.
+        assert!(r.update(1259, 2_500).is_none());
+        let p = r.update(1260, 2_600).unwrap();
+        assert_eq!(p.left_s, Some(174));
+    }
+
+    #[test]
+    fn a_line_at_least_every_10_s_on_a_big_job() {
+        // A million wraps of 3 s: 1 % is over 8 hours.
+        let mut r = Reporter::start_at(Phase::Winding, 1_000_000, 0, 0);
+        let lines: std::vec::Vec<u32> = (1..=100)
+            .filter_map(|d| r.update(d, d * 3000))
+            .map(|p| p.done)
+            .collect();
+        assert_eq!(
+            lines,
+            [
+                4, 8, 12, 16, 20, 24, 28, 32, 36, 40, 44, 48, 52, 56, 60, 64, 68, 72, 76, 80, 84,
+                88, 92, 96, 100
+            ]
+        );
+        // Nothing done in 10 s (the machine held): no line.
+        assert!(r.update(100, 400_000).is_none());
     }
 }
