@@ -2,7 +2,7 @@
 
 use std::process::ExitCode;
 use taut_studio::args::Args;
-use taut_studio::{bench, preview, send, stringart, template, text, vectorize};
+use taut_studio::{app, bench, preview, send, stringart, template, text, vectorize};
 
 const HELP: &str = "usage: taut <command> [args]   (cargo run --release --bin taut -- <command> …)";
 
@@ -14,6 +14,7 @@ fn usage() -> String {
         text::USAGE,
         preview::USAGE,
         send::USAGE,
+        app::USAGE,
         bench::USAGE,
     ]
     .join("\n\n")
@@ -33,6 +34,7 @@ fn main() -> ExitCode {
         "text" => run(text::run),
         "preview" => run(preview::run),
         "send" => run(send::run),
+        "studio" => run(app::run),
         "bench" => run(bench::run),
         "help" | "--help" | "-h" => {
             println!("{HELP}\n\n{}", usage());

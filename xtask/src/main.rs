@@ -8,6 +8,7 @@ mod estimate;
 mod firmware;
 mod fuzz;
 mod run;
+mod studio;
 
 use run::{cargo, root, Result};
 use std::process::ExitCode;
@@ -26,6 +27,8 @@ usage: cargo xtask <command> [args]
                     10 min a target): tens of minutes
   build             release ELF + Intel HEX + size report
   sim [args]        run the firmware in simavr (see `cargo xtask sim --help`)
+  studio [--port N] [--machine NAME] [--vcd FILE]
+                    the web app (taut studio) against the simulated Mega
   sdimage DIR -o IMG  build a FAT card image from a folder (dd it to a real card)
   estimate DIR      the machine time of a card folder's job: this firmware's (its
                     own job, planner and trapezoids, on the host) and the original's
@@ -57,6 +60,7 @@ fn main() -> ExitCode {
             fuzz::Plan::parse(rest).and_then(|plan| run::setup().and_then(|_| fuzz::run(&plan)))
         }
         "sim" => run::setup().and_then(|_| sim(rest)),
+        "studio" => run::setup().and_then(|_| studio::run(rest)),
         "sdimage" => run::setup().and_then(|_| run::bin("taut-sdimage", rest)),
         "demo" => run::setup().and_then(|_| match rest.first().map(String::as_str) {
             None => demo::run(),
