@@ -101,9 +101,9 @@ pub fn send_ok(sim: &mut sim::Sim, line: &str, timeout: std::time::Duration) {
     }
 }
 
-/// Static RAM plus the deepest stack seen must stay under 6 KiB of the 8
-/// (issue #11; issue #13's bar is 4.5 KiB).
-pub const RAM_BUDGET: u32 = 6144;
+/// Static RAM plus the deepest stack seen stays within 5.5 KiB of the 8:
+/// the rest is headroom for what the tests do not reach.
+pub const RAM_BUDGET: u32 = 5632;
 
 /// With `TAUT_STACK_CHAINS` set (`cargo xtask test` sets it), the call
 /// chain at the test's deepest stack goes to `target/hil-stack-chains.txt`
@@ -147,9 +147,10 @@ pub fn assert_ram_budget(sim: &sim::Sim) {
     append("hil-stack-peaks.txt", &peak);
     record_chain(sim, &test);
     assert!(
-        statics + stack < RAM_BUDGET,
-        "static {statics} B + stack {stack} B, deepest at {:#x} (avr-addr2line -fe taut.elf; \
-         the call chain: target/hil-stack-chains.txt)",
+        statics + stack <= RAM_BUDGET,
+        "static {statics} B + stack {stack} B = {} B, over the {RAM_BUDGET} B budget; \
+         deepest at {:#x} (avr-addr2line -fe taut.elf; the call chain: target/hil-stack-chains.txt)",
+        statics + stack,
         sim.peak_stack_pc()
     );
 }

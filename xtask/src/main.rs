@@ -121,14 +121,12 @@ fn simtest() -> Result<()> {
     let _ = std::fs::remove_file(root().join("target/hil-stack-chains.txt"));
     let mut test = run::cargo_cmd(&["test", "-p", "hil-tests"], &root());
     run::status(test.env("TAUT_STACK_CHAINS", "1"))?;
-    print_ram(&img, &peaks);
-    Ok(())
+    print_ram(&img, &peaks)
 }
 
 /// The run's RAM figure: static data plus the deepest stack any HIL test
-/// saw (each test checks its own against 6 KiB; issue #13's bar is
-/// 4.5 KiB).
-fn print_ram(img: &firmware::Image, peaks: &std::path::Path) {
+/// saw, checked against the budget (each test also checks its own).
+fn print_ram(img: &firmware::Image, peaks: &std::path::Path) -> Result<()> {
     let text = std::fs::read_to_string(peaks).unwrap_or_default();
     let deepest = text
         .lines()
@@ -139,13 +137,22 @@ fn print_ram(img: &firmware::Image, peaks: &std::path::Path) {
         })
         .max();
     if let Some((stack, test)) = deepest {
+        let total = img.ram_static_bytes + stack;
         println!(
-            "== RAM: static {} B + deepest stack {stack} B ({test}) = {} B of 8192 \
+            "== RAM: static {} B + deepest stack {stack} B ({test}) = {total} B of the {} B budget \
              (each test's call chain: target/hil-stack-chains.txt)",
             img.ram_static_bytes,
-            img.ram_static_bytes + stack
+            firmware::RAM_BUDGET
         );
+        if total > firmware::RAM_BUDGET {
+            return Err(format!(
+                "static RAM + deepest stack {total} B is over the {} B budget",
+                firmware::RAM_BUDGET
+            )
+            .into());
+        }
     }
+    Ok(())
 }
 
 /// The campaigns too long for CI: every HIL test at its full size
