@@ -150,7 +150,7 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     tokio::time::sleep(Duration::from_millis(500)).await;
     let m = ok(&app, "GET", "/api/machine", "").await;
     let notice = m["notice"].as_str().unwrap_or_default();
-    assert!(notice.starts_with("ALARM:3") && notice.contains("unlock it ($X)"), "{notice}");
+    assert!(notice.starts_with("ALARM:3") && notice.contains("unlock ($X)"), "{notice}");
     ok(&app, "POST", "/api/machine/line", "$X").await;
     ok(&app, "POST", "/api/machine/realtime?cmd=status", "").await;
 

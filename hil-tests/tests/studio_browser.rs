@@ -20,6 +20,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
+use taut_studio::vectorize::simplify::distance;
 
 fn example(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -29,17 +30,6 @@ fn example(name: &str) -> String {
         .unwrap()
         .display()
         .to_string()
-}
-
-/// The least distance from `p` to the segment `a`–`b`.
-fn distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    let t = match len2 {
-        0.0 => 0.0,
-        _ => (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0),
-    };
-    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -111,11 +101,10 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
     let step = 1.0 / 40.0;
     let within = step * 2f64.sqrt() + 0.001;
     let (mut down, mut worst) = (0, 0.0f64);
-    // From the first move of the drawing on (power-on homing before it).
-    let first = points
-        .iter()
-        .position(|((x, y), _)| (x - moves[0].0[0]).abs() < 0.1 && (y - moves[0].0[1]).abs() < 0.1)
-        .unwrap_or(0);
+    // From the pen's first stroke on: before it the machine homed at
+    // power-on and went from where homing left it, which the toolpath
+    // (read from the G-code alone) puts at 0, 0.
+    let first = points.iter().position(|(_, down)| *down).expect("the pen went down");
     for ((x, y), is_down) in &points[first..] {
         let off = moves
             .iter()
@@ -126,7 +115,7 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
         down += usize::from(*is_down);
         assert!(off <= within, "({x:.3}, {y:.3}) is {off:.3} mm off the toolpath, pen down: {is_down}");
     }
-    let drawn: f64 = moves.iter().filter(|m| m.2).map(|m| distance(m.0, m.1, m.1)).sum();
+    let drawn: f64 = moves.iter().filter(|m| m.2).map(|m| (m.1[0] - m.0[0]).hypot(m.1[1] - m.0[1])).sum();
     assert!(down as f64 > 0.9 * drawn / step, "{down} steps down for {drawn:.1} mm");
     eprintln!(
         "studio plot: {} steps ({down} pen down), worst {worst:.4} mm off; {:.0} s machine time; {} in {:.1} s",

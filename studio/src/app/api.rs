@@ -35,12 +35,12 @@ pub fn router(app: App) -> Router {
         .route("/app.js", get(web::script))
         .route("/style.css", get(web::style))
         .route("/api/machines", get(|| async { Json(tools::machines()) }))
-        .route("/api/vectorize", post(vectorize))
-        .route("/api/text", post(text))
-        .route("/api/gcode", post(gcode))
-        .route("/api/stringart", post(stringart))
+        .route("/api/vectorize", post(|u, h, b| tool(u, h, b, tools::vectorize)))
+        .route("/api/text", post(|u, h, b| tool(u, h, b, tools::text)))
+        .route("/api/gcode", post(|u, h, b| tool(u, h, b, tools::gcode)))
+        .route("/api/stringart", post(|u, h, b| tool(u, h, b, tools::stringart)))
         .route("/api/template", get(template))
-        .route("/api/card", post(card))
+        .route("/api/card", post(|u, h, b| tool(u, h, b, tools::write_card)))
         .route("/api/ports", get(ports))
         .route("/api/connect", post(connect_handler))
         .route("/api/disconnect", post(disconnect))
@@ -151,28 +151,16 @@ async fn blocking<T: Send + 'static>(f: impl FnOnce() -> Result<T, Bad> + Send +
     })?
 }
 
-async fn vectorize(uri: axum::http::Uri, headers: HeaderMap, body: Body) -> Answer {
+/// A tool's request: the body and the query in, its JSON out.
+async fn tool(
+    uri: axum::http::Uri,
+    headers: HeaderMap,
+    body: Body,
+    f: fn(&[u8], &Query) -> Result<Value, Bad>,
+) -> Answer {
     let bytes = upload(&headers, body).await?;
     let q = options(&uri);
-    blocking(move || tools::vectorize(&bytes, &q)).await.map(Json)
-}
-
-async fn text(uri: axum::http::Uri, headers: HeaderMap, body: Body) -> Answer {
-    let bytes = upload(&headers, body).await?;
-    let q = options(&uri);
-    blocking(move || tools::text(&bytes, &q)).await.map(Json)
-}
-
-async fn gcode(uri: axum::http::Uri, headers: HeaderMap, body: Body) -> Answer {
-    let bytes = upload(&headers, body).await?;
-    let q = options(&uri);
-    blocking(move || tools::gcode(&bytes, &q)).await.map(Json)
-}
-
-async fn stringart(uri: axum::http::Uri, headers: HeaderMap, body: Body) -> Answer {
-    let bytes = upload(&headers, body).await?;
-    let q = options(&uri);
-    blocking(move || tools::stringart(&bytes, &q)).await.map(Json)
+    blocking(move || f(&bytes, &q)).await.map(Json)
 }
 
 async fn template(uri: axum::http::Uri) -> Result<Response, Bad> {
@@ -185,12 +173,6 @@ async fn template(uri: axum::http::Uri) -> Result<Response, Bad> {
         svg,
     )
         .into_response())
-}
-
-async fn card(uri: axum::http::Uri, headers: HeaderMap, body: Body) -> Answer {
-    let bytes = upload(&headers, body).await?;
-    let q = options(&uri);
-    blocking(move || tools::write_card(&bytes, &q)).await.map(Json)
 }
 
 async fn ports(State(app): State<App>) -> Json<Value> {
@@ -317,7 +299,7 @@ async fn disconnect(State(app): State<App>, headers: HeaderMap, uri: axum::http:
 
 async fn machine(State(app): State<App>) -> Json<Value> {
     let mut s = app.hub.snapshot();
-    s["simulator"] = json!(app.sim.as_ref().map(|s| s.machine.name()));
+    s["simulator"] = json!(app.sim.as_ref().map(|s| s.machine.name().to_string()));
     Json(s)
 }
 
@@ -508,11 +490,11 @@ async fn run_action(
         .ok_or_else(|| Bad::conflict("no run is going"))?;
     let byte = match action.as_str() {
         "pause" => {
-            run.pause().map_err(Bad::conflict)?;
+            run.hold(true).map_err(Bad::conflict)?;
             b'!'
         }
         "resume" => {
-            run.resume().map_err(Bad::conflict)?;
+            run.hold(false).map_err(Bad::conflict)?;
             b'~'
         }
         "stop" => {
@@ -559,7 +541,7 @@ async fn watch(app: App, who: String, mut socket: WebSocket) {
         let mut s = app.hub.snapshot();
         s["type"] = json!("hello");
         s["you"] = json!(who);
-        s["simulator"] = json!(app.sim.as_ref().map(|s| s.machine.name()));
+        s["simulator"] = json!(app.sim.as_ref().map(|s| s.machine.name().to_string()));
         s
     };
     if socket.send(Message::Text(hello.to_string().into())).await.is_err() {

@@ -267,7 +267,6 @@ impl Hub {
             remember_setting(&mut inner.settings, setting);
         }
         if line.starts_with("Grbl ") {
-            inner.settings.clear();
             if let Some(w) = inner.waiter.take() {
                 let _ = w.done.send(Err("the machine reset".into()));
             }

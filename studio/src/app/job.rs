@@ -128,24 +128,15 @@ impl Run {
         self.moved || self.finishing.is_some_and(|t| t.elapsed().as_secs_f64() > 1.0)
     }
 
-    pub fn pause(&mut self) -> Result<(), String> {
-        match self.state {
-            State::Running => {
-                self.state = State::Paused;
-                Ok(())
-            }
-            _ => Err(format!("the run is {}, not running", self.word())),
+    /// Paused (`!` sent) or running again (`~`).
+    pub fn hold(&mut self, paused: bool) -> Result<(), String> {
+        match (&self.state, paused) {
+            (State::Running, true) => self.state = State::Paused,
+            (State::Paused, false) => self.state = State::Running,
+            (_, true) => return Err(format!("the run is {}, not running", self.word())),
+            (_, false) => return Err(format!("the run is {}, not paused", self.word())),
         }
-    }
-
-    pub fn resume(&mut self) -> Result<(), String> {
-        match self.state {
-            State::Paused => {
-                self.state = State::Running;
-                Ok(())
-            }
-            _ => Err(format!("the run is {}, not paused", self.word())),
-        }
+        Ok(())
     }
 
     /// Over, with why; the last acknowledged line is kept.
@@ -217,9 +208,9 @@ mod tests {
         let notes = run.on_reply("error:15");
         assert_eq!(notes, ["t: line 2: G1X10F600: error:15 Travel exceeded (col 3)"]);
         assert_eq!(run.report()["line"], 2);
-        run.pause().unwrap();
-        assert!(run.pause().is_err());
-        run.resume().unwrap();
+        run.hold(true).unwrap();
+        assert!(run.hold(true).is_err());
+        run.hold(false).unwrap();
         run.on_reply("ok");
         assert_eq!(run.report()["last_acknowledged"], 4);
         assert!(!run.on_status("Run"));

@@ -104,7 +104,7 @@ fn drawing(gcode: String, path: &Toolpath, machine: Machine) -> Value {
         .map(|m| json!([r(m.from[0]), r(m.from[1]), r(m.to[0]), r(m.to[1]), u8::from(m.down)]))
         .collect();
     json!({
-        "machine": machine.name(),
+        "machine": machine.name().to_string(),
         "estimate_s": estimate_s(gcode.as_bytes(), machine),
         "lines": gcode.lines().count(),
         "pen_down_mm": down,
@@ -355,7 +355,7 @@ pub fn machines() -> Value {
     json!(all
         .iter()
         .map(|&m| json!({
-            "name": m.name(),
+            "name": m.name().to_string(),
             "plotter": !m.is_string_art(),
             "width_max_mm": width_max_mm(m),
         }))

@@ -72,7 +72,7 @@ mod tests {
             explain("error:9").unwrap(),
             "error:9: the machine is locked: its position is unknown. What to do: home it ($H) or unlock it ($X), then zero."
         );
-        assert!(explain("ALARM:3").unwrap().contains("unlock it ($X)"));
+        assert!(explain("ALARM:3").unwrap().contains("unlock ($X)"));
         assert!(explain("error:999").unwrap().contains("see the message"));
         assert_eq!(explain("ok"), None);
         assert_eq!(explain("error:x"), None);
