@@ -141,7 +141,11 @@ async fn broken_pictures_and_options_are_refused_with_what_is_wrong() {
     let big = vec![b'x'; app::UPLOAD_LIMIT + 1];
     let r = post(&app, "/api/vectorize", big.clone()).await;
     assert_eq!(r.status, 413);
-    assert_eq!(r.error(), "the file is 25.0 MB: the studio takes files up to 25 MB");
+    assert_eq!(r.error(), "the file is over 25 MB, the most the studio takes");
+    let length = (big.len() + (1 << 20)).to_string();
+    let r = call(&app, "POST", "/api/stringart", big, &[("content-length", &length)]).await;
+    assert_eq!(r.status, 413);
+    assert_eq!(r.error(), "the file is 26.0 MB: the studio takes files up to 25 MB");
     // The server goes on.
     let ok = post(&app, "/api/text?height_mm=5", b"ok".to_vec()).await;
     assert_eq!(ok.status, 200);

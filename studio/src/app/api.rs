@@ -252,9 +252,8 @@ pub async fn connect(app: &Studio, port: &str) -> Result<Value, Bad> {
     // A Mega resets as its port opens (its boot loader waits ~1.6 s): up
     // to 5 s for the first status report the poller asks for.
     let mut answered = false;
-    for _ in 0..50 {
-        tokio::time::sleep(Duration::from_millis(100)).await;
-        let inner = app.hub.lock();
+    for k in 0..50 {
+        let mut inner = app.hub.lock();
         if inner.link.is_none() {
             break;
         }
@@ -262,6 +261,11 @@ pub async fn connect(app: &Studio, port: &str) -> Result<Value, Bad> {
             answered = true;
             break;
         }
+        if k % 3 == 0 {
+            let _ = app.hub.write(&mut inner, b"?");
+        }
+        drop(inner);
+        tokio::time::sleep(Duration::from_millis(100)).await;
     }
     if !answered {
         disconnect_now(&app.hub, "no status report");
