@@ -253,18 +253,20 @@ pub async fn connect(app: &Studio, port: &str) -> Result<Value, Bad> {
     // to 5 s for the first status report the poller asks for.
     let mut answered = false;
     for k in 0..50 {
-        let mut inner = app.hub.lock();
-        if inner.link.is_none() {
+        let (linked, state) = {
+            let mut inner = app.hub.lock();
+            if k % 3 == 0 && inner.link.is_some() {
+                let _ = app.hub.write(&mut inner, b"?");
+            }
+            (inner.link.is_some(), inner.status.state.clone())
+        };
+        if !linked {
             break;
         }
-        if !matches!(inner.status.state.as_str(), "Connecting" | "Disconnected") {
+        if !matches!(state.as_str(), "Connecting" | "Disconnected") {
             answered = true;
             break;
         }
-        if k % 3 == 0 {
-            let _ = app.hub.write(&mut inner, b"?");
-        }
-        drop(inner);
         tokio::time::sleep(Duration::from_millis(100)).await;
     }
     if !answered {
