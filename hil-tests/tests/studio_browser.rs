@@ -40,14 +40,13 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
     b.client.goto(&studio.url).await.unwrap();
     b.until("the page", Duration::from_secs(10), "return document.getElementById('ports').options.length > 0").await;
 
-    // Open the picture, small and quick: 12 mm wide at the flatbed's
-    // top speed.
-    b.set("v-width", "12").await;
-    b.set("v-feed", "3000").await;
+    // Open the picture: 30 mm wide, some twenty seconds of drawing.
+    b.set("v-width", "30").await;
+    b.set("v-feed", "1500").await;
     b.by_id("open").await.send_keys(&example("horse.png")).await.unwrap();
     b.click("vectorize").await;
     b.until("the toolpath", Duration::from_secs(30),
-        "return S.drawing && S.drawing.width_mm === 12 && document.getElementById('v-figures').textContent.includes('G-code lines')").await;
+        "return S.drawing && S.drawing.width_mm === 30 && document.getElementById('v-figures').textContent.includes('G-code lines')").await;
     let figures = b.text("drawing-figures").await;
     assert!(figures.contains("drawing time") && figures.contains("pen-up travel"), "{figures}");
     b.screenshot("vectorised.png").await;
@@ -56,7 +55,7 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
     let port = b.js("return document.getElementById('ports').value").await;
     assert_eq!(port.as_str().unwrap(), studio.sim.tty.display().to_string());
     b.click("connect").await;
-    b.until("connected", Duration::from_secs(40), "return S.connected && S.status.state === 'Idle'").await;
+    b.until("connected", Duration::from_secs(40), "return S.connected && S.settings.length > 0 && S.status.state === 'Idle'").await;
 
     // Send; pause once mid-run, resume.
     b.click("send").await;
@@ -211,7 +210,7 @@ async fn the_console_answers_unlock_home_a_jog_and_a_status_request() {
     b.client.goto(&studio.url).await.unwrap();
     b.until("the page", Duration::from_secs(10), "return document.getElementById('ports').options.length > 0").await;
     b.click("connect").await;
-    b.until("connected", Duration::from_secs(40), "return S.connected && S.status.state === 'Idle'").await;
+    b.until("connected", Duration::from_secs(40), "return S.connected && S.settings.length > 0 && S.status.state === 'Idle'").await;
     // The console's lines after the n-th, as the page shows them.
     let lines_after = |n: usize| format!("return [...document.querySelectorAll('#log div')].slice({n}).map(d => d.firstChild.textContent)");
     let count = "return document.querySelectorAll('#log div').length";

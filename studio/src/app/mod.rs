@@ -167,6 +167,7 @@ pub struct Started {
     token_shown: bool,
     listener: tokio::net::TcpListener,
     app: Arc<Studio>,
+    poller: tokio::task::JoinHandle<()>,
 }
 
 /// Binds, starts the simulator if asked, connects if asked.
@@ -191,6 +192,7 @@ pub async fn start(o: Options) -> Result<Started, String> {
         .clone()
         .or_else(|| app.sim.as_ref().map(|s| s.tty.display().to_string()))
         .filter(|_| o.connect);
+    let poller = tokio::spawn(poll(app.hub.clone()));
     if let Some(port) = serial {
         api::connect(&app, &port).await.map_err(|e| e.message)?;
     }
@@ -208,6 +210,7 @@ pub async fn start(o: Options) -> Result<Started, String> {
         token_shown: token.is_some(),
         listener,
         app,
+        poller,
     })
 }
 
@@ -229,12 +232,11 @@ impl Started {
         self,
         stop: impl std::future::Future<Output = ()> + Send + 'static,
     ) -> Result<Option<Ended>, String> {
-        let poller = tokio::spawn(poll(self.app.hub.clone()));
         axum::serve(self.listener, api::router(self.app.clone()))
             .with_graceful_shutdown(stop)
             .await
             .map_err(|e| e.to_string())?;
-        poller.abort();
+        self.poller.abort();
         if let Some(link) = self.app.hub.lock().link.take() {
             link.close();
         }
