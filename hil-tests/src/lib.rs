@@ -9,6 +9,7 @@ use std::sync::Once;
 
 pub use taut_simavr as sim;
 
+pub mod board;
 pub mod drawing;
 pub mod senders;
 
@@ -225,7 +226,7 @@ pub fn wait_for(sim: &mut sim::Sim, text: &str, timeout: std::time::Duration) {
 
 /// Timer3 COMPA vector (byte address): the step interrupt.
 pub const STEP_VECTOR: u32 = 0x80;
-/// Documented bound (README): no code masks the step interrupt longer.
+/// Documented bound (docs/architecture.md): no code masks the step interrupt longer.
 pub const MASKED_BOUND_CYCLES: u64 = 80;
 
 /// Nothing (the card driver, the job, the console…) kept the step

@@ -25,7 +25,10 @@ async fn call(app: &axum::Router, method: &str, uri: &str, body: &str) -> (u16, 
     let res = app.clone().oneshot(req).await.unwrap();
     let status = res.status().as_u16();
     let bytes = res.into_body().collect().await.unwrap().to_bytes();
-    (status, serde_json::from_slice(&bytes).unwrap_or(Value::Null))
+    (
+        status,
+        serde_json::from_slice(&bytes).unwrap_or(Value::Null),
+    )
 }
 
 async fn ok(app: &axum::Router, method: &str, uri: &str, body: &str) -> Value {
@@ -81,43 +84,94 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     // Connect: a status report, then the settings read ($$).
     let m = ok(&app, "POST", &format!("/api/connect?port={tty}"), "").await;
     assert_eq!(m["connected"], true);
-    assert!(m["settings"].as_array().unwrap().iter().any(|s| s == "$machine=flatbed"), "{m}");
+    assert!(
+        m["settings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|s| s == "$machine=flatbed"),
+        "{m}"
+    );
     let (status, again) = call(&app, "POST", &format!("/api/connect?port={tty}"), "").await;
     assert_eq!(status, 409, "{again}");
 
     // Console lines and their replies.
     let r = ok(&app, "POST", "/api/machine/line", "$I").await;
-    assert!(r["replies"][0].as_str().unwrap().starts_with("[VER:1.1h.taut"), "{r}");
+    assert!(
+        r["replies"][0]
+            .as_str()
+            .unwrap()
+            .starts_with("[VER:1.1h.taut"),
+        "{r}"
+    );
     assert_eq!(r["replies"].as_array().unwrap().last().unwrap(), "ok");
     let r = ok(&app, "POST", "/api/machine/line", "?").await;
-    assert!(r["replies"][0].as_str().unwrap().starts_with("<Idle|MPos:"), "{r}");
+    assert!(
+        r["replies"][0].as_str().unwrap().starts_with("<Idle|MPos:"),
+        "{r}"
+    );
     let r = ok(&app, "POST", "/api/machine/line", "G1 X900 F100").await;
     assert_eq!(r["replies"].as_array().unwrap().last().unwrap(), "error:15");
-    assert!(r["words"][0].as_str().unwrap().contains("outside the machine's travel"), "{r}");
+    assert!(
+        r["words"][0]
+            .as_str()
+            .unwrap()
+            .contains("outside the machine's travel"),
+        "{r}"
+    );
     let (status, v) = call(&app, "POST", "/api/machine/line", "G0 X1\nG0 X2").await;
-    assert_eq!((status, v["error"].as_str().unwrap()), (400, "one line at a time"));
+    assert_eq!(
+        (status, v["error"].as_str().unwrap()),
+        (400, "one line at a time")
+    );
     let m = ok(&app, "GET", "/api/machine", "").await;
     assert_eq!(m["simulator"], "flatbed");
-    assert!(m["log"].as_array().unwrap().iter().any(|l| l["dir"] == "tx" && l["text"] == "$I"));
+    assert!(m["log"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|l| l["dir"] == "tx" && l["text"] == "$I"));
 
     // A broken file: refused with where and why, nothing sent.
-    let sent_before = m["log"].as_array().unwrap().iter().filter(|l| l["dir"] == "tx").count();
-    let (status, v) = call(&app, "POST", "/api/run?name=bad", "G21\nG1 X10 F600\nG1 X200\n").await;
+    let sent_before = m["log"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|l| l["dir"] == "tx")
+        .count();
+    let (status, v) = call(
+        &app,
+        "POST",
+        "/api/run?name=bad",
+        "G21\nG1 X10 F600\nG1 X200\n",
+    )
+    .await;
     assert_eq!(status, 400);
     assert_eq!(
         v["error"],
         "the G-code, line 3: error:15 Travel exceeded (soft limit): nothing was sent to the flatbed"
     );
     let m = ok(&app, "GET", "/api/machine", "").await;
-    let sent_after = m["log"].as_array().unwrap().iter().filter(|l| l["dir"] == "tx").count();
+    let sent_after = m["log"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|l| l["dir"] == "tx")
+        .count();
     assert_eq!(sent_before, sent_after, "a line went out");
 
     // A run: counts, pause (the machine holds), resume, the end.
     let r = ok(&app, "POST", "/api/run?name=square", &square()).await;
-    assert_eq!((r["state"].as_str(), r["of"].as_u64()), (Some("running"), Some(169)));
+    assert_eq!(
+        (r["state"].as_str(), r["of"].as_u64()),
+        (Some("running"), Some(169))
+    );
     assert!(r["estimate_s"].as_f64().unwrap() > 3.0, "{r}");
     let (status, v) = call(&app, "POST", "/api/machine/line", "$$").await;
-    assert_eq!((status, v["error"].as_str().unwrap()), (409, "a run is sending: pause it or stop it first"));
+    assert_eq!(
+        (status, v["error"].as_str().unwrap()),
+        (409, "a run is sending: pause it or stop it first")
+    );
     let (status, _) = call(&app, "POST", "/api/run", "G0 X1\n").await;
     assert_eq!(status, 409, "a second run");
     tokio::time::sleep(Duration::from_millis(1500)).await;
@@ -130,11 +184,17 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     }
     let held = ok(&app, "GET", "/api/machine", "").await["status"]["mpos"].clone();
     tokio::time::sleep(Duration::from_millis(600)).await;
-    assert_eq!(ok(&app, "GET", "/api/machine", "").await["status"]["mpos"], held);
+    assert_eq!(
+        ok(&app, "GET", "/api/machine", "").await["status"]["mpos"],
+        held
+    );
     let r = ok(&app, "POST", "/api/run/resume", "").await;
     assert_eq!(r["state"], "running");
     let r = run_until(&app, "done", Duration::from_secs(60)).await;
-    assert_eq!((r["line"].as_u64(), r["of"].as_u64(), r["percent"].as_f64()), (Some(169), Some(169), Some(100.0)));
+    assert_eq!(
+        (r["line"].as_u64(), r["of"].as_u64(), r["percent"].as_f64()),
+        (Some(169), Some(169), Some(100.0))
+    );
     assert_eq!(r["errors"].as_array().unwrap().len(), 0);
     let (status, _) = call(&app, "POST", "/api/run/resume", "").await;
     assert_eq!(status, 409, "nothing to resume");
@@ -145,12 +205,18 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     let r = ok(&app, "POST", "/api/run/stop", "").await;
     assert_eq!(r["state"], "interrupted");
     let reason = r["reason"].as_str().unwrap();
-    assert!(reason.starts_with("stopped: Ctrl-X sent, the machine reset (last acknowledged line: "), "{reason}");
+    assert!(
+        reason.starts_with("stopped: Ctrl-X sent, the machine reset (last acknowledged line: "),
+        "{reason}"
+    );
     // The machine lost its position (ALARM:3) and says what to do.
     tokio::time::sleep(Duration::from_millis(500)).await;
     let m = ok(&app, "GET", "/api/machine", "").await;
     let notice = m["notice"].as_str().unwrap_or_default();
-    assert!(notice.starts_with("ALARM:3") && notice.contains("unlock ($X)"), "{notice}");
+    assert!(
+        notice.starts_with("ALARM:3") && notice.contains("unlock ($X)"),
+        "{notice}"
+    );
     ok(&app, "POST", "/api/machine/line", "$X").await;
     ok(&app, "POST", "/api/machine/realtime?cmd=status", "").await;
 
@@ -158,20 +224,37 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     // interrupted at its last acknowledged line, nothing sent again.
     ok(&app, "POST", "/api/run?name=square", &square()).await;
     tokio::time::sleep(Duration::from_millis(800)).await;
-    let acked = ok(&app, "GET", "/api/run", "").await["last_acknowledged"].as_u64().unwrap();
+    let acked = ok(&app, "GET", "/api/run", "").await["last_acknowledged"]
+        .as_u64()
+        .unwrap();
     let ended = Instant::now();
     sim.stop().unwrap();
     let r = run_until(&app, "interrupted", Duration::from_secs(2)).await;
     let shown = ended.elapsed();
     let reason = r["reason"].as_str().unwrap();
-    assert!(reason.starts_with(&format!("connection to {tty} lost")), "{reason}");
-    let last: u64 = reason.rsplit(": ").next().unwrap().trim_end_matches(')').parse().unwrap();
+    assert!(
+        reason.starts_with(&format!("connection to {tty} lost")),
+        "{reason}"
+    );
+    let last: u64 = reason
+        .rsplit(": ")
+        .next()
+        .unwrap()
+        .trim_end_matches(')')
+        .parse()
+        .unwrap();
     assert!(last >= acked, "{reason}");
     let m = ok(&app, "GET", "/api/machine", "").await;
-    assert_eq!((m["connected"].clone(), m["status"]["state"].clone()), (false.into(), "Disconnected".into()));
+    assert_eq!(
+        (m["connected"].clone(), m["status"]["state"].clone()),
+        (false.into(), "Disconnected".into())
+    );
     assert!(m["lost"].as_str().unwrap().starts_with("connection to"));
     let (status, v) = call(&app, "POST", "/api/run/resume", "").await;
-    assert_eq!((status, v["error"].as_str().unwrap()), (409, "no run is going"));
+    assert_eq!(
+        (status, v["error"].as_str().unwrap()),
+        (409, "no run is going")
+    );
     eprintln!("studio app: the lost link shown in {shown:?}; {reason}");
     assert!(shown < Duration::from_secs(1), "{shown:?}");
 }

@@ -38,42 +38,81 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
     let mut studio = Studio::start(Machine::Flatbed, "plot").await;
     let mut b = Browser::open().await;
     b.client.goto(&studio.url).await.unwrap();
-    b.until("the page", Duration::from_secs(10), "return document.getElementById('ports').options.length > 0").await;
+    b.until(
+        "the page",
+        Duration::from_secs(10),
+        "return document.getElementById('ports').options.length > 0",
+    )
+    .await;
 
     // Open the picture: 30 mm wide, some twenty seconds of drawing.
     b.set("v-width", "30").await;
     b.set("v-feed", "1500").await;
-    b.by_id("open").await.send_keys(&example("horse.png")).await.unwrap();
+    b.by_id("open")
+        .await
+        .send_keys(&example("horse.png"))
+        .await
+        .unwrap();
     b.click("vectorize").await;
     b.until("the toolpath", Duration::from_secs(30),
         "return S.drawing && S.drawing.width_mm === 30 && document.getElementById('v-figures').textContent.includes('G-code lines')").await;
     let figures = b.text("drawing-figures").await;
-    assert!(figures.contains("drawing time") && figures.contains("pen-up travel"), "{figures}");
+    assert!(
+        figures.contains("drawing time") && figures.contains("pen-up travel"),
+        "{figures}"
+    );
     b.screenshot("vectorised.png").await;
 
     // Connect to the simulated flatbed (first in the port list).
     let port = b.js("return document.getElementById('ports').value").await;
     assert_eq!(port.as_str().unwrap(), studio.sim.tty.display().to_string());
     b.click("connect").await;
-    b.until("connected", Duration::from_secs(40), "return S.connected && S.settings.length > 0 && S.status.state === 'Idle'").await;
+    b.until(
+        "connected",
+        Duration::from_secs(40),
+        "return S.connected && S.settings.length > 0 && S.status.state === 'Idle'",
+    )
+    .await;
 
     // Send; pause once mid-run, resume.
     b.click("send").await;
-    b.until("running", Duration::from_secs(10), "return S.run && S.run.state === 'running' && S.run.line > 10").await;
+    b.until(
+        "running",
+        Duration::from_secs(10),
+        "return S.run && S.run.state === 'running' && S.run.line > 10",
+    )
+    .await;
     b.click("pause").await;
-    b.until("held", Duration::from_secs(10), "return S.status.state === 'Hold:0'").await;
+    b.until(
+        "held",
+        Duration::from_secs(10),
+        "return S.status.state === 'Hold:0'",
+    )
+    .await;
     let held_at = b.js("return S.status.mpos").await;
     tokio::time::sleep(Duration::from_millis(800)).await;
-    assert_eq!(b.js("return S.status.mpos").await, held_at, "moved while held");
+    assert_eq!(
+        b.js("return S.status.mpos").await,
+        held_at,
+        "moved while held"
+    );
     let progress = b.text("progress").await;
     assert!(progress.starts_with("paused: line "), "{progress}");
     b.screenshot("paused.png").await;
     b.click("resume").await;
-    b.until("done", Duration::from_secs(120), "return S.run.state === 'done'").await;
+    b.until(
+        "done",
+        Duration::from_secs(120),
+        "return S.run.state === 'done'",
+    )
+    .await;
     let progress = b.text("progress").await;
     assert!(progress.starts_with("done: "), "{progress}");
     let travelled = b.js("return S.travelled.length").await.as_u64().unwrap();
-    assert!(travelled > 10, "{travelled} positions drawn over the preview");
+    assert!(
+        travelled > 10,
+        "{travelled} positions drawn over the preview"
+    );
     assert!(b.text("position").await.starts_with("X "));
     let shot = b.screenshot("plotter.png").await;
     // The toolpath the page showed.
@@ -85,9 +124,9 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
     // a pen-down move, up on a travel, within a step of each motor.
     let ended = studio.end().await;
     let text = std::fs::read_to_string(&studio.vcd).unwrap();
-    let signals = taut_simavr::vcd::parse(&text).unwrap();
+    let signals = taut_trace::vcd::parse(&text).unwrap();
     let cfg = MachineConfig::defaults(Machine::Flatbed);
-    let points = taut_simavr::picture::plot_points(&signals, &cfg, ended.origin).unwrap();
+    let points = taut_trace::picture::plot_points(&signals, &cfg, ended.origin).unwrap();
     let moves: Vec<([f64; 2], [f64; 2], bool)> = shown
         .as_array()
         .unwrap()
@@ -103,7 +142,10 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
     // From the pen's first stroke on: before it the machine homed at
     // power-on and went from where homing left it, which the toolpath
     // (read from the G-code alone) puts at 0, 0.
-    let first = points.iter().position(|(_, down)| *down).expect("the pen went down");
+    let first = points
+        .iter()
+        .position(|(_, down)| *down)
+        .expect("the pen went down");
     for ((x, y), is_down) in &points[first..] {
         let off = moves
             .iter()
@@ -112,10 +154,20 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
             .fold(f64::MAX, f64::min);
         worst = worst.max(off);
         down += usize::from(*is_down);
-        assert!(off <= within, "({x:.3}, {y:.3}) is {off:.3} mm off the toolpath, pen down: {is_down}");
+        assert!(
+            off <= within,
+            "({x:.3}, {y:.3}) is {off:.3} mm off the toolpath, pen down: {is_down}"
+        );
     }
-    let drawn: f64 = moves.iter().filter(|m| m.2).map(|m| (m.1[0] - m.0[0]).hypot(m.1[1] - m.0[1])).sum();
-    assert!(down as f64 > 0.9 * drawn / step, "{down} steps down for {drawn:.1} mm");
+    let drawn: f64 = moves
+        .iter()
+        .filter(|m| m.2)
+        .map(|m| (m.1[0] - m.0[0]).hypot(m.1[1] - m.0[1]))
+        .sum();
+    assert!(
+        down as f64 > 0.9 * drawn / step,
+        "{down} steps down for {drawn:.1} mm"
+    );
     eprintln!(
         "studio plot: {} steps ({down} pen down), worst {worst:.4} mm off; {:.0} s machine time; {} in {:.1} s",
         points.len() - first,
@@ -131,9 +183,19 @@ async fn a_string_art_card_made_in_the_page_is_wound_to_its_end() {
     let mut studio = Studio::start(Machine::StringArt, "card").await;
     let mut b = Browser::open().await;
     b.client.goto(&studio.url).await.unwrap();
-    b.until("the page", Duration::from_secs(10), "return document.getElementById('ports').options.length > 0").await;
+    b.until(
+        "the page",
+        Duration::from_secs(10),
+        "return document.getElementById('ports').options.length > 0",
+    )
+    .await;
     b.click("connect").await;
-    b.until("connected", Duration::from_secs(40), "return S.connected && S.settings.length > 0").await;
+    b.until(
+        "connected",
+        Duration::from_secs(40),
+        "return S.connected && S.settings.length > 0",
+    )
+    .await;
     // A quick machine: its axes 4 times as fast, accelerating 16 times as
     // hard (the steps, and so the replay, are the same), as a maker sets
     // them in the settings table.
@@ -151,17 +213,41 @@ async fn a_string_art_card_made_in_the_page_is_wound_to_its_end() {
 
     // A small board: 8 nails on a circle of 8 cm, 6 chords.
     b.js("document.getElementById('stringart-panel').open = true; document.getElementById('plotter-panel').open = false; return true").await;
-    b.js("document.getElementById('s-live').checked = false; return true").await;
+    b.js("document.getElementById('s-live').checked = false; return true")
+        .await;
     b.set("s-nails", "8").await;
     b.set("s-radius", "8").await;
     b.set("s-lines", "6").await;
-    b.by_id("open").await.send_keys(&example("horse.png")).await.unwrap();
+    b.by_id("open")
+        .await
+        .send_keys(&example("horse.png"))
+        .await
+        .unwrap();
     b.click("stringart").await;
-    b.until("the card", Duration::from_secs(60), "return S.card && S.card.lines === 6").await;
+    b.until(
+        "the card",
+        Duration::from_secs(60),
+        "return S.card && S.card.lines === 6",
+    )
+    .await;
     let figures = b.text("card-figures").await;
-    assert!(figures.contains("machine time") && figures.contains("thread"), "{figures}");
-    let poradi = b.js("return S.card.poradi").await.as_str().unwrap().to_string();
-    let pattern: Vec<u16> = poradi.lines().skip(1).flat_map(|l| l.split(',')).filter(|n| !n.trim().is_empty()).map(|n| n.trim().parse().unwrap()).collect();
+    assert!(
+        figures.contains("machine time") && figures.contains("thread"),
+        "{figures}"
+    );
+    let poradi = b
+        .js("return S.card.poradi")
+        .await
+        .as_str()
+        .unwrap()
+        .to_string();
+    let pattern: Vec<u16> = poradi
+        .lines()
+        .skip(1)
+        .flat_map(|l| l.split(','))
+        .filter(|n| !n.trim().is_empty())
+        .map(|n| n.trim().parse().unwrap())
+        .collect();
     b.screenshot("stringart.png").await;
     b.click("card-insert").await;
 
@@ -178,8 +264,12 @@ async fn a_string_art_card_made_in_the_page_is_wound_to_its_end() {
             b.click("green").await;
             presses += 1;
             let before = prompt.clone();
-            b.until("the prompt answered", Duration::from_secs(20),
-                &format!("return !S.job.prompt || S.job.prompt !== {before:?} || null")).await;
+            b.until(
+                "the prompt answered",
+                Duration::from_secs(20),
+                &format!("return !S.job.prompt || S.job.prompt !== {before:?} || null"),
+            )
+            .await;
         }
         assert!(Instant::now() < limit, "the job did not end: {prompt}");
         tokio::time::sleep(Duration::from_millis(200)).await;
@@ -192,7 +282,7 @@ async fn a_string_art_card_made_in_the_page_is_wound_to_its_end() {
 
     let ended = studio.end().await;
     let text = std::fs::read_to_string(&studio.vcd).unwrap();
-    let signals = taut_simavr::vcd::parse(&text).unwrap();
+    let signals = taut_trace::vcd::parse(&text).unwrap();
     let param = format!("tvar = 0\npocet_hrebiku = 8\npolomer_matrice = 8\n");
     let (_, wrapped) = taut_studio::preview::wrapped_nails(&signals, param.as_bytes()).unwrap();
     assert_eq!(wrapped, pattern, "the nails wrapped, from the pulses");
@@ -208,11 +298,23 @@ async fn the_console_answers_unlock_home_a_jog_and_a_status_request() {
     let mut studio = Studio::start(Machine::Flatbed, "console").await;
     let mut b = Browser::open().await;
     b.client.goto(&studio.url).await.unwrap();
-    b.until("the page", Duration::from_secs(10), "return document.getElementById('ports').options.length > 0").await;
+    b.until(
+        "the page",
+        Duration::from_secs(10),
+        "return document.getElementById('ports').options.length > 0",
+    )
+    .await;
     b.click("connect").await;
-    b.until("connected", Duration::from_secs(40), "return S.connected && S.settings.length > 0 && S.status.state === 'Idle'").await;
+    b.until(
+        "connected",
+        Duration::from_secs(40),
+        "return S.connected && S.settings.length > 0 && S.status.state === 'Idle'",
+    )
+    .await;
     // The console's lines after the n-th, as the page shows them.
-    let lines_after = |n: usize| format!("return [...document.querySelectorAll('#log div')].slice({n}).map(d => d.firstChild.textContent)");
+    let lines_after = |n: usize| {
+        format!("return [...document.querySelectorAll('#log div')].slice({n}).map(d => d.firstChild.textContent)")
+    };
     let count = "return document.querySelectorAll('#log div').length";
     let mut answers = Vec::new();
     for (line, want) in [
@@ -223,11 +325,22 @@ async fn the_console_answers_unlock_home_a_jog_and_a_status_request() {
     ] {
         let n = b.js(count).await.as_u64().unwrap() as usize;
         b.type_line("console-input", line).await;
-        let got = b.until(line, Duration::from_secs(60), &format!(
-            "const l = {}; return l.some(t => t.startsWith('{want}')) ? l : null",
-            lines_after(n).trim_start_matches("return ")
-        )).await;
-        let got: Vec<String> = got.as_array().unwrap().iter().map(|v| v.as_str().unwrap().to_string()).collect();
+        let got = b
+            .until(
+                line,
+                Duration::from_secs(60),
+                &format!(
+                    "const l = {}; return l.some(t => t.startsWith('{want}')) ? l : null",
+                    lines_after(n).trim_start_matches("return ")
+                ),
+            )
+            .await;
+        let got: Vec<String> = got
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap().to_string())
+            .collect();
         assert_eq!(got[0], line, "the line typed is shown first");
         answers.push(got);
     }
@@ -236,8 +349,16 @@ async fn the_console_answers_unlock_home_a_jog_and_a_status_request() {
     assert_eq!(answers[0].last().unwrap(), "ok");
     assert_eq!(answers[1].last().unwrap(), "ok");
     let status = answers[3].iter().find(|l| l.starts_with('<')).unwrap();
-    assert!(status.starts_with("<Idle|MPos:") || status.starts_with("<Jog|MPos:"), "{status}");
-    b.until("the jog's end", Duration::from_secs(10), "return S.status.state === 'Idle'").await;
+    assert!(
+        status.starts_with("<Idle|MPos:") || status.starts_with("<Jog|MPos:"),
+        "{status}"
+    );
+    b.until(
+        "the jog's end",
+        Duration::from_secs(10),
+        "return S.status.state === 'Idle'",
+    )
+    .await;
     let pos = b.js("return S.status.mpos").await;
     let y = pos[1].as_f64().unwrap();
     assert!((y - 2.0).abs() < 0.03, "Y {y} after a 2 mm jog");
@@ -248,14 +369,30 @@ async fn the_console_answers_unlock_home_a_jog_and_a_status_request() {
     assert!(notice.as_str().unwrap().contains("What to do:"), "{notice}");
     // The jog button: held jogs, released cancels (0x85).
     let x0 = b.js("return S.status.mpos[0]").await.as_f64().unwrap();
-    b.js("const e = document.querySelector('[data-testid=\"jog-x+\"]'); \
-          e.dispatchEvent(new PointerEvent('pointerdown', {bubbles: true})); return true").await;
-    b.until("jogging", Duration::from_secs(10), &format!("return S.status.mpos[0] > {x0} + 0.01")).await;
-    b.js("const e = document.querySelector('[data-testid=\"jog-x+\"]'); \
-          e.dispatchEvent(new PointerEvent('pointerup', {bubbles: true})); return true").await;
+    b.js(
+        "const e = document.querySelector('[data-testid=\"jog-x+\"]'); \
+          e.dispatchEvent(new PointerEvent('pointerdown', {bubbles: true})); return true",
+    )
+    .await;
+    b.until(
+        "jogging",
+        Duration::from_secs(10),
+        &format!("return S.status.mpos[0] > {x0} + 0.01"),
+    )
+    .await;
+    b.js(
+        "const e = document.querySelector('[data-testid=\"jog-x+\"]'); \
+          e.dispatchEvent(new PointerEvent('pointerup', {bubbles: true})); return true",
+    )
+    .await;
     b.until("jog cancel sent", Duration::from_secs(10),
         "return [...document.querySelectorAll('#log div')].some(d => d.textContent.startsWith('0x85'))").await;
-    b.until("standing", Duration::from_secs(10), "return S.status.state === 'Idle'").await;
+    b.until(
+        "standing",
+        Duration::from_secs(10),
+        "return S.status.state === 'Idle'",
+    )
+    .await;
     let x1 = b.js("return S.status.mpos[0]").await.as_f64().unwrap();
     assert!(x1 > x0 && x1 <= x0 + 1.0 + 0.03, "jogged from {x0} to {x1}");
     b.screenshot("console.png").await;

@@ -17,6 +17,7 @@ pub struct Image {
     pub flash_bytes: u64,
     pub ram_static_bytes: u64,
     pub data_bytes: u64,
+    pub map: crate::flashmap::FlashMap,
 }
 
 pub fn dir() -> PathBuf {
@@ -40,8 +41,10 @@ pub fn build_release() -> Result<Image> {
     )?;
     let sizes = section_sizes(&elf)?;
     let get = |n: &str| sizes.iter().find(|(s, _)| s == n).map_or(0, |(_, v)| *v);
+    let map = crate::flashmap::check(&elf)?;
     let img = Image {
-        flash_bytes: get(".text") + get(".data"),
+        flash_bytes: get(".text") + get(".data") + get(".endmark"),
+        map,
         ram_static_bytes: get(".data") + get(".bss") + get(".noinit"),
         data_bytes: get(".data"),
         elf,
@@ -59,15 +62,34 @@ pub fn build_release() -> Result<Image> {
 }
 
 /// The special-purpose images in firmware/examples (crash, hang, …).
+/// Those built on the firmware's crate (its start-up, its runtime) have
+/// their flash map checked like the firmware's (the watchdog entry, the
+/// end mark); the bare ones (blink, crash, …) test the simulator alone
+/// and are never flashed through the bootloader.
 pub fn build_examples() -> Result<()> {
     println!("== building the example images");
-    cargo(&["build", "--release", "--examples"], &dir())
+    cargo(&["build", "--release", "--examples"], &dir())?;
+    for e in std::fs::read_dir(dir().join("examples"))? {
+        let src = e?.path();
+        let Some(name) = src.file_stem().and_then(|s| s.to_str()) else {
+            continue;
+        };
+        if src.extension().is_some_and(|x| x == "rs")
+            && std::fs::read_to_string(&src)?.contains("taut_firmware::")
+        {
+            crate::flashmap::check(&release_dir().join(format!("examples/{name}.elf")))?;
+        }
+    }
+    Ok(())
 }
 
 pub fn flash() -> Result<()> {
     let img = build_release()?;
     img.print_size();
-    println!("== flashing through ravedude (Mega 2560 on the first serial port it finds)");
+    println!(
+        "== flashing through ravedude (Mega 2560 on the first serial port it finds, \
+         or RAVEDUDE_PORT)"
+    );
     let mut c = cargo_cmd(&["run", "--release"], &dir());
     status(&mut c)
 }
@@ -83,6 +105,7 @@ impl Image {
             self.elf.display(),
             self.hex.display()
         );
+        self.map.print();
     }
 }
 

@@ -7,14 +7,19 @@
 use crate::firmware;
 use crate::run::{self, root, Result};
 
-pub const USAGE: &str = "cargo xtask studio [--port 8080] [--machine flatbed] [--vcd target/studio/studio.vcd]";
+pub const USAGE: &str =
+    "cargo xtask studio [--port 8080] [--machine flatbed] [--vcd target/studio/studio.vcd]";
 
 pub fn run(args: &[String]) -> Result<()> {
     let (mut port, mut machine) = ("8080".to_string(), "flatbed".to_string());
     let mut vcd = root().join("target/studio/studio.vcd");
     let mut it = args.iter();
     while let Some(a) = it.next() {
-        let mut value = || it.next().cloned().ok_or(format!("{a} needs a value\n{USAGE}"));
+        let mut value = || {
+            it.next()
+                .cloned()
+                .ok_or(format!("{a} needs a value\n{USAGE}"))
+        };
         match a.as_str() {
             "--port" => port = value()?,
             "--machine" => machine = value()?,
@@ -30,8 +35,24 @@ pub fn run(args: &[String]) -> Result<()> {
         "== taut studio on the simulated {machine} (trace: {} when it ends)",
         vcd.display()
     );
-    run::studio(&[
-        "studio".into(),
+    // The simulator is built into taut only with the `sim` feature.
+    let mut c = run::cargo_cmd(
+        &[
+            "run",
+            "--quiet",
+            "--release",
+            "-p",
+            "taut-studio",
+            "--features",
+            "sim",
+            "--bin",
+            "taut",
+            "--",
+        ],
+        &root(),
+    );
+    c.args([
+        "studio".to_string(),
         "--port".into(),
         port,
         "--sim".into(),
@@ -40,5 +61,6 @@ pub fn run(args: &[String]) -> Result<()> {
         machine,
         "--vcd".into(),
         vcd.display().to_string(),
-    ])
+    ]);
+    run::status(&mut c)
 }

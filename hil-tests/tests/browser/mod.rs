@@ -25,7 +25,11 @@ pub fn screenshots() -> PathBuf {
 
 /// A free port on 127.0.0.1 (bound, read, let go).
 fn free_port() -> u16 {
-    TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+    TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
 }
 
 /// `taut studio --sim` on the release image, serving on a free port.
@@ -39,7 +43,8 @@ pub struct Studio {
 
 impl Studio {
     pub async fn start(machine: Machine, name: &str) -> Studio {
-        let vcd = std::env::temp_dir().join(format!("taut-studio-{}-{name}.vcd", std::process::id()));
+        let vcd =
+            std::env::temp_dir().join(format!("taut-studio-{}-{name}.vcd", std::process::id()));
         let o = Options {
             port: 0,
             sim: Some(hil_tests::firmware_elf()),
@@ -78,12 +83,19 @@ impl Studio {
 struct BrowserLog;
 
 impl WebDriverCompatibleCommand for BrowserLog {
-    fn endpoint(&self, base: &url::Url, session: Option<&str>) -> Result<url::Url, url::ParseError> {
+    fn endpoint(
+        &self,
+        base: &url::Url,
+        session: Option<&str>,
+    ) -> Result<url::Url, url::ParseError> {
         base.join(&format!("session/{}/se/log", session.unwrap_or_default()))
     }
 
     fn method_and_body(&self, _: &url::Url) -> (http::Method, Option<String>) {
-        (http::Method::POST, Some(json!({ "type": "browser" }).to_string()))
+        (
+            http::Method::POST,
+            Some(json!({ "type": "browser" }).to_string()),
+        )
     }
 }
 
@@ -104,8 +116,11 @@ impl Browser {
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()
-            .expect("chromedriver (Debian's chromium-driver: hil-tests/clients/install.sh installs it)");
-        let profile = std::env::temp_dir().join(format!("taut-chromium-{}-{port}", std::process::id()));
+            .expect(
+                "chromedriver (Debian's chromium-driver: hil-tests/clients/install.sh installs it)",
+            );
+        let profile =
+            std::env::temp_dir().join(format!("taut-chromium-{}-{port}", std::process::id()));
         let until = Instant::now() + Duration::from_secs(20);
         while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
             assert!(Instant::now() < until, "chromedriver did not listen");
@@ -151,7 +166,11 @@ impl Browser {
     }
 
     pub async fn click(&self, testid: &str) {
-        self.by_id(testid).await.click().await.unwrap_or_else(|e| panic!("click {testid}: {e}"));
+        self.by_id(testid)
+            .await
+            .click()
+            .await
+            .unwrap_or_else(|e| panic!("click {testid}: {e}"));
     }
 
     pub async fn text(&self, testid: &str) -> String {
@@ -159,7 +178,10 @@ impl Browser {
     }
 
     pub async fn js(&self, script: &str) -> Value {
-        self.client.execute(script, Vec::new()).await.unwrap_or_else(|e| panic!("{script}: {e}"))
+        self.client
+            .execute(script, Vec::new())
+            .await
+            .unwrap_or_else(|e| panic!("{script}: {e}"))
     }
 
     /// Waits (up to `limit`) until `f` holds of the page, polling.
@@ -171,9 +193,16 @@ impl Browser {
                 return v;
             }
             if Instant::now() > until {
-                let notice = self.js("return document.getElementById('notice').textContent").await;
-                let log = self.js("return document.getElementById('log').innerText.slice(-1500)").await;
-                panic!("waited {limit:?} for {what}\nnotice: {notice}\nconsole:\n{}", log.as_str().unwrap_or(""));
+                let notice = self
+                    .js("return document.getElementById('notice').textContent")
+                    .await;
+                let log = self
+                    .js("return document.getElementById('log').innerText.slice(-1500)")
+                    .await;
+                panic!(
+                    "waited {limit:?} for {what}\nnotice: {notice}\nconsole:\n{}",
+                    log.as_str().unwrap_or("")
+                );
             }
             tokio::time::sleep(Duration::from_millis(100)).await;
         }
@@ -203,7 +232,11 @@ impl Browser {
 
     /// The browser's log since the last call; panics on any error in it.
     pub async fn assert_no_console_errors(&mut self) {
-        let log = self.client.issue_cmd(BrowserLog).await.expect("the browser's log");
+        let log = self
+            .client
+            .issue_cmd(BrowserLog)
+            .await
+            .expect("the browser's log");
         let entries = log.as_array().cloned().unwrap_or_default();
         let errors: Vec<&Value> = entries
             .iter()

@@ -35,12 +35,21 @@ pub fn router(app: App) -> Router {
         .route("/app.js", get(web::script))
         .route("/style.css", get(web::style))
         .route("/api/machines", get(|| async { Json(tools::machines()) }))
-        .route("/api/vectorize", post(|u, h, b| tool(u, h, b, tools::vectorize)))
+        .route(
+            "/api/vectorize",
+            post(|u, h, b| tool(u, h, b, tools::vectorize)),
+        )
         .route("/api/text", post(|u, h, b| tool(u, h, b, tools::text)))
         .route("/api/gcode", post(|u, h, b| tool(u, h, b, tools::gcode)))
-        .route("/api/stringart", post(|u, h, b| tool(u, h, b, tools::stringart)))
+        .route(
+            "/api/stringart",
+            post(|u, h, b| tool(u, h, b, tools::stringart)),
+        )
         .route("/api/template", get(template))
-        .route("/api/card", post(|u, h, b| tool(u, h, b, tools::write_card)))
+        .route(
+            "/api/card",
+            post(|u, h, b| tool(u, h, b, tools::write_card)),
+        )
         .route("/api/ports", get(ports))
         .route("/api/connect", post(connect_handler))
         .route("/api/disconnect", post(disconnect))
@@ -53,7 +62,12 @@ pub fn router(app: App) -> Router {
         .route("/api/run/{action}", post(run_action))
         .route("/api/controller", get(controller).post(take_over))
         .route("/api/events", get(events))
-        .fallback(|| async { Bad { status: 404, message: "no such page or API".into() } })
+        .fallback(|| async {
+            Bad {
+                status: 404,
+                message: "no such page or API".into(),
+            }
+        })
         .layer(middleware::from_fn_with_state(app.clone(), guard))
         .with_state(app)
 }
@@ -127,7 +141,10 @@ async fn upload(headers: &HeaderMap, body: Body) -> Result<Bytes, Bad> {
                 n as f64 / (1 << 20) as f64,
                 UPLOAD_LIMIT >> 20
             ),
-            None => format!("the file is over {} MB, the most the studio takes", UPLOAD_LIMIT >> 20),
+            None => format!(
+                "the file is over {} MB, the most the studio takes",
+                UPLOAD_LIMIT >> 20
+            ),
         },
     };
     let declared = headers
@@ -144,7 +161,9 @@ async fn upload(headers: &HeaderMap, body: Body) -> Result<Bytes, Bad> {
 
 /// Runs a tool off the async threads (vectorising and generating take
 /// seconds).
-async fn blocking<T: Send + 'static>(f: impl FnOnce() -> Result<T, Bad> + Send + 'static) -> Result<T, Bad> {
+async fn blocking<T: Send + 'static>(
+    f: impl FnOnce() -> Result<T, Bad> + Send + 'static,
+) -> Result<T, Bad> {
     tokio::task::spawn_blocking(f).await.map_err(|e| Bad {
         status: 500,
         message: format!("the tool failed: {e}"),
@@ -168,7 +187,10 @@ async fn template(uri: axum::http::Uri) -> Result<Response, Bad> {
     Ok((
         [
             (header::CONTENT_TYPE, "image/svg+xml"),
-            (header::CONTENT_DISPOSITION, "attachment; filename=\"template.svg\""),
+            (
+                header::CONTENT_DISPOSITION,
+                "attachment; filename=\"template.svg\"",
+            ),
         ],
         svg,
     )
@@ -213,22 +235,29 @@ async fn controller(State(app): State<App>) -> Json<Value> {
 }
 
 /// `POST /api/controller`: take over, explicitly.
-async fn take_over(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri) -> Json<Value> {
+async fn take_over(
+    State(app): State<App>,
+    headers: HeaderMap,
+    uri: axum::http::Uri,
+) -> Json<Value> {
     let who = client(&headers, &uri);
     app.hub.lock().controller = Some(who.clone());
     app.hub.emit("controller", json!({ "controller": who }));
     Json(json!({ "controller": who }))
 }
 
-async fn connect_handler(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri) -> Answer {
+async fn connect_handler(
+    State(app): State<App>,
+    headers: HeaderMap,
+    uri: axum::http::Uri,
+) -> Answer {
     control(&app, &client(&headers, &uri))?;
     let q = options(&uri);
-    let port = q
-        .0
-        .get("port")
-        .cloned()
-        .or_else(|| app.sim.as_ref().map(|s| s.tty.display().to_string()))
-        .ok_or_else(|| Bad::input("missing port".into()))?;
+    let port =
+        q.0.get("port")
+            .cloned()
+            .or_else(|| app.sim.as_ref().map(|s| s.tty.display().to_string()))
+            .ok_or_else(|| Bad::input("missing port".into()))?;
     connect(&app, &port).await.map(Json)
 }
 
@@ -236,7 +265,10 @@ async fn connect_handler(State(app): State<App>, headers: HeaderMap, uri: axum::
 /// then reads its settings (`$$`).
 pub async fn connect(app: &Studio, port: &str) -> Result<Value, Bad> {
     if let Some(l) = &app.hub.lock().link {
-        return Err(Bad::conflict(format!("connected to {} already: disconnect first", l.name)));
+        return Err(Bad::conflict(format!(
+            "connected to {} already: disconnect first",
+            l.name
+        )));
     }
     let link = Link::open(port, app.hub.clone()).map_err(|e| Bad {
         status: 502,
@@ -247,7 +279,8 @@ pub async fn connect(app: &Studio, port: &str) -> Result<Value, Bad> {
         inner.link = Some(link);
         inner.lost = None;
         inner.status.state = "Connecting".into();
-        app.hub.emit("link", json!({ "connected": true, "port": port }));
+        app.hub
+            .emit("link", json!({ "connected": true, "port": port }));
     }
     // A Mega resets as its port opens (its boot loader waits ~1.6 s): up
     // to 5 s for the first status report the poller asks for.
@@ -273,7 +306,9 @@ pub async fn connect(app: &Studio, port: &str) -> Result<Value, Bad> {
         disconnect_now(&app.hub, "no status report");
         return Err(Bad {
             status: 502,
-            message: format!("{port}: no answer to a status request (?): is it a Grbl machine at 115200 baud?"),
+            message: format!(
+                "{port}: no answer to a status request (?): is it a Grbl machine at 115200 baud?"
+            ),
         });
     }
     // Its figures, for the ETA and the settings table; a machine homing
@@ -291,7 +326,11 @@ fn disconnect_now(hub: &Hub, why: &str) {
             run.interrupt(why);
             hub.emit("run", run.report());
         }
-        hub.log(&mut inner, "note", &format!("disconnected from {}", link.name));
+        hub.log(
+            &mut inner,
+            "note",
+            &format!("disconnected from {}", link.name),
+        );
         hub.emit("link", json!({ "connected": false, "port": Value::Null }));
         hub.emit("status", json!({ "status": inner.status }));
     }
@@ -310,7 +349,12 @@ async fn machine(State(app): State<App>) -> Json<Value> {
 }
 
 /// `POST /api/machine/line`: one console line (the body); its replies.
-async fn line(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri, body: Body) -> Answer {
+async fn line(
+    State(app): State<App>,
+    headers: HeaderMap,
+    uri: axum::http::Uri,
+    body: Body,
+) -> Answer {
     control(&app, &client(&headers, &uri))?;
     let bytes = upload(&headers, body).await?;
     let text = String::from_utf8_lossy(&bytes);
@@ -319,7 +363,10 @@ async fn line(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri, 
         return Err(Bad::input("one line at a time".into()));
     }
     if line.len() > 127 {
-        return Err(Bad::input(format!("{} characters: Grbl's buffer takes 127", line.len())));
+        return Err(Bad::input(format!(
+            "{} characters: Grbl's buffer takes 127",
+            line.len()
+        )));
     }
     // Homing and waiting for motion take as long as the machine needs.
     let upper = line.to_ascii_uppercase();
@@ -328,8 +375,13 @@ async fn line(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri, 
         _ => Duration::from_secs(30),
     };
     let replies = app.hub.console(line, wait).await.map_err(Bad::conflict)?;
-    let words: Vec<String> = replies.iter().filter_map(|r| super::words::explain(r)).collect();
-    Ok(Json(json!({ "line": line, "replies": replies, "words": words })))
+    let words: Vec<String> = replies
+        .iter()
+        .filter_map(|r| super::words::explain(r))
+        .collect();
+    Ok(Json(
+        json!({ "line": line, "replies": replies, "words": words }),
+    ))
 }
 
 /// `POST /api/machine/realtime?cmd=…`: one of Grbl's real-time bytes.
@@ -373,11 +425,19 @@ async fn button(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri
     let b = Button::ALL
         .into_iter()
         .find(|b| b.name() == name || (name == "green" && *b == Button::Confirm))
-        .ok_or_else(|| Bad::input(format!("name={name}: green, zero_base, zero_radial or zero_drill")))?;
+        .ok_or_else(|| {
+            Bad::input(format!(
+                "name={name}: green, zero_base, zero_radial or zero_drill"
+            ))
+        })?;
     if let Some(sim) = &app.sim {
         sim.press(b, long).map_err(Bad::conflict)?;
         let mut inner = app.hub.lock();
-        let what = format!("{} button pressed{} (simulator)", name, if long { " for 2.5 s" } else { "" });
+        let what = format!(
+            "{} button pressed{} (simulator)",
+            name,
+            if long { " for 2.5 s" } else { "" }
+        );
         app.hub.log(&mut inner, "note", &what);
         return Ok(Json(json!({ "pressed": name, "long": long })));
     }
@@ -395,26 +455,41 @@ async fn button(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri
 
 /// `POST /api/sim/card`: the card (`poradi.txt` the body, the board the
 /// query) put in the simulated machine's slot.
-async fn sim_card(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri, body: Body) -> Answer {
+async fn sim_card(
+    State(app): State<App>,
+    headers: HeaderMap,
+    uri: axum::http::Uri,
+    body: Body,
+) -> Answer {
     control(&app, &client(&headers, &uri))?;
-    let sim = app
-        .sim
-        .as_ref()
-        .ok_or_else(|| Bad::conflict("no simulator: start taut studio with --sim (cargo xtask studio)"))?;
+    let sim = app.sim.as_ref().ok_or_else(|| {
+        Bad::conflict("no simulator: start taut studio with --sim (cargo xtask studio)")
+    })?;
     let bytes = upload(&headers, body).await?;
     let (spec, pattern) = tools::card_files(&bytes, &options(&uri))?;
     let param = spec.param_txt();
     sim.insert_card(&[("param.txt", param.as_bytes()), ("poradi.txt", &bytes[..])])
         .map_err(Bad::conflict)?;
     let mut inner = app.hub.lock();
-    let note = format!("card put in the simulator: {} nails, {} connections", spec.nails, pattern.len());
+    let note = format!(
+        "card put in the simulator: {} nails, {} connections",
+        spec.nails,
+        pattern.len()
+    );
     app.hub.log(&mut inner, "note", &note);
-    Ok(Json(json!({ "inserted": true, "nails": spec.nails, "connections": pattern.len() })))
+    Ok(Json(
+        json!({ "inserted": true, "nails": spec.nails, "connections": pattern.len() }),
+    ))
 }
 
 /// `POST /api/run?name=…`: the body, a G-code file, checked as the
 /// machine reads it, then streamed.
-async fn run_start(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri, body: Body) -> Answer {
+async fn run_start(
+    State(app): State<App>,
+    headers: HeaderMap,
+    uri: axum::http::Uri,
+    body: Body,
+) -> Answer {
     control(&app, &client(&headers, &uri))?;
     let bytes = upload(&headers, body).await?;
     let q = options(&uri);
@@ -507,7 +582,12 @@ async fn run_action(
             run.interrupt("stopped: Ctrl-X sent, the machine reset");
             0x18
         }
-        a => return Err(Bad { status: 404, message: format!("/api/run/{a}: pause, resume or stop") }),
+        a => {
+            return Err(Bad {
+                status: 404,
+                message: format!("/api/run/{a}: pause, resume or stop"),
+            })
+        }
     };
     let report = run.report();
     app.hub.write(inner, &[byte]).map_err(Bad::conflict)?;
@@ -550,7 +630,11 @@ async fn watch(app: App, who: String, mut socket: WebSocket) {
         s["simulator"] = json!(app.sim.as_ref().map(|s| s.machine.name().to_string()));
         s
     };
-    if socket.send(Message::Text(hello.to_string().into())).await.is_err() {
+    if socket
+        .send(Message::Text(hello.to_string().into()))
+        .await
+        .is_err()
+    {
         return left(&app, &who);
     }
     loop {
@@ -588,7 +672,8 @@ fn left(app: &Studio, who: &str) {
     }
     if inner.controller.as_deref() == Some(who) && !inner.watchers.iter().any(|w| w == who) {
         inner.controller = None;
-        app.hub.emit("controller", json!({ "controller": Value::Null }));
+        app.hub
+            .emit("controller", json!({ "controller": Value::Null }));
     }
 }
 
@@ -598,7 +683,9 @@ mod tests {
 
     #[test]
     fn query_strings_decode_and_tokens_compare_whole() {
-        let uri: axum::http::Uri = "/api/text?a=1&text=Hello%2C+world%21&at=3%2C4&b".parse().unwrap();
+        let uri: axum::http::Uri = "/api/text?a=1&text=Hello%2C+world%21&at=3%2C4&b"
+            .parse()
+            .unwrap();
         let q = query_pairs(&uri);
         assert_eq!(q["text"], "Hello, world!");
         assert_eq!(q["at"], "3,4");

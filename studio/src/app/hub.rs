@@ -40,7 +40,8 @@ impl Status {
             raw: line.to_string(),
             ..Status::default()
         };
-        let numbers = |v: &str| -> Vec<f64> { v.split(',').filter_map(|n| n.parse().ok()).collect() };
+        let numbers =
+            |v: &str| -> Vec<f64> { v.split(',').filter_map(|n| n.parse().ok()).collect() };
         for f in fields {
             match f.split_once(':') {
                 Some(("MPos", v)) => s.mpos = numbers(v),
@@ -311,7 +312,11 @@ impl Hub {
 
     /// A console line: waits for its answer. `?` alone waits for the next
     /// status report; a line gets every reply up to its `ok` / `error:`.
-    pub async fn console(&self, line: &str, wait: std::time::Duration) -> Result<Vec<String>, String> {
+    pub async fn console(
+        &self,
+        line: &str,
+        wait: std::time::Duration,
+    ) -> Result<Vec<String>, String> {
         let (tx, rx) = oneshot::channel();
         {
             let mut inner = self.lock();
@@ -372,7 +377,10 @@ impl Hub {
             self.emit("run", run.report());
         }
         self.log(inner, "note", &why);
-        self.emit("link", json!({ "connected": false, "port": Value::Null, "lost": why }));
+        self.emit(
+            "link",
+            json!({ "connected": false, "port": Value::Null, "lost": why }),
+        );
         self.emit("status", json!({ "status": inner.status }));
     }
 
@@ -411,7 +419,10 @@ mod tests {
         assert!(job.read("[MSG:I 121 job: >>> zero, drill on, press green to drill]"));
         assert!(job.read("[MSG:I 122 job: drill 3/24]"));
         assert_eq!(job.progress, Some(("drill".into(), 3, 24)));
-        assert_eq!(job.prompt.as_deref(), Some(">>> zero, drill on, press green to drill"));
+        assert_eq!(
+            job.prompt.as_deref(),
+            Some(">>> zero, drill on, press green to drill")
+        );
         assert!(job.read("[MSG:I 123 job: state: winding]"));
         assert_eq!(job.prompt, None);
         assert!(!job.read("[MSG:Caution: Unlocked]"));

@@ -125,7 +125,10 @@ impl Run {
     /// Motion was seen after the last answer, or a second has gone by (a
     /// file of no motion stands at once).
     fn moved_or_late(&self) -> bool {
-        self.moved || self.finishing.is_some_and(|t| t.elapsed().as_secs_f64() > 1.0)
+        self.moved
+            || self
+                .finishing
+                .is_some_and(|t| t.elapsed().as_secs_f64() > 1.0)
     }
 
     /// Paused (`!` sent) or running again (`~`).
@@ -201,12 +204,22 @@ mod tests {
         let mut run = Run::new("t", b"G21\nG1 X10 F600\n; c\nG1 X20\n", &cfg).unwrap();
         let mut out = Vec::new();
         run.fill(&mut out).unwrap();
-        assert_eq!(out, [b"G21\n".to_vec(), b"G1X10F600\n".to_vec(), b"G1X20\n".to_vec()]);
+        assert_eq!(
+            out,
+            [
+                b"G21\n".to_vec(),
+                b"G1X10F600\n".to_vec(),
+                b"G1X20\n".to_vec()
+            ]
+        );
         assert!(run.on_reply("ok").is_empty());
         let notes = run.on_reply("[MSG:Travel exceeded (col 3)]");
         assert!(notes.is_empty());
         let notes = run.on_reply("error:15");
-        assert_eq!(notes, ["t: line 2: G1X10F600: error:15 Travel exceeded (col 3)"]);
+        assert_eq!(
+            notes,
+            ["t: line 2: G1X10F600: error:15 Travel exceeded (col 3)"]
+        );
         assert_eq!(run.report()["line"], 2);
         run.hold(true).unwrap();
         assert!(run.hold(true).is_err());
@@ -233,10 +246,7 @@ mod tests {
         );
         let mut run = Run::new("t", b"G21\n", &cfg).unwrap();
         run.on_reply("ALARM:3");
-        assert_eq!(
-            run.report()["reason"],
-            "ALARM:3 (no line acknowledged)"
-        );
+        assert_eq!(run.report()["reason"], "ALARM:3 (no line acknowledged)");
         assert!(Run::new("t", b"; nothing\n", &cfg).is_err());
     }
 }

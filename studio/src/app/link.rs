@@ -41,7 +41,9 @@ pub fn ports(sim: Option<&str>) -> Vec<PortInfo> {
         .map(|p| PortInfo {
             what: match p.port_type {
                 serialport::SerialPortType::UsbPort(u) => {
-                    format!("USB {}", u.product.unwrap_or_default()).trim().to_string()
+                    format!("USB {}", u.product.unwrap_or_default())
+                        .trim()
+                        .to_string()
                 }
                 serialport::SerialPortType::BluetoothPort => "Bluetooth".into(),
                 _ => "serial".into(),

@@ -110,13 +110,16 @@ pub fn run(mut args: crate::args::Args) -> Result<(), String> {
         ..Options::default()
     };
     if let Some(b) = args.value("bind") {
-        o.bind = b.parse().map_err(|_| format!("--bind {b}: not an IP address"))?;
+        o.bind = b
+            .parse()
+            .map_err(|_| format!("--bind {b}: not an IP address"))?;
     }
     o.token = args.value("token");
     o.serial = args.value("serial");
     o.sim = args.value("sim").map(PathBuf::from);
     if let Some(m) = args.value("machine") {
-        o.machine = Machine::parse(m.as_bytes()).ok_or(format!("--machine {m}: no such machine"))?;
+        o.machine =
+            Machine::parse(m.as_bytes()).ok_or(format!("--machine {m}: no such machine"))?;
     }
     o.vcd = args.value("vcd").map(PathBuf::from);
     o.connect = true;
@@ -285,8 +288,8 @@ fn new_token() -> Result<String, String> {
 /// The answer to a bad request.
 impl axum::response::IntoResponse for Bad {
     fn into_response(self) -> axum::response::Response {
-        let status =
-            axum::http::StatusCode::from_u16(self.status).unwrap_or(axum::http::StatusCode::BAD_REQUEST);
+        let status = axum::http::StatusCode::from_u16(self.status)
+            .unwrap_or(axum::http::StatusCode::BAD_REQUEST);
         (status, axum::Json(json!({ "error": self.message }))).into_response()
     }
 }

@@ -5,25 +5,26 @@
 //! process, the page can also do what a person at the machine does: put a
 //! card in the slot and press the machine's buttons. Every pin is probed,
 //! and the trace (VCD) is written when the app ends.
+//!
+//! The simulator (simavr, in C) is built into `taut` only with the `sim`
+//! feature, which `cargo xtask studio` and the HIL tests turn on: a maker's
+//! `taut` stays pure Rust, and `--sim` then says how to get it.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
-use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
 use taut_logic::pinmap::Button;
-use taut_logic::settings::image;
-use taut_simavr::pty::Pty;
-use taut_simavr::sdcard::SdImage;
-use taut_simavr::Sim;
 
 /// How long a short press is held (a long press: 2.5 s).
 const PRESS: Duration = Duration::from_millis(150);
 const LONG_PRESS: Duration = Duration::from_millis(2500);
 
+#[cfg_attr(not(feature = "sim"), allow(dead_code))]
 enum Command {
     Press(Button, Duration),
-    Card(Box<SdImage>),
+    /// A folder holding the card's files (imaged, then removed).
+    Card(PathBuf),
     Stop(mpsc::Sender<Result<Ended, String>>),
 }
 
@@ -82,10 +83,7 @@ impl SimHost {
         for (name, bytes) in files {
             std::fs::write(dir.join(name), bytes).map_err(|e| e.to_string())?;
         }
-        let image = SdImage::from_dir(&dir, taut_simavr::sdimage::FatChoice::Auto)
-            .map_err(|e| format!("the card image: {e}"));
-        let _ = std::fs::remove_dir_all(&dir);
-        self.send(Command::Card(Box::new(image?)))
+        self.send(Command::Card(dir))
     }
 
     /// Ends the simulation; the trace is written (if asked for).
@@ -107,7 +105,25 @@ fn unique() -> u64 {
     N.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
+/// Without the simulator built in: says how to get it.
+#[cfg(not(feature = "sim"))]
+fn serve(
+    _: &Path,
+    _: Machine,
+    _: &Path,
+    _: Option<PathBuf>,
+    _: &mpsc::Receiver<Command>,
+    ready: &mpsc::Sender<Result<(), String>>,
+) {
+    let _ = ready.send(Err(
+        "this taut was built without the simulator: run `cargo xtask studio`, \
+         or build taut with `--features sim`"
+            .into(),
+    ));
+}
+
 /// The simulator's thread: the machine in real time until told to stop.
+#[cfg(feature = "sim")]
 fn serve(
     elf: &Path,
     machine: Machine,
@@ -116,6 +132,9 @@ fn serve(
     inbox: &mpsc::Receiver<Command>,
     ready: &mpsc::Sender<Result<(), String>>,
 ) {
+    use taut_logic::config::MachineConfig;
+    use taut_logic::settings::image;
+    use taut_simavr::{pty::Pty, sdcard::SdImage, sdimage::FatChoice, Sim};
     let mut sim = match Sim::load(elf) {
         Ok(sim) => sim,
         Err(e) => {
@@ -144,7 +163,13 @@ fn serve(
                 sim.press(b.pin());
                 releases.push((sim.time_s() + hold.as_secs_f64(), b.pin()));
             }
-            Ok(Command::Card(image)) => sim.insert_sd(*image),
+            Ok(Command::Card(dir)) => {
+                match SdImage::from_dir(&dir, FatChoice::Auto) {
+                    Ok(image) => sim.insert_sd(image),
+                    Err(e) => eprintln!("taut studio: simulator: the card image: {e}"),
+                }
+                let _ = std::fs::remove_dir_all(&dir);
+            }
             Ok(Command::Stop(tx)) => break Some(tx),
             Err(mpsc::TryRecvError::Empty) => {}
             Err(mpsc::TryRecvError::Disconnected) => break None,

@@ -101,7 +101,15 @@ fn drawing(gcode: String, path: &Toolpath, machine: Machine) -> Value {
     let moves: Vec<Value> = path
         .moves
         .iter()
-        .map(|m| json!([r(m.from[0]), r(m.from[1]), r(m.to[0]), r(m.to[1]), u8::from(m.down)]))
+        .map(|m| {
+            json!([
+                r(m.from[0]),
+                r(m.from[1]),
+                r(m.to[0]),
+                r(m.to[1]),
+                u8::from(m.down)
+            ])
+        })
         .collect();
     json!({
         "machine": machine.name().to_string(),
@@ -175,8 +183,8 @@ pub fn vectorize(bytes: &[u8], q: &Query) -> Result<Value, Bad> {
 
 /// `POST /api/text`: the body (or `text=`) in a Hershey font.
 pub fn text(body: &[u8], q: &Query) -> Result<Value, Bad> {
-    let body = String::from_utf8(body.to_vec())
-        .map_err(|_| Bad::input("the text is not UTF-8".into()))?;
+    let body =
+        String::from_utf8(body.to_vec()).map_err(|_| Bad::input("the text is not UTF-8".into()))?;
     let words = match body.is_empty() {
         true => q.required("text")?.to_string(),
         false => body,
@@ -198,8 +206,8 @@ pub fn text(body: &[u8], q: &Query) -> Result<Value, Bad> {
         .pair("at")?
         .unwrap_or_else(|| plot::default_corner(machine, size));
     let shifted = text::strokes(&font, &words, height, wrap, corner).map_err(Bad::input)?;
-    let (gcode, path) = plot::plot(&shifted, machine, feed, &format!("taut text {words}"))
-        .map_err(Bad::input)?;
+    let (gcode, path) =
+        plot::plot(&shifted, machine, feed, &format!("taut text {words}")).map_err(Bad::input)?;
     Ok(drawing(gcode, &path, machine))
 }
 
@@ -212,8 +220,8 @@ pub fn gcode(bytes: &[u8], q: &Query) -> Result<Value, Bad> {
     if text.trim().is_empty() {
         return Err(Bad::input("the G-code file is empty".into()));
     }
-    let path = toolpath::from_gcode(text, machine)
-        .map_err(|e| Bad::input(format!("the G-code, {e}")))?;
+    let path =
+        toolpath::from_gcode(text, machine).map_err(|e| Bad::input(format!("the G-code, {e}")))?;
     if path.moves.is_empty() {
         return Err(Bad::input("the G-code moves nowhere".into()));
     }
@@ -230,7 +238,9 @@ pub fn spec(q: &Query) -> Result<Spec, Bad> {
     };
     let radius_cm: f64 = q.number("radius_cm", 20.0)?;
     if !(radius_cm > 0.0 && radius_cm <= 1000.0) {
-        return Err(Bad::input("radius_cm must be above 0 and at most 1000".into()));
+        return Err(Bad::input(
+            "radius_cm must be above 0 and at most 1000".into(),
+        ));
     }
     let spec = Spec {
         shape,
@@ -379,8 +389,16 @@ mod tests {
     fn framing_crops_zooms_and_stretches() {
         let mut g = Gray::new(40, 20, 1.0);
         g.pixels[5 * 40 + 30] = 0.25;
-        let f = frame(&g, &q(&[("zoom", "2"), ("cx", "0.75"), ("cy", "0.5"), ("contrast", "2")]))
-            .unwrap();
+        let f = frame(
+            &g,
+            &q(&[
+                ("zoom", "2"),
+                ("cx", "0.75"),
+                ("cy", "0.5"),
+                ("contrast", "2"),
+            ]),
+        )
+        .unwrap();
         // A 10-pixel square from (25, 5).
         assert_eq!((f.width, f.height), (10, 10));
         assert_eq!(f.at(5, 0), 0.0, "0.25 stretched twice about 0.5");

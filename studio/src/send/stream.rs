@@ -74,10 +74,7 @@ fn clean(line: &str) -> String {
 pub enum Answer {
     /// The line at `index` (into [`Stream::lines`]) was answered; with the
     /// reply and the firmware's words (its `[MSG:…]` before) if refused.
-    Line {
-        index: usize,
-        error: Option<String>,
-    },
+    Line { index: usize, error: Option<String> },
     /// `ALARM:n` and the firmware's words: the stream must stop.
     Alarm(String),
     /// Not an answer (a status report, a log line).
