@@ -530,8 +530,11 @@ fn taut_studio_prints_its_url_and_ends_on_ctrl_c() {
         answer.starts_with("HTTP/1.1 200") && answer.contains("\"idle\""),
         "{answer}"
     );
-    // SAFETY: a signal to the child this test started.
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let sent = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
     let status = child.wait().unwrap();
     assert!(status.success(), "{status:?}");
 }

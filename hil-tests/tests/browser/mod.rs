@@ -110,6 +110,10 @@ pub struct Browser {
 
 impl Browser {
     pub async fn open() -> Browser {
+        // Chromium and its driver, as the sender tests get theirs.
+        tokio::task::spawn_blocking(hil_tests::senders::install_clients)
+            .await
+            .unwrap();
         let port = free_port();
         let driver = Command::new("chromedriver")
             .arg(format!("--port={port}"))
