@@ -210,13 +210,18 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
         "{reason}"
     );
     // The machine lost its position (ALARM:3) and says what to do.
-    tokio::time::sleep(Duration::from_millis(500)).await;
-    let m = ok(&app, "GET", "/api/machine", "").await;
-    let notice = m["notice"].as_str().unwrap_or_default();
-    assert!(
-        notice.starts_with("ALARM:3") && notice.contains("unlock ($X)"),
-        "{notice}"
-    );
+    let until = Instant::now() + Duration::from_secs(3);
+    loop {
+        let m = ok(&app, "GET", "/api/machine", "").await;
+        let notice = m["notice"].as_str().unwrap_or_default();
+        if notice.starts_with("ALARM:3") {
+            assert!(notice.contains("unlock ($X)"), "{notice}");
+            break;
+        }
+        let log: Vec<&Value> = m["log"].as_array().unwrap().iter().rev().take(12).collect();
+        assert!(Instant::now() < until, "{notice}\n{log:#?}");
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
     ok(&app, "POST", "/api/machine/line", "$X").await;
     ok(&app, "POST", "/api/machine/realtime?cmd=status", "").await;
 

@@ -227,7 +227,7 @@ async fn a_string_art_card_made_in_the_page_is_wound_to_its_end() {
     b.until(
         "the card",
         Duration::from_secs(60),
-        "return S.card && S.card.lines === 6",
+        "return S.card && S.card.lines === 6 && document.getElementById('s-figures').textContent.includes('machine time')",
     )
     .await;
     let figures = b.text("card-figures").await;

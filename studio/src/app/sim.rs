@@ -181,9 +181,17 @@ fn serve(
             }
             at > now
         });
-        if let Err(e) = pty.serve(&mut sim, Duration::from_millis(5)) {
-            eprintln!("taut studio: simulator: {e}");
-            break None;
+        match pty.serve(&mut sim, Duration::from_millis(5)) {
+            Ok(outcome) if outcome.is_fatal() => {
+                // The port goes away with it: the page shows the link lost.
+                eprintln!("taut studio: simulator: firmware fault: {outcome:?}");
+                break None;
+            }
+            Ok(_) => {}
+            Err(e) => {
+                eprintln!("taut studio: simulator: {e}");
+                break None;
+            }
         }
     };
     let result = match &vcd {
