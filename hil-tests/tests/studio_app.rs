@@ -200,8 +200,18 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     assert_eq!(status, 409, "nothing to resume");
 
     // Stop: Ctrl-X, the run interrupted at its last acknowledged line.
+    // Stopped while drawing the square's first side (not while the pen
+    // goes down, when the machine stands and keeps its position).
     ok(&app, "POST", "/api/run?name=square", &square()).await;
-    tokio::time::sleep(Duration::from_millis(800)).await;
+    let until = Instant::now() + Duration::from_secs(10);
+    loop {
+        let s = ok(&app, "GET", "/api/machine", "").await["status"].clone();
+        if s["state"] == "Run" && s["mpos"][0].as_f64().unwrap_or(0.0) > 12.0 {
+            break;
+        }
+        assert!(Instant::now() < until, "not drawing: {s}");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
     let r = ok(&app, "POST", "/api/run/stop", "").await;
     assert_eq!(r["state"], "interrupted");
     let reason = r["reason"].as_str().unwrap();
@@ -219,7 +229,11 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
             break;
         }
         let log: Vec<&Value> = m["log"].as_array().unwrap().iter().rev().take(12).collect();
-        assert!(Instant::now() < until, "{notice}\n{log:#?}");
+        assert!(
+            Instant::now() < until,
+            "{notice}\nstatus {}\n{log:#?}",
+            m["status"]
+        );
         tokio::time::sleep(Duration::from_millis(50)).await;
     }
     ok(&app, "POST", "/api/machine/line", "$X").await;
