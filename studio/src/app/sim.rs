@@ -133,7 +133,7 @@ fn serve(
     ready: &mpsc::Sender<Result<(), String>>,
 ) {
     use taut_logic::config::MachineConfig;
-    use taut_logic::settings::image;
+    use taut_logic::settings::record::host;
     use taut_simavr::{pty::Pty, sdcard::SdImage, sdimage::FatChoice, Sim};
     let mut sim = match Sim::load(elf) {
         Ok(sim) => sim,
@@ -143,7 +143,7 @@ fn serve(
         }
     };
     let cfg = MachineConfig::defaults(machine);
-    let eeprom: Vec<u8> = image::bytes(&cfg).collect();
+    let eeprom = host::eeprom(&cfg, &Default::default(), &Default::default());
     sim.set_eeprom(&eeprom);
     sim.probe_machine(machine);
     let endstops = sim.fit_machine_endstops(&cfg, 3.0);
