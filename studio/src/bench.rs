@@ -7,7 +7,6 @@
 //! `stringart_seconds_<image>` for ours, `…_plain_<image>` for the plain
 //! greedy, `stringart_rmse_random_<image>`, `stringart_thread_m_<image>`.
 
-use crate::args::Args;
 use crate::gray::Gray;
 use crate::progress;
 use crate::stringart::card::{thread_mm, Spec};
@@ -15,7 +14,17 @@ use crate::stringart::{generate, Method, Options};
 use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
 
-pub const USAGE: &str = "taut bench [--json target/bench.json] [--images DIR]";
+/// The string-art figures of the docs, on the host (generator, plain greedy, random)
+#[derive(clap::Args, Debug)]
+#[command(after_help = "Example:\n  taut bench --json target/bench.json")]
+pub struct Cli {
+    /// Add the figures to this JSON file (made if missing)
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// The example images' folder [default: examples/images]
+    #[arg(long, value_name = "DIR")]
+    pub images: Option<PathBuf>,
+}
 
 pub const IMAGES: [&str; 3] = ["camera.jpg", "astronaut.jpg", "horse.png"];
 
@@ -31,13 +40,22 @@ pub fn options() -> Options {
     )
 }
 
-pub fn run(mut args: Args) -> Result<(), String> {
-    let json_path = args.value("json").map(PathBuf::from);
-    let dir = args
-        .value("images")
-        .map(PathBuf::from)
+pub fn run(cli: Cli) -> Result<(), String> {
+    let json_path = cli.json;
+    let dir = cli
+        .images
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/images"));
-    args.finish()?;
+    let images: Vec<PathBuf> = IMAGES.iter().map(|n| dir.join(n)).collect();
+    let images: Vec<&Path> = images.iter().map(PathBuf::as_path).collect();
+    crate::output::refuse_overwriting(
+        &images,
+        json_path
+            .as_slice()
+            .iter()
+            .map(PathBuf::as_path)
+            .collect::<Vec<_>>()
+            .as_slice(),
+    )?;
     let o = options();
     let board = o.spec.board()?;
     let mut figures = Map::new();
@@ -108,7 +126,7 @@ fn merge(path: &Path, figures: Map<String, Value>) -> Result<(), String> {
     };
     all.extend(figures);
     let text = serde_json::to_string_pretty(&Value::Object(all)).map_err(|e| fail(&e))?;
-    std::fs::write(path, text).map_err(|e| fail(&e))
+    crate::output::write(path, text.as_bytes())
 }
 
 #[cfg(test)]

@@ -9,11 +9,12 @@
 //! the web app over all of them and the machine's serial port.
 
 pub mod app;
-pub mod args;
 pub mod bench;
 pub mod board;
+pub mod cli;
 pub mod gray;
 pub mod hershey;
+pub mod output;
 pub mod plot;
 pub mod preview;
 pub mod progress;

@@ -1,13 +1,15 @@
-//! `taut preview FILE.gcode|TRACE.vcd --machine … -o out.png|svg`: a
-//! toolpath as a picture, the pen down solid and its travel dashed.
+//! `taut preview FILE.gcode|DRAWING.svg|TRACE.vcd --machine … -o
+//! out.png|svg`: a toolpath as a picture, the pen down solid and its travel
+//! dashed.
 //!
 //! G-code is read through the firmware's parser and interpreter
-//! (`toolpath::from_gcode`); a simulator trace (`cargo xtask sim --vcd`)
+//! (`toolpath::from_gcode`); an SVG drawing as `taut vectorize` would draw
+//! it with its defaults (its own size, its layers in order); a simulator trace (`cargo xtask sim --vcd`)
 //! through the pulse replay: a plotter's steps and pen pulses, or — with
 //! `--machine string_art --card DIR` — the nails the string-art job wrapped,
 //! drawn as `taut stringart`'s preview draws the card's pattern.
 
-use crate::args::Args;
+use crate::cli::AnyMachine;
 use crate::raster::{Canvas, Rgb};
 use crate::stringart::picture;
 use crate::svg::{num, points, Svg};
@@ -18,9 +20,34 @@ use taut_logic::machine::Machine;
 use taut_trace::replay::{board_from_param, JobReplay};
 use taut_trace::vcd;
 
-pub const USAGE: &str = "\
-taut preview FILE.gcode|TRACE.vcd --machine flatbed|drum|whiteboard|scara|string_art -o out.png|svg
-    [--px 1000] [--card DIR --thread-mm 0.3 (string_art traces)]";
+/// A toolpath (G-code or a simulator trace) as a picture
+#[derive(clap::Args, Debug)]
+#[command(after_help = "\
+Examples:
+  taut preview horse.gcode --machine flatbed -o horse.png
+  taut preview drawing.svg --machine flatbed -o drawing.png
+  cargo xtask sim --vcd run.vcd …; taut preview run.vcd --machine flatbed -o run.svg
+  taut preview job.vcd --machine string_art --card CARD -o wound.png")]
+pub struct Cli {
+    /// The G-code file, an SVG drawing (drawn as `taut vectorize` draws it
+    /// with its defaults), or a simulator trace (.vcd)
+    pub input: PathBuf,
+    /// The machine the file is for
+    #[arg(long, value_enum)]
+    pub machine: AnyMachine,
+    /// The picture (.png or .svg)
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Side of the PNG, pixels
+    #[arg(long, default_value_t = 1000)]
+    pub px: usize,
+    /// The string-art job's card (its param.txt), for a string_art trace
+    #[arg(long, value_name = "DIR")]
+    pub card: Option<PathBuf>,
+    /// The thread's width in a string_art picture, mm
+    #[arg(long, default_value_t = 0.3)]
+    pub thread_mm: f64,
+}
 
 const INK: Rgb = [20, 20, 40];
 const TRAVEL: Rgb = [70, 130, 230];
@@ -89,15 +116,21 @@ pub fn svg(path: &Toolpath) -> String {
     s.finish()
 }
 
-/// Writes the toolpath as PNG or SVG, by `out`'s extension.
-pub fn save(path: &Toolpath, out: &Path, px: usize) -> Result<(), String> {
-    match extension(out)?.as_str() {
-        "svg" => std::fs::write(out, svg(path)).map_err(|e| format!("{}: {e}", out.display())),
-        _ => png(path, px).save_png(out),
-    }
+/// The toolpath as PNG or SVG bytes, by `out`'s extension.
+pub fn bytes(path: &Toolpath, out: &Path, px: usize) -> Result<Vec<u8>, String> {
+    Ok(match extension(out)?.as_str() {
+        "svg" => svg(path).into_bytes(),
+        _ => png(path, px).png(),
+    })
 }
 
-fn extension(out: &Path) -> Result<String, String> {
+/// Writes the toolpath as PNG or SVG, by `out`'s extension, atomically.
+pub fn save(path: &Toolpath, out: &Path, px: usize) -> Result<(), String> {
+    crate::output::write(out, &bytes(path, out, px)?)
+}
+
+/// `png` or `svg`, from the picture's name; anything else is refused.
+pub fn extension(out: &Path) -> Result<String, String> {
     let ext = out
         .extension()
         .and_then(|e| e.to_str())
@@ -123,18 +156,25 @@ pub fn wrapped_nails(
 }
 
 /// `taut preview …` from the command line.
-pub fn run(mut args: Args) -> Result<(), String> {
-    let input = PathBuf::from(args.positional("FILE.gcode or TRACE.vcd")?);
-    let name = args.required("machine")?;
-    let machine =
-        Machine::parse(name.as_bytes()).ok_or(format!("--machine {name}: not a machine"))?;
-    let out = PathBuf::from(args.required("o")?);
-    let px = args.number("px", 1000usize)?;
-    let card = args.value("card").map(PathBuf::from);
-    let thread_mm = args.number("thread-mm", 0.3)?;
-    args.finish()?;
+pub fn run(cli: Cli) -> Result<(), String> {
+    let (input, out, px, card, thread_mm) =
+        (cli.input, cli.output, cli.px, cli.card, cli.thread_mm);
+    let machine = Machine::from(cli.machine);
+    let param_path = card.as_ref().map(|c| c.join("param.txt"));
+    let mut inputs = vec![input.as_path()];
+    inputs.extend(param_path.as_deref());
+    crate::output::refuse_overwriting(&inputs, &[&out])?;
     extension(&out)?;
-    let text = std::fs::read_to_string(&input).map_err(|e| format!("{}: {e}", input.display()))?;
+    let bytes = std::fs::read(&input).map_err(|e| format!("{}: {e}", input.display()))?;
+    if machine != Machine::StringArt && crate::vectorize::is_svg(&bytes) {
+        return svg_drawing(&input, machine, &out, px);
+    }
+    let text = String::from_utf8(bytes).map_err(|_| {
+        format!(
+            "{}: neither G-code, SVG nor a trace (not UTF-8 text)",
+            input.display()
+        )
+    })?;
     let is_vcd = input
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("vcd"));
@@ -147,11 +187,11 @@ pub fn run(mut args: Args) -> Result<(), String> {
         let param = std::fs::read(&param).map_err(|e| format!("{}: {e}", param.display()))?;
         let signals = vcd::parse(&text)?;
         let (board, nails) = wrapped_nails(&signals, &param)?;
-        match extension(&out)?.as_str() {
-            "svg" => std::fs::write(&out, picture::svg(&board, &nails, thread_mm))
-                .map_err(|e| e.to_string())?,
-            _ => picture::png(&board, &nails, thread_mm, px).save_png(&out)?,
-        }
+        let picture = match extension(&out)?.as_str() {
+            "svg" => picture::svg(&board, &nails, thread_mm).into_bytes(),
+            _ => picture::png(&board, &nails, thread_mm, px).png(),
+        };
+        crate::output::write(&out, &picture)?;
         println!(
             "{}: {} nails wrapped; written {}",
             input.display(),
@@ -171,6 +211,28 @@ pub fn run(mut args: Args) -> Result<(), String> {
     println!(
         "{}: pen down {down:.0} mm, up {up:.0} mm; written {}",
         input.display(),
+        out.display()
+    );
+    Ok(())
+}
+
+/// An SVG drawing as `taut vectorize` draws it with its defaults.
+fn svg_drawing(input: &Path, machine: Machine, out: &Path, px: usize) -> Result<(), String> {
+    use crate::vectorize::{self, Options, Source};
+    let source = Source::open(input)?;
+    let mut o = Options::new(machine, 1.0);
+    o.width_mm = None;
+    let v = vectorize::vectorize(&source, &o, &input.display().to_string())?;
+    for w in &v.warnings {
+        eprintln!("warning: {w}");
+    }
+    save(&v.toolpath, out, px)?;
+    let (down, up) = v.toolpath.lengths();
+    println!(
+        "{}: {} strokes in {} pass(es), pen down {down:.0} mm, up {up:.0} mm; written {}",
+        input.display(),
+        v.strokes.len(),
+        v.layers.len(),
         out.display()
     );
     Ok(())

@@ -170,27 +170,30 @@ impl Canvas {
         }
     }
 
+    /// The canvas as PNG bytes.
+    pub fn png(&self) -> Vec<u8> {
+        encode_png(self.cols, self.rows, png::ColorType::Rgb, &self.rgb)
+    }
+
+    /// Written atomically (`output::write`).
     pub fn save_png(&self, path: &Path) -> Result<(), String> {
-        write_png(path, self.cols, self.rows, png::ColorType::Rgb, &self.rgb)
+        crate::output::write(path, &self.png())
     }
 }
 
 /// 8-bit PNG of `data` (grey or RGB rows).
-pub fn write_png(
-    path: &Path,
-    cols: usize,
-    rows: usize,
-    color: png::ColorType,
-    data: &[u8],
-) -> Result<(), String> {
-    let fail = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    let file = std::fs::File::create(path).map_err(|e| fail(&e))?;
-    let mut png = png::Encoder::new(std::io::BufWriter::new(file), cols as u32, rows as u32);
+pub fn encode_png(cols: usize, rows: usize, color: png::ColorType, data: &[u8]) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    let mut png = png::Encoder::new(&mut bytes, cols as u32, rows as u32);
     png.set_color(color);
     png.set_depth(png::BitDepth::Eight);
-    let mut writer = png.write_header().map_err(|e| fail(&e))?;
-    writer.write_image_data(data).map_err(|e| fail(&e))?;
-    writer.finish().map_err(|e| fail(&e))
+    // Encoding into memory fails only on a wrong buffer size: a bug.
+    let mut writer = png.write_header().expect("PNG header");
+    writer
+        .write_image_data(data)
+        .expect("PNG data of the canvas's size");
+    writer.finish().expect("PNG end");
+    bytes
 }
 
 /// A Gaussian blur of a `size` × `size` raster (zero beyond its edges).

@@ -19,10 +19,11 @@
 mod port;
 pub mod stream;
 
-use crate::args::Args;
+use crate::cli::AnyMachine;
 use indicatif::{ProgressBar, ProgressStyle};
 use port::Port;
 use std::io::Read;
+use std::path::PathBuf;
 use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
 use stream::{Answer, Stream};
@@ -31,25 +32,58 @@ use taut_logic::interp::estimate::GcodeTime;
 use taut_logic::machine::Machine;
 use taut_logic::settings;
 
-pub const USAGE: &str = "\
-taut send FILE [--port PATH] [--machine NAME]
-    stream a G-code file to the machine counting characters (Grbl's 128-byte
-    buffer), with progress and the firmware planner's ETA; keys: ! or space
-    hold, ~ or space resume, q or Ctrl-C stop (Ctrl-X) and quit. PATH: the
-    Mega (/dev/ttyACM0, default) or the simulator's terminal (cargo xtask sim
-    --pty PATH). NAME: the machine whose default figures the ETA is worked
-    out with (default: the figures the machine lists in $$). Exit status 1
-    after any error, alarm or stop.";
+/// Streams a G-code file to the machine, Grbl's way, with progress and ETA
+///
+/// Lines go by character counting (Grbl's 128-byte buffer), with a bar and
+/// the firmware planner's ETA. Keys: `!` or space hold, `~` or space resume,
+/// `q` or Ctrl-C stop (Ctrl-X) and quit. Exit status 1 after any error,
+/// alarm or stop.
+#[derive(clap::Args, Debug)]
+#[command(after_help = "\
+Examples:
+  taut send drawing.gcode                       (a Mega on /dev/ttyACM0)
+  cargo xtask sim --pty /tmp/taut-tty --machine flatbed
+  taut send drawing.gcode --port /tmp/taut-tty")]
+pub struct Cli {
+    /// The G-code file
+    pub file: PathBuf,
+    /// The serial port: the Mega, or the simulator's terminal
+    #[arg(long, default_value = "/dev/ttyACM0")]
+    pub port: String,
+    /// The machine whose default figures the ETA is worked out with [default: what the machine lists in $$]
+    #[arg(long, value_enum)]
+    pub machine: Option<AnyMachine>,
+}
 
-pub fn run(mut args: Args) -> Result<(), String> {
-    let file = args.positional("FILE")?;
-    let port = args.value("port").unwrap_or_else(|| "/dev/ttyACM0".into());
-    let machine = args.value("machine");
-    let chosen = match &machine {
-        Some(name) => Some(Machine::parse(name.as_bytes()).ok_or(format!("no machine {name:?}"))?),
-        None => None,
-    };
-    args.finish()?;
+/// Whether a line is a program pause (`M0`, `M00`, `M1`), outside its
+/// comments.
+fn is_pause(line: &str) -> bool {
+    let code: String = line
+        .split(['(', ';'])
+        .next()
+        .unwrap_or("")
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect::<String>()
+        .to_ascii_uppercase();
+    let mut rest = code.as_str();
+    while let Some(at) = rest.find('M') {
+        let digits: String = rest[at + 1..]
+            .chars()
+            .take_while(|c| c.is_ascii_digit())
+            .collect();
+        if matches!(digits.trim_start_matches('0'), "" | "1") && !digits.is_empty() {
+            return true;
+        }
+        rest = &rest[at + 1..];
+    }
+    false
+}
+
+pub fn run(cli: Cli) -> Result<(), String> {
+    let (file, port) = (cli.file.display().to_string(), cli.port);
+    let chosen = cli.machine.map(Machine::from);
+    let machine = chosen.map(|m| m.name().to_string());
     let text = std::fs::read(&file).map_err(|e| format!("{file}: {e}"))?;
     let stream = Stream::new(&text)?;
     let mut port = Port::open(&port)?;
@@ -302,10 +336,17 @@ fn send(
         };
         match stream.reply(&reply)? {
             Answer::Line { index, error } => {
-                if let Some(error) = error {
-                    let (number, text) = &stream.lines()[index];
-                    p.bar
-                        .suspend(|| eprintln!("line {number}: {text}: {error}"));
+                let (number, text) = &stream.lines()[index];
+                match error {
+                    Some(error) => p
+                        .bar
+                        .suspend(|| eprintln!("line {number}: {text}: {error}")),
+                    // A program pause (M0, as a pen change): the machine
+                    // holds there; the line's comment says what to do.
+                    None if is_pause(text) => p.bar.suspend(|| {
+                        eprintln!("line {number}: paused: {text} — resume with ~ or space")
+                    }),
+                    None => {}
                 }
                 p.bar.set_position((eta.after[index] * 1000.0) as u64);
                 p.left = eta.total - eta.after[index];

@@ -12,12 +12,12 @@
 
 pub mod baseline;
 pub mod card;
+pub mod framing;
 pub mod greedy;
 pub mod picture;
 mod spread;
 pub mod target;
 
-use crate::args::Args;
 use crate::gray::Gray;
 use crate::progress;
 use card::Spec;
@@ -26,12 +26,111 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use target::Target;
 
-pub const USAGE: &str = "\
-taut stringart IMAGE --nails N --shape circle|<n> --radius-cm R --lines C -o CARD_DIR
-    [--thread-mm 0.3] [--resolution 512] [--min-separation N/25] [--passes 3]
-    [--window 8] [--seed 1] [--method ours|plain|random] [--preview-px 1200]";
+const EXAMPLES: &str = "\
+Examples:
+  taut stringart camera.jpg --nails 250 --shape circle --radius-cm 40.2 --lines 3000 -o CARD
+  taut stringart face.png --nails 180 --shape 6 --radius-cm 30 --lines 2000 --thread-mm 0.2 -o /media/sd
+  taut stringart group.jpg --zoom 2 --offset 0.1,0.15 --contrast 1.3 --mask faces.png … -o CARD
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+CARD gets param.txt and poradi.txt (copy them onto the card), preview.png and
+preview.svg (the winding), target.png (the picture as framed and toned for it).";
+
+/// A picture to a string-art card (param.txt, poradi.txt, previews)
+#[derive(clap::Args, Debug)]
+#[command(after_help = EXAMPLES)]
+pub struct Cli {
+    /// The picture (PNG or JPEG)
+    pub image: PathBuf,
+    #[command(flatten)]
+    pub board: BoardArgs,
+    /// Chords to wind
+    #[arg(long)]
+    pub lines: usize,
+    /// The card's folder (made if missing)
+    #[arg(short = 'o', long = "output", value_name = "CARD_DIR")]
+    pub output: PathBuf,
+    /// The thread's width, mm
+    #[arg(long, default_value_t = 0.3)]
+    pub thread_mm: f32,
+    /// Pixels across the ring of nails the generator works at
+    #[arg(long, default_value_t = 512)]
+    pub resolution: usize,
+    /// Least nails between a chord's ends [default: nails / 25]
+    #[arg(long)]
+    pub min_separation: Option<u16>,
+    /// Optimisation passes after the greedy choice
+    #[arg(long, default_value_t = 3)]
+    pub passes: usize,
+    /// Nails either side an optimisation pass tries
+    #[arg(long, default_value_t = 8)]
+    pub window: u16,
+    /// Seed of the random choices
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// ours: squared-error greedy and passes; plain: kmmeerts' greedy; random: random chords
+    #[arg(long, value_enum, default_value_t = Method::Ours)]
+    pub method: Method,
+    /// Side of preview.png, pixels
+    #[arg(long, default_value_t = 1200)]
+    pub preview_px: usize,
+    /// Zoom into the picture: the ring sees its shorter side divided by this
+    #[arg(long, default_value_t = 1.0)]
+    pub zoom: f64,
+    /// Move the ring over the picture X,Y, fractions of its shorter side (x right, y up)
+    #[arg(long, value_parser = crate::cli::pair, default_value = "0,0", allow_hyphen_values = true)]
+    pub offset: [f64; 2],
+    /// Contrast about mid-grey (1: as it is; 2: twice)
+    #[arg(long, default_value_t = 1.0)]
+    pub contrast: f32,
+    /// Gamma of the grey levels (above 1 darkens the midtones)
+    #[arg(long, default_value_t = 1.0)]
+    pub gamma: f32,
+    /// Light thread on a dark board: the picture's tones inverted
+    #[arg(long)]
+    pub invert: bool,
+    /// Importance mask (a picture framed as the image): darkness kept where it is white, halved where black
+    #[arg(long, value_name = "PICTURE")]
+    pub mask: Option<PathBuf>,
+}
+
+/// The board: its shape, nails and size.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct BoardArgs {
+    /// Nails on the board
+    #[arg(long)]
+    pub nails: u16,
+    /// circle, or the number of sides of a polygon
+    #[arg(long, value_parser = shape)]
+    pub shape: u16,
+    /// The board's radius (the ring's; a polygon's corner), cm
+    #[arg(long, value_parser = crate::cli::positive)]
+    pub radius_cm: f64,
+}
+
+impl BoardArgs {
+    pub fn spec(&self) -> Result<Spec, String> {
+        if self.radius_cm > 1000.0 {
+            return Err("--radius-cm must be at most 1000".into());
+        }
+        Ok(Spec {
+            shape: self.shape,
+            nails: self.nails,
+            radius_um: (self.radius_cm * 10_000.0).round() as u32,
+        })
+    }
+}
+
+/// `circle` (0) or a number of sides.
+fn shape(v: &str) -> Result<u16, String> {
+    match v {
+        "circle" => Ok(0),
+        n => n
+            .parse()
+            .map_err(|_| format!("{n}: circle or a number of sides")),
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
     /// Squared-error greedy, then single-nail passes.
     Ours,
@@ -139,6 +238,17 @@ pub struct Card {
     pub winding_s: f64,
 }
 
+/// The files a card gets.
+/// (`target.png`, the picture as the generator saw it, is written by the
+/// command beside them.)
+pub const CARD_FILES: [&str; 5] = [
+    "param.txt",
+    "poradi.txt",
+    "preview.png",
+    "preview.svg",
+    "target.png",
+];
+
 /// Writes `param.txt`, `poradi.txt` (both read back through the
 /// firmware's parsers first), `preview.png` and `preview.svg` into `dir`.
 pub fn write_card(
@@ -154,18 +264,19 @@ pub fn write_card(
         return Err("poradi.txt does not read back as written".into());
     }
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let write = |name: &str, bytes: &[u8]| {
-        let path = dir.join(name);
-        std::fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))
-    };
-    write("param.txt", param.as_bytes())?;
-    write("poradi.txt", poradi.as_bytes())?;
     let thread = f64::from(options.thread_mm);
-    picture::png(&board, pattern, thread, preview_px).save_png(&dir.join("preview.png"))?;
-    write(
-        "preview.svg",
-        picture::svg(&board, pattern, thread).as_bytes(),
-    )?;
+    let mut files = crate::output::Batch::new();
+    files.add(
+        dir.join("preview.png"),
+        picture::png(&board, pattern, thread, preview_px).png(),
+    );
+    files.add(
+        dir.join("preview.svg"),
+        picture::svg(&board, pattern, thread),
+    );
+    files.add(dir.join("poradi.txt"), poradi.clone());
+    files.add(dir.join("param.txt"), param.clone());
+    files.commit()?;
     let (drilling_s, winding_s) = card::machine_seconds(param.as_bytes(), poradi.as_bytes())?;
     Ok(Card {
         thread_m: card::thread_mm(&board, pattern) / 1000.0,
@@ -175,33 +286,42 @@ pub fn write_card(
 }
 
 /// `taut stringart …` from the command line.
-pub fn run(mut args: Args) -> Result<(), String> {
-    let image_path = PathBuf::from(args.positional("IMAGE")?);
-    let spec = spec_from(&mut args)?;
-    let mut o = Options::new(spec, args.number("lines", 0usize)?);
-    o.thread_mm = args.number("thread-mm", o.thread_mm)?;
-    o.resolution = args.number("resolution", o.resolution)?;
-    o.min_separation = args.number("min-separation", o.min_separation)?;
-    o.passes = args.number("passes", o.passes)?;
-    o.window = args.number("window", o.window)?;
-    o.seed = args.number("seed", o.seed)?;
-    o.method = match args.value("method").as_deref() {
-        None | Some("ours") => Method::Ours,
-        Some("plain") => Method::Plain,
-        Some("random") => Method::Random,
-        Some(m) => return Err(format!("--method {m}: ours, plain or random")),
+pub fn run(cli: Cli) -> Result<(), String> {
+    let spec = cli.board.spec()?;
+    let mut o = Options::new(spec, cli.lines);
+    o.thread_mm = cli.thread_mm;
+    o.resolution = cli.resolution;
+    o.min_separation = cli.min_separation.unwrap_or(o.min_separation);
+    o.passes = cli.passes;
+    o.window = cli.window;
+    o.seed = cli.seed;
+    o.method = cli.method;
+    let (image_path, dir, preview_px) = (cli.image, cli.output, cli.preview_px);
+    let outputs: Vec<PathBuf> = CARD_FILES.iter().map(|f| dir.join(f)).collect();
+    let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
+    let mut inputs = vec![image_path.as_path()];
+    inputs.extend(cli.mask.as_deref());
+    crate::output::refuse_overwriting(&inputs, &outputs)?;
+    let framing = framing::Framing {
+        zoom: cli.zoom,
+        offset: cli.offset,
+        contrast: cli.contrast,
+        gamma: cli.gamma,
+        invert: cli.invert,
     };
-    let preview_px = args.number("preview-px", 1200usize)?;
-    let dir = PathBuf::from(args.required("o")?);
-    args.finish()?;
-
+    framing.check()?;
     let board = spec.board()?;
-    let image = Gray::open(&image_path)?;
+    let mask = cli.mask.as_deref().map(Gray::open).transpose()?;
+    let image = framing.apply(&Gray::open(&image_path)?, mask.as_ref());
     let radius_cm = f64::from(spec.radius_um) / 10_000.0;
     let bar = progress::bar("lines", o.lines as u64);
     let w = generate(&image, &o, &bar)?;
     bar.finish_and_clear();
     let card = write_card(&dir, &o, &w.pattern, preview_px)?;
+    crate::output::write(
+        &dir.join("target.png"),
+        &target_png(&image, board, preview_px.min(1200)),
+    )?;
     let random = Target::new(&image, board, o.resolution, o.thread_mm).rmse(&baseline::random(
         spec.nails,
         o.lines,
@@ -235,29 +355,26 @@ pub fn run(mut args: Args) -> Result<(), String> {
         hours(card.winding_s)
     );
     println!(
-        "  written: {}/{{param.txt,poradi.txt,preview.png,preview.svg}}",
+        "  written: {}/{{param.txt,poradi.txt,preview.png,preview.svg,target.png}}",
         dir.display()
     );
     Ok(())
 }
 
-/// The board of `--shape`, `--nails` and `--radius-cm`.
-pub fn spec_from(args: &mut Args) -> Result<Spec, String> {
-    let shape = match args.required("shape")?.as_str() {
-        "circle" => 0,
-        n => n
-            .parse()
-            .map_err(|_| format!("--shape {n}: circle or a number of sides"))?,
-    };
-    let radius_cm: f64 = args.number("radius-cm", f64::NAN)?;
-    if !(radius_cm > 0.0 && radius_cm <= 1000.0) {
-        return Err("--radius-cm must be given, above 0 and at most 1000".into());
-    }
-    Ok(Spec {
-        shape,
-        nails: args.number("nails", 0u16)?,
-        radius_um: (radius_cm * 10_000.0).round() as u32,
-    })
+/// The picture as the generator aims at it: framed and toned, inside the
+/// ring of nails (outside it a light grey), `px` across.
+pub fn target_png(image: &Gray, board: taut_logic::geometry::Board, px: usize) -> Vec<u8> {
+    let t = Target::new(image, board, px, 0.3);
+    let grey: Vec<u8> = t
+        .darkness
+        .iter()
+        .zip(&t.frame.mask)
+        .map(|(d, &inside)| match inside {
+            true => ((1.0 - d) * 255.0).round() as u8,
+            false => 200,
+        })
+        .collect();
+    crate::raster::encode_png(px, px, png::ColorType::Grayscale, &grey)
 }
 
 /// `3 h 05 min` or `12 min 30 s`.

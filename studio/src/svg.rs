@@ -5,6 +5,8 @@
 pub struct Svg {
     head: String,
     body: String,
+    /// The view box: x, y (top left), width, height, mm.
+    pub view: [f64; 4],
 }
 
 impl Svg {
@@ -21,12 +23,18 @@ impl Svg {
         Svg {
             head,
             body: String::new(),
+            view: [x, y, width, height],
         }
     }
 
     pub fn push(&mut self, element: &str) {
         self.body.push_str(element);
         self.body.push('\n');
+    }
+
+    /// The elements so far.
+    pub fn body(&self) -> &str {
+        &self.body
     }
 
     pub fn finish(self) -> String {

@@ -8,7 +8,6 @@
 //! the numbers go (counter-clockwise, seen from above). A 100 mm bar
 //! checks the printer's scale.
 
-use crate::args::Args;
 use crate::board::nail_mm;
 use crate::stringart::card::Spec;
 use crate::stringart::picture::outline;
@@ -16,13 +15,37 @@ use crate::svg::{num, points, Svg};
 use std::f64::consts::TAU;
 use taut_logic::geometry::Board;
 
-pub const USAGE: &str = "taut template --nails N --shape circle|<n> --radius-cm R -o template.svg";
+/// A 1:1 drilling template of a board (SVG), whole or tiled on pages
+#[derive(clap::Args, Debug)]
+#[command(after_help = "\
+Examples:
+  taut template --nails 250 --shape circle --radius-cm 40.2 -o template.svg
+  taut template --nails 250 --shape circle --radius-cm 40.2 --paper A4 -o template.svg
+
+With --paper the pages are template.A1.svg, template.A2.svg, … (rows A, B, …,
+columns 1, 2, …). Print at 100 % (no fitting to the page): the 100 mm bar, or
+each page's 20 mm square, checks the scale.")]
+pub struct Cli {
+    #[command(flatten)]
+    pub board: crate::stringart::BoardArgs,
+    /// The template (.svg); with --paper, the pages' names are made from it
+    #[arg(short = 'o', long = "output")]
+    pub output: std::path::PathBuf,
+    /// Tile the template on pages of this paper: A4, letter, A3, … or WxH (mm)
+    #[arg(long, value_parser = crate::vectorize::place::paper)]
+    pub paper: Option<[f64; 2]>,
+}
 
 /// Room round the board for the numbers, mm.
 const MARGIN_MM: f64 = 22.0;
 
 /// The template of `spec`'s board as an SVG document.
 pub fn template(spec: &Spec) -> Result<String, String> {
+    Ok(drawing(spec)?.finish())
+}
+
+/// The template's drawing, 1:1 in mm.
+fn drawing(spec: &Spec) -> Result<Svg, String> {
     let board = spec.board()?;
     let r = f64::from(board.radius());
     let bar = if r >= 60.0 { 100.0 } else { 20.0 };
@@ -93,7 +116,135 @@ pub fn template(spec: &Spec) -> Result<String, String> {
         num(r / 10.0),
         num(f64::from(taut_logic::geometry::NAIL_MARGIN_MM)),
     ));
-    Ok(s.finish())
+    Ok(s)
+}
+
+/// Room at each edge of a page no printer prints on, mm.
+const PAGE_MARGIN_MM: f64 = 8.0;
+/// The strip at the foot of each page for its label and scale square, mm.
+const FOOT_MM: f64 = 26.0;
+/// How far neighbouring pages overlap, mm.
+pub const OVERLAP_MM: f64 = 12.0;
+/// The scale check square, mm.
+const CHECK_MM: f64 = 20.0;
+
+/// The template tiled on pages of `paper` (mm, portrait): one SVG a page,
+/// row by row from the top left. Each page shows its part of the drawing
+/// 1:1 within the margins; where a neighbour overlaps it, a dashed line
+/// marks the neighbour's edge (lay that page's edge on it) and crosses
+/// mark the corners of the part for alignment; its foot names the page
+/// and its neighbours and holds a 20 mm square to check the print's scale.
+pub fn pages(spec: &Spec, paper: [f64; 2]) -> Result<Vec<String>, String> {
+    let d = drawing(spec)?;
+    let [vx, vy, vw, vh] = d.view;
+    let part = [
+        paper[0] - 2.0 * PAGE_MARGIN_MM,
+        paper[1] - 2.0 * PAGE_MARGIN_MM - FOOT_MM,
+    ];
+    let step = [part[0] - OVERLAP_MM, part[1] - OVERLAP_MM];
+    let count =
+        |span: f64, part: f64, step: f64| 1 + ((span - part) / step).max(0.0).ceil() as usize;
+    let (cols, rows) = (count(vw, part[0], step[0]), count(vh, part[1], step[1]));
+    // The tiles' whole span, centred on the drawing.
+    let total = [
+        part[0] + (cols - 1) as f64 * step[0],
+        part[1] + (rows - 1) as f64 * step[1],
+    ];
+    let origin = [vx - (total[0] - vw) / 2.0, vy - (total[1] - vh) / 2.0];
+    let mut out = Vec::new();
+    for r in 0..rows {
+        for c in 0..cols {
+            let at = [
+                origin[0] + c as f64 * step[0],
+                origin[1] + r as f64 * step[1],
+            ];
+            let mut p = Svg::new(0.0, 0.0, paper[0], paper[1]);
+            let (m, pw, ph) = (PAGE_MARGIN_MM, part[0], part[1]);
+            // Clipped to the part (a nested viewport alone is not
+            // clipped by every viewer).
+            p.push(&format!(
+                "<defs><clipPath id=\"part\"><rect x=\"{m}\" y=\"{m}\" width=\"{pw}\" height=\"{ph}\"/></clipPath></defs>\n\
+                 <g clip-path=\"url(#part)\"><svg x=\"{m}\" y=\"{m}\" width=\"{pw}\" height=\"{ph}\" viewBox=\"{} {} {pw} {ph}\">\n{}</svg></g>",
+                num(at[0]),
+                num(at[1]),
+                d.body(),
+                m = num(m),
+                pw = num(pw),
+                ph = num(ph),
+            ));
+            p.push(&format!(
+                "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#999\" stroke-width=\"0.2\"/>",
+                num(m), num(m), num(pw), num(ph)
+            ));
+            // The neighbours' edges on this page (dashed), with their names.
+            let dash = "stroke=\"#c03020\" stroke-width=\"0.3\" stroke-dasharray=\"3 2\"";
+            let label = |x: f64, y: f64, rot: f64, t: &str| {
+                format!(
+                    "<text x=\"{x}\" y=\"{y}\" transform=\"rotate({} {x} {y})\" font-family=\"sans-serif\" font-size=\"2.5\" fill=\"#c03020\">{t}</text>",
+                    num(rot), x = num(x), y = num(y)
+                )
+            };
+            let name = |r: usize, c: usize| format!("{}{}", (b'A' + r as u8) as char, c + 1);
+            if c + 1 < cols {
+                let x = m + pw - OVERLAP_MM;
+                p.push(&format!(
+                    "<line x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" {dash}/>",
+                    num(x),
+                    num(m),
+                    num(x),
+                    num(m + ph)
+                ));
+                p.push(&label(
+                    x + 1.0,
+                    m + 4.0,
+                    90.0,
+                    &format!("page {}'s left edge here", name(r, c + 1)),
+                ));
+            }
+            if r + 1 < rows {
+                let y = m + ph - OVERLAP_MM;
+                p.push(&format!(
+                    "<line x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" {dash}/>",
+                    num(m),
+                    num(y),
+                    num(m + pw),
+                    num(y)
+                ));
+                p.push(&label(
+                    m + 2.0,
+                    y - 1.0,
+                    0.0,
+                    &format!("page {}'s top edge here", name(r + 1, c)),
+                ));
+            }
+            // Crosses at the corners of the part every page shares.
+            for (x, y) in [(m, m), (m + pw, m), (m, m + ph), (m + pw, m + ph)] {
+                p.push(&format!(
+                    "<path d=\"M {} {} h 8 M {} {} v 8\" stroke=\"#000\" stroke-width=\"0.25\"/>",
+                    num(x - 4.0),
+                    num(y),
+                    num(x),
+                    num(y - 4.0)
+                ));
+            }
+            let foot = m + ph + 4.0;
+            p.push(&format!(
+                "<rect x=\"{}\" y=\"{}\" width=\"{c}\" height=\"{c}\" fill=\"none\" stroke=\"#000\" stroke-width=\"0.3\"/>",
+                num(m), num(foot), c = num(CHECK_MM)
+            ));
+            p.push(&format!(
+                "<text x=\"{x}\" y=\"{}\" font-family=\"sans-serif\" font-size=\"4\">page {} of {} ({} rows × {} columns)</text>\n\
+                 <text x=\"{x}\" y=\"{}\" font-family=\"sans-serif\" font-size=\"2.8\">the square must measure {} mm: print at 100 %, no fitting to the page</text>\n\
+                 <text x=\"{x}\" y=\"{}\" font-family=\"sans-serif\" font-size=\"2.8\">pages overlap {} mm: lay the next page's edge on the dashed line, the crosses on each other</text>",
+                num(foot + 5.0), name(r, c), rows * cols, rows, cols,
+                num(foot + 11.0), num(CHECK_MM),
+                num(foot + 16.0), num(OVERLAP_MM),
+                x = num(m + CHECK_MM + 4.0),
+            ));
+            out.push(p.finish());
+        }
+    }
+    Ok(out)
 }
 
 /// The least distance between neighbouring nails, mm.
@@ -178,17 +329,51 @@ fn numbering_arrow(board: &Board, font: f64) -> String {
 }
 
 /// `taut template …` from the command line.
-pub fn run(mut args: Args) -> Result<(), String> {
-    let spec = crate::stringart::spec_from(&mut args)?;
-    let out = std::path::PathBuf::from(args.required("o")?);
-    args.finish()?;
-    let doc = template(&spec)?;
-    std::fs::write(&out, doc).map_err(|e| format!("{}: {e}", out.display()))?;
+pub fn run(cli: Cli) -> Result<(), String> {
+    let spec = cli.board.spec()?;
+    let out = cli.output;
+    let Some(paper) = cli.paper else {
+        crate::output::refuse_overwriting(&[], &[&out])?;
+        let doc = template(&spec)?;
+        crate::output::write(&out, doc.as_bytes())?;
+        println!(
+            "written: {} (print at 100 %, no fitting to the page)",
+            out.display()
+        );
+        return Ok(());
+    };
+    let pages = pages(&spec, paper)?;
+    let total = pages.len();
+    let mut files = crate::output::Batch::new();
+    let mut names = Vec::new();
+    let rows = pages_rows(&spec, paper)?;
+    for (k, page) in pages.into_iter().enumerate() {
+        let (r, c) = (k / (total / rows), k % (total / rows));
+        let name = crate::output::derived(
+            &out,
+            &format!("{}{}", (b'A' + r as u8) as char, c + 1),
+            "svg",
+        );
+        files.add(&name, page);
+        names.push(name);
+    }
+    let refs: Vec<&std::path::Path> = names.iter().map(|n| n.as_path()).collect();
+    crate::output::refuse_overwriting(&[], &refs)?;
+    files.commit()?;
     println!(
-        "written: {} (print at 100 %, no fitting to the page)",
-        out.display()
+        "written: {} pages, {} … {} (print each at 100 %, no fitting to the page)",
+        names.len(),
+        names[0].display(),
+        names[names.len() - 1].display()
     );
     Ok(())
+}
+
+/// How many rows of pages the template takes.
+fn pages_rows(spec: &Spec, paper: [f64; 2]) -> Result<usize, String> {
+    let d = drawing(spec)?;
+    let part = paper[1] - 2.0 * PAGE_MARGIN_MM - FOOT_MM;
+    Ok(1 + ((d.view[3] - part) / (part - OVERLAP_MM)).max(0.0).ceil() as usize)
 }
 
 #[cfg(test)]
@@ -215,6 +400,65 @@ mod tests {
         }
         assert!(doc.contains("100 mm: check the print is 1:1"));
         assert!(doc.contains("nail 0, numbers go this way"));
+    }
+
+    #[test]
+    fn tiled_pages_cover_the_template_with_overlap_and_a_scale_square() {
+        let spec = Spec {
+            shape: 0,
+            nails: 250,
+            radius_um: 402_000,
+        };
+        // 85 × 87 cm on A4 (194 × 255 mm a page, 12 mm overlap): 5 × 4.
+        let p = pages(&spec, [210.0, 297.0]).unwrap();
+        assert_eq!(p.len(), 20);
+        assert_eq!(pages_rows(&spec, [210.0, 297.0]).unwrap(), 4);
+        for (k, page) in p.iter().enumerate() {
+            assert!(page.contains("width=\"210mm\" height=\"297mm\""));
+            assert!(page.contains("the square must measure 20 mm"), "page {k}");
+            assert!(page.contains("width=\"20\" height=\"20\""), "page {k}");
+        }
+        // The first page: neighbours right and below, marked.
+        assert!(
+            p[0].contains("page A2's left edge here") && p[0].contains("page B1's top edge here")
+        );
+        // The last: none.
+        assert!(!p[19].contains("edge here"));
+        // Every nail's cross is on some page, by its position in the part
+        // each page shows.
+        let board = spec.board().unwrap();
+        let d = drawing(&spec).unwrap();
+        let [vx, vy, vw, vh] = d.view;
+        let part = [210.0 - 16.0, 297.0 - 16.0 - 26.0];
+        let step = [part[0] - OVERLAP_MM, part[1] - OVERLAP_MM];
+        let origin = [
+            vx - (part[0] + 4.0 * step[0] - vw) / 2.0,
+            vy - (part[1] + 3.0 * step[1] - vh) / 2.0,
+        ];
+        for i in 0..board.nails() {
+            let [x, y] = nail_mm(&board, i);
+            let (x, y) = (x, -y);
+            let shown = (0..4).any(|r| {
+                (0..5).any(|c| {
+                    let at = [
+                        origin[0] + c as f64 * step[0],
+                        origin[1] + r as f64 * step[1],
+                    ];
+                    x > at[0] + 3.0
+                        && x < at[0] + part[0] - 3.0
+                        && y > at[1] + 3.0
+                        && y < at[1] + part[1] - 3.0
+                })
+            });
+            assert!(shown, "nail {i} at ({x:.1}, {y:.1}) is on no page whole");
+        }
+        // A small board fits one letter page.
+        let small = Spec {
+            shape: 0,
+            nails: 24,
+            radius_um: 60_000,
+        };
+        assert_eq!(pages(&small, [215.9, 279.4]).unwrap().len(), 1);
     }
 
     #[test]

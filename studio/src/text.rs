@@ -8,17 +8,50 @@
 //! glyph to the bottom of the deepest). The pen lifts between strokes; the
 //! text's ink starts at `--at` (its lower left corner).
 
-use crate::args::Args;
-use crate::hershey::{Font, BASE_LINE, CAP_LINE};
+use crate::cli::{pair, Plotter};
+use crate::hershey::{Font, Shape, BASE_LINE, CAP_LINE};
 use crate::toolpath::Toolpath;
 use crate::vectorize::trace::Polyline;
 use crate::{plot, preview};
 use std::path::PathBuf;
 use taut_logic::machine::Machine;
 
-pub const USAGE: &str = "\
-taut text TEXT --font futural --height-mm H -o out.gcode [--machine flatbed]
-    [--wrap-mm W] [--at X,Y] [--feed 1500] [--preview out.png]";
+/// Text in a Hershey font as plotter G-code, with a preview
+#[derive(clap::Args, Debug)]
+#[command(after_help = "\
+Examples:
+  taut text 'Hello' --height-mm 10 -o hello.gcode
+  taut text 'Dear Ann,\\nthank you' --font scripts --height-mm 8 --wrap-mm 120 --machine whiteboard -o card.gcode
+
+The preview goes to OUT's name with .preview.png unless --preview names it.")]
+pub struct Cli {
+    /// The text (a newline, or a typed \\n, breaks the line)
+    pub text: String,
+    /// The font
+    #[arg(long, default_value = "futural")]
+    pub font: String,
+    /// Height of the capitals, mm
+    #[arg(long, value_parser = crate::cli::positive)]
+    pub height_mm: f64,
+    /// The G-code file
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// The machine the G-code is for
+    #[arg(long, value_enum, default_value_t = Plotter::Flatbed)]
+    pub machine: Plotter,
+    /// Break lines between words before they pass this width, mm
+    #[arg(long, value_parser = crate::cli::positive)]
+    pub wrap_mm: Option<f64>,
+    /// The text's lower left corner X,Y, mm [default: the origin; the whiteboard: centred]
+    #[arg(long, value_parser = pair, allow_hyphen_values = true)]
+    pub at: Option<[f64; 2]>,
+    /// Drawing feed, mm/min
+    #[arg(long, default_value_t = 1500.0)]
+    pub feed: f64,
+    /// The preview picture (.png or .svg) [default: OUT.preview.png]
+    #[arg(long)]
+    pub preview: Option<PathBuf>,
+}
 
 /// Lines are this many font units apart.
 const LINE_PITCH: i32 = 32;
@@ -37,33 +70,51 @@ pub fn strokes(
         return Err("--height-mm must be above 0".into());
     }
     let scale = height_mm / f64::from(BASE_LINE - CAP_LINE);
-    let advance = |c: char| font.glyph(c).map(|g| f64::from(g.right - g.left) * scale);
-    if let Some(c) = text.chars().find(|&c| c != '\n' && advance(c).is_none()) {
-        return Err(format!("{c:?} is not in the font (printable ASCII only)"));
+    let text = text.replace("\\n", "\n");
+    // Every character the fonts cannot draw, named once each.
+    let mut missing: Vec<char> = Vec::new();
+    for c in text.chars().filter(|&c| c != '\n') {
+        if font.shape(c).is_none() && !missing.contains(&c) {
+            missing.push(c);
+        }
     }
-    let lines = layout(&text.replace("\\n", "\n"), wrap_mm, |c| {
-        advance(c).unwrap_or(0.0)
-    });
+    if !missing.is_empty() {
+        let names: Vec<String> = missing
+            .iter()
+            .map(|c| format!("{c:?} (U+{:04X})", *c as u32))
+            .collect();
+        return Err(format!(
+            "no glyph for {}: the Hershey fonts draw ASCII, Latin letters with accents, Greek, and Cyrillic А–Щ",
+            names.join(", ")
+        ));
+    }
+    let shapes: std::collections::HashMap<char, Shape> = text
+        .chars()
+        .filter(|&c| c != '\n')
+        .filter_map(|c| Some((c, font.shape(c)?)))
+        .collect();
+    let advance = |c: char| shapes.get(&c).map_or(0.0, |g| (g.right - g.left) * scale);
+    let lines = layout(&text, wrap_mm, advance);
     let pitch = f64::from(LINE_PITCH) * scale;
     let mut out: Vec<Polyline> = Vec::new();
     for (k, line) in lines.iter().enumerate() {
         let base = (lines.len() - 1 - k) as f64 * pitch;
         let mut x = 0.0;
         for c in line.chars() {
-            let g = font.glyph(c).expect("checked above");
+            let g = &shapes[&c];
             for s in &g.strokes {
                 let pts = s.iter().map(|p| {
                     [
-                        x + f64::from(p[0] - g.left) * scale,
-                        base - f64::from(p[1] - BASE_LINE) * scale,
+                        x + (p[0] - g.left) * scale,
+                        base - (p[1] - f64::from(BASE_LINE)) * scale,
                     ]
                 });
                 out.push(pts.collect());
             }
-            x += f64::from(g.right - g.left) * scale;
+            x += (g.right - g.left) * scale;
         }
     }
-    let (lo, _) = extent(&out);
+    let (lo, _) = crate::vectorize::bounds(&out);
     for p in out.iter_mut().flatten() {
         *p = [p[0] - lo[0] + at[0], p[1] - lo[1] + at[1]];
     }
@@ -98,50 +149,33 @@ fn layout(text: &str, wrap: Option<f64>, advance: impl Fn(char) -> f64) -> Vec<S
 }
 
 /// `taut text …` from the command line.
-pub fn run(mut args: Args) -> Result<(), String> {
-    let text = args.positional("TEXT")?;
-    let font = Font::named(&args.value("font").unwrap_or_else(|| "futural".into()))?;
-    let height = args.number("height-mm", f64::NAN)?;
-    let machine = match args.value("machine") {
-        Some(m) => plot::machine(&m)?,
-        None => Machine::Flatbed,
-    };
-    let wrap = args
-        .value("wrap-mm")
-        .map(|w| {
-            w.parse::<f64>()
-                .map_err(|_| format!("--wrap-mm {w}: not a number"))
-        })
-        .transpose()?;
-    let at = args.pair("at")?;
-    let feed = args.number("feed", 1500.0)?;
-    let out = PathBuf::from(args.required("o")?);
-    let preview_path = args
-        .value("preview")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| out.with_extension("png"));
-    args.finish()?;
+pub fn run(cli: Cli) -> Result<(), String> {
+    let font = Font::named(&cli.font)?;
+    let machine = Machine::from(cli.machine);
+    let (text, height, wrap, at, feed, out) = (
+        cli.text,
+        cli.height_mm,
+        cli.wrap_mm,
+        cli.at,
+        cli.feed,
+        cli.output,
+    );
+    let preview_path = cli
+        .preview
+        .unwrap_or_else(|| crate::output::derived(&out, "preview", "png"));
+    crate::output::refuse_overwriting(&[], &[&out, &preview_path])?;
+    preview::extension(&preview_path)?;
     let placed = strokes(&font, &text, height, wrap, [0.0, 0.0])?;
-    let (_, size) = extent(&placed);
+    let (_, size) = crate::vectorize::bounds(&placed);
     let corner = at.unwrap_or_else(|| plot::default_corner(machine, size));
     let shifted = strokes(&font, &text, height, wrap, corner)?;
     let (gcode, path) = plot::plot(&shifted, machine, feed, &format!("taut text {text}"))?;
-    std::fs::write(&out, &gcode).map_err(|e| format!("{}: {e}", out.display()))?;
-    preview::save(&path, &preview_path, 1000)?;
+    let mut files = crate::output::Batch::new();
+    files.add(&out, gcode.as_bytes());
+    files.add(&preview_path, preview::bytes(&path, &preview_path, 1000)?);
+    files.commit()?;
     report(&path, &out, &preview_path);
     Ok(())
-}
-
-fn extent(strokes: &[Polyline]) -> ([f64; 2], [f64; 2]) {
-    strokes
-        .iter()
-        .flatten()
-        .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
-            (
-                [lo[0].min(p[0]), lo[1].min(p[1])],
-                [hi[0].max(p[0]), hi[1].max(p[1])],
-            )
-        })
 }
 
 fn report(path: &Toolpath, out: &std::path::Path, preview: &std::path::Path) {
@@ -162,6 +196,59 @@ fn report(path: &Toolpath, out: &std::path::Path, preview: &std::path::Path) {
 mod tests {
     use super::*;
     use crate::hershey::FONTS;
+
+    #[test]
+    fn accents_greek_and_cyrillic_are_drawn() {
+        for (name, _) in FONTS {
+            let font = Font::named(name).unwrap();
+            let plain = strokes(&font, "e", 10.0, None, [0.0; 2]).unwrap();
+            // A mark is one stroke more (two for ¨), above the letter.
+            for (c, more) in [
+                ('é', 1),
+                ('è', 1),
+                ('ê', 1),
+                ('ě', 1),
+                ('ë', 2),
+                ('ę', 1),
+                ('ȩ', 1),
+            ] {
+                let s = strokes(&font, &c.to_string(), 10.0, None, [0.0; 2]).unwrap();
+                assert_eq!(s.len(), plain.len() + more, "{name} {c}");
+            }
+            let (_, top_e) = crate::vectorize::bounds(&plain);
+            let (_, top_acute) =
+                crate::vectorize::bounds(&strokes(&font, "é", 10.0, None, [0.0; 2]).unwrap());
+            assert!(
+                top_acute[1] > top_e[1] + 0.5,
+                "{name}: the acute is above the e"
+            );
+            // í loses the i's dot: ı and the acute.
+            let count = |t: &str| strokes(&font, t, 10.0, None, [0.0; 2]).unwrap().len();
+            assert_eq!(count("í"), count("ı") + 1, "{name}");
+            assert!(count("ı") < count("i"), "{name}");
+            for text in [
+                "Příliš žluťoučký kůň úpěl ďábelské ódy",
+                "Împărați, ștergeți țările",
+                "Þú ert",
+                "ΑΒΓΔ αβγδ ως",
+                "Привет, Щука",
+            ] {
+                let r = strokes(&font, text, 10.0, None, [0.0; 2]);
+                match text.starts_with('Þ') {
+                    true => assert!(r.unwrap_err().contains("'Þ' (U+00DE)"), "{name}"),
+                    false => assert!(r.is_ok(), "{name} {text}: {r:?}"),
+                }
+            }
+            // Ъ Ы Ь Э Ю Я are not in Hershey's Cyrillic.
+            assert!(strokes(&font, "Я", 10.0, None, [0.0; 2])
+                .unwrap_err()
+                .contains("'Я' (U+042F)"));
+        }
+        // Greek Α is not Latin A in a complex font: the sets differ.
+        let f = Font::named("timesr").unwrap();
+        assert!(!f.shape('Σ').unwrap().strokes.is_empty());
+        assert_ne!(f.shape('Ж'), f.shape('Z'));
+    }
 
     #[test]
     fn every_printable_glyph_of_every_font_plots() {
@@ -186,7 +273,7 @@ mod tests {
     fn capitals_have_the_height_and_glyphs_their_widths() {
         let font = Font::named("futural").unwrap();
         let s = strokes(&font, "HH", 10.0, None, [3.0, 4.0]).unwrap();
-        let (lo, hi) = extent(&s);
+        let (lo, hi) = crate::vectorize::bounds(&s);
         let unit = 10.0 / 21.0;
         assert_eq!(lo, [3.0, 4.0]);
         assert!((hi[1] - lo[1] - 10.0).abs() < 1e-9, "{lo:?} {hi:?}");
@@ -214,8 +301,10 @@ mod tests {
         let adv = |c: char| if c == ' ' { 1.0 } else { 2.0 };
         assert_eq!(layout("ab cd ef", Some(9.0), adv), ["ab cd", "ef"]);
         assert_eq!(layout("abcdefgh ij", Some(5.0), adv), ["abcdefgh", "ij"]);
-        assert!(strokes(&font, "é", 10.0, None, [0.0; 2])
-            .unwrap_err()
-            .starts_with("'é' is not in the font"));
+        let e = strokes(&font, "Straße 中", 10.0, None, [0.0; 2]).unwrap_err();
+        assert!(
+            e.starts_with("no glyph for 'ß' (U+00DF), '中' (U+4E2D): "),
+            "{e}"
+        );
     }
 }

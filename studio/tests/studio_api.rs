@@ -203,7 +203,7 @@ async fn broken_pictures_and_options_are_refused_with_what_is_wrong() {
         (
             "/api/vectorize?mode=dots",
             example("horse.png"),
-            "mode=dots: edges or hatch",
+            "mode=dots: edges, hatch, outline, centerline or auto",
         ),
         (
             "/api/vectorize?canny=1",
@@ -212,8 +212,8 @@ async fn broken_pictures_and_options_are_refused_with_what_is_wrong() {
         ),
         (
             "/api/text",
-            "é".as_bytes().to_vec(),
-            "'é' is not in the font",
+            "中".as_bytes().to_vec(),
+            "no glyph for '中' (U+4E2D)",
         ),
         (
             "/api/text?font=comic",

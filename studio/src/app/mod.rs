@@ -20,6 +20,7 @@ pub mod tools;
 mod web;
 mod words;
 
+use crate::cli::AnyMachine;
 pub use api::UPLOAD_LIMIT;
 use hub::Hub;
 use serde_json::json;
@@ -30,16 +31,42 @@ use std::sync::Arc;
 use std::time::Duration;
 use taut_logic::machine::Machine;
 
-pub const USAGE: &str = "\
-taut studio [--port 8080] [--bind 127.0.0.1] [--token T] [--serial PATH]
-            [--sim ELF [--machine NAME] [--vcd FILE]]
-    the web app: open a picture, an SVG or G-code, vectorise it or make a
-    string-art card, preview, connect, send, pause, stop. Prints its URL and
-    runs until Ctrl-C. --serial PATH connects at start (/dev/ttyACM0: a
-    Mega on USB). --sim ELF runs that firmware image in the simulator,
-    powered on as NAME (default flatbed), and connects to it; --vcd FILE
-    writes its trace when the app ends. On an address other than 127.0.0.1
-    every request needs the token (printed, or --token T).";
+/// The web app: open a picture, SVG or G-code, preview, connect, send
+///
+/// Vectorise a picture or make a string-art card, see the toolpath, connect
+/// to the machine, use its console and buttons, send, pause, resume and
+/// stop. Prints its URL and runs until Ctrl-C. On an address other than
+/// 127.0.0.1 every request needs the token (printed, or --token T).
+#[derive(clap::Args, Debug)]
+#[command(after_help = "\
+Examples:
+  taut studio --serial /dev/ttyACM0             (a Mega on USB)
+  cargo xtask studio --machine flatbed          (the simulated Mega)
+  taut studio --sim firmware/target/avr-none/release/taut.elf --machine drum
+                                                (a taut built with --features sim)")]
+pub struct Cli {
+    /// The HTTP port (0: any free one)
+    #[arg(long, default_value_t = 8080)]
+    pub port: u16,
+    /// The address to listen on (127.0.0.1: this computer only)
+    #[arg(long, default_value = "127.0.0.1", value_name = "ADDR")]
+    pub bind: IpAddr,
+    /// The token every request must carry (at least 8 characters) [default: made up when --bind is not 127.0.0.1]
+    #[arg(long, value_name = "T")]
+    pub token: Option<String>,
+    /// Connect to this serial port at start (/dev/ttyACM0: a Mega on USB)
+    #[arg(long, value_name = "PATH")]
+    pub serial: Option<String>,
+    /// Run this firmware image in the simulator and connect to it (needs the `sim` feature)
+    #[arg(long, value_name = "ELF")]
+    pub sim: Option<PathBuf>,
+    /// The simulated board's machine; before `$$` is read, whose figures an ETA takes
+    #[arg(long, value_enum, default_value = "flatbed")]
+    pub machine: AnyMachine,
+    /// Write the simulator's trace to this file when the app ends
+    #[arg(long, value_name = "FILE", requires = "sim")]
+    pub vcd: Option<PathBuf>,
+}
 
 /// What `taut studio` was told.
 #[derive(Clone, Debug)]
@@ -104,26 +131,20 @@ pub struct Studio {
 }
 
 /// `taut studio …` from the command line.
-pub fn run(mut args: crate::args::Args) -> Result<(), String> {
-    let mut o = Options {
-        port: args.number("port", 8080u16)?,
-        ..Options::default()
+pub fn run(cli: Cli) -> Result<(), String> {
+    if let (Some(elf), Some(vcd)) = (&cli.sim, &cli.vcd) {
+        crate::output::refuse_overwriting(&[elf.as_path()], &[vcd.as_path()])?;
+    }
+    let o = Options {
+        bind: cli.bind,
+        port: cli.port,
+        token: cli.token,
+        serial: cli.serial,
+        sim: cli.sim,
+        machine: cli.machine.into(),
+        vcd: cli.vcd,
+        connect: true,
     };
-    if let Some(b) = args.value("bind") {
-        o.bind = b
-            .parse()
-            .map_err(|_| format!("--bind {b}: not an IP address"))?;
-    }
-    o.token = args.value("token");
-    o.serial = args.value("serial");
-    o.sim = args.value("sim").map(PathBuf::from);
-    if let Some(m) = args.value("machine") {
-        o.machine =
-            Machine::parse(m.as_bytes()).ok_or(format!("--machine {m}: no such machine"))?;
-    }
-    o.vcd = args.value("vcd").map(PathBuf::from);
-    o.connect = true;
-    args.finish()?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()

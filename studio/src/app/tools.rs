@@ -130,6 +130,9 @@ fn is_svg(bytes: &[u8]) -> bool {
     head.contains("<svg") || head.trim_start().starts_with("<?xml")
 }
 
+/// The modes `mode=` takes, as `taut vectorize --mode`.
+const MODES: &str = "edges, hatch, outline, centerline or auto";
+
 /// `POST /api/vectorize`: a picture to plotter G-code.
 pub fn vectorize(bytes: &[u8], q: &Query) -> Result<Value, Bad> {
     if bytes.is_empty() {
@@ -151,25 +154,32 @@ pub fn vectorize(bytes: &[u8], q: &Query) -> Result<Value, Bad> {
         width = max;
     }
     let mut o = vectorize::Options::new(machine, width);
-    let [low, high] = q.pair("canny")?.unwrap_or([50.0, 150.0]);
+    // The page's two modes (Canny edges; hatching at the tone levels), or
+    // any of the CLI's `--mode`.
     o.mode = match q.text("mode").unwrap_or("edges") {
-        "edges" | "" => Mode::Edges {
-            low: low as f32,
-            high: high as f32,
-        },
-        "hatch" => Mode::Hatch {
-            threshold: q.number("threshold", 0.5f32)?,
-            spacing_mm: q.number("hatch_mm", 1.0)?,
-            angle: q.number("angle", 45.0)?,
-        },
-        m => return Err(Bad::input(format!("mode={m}: edges or hatch"))),
+        "" => Mode::Edges,
+        m => <Mode as clap::ValueEnum>::from_str(m, true)
+            .map_err(|_| Bad::input(format!("mode={m}: {}", MODES)))?,
     };
+    if let Some([low, high]) = q.pair("canny")? {
+        o.canny = [low as f32, high as f32];
+    }
+    if q.text("threshold").is_some_and(|t| !t.is_empty()) {
+        o.threshold = Some(q.number("threshold", 0.5f32)?);
+    }
+    o.hatch_mm = q.number("hatch_mm", o.hatch_mm)?;
+    o.angle = q.number("angle", o.angle)?;
     o.blur = q.number("blur", o.blur)?;
-    o.tolerance_mm = q.number("tolerance_mm", o.tolerance_mm)?;
-    o.min_length_mm = q.number("min_length_mm", o.min_length_mm)?;
-    o.at = q.pair("at")?;
+    if q.text("tolerance_mm").is_some_and(|t| !t.is_empty()) {
+        o.tolerance_mm = Some(q.number("tolerance_mm", 0.0)?);
+    }
+    if q.text("min_length_mm").is_some_and(|t| !t.is_empty()) {
+        o.min_length_mm = Some(q.number("min_length_mm", 0.0)?);
+    }
+    o.layout.at = q.pair("at")?;
     o.feed = q.number("feed", o.feed)?;
     let image = Gray::decode(bytes).map_err(|e| Bad::input(format!("the picture: {e}")))?;
+    let image = vectorize::Source::Picture(image);
     let title = format!("taut studio {}", q.text("name").unwrap_or("picture"));
     let v = vectorize::vectorize(&image, &o, &title).map_err(Bad::input)?;
     let mut out = drawing(v.gcode, &v.toolpath, machine);

@@ -98,3 +98,17 @@ fn clock_reads_as_minutes_or_hours() {
     assert_eq!(clock(65.34), "1:05.3");
     assert_eq!(clock(3725.0), "1:02:05");
 }
+
+#[test]
+fn program_pauses_are_told_apart_from_other_m_words() {
+    assert!(super::is_pause(
+        "M0 (MSG, change the pen: pass 2 of 3, red)"
+    ));
+    assert!(super::is_pause("m00"));
+    assert!(super::is_pause("G0 X1 M1"));
+    assert!(!super::is_pause("M3 S1000"));
+    assert!(!super::is_pause("M30"));
+    assert!(!super::is_pause("M10"));
+    assert!(!super::is_pause("G1 X5 ; M0 in a comment"));
+    assert!(!super::is_pause("M300 S30"));
+}

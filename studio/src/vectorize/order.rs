@@ -4,7 +4,9 @@
 //! way, a closed one from any of its points — then 2-opt, which reverses a
 //! run of strokes (and each stroke in it) whenever that shortens the two
 //! travels at its ends. The pen starts and ends at `home`. Never worse
-//! than the order given: if it were, the order given is kept.
+//! than the order given: if it were, the order given is kept. Before
+//! ordering, [`merge`] joins strokes that touch end to end (vpype's
+//! `linemerge`), so the pen is not lifted where the line goes on.
 
 use super::trace::Polyline;
 
@@ -14,6 +16,71 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
 
 fn closed(s: &Polyline) -> bool {
     s.len() > 2 && s.first() == s.last()
+}
+
+/// Strokes whose ends meet (within `tolerance`) joined into one, either
+/// way round; a stroke that comes back to its start stays closed.
+pub fn merge(strokes: Vec<Polyline>, tolerance: f64) -> Vec<Polyline> {
+    use std::collections::HashMap;
+    let cell = tolerance.max(1e-9);
+    let key = |p: [f64; 2]| ((p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64);
+    // Ends by grid cell: (stroke, is its last point).
+    let mut grid: HashMap<(i64, i64), Vec<(usize, bool)>> = HashMap::new();
+    let strokes: Vec<Polyline> = strokes.into_iter().filter(|s| s.len() >= 2).collect();
+    for (i, s) in strokes.iter().enumerate() {
+        if !closed(s) {
+            grid.entry(key(s[0])).or_default().push((i, false));
+            grid.entry(key(*s.last().unwrap()))
+                .or_default()
+                .push((i, true));
+        }
+    }
+    let mut used = vec![false; strokes.len()];
+    // An unused open stroke with an end within reach of `p`.
+    let find = |p: [f64; 2], used: &[bool]| {
+        let (cx, cy) = key(p);
+        let mut best: Option<(f64, usize, bool)> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for &(i, last) in grid.get(&(cx + dx, cy + dy)).into_iter().flatten() {
+                    let q = if last {
+                        *strokes[i].last().unwrap()
+                    } else {
+                        strokes[i][0]
+                    };
+                    let d = dist(p, q);
+                    if !used[i] && d <= tolerance && best.is_none_or(|b| d < b.0) {
+                        best = Some((d, i, last));
+                    }
+                }
+            }
+        }
+        best.map(|b| (b.1, b.2))
+    };
+    let mut out = Vec::new();
+    for i in 0..strokes.len() {
+        if used[i] {
+            continue;
+        }
+        used[i] = true;
+        let mut line = strokes[i].clone();
+        if !closed(&line) {
+            // Grow at the end, then at the start.
+            for _ in 0..2 {
+                while let Some((j, last)) = find(*line.last().unwrap(), &used) {
+                    used[j] = true;
+                    let mut more = strokes[j].clone();
+                    if last {
+                        more.reverse();
+                    }
+                    line.extend_from_slice(&more[1..]);
+                }
+                line.reverse();
+            }
+        }
+        out.push(line);
+    }
+    out
 }
 
 /// Pen-up travel of drawing `strokes` in this order, from `home` and back.
@@ -174,6 +241,34 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn touching_strokes_merge_either_way_round() {
+        let strokes = vec![
+            vec![[0.0, 0.0], [1.0, 0.0]],
+            vec![[2.0, 0.0], [1.0, 0.0]],
+            vec![[2.0, 0.0], [3.0, 1.0]],
+            vec![[10.0, 0.0], [11.0, 0.0]],
+            vec![[5.0, 5.0], [6.0, 5.0], [6.0, 6.0], [5.0, 5.0]],
+        ];
+        let m = merge(strokes, 0.01);
+        assert_eq!(m.len(), 3, "{m:?}");
+        let long = m.iter().find(|s| s.len() == 4).unwrap();
+        let ends = [long[0], long[3]];
+        assert!(
+            ends.contains(&[0.0, 0.0]) && ends.contains(&[3.0, 1.0]),
+            "{long:?}"
+        );
+        // Within the tolerance only.
+        assert_eq!(
+            merge(
+                vec![vec![[0.0, 0.0], [1.0, 0.0]], vec![[1.1, 0.0], [2.0, 0.0]]],
+                0.05
+            )
+            .len(),
+            2
+        );
     }
 
     #[test]
