@@ -3,7 +3,7 @@
 //! misspelt flags with a suggestion, missing arguments named, and
 //! `taut completions SHELL` for the shells' completion scripts.
 
-use crate::{bench, preview, send, stringart, template, text, vectorize};
+use crate::{app, bench, preview, send, stringart, template, text, vectorize};
 use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use taut_logic::machine::Machine;
 
@@ -12,7 +12,7 @@ use taut_logic::machine::Machine;
     name = "taut",
     version,
     about = "taut's host tools: pictures, SVG and text to plotter G-code, string-art cards, \
-             templates, previews, and a Grbl sender",
+             templates, previews, a Grbl sender and the studio web app",
     after_help = "Run `taut <COMMAND> --help` for a command's options, defaults and examples.\n\
                   From the repository: cargo taut <COMMAND> … (cargo run --release --bin taut -- …)",
     arg_required_else_help = true
@@ -30,6 +30,7 @@ pub enum Command {
     Text(text::Cli),
     Preview(preview::Cli),
     Send(send::Cli),
+    Studio(app::Cli),
     Bench(bench::Cli),
     /// Prints the completion script of a shell (bash, zsh, fish, elvish, powershell)
     #[command(
@@ -51,6 +52,7 @@ impl Command {
             Command::Text(_) => "text",
             Command::Preview(_) => "preview",
             Command::Send(_) => "send",
+            Command::Studio(_) => "studio",
             Command::Bench(_) => "bench",
             Command::Completions { .. } => "completions",
         }
@@ -64,6 +66,7 @@ impl Command {
             Command::Text(c) => text::run(c),
             Command::Preview(c) => preview::run(c),
             Command::Send(c) => send::run(c),
+            Command::Studio(c) => app::run(c),
             Command::Bench(c) => bench::run(c),
             Command::Completions { shell } => {
                 clap_complete::generate(shell, &mut Cli::command(), "taut", &mut std::io::stdout());

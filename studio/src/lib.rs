@@ -5,8 +5,10 @@
 //! streamed to the machine, Grbl's way). They share the firmware's
 //! logic crate (`taut_logic`): its nail geometry, card parsers, G-code
 //! parser and interpreter, kinematics and machine-time estimate, so what
-//! the tools predict is what the machine does.
+//! the tools predict is what the machine does. `studio` (the [`app`]) is
+//! the web app over all of them and the machine's serial port.
 
+pub mod app;
 pub mod bench;
 pub mod board;
 pub mod cli;

@@ -17,15 +17,16 @@
 //! PATH`: it greeted before the port opened, so a Ctrl-X asks again).
 
 mod port;
+pub mod stream;
 
 use crate::cli::AnyMachine;
 use indicatif::{ProgressBar, ProgressStyle};
 use port::Port;
-use std::collections::VecDeque;
 use std::io::Read;
 use std::path::PathBuf;
 use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
+use stream::{Answer, Stream};
 use taut_logic::config::MachineConfig;
 use taut_logic::interp::estimate::GcodeTime;
 use taut_logic::machine::Machine;
@@ -79,54 +80,12 @@ fn is_pause(line: &str) -> bool {
     false
 }
 
-/// Grbl 1.1's receive buffer; senders keep one byte of it free, as Grbl's
-/// own stream.py and grbl-streamer do (bytes of lines sent and not yet
-/// answered stay under it).
-const RX_BUFFER: usize = 128;
-
-/// Character counting: the lines sent and not yet answered, oldest first
-/// (index into the file's lines, bytes with the newline). Grbl answers in
-/// order, so each `ok` or `error:` frees the oldest.
-#[derive(Default)]
-struct Window {
-    in_flight: VecDeque<(usize, usize)>,
-    bytes: usize,
-}
-
-impl Window {
-    /// `line` (without its newline) fits beside the bytes in flight.
-    fn fits(&self, line: &str) -> bool {
-        self.bytes + line.len() + 1 < RX_BUFFER
-    }
-
-    fn sent(&mut self, index: usize, line: &str) {
-        self.in_flight.push_back((index, line.len() + 1));
-        self.bytes += line.len() + 1;
-    }
-
-    /// A reply came: the index of the line it answers.
-    fn answered(&mut self) -> Option<usize> {
-        let (i, n) = self.in_flight.pop_front()?;
-        self.bytes -= n;
-        Some(i)
-    }
-}
-
 pub fn run(cli: Cli) -> Result<(), String> {
     let (file, port) = (cli.file.display().to_string(), cli.port);
     let chosen = cli.machine.map(Machine::from);
     let machine = chosen.map(|m| m.name().to_string());
     let text = std::fs::read(&file).map_err(|e| format!("{file}: {e}"))?;
-    let lines = lines_of(&text);
-    // A line longer than the buffer would never fit beside nothing: the
-    // stream would wait for it forever.
-    if let Some((n, l)) = lines.iter().find(|(_, l)| !Window::default().fits(l)) {
-        return Err(format!(
-            "line {n}: {} characters, more than Grbl's buffer takes ({}): {l}",
-            l.len(),
-            RX_BUFFER - 2
-        ));
-    }
+    let stream = Stream::new(&text)?;
     let mut port = Port::open(&port)?;
     let mut replies = port.replies()?;
     greet(&mut port, &mut replies)?;
@@ -141,15 +100,15 @@ pub fn run(cli: Cli) -> Result<(), String> {
         _ => listed_config(&mut port, &mut replies)
             .unwrap_or(("string_art".into(), MachineConfig::STRING_ART)),
     };
-    let eta = Eta::of(&lines, &config);
+    let eta = Eta::of(stream.lines(), &config);
+    let count = stream.lines().len();
     eprintln!(
-        "taut send: {} lines to the {name}, {} of machine time by its planner",
-        lines.len(),
+        "taut send: {count} lines to the {name}, {} of machine time by its planner",
         clock(eta.total)
     );
     let keys = keys();
     let started = Instant::now();
-    let outcome = stream(&mut port, &mut replies, &lines, &eta, &keys);
+    let outcome = send(&mut port, &mut replies, stream, &eta, &keys);
     drop(keys);
     let Outcome {
         answered,
@@ -157,8 +116,7 @@ pub fn run(cli: Cli) -> Result<(), String> {
         alarm,
     } = outcome?;
     println!(
-        "taut send: {answered} of {} lines answered, {errors} error(s), {} (the planner said {})",
-        lines.len(),
+        "taut send: {answered} of {count} lines answered, {errors} error(s), {} (the planner said {})",
         clock(started.elapsed().as_secs_f64()),
         clock(eta.total)
     );
@@ -178,37 +136,6 @@ fn clock(s: f64) -> String {
             let t = s as u64;
             format!("{}:{:02}:{:02}", t / 3600, t / 60 % 60, t % 60)
         }
-    }
-}
-
-/// The file's lines as sent, each with its line number: blanks, `%` tape
-/// marks and comments (`( … )`, `;` to the end) kept home, and G-code's
-/// spaces too, as Grbl's stream.py does (every byte in flight is a byte of
-/// the 128); `$` lines only trimmed (their values are text).
-fn lines_of(text: &[u8]) -> Vec<(usize, String)> {
-    String::from_utf8_lossy(text)
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, clean(l)))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('%'))
-        .collect()
-}
-
-fn clean(line: &str) -> String {
-    let mut code = String::new();
-    let mut in_comment = false;
-    for c in line.chars() {
-        match c {
-            _ if in_comment => in_comment = c != ')',
-            '(' => in_comment = true,
-            ';' => break,
-            c => code.push(c),
-        }
-    }
-    let code = code.trim();
-    match code.starts_with('$') && !code.starts_with("$J=") {
-        true => code.to_string(),
-        false => code.chars().filter(|c| !c.is_whitespace()).collect(),
     }
 }
 
@@ -235,7 +162,7 @@ fn listed_config(
     config_of(&listing)
 }
 
-fn config_of(listing: &[String]) -> Option<(String, MachineConfig)> {
+pub fn config_of(listing: &[String]) -> Option<(String, MachineConfig)> {
     // Grbl's numbered settings (`$110=…`) stand for named ones: skipped.
     let named: Vec<(&str, &str)> = listing
         .iter()
@@ -261,13 +188,13 @@ fn config_of(listing: &[String]) -> Option<(String, MachineConfig)> {
 /// Counted when the planner hands a block on, it lags the line by the
 /// planner's depth, as the machine lags the `ok` (the firmware answers a
 /// line when it is queued): the two lags cancel on the bar.
-struct Eta {
-    after: Vec<f64>,
-    total: f64,
+pub struct Eta {
+    pub after: Vec<f64>,
+    pub total: f64,
 }
 
 impl Eta {
-    fn of(lines: &[(usize, String)], config: &MachineConfig) -> Eta {
+    pub fn of(lines: &[(usize, String)], config: &MachineConfig) -> Eta {
         let Some(mut t) = GcodeTime::new(config) else {
             return Eta {
                 after: vec![0.0; lines.len()],
@@ -390,65 +317,52 @@ impl Drop for Progress {
     }
 }
 
-fn stream(
+fn send(
     port: &mut Port,
     replies: &mut Receiver<String>,
-    lines: &[(usize, String)],
+    mut stream: Stream,
     eta: &Eta,
     keys: &Keys,
 ) -> Result<Outcome, String> {
     let mut p = Progress::new(eta.total)?;
-    let mut window = Window::default();
-    let mut next = 0;
     let mut o = Outcome::default();
-    // The firmware's words for an error or alarm come just before it.
-    let mut message = String::new();
-    while o.answered < lines.len() {
-        // Fill the buffer.
-        while let Some((_, line)) = lines.get(next).filter(|(_, l)| window.fits(l)) {
-            port.write(format!("{line}\n").as_bytes())?;
-            window.sent(next, line);
-            next += 1;
-        }
+    while !stream.done() {
+        stream.fill(|line| port.write(line))?;
         keys.act(port, &mut p)?;
         let reply = match replies.recv_timeout(Duration::from_millis(50)) {
             Ok(reply) => reply,
             Err(mpsc::RecvTimeoutError::Timeout) => continue,
             Err(mpsc::RecvTimeoutError::Disconnected) => return Err("the port closed".into()),
         };
-        if reply == "ok" || reply.starts_with("error:") {
-            let i = window
-                .answered()
-                .ok_or(format!("a reply with no line sent: {reply}"))?;
-            o.answered += 1;
-            // A program pause (M0, as a pen change): the machine holds
-            // there; the line's comment says what to do.
-            if reply == "ok" && is_pause(&lines[i].1) {
-                let (number, text) = &lines[i];
-                p.bar.suspend(|| {
-                    eprintln!("line {number}: paused: {text} — resume with ~ or space")
-                });
+        match stream.reply(&reply)? {
+            Answer::Line { index, error } => {
+                let (number, text) = &stream.lines()[index];
+                match error {
+                    Some(error) => p
+                        .bar
+                        .suspend(|| eprintln!("line {number}: {text}: {error}")),
+                    // A program pause (M0, as a pen change): the machine
+                    // holds there; the line's comment says what to do.
+                    None if is_pause(text) => p.bar.suspend(|| {
+                        eprintln!("line {number}: paused: {text} — resume with ~ or space")
+                    }),
+                    None => {}
+                }
+                p.bar.set_position((eta.after[index] * 1000.0) as u64);
+                p.left = eta.total - eta.after[index];
+                p.show();
             }
-            if reply != "ok" {
-                o.errors += 1;
-                let (number, text) = &lines[i];
-                p.bar
-                    .suspend(|| eprintln!("line {number}: {text}: {reply} {message}"));
+            Answer::Alarm(alarm) => {
+                o.alarm = Some(alarm);
+                break;
             }
-            p.bar.set_position((eta.after[i] * 1000.0) as u64);
-            p.left = eta.total - eta.after[i];
-            p.show();
-        } else if reply.starts_with("ALARM:") {
-            o.alarm = Some(format!("{reply} {message}").trim().to_string());
-            return Ok(o);
-        } else if let Some(m) = reply
-            .strip_prefix("[MSG:")
-            .and_then(|m| m.strip_suffix(']'))
-        {
-            message = m.to_string();
-            continue;
+            Answer::Other => {}
         }
-        message.clear();
+        (o.answered, o.errors) = (stream.answered(), stream.errors());
+    }
+    (o.answered, o.errors) = (stream.answered(), stream.errors());
+    if o.alarm.is_some() {
+        return Ok(o);
     }
     // Every line queued: wait until the machine stands.
     o.alarm = wait_idle(port, replies, keys, &mut p)?;

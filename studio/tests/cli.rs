@@ -71,6 +71,7 @@ fn every_subcommand_has_help_listing_its_flags() {
             "text",
             "preview",
             "send",
+            "studio",
         ]
         .contains(&name)
         {
@@ -101,6 +102,13 @@ fn misspelt_and_missing_flags_are_named() {
         e.contains("unexpected argument '--machin'")
             && e.contains("tip: a similar argument exists: '--machine'"),
         "{e}"
+    );
+    let out = taut(&["studio", "--serail", "/dev/ttyACM0"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out).contains("tip: a similar argument exists: '--serial'"),
+        "{}",
+        text(&out)
     );
     let out = taut(&[
         "template", "--nails", "100", "--shape", "circle", "-o", "t.svg",

@@ -10,6 +10,7 @@ mod firmware;
 mod flashmap;
 mod fuzz;
 mod run;
+mod studio;
 
 use run::{cargo, root, Result};
 use std::process::ExitCode;
@@ -40,6 +41,8 @@ usage: cargo xtask <command> [args]
   sim --bootloader HEX --pty PATH [OPTIONS]
                     a Mega holding only that bootloader, its serial port on PATH:
                     flash it with avrdude -c wiring or ravedude (docs/hardware.md)
+  studio [--port N] [--machine NAME] [--vcd FILE]
+                    the web app (taut studio) against the simulated Mega
   sdimage DIR -o IMG
                     build a FAT card image from a folder (dd it to a real card)
   estimate DIR      the machine time of a card folder's job: this firmware's (its
@@ -76,6 +79,7 @@ fn main() -> ExitCode {
             fuzz::Plan::parse(rest).and_then(|plan| run::setup().and_then(|_| fuzz::run(&plan)))
         }
         "sim" => run::setup().and_then(|_| sim(rest)),
+        "studio" => run::setup().and_then(|_| studio::run(rest)),
         "sdimage" => run::setup().and_then(|_| run::bin("taut-sdimage", rest)),
         "demo" => run::setup().and_then(|_| match rest.first().map(String::as_str) {
             None => demo::run(),

@@ -1,3 +1,4 @@
+use super::stream::{lines_of, Window, RX_BUFFER};
 use super::*;
 
 #[test]
