@@ -583,6 +583,7 @@ impl Console {
             }
             Order::SetPosition { steps } => m.set_position(*steps),
             Order::Drivers { on } => m.drivers.set(0xFF, *on),
+            Order::IdleDelay { ms } => m.drivers.set_delay(*ms),
             Order::ReportPosition => report_position(m, kin),
         }
         None
@@ -602,7 +603,7 @@ impl Console {
     /// Home `axes` (bits), their drivers on; `reply`: answer the line
     /// that asked at the end.
     pub fn start_homing(&mut self, axes: u8, m: &mut Motion, reply: bool) {
-        m.drivers.set(axes, true);
+        m.drivers.wake(axes);
         self.pending = Some(Pending::Home {
             homing: Homing::new(axes),
             moving: false,

@@ -29,8 +29,9 @@ fn drawn_from_the_pulses(machine: Machine, pen: PenWords, at: [f64; 2], within: 
 
 #[test]
 fn the_drum_plotter_draws_its_toolpath() {
-    // Y: 7.24 steps/mm of paper (a step is 0.14 mm).
-    drawn_from_the_pulses(Machine::Drum, PenWords::Spindle, [5.0, 5.0], 0.15);
+    // Its 28BYJ-48s half-stepped through their coils (x_in*, y_in*): Y
+    // 14.5 half-steps a mm of paper (0.07 mm each).
+    drawn_from_the_pulses(Machine::Drum, PenWords::Spindle, [5.0, 5.0], 0.1);
 }
 
 #[test]
@@ -273,7 +274,7 @@ fn the_picture_counts_from_the_homed_zero_not_from_power_on() {
     use taut_logic::pinmap::Button;
     use taut_logic::settings::image;
     let cfg = MachineConfig::defaults(Machine::Flatbed);
-    let mut sim = Sim::load(&hil_tests::firmware_elf()).unwrap();
+    let mut sim = hil_tests::load();
     sim.set_eeprom(&image::bytes(&cfg).collect::<Vec<u8>>());
     sim.probe_machine(Machine::Flatbed);
     for b in Button::ALL {

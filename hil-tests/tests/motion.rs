@@ -2,7 +2,7 @@
 //! pulses, with the configured pulse width and DIR set-up, and a velocity
 //! profile within the configured acceleration.
 
-use hil_tests::{firmware_elf, max_accel, rising, sim::Outcome, sim::Sim};
+use hil_tests::{max_accel, rising, sim::Outcome, sim::Sim};
 use std::time::Duration;
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
@@ -10,7 +10,7 @@ use taut_logic::pinmap::driver;
 
 /// Boot, probe every driver, and wait for the banner.
 fn boot() -> Sim {
-    let mut sim = Sim::load(&firmware_elf()).unwrap();
+    let mut sim = hil_tests::load();
     for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
         let d = driver(axis);
         sim.probe_step_dir(axis.name(), d.step, d.dir, true);
@@ -61,26 +61,55 @@ fn absolute_moves_give_exact_pulse_counts() {
 /// last this long there.
 const PULSE_FLOOR: u64 = 130;
 
-/// A longer pulse setting is kept exactly too, on every pulse (within the
-/// 2 µs the drop takes).
+/// Every pulse is as wide as set, from 5 to 200 µs, on one, two and three
+/// axes, at every event: inside a segment, where the assembly path takes
+/// the next segment (single-axis and equal-count moves: once a pulse there
+/// ended early, at 14.4 µs), and on the DDA's general path. Each setting's
+/// moves are replayed edge by edge; a pulse lasts the set width, or the
+/// general path's floor when that is longer, and at most 2 µs more.
 #[test]
-fn a_longer_pulse_setting_gives_every_pulse_that_width() {
+fn every_pulse_is_as_wide_as_set_on_one_two_and_three_axes() {
     let mut sim = boot();
-    send(&mut sim, "$step_pulse_us=40", Duration::from_millis(100));
-    send(&mut sim, "M17", Duration::from_millis(100));
-    send(&mut sim, "G0 C10 X3 Z1", Duration::from_millis(100));
-    send(&mut sim, "M400", Duration::from_secs(20));
-    for axis in ["base", "radial", "drill"] {
-        let step = sim.probed(&format!("{axis}_step"));
-        let (min, max) = (
-            step.min_high_cycles().unwrap(),
-            step.max_high_cycles().unwrap(),
-        );
-        assert!(
-            min >= 640 && max <= 640 + 32,
-            "{axis} pulses {min}..{max} cycles"
-        );
+    send(&mut sim, "G91", Duration::from_millis(100));
+    let mut from = [0usize; 3];
+    for (k, us) in [5u64, 20, 40, 100, 200].into_iter().enumerate() {
+        send(&mut sim, &format!("$step_pulse_us={us}"), Duration::from_millis(100));
+        // There and back, within the carriage's and the drill's travel.
+        let s = [1.0, -1.0][k % 2];
+        for line in [
+            // One axis (the assembly path, segment after segment).
+            format!("G0 X{}", -20.0 * s),
+            format!("G0 C{}", -30.0 * s),
+            // Two, in step (320 each, the two STEP ports) and not.
+            format!("G0 X{} Z{}", 10.0 * s, 2.4 * s),
+            format!("G0 C{} X{}", 20.0 * s, 5.0 * s),
+            // Three.
+            format!("G0 C{} X{} Z{}", 10.0 * s, 3.0 * s, s),
+        ] {
+            send(&mut sim, &line, Duration::from_millis(100));
+        }
+        send(&mut sim, "M400", Duration::from_secs(60));
+        let set = us * 16;
+        for (i, axis) in ["base", "radial", "drill"].into_iter().enumerate() {
+            let step = sim.probed(&format!("{axis}_step"));
+            let edges = &step.edges()[from[i]..];
+            from[i] = step.edges().len();
+            let widths: Vec<u64> = edges
+                .windows(2)
+                .filter(|w| w[0].high && !w[1].high)
+                .map(|w| w[1].cycle - w[0].cycle)
+                .collect();
+            assert!(widths.len() > 100, "{axis} at {us} µs: {} pulses", widths.len());
+            let short = widths.iter().filter(|&&w| w < set).count();
+            let (min, max) = (widths.iter().min().unwrap(), widths.iter().max().unwrap());
+            assert!(
+                short == 0 && *max <= set.max(PULSE_FLOOR) + 32,
+                "{axis} at {us} µs: {short} of {} pulses short, {min}..{max} cycles",
+                widths.len()
+            );
+        }
     }
+    assert!(!sim.uart_text().contains("late"), "{}", sim.uart_text());
 }
 
 #[test]

@@ -19,7 +19,7 @@ fn stored(sim: &Sim) -> Result<MachineConfig, image::Unusable> {
 
 /// The same image powered up again with `eeprom` (all a power cut keeps).
 fn power_on(eeprom: &[u8]) -> Sim {
-    let mut sim = Sim::load(&firmware_elf()).unwrap();
+    let mut sim = hil_tests::load();
     sim.set_eeprom(eeprom);
     wait_for(&mut sim, "reset:", Duration::from_millis(50));
     sim

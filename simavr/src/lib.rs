@@ -8,6 +8,7 @@
 mod calls;
 mod card_slot;
 pub mod clock;
+pub mod coils;
 pub mod console;
 pub mod elf;
 pub mod endstop;

@@ -62,6 +62,11 @@ pub enum Order {
     Drivers {
         on: bool,
     },
+    /// `M18 S`/`M84 S` (Marlin): the drivers go off this long after
+    /// motion stands, ms (0: never), instead of after `$1`.
+    IdleDelay {
+        ms: u32,
+    },
     /// Answer once motion is done.
     WaitIdle,
     ReportPosition,
@@ -389,7 +394,13 @@ impl Interpreter {
                 Order::SetPosition { steps }
             }
             Command::EnableDrivers => Order::Drivers { on: true },
-            Command::DisableDrivers => Order::Drivers { on: false },
+            // Seconds, read as thousandths: ms.
+            Command::DisableDrivers => match line.s.get() {
+                Some(s) => Order::IdleDelay {
+                    ms: s.0.max(0) as u32,
+                },
+                None => Order::Drivers { on: false },
+            },
             Command::WaitIdle => Order::WaitIdle,
             Command::ReportPosition => Order::ReportPosition,
         };

@@ -117,7 +117,6 @@ macro_rules! step_vector {
                 "3:",
                 "push r18", "push r19", "push r20", "push r21", "push r22",
                 "push r23", "push r25", "push r26", "push r27", "push r30", "push r31",
-                "lds r30, {e}+{raised}", "lds r31, {e}+{raised}+1",
                 // left -= 1; the segment's last event takes the next one
                 "lds r24, {e}+{left}", "lds r25, {e}+{left}+1",
                 "sbiw r24, 1",
@@ -195,7 +194,10 @@ macro_rules! step_vector {
                 "sts {e}+{late}+1, r25", "sts {e}+{late}, r24",
                 "4:",
                 "sts 0x99, r27", "sts 0x98, r26", // OCR3A, high byte first
-                // Hold the pulse: TCNT3 - raised >= pulse_ticks.
+                // Hold the pulse: TCNT3 - raised >= pulse_ticks. `raised` is
+                // read here, not kept from the entry: taking the next
+                // segment above uses Z (r31:r30) to address it.
+                "lds r30, {e}+{raised}", "lds r31, {e}+{raised}+1",
                 "lds r20, {e}+{pulse}", "lds r21, {e}+{pulse}+1",
                 "5:",
                 "lds r18, 0x94", "lds r19, 0x95",

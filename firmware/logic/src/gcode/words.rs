@@ -325,7 +325,13 @@ impl Words {
         if line.p.is_some() && line.command != Command::Dwell {
             return fail(ErrorKind::UnusedValueWords, self.p_column);
         }
-        if line.s.is_some() && !matches!(line.command, Command::PenDown | Command::Servo) {
+        // `S` is the pen's angle, or `M18 S`'s seconds (Marlin).
+        if line.s.is_some()
+            && !matches!(
+                line.command,
+                Command::PenDown | Command::Servo | Command::DisableDrivers
+            )
+        {
             return fail(ErrorKind::UnusedValueWords, self.s_column);
         }
         // Arc words only with an arc (or axis words in an arc's modal

@@ -103,7 +103,7 @@ impl GcodeTime {
             Order::Home { .. } | Order::Pause | Order::WaitIdle | Order::Drivers { .. } => {
                 self.settle()
             }
-            Order::None | Order::ReportPosition => {}
+            Order::None | Order::ReportPosition | Order::IdleDelay { .. } => {}
         }
     }
 

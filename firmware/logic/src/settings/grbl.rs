@@ -20,8 +20,10 @@ use taut_progmem::text;
 pub enum Numbered {
     /// `$0` step pulse, µs.
     StepPulse,
-    /// `$1` step idle delay: 255, the drivers always hold.
+    /// `$1` step idle delay, ms: 255, the drivers always hold.
     IdleDelay,
+    /// `$4` step enable invert: 1, ENABLE high switches a driver on.
+    EnableInvert,
     /// `$3` direction invert, a bit per place.
     DirInvert,
     /// `$10` status report fields.
@@ -51,7 +53,7 @@ pub enum Numbered {
 }
 
 /// How many numbered settings `$$` lists.
-pub const COUNT: usize = 11 + 4 * 3;
+pub const COUNT: usize = 12 + 4 * 3;
 
 /// The channel in each of Grbl's X, Y, Z places: a plotter's X Y Z
 /// channels in order; on the string-art machine the radial carriage
@@ -74,12 +76,12 @@ pub const fn report_angles(machine: Machine) -> u8 {
 }
 
 impl Numbered {
-    /// The setting at `index` in `$$` order: `$0 $1 $3 $10 $11 $12 $13
+    /// The setting at `index` in `$$` order: `$0 $1 $3 $4 $10 $11 $12 $13
     /// $20 $21 $22 $27`, then `$100…$132`.
     pub fn at(index: usize) -> Option<Numbered> {
         // Grbl's numbers below 100 as bytes of a flash text: a table would
         // sit in SRAM on the AVR.
-        let small = text!("\0\x01\x03\n\x0b\x0c\r\x14\x15\x16\x1b");
+        let small = text!("\0\x01\x03\x04\n\x0b\x0c\r\x14\x15\x16\x1b");
         let n = match index {
             i if i < small.len() => small.byte(i),
             i if i < COUNT => {
@@ -98,6 +100,7 @@ impl Numbered {
             0 => Numbered::StepPulse,
             1 => Numbered::IdleDelay,
             3 => Numbered::DirInvert,
+            4 => Numbered::EnableInvert,
             10 => Numbered::StatusReport,
             11 => Numbered::JunctionDeviation,
             12 => Numbered::ArcTolerance,
@@ -127,6 +130,7 @@ impl Numbered {
             Numbered::StepPulse => 0,
             Numbered::IdleDelay => 1,
             Numbered::DirInvert => 3,
+            Numbered::EnableInvert => 4,
             Numbered::StatusReport => 10,
             Numbered::JunctionDeviation => 11,
             Numbered::ArcTolerance => 12,
@@ -149,6 +153,7 @@ impl Numbered {
         let global = |g| Setting::Global(g);
         Some(match self {
             Numbered::StepPulse => (global(GlobalField::StepPulseUs), Unit::Same),
+            Numbered::IdleDelay => (global(GlobalField::StepIdleDelay), Unit::Same),
             Numbered::StatusReport => (global(GlobalField::StatusReport), Unit::Same),
             Numbered::ReportInches => (global(GlobalField::ReportInches), Unit::Same),
             Numbered::HomingPullOff => (global(GlobalField::HomingPullOff), Unit::Same),
@@ -188,17 +193,19 @@ impl Numbered {
     /// The value of a switch or mask over the report places.
     fn over_places(self, cfg: &MachineConfig) -> u32 {
         // Bytes: a `u32`'s shifts are four times as long on the AVR.
-        let mut mask = [0u8; 2];
+        let mut mask = [0u8; 3];
         for (p, axis) in report_axes(cfg.machine).iter().enumerate() {
             let a = &cfg.axes[axis.index()];
             mask[0] |= (!a.dir_high_is_positive as u8) << p;
             mask[1] |= (a.soft_limits as u8) << p;
+            mask[2] |= (!a.enable_active_high as u8) << p;
         }
         (match self {
             Numbered::DirInvert => mask[0],
             Numbered::SoftLimits => (mask[1] != 0) as u8,
             Numbered::Homing => (cfg.homing.axes != 0) as u8,
-            Numbered::IdleDelay => 255,
+            // Grbl's ENABLE is active low unless inverted.
+            Numbered::EnableInvert => (mask[2] == 0) as u8,
             _ => 0,
         }) as u32
     }
@@ -258,9 +265,7 @@ impl Numbered {
     fn put_over_places(self, cfg: &mut MachineConfig, n: u32) -> Result<(), ErrorKind> {
         let max = match self {
             Numbered::DirInvert => 7,
-            Numbered::SoftLimits | Numbered::Homing => 1,
-            // Another value than the one listed (checked first).
-            Numbered::IdleDelay => return Err(ErrorKind::Range { min: 255, max: 255 }),
+            Numbered::SoftLimits | Numbered::Homing | Numbered::EnableInvert => 1,
             _ => 0,
         };
         if n > max {
@@ -278,6 +283,8 @@ impl Numbered {
                     let a = &mut cfg.axes[axis.index()];
                     match self {
                         Numbered::DirInvert => a.dir_high_is_positive = n >> p & 1 == 0,
+                        // Every driver alike, as Grbl's one ENABLE pin.
+                        Numbered::EnableInvert => a.enable_active_high = n == 1,
                         // On only where a travel is set: the base turns freely.
                         _ => a.soft_limits = n == 1 && a.travel.0 < a.travel.1,
                     }

@@ -10,13 +10,13 @@
 
 use super::{all, Setting, Value, COUNT};
 use crate::axis::AXES;
-use crate::config::MachineConfig;
+use crate::config::{Driver, MachineConfig};
 use crate::machine::Machine;
 use crate::units::{Milli, StepsPerUnit};
 
 pub const MAGIC: [u8; 4] = *b"taut";
 /// Bumped whenever the settings or their kinds change.
-pub const VERSION: u8 = 6;
+pub const VERSION: u8 = 7;
 const HEADER: usize = MAGIC.len() + 1;
 
 /// Why the image was not taken.
@@ -175,6 +175,7 @@ fn value_array(v: Value) -> ([u8; 8], usize) {
         Value::Number(n) => (widen(n.to_le_bytes()), 4),
         Value::Milli(m) => (widen(m.0.to_le_bytes()), 4),
         Value::Machine(m) => (widen((m as u32).to_le_bytes()), 4),
+        Value::Driver(d) => (widen((d as u32).to_le_bytes()), 4),
         Value::Ratio(r) => {
             let mut b = [0; 8];
             b[..4].copy_from_slice(&r.num.to_le_bytes());
@@ -239,6 +240,7 @@ fn value(read: &impl Fn(usize) -> u8, like: Value, at: usize) -> Option<Value> {
         Value::Number(_) => Value::Number(word(at)),
         Value::Milli(_) => Value::Milli(Milli(word(at) as i32)),
         Value::Machine(_) => Value::Machine(Machine::from_index(u8::try_from(word(at)).ok()?)?),
+        Value::Driver(_) => Value::Driver(Driver::from_index(word(at))?),
         Value::Ratio(_) => Value::Ratio(StepsPerUnit::new(word(at), word(at + 4))),
     })
 }

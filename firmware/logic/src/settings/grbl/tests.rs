@@ -28,6 +28,7 @@ fn dollar_dollar_lists_grbl_s_numbers_then_the_named_settings() {
             "$0=5",
             "$1=255",
             "$3=0",
+            "$4=1",
             "$10=3",
             "$11=0.010",
             "$12=0.010",
@@ -58,10 +59,15 @@ fn dollar_dollar_lists_grbl_s_numbers_then_the_named_settings() {
     assert_eq!(lines[COUNT + 2], "$base_max_rate=2000");
     // A plotter's channels are in their own places.
     let flatbed = listing(&MachineConfig::defaults(Machine::Flatbed));
-    assert_eq!(flatbed[9], "$22=1");
-    assert_eq!(flatbed[11], "$100=40.000");
-    assert_eq!(flatbed[14], "$110=3000.000");
-    assert_eq!(flatbed[20], "$130=140.000");
+    assert_eq!(flatbed[10], "$22=1");
+    assert_eq!(flatbed[12], "$100=40.000");
+    assert_eq!(flatbed[15], "$110=3000.000");
+    assert_eq!(flatbed[21], "$130=140.000");
+    // The drum's 28BYJ-48s: 4096 half-steps per 40 mm, their coils
+    // released 250 ms after it stands.
+    let drum = listing(&MachineConfig::defaults(Machine::Drum));
+    assert_eq!(drum[1], "$1=250");
+    assert_eq!(drum[12], "$100=102.400");
 }
 
 #[test]
@@ -72,7 +78,7 @@ fn numbers_index_and_name_each_other() {
         assert_eq!(Numbered::parse(show(&n.number()).as_bytes()), Some(n));
     }
     assert_eq!(Numbered::at(COUNT), None);
-    for absent in [2u8, 4, 5, 6, 14, 23, 24, 25, 26, 30, 31, 32, 103, 113, 140] {
+    for absent in [2u8, 5, 6, 14, 23, 24, 25, 26, 30, 31, 32, 103, 113, 140] {
         assert_eq!(Numbered::from_number(absent), None, "${absent}");
     }
     assert_eq!(Numbered::parse(b"1000"), None);
@@ -116,8 +122,15 @@ fn writes_in_grbl_s_units_land_in_the_named_settings() {
     assert!(cfg.axes.iter().all(|a| !a.soft_limits));
     set(&mut cfg, "20", "1").unwrap();
     assert_eq!(cfg.axes.map(|a| a.soft_limits), [false, true, true]);
+    // The step idle delay, ms (255: the drivers stay on); the ENABLE
+    // polarity of every driver (1: high is on).
+    set(&mut cfg, "1", "25").unwrap();
+    assert_eq!(cfg.idle_delay_ms, 25);
+    set(&mut cfg, "4", "0").unwrap();
+    assert!(cfg.axes.iter().all(|a| !a.enable_active_high));
+    set(&mut cfg, "4", "1").unwrap();
+    assert!(cfg.axes.iter().all(|a| a.enable_active_high));
     // What cannot change here accepts only its value.
-    set(&mut cfg, "1", "255").unwrap();
     set(&mut cfg, "21", "0").unwrap();
 }
 
@@ -130,9 +143,10 @@ fn refused_writes_say_why_and_change_nothing() {
     };
     assert_eq!(error(&mut cfg, "21", "1"), (0, "expected 0 to 0".into()));
     assert_eq!(
-        error(&mut cfg, "1", "25"),
-        (0, "expected 255 to 255".into())
+        error(&mut cfg, "1", "256"),
+        (0, "expected 0 to 255".into())
     );
+    assert_eq!(error(&mut cfg, "4", "2"), (0, "expected 0 to 1".into()));
     assert_eq!(error(&mut cfg, "3", "8"), (0, "expected 0 to 7".into()));
     assert_eq!(error(&mut cfg, "10", "4"), (0, "expected 0 to 3".into()));
     assert_eq!(
