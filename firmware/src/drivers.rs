@@ -64,14 +64,14 @@ impl Drivers {
             active_high: 0,
             coils: 0,
             setup_us: 0,
-            on: 0xFF,
+            on: 0,
             held: 0,
             delay_ms: KEEP,
             delay_setting: KEEP_DRIVERS_ON,
             since: None,
         };
+        // Every pin written: all off.
         d.configure(config);
-        d.set(0xFF, false);
         d
     }
 
@@ -145,12 +145,15 @@ impl Drivers {
         }
         let since = *self.since.get_or_insert(now_ms);
         let waited = now_ms.wrapping_sub(since);
-        if waited >= self.delay_ms {
+        // The clock counts whole ms: a tick more, never less than the
+        // delay (none for 0, Grbl's "at once").
+        let due = self.delay_ms + (self.delay_ms != 0) as u32;
+        if waited >= due {
             self.switch(loose, false);
             self.since = None;
             return None;
         }
-        Some(self.delay_ms - waited)
+        Some(due - waited)
     }
 
     /// Set the ENABLE pins (and coils) of `mask`. After switching one on,

@@ -1,7 +1,7 @@
 //! Issue 2: the release firmware boots in simavr, prints its banner within
 //! 50 ms of machine time, and blinks its status LED exactly as designed.
 
-use hil_tests::{firmware_elf, firmware_version, sim::Outcome, sim::Sim};
+use hil_tests::{firmware_version, sim::Outcome};
 use std::time::Duration;
 use taut_logic::pinmap::STATUS_LED;
 

@@ -2,7 +2,7 @@
 //! gives the defaults with one warning line, never garbage.
 
 use hil_tests::sim::Sim;
-use hil_tests::{boot_machine, firmware_elf, log_tail, send_ok, wait_for};
+use hil_tests::{boot_machine, log_tail, send_ok, wait_for};
 use std::time::Duration;
 use taut_logic::config::MachineConfig;
 use taut_logic::settings::image;
