@@ -289,8 +289,7 @@ fn init() -> Watchdog {
             pins.d34.into_output_at(false),
         ),
     };
-    let stepper =
-        CONFIG.with(|c| Stepper::new(step_dir, coils, StepTimer::start(dp.TC3), c));
+    let stepper = CONFIG.with(|c| Stepper::new(step_dir, coils, StepTimer::start(dp.TC3), c));
     // After the stepper: a coil axis's driver is its coils.
     let drivers = CONFIG.with(|c| Drivers::new(enable, c));
     // The pen starts up, whatever the machine (SERVO0 is unused on the

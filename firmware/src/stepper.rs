@@ -281,9 +281,24 @@ const _: () = {
 /// outputs: X on PA0–PA3, Y on PA4–PA7, Z on PC0–PC3. Written by the
 /// step interrupt and [`coils`], four bits of one port at a time.
 pub struct CoilPins {
-    pub x: (Pin<22, Output>, Pin<23, Output>, Pin<24, Output>, Pin<25, Output>),
-    pub y: (Pin<26, Output>, Pin<27, Output>, Pin<28, Output>, Pin<29, Output>),
-    pub z: (Pin<37, Output>, Pin<36, Output>, Pin<35, Output>, Pin<34, Output>),
+    pub x: (
+        Pin<22, Output>,
+        Pin<23, Output>,
+        Pin<24, Output>,
+        Pin<25, Output>,
+    ),
+    pub y: (
+        Pin<26, Output>,
+        Pin<27, Output>,
+        Pin<28, Output>,
+        Pin<29, Output>,
+    ),
+    pub z: (
+        Pin<37, Output>,
+        Pin<36, Output>,
+        Pin<35, Output>,
+        Pin<34, Output>,
+    ),
 }
 
 const _: () = {

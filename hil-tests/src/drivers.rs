@@ -120,7 +120,10 @@ pub fn assert_drivers_timing(sim: &Sim) {
     }
     for axis in 0..AXES {
         let names = taut_simavr::coils::names(axis);
-        if names.iter().any(|n| !sim.probes().iter().any(|p| p.name() == n)) {
+        if names
+            .iter()
+            .any(|n| !sim.probes().iter().any(|p| p.name() == n))
+        {
             continue;
         }
         let track = sim.coil_track(axis);

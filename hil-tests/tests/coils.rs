@@ -63,12 +63,7 @@ fn the_drum_draws_on_its_coils_what_step_dir_drivers_draw() {
         assert!(t.illegal.is_empty(), "{:?}", t.illegal);
         // No faster than the motor pulls out (the planner's rate, a
         // little jitter of the interrupt's entry aside).
-        let fastest = t
-            .steps
-            .windows(2)
-            .map(|w| w[1].0 - w[0].0)
-            .min()
-            .unwrap();
+        let fastest = t.steps.windows(2).map(|w| w[1].0 - w[0].0).min().unwrap();
         let rate = 16e6 / fastest as f64;
         assert!(
             rate <= f64::from(COIL_MAX_RATE) * 1.01,
@@ -83,9 +78,8 @@ fn the_drum_draws_on_its_coils_what_step_dir_drivers_draw() {
         let moves = on_coils.coil_track(1 - axis);
         for off in offs {
             // The last half-step of either motor before the release.
-            let last = |steps: &[(u64, i64)]| {
-                steps.iter().rev().find(|s| s.0 < off).map_or(0, |s| s.0)
-            };
+            let last =
+                |steps: &[(u64, i64)]| steps.iter().rev().find(|s| s.0 < off).map_or(0, |s| s.0);
             let ms = (off - last(&t.steps).max(last(&moves.steps))) as f64 / 16e3;
             assert!(
                 ms >= f64::from(cfg.idle_delay_ms) && ms < f64::from(cfg.idle_delay_ms) + 20.0,
@@ -93,7 +87,11 @@ fn the_drum_draws_on_its_coils_what_step_dir_drivers_draw() {
             );
         }
     }
-    assert!(!on_coils.uart_text().contains("error"), "{}", log_tail(&on_coils));
+    assert!(
+        !on_coils.uart_text().contains("error"),
+        "{}",
+        log_tail(&on_coils)
+    );
     assert_ram_budget(&on_coils);
 }
 
@@ -162,7 +160,11 @@ fn the_driver_setting_is_listed_stored_and_checked() {
     let start = sim.uart_bytes().len();
     send(&mut sim, "$$");
     let list = sim.uart_text_from(start);
-    for line in ["$x_driver=uln2003\n", "$y_driver=stepdir\n", "$z_driver=stepdir\n"] {
+    for line in [
+        "$x_driver=uln2003\n",
+        "$y_driver=stepdir\n",
+        "$z_driver=stepdir\n",
+    ] {
         assert!(list.contains(line), "{line:?} in {list}");
     }
     // 4096 half-steps per 40 mm.

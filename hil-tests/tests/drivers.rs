@@ -16,7 +16,10 @@ fn send(sim: &mut Sim, line: &str) {
 }
 
 fn star() -> Vec<String> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/plotter/star.gcode");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../examples/plotter/star.gcode"
+    );
     std::fs::read_to_string(path)
         .unwrap()
         .lines()

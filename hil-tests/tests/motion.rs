@@ -73,12 +73,20 @@ fn every_pulse_is_as_wide_as_set_on_one_two_and_three_axes() {
     // Quick ramps: the moves cruise above 651 steps/s, where every event
     // fits the 16-bit timer and segments take the assembly path.
     for axis in ["base", "radial", "drill"] {
-        send(&mut sim, &format!("${axis}_accel=4000"), Duration::from_millis(100));
+        send(
+            &mut sim,
+            &format!("${axis}_accel=4000"),
+            Duration::from_millis(100),
+        );
     }
     send(&mut sim, "G91", Duration::from_millis(100));
     let mut from = [0usize; 3];
     for (k, us) in [5u64, 20, 40, 100, 200].into_iter().enumerate() {
-        send(&mut sim, &format!("$step_pulse_us={us}"), Duration::from_millis(100));
+        send(
+            &mut sim,
+            &format!("$step_pulse_us={us}"),
+            Duration::from_millis(100),
+        );
         // There and back, within the carriage's and the drill's travel.
         let s = [1.0, -1.0][k % 2];
         for line in [
@@ -104,7 +112,11 @@ fn every_pulse_is_as_wide_as_set_on_one_two_and_three_axes() {
                 .filter(|w| w[0].high && !w[1].high)
                 .map(|w| w[1].cycle - w[0].cycle)
                 .collect();
-            assert!(widths.len() > 100, "{axis} at {us} µs: {} pulses", widths.len());
+            assert!(
+                widths.len() > 100,
+                "{axis} at {us} µs: {} pulses",
+                widths.len()
+            );
             let short = widths.iter().filter(|&&w| w < set).count();
             let (min, max) = (widths.iter().min().unwrap(), widths.iter().max().unwrap());
             assert!(

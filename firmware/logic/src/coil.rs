@@ -39,7 +39,9 @@ mod tests {
     /// The sequence as the ULN2003 boards' sellers print it, IN1 first.
     #[test]
     fn the_half_step_sequence() {
-        let seq = ["1000", "1100", "0100", "0110", "0010", "0011", "0001", "1001"];
+        let seq = [
+            "1000", "1100", "0100", "0110", "0010", "0011", "0001", "1001",
+        ];
         for (p, s) in seq.iter().enumerate() {
             let bits = s
                 .bytes()

@@ -316,8 +316,18 @@ const fn seed(machine: Machine) -> MachineConfig {
         // pull-out rate; the coils released a quarter second after the
         // drawing stops (they heat when held), kept through a pen lift.
         Machine::Drum => {
-            let mut x = axis(StepsPerUnit::new(4096, 40), COIL_MAX_RATE, 1500, Some((0, 200)));
-            let mut y = axis(StepsPerUnit::new(4_096_000, 282_743), COIL_MAX_RATE, 1500, None);
+            let mut x = axis(
+                StepsPerUnit::new(4096, 40),
+                COIL_MAX_RATE,
+                1500,
+                Some((0, 200)),
+            );
+            let mut y = axis(
+                StepsPerUnit::new(4_096_000, 282_743),
+                COIL_MAX_RATE,
+                1500,
+                None,
+            );
             x.driver = Driver::Uln2003;
             y.driver = Driver::Uln2003;
             let mut cfg = plotter(machine, [x, y]);

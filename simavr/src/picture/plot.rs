@@ -4,12 +4,12 @@
 //! faint blue while it travels up.
 
 use super::{write_png, Canvas, SIZE};
+use crate::coils::CoilTrack;
 use crate::vcd::Signal;
 use serde::Serialize;
 use std::io;
 use std::path::Path;
 use taut_logic::axis::{Axis, AXES};
-use crate::coils::CoilTrack;
 use taut_logic::config::{Driver, MachineConfig};
 use taut_logic::kinematics::{AnyKinematics, Kinematics};
 

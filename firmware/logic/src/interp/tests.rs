@@ -178,7 +178,10 @@ fn dwell_and_drivers() {
     assert_eq!(run(&mut i, "M84", FREE), Ok(Order::Drivers { on: false }));
     // Marlin's `M18 S`/`M84 S`: seconds until the drivers go off once
     // motion stands (0: never), nothing switched now.
-    assert_eq!(run(&mut i, "M18 S2.5", FREE), Ok(Order::IdleDelay { ms: 2500 }));
+    assert_eq!(
+        run(&mut i, "M18 S2.5", FREE),
+        Ok(Order::IdleDelay { ms: 2500 })
+    );
     assert_eq!(run(&mut i, "M84 S0", FREE), Ok(Order::IdleDelay { ms: 0 }));
     assert_eq!(run(&mut i, "G91", FREE), Ok(Order::None));
 }

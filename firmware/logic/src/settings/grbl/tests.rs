@@ -142,10 +142,7 @@ fn refused_writes_say_why_and_change_nothing() {
         (e.at, show(&e.kind))
     };
     assert_eq!(error(&mut cfg, "21", "1"), (0, "expected 0 to 0".into()));
-    assert_eq!(
-        error(&mut cfg, "1", "256"),
-        (0, "expected 0 to 255".into())
-    );
+    assert_eq!(error(&mut cfg, "1", "256"), (0, "expected 0 to 255".into()));
     assert_eq!(error(&mut cfg, "4", "2"), (0, "expected 0 to 1".into()));
     assert_eq!(error(&mut cfg, "3", "8"), (0, "expected 0 to 7".into()));
     assert_eq!(error(&mut cfg, "10", "4"), (0, "expected 0 to 3".into()));
