@@ -128,18 +128,19 @@ impl Drivers {
         };
     }
 
-    /// The step interrupt has started: the machine no longer stands.
+    /// The machine moves (or the step interrupt has just started).
     pub fn moving(&mut self) {
         self.since = None;
     }
 
-    /// Called with the time whenever the motion task runs: once the
-    /// machine has stood (`standing`: nothing queued, no step running)
-    /// for the idle delay, the drivers that do not hold go off. Returns
-    /// the ms until it should be called again, if drivers wait to go off.
-    pub fn idle(&mut self, now_ms: u32, standing: bool) -> Option<u32> {
+    /// Called with the time whenever the motion task finds the machine
+    /// standing (nothing queued, no step running; [`Drivers::moving`]
+    /// otherwise): once it has stood for the idle delay, the drivers that
+    /// do not hold go off. Returns the ms until it should be called again,
+    /// if drivers wait to go off.
+    pub fn idle(&mut self, now_ms: u32) -> Option<u32> {
         let loose = self.on & !self.held;
-        if !standing || loose == 0 || self.delay_ms == KEEP {
+        if loose == 0 || self.delay_ms == KEEP {
             self.since = None;
             return None;
         }

@@ -439,12 +439,19 @@ fn motion() {
     /// Pieces of work per run (a part of a block's profile or of a
     /// segment, ≤ ~1 ms each): one keeps the console's wait short.
     const BATCH: usize = 1;
-    let now = clock::millis();
     let (freed, more, idle, stepping, release) = MOTION.with(|m| {
         let m = m.as_mut().unwrap();
         let (freed, more) = m.refill(BATCH);
         let idle = m.is_idle();
-        let release = m.drivers.idle(now, idle);
+        // The clock only while standing: reading it masks interrupts,
+        // which would delay a step.
+        let release = match idle {
+            true => m.drivers.idle(clock::millis()),
+            false => {
+                m.drivers.moving();
+                None
+            }
+        };
         (freed, more, idle, m.stepper.is_running(), release)
     });
     // Drivers wait to go off after the step idle delay (`$1`).

@@ -176,11 +176,14 @@ fn unknown_but_harmless_codes_are_refused_and_the_stream_goes_on() {
         }
     }
     sim.run_for(Duration::from_millis(200));
+    // The drum's motors step through their coils (x_in*, y_in*).
+    let coils = |sim: &Sim| [0, 1].map(|axis| sim.coil_track(axis).position());
     assert_eq!(steps_on_pins(&sim), [0, 0, 0], "nothing moved");
+    assert_eq!(coils(&sim), [0, 0], "nothing moved");
     send(&mut sim, "G0 X1");
     send(&mut sim, "M400");
-    // 2048 steps per 40 mm of belt: 1 mm is 51.2, rounded once.
-    assert_eq!(steps_on_pins(&sim), [51, 0, 0]);
+    // 4096 half-steps per 40 mm of belt: 1 mm is 102.4, rounded once.
+    assert_eq!(coils(&sim), [102, 0]);
 }
 
 /// A flatbed (not homing: no switch here), drivers on, standing at

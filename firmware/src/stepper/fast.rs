@@ -4,11 +4,12 @@
 //! after the compare match, whichever path follows). A plain event — inside a segment, every moving axis stepping at every
 //! event, no wait beyond the 16-bit timer, no DIR change — needs only: raise
 //! the STEP pins, advance the 24.8 time by the interval, move the compare
-//! register, hold the pulse, drop the pins. At a segment's last event the
-//! pulse is held and dropped first (taking the next segment lasts longer
-//! than a short pulse), then the next segment, if it may take this path
-//! too, is taken here, else the Rust path takes it: every pulse lasts its
-//! set width, or the ~6 µs from the compare match to where it can end. Compiled from Rust that costs
+//! register, hold the pulse, drop the pins. At a segment's last event it
+//! also takes the next segment when that one may take this path too, so a
+//! pulse set shorter than that work (~14 µs) lasts that long there; the
+//! hold is timed from the rise, so none is ever shorter than set. (Holding
+//! and dropping first there cost a 1-axis rate of 59 kHz: the interrupt
+//! outlasted the step period.) Compiled from Rust that costs
 //! ~400 cycles, most of it saving the 33 registers the general path needs;
 //! here it is ~170 and saves 13. The Rust handler (`super::on_compare`)
 //! decides per segment whether its events may take this path (`fast_ok`)
@@ -97,43 +98,6 @@ macro_rules! step_vector {
         #[unsafe(no_mangle)]
         pub unsafe extern "C" fn __vector_32() {
             core::arch::naked_asm!(
-                // The next event's time: t = frac + interval, the compare
-                // register moved by t >> 8 (late if less than LEAD ahead
-                // of TCNT3), interval += add. Both paths below use it.
-                ".macro taut_step_time",
-                // t = frac + interval; ticks (r25:r24) = t >> 8 (< 0x6000)
-                "lds r18, {e}+{interval}", "lds r19, {e}+{interval}+1",
-                "lds r20, {e}+{interval}+2", "lds r21, {e}+{interval}+3",
-                "clr r23",
-                "lds r22, {e}+{frac}",
-                "add r22, r18",
-                "mov r24, r19", "adc r24, r23",
-                "mov r25, r20", "adc r25, r23",
-                "sts {e}+{frac}, r22",
-                // interval += add
-                "lds r26, {e}+{add}", "lds r27, {e}+{add}+1",
-                "add r18, r26", "adc r19, r27",
-                "lds r26, {e}+{add}+2", "lds r27, {e}+{add}+3",
-                "adc r20, r26", "adc r21, r27",
-                "sts {e}+{interval}, r18", "sts {e}+{interval}+1, r19",
-                "sts {e}+{interval}+2, r20", "sts {e}+{interval}+3, r21",
-                // at = OCR3A + ticks; late if less than LEAD ahead of TCNT3
-                "lds r26, 0x98", "lds r27, 0x99",
-                "add r26, r24", "adc r27, r25",
-                "lds r18, 0x94", "lds r19, 0x95",
-                "movw r20, r26",
-                "sub r20, r18", "sbc r21, r19",
-                "cpi r20, {lead}", "cpc r21, r23",
-                "brge 4f",
-                "ldi r20, {lead}",
-                "add r18, r20", "adc r19, r23",
-                "movw r26, r18",
-                "lds r24, {e}+{late}", "lds r25, {e}+{late}+1",
-                "adiw r24, 1",
-                "sts {e}+{late}+1, r25", "sts {e}+{late}, r24",
-                "4:",
-                "sts 0x99, r27", "sts 0x98, r26", // OCR3A, high byte first
-                ".endm",
                 "push r24",
                 "in r24, 0x3f",
                 "push r24",
@@ -161,44 +125,8 @@ macro_rules! step_vector {
                 // left -= 1; the segment's last event takes the next one
                 "lds r24, {e}+{left}", "lds r25, {e}+{left}+1",
                 "sbiw r24, 1",
-                "brne 6f", "rjmp 10f", // (branches reach ±64 words)
-                // Inside a segment.
-                "6:",
-                "sts {e}+{left}+1, r25", "sts {e}+{left}, r24",
-                "taut_step_time",
-                // Hold the pulse: TCNT3 - raised >= pulse_ticks.
-                "lds r30, {e}+{raised}", "lds r31, {e}+{raised}+1",
-                "lds r20, {e}+{pulse}", "lds r21, {e}+{pulse}+1",
-                "5:",
-                "lds r18, 0x94", "lds r19, 0x95",
-                "sub r18, r30", "sbc r19, r31",
-                "cp r18, r20", "cpc r19, r21",
-                "brlo 5b",
-                // Drop the STEP pins.
-                "lds r24, {e}+{masks}+0", "sts {pin0}, r24",
-                "lds r24, {e}+{masks}+1", "sts {pin1}, r24",
-                "8:",
-                "pop r31", "pop r30", "pop r27", "pop r26", "pop r25",
-                "pop r23", "pop r22", "pop r21", "pop r20", "pop r19", "pop r18",
-                "pop r24",
-                "out 0x3f, r24",
-                "pop r24",
-                "reti",
-                // The segment's last event. Taking the next segment (here
-                // or in the Rust path) outlasts a short pulse: hold and drop
-                // it first, so it is as long as set here too.
-                "10:",
-                "lds r20, {e}+{raised}", "lds r21, {e}+{raised}+1",
-                "lds r22, {e}+{pulse}", "lds r23, {e}+{pulse}+1",
-                "12:",
-                "lds r18, 0x94", "lds r19, 0x95",
-                "sub r18, r20", "sbc r19, r21",
-                "cp r18, r22", "cpc r19, r23",
-                "brlo 12b",
-                "lds r18, {e}+{masks}+0", "sts {pin0}, r18",
-                "lds r18, {e}+{masks}+1", "sts {pin1}, r18",
-                // The next segment, if queued, fast and of the same block;
-                // else the Rust path.
+                "breq 10f", "rjmp 6f", "10:", // (branches reach ±64 words)
+                // Next segment: queued, fast, same block? Else the Rust path.
                 "lds r26, {ring}+{tail}",
                 "lds r27, {ring}+{head}",
                 "cp r26, r27",
@@ -235,22 +163,66 @@ macro_rules! step_vector {
                 "sts {ring}+{tail}, r26",
                 "sub r27, r26", "andi r27, {ring_mask}",
                 "cpi r27, {low}",
-                "brsh 13f",
+                "brsh 6f",
                 "ldi r18, 1", "sts {e}+{refill}, r18",
-                "13:",
+                "6:",
                 "sts {e}+{left}+1, r25", "sts {e}+{left}, r24",
-                "taut_step_time",
-                "rjmp 8b",
+                // t = frac + interval; ticks (r25:r24) = t >> 8 (< 0x6000)
+                "lds r18, {e}+{interval}", "lds r19, {e}+{interval}+1",
+                "lds r20, {e}+{interval}+2", "lds r21, {e}+{interval}+3",
+                "clr r23",
+                "lds r22, {e}+{frac}",
+                "add r22, r18",
+                "mov r24, r19", "adc r24, r23",
+                "mov r25, r20", "adc r25, r23",
+                "sts {e}+{frac}, r22",
+                // interval += add
+                "lds r26, {e}+{add}", "lds r27, {e}+{add}+1",
+                "add r18, r26", "adc r19, r27",
+                "lds r26, {e}+{add}+2", "lds r27, {e}+{add}+3",
+                "adc r20, r26", "adc r21, r27",
+                "sts {e}+{interval}, r18", "sts {e}+{interval}+1, r19",
+                "sts {e}+{interval}+2, r20", "sts {e}+{interval}+3, r21",
+                // at = OCR3A + ticks; late if less than LEAD ahead of TCNT3
+                "lds r26, 0x98", "lds r27, 0x99",
+                "add r26, r24", "adc r27, r25",
+                "lds r18, 0x94", "lds r19, 0x95",
+                "movw r20, r26",
+                "sub r20, r18", "sbc r21, r19",
+                "cpi r20, {lead}", "cpc r21, r23",
+                "brge 4f",
+                "ldi r20, {lead}",
+                "add r18, r20", "adc r19, r23",
+                "movw r26, r18",
+                "lds r24, {e}+{late}", "lds r25, {e}+{late}+1",
+                "adiw r24, 1",
+                "sts {e}+{late}+1, r25", "sts {e}+{late}, r24",
+                "4:",
+                "sts 0x99, r27", "sts 0x98, r26", // OCR3A, high byte first
+                // Hold the pulse: TCNT3 - raised >= pulse_ticks. `raised` is
+                // read here, not kept from the entry: taking the next
+                // segment above uses Z (r31:r30) to address it.
+                "lds r30, {e}+{raised}", "lds r31, {e}+{raised}+1",
+                "lds r20, {e}+{pulse}", "lds r21, {e}+{pulse}+1",
+                "5:",
+                "lds r18, 0x94", "lds r19, 0x95",
+                "sub r18, r30", "sbc r19, r31",
+                "cp r18, r20", "cpc r19, r21",
+                "brlo 5b",
+                // Drop the STEP pins.
+                "lds r24, {e}+{masks}+0", "sts {pin0}, r24",
+                "lds r24, {e}+{masks}+1", "sts {pin1}, r24",
+                "pop r31", "pop r30", "pop r27", "pop r26", "pop r25",
+                "pop r23", "pop r22", "pop r21", "pop r20", "pop r19", "pop r18",
+                "pop r24",
+                "out 0x3f, r24",
+                "pop r24",
+                "reti",
                 // Not a segment the fast path can take: restore, Rust path.
-                // Its pulse is over: the Rust path's drop toggles nothing
-                // (it works out the next event's masks afresh).
                 "7:",
-                "clr r18",
-                "sts {e}+{masks}+0, r18", "sts {e}+{masks}+1, r18",
                 "pop r31", "pop r30", "pop r27", "pop r26", "pop r25",
                 "pop r23", "pop r22", "pop r21", "pop r20", "pop r19", "pop r18",
                 "rjmp 2b",
-                ".purgem taut_step_time",
                 e = sym $crate::stepper::EXEC,
                 ring = sym $crate::queues::SEGMENTS,
                 head = const $crate::stepper::fast::RING_HEAD,
