@@ -126,7 +126,11 @@ impl Sim {
     /// by [`Sim::probe_coils`].
     pub fn coil_track(&self, axis: usize) -> crate::coils::CoilTrack {
         let names = crate::coils::names(axis);
-        crate::coils::CoilTrack::from_probes(std::array::from_fn(|k| self.probed(&names[k])))
+        let probes: [&crate::probe::Probe; 4] = std::array::from_fn(|k| self.probed(&names[k]));
+        let edges = probes.map(|p| p.edges().iter().map(|e| (e.cycle, e.high)).collect::<Vec<_>>());
+        crate::coils::CoilTrack::decode(std::array::from_fn(|k| {
+            (probes[k].initial(), edges[k].as_slice())
+        }))
     }
 
     /// The MIN switches of `cfg`'s homing axes, `mm` below where each

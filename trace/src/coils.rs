@@ -5,7 +5,6 @@
 //! half-step, coils coming back on at another phase than they went off).
 //! Edges at the same instant are one port write, taken together.
 
-use crate::probe::Probe;
 use crate::vcd::Signal;
 use taut_logic::coil::{phase_of, step_between};
 
@@ -19,8 +18,8 @@ pub fn names(axis: usize) -> [String; 4] {
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct CoilTrack {
     /// `(time, position after)` of every half-step (time in the edges'
-    /// unit: cycles from probes, ns from a VCD); positive as the phase
-    /// counts up the sequence.
+    /// unit: cycles from the simulator's probes, ns from a VCD); positive
+    /// as the phase counts up the sequence.
     pub steps: Vec<(u64, i64)>,
     /// `(time, energised)` whenever the coils went on or off.
     pub power: Vec<(u64, bool)>,
@@ -93,17 +92,6 @@ impl CoilTrack {
         }
         track.last = state;
         track
-    }
-
-    /// From four probes (IN1 first): times in cycles.
-    pub fn from_probes(probes: [&Probe; 4]) -> CoilTrack {
-        let edges: Vec<Vec<(u64, bool)>> = probes
-            .iter()
-            .map(|p| p.edges().iter().map(|e| (e.cycle, e.high)).collect())
-            .collect();
-        CoilTrack::decode(std::array::from_fn(|k| {
-            (probes[k].initial(), edges[k].as_slice())
-        }))
     }
 
     /// From a VCD's signals named [`names`]`(axis)`: times in ns.
