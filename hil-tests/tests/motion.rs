@@ -69,9 +69,10 @@ const SEGMENT_FLOOR: u64 = 232;
 /// axes, at every event: inside a segment, where the assembly path takes
 /// the next segment (single-axis and equal-count moves: once a pulse there
 /// ended early, at 14.4 µs, whatever was set), and on the DDA's general
-/// path. Each setting's moves are replayed edge by edge; a pulse lasts the
-/// set width, or the path's floor when that is longer, and at most 2 µs
-/// more.
+/// path. Each move is replayed edge by edge (every rise has its fall, as
+/// many as the move's steps); a pulse lasts the set width, or the path's
+/// floor when that is longer, and at most 2 µs more. Prints the narrowest
+/// and widest pulse of each move.
 #[test]
 fn every_pulse_is_as_wide_as_set_on_one_two_and_three_axes() {
     let mut sim = boot();
@@ -85,13 +86,18 @@ fn every_pulse_is_as_wide_as_set_on_one_two_and_three_axes() {
         );
     }
     send(&mut sim, "G91", Duration::from_millis(100));
+    let names = ["base", "radial", "drill"];
     let mut from = [0usize; 3];
-    for (k, us) in [5u64, 20, 40, 100, 200].into_iter().enumerate() {
+    let mut at = [0i64; 3];
+    let us_of = |c: u64| c as f64 / 16.0;
+    eprintln!("step_pulse_us  move                 per moving axis: pulses, narrowest..widest µs");
+    for (k, us) in [5u64, 10, 20, 40, 100, 200].into_iter().enumerate() {
         send(
             &mut sim,
             &format!("$step_pulse_us={us}"),
             Duration::from_millis(100),
         );
+        let set = us * 16;
         // There and back, within the carriage's and the drill's travel.
         let s = [1.0, -1.0][k % 2];
         for line in [
@@ -105,30 +111,45 @@ fn every_pulse_is_as_wide_as_set_on_one_two_and_three_axes() {
             format!("G0 C{} X{} Z{}", 10.0 * s, 3.0 * s, s),
         ] {
             send(&mut sim, &line, Duration::from_millis(100));
-        }
-        send(&mut sim, "M400", Duration::from_secs(60));
-        let set = us * 16;
-        for (i, axis) in ["base", "radial", "drill"].into_iter().enumerate() {
-            let step = sim.probed(&format!("{axis}_step"));
-            let edges = &step.edges()[from[i]..];
-            from[i] = step.edges().len();
-            let widths: Vec<u64> = edges
-                .windows(2)
-                .filter(|w| w[0].high && !w[1].high)
-                .map(|w| w[1].cycle - w[0].cycle)
-                .collect();
-            assert!(
-                widths.len() > 100,
-                "{axis} at {us} µs: {} pulses",
-                widths.len()
-            );
-            let short = widths.iter().filter(|&&w| w < set).count();
-            let (min, max) = (widths.iter().min().unwrap(), widths.iter().max().unwrap());
-            assert!(
-                short == 0 && *max <= set.max(SEGMENT_FLOOR) + 32,
-                "{axis} at {us} µs: {short} of {} pulses short, {min}..{max} cycles",
-                widths.len()
-            );
+            send(&mut sim, "M400", Duration::from_secs(60));
+            let mut row = String::new();
+            for (i, axis) in names.into_iter().enumerate() {
+                let step = sim.probed(&format!("{axis}_step"));
+                let edges = &step.edges()[from[i]..];
+                from[i] = step.edges().len();
+                let now = steps(&sim, [Axis::Base, Axis::Radial, Axis::Drill][i]);
+                let moved = (now - at[i]).unsigned_abs() as usize;
+                at[i] = now;
+                // Rise, fall, rise, fall…: every pulse complete.
+                assert!(
+                    edges
+                        .iter()
+                        .enumerate()
+                        .all(|(j, e)| e.high == (j % 2 == 0)),
+                    "{axis} at {us} µs, {line}: edges out of order"
+                );
+                assert_eq!(edges.len(), 2 * moved, "{axis} at {us} µs, {line}");
+                if moved == 0 {
+                    continue;
+                }
+                let widths: Vec<u64> = edges.chunks(2).map(|w| w[1].cycle - w[0].cycle).collect();
+                let short = widths.iter().filter(|&&w| w < set).count();
+                let (min, max) = (*widths.iter().min().unwrap(), *widths.iter().max().unwrap());
+                assert!(
+                    short == 0 && max <= set.max(SEGMENT_FLOOR) + 32,
+                    "{axis} at {us} µs, {line}: {short} of {} pulses short, {:.2}..{:.2} µs",
+                    widths.len(),
+                    us_of(min),
+                    us_of(max)
+                );
+                row += &format!(
+                    "  {axis} {}: {:.2}..{:.2}",
+                    widths.len(),
+                    us_of(min),
+                    us_of(max)
+                );
+            }
+            eprintln!("{us:>8}       {line:<20}{row}");
         }
     }
     assert!(!sim.uart_text().contains("late"), "{}", sim.uart_text());
