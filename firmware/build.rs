@@ -61,8 +61,19 @@ fn main() {
     for dir in ["src", "logic/src", "progmem/src", "examples", "Cargo.lock"] {
         println!("cargo:rerun-if-changed={dir}");
     }
-    println!("cargo:rerun-if-changed=../.git/HEAD");
-    println!("cargo:rerun-if-changed=../.git/index");
+    // The commit and the index, where git keeps them: in a linked worktree
+    // `.git` is a file naming a directory elsewhere (a path that does not
+    // exist would rerun this script, and rebuild the image, every time).
+    let git_dir = Command::new("git")
+        .args(["rev-parse", "--absolute-git-dir"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+    if let Some(dir) = git_dir {
+        println!("cargo:rerun-if-changed={dir}/HEAD");
+        println!("cargo:rerun-if-changed={dir}/index");
+    }
 
     // rustc links every executable for a GNU cc-style linker with `-no-pie`
     // (avr-none: linker avr-gcc, flavor gnu-cc, static relocation). avr-gcc 5
