@@ -147,8 +147,12 @@ pub fn check(elf: &Path) -> Result<FlashMap> {
         (w & 0xF000 == 0xE000).then_some(((w >> 4) & 0xF0) as u8 | (w & 0x0F) as u8)
     };
     let (mut pointers, mut through) = (0, 0);
+    // Relocations of any kind: their absence means the link dropped them
+    // (no `--emit-relocs`), not that the image takes no function's address.
+    let mut relocations = 0;
     for section in file.sections() {
         for (offset, reloc) in section.relocations() {
+            relocations += 1;
             let RelocationFlags::Elf { r_type } = reloc.flags() else {
                 continue;
             };
@@ -198,7 +202,7 @@ pub fn check(elf: &Path) -> Result<FlashMap> {
             }
         }
     }
-    if pointers == 0 {
+    if relocations == 0 {
         problems.push(format!(
             "{name} has no relocations: link it with --emit-relocs (firmware/avr-link.sh)"
         ));
