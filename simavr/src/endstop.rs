@@ -127,7 +127,12 @@ impl Sim {
     pub fn coil_track(&self, axis: usize) -> crate::coils::CoilTrack {
         let names = crate::coils::names(axis);
         let probes: [&crate::probe::Probe; 4] = std::array::from_fn(|k| self.probed(&names[k]));
-        let edges = probes.map(|p| p.edges().iter().map(|e| (e.cycle, e.high)).collect::<Vec<_>>());
+        let edges = probes.map(|p| {
+            p.edges()
+                .iter()
+                .map(|e| (e.cycle, e.high))
+                .collect::<Vec<_>>()
+        });
         crate::coils::CoilTrack::decode(std::array::from_fn(|k| {
             (probes[k].initial(), edges[k].as_slice())
         }))
