@@ -61,18 +61,19 @@ fn main() {
     for dir in ["src", "logic/src", "progmem/src", "examples", "Cargo.lock"] {
         println!("cargo:rerun-if-changed={dir}");
     }
-    // The commit and the index, where git keeps them: in a linked worktree
-    // `.git` is a file naming a directory elsewhere (a path that does not
-    // exist would rerun this script, and rebuild the image, every time).
-    let git_dir = Command::new("git")
-        .args(["rev-parse", "--absolute-git-dir"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
-    if let Some(dir) = git_dir {
-        println!("cargo:rerun-if-changed={dir}/HEAD");
-        println!("cargo:rerun-if-changed={dir}/index");
+    // The commit (and `--dirty`) change with HEAD and the index: where git
+    // keeps them, in a clone (`../.git/HEAD`) or a worktree (`.git` is a
+    // file there). A path that does not exist would rerun this every build.
+    for name in ["HEAD", "index"] {
+        let at = Command::new("git")
+            .args(["rev-parse", "--git-path", name])
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+        if let Some(at) = at.filter(|a| Path::new(a).exists()) {
+            println!("cargo:rerun-if-changed={at}");
+        }
     }
 
     // rustc links every executable for a GNU cc-style linker with `-no-pie`

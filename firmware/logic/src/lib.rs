@@ -25,6 +25,7 @@ pub mod checkpoint;
 /// A 28BYJ-48's half-step coil sequence.
 pub mod coil;
 pub mod config;
+pub mod coords;
 pub mod fat;
 pub mod files;
 /// Table-free `sin_cos`, `atan2` and `sqrt`: no constant tables in the AVR's SRAM.

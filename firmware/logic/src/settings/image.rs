@@ -1,32 +1,29 @@
-//! The settings as the EEPROM keeps them: `taut`, a format version, every
-//! setting in `$$` order (whole numbers and millis as 4 bytes, ratios as
-//! 8, little-endian), then a Fletcher-16 checksum of all that. Read back
-//! only whole: a blank EEPROM, another version, a wrong checksum or a value
-//! the firmware would refuse gives the defaults (and one warning line)
-//! rather than anything half-read.
+//! The settings as the EEPROM keeps them: the payload of the settings
+//! record ([`record::SETTINGS`](super::record::SETTINGS), two copies,
+//! cut-safe): every named setting in `$$` order (whole numbers and millis
+//! as 4 bytes, ratios as 8, little-endian), then Grbl's [`Extras`]. Read
+//! back only whole: a value the firmware would refuse, or a set of values
+//! it refuses together, makes the copy unusable (the other is tried).
 //!
-//! Written by streaming [`bytes`] (no copy in RAM: the firmware compares
-//! each byte with the EEPROM and writes only those that differ).
+//! [`legacy`]: the one-copy image of format version 6 that boards flashed
+//! before kept at byte 0, read once to carry its settings over.
 
-use super::{all, Setting, Value, COUNT};
+use super::grbl::{Extras, EXTRAS_BYTES};
+use super::record::Part;
+use super::{all, AxisField, GlobalField, Setting, Value, COUNT};
 use crate::axis::AXES;
 use crate::config::{Driver, MachineConfig};
 use crate::machine::Machine;
 use crate::units::{Milli, StepsPerUnit};
 
-pub const MAGIC: [u8; 4] = *b"taut";
-/// Bumped whenever the settings or their kinds change.
-pub const VERSION: u8 = 7;
-const HEADER: usize = MAGIC.len() + 1;
-
-/// Why the image was not taken.
+/// Why stored settings were not taken.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Unusable {
-    /// Never written (erased EEPROM reads 0xFF).
+    /// Never written (erased EEPROM reads 0xFF), or never written whole.
     Blank,
     /// Written by a firmware with another settings format.
     OtherVersion(u8),
-    /// Corrupted (a cut in mid-write, a worn cell).
+    /// Corrupted (a worn cell, a stray write).
     Checksum,
     /// Consistent, but a value this firmware refuses.
     Refused(Setting),
@@ -42,131 +39,25 @@ fn width(s: Setting) -> usize {
     }
 }
 
-/// Bytes of an image: 4 a setting, 4 more for each ratio ([`width`]: the
-/// steps per unit of every axis, the crosstalk), the checksum's 2. A
+/// Bytes of the named settings: 4 a setting, 4 more for each ratio
+/// ([`width`]: the steps per unit of every axis, the crosstalk). A
 /// constant: summed over the settings at run time it took 248 bytes of
 /// flash on the AVR.
-pub const fn len() -> usize {
-    HEADER + 4 * COUNT + 4 * (AXES + 1) + 2
-}
+pub const NAMED_BYTES: usize = 4 * COUNT + 4 * (AXES + 1);
 
-/// The image of `cfg`, byte by byte.
-pub fn bytes(cfg: &MachineConfig) -> impl Iterator<Item = u8> + '_ {
-    let body = MAGIC
-        .into_iter()
-        .chain([VERSION])
-        .chain(all().flat_map(move |s| value_bytes(s.get(cfg))));
-    let mut sum = Fletcher::new();
-    let mut tail = 0;
-    body.map(Some).chain([None, None]).map(move |b| match b {
-        Some(b) => {
-            sum.add(b);
-            b
+/// Bytes of the settings record's payload.
+pub const PAYLOAD: u16 = NAMED_BYTES as u16 + EXTRAS_BYTES;
+
+/// Part `k` of the payload: setting `k`'s value, then the extras' parts.
+pub fn part(cfg: &MachineConfig, ex: &Extras, k: u8) -> Option<Part> {
+    let k = k as usize;
+    match Setting::at(k) {
+        Some(s) => {
+            let (b, n) = value_array(s.get(cfg));
+            Some((b, n as u8))
         }
-        None => {
-            tail += 1;
-            sum.value().to_le_bytes()[tail - 1]
-        }
-    })
-}
-
-/// A comparison of `cfg`'s image with the EEPROM, resumable: the store
-/// task looks for one byte to write per run, and walking the whole image
-/// in one run took ~2.3 ms on the AVR (every task waits behind a run).
-/// [`Scan::step`] goes on where the last call stopped, with the checksum
-/// summed so far. Start a new scan when the settings change.
-#[derive(Clone, Copy, Debug)]
-pub struct Scan {
-    /// The next part: 0 the header, then setting `next - 1` (an index of
-    /// [`Setting::at`]) up to [`COUNT`], then the checksum.
-    next: u8,
-    /// Its first byte in the image.
-    at: u16,
-    sum: Fletcher,
-}
-
-/// What [`Scan::step`] found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Step {
-    /// Byte `.0` of the EEPROM must become `.1`; the scan compares it
-    /// again next (once written, it goes on).
-    Write(usize, u8),
-    /// No difference in the parts compared; more to compare.
-    More,
-    /// The EEPROM holds the image.
-    Same,
-}
-
-const LAST_SETTING: u8 = COUNT as u8;
-const _: () = assert!(COUNT < u8::MAX as usize - 1);
-
-impl Scan {
-    pub const fn new() -> Scan {
-        Scan {
-            next: 0,
-            at: 0,
-            sum: Fletcher::new(),
-        }
+        None => ex.part((k - COUNT) as u8),
     }
-
-    /// Compares up to `parts` parts of the image (the header, a setting,
-    /// the checksum) with what `read(i)` holds at byte `i`.
-    /// Built for speed: the store task runs it, which every task waits
-    /// behind.
-    #[cfg_attr(target_arch = "avr", optimize(speed))]
-    pub fn step(&mut self, cfg: &MachineConfig, read: impl Fn(usize) -> u8, parts: u8) -> Step {
-        for _ in 0..parts {
-            let (buf, n, checksum) = match self.next {
-                0 => {
-                    let m = MAGIC;
-                    ([m[0], m[1], m[2], m[3], VERSION, 0, 0, 0], HEADER, false)
-                }
-                i if i <= LAST_SETTING => match Setting::at(i as usize - 1) {
-                    Some(s) => {
-                        let (buf, n) = value_array(s.get(cfg));
-                        (buf, n, false)
-                    }
-                    None => ([0; 8], 0, false),
-                },
-                i if i == LAST_SETTING + 1 => (widen2(self.sum.value().to_le_bytes()), 2, true),
-                _ => return Step::Same,
-            };
-            // The checksum is not summed: its bytes compare plainly.
-            let mut sum = self.sum;
-            for (k, &b) in buf[..n].iter().enumerate() {
-                let i = self.at as usize + k;
-                if read(i) != b {
-                    return Step::Write(i, b);
-                }
-                if !checksum {
-                    sum.add(b);
-                }
-            }
-            self.sum = sum;
-            self.at += n as u16;
-            self.next += 1;
-        }
-        match self.next > LAST_SETTING + 1 {
-            true => Step::Same,
-            false => Step::More,
-        }
-    }
-}
-
-impl Default for Scan {
-    fn default() -> Self {
-        Scan::new()
-    }
-}
-
-fn widen2(b: [u8; 2]) -> [u8; 8] {
-    [b[0], b[1], 0, 0, 0, 0, 0, 0]
-}
-
-/// Value bytes: up to 8, the unused ones skipped.
-fn value_bytes(v: Value) -> impl Iterator<Item = u8> {
-    let (buf, n) = value_array(v);
-    buf.into_iter().take(n)
 }
 
 /// A value's bytes and how many of them count.
@@ -189,40 +80,38 @@ fn widen(b: [u8; 4]) -> [u8; 8] {
     [b[0], b[1], b[2], b[3], 0, 0, 0, 0]
 }
 
-/// Reads an image through `read(i)` (byte `i` of the EEPROM) onto the
-/// defaults `base`.
-pub fn decode(read: impl Fn(usize) -> u8, base: &MachineConfig) -> Result<MachineConfig, Unusable> {
-    let mut cfg = *base;
-    decode_into(read, &mut cfg).map(|()| cfg)
-}
-
-/// [`decode`] in place, onto `cfg` (the defaults on entry): on the AVR no
-/// copy of the settings sits on the stack. Every value is checked before
-/// any is taken, so on an error `cfg` is unchanged, except after
+/// Reads a payload through `byte(i)` (its byte `i`, as given) onto `cfg`
+/// (the defaults on entry) and `ex`, in place: on the AVR no copy of the
+/// settings sits on the stack. Every value is checked before any is
+/// taken, so on an error `cfg` and `ex` are unchanged, except after
 /// [`Unusable::Inconsistent`] (each value fine, the set not): the caller
 /// loads the defaults again.
 // Out of line: at boot its locals would sit under the checkpoint's
 // scan and the kinematics' check (the boot's stack peak).
 #[inline(never)]
-pub fn decode_into(read: impl Fn(usize) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
-    if (0..HEADER).all(|i| read(i) == 0xFF) {
-        return Err(Unusable::Blank);
-    }
-    let magic_ok = (0..MAGIC.len()).all(|i| read(i) == MAGIC[i]);
-    if magic_ok && read(MAGIC.len()) != VERSION {
-        return Err(Unusable::OtherVersion(read(MAGIC.len())));
-    }
-    let n = len();
-    let mut sum = Fletcher::new();
-    (0..n - 2).for_each(|i| sum.add(read(i)));
-    if !magic_ok || u16::from_le_bytes([read(n - 2), read(n - 1)]) != sum.value() {
-        return Err(Unusable::Checksum);
-    }
+pub fn decode_into(
+    byte: impl Fn(u16) -> u8,
+    cfg: &mut MachineConfig,
+    ex: &mut Extras,
+) -> Result<(), Unusable> {
+    take_named(&byte, cfg, false)?;
+    *ex = Extras::decode(|i| byte(NAMED_BYTES as u16 + i));
+    Ok(())
+}
+
+/// The named settings from bytes 0… of `byte` (a version-6 image's from
+/// its byte 5: `v6`, without the settings it had not), each checked, then
+/// the set.
+pub fn take_named(
+    byte: &impl Fn(u16) -> u8,
+    cfg: &mut MachineConfig,
+    v6: bool,
+) -> Result<(), Unusable> {
     for take in [false, true] {
-        let mut at = HEADER;
-        for s in all() {
-            let value = value(&read, s.get(cfg), at).ok_or(Unusable::Refused(s))?;
-            at += width(s);
+        let mut at = 0;
+        for s in all().filter(|&s| !v6 || legacy::had(s)) {
+            let value = value(byte, s.get(cfg), at).ok_or(Unusable::Refused(s))?;
+            at += width(s) as u16;
             s.check(value).map_err(|_| Unusable::Refused(s))?;
             if take {
                 s.force(cfg, value);
@@ -233,9 +122,9 @@ pub fn decode_into(read: impl Fn(usize) -> u8, cfg: &mut MachineConfig) -> Resul
     super::check_whole(cfg).map_err(|_| Unusable::Inconsistent)
 }
 
-/// The value in the image at byte `at`, of the kind `like` is.
-fn value(read: &impl Fn(usize) -> u8, like: Value, at: usize) -> Option<Value> {
-    let word = |i: usize| u32::from_le_bytes([read(i), read(i + 1), read(i + 2), read(i + 3)]);
+/// The value at byte `at`, of the kind `like` is.
+fn value(byte: &impl Fn(u16) -> u8, like: Value, at: u16) -> Option<Value> {
+    let word = |i: u16| u32::from_le_bytes([byte(i), byte(i + 1), byte(i + 2), byte(i + 3)]);
     Some(match like {
         Value::Number(_) => Value::Number(word(at)),
         Value::Milli(_) => Value::Milli(Milli(word(at) as i32)),
@@ -245,39 +134,124 @@ fn value(read: &impl Fn(usize) -> u8, like: Value, at: usize) -> Option<Value> {
     })
 }
 
-/// Fletcher-16: two running sums mod 255 (catches swapped and zeroed
-/// bytes, which a plain sum misses).
-#[derive(Clone, Copy, Debug)]
-struct Fletcher {
-    a: u16,
-    b: u16,
+/// The one-copy image of format version 6 at byte 0: `taut`, the version,
+/// the named settings as [`decode_into`] reads them (not inverted), a
+/// Fletcher-16 checksum. Read once, when no settings record is usable,
+/// to carry a board's settings over; its header then becomes the layout
+/// marker ([`MARKER`](super::record::MARKER)).
+pub mod legacy {
+    use super::*;
+
+    pub const MAGIC: [u8; 4] = *b"taut";
+    pub const VERSION: u8 = 6;
+    const HEADER: usize = MAGIC.len() + 1;
+
+    /// Bytes of a version-6 image: its settings had no driver per axis
+    /// and no step idle delay ([`had`]).
+    pub const fn len() -> usize {
+        HEADER + NAMED_BYTES - 4 * (AXES + 1) + 2
+    }
+
+    /// Whether a version-6 image holds setting `s`. Those it does not
+    /// keep what the version-6 firmware did: STEP/DIR drivers, always on
+    /// (the string-art defaults the reader starts from).
+    pub fn had(s: Setting) -> bool {
+        !matches!(
+            s,
+            Setting::Axis(_, AxisField::Driver) | Setting::Global(GlobalField::StepIdleDelay)
+        )
+    }
+
+    /// The version byte at byte 4 when bytes 0…3 are `taut`.
+    pub fn version(read: &impl Fn(u16) -> u8) -> Option<u8> {
+        (0..MAGIC.len())
+            .all(|i| read(i as u16) == MAGIC[i])
+            .then(|| read(4))
+    }
+
+    /// A version-6 image of `cfg` (boards flashed before held these).
+    pub fn bytes(cfg: &MachineConfig) -> impl Iterator<Item = u8> + '_ {
+        let body = MAGIC
+            .into_iter()
+            .chain([VERSION])
+            .chain(all().filter(|&s| had(s)).flat_map(move |s| {
+                let (b, n) = value_array(s.get(cfg));
+                b.into_iter().take(n)
+            }));
+        let mut sum = Fletcher::new();
+        let mut tail = 0;
+        body.map(Some).chain([None, None]).map(move |b| match b {
+            Some(b) => {
+                sum.add(b);
+                b
+            }
+            None => {
+                tail += 1;
+                sum.value().to_le_bytes()[tail - 1]
+            }
+        })
+    }
+
+    /// Whether `read` (byte `i` of the EEPROM) holds a whole version-6
+    /// image; its settings are then [`super::take_named`] from byte
+    /// [`BODY`].
+    pub fn check(read: &impl Fn(u16) -> u8) -> Result<(), Unusable> {
+        match version(read) {
+            Some(VERSION) => {}
+            Some(v) => return Err(Unusable::OtherVersion(v)),
+            None if (0..HEADER as u16).all(|i| read(i) == 0xFF) => return Err(Unusable::Blank),
+            None => return Err(Unusable::Checksum),
+        }
+        let n = len() as u16;
+        let mut sum = Fletcher::new();
+        (0..n - 2).for_each(|i| sum.add(read(i)));
+        match u16::from_le_bytes([read(n - 2), read(n - 1)]) == sum.value() {
+            true => Ok(()),
+            false => Err(Unusable::Checksum),
+        }
+    }
+
+    /// Where a version-6 image's settings begin.
+    pub const BODY: u16 = HEADER as u16;
+
+    /// The settings of a version-6 image onto `cfg` (the defaults on
+    /// entry), as [`super::decode_into`].
+    pub fn decode_into(read: impl Fn(u16) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
+        check(&read)?;
+        take_named(&|i| read(BODY + i), cfg, true)
+    }
+
+    /// Fletcher-16: two running sums mod 255.
+    #[derive(Clone, Copy, Debug)]
+    struct Fletcher {
+        a: u16,
+        b: u16,
+    }
+
+    impl Fletcher {
+        const fn new() -> Self {
+            Fletcher { a: 0, b: 0 }
+        }
+
+        fn add(&mut self, x: u8) {
+            self.a += x as u16;
+            if self.a >= 255 {
+                self.a -= 255;
+            }
+            self.b += self.a;
+            if self.b >= 255 {
+                self.b -= 255;
+            }
+        }
+
+        fn value(&self) -> u16 {
+            self.b << 8 | self.a
+        }
+    }
 }
 
-impl Fletcher {
-    const fn new() -> Self {
-        Fletcher { a: 0, b: 0 }
-    }
-
-    /// Both sums stay below 255, so one subtraction reduces them (a `%`
-    /// is a 16-bit division on the AVR, twice a byte).
-    /// Inlined: once a byte of the image each time the store task looks
-    /// for a change (at `z` it was a call).
-    #[inline(always)]
-    fn add(&mut self, x: u8) {
-        self.a += x as u16;
-        if self.a >= 255 {
-            self.a -= 255;
-        }
-        self.b += self.a;
-        if self.b >= 255 {
-            self.b -= 255;
-        }
-    }
-
-    fn value(&self) -> u16 {
-        self.b << 8 | self.a
-    }
-}
+/// Bytes a version-6 image takes.
+pub const LEGACY_LEN: usize = legacy::len();
 
 #[cfg(test)]
 mod tests;
