@@ -438,6 +438,14 @@ impl Interpreter {
         if !env.allowed.motion && moves(b) {
             return Err(ErrorKind::JobOwnsMotion);
         }
+        // Marlin's `M17 X`/`M18 X` name the drivers to switch, not a move
+        // (taut switches them all): refused, so the axis words move nothing.
+        if b.has(group::TAUT)
+            && matches!(b.taut, TautCode::EnableDrivers | TautCode::DisableDrivers)
+            && b.has_axes()
+        {
+            return Err(ErrorKind::AxisWordsExist);
+        }
         if b.has(group::TAUT) && b.taut == TautCode::Servo {
             if !plotter {
                 return Err(ErrorKind::UnsupportedCommand);

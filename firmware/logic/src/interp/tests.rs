@@ -514,6 +514,11 @@ fn drivers_on_off_and_their_idle_delay() {
     // Negative seconds are Grbl's error 4, one on/off per line its 21.
     assert_eq!(b.err("M18 S-1"), 4);
     assert_eq!(b.err("M17 M18"), 21);
+    // Marlin's `M18 X` (that driver only) is no move here: Grbl's 31.
+    b.io.did.clear();
+    assert_eq!(b.err("M18 X1"), 31);
+    assert_eq!(b.err("M17 Y2"), 31);
+    assert!(b.io.did.is_empty());
     // `$C`: checked, nothing switched.
     let mut p = Parser::new();
     let block = match p.push_all_test(b"M18 S5\n") {
