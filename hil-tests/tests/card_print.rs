@@ -261,10 +261,11 @@ fn seeded_pulls_and_holds_mid_print_still_draw_the_whole_drawing() {
                 let image = sim.remove_sd().unwrap();
                 sim.run_for(Duration::from_secs_f64(back));
                 sim.insert_sd(image);
-                // Mounted again (it is looked for once a second).
+                // Mounted again: looked for once a second, but not while the
+                // moves already planned before the pull are still drawn.
                 let again = sim.run_until(
                     |s| s.uart_text().matches("MiB FAT").count() > mounts,
-                    Duration::from_secs(5),
+                    Duration::from_secs(20),
                 );
                 assert_eq!(again, hil_tests::sim::Outcome::Done, "{}", log_tail(sim));
                 // Lost only if it noticed while lines were left to read.
