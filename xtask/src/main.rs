@@ -10,6 +10,7 @@ mod firmware;
 mod flashmap;
 mod fuzz;
 mod run;
+mod stackargs;
 
 use run::{cargo, root, Result};
 use std::process::ExitCode;
