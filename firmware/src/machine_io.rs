@@ -69,6 +69,10 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
         self.m.drivers.set(0xFF, on);
     }
 
+    fn idle_delay(&mut self, ms: u32) {
+        self.m.drivers.set_delay(ms);
+    }
+
     fn pause(&mut self) {
         self.m.hold();
     }

@@ -48,7 +48,7 @@ use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL, SIG
 use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{stack, Poll, TaskCell};
-use taut_firmware::stepper::{self, StepDirPins, Stepper};
+use taut_firmware::stepper::{self, CoilPins, StepDirPins, Stepper};
 use taut_firmware::store::Store;
 use taut_firmware::{
     board::usart::{RXCIE0, UDRIE0},
@@ -263,7 +263,6 @@ fn init() -> Watchdog {
         radial: pins.a2.into_output(),
         drill: pins.a8.into_output(),
     };
-    let drivers = CONFIG.with(|c| Drivers::new(enable, c));
     let step_dir = StepDirPins {
         base_step: pins.a0.into_output_at(false),
         base_dir: pins.a1.into_output_at(false),
@@ -272,7 +271,29 @@ fn init() -> Watchdog {
         drill_step: pins.d46.into_output_at(false),
         drill_dir: pins.d48.into_output_at(false),
     };
-    let stepper = CONFIG.with(|c| Stepper::new(step_dir, StepTimer::start(dp.TC3), c));
+    let coils = CoilPins {
+        x: (
+            pins.d22.into_output_at(false),
+            pins.d23.into_output_at(false),
+            pins.d24.into_output_at(false),
+            pins.d25.into_output_at(false),
+        ),
+        y: (
+            pins.d26.into_output_at(false),
+            pins.d27.into_output_at(false),
+            pins.d28.into_output_at(false),
+            pins.d29.into_output_at(false),
+        ),
+        z: (
+            pins.d37.into_output_at(false),
+            pins.d36.into_output_at(false),
+            pins.d35.into_output_at(false),
+            pins.d34.into_output_at(false),
+        ),
+    };
+    let stepper = CONFIG.with(|c| Stepper::new(step_dir, coils, StepTimer::start(dp.TC3), c));
+    // After the stepper: a coil axis's driver is its coils.
+    let drivers = CONFIG.with(|c| Drivers::new(enable, c));
     // The pen starts up, whatever the machine (SERVO0 is unused on the
     // string-art machine).
     let pen = PenServo::start(
@@ -426,11 +447,25 @@ fn motion() {
     /// Pieces of work per run (a part of a block's profile or of a
     /// segment, ≤ ~1 ms each): one keeps the console's wait short.
     const BATCH: usize = 1;
-    let (freed, more, idle, stepping) = MOTION.with(|m| {
+    let (freed, more, idle, stepping, release) = MOTION.with(|m| {
         let m = m.as_mut().unwrap();
         let (freed, more) = m.refill(BATCH);
-        (freed, more, m.is_idle(), m.stepper.is_running())
+        let idle = m.is_idle();
+        // The clock only while standing: reading it masks interrupts,
+        // which would delay a step.
+        let release = match idle {
+            true => m.drivers.idle(clock::millis()),
+            false => {
+                m.drivers.moving();
+                None
+            }
+        };
+        (freed, more, idle, m.stepper.is_running(), release)
     });
+    // Drivers wait to go off after the step idle delay (`$1`).
+    if let Some(ms) = release {
+        spawn_after(Task::Motion, ms);
+    }
     // Urgent only while steps run out of it: standing, a motion's first
     // profile and segments wait behind a console line (≤ 1 ms) rather
     // than keep a `?` or a line waiting ~7 ms for all their parts.

@@ -214,7 +214,9 @@ impl Motion {
             SHORT_AT.store(short as u8, Relaxed);
         }
         self.blocks = BLOCKS.len() as u8;
-        self.stepper.kick();
+        if self.stepper.kick() {
+            self.drivers.moving();
+        }
         if self.cancel && self.prep.hold_state() == Hold::Stopped && !self.stepper.is_running() {
             self.abort();
             freed = true;
@@ -231,9 +233,16 @@ impl Motion {
     fn queue(&mut self, cut: &Cut) -> bool {
         let mut seg = cut.segment;
         if let Some(block) = &cut.block {
+            // Its drivers on before the step interrupt can reach it.
+            let mut moving = 0;
+            for (i, &steps) in block.steps.iter().enumerate() {
+                moving |= ((steps != 0) as u8) << i;
+            }
+            self.drivers.wake(moving);
             // The block goes first: its first segment refers to it.
             let _ = BLOCKS.push(*block);
-            self.every_event = every_event(block);
+            // Coils step in the interrupt's general path only.
+            self.every_event = every_event(block) && moving & self.stepper.coil_axes() == 0;
         }
         if self.every_event && fast_segment(&seg) {
             seg.flags |= FAST;
@@ -329,8 +338,8 @@ impl Motion {
     /// Take new machine figures (a `$` setting); only when idle.
     pub fn configure(&mut self, config: &MachineConfig) {
         PLANNER.with(|p| p.configure(config));
+        self.stepper.configure(config);
         self.drivers.configure(config);
-        self.stepper.set_timing(&config.pulse);
     }
 
     /// Redefine where the machine is (`G92`, zeroing). Only when idle.

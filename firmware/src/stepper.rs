@@ -11,6 +11,11 @@
 //! the interval), so a late interrupt never shifts the events after it.
 //! Waits longer than the 16-bit timer are split.
 //!
+//! An axis driven through a ULN2003 board (`$x_driver=uln2003`) takes the
+//! same events: its DDA marks the events it steps at, and the general path
+//! writes the next half-step's coil pattern to its four inputs in one port
+//! write (its blocks never take the fast path; coils step at ≤ 1 000/s).
+//!
 //! Positions are not counted per step: the DDA's closed form gives the steps
 //! done by each axis from the events fired, so the interrupt only counts
 //! events. Everything here is inlined into the handler: a call would make the
@@ -24,8 +29,9 @@ use crate::queues::{BLOCKS, SEGMENTS};
 use core::cell::UnsafeCell;
 use core::ptr::{read_volatile, write_volatile};
 use taut_logic::axis::{PerAxis, AXES};
-use taut_logic::config::MachineConfig;
-use taut_logic::pinmap::{port_bit, Port, DRIVERS};
+use taut_logic::coil;
+use taut_logic::config::{Driver, MachineConfig};
+use taut_logic::pinmap::{coil_port, port_bit, Port, DRIVERS};
 use taut_logic::segment::{Segment, StepBlock, FRAC_BITS, NEW_BLOCK, STOP};
 
 /// Refill the queues when this few segments are left (of 15).
@@ -118,6 +124,16 @@ const DIR: [PinReg; AXES] = [
     reg(DRIVERS[2].dir),
 ];
 
+/// PORTx data address of each channel's coil inputs and the bit of IN1,
+/// worked out at compile time (read only in `const` blocks: a table read at
+/// run time would sit in SRAM, with the pin map behind it).
+const COIL_REG: [(u16, u8); AXES] = [coil_reg(0), coil_reg(1), coil_reg(2)];
+
+const fn coil_reg(axis: usize) -> (u16, u8) {
+    let (port, shift) = coil_port(axis);
+    (port.pin_register() + 2, shift)
+}
+
 /// State owned by the interrupt once motion runs. `repr(C)`: the assembly
 /// fast path (`fast.rs`) reads fields at their `offset_of!`.
 #[repr(C)]
@@ -173,6 +189,17 @@ pub struct Exec {
     /// The current segment is a hold's stop ([`STOP`]): running out of
     /// segments after it is no underrun.
     stop: u8,
+    /// Axes driven through their coils (`Driver::Uln2003`).
+    coils: u8,
+    /// Coil axes the current block moves: the DDA runs for them.
+    coil_moving: u8,
+    /// Coil axes that step at the pending event.
+    coil_due: u8,
+    /// Coil axes whose coils are energised (the driver on).
+    energised: u8,
+    /// Each coil axis's half-step phase (0..8): kept while the coils are
+    /// off, so they come back on where the rotor stands.
+    phase: PerAxis<u8>,
 }
 
 #[doc(hidden)]
@@ -212,6 +239,11 @@ pub static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {
     late: 0,
     underruns: 0,
     stop: 0,
+    coils: 0,
+    coil_moving: 0,
+    coil_due: 0,
+    energised: 0,
+    phase: [0; AXES],
 }));
 
 #[inline(always)]
@@ -245,47 +277,103 @@ const _: () = {
     assert!(DRIVERS[2].step == 46 && DRIVERS[2].dir == 48);
 };
 
-/// Owner of the STEP and DIR pins and of Timer3.
+/// The ULN2003 boards' IN1..IN4 (`taut_logic::pinmap::COILS`), low
+/// outputs: X on PA0–PA3, Y on PA4–PA7, Z on PC0–PC3. Written by the
+/// step interrupt and [`coils`], four bits of one port at a time.
+pub struct CoilPins {
+    pub x: (
+        Pin<22, Output>,
+        Pin<23, Output>,
+        Pin<24, Output>,
+        Pin<25, Output>,
+    ),
+    pub y: (
+        Pin<26, Output>,
+        Pin<27, Output>,
+        Pin<28, Output>,
+        Pin<29, Output>,
+    ),
+    pub z: (
+        Pin<37, Output>,
+        Pin<36, Output>,
+        Pin<35, Output>,
+        Pin<34, Output>,
+    ),
+}
+
+const _: () = {
+    use taut_logic::pinmap::COILS;
+    assert!(COILS[0][0] == 22 && COILS[0][3] == 25);
+    assert!(COILS[1][0] == 26 && COILS[1][3] == 29);
+    assert!(COILS[2][0] == 37 && COILS[2][3] == 34);
+};
+
+/// Owner of the STEP and DIR pins, the coil inputs and Timer3.
 pub struct Stepper {
     _pins: StepDirPins,
+    _coils: CoilPins,
     _timer: StepTimer,
+    /// Axes driven through their coils, as the interrupt has them.
+    coils: u8,
 }
 
 impl Stepper {
-    /// Takes the pins, and the pulse timing and DIR polarity from
-    /// `config`. Timer3 must run at clk/1 (`StepTimer`).
-    pub fn new(pins: StepDirPins, timer: StepTimer, config: &MachineConfig) -> Stepper {
-        let e = exec();
-        e.pulse_ticks = config.pulse.step_pulse_us as u16 * 16;
-        e.dir_setup_ticks = config.pulse.dir_setup_us as u16 * 16;
-        e.dir_high_positive = 0;
-        for i in 0..AXES {
-            if config.axes[i].dir_high_is_positive {
-                e.dir_high_positive |= 1 << i;
-            }
-        }
-        Stepper {
+    /// Takes the pins, and the pulse timing, DIR polarity and drivers
+    /// from `config`. Timer3 must run at clk/1 (`StepTimer`).
+    pub fn new(
+        pins: StepDirPins,
+        coils: CoilPins,
+        timer: StepTimer,
+        config: &MachineConfig,
+    ) -> Stepper {
+        let mut s = Stepper {
             _pins: pins,
+            _coils: coils,
             _timer: timer,
-        }
+            coils: 0,
+        };
+        s.configure(config);
+        s
     }
 
-    pub fn set_timing(&mut self, pulse: &taut_logic::config::PulseTiming) {
+    /// The pulse timing, DIR polarity and drivers of `config`. Only while
+    /// stopped (the interrupt reads them per event): coils of an axis
+    /// that leaves coil drive are switched off.
+    pub fn configure(&mut self, config: &MachineConfig) {
+        let mut high_positive = 0;
+        let mut coil_axes = 0;
+        for i in 0..AXES {
+            high_positive |= (config.axes[i].dir_high_is_positive as u8) << i;
+            coil_axes |= ((config.axes[i].driver == Driver::Uln2003) as u8) << i;
+        }
+        coils(self.coils & !coil_axes, false);
         avr_device::interrupt::free(|_| {
-            exec().pulse_ticks = pulse.step_pulse_us as u16 * 16;
-            exec().dir_setup_ticks = pulse.dir_setup_us as u16 * 16;
+            let e = exec();
+            e.pulse_ticks = config.pulse.step_pulse_us as u16 * 16;
+            e.dir_setup_ticks = config.pulse.dir_setup_us as u16 * 16;
+            e.dir_high_positive = high_positive;
+            e.coils = coil_axes;
         });
+        self.coils = coil_axes;
+    }
+
+    /// Axes driven through their coils: their blocks take the general path.
+    pub fn coil_axes(&self) -> u8 {
+        self.coils
     }
 
     /// Start executing queued segments if the interrupt is idle; the first
     /// event comes one interval after now. Needs no critical section: while
     /// motion is stopped the compare interrupt is off, and only this code
     /// turns it on.
-    pub fn kick(&mut self) {
+    /// Returns whether it started.
+    pub fn kick(&mut self) -> bool {
         let e = exec();
-        if !avr_device::interrupt::free(|_| e.running) && !SEGMENTS.is_empty() {
+        let start = !avr_device::interrupt::free(|_| e.running) && !SEGMENTS.is_empty();
+        if start {
             Self::start(e);
         }
+        start
     }
 
     /// The interrupt is idle and segments wait: take the first, start the
@@ -369,6 +457,7 @@ impl Stepper {
         e.wait = 0;
         e.waiting = 0;
         e.fast_ok = 0;
+        e.coil_due = 0;
         self.set_position(at);
         at
     }
@@ -480,8 +569,14 @@ fn begin_block(e: &mut Exec, block: &StepBlock) {
     e.block.dir = block.dir;
     let mut always = [0u8; SLOTS];
     let mut partial = 0;
+    let mut coil_moving = 0;
     for i in 0..AXES {
-        if block.steps[i] == block.events {
+        if e.coils & (1 << i) != 0 {
+            // Coils: no STEP pin; their own DDA marks the events.
+            if block.steps[i] != 0 {
+                coil_moving |= 1 << i;
+            }
+        } else if block.steps[i] == block.events {
             always[MAP.slot[i]] |= MAP.bit[i];
         } else if block.steps[i] != 0 {
             partial |= 1 << i;
@@ -489,6 +584,9 @@ fn begin_block(e: &mut Exec, block: &StepBlock) {
     }
     e.always = always;
     e.partial = partial;
+    e.coil_moving = coil_moving;
+    // Set again by the coils' DDA if this block moves any.
+    e.coil_due = 0;
 }
 
 /// [`Segment::flags`] bit, set by the motion task: every event of the
@@ -547,6 +645,93 @@ fn dda_partial(e: &mut Exec, m: &mut [u8; SLOTS]) {
     dda_axis!(e, m, 2);
 }
 
+/// The DDA of the coil axes: which of them step at the pending event.
+#[inline(never)]
+fn dda_coils(e: &mut Exec) {
+    let mut due = 0;
+    for i in 0..AXES {
+        if e.coil_moving & (1 << i) != 0 {
+            let c = e.counter[i].wrapping_add(e.block.steps[i]);
+            if c >= e.block.events {
+                e.counter[i] = c - e.block.events;
+                due |= 1 << i;
+            } else {
+                e.counter[i] = c;
+            }
+        }
+    }
+    e.coil_due = due;
+}
+
+/// The coil axes due at this event take their next half-step, in the
+/// block's direction; true when no STEP pin was raised with them (no
+/// pulse to hold).
+#[inline(never)]
+fn step_coils(e: &mut Exec) -> bool {
+    // Bit set: the phase counts up (a positive step, DIR not inverted).
+    let up = !(e.block.dir ^ e.dir_high_positive);
+    for i in 0..AXES {
+        if e.coil_due & (1 << i) != 0 {
+            let step = if up & (1 << i) != 0 { 1 } else { 7 };
+            let phase = (e.phase[i] + step) & 7;
+            e.phase[i] = phase;
+            if e.energised & (1 << i) != 0 {
+                write_coils(i, coil::pattern(phase));
+            }
+        }
+    }
+    e.masks == [0; SLOTS]
+}
+
+/// Write the four inputs of axis `i`'s coils: one store to their port.
+/// From the step interrupt, or with it masked.
+#[inline(always)]
+fn write_coils(i: usize, inputs: u8) {
+    match i {
+        0 => write_coils_of::<0>(inputs),
+        1 => write_coils_of::<1>(inputs),
+        _ => write_coils_of::<2>(inputs),
+    }
+}
+
+#[inline(always)]
+fn write_coils_of<const I: usize>(inputs: u8) {
+    let (port, shift) = const { COIL_REG[I] };
+    let port = port as *mut u8;
+    // SAFETY: the coil ports are the stepper's alone (`CoilPins`); callers
+    // run in the step interrupt or with interrupts masked, so this
+    // read-modify-write is not torn.
+    unsafe {
+        let keep = read_volatile(port) & !(0x0F << shift);
+        write_volatile(port, keep | inputs << shift);
+    }
+}
+
+/// Energise (`on`) or release the coils of the coil axes in `mask`, at
+/// the phase they stand at: no step is gained or lost across a release.
+/// Each axis's write masks interrupts for a few cycles.
+pub fn coils(mask: u8, on: bool) {
+    for i in 0..AXES {
+        if mask & (1 << i) == 0 {
+            continue;
+        }
+        avr_device::interrupt::free(|_| {
+            let e = exec();
+            if e.coils & (1 << i) == 0 {
+                return;
+            }
+            let inputs = if on {
+                e.energised |= 1 << i;
+                coil::pattern(e.phase[i])
+            } else {
+                e.energised &= !(1 << i);
+                0
+            };
+            write_coils(i, inputs);
+        });
+    }
+}
+
 /// Time, DDA and compare register of the next event.
 ///
 /// # Safety
@@ -559,6 +744,9 @@ unsafe fn schedule_next(e: &mut Exec) {
     let mut m = e.always;
     if e.partial != 0 {
         dda_partial(e, &mut m);
+    }
+    if e.coil_moving != 0 {
+        dda_coils(e);
     }
     e.masks = m;
     e.wait = t >> FRAC_BITS;
@@ -620,8 +808,11 @@ pub fn on_compare() -> bool {
         // ends at its set width, before the work below (a new segment, the
         // DDA) that can take longer than the pulse.
         let raised = e.raised;
-        while read_volatile(TCNT3).wrapping_sub(raised) < e.pulse_ticks {}
-        toggle_steps(&e.masks);
+        // Coils step at the event too; a coil-only event raised no pin.
+        if e.coil_due == 0 || !step_coils(e) {
+            while read_volatile(TCNT3).wrapping_sub(raised) < e.pulse_ticks {}
+            toggle_steps(&e.masks);
+        }
         e.left -= 1;
         let loaded = e.left == 0 && load_segment_cold(e);
         if e.left > 0 {

@@ -127,7 +127,7 @@ impl Store {
             writer: None,
             upgrading: false,
             extras: Extras {
-                bytes: [0; 5],
+                bytes: [0; taut_logic::settings::grbl::BYTES],
                 spindle: [0; 2],
                 typed: [0; taut_logic::settings::grbl::TYPED],
             },
@@ -184,7 +184,7 @@ impl Store {
             extras.reset();
             let why = match (layout, loaded[0]) {
                 (Layout::Legacy, _) => match legacy::check(&read)
-                    .and_then(|()| image::take_named(&from(legacy::BODY, false), cfg))
+                    .and_then(|()| image::take_named(&from(legacy::BODY, false), cfg, true))
                 {
                     Ok(()) => None,
                     Err(why) => {

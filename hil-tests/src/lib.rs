@@ -11,6 +11,7 @@ pub use taut_simavr as sim;
 
 pub mod board;
 pub mod drawing;
+pub mod drivers;
 pub mod reference;
 pub mod senders;
 
@@ -178,7 +179,8 @@ pub fn sample_card_dir() -> PathBuf {
 }
 
 /// The release image with every machine pin probed under its VCD name
-/// (`<axis>_step|dir|en`, `btn_<button>`, `pen_pwm`), booted.
+/// (`<axis>_step|dir|en`, `x_in1`..`z_in4`, `btn_<button>`, `pen_pwm`),
+/// booted; its drivers checked when it ends (`drivers`).
 pub fn boot_machine() -> sim::Sim {
     let mut sim = machine();
     let booted = sim.run_until_uart_contains("reset:", std::time::Duration::from_millis(50));
@@ -191,17 +193,27 @@ pub fn boot_machine() -> sim::Sim {
 pub fn machine() -> sim::Sim {
     use taut_logic::axis::Axis;
     use taut_logic::pinmap::{self, Button};
-    let mut sim = sim::Sim::load(&firmware_elf()).unwrap();
+    let mut sim = load();
     for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
         let d = pinmap::driver(axis);
         sim.probe_step_dir(axis.name(), d.step, d.dir, true);
         sim.probe(d.enable, &format!("{}_en", axis.name()));
     }
+    sim.probe_coils();
     sim.probe(pinmap::PEN_SERVO, "pen_pwm");
     for b in Button::ALL {
         sim.release(b.pin());
         sim.probe(b.pin(), &format!("btn_{}", b.name()));
     }
+    sim
+}
+
+/// The release image, nothing probed yet, not run; its drivers checked
+/// when it ends ([`drivers::check_at_end`]: probe STEP, DIR and ENABLE of
+/// any driver it moves).
+pub fn load() -> sim::Sim {
+    let mut sim = sim::Sim::load(&firmware_elf()).unwrap();
+    drivers::check_at_end(&mut sim);
     sim
 }
 
@@ -335,9 +347,10 @@ pub fn press(sim: &mut sim::Sim, button: taut_logic::pinmap::Button, ms: u64) {
     sim.run_for(std::time::Duration::from_millis(100));
 }
 
-/// The machine's path rebuilt from its STEP and DIR pins alone: after
-/// every STEP pulse of any of the three axes (base, radial, drill), its
-/// cycle and the three step counts then.
+/// The machine's path rebuilt from its STEP and DIR pins alone, and from
+/// its coil inputs where they are probed (a 28BYJ-48's half-steps, phase
+/// up positive): after every step of any of the three axes (base, radial,
+/// drill), its cycle and the three step counts then.
 pub fn track(sim: &sim::Sim) -> Vec<(u64, [i64; 3])> {
     use taut_logic::axis::Axis;
     let mut steps: Vec<(u64, usize, i64)> = Vec::new();
@@ -349,6 +362,13 @@ pub fn track(sim: &sim::Sim) -> Vec<(u64, [i64; 3])> {
         let dir = sim.probed(&format!("{}_dir", axis.name()));
         for e in step.edges().iter().filter(|e| e.high) {
             steps.push((e.cycle, i, if dir.level_at(e.cycle) { 1 } else { -1 }));
+        }
+        if sim.probes().iter().any(|p| p.name() == "x_in1") {
+            let mut last = 0;
+            for (cycle, pos) in sim.coil_track(i).steps {
+                steps.push((cycle, i, pos - last));
+                last = pos;
+            }
         }
     }
     steps.sort_unstable();

@@ -1,13 +1,13 @@
 //! The release firmware boots in simavr, prints its banner within
 //! 50 ms of machine time, and blinks its status LED exactly as designed.
 
-use hil_tests::{firmware_elf, firmware_version, sim::Outcome, sim::Sim};
+use hil_tests::{firmware_version, sim::Outcome};
 use std::time::Duration;
 use taut_logic::pinmap::STATUS_LED;
 
 #[test]
 fn banner_within_50_ms_with_version_and_reset_cause() {
-    let mut sim = Sim::load(&firmware_elf()).unwrap();
+    let mut sim = hil_tests::load();
     let out = sim.run_until_uart_contains("reset:", Duration::from_millis(50));
     assert_eq!(
         out,
@@ -44,7 +44,7 @@ fn banner_within_50_ms_with_version_and_reset_cause() {
 
 #[test]
 fn status_led_blinks_three_times_at_boot_then_stays_off() {
-    let mut sim = Sim::load(&firmware_elf()).unwrap();
+    let mut sim = hil_tests::load();
     sim.probe(STATUS_LED, "led");
     assert_eq!(sim.run_for(Duration::from_secs(2)), Outcome::Running);
     let led = sim.probed("led");
@@ -61,7 +61,7 @@ fn status_led_blinks_three_times_at_boot_then_stays_off() {
 
 #[test]
 fn idle_firmware_sleeps_and_keeps_its_stack_small() {
-    let mut sim = Sim::load(&firmware_elf()).unwrap();
+    let mut sim = hil_tests::load();
     assert_eq!(sim.run_for(Duration::from_secs(1)), Outcome::Running);
     let elf = sim.elf().unwrap();
     let stack = sim.peak_stack_bytes() as u32;

@@ -69,6 +69,13 @@ fn avrdude_writes_taut_through_the_stock_bootloader_and_taut_runs() {
     let want_radial = steps(1, 5_000);
     let got = (rises(&signals, "base_step"), rises(&signals, "radial_step"));
     assert_eq!(got, (want_base, want_radial), "pulses of the moves");
+    // Out of process, no end check of the simulation: the replay's.
+    let trace = taut_trace::replay::Trace::from_signals(&signals, &cfg).unwrap();
+    assert!(
+        trace.steps_while_off().is_empty(),
+        "stepped while off: {:?}",
+        &trace.steps_while_off()[..trace.steps_while_off().len().min(5)]
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -155,8 +155,8 @@ fn numbered_settings_list_and_write_through_to_the_named_ones() {
     let mut sim = boot_machine();
     let listing = replies_all(&send(&mut sim, "$$"));
     assert_eq!(
-        listing[..4],
-        ["$0=5", "$1=255", "$2=0", "$3=0"],
+        listing[..5],
+        ["$0=5", "$1=255", "$2=0", "$3=0", "$4=1"],
         "{listing:?}"
     );
     for line in [

@@ -66,6 +66,14 @@ fn the_sample_job_drills_and_winds_as_its_pulses_show() {
     std::fs::remove_file(&path).unwrap();
     let board = board_from_param(&std::fs::read(card.join("param.txt")).unwrap()).unwrap();
     let job = JobReplay::from_signals(&signals, board, &config).unwrap();
+    // Read back from the VCD as well as at the simulation's end: no STEP
+    // edge reached a driver held off.
+    let off = job.trace.steps_while_off();
+    assert!(
+        off.is_empty(),
+        "stepped while off: {:?}",
+        &off[..off.len().min(5)]
+    );
     let scale = StepScale::from_config(&config);
     let turn = i64::from(scale.steps_per_turn);
     let radial_per_mm = f64::from(scale.radial.as_f32());

@@ -29,8 +29,9 @@ fn drawn_from_the_pulses(machine: Machine, pen: PenWords, at: [f64; 2], within: 
 
 #[test]
 fn the_drum_plotter_draws_its_toolpath() {
-    // Y: 7.24 steps/mm of paper (a step is 0.14 mm).
-    drawn_from_the_pulses(Machine::Drum, PenWords::Spindle, [5.0, 5.0], 0.15);
+    // Its 28BYJ-48s half-stepped through their coils (x_in*, y_in*): Y
+    // 14.5 half-steps a mm of paper (0.07 mm each).
+    drawn_from_the_pulses(Machine::Drum, PenWords::Spindle, [5.0, 5.0], 0.1);
 }
 
 #[test]
@@ -170,11 +171,14 @@ fn unknown_but_harmless_codes_are_refused_and_the_stream_goes_on() {
         }
     }
     sim.run_for(Duration::from_millis(200));
+    // The drum's motors step through their coils (x_in*, y_in*).
+    let coils = |sim: &Sim| [0, 1].map(|axis| sim.coil_track(axis).position());
     assert_eq!(steps_on_pins(&sim), [0, 0, 0], "nothing moved");
+    assert_eq!(coils(&sim), [0, 0], "nothing moved");
     send(&mut sim, "G0 X1");
     send(&mut sim, "M400");
-    // 2048 steps per 40 mm of belt: 1 mm is 51.2, rounded once.
-    assert_eq!(steps_on_pins(&sim), [51, 0, 0]);
+    // 4096 half-steps per 40 mm of belt: 1 mm is 102.4, rounded once.
+    assert_eq!(coils(&sim), [102, 0]);
 }
 
 /// A flatbed (not homing: no switch here), drivers on, standing at
@@ -268,7 +272,7 @@ fn the_picture_counts_from_the_homed_zero_not_from_power_on() {
     use taut_logic::pinmap::Button;
     use taut_logic::settings::record::host;
     let cfg = MachineConfig::defaults(Machine::Flatbed);
-    let mut sim = Sim::load(&hil_tests::firmware_elf()).unwrap();
+    let mut sim = hil_tests::load();
     sim.set_eeprom(&host::eeprom(
         &cfg,
         &Default::default(),

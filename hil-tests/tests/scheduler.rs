@@ -1,8 +1,7 @@
 //! The scheduler under load, the watchdog, and the RAM budget.
 
 use hil_tests::{
-    assert_ram_budget, assert_step_interrupt_never_masked_long, example_elf, firmware_elf,
-    sim::Outcome, sim::Sim,
+    assert_ram_budget, assert_step_interrupt_never_masked_long, example_elf, sim::Outcome, sim::Sim,
 };
 use std::time::Duration;
 use taut_logic::axis::Axis;
@@ -20,9 +19,10 @@ fn send(sim: &mut Sim, line: &str) {
 /// train keeps its timing, the masked-span bound holds.
 #[test]
 fn no_message_lost_and_pulses_on_time_under_load() {
-    let mut sim = Sim::load(&firmware_elf()).unwrap();
+    let mut sim = hil_tests::load();
     let d = driver(Axis::Base);
     sim.probe_step_dir("base", d.step, d.dir, true);
+    sim.probe(d.enable, "base_en");
     assert_eq!(
         sim.run_until_uart_contains("reset:", Duration::from_millis(50)),
         Outcome::Done
@@ -160,7 +160,7 @@ fn a_task_that_never_returns_is_reset_by_the_watchdog() {
 
 #[test]
 fn idle_release_image_stays_within_the_ram_budget() {
-    let mut sim = Sim::load(&firmware_elf()).unwrap();
+    let mut sim = hil_tests::load();
     sim.run_for(Duration::from_secs(2));
     send(&mut sim, "$$");
     send(&mut sim, "$S");

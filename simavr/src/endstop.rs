@@ -109,6 +109,33 @@ impl Sim {
         }
         self.probe(pinmap::PEN_SERVO, "pen_pwm");
         self.probe(pinmap::STATUS_LED, "led");
+        self.probe_coils();
+    }
+
+    /// Probes every channel's ULN2003 inputs as `x_in1`..`x_in4`,
+    /// `y_in*`, `z_in*` ([`crate::coils`] reads them back).
+    pub fn probe_coils(&mut self) {
+        for (axis, pins) in pinmap::COILS.iter().enumerate() {
+            for (pin, name) in pins.iter().zip(crate::coils::names(axis)) {
+                self.probe(*pin, &name);
+            }
+        }
+    }
+
+    /// The half-steps of channel `axis`'s coils (0 X, 1 Y, 2 Z), probed
+    /// by [`Sim::probe_coils`].
+    pub fn coil_track(&self, axis: usize) -> crate::coils::CoilTrack {
+        let names = crate::coils::names(axis);
+        let probes: [&crate::probe::Probe; 4] = std::array::from_fn(|k| self.probed(&names[k]));
+        let edges = probes.map(|p| {
+            p.edges()
+                .iter()
+                .map(|e| (e.cycle, e.high))
+                .collect::<Vec<_>>()
+        });
+        crate::coils::CoilTrack::decode(std::array::from_fn(|k| {
+            (probes[k].initial(), edges[k].as_slice())
+        }))
     }
 
     /// The MIN switches of `cfg`'s homing axes, `mm` below where each

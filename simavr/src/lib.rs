@@ -44,4 +44,4 @@ pub use report::{PinReport, Report};
 pub use sim::Sim;
 /// The trace code (VCD, pulse replay, pictures) lives in `taut-trace`,
 /// free of simavr: re-exported here for the harness's users.
-pub use taut_trace::{picture, replay, vcd};
+pub use taut_trace::{coils, picture, replay, vcd};

@@ -93,6 +93,8 @@ pub struct Sim {
     pub(crate) code_ranges: Vec<(u32, u32)>,
     /// `unseen_mask` was reported once.
     pub(crate) warned_unseen_mask: bool,
+    /// Run on the whole record when the simulation ends ([`Sim::check_at_end`]).
+    end_checks: Vec<fn(&Sim)>,
     /// The lock bits' and the boot section's rules on SPM, on a board with
     /// a bootloader (`boot`).
     pub(crate) spm_guard: Option<Box<crate::boot::SpmGuard>>,
@@ -287,9 +289,18 @@ impl Sim {
             code: Vec::new(),
             code_ranges: Vec::new(),
             warned_unseen_mask: false,
+            end_checks: Vec::new(),
             spm_guard: None,
             external_resets: 0,
         }
+    }
+
+    /// Runs `check` on the simulation when it is dropped, unless the
+    /// thread is already panicking: a rule every test of a kind keeps
+    /// (a driver on whenever it is stepped), checked over the whole run
+    /// without each test having to ask.
+    pub fn check_at_end(&mut self, check: fn(&Sim)) {
+        self.end_checks.push(check);
     }
 
     /// Puts the traps of `traps` into the loaded code: on every `cli` in
@@ -799,6 +810,11 @@ fn board_pin(pin: u8) -> (Port, u8) {
 
 impl Drop for Sim {
     fn drop(&mut self) {
+        if !std::thread::panicking() {
+            for check in std::mem::take(&mut self.end_checks) {
+                check(self);
+            }
+        }
         // SAFETY: `avr` is live and used no more; callbacks can no longer run
         // once it is terminated, so `shared` may be freed after it.
         unsafe {

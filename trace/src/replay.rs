@@ -131,6 +131,8 @@ pub struct Trace {
     enables: [Level; 3],
     enable_active_high: [bool; 3],
     buttons: Vec<(String, Level)>,
+    /// STEP edges (rise or fall) while the axis's driver was off.
+    off_steps: Vec<(Axis, u64)>,
     /// The last change of any signal, ns.
     pub end_ns: u64,
 }
@@ -148,6 +150,7 @@ impl Trace {
         let mut tracks: [Track; 3] = Default::default();
         let mut enables: [Level; 3] = Default::default();
         let mut enable_active_high = [true; 3];
+        let mut off_steps = Vec::new();
         for (i, axis) in MACHINE_AXES.iter().enumerate() {
             let cfg = config.axes[axis.index()];
             let (step, dir) = (
@@ -157,7 +160,14 @@ impl Trace {
             tracks[i] = Track::from_pulses(step, dir, cfg.dir_high_is_positive);
             enables[i] = Level::of(find(format!("{}_en", axis.name()))?);
             enable_active_high[i] = cfg.enable_active_high;
+            off_steps.extend(
+                step.changes
+                    .iter()
+                    .filter(|&&(t, _)| enables[i].at(t) != cfg.enable_active_high)
+                    .map(|&(t, _)| (*axis, t)),
+            );
         }
+        off_steps.sort_by_key(|&(_, t)| t);
         let buttons = signals
             .iter()
             .filter_map(|s| Some((s.name.strip_prefix("btn_")?.to_string(), Level::of(s))))
@@ -172,6 +182,7 @@ impl Trace {
             enables,
             enable_active_high,
             buttons,
+            off_steps,
             end_ns,
         })
     }
@@ -202,6 +213,13 @@ impl Trace {
     /// Base, radial and drill drivers on at `t`.
     pub fn drivers_on(&self, t: u64) -> [bool; 3] {
         MACHINE_AXES.map(|a| self.driver_on(a, t))
+    }
+
+    /// Every STEP edge, rising or falling, that reached a driver while its
+    /// ENABLE held it off, `(axis, ns)` in time order: on a real machine
+    /// the motor did not take it. A firmware keeps this empty.
+    pub fn steps_while_off(&self) -> &[(Axis, u64)] {
+        &self.off_steps
     }
 
     /// Times button `name` (`confirm`, `zero_base`, …) went down.

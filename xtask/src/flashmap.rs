@@ -4,7 +4,8 @@
 //! reaches after a watchdog reset, the image ends with its build's mark,
 //! and every function reached through a pointer is reachable by a 16-bit
 //! word pointer: directly below 128 KiB, or through one of the linker's
-//! trampolines (`.trampolines`, a `jmp` each, below 128 KiB).
+//! trampolines (`.trampolines`, a `jmp` each, below 128 KiB); and no
+//! function reads arguments from the stack (`stackargs`).
 //!
 //! LLVM's AVR backend calls through pointers with `eicall`/`eijmp`, and
 //! the start-up sets EIND to 0 (avr-libc's crt for the ATmega2560), so a
@@ -201,6 +202,23 @@ pub fn check(elf: &Path) -> Result<FlashMap> {
                 through += 1;
             }
         }
+    }
+    // Functions reading stack arguments, which the AVR back end misreads.
+    let functions: Vec<(&str, u64, u64)> = file
+        .symbols()
+        .filter(|s| s.kind() == object::SymbolKind::Text && s.size() > 0)
+        .filter(|s| s.address() + s.size() <= BOOT_START)
+        .map(|s| (s.name().unwrap_or("?"), s.address(), s.size()))
+        .collect();
+    let code = functions
+        .iter()
+        .map(|&(n, at, size)| (n, &flash[at as usize..(at + size) as usize]));
+    for (function, q) in crate::stackargs::readers(code) {
+        problems.push(format!(
+            "{function} reads arguments from the stack (ldd Y+{q}), which LLVM's AVR back end \
+             reads a byte off on the ATmega2560: keep its arguments within 18 bytes, or \
+             #[inline(always)] (xtask/src/stackargs.rs)"
+        ));
     }
     if relocations == 0 {
         problems.push(format!(

@@ -10,6 +10,7 @@ mod firmware;
 mod flashmap;
 mod fuzz;
 mod run;
+mod stackargs;
 mod studio;
 
 use run::{cargo, root, Result};

@@ -22,12 +22,64 @@ pub struct AxisConfig {
     pub dir_high_is_positive: bool,
     /// Level of the ENABLE pin that switches the driver on.
     pub enable_active_high: bool,
+    /// What drives the motor: a STEP/DIR driver, or a ULN2003 board's
+    /// four coil inputs.
+    pub driver: Driver,
     /// Soft limits: the console refuses a target outside `travel` before
     /// any step. Off for an axis that turns freely (the base).
     pub soft_limits: bool,
     /// Travel allowed, thousandths of the unit, from the axis's zero.
     pub travel: (Milli, Milli),
 }
+
+/// What an axis's motor hangs on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Driver {
+    /// A STEP/DIR driver (TB6600, A4988, …) on the RAMPS socket's STEP,
+    /// DIR and ENABLE pins.
+    StepDir = 0,
+    /// A ULN2003 board driving a 28BYJ-48's coils in the half-step
+    /// sequence from its IN1..IN4 (`pinmap::COILS`).
+    Uln2003 = 1,
+}
+
+impl Driver {
+    pub const ALL: [Driver; 2] = [Driver::StepDir, Driver::Uln2003];
+
+    /// As `$x_driver` names it.
+    pub fn name(self) -> taut_progmem::Text {
+        taut_progmem::text_table!(Driver; [
+            StepDir => "stepdir",
+            Uln2003 => "uln2003",
+        ])
+        .get(self as usize)
+    }
+
+    /// The driver of discriminant `i`.
+    pub fn from_index(i: u32) -> Option<Driver> {
+        match i {
+            0 => Some(Driver::StepDir),
+            1 => Some(Driver::Uln2003),
+            _ => None,
+        }
+    }
+
+    /// The driver `text` names, in any case.
+    pub fn parse(text: &[u8]) -> Option<Driver> {
+        (0..2)
+            .filter_map(Driver::from_index)
+            .find(|d| d.name().eq_ignore_ascii_case(text))
+    }
+}
+
+/// A 28BYJ-48 at 5 V pulls out above ~1 000 half-steps/s: an axis
+/// switched to coil drive is slowed to this (its `max_rate` stays
+/// settable).
+pub const COIL_MAX_RATE: u32 = 1000;
+
+/// Grbl's `$1` of 255: the drivers stay on once motion has switched them on.
+pub const KEEP_DRIVERS_ON: u8 = 255;
 
 /// Pulse timing of the STEP/DIR/ENABLE interface, µs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,6 +120,9 @@ pub struct MachineConfig {
     pub report_inches: bool,
     /// The string-art machine's nails and winding needle.
     pub winding: WindingConfig,
+    /// Grbl's `$1`: how long the drivers stay on once motion stands, ms;
+    /// [`KEEP_DRIVERS_ON`] (255) keeps them on.
+    pub idle_delay_ms: u8,
 }
 
 /// What the needle must clear while winding (`stringart::clearance`): the
@@ -255,15 +310,30 @@ const fn seed(machine: Machine) -> MachineConfig {
             );
             cfg
         }
-        // 28BYJ-48: 2048 steps a turn; a GT2 belt pulls 40 mm a turn;
-        // the 90 mm drum carries π·90 mm of paper a turn.
-        Machine::Drum => plotter(
-            machine,
-            [
-                axis(StepsPerUnit::new(2048, 40), 600, 1500, Some((0, 200))),
-                axis(StepsPerUnit::new(2_048_000, 282_743), 600, 1500, None),
-            ],
-        ),
+        // 28BYJ-48s on ULN2003 boards, half-stepped: 4096 half-steps a
+        // turn (2048 full steps); a GT2 belt pulls 40 mm a turn; the 90 mm
+        // drum carries π·90 mm of paper a turn. At most the motor's
+        // pull-out rate; the coils released a quarter second after the
+        // drawing stops (they heat when held), kept through a pen lift.
+        Machine::Drum => {
+            let mut x = axis(
+                StepsPerUnit::new(4096, 40),
+                COIL_MAX_RATE,
+                1500,
+                Some((0, 200)),
+            );
+            let mut y = axis(
+                StepsPerUnit::new(4_096_000, 282_743),
+                COIL_MAX_RATE,
+                1500,
+                None,
+            );
+            x.driver = Driver::Uln2003;
+            y.driver = Driver::Uln2003;
+            let mut cfg = plotter(machine, [x, y]);
+            cfg.idle_delay_ms = 250;
+            cfg
+        }
         // EasyDriver at 1/8 step: 0.025 mm a step; X 140 mm, homed
         // against its switch at power-on.
         Machine::Flatbed => {
@@ -323,6 +393,7 @@ const fn axis(
         accel,
         dir_high_is_positive: true,
         enable_active_high: true,
+        driver: Driver::StepDir,
         soft_limits,
         travel: (Milli::from_units(min), Milli::from_units(max)),
     }
@@ -347,6 +418,7 @@ const fn plotter(machine: Machine, xy: [AxisConfig; 2]) -> MachineConfig {
         status_report: 3,
         report_inches: false,
         winding: WindingConfig::DEFAULT,
+        idle_delay_ms: KEEP_DRIVERS_ON,
     }
 }
 

@@ -107,6 +107,9 @@ pub trait MachineIo {
     fn pen(&mut self, deg: u8) -> bool;
     /// Every driver on or off.
     fn drivers(&mut self, on: bool);
+    /// `M18 S`: the drivers go off `ms` after motion stands (0: never),
+    /// instead of after `$1`, until `$1` changes or a reset.
+    fn idle_delay(&mut self, ms: u32);
     /// `M0`: hold until `~` (or the green button).
     fn pause(&mut self);
     /// `M114`: the executed position.
@@ -180,6 +183,8 @@ mod todo {
     pub const WAIT: u16 = 1 << 10;
     /// `M114`.
     pub const REPORT: u16 = 1 << 11;
+    /// `M18 S`, `M84 S`.
+    pub const IDLE_DELAY: u16 = 1 << 12;
 }
 
 /// An accepted line's actions.
@@ -190,6 +195,8 @@ struct Run {
     pen: u8,
     pen_z: u8,
     dwell_ms: u32,
+    /// `IDLE_DELAY`'s ms.
+    idle_delay_ms: u32,
     /// Where the moves go (machine coordinates), and from where the next
     /// one starts.
     legs: [Exact; 2],
@@ -207,6 +214,7 @@ impl Run {
             pen: 0,
             pen_z: 0,
             dwell_ms: 0,
+            idle_delay_ms: 0,
             legs: [[0; AXES]; 2],
             from: [0; AXES],
             feed: Feed::Rapid,
@@ -430,6 +438,14 @@ impl Interpreter {
         if !env.allowed.motion && moves(b) {
             return Err(ErrorKind::JobOwnsMotion);
         }
+        // Marlin's `M17 X`/`M18 X` name the drivers to switch, not a move
+        // (taut switches them all): refused, so the axis words move nothing.
+        if b.has(group::TAUT)
+            && matches!(b.taut, TautCode::EnableDrivers | TautCode::DisableDrivers)
+            && b.has_axes()
+        {
+            return Err(ErrorKind::AxisWordsExist);
+        }
         if b.has(group::TAUT) && b.taut == TautCode::Servo {
             if !plotter {
                 return Err(ErrorKind::UnsupportedCommand);
@@ -514,9 +530,11 @@ impl Interpreter {
             Milli::ZERO
         };
         // [4], [5] Spindle speed and tool (Grbl takes `T` from every line,
-        // 0 when it has none). `M300`'s `S` is its angle.
+        // 0 when it has none). `M300`'s `S` is its angle, `M18 S`'s the
+        // drivers' idle delay.
         let servo = b.has(group::TAUT) && b.taut == TautCode::Servo;
-        let speed = match b.has_word(word::S) && !servo {
+        let idle_delay = b.has(group::TAUT) && b.taut == TautCode::DisableDrivers;
+        let speed = match b.has_word(word::S) && !servo && !idle_delay {
             true => b.s,
             false => self.speed,
         };
@@ -870,6 +888,13 @@ impl Interpreter {
             if b.has(group::TAUT) {
                 run.todo |= match b.taut {
                     TautCode::EnableDrivers => todo::DRIVERS_ON,
+                    // Marlin's `M18 S`/`M84 S`: the drivers go off this many
+                    // seconds (thousandths: ms) after motion stands, 0
+                    // never; nothing is switched now.
+                    TautCode::DisableDrivers if b.has_word(word::S) => {
+                        run.idle_delay_ms = b.s.0.max(0) as u32;
+                        todo::IDLE_DELAY
+                    }
                     TautCode::DisableDrivers => todo::DRIVERS_OFF,
                     TautCode::ReportPosition => todo::REPORT,
                     TautCode::WaitIdle => todo::WAIT,

@@ -22,6 +22,8 @@ pub mod arc;
 pub mod axis;
 pub mod buttons;
 pub mod checkpoint;
+/// A 28BYJ-48's half-step coil sequence.
+pub mod coil;
 pub mod config;
 pub mod coords;
 pub mod fat;

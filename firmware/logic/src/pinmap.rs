@@ -16,6 +16,7 @@
 //! | status LED | "L" | D13 | PB7 |
 //! | SD card MISO / MOSI / SCK / CS | AUX-3 | D50 / D51 / D52 / D53 | PB3 / PB2 / PB1 / PB0 |
 //! | serial console (USART0) RX / TX | | D0 / D1 | PE0 / PE1 |
+//! | ULN2003 IN1..IN4 of channel X / Y / Z (coil drive) | (E0, E1 sockets) | D22–D25 / D26–D29 / D37–D34 | PA0–PA3 / PA4–PA7 / PC0–PC3 |
 //!
 //! Buttons switch to ground and use the internal pull-ups: pressed reads low.
 
@@ -123,6 +124,36 @@ pub const fn driver(axis: Axis) -> DriverPins {
     DRIVERS[axis as usize]
 }
 
+/// A ULN2003 board's IN1..IN4 per channel (a 28BYJ-48's coils, driven
+/// when `$x_driver=uln2003`): four bits of one port, IN1 the lowest, so
+/// that one port write changes a motor's four inputs together. On a bare
+/// Mega, away from the pen servo, the card, the buttons and UART1; on a
+/// RAMPS 1.4 they are the E0 and E1 sockets' signals (leave those empty).
+pub const COILS: PerAxis<[u8; 4]> = [[22, 23, 24, 25], [26, 27, 28, 29], [37, 36, 35, 34]];
+
+/// The port of a channel's coil inputs and the bit of IN1 (IN2..IN4
+/// follow it). Panics at compile time for a map whose four pins are not
+/// consecutive bits of one port.
+pub const fn coil_port(axis: usize) -> (Port, u8) {
+    let pins = COILS[axis];
+    let (port, first) = port_bit(pins[0]);
+    let mut i = 1;
+    while i < 4 {
+        let (p, bit) = port_bit(pins[i]);
+        assert!(p as u8 == port as u8 && bit == first + i as u8);
+        i += 1;
+    }
+    (port, first)
+}
+
+const _: () = {
+    let mut i = 0;
+    while i < COILS.len() {
+        let _ = coil_port(i);
+        i += 1;
+    }
+};
+
 /// The four buttons of the string-art machine (RAMPS end-stop inputs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
@@ -169,6 +200,9 @@ mod tests {
         assert_eq!(port_bit(46), (L, 3));
         assert_eq!(port_bit(SD_CS), (B, 0));
         assert_eq!(port_bit(Button::ZeroRadial.pin()), (J, 1));
+        assert_eq!(coil_port(0), (A, 0));
+        assert_eq!(coil_port(1), (A, 4));
+        assert_eq!(coil_port(2), (C, 0));
     }
 
     #[test]
@@ -196,6 +230,10 @@ mod tests {
         }
         used.extend([STATUS_LED, SD_MISO, SD_MOSI, SD_SCK, SD_CS]);
         used.extend(SERVOS);
+        used.extend(COILS.iter().flatten());
+        // UART1 (D19 RX1, D18 TX1) is the zero_drill button's D18 on the
+        // string-art machine: only the coils must stay off it.
+        assert!(COILS.iter().flatten().all(|p| ![18, 19].contains(p)));
         let mut ports: std::vec::Vec<_> = used.iter().map(|&p| port_bit(p)).collect();
         ports.sort_by_key(|&(p, b)| (p as u8, b));
         ports.dedup();

@@ -6,7 +6,7 @@
 //! every string costs SRAM on the AVR. Printing uses ufmt only.
 
 use crate::axis::{Axis, AXES};
-use crate::config::{MachineConfig, WindingConfig};
+use crate::config::{Driver, MachineConfig, WindingConfig, COIL_MAX_RATE};
 use crate::kinematics::AnyKinematics;
 use crate::machine::Machine;
 use crate::text::num::{parse_milli, parse_ratio, parse_u32, trim, NumError};
@@ -40,6 +40,8 @@ pub enum AxisField {
     /// The travel's ends, units from the zero (Grbl's `$130…`, both ends).
     TravelMin,
     TravelMax,
+    /// `stepdir` or `uln2003` (a 28BYJ-48's coils).
+    Driver,
 }
 
 /// The machine-wide figures.
@@ -83,6 +85,8 @@ pub enum GlobalField {
     /// which the needle's clearance from the nails is worked out from.
     NailDiameter,
     NeedleDiameter,
+    /// Grbl's `$1`: ms the drivers stay on once motion stands (255: on).
+    StepIdleDelay,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,9 +103,10 @@ pub enum Value {
     /// Thousandths of a unit, printed `-450.000`.
     Milli(Milli),
     Machine(Machine),
+    Driver(Driver),
 }
 
-const AXIS_FIELDS: [AxisField; 8] = [
+const AXIS_FIELDS: [AxisField; 9] = [
     AxisField::StepsPerUnit,
     AxisField::MaxRate,
     AxisField::Accel,
@@ -110,9 +115,10 @@ const AXIS_FIELDS: [AxisField; 8] = [
     AxisField::SoftLimits,
     AxisField::TravelMin,
     AxisField::TravelMax,
+    AxisField::Driver,
 ];
 
-const GLOBAL_FIELDS: [GlobalField; 24] = [
+const GLOBAL_FIELDS: [GlobalField; 25] = [
     GlobalField::Machine,
     GlobalField::StepPulseUs,
     GlobalField::DirSetupUs,
@@ -137,6 +143,7 @@ const GLOBAL_FIELDS: [GlobalField; 24] = [
     GlobalField::ReportInches,
     GlobalField::NailDiameter,
     GlobalField::NeedleDiameter,
+    GlobalField::StepIdleDelay,
 ];
 
 // The tables above in order of discriminant: `at` works them out.
@@ -183,13 +190,14 @@ impl GlobalField {
             21 => ReportInches,
             22 => NailDiameter,
             23 => NeedleDiameter,
+            24 => StepIdleDelay,
             _ => return None,
         })
     }
 }
 
 impl AxisField {
-    /// `AXIS_FIELDS[i % 8]`, worked out (see [`GlobalField::at`]).
+    /// `AXIS_FIELDS[i % 9]`, worked out (see [`GlobalField::at`]).
     fn at(i: usize) -> AxisField {
         use AxisField::*;
         match i % AXIS_FIELDS.len() {
@@ -201,7 +209,7 @@ impl AxisField {
             5 => SoftLimits,
             6 => TravelMin,
             7 => TravelMax,
-            _ => TravelMax,
+            _ => Driver,
         }
     }
 }
@@ -224,6 +232,7 @@ impl AxisField {
             SoftLimits => "soft_limits",
             TravelMin => "travel_min",
             TravelMax => "travel_max",
+            Driver => "driver",
         ])
         .get(self as usize)
     }
@@ -256,6 +265,7 @@ impl GlobalField {
             ReportInches => "report_inches",
             NailDiameter => "nail_diameter",
             NeedleDiameter => "needle_diameter",
+            StepIdleDelay => "step_idle_delay_ms",
         ])
         .get(self as usize)
     }
@@ -328,6 +338,7 @@ enum Kind {
     /// `num/den`: `num` at least `min`, `den` from 1 to `max`, else invalid.
     Ratio,
     Machine,
+    Driver,
 }
 
 /// A setting's kind and bounds, read from a flash table by
@@ -415,6 +426,7 @@ impl Setting {
                     AxisField::SoftLimits => axis.soft_limits as u32,
                     AxisField::TravelMin => return Value::Milli(axis.travel.0),
                     AxisField::TravelMax => return Value::Milli(axis.travel.1),
+                    AxisField::Driver => return Value::Driver(axis.driver),
                 }
             }
             Setting::Global(GlobalField::StepPulseUs) => p.step_pulse_us as u32,
@@ -447,6 +459,7 @@ impl Setting {
             Setting::Global(GlobalField::NeedleDiameter) => {
                 return Value::Milli(Milli(i32::from(cfg.winding.needle_um)))
             }
+            Setting::Global(GlobalField::StepIdleDelay) => cfg.idle_delay_ms as u32,
         })
     }
 
@@ -482,6 +495,7 @@ impl Setting {
             SWITCH,
             LENGTH,
             LENGTH,
+            spec(Driver, 0, 0),
             // Global fields.
             spec(Machine, 0, 0),
             number(1, 255),
@@ -507,6 +521,7 @@ impl Setting {
             SWITCH,
             spec(Milli, MIN_UM, MAX_UM),
             spec(Milli, MIN_UM, MAX_UM),
+            number(0, 255),
         ]);
         specs.get(match self {
             Setting::Axis(_, f) => f as usize,
@@ -534,6 +549,15 @@ impl Setting {
                     })
                 }
             },
+            Kind::Driver => match Driver::parse(text) {
+                Some(d) => Value::Driver(d),
+                None => {
+                    return Err(NumError {
+                        at: 0,
+                        kind: ErrorKind::Invalid(self.field_name()),
+                    })
+                }
+            },
             Kind::Milli | Kind::Length => Value::Milli(parse_milli(text)?),
             Kind::Ratio => Value::Ratio(parse_ratio(text)?),
             Kind::Number => Value::Number(parse_u32(text)?),
@@ -554,6 +578,11 @@ impl Setting {
         // configuration on the AVR's small stack.
         let old = self.get(cfg);
         self.force(cfg, value);
+        // Coils: no faster than a 28BYJ-48 pulls out (settable after).
+        if let (Setting::Axis(a, _), Value::Driver(Driver::Uln2003)) = (self, value) {
+            let rate = &mut cfg.axes[a.index()].max_rate;
+            *rate = (*rate).min(COIL_MAX_RATE);
+        }
         check_whole(cfg).inspect_err(|_| self.force(cfg, old))
     }
 
@@ -568,7 +597,9 @@ impl Setting {
                     false => Err(ErrorKind::Range { min, max }),
                 };
             }
-            (Kind::Length, Value::Milli(_)) | (Kind::Machine, Value::Machine(_)) => return Ok(()),
+            (Kind::Length, Value::Milli(_))
+            | (Kind::Machine, Value::Machine(_))
+            | (Kind::Driver, Value::Driver(_)) => return Ok(()),
             (Kind::Milli, Value::Milli(m)) => (min as i32..=max as i32).contains(&m.0),
             (Kind::Ratio, Value::Ratio(r)) => r.num >= min as u32 && r.den != 0 && r.den <= max,
             _ => return Err(ErrorKind::NotANumber),
@@ -600,6 +631,7 @@ impl Setting {
                         axis.enable_active_high = n == 1
                     }
                     (AxisField::SoftLimits, Value::Number(_)) => axis.soft_limits = n == 1,
+                    (AxisField::Driver, Value::Driver(d)) => axis.driver = d,
                     _ => {}
                 }
             }
@@ -621,7 +653,7 @@ impl Setting {
             (Setting::Global(GlobalField::NeedleDiameter), Value::Milli(m)) => {
                 cfg.winding.needle_um = m.0 as u16
             }
-            (_, Value::Ratio(_) | Value::Milli(_) | Value::Machine(_)) => {}
+            (_, Value::Ratio(_) | Value::Milli(_) | Value::Machine(_) | Value::Driver(_)) => {}
             // The ranges keep these within u8.
             (Setting::Global(GlobalField::StepPulseUs), _) => cfg.pulse.step_pulse_us = n as u8,
             (Setting::Global(GlobalField::DirSetupUs), _) => cfg.pulse.dir_setup_us = n as u8,
@@ -638,6 +670,7 @@ impl Setting {
             (Setting::Global(GlobalField::HomingLocate), _) => cfg.homing.locate = n as u16,
             (Setting::Global(GlobalField::StatusReport), _) => cfg.status_report = n as u8,
             (Setting::Global(GlobalField::ReportInches), _) => cfg.report_inches = n == 1,
+            (Setting::Global(GlobalField::StepIdleDelay), _) => cfg.idle_delay_ms = n as u8,
             (Setting::Global(_), Value::Number(_)) => {}
         }
     }
@@ -672,6 +705,7 @@ impl uDisplay for Value {
         match *self {
             Value::Number(n) => uwrite!(f, "{}", n),
             Value::Machine(m) => uwrite!(f, "{}", m.name()),
+            Value::Driver(d) => uwrite!(f, "{}", d.name()),
             Value::Ratio(r) if r.den == 1 => uwrite!(f, "{}", r.num),
             Value::Ratio(r) => uwrite!(f, "{}/{}", r.num, r.den),
             Value::Milli(m) => uwrite!(f, "{}", Decimal(m.0, 3)),
@@ -708,6 +742,7 @@ mod tests {
                 Value::Milli(_) => matches!(kind, Kind::Milli | Kind::Length),
                 Value::Ratio(_) => matches!(kind, Kind::Ratio),
                 Value::Machine(_) => matches!(kind, Kind::Machine),
+                Value::Driver(_) => matches!(kind, Kind::Driver),
             };
             assert!(same, "{s:?}: {kind:?}");
         }
@@ -729,27 +764,33 @@ mod tests {
         assert_eq!(lines[1], "base_steps_per_unit = 9600/360");
         assert_eq!(lines[2], "base_max_rate = 2000");
         assert_eq!(lines[6], "base_soft_limits = 0");
-        assert_eq!(lines[9], "radial_steps_per_unit = 32");
-        assert_eq!(lines[14], "radial_soft_limits = 1");
-        assert_eq!(lines[15], "radial_travel_min = -450.000");
-        assert_eq!(lines[16], "radial_travel_max = 30.000");
-        assert_eq!(lines[17], "drill_steps_per_unit = 1600/12");
-        assert_eq!(lines[20], "drill_dir_invert = 0");
-        assert_eq!(lines[21], "drill_enable_active_high = 1");
-        assert_eq!(lines[25], "step_pulse_us = 5");
-        assert_eq!(lines[28], "junction_deviation_um = 10");
-        assert_eq!(lines[29], "arc_tolerance_um = 10");
-        assert_eq!(lines[30], "length_1 = 0.000");
-        assert_eq!(lines[34], "crosstalk = 0");
+        assert_eq!(lines[9], "base_driver = stepdir");
+        assert_eq!(lines[10], "radial_steps_per_unit = 32");
+        assert_eq!(lines[15], "radial_soft_limits = 1");
+        assert_eq!(lines[16], "radial_travel_min = -450.000");
+        assert_eq!(lines[17], "radial_travel_max = 30.000");
+        assert_eq!(lines[19], "drill_steps_per_unit = 1600/12");
+        assert_eq!(lines[22], "drill_dir_invert = 0");
+        assert_eq!(lines[23], "drill_enable_active_high = 1");
+        assert_eq!(lines[28], "step_pulse_us = 5");
+        assert_eq!(lines[31], "junction_deviation_um = 10");
+        assert_eq!(lines[32], "arc_tolerance_um = 10");
+        assert_eq!(lines[33], "length_1 = 0.000");
+        assert_eq!(lines[37], "crosstalk = 0");
+        assert_eq!(lines[COUNT - 1], "step_idle_delay_ms = 255");
         // Another machine names its channels its own way.
         let scara = listing(&MachineConfig::defaults(Machine::Scara));
         assert_eq!(scara[0], "machine = scara");
         assert_eq!(scara[1], "shoulder_steps_per_unit = 9600/360");
-        assert_eq!(scara[9], "elbow_steps_per_unit = 9600/360");
-        assert_eq!(scara[30], "length_1 = 150.000");
-        assert_eq!(scara[32], "origin_x = 100.000");
-        assert_eq!(scara[33], "origin_y = -56.000");
-        assert_eq!(scara[34], "crosstalk = 3");
+        assert_eq!(scara[10], "elbow_steps_per_unit = 9600/360");
+        assert_eq!(scara[33], "length_1 = 150.000");
+        assert_eq!(scara[35], "origin_x = 100.000");
+        assert_eq!(scara[36], "origin_y = -56.000");
+        assert_eq!(scara[37], "crosstalk = 3");
+        let drum = listing(&MachineConfig::defaults(Machine::Drum));
+        assert_eq!(drum[9], "x_driver = uln2003");
+        assert_eq!(drum[18], "y_driver = uln2003");
+        assert_eq!(drum[27], "z_driver = stepdir");
         for (i, s) in all().enumerate() {
             assert_eq!(s.index(), i);
             assert_eq!(Setting::at(i), Some(s));
@@ -781,6 +822,14 @@ mod tests {
         set(&mut cfg, "enable_setup_us", "0").unwrap();
         set(&mut cfg, "junction_deviation_um", "20").unwrap();
         set(&mut cfg, "arc_tolerance_um", "2").unwrap();
+        set(&mut cfg, "step_idle_delay_ms", "25").unwrap();
+        set(&mut cfg, "drill_driver", " ULN2003 ").unwrap();
+        assert_eq!(cfg.idle_delay_ms, 25);
+        assert_eq!(cfg.axes[2].driver, Driver::Uln2003);
+        // Coils: no faster than a 28BYJ-48 pulls out; then as set.
+        assert_eq!(cfg.axes[2].max_rate, COIL_MAX_RATE);
+        set(&mut cfg, "drill_max_rate", "1200").unwrap();
+        assert_eq!(cfg.axes[2].max_rate, 1200);
         assert_eq!(cfg.axes[2].steps_per_unit, StepsPerUnit::new(1600, 12));
         assert_eq!(cfg.axes[1].steps_per_unit, StepsPerUnit::new(53, 2));
         assert!(!cfg.axes[1].dir_high_is_positive);
@@ -850,6 +899,10 @@ mod tests {
         assert_eq!(
             error(&mut cfg, "drill_steps_per_unit", "1600/x"),
             (5, "expected a number".into())
+        );
+        assert_eq!(
+            error(&mut cfg, "drill_driver", "a4988"),
+            (0, "invalid driver".into())
         );
         assert_eq!(cfg, MachineConfig::STRING_ART);
     }

@@ -29,7 +29,7 @@ impl Console {
     /// Home `axes` (bits), their drivers on; `reply`: answer the line
     /// that asked at the end.
     pub fn start_homing(&mut self, axes: u8, m: &mut Motion, reply: bool) {
-        m.drivers.set(axes, true);
+        m.drivers.wake(axes);
         self.homing = Some(HomingRun {
             homing: Homing::new(axes),
             moving: false,

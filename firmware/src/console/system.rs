@@ -15,7 +15,7 @@ use crate::{flash_str, tools};
 use taut_logic::axis::AXES;
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Error, ErrorKind, Read, Restore, SystemLine};
-use taut_logic::interp::coords;
+use taut_logic::interp::{axis_letters, coords};
 use taut_logic::settings;
 use taut_logic::settings::grbl::{Numbered, SetError};
 use taut_progmem::text;
@@ -205,6 +205,9 @@ impl Console {
             // record written, whole or not at all; `$RST=#` clears it).
             m.set_position([0; AXES]);
             self.interp.reset(&coords::stored(store.coords(), 0));
+            // Its words from the next line on (read before it is taken).
+            self.parser
+                .set_axis_letters(axis_letters(&cfg.machine.words()));
             self.resync_next_run(m);
         }
         self.settings_changed = true;

@@ -4,7 +4,12 @@
 //! after the compare match, whichever path follows). A plain event — inside a segment, every moving axis stepping at every
 //! event, no wait beyond the 16-bit timer, no DIR change — needs only: raise
 //! the STEP pins, advance the 24.8 time by the interval, move the compare
-//! register, hold the pulse, drop the pins. Compiled from Rust that costs
+//! register, hold the pulse, drop the pins. At a segment's last event it
+//! also takes the next segment when that one may take this path too, so a
+//! pulse set shorter than that work (~14 µs) lasts that long there; the
+//! hold is timed from the rise, so none is ever shorter than set. (Holding
+//! and dropping first there cost a 1-axis rate of 59 kHz: the interrupt
+//! outlasted the step period.) Compiled from Rust that costs
 //! ~400 cycles, most of it saving the 33 registers the general path needs;
 //! here it is ~170 and saves 13. The Rust handler (`super::on_compare`)
 //! decides per segment whether its events may take this path (`fast_ok`)
@@ -117,7 +122,6 @@ macro_rules! step_vector {
                 "3:",
                 "push r18", "push r19", "push r20", "push r21", "push r22",
                 "push r23", "push r25", "push r26", "push r27", "push r30", "push r31",
-                "lds r30, {e}+{raised}", "lds r31, {e}+{raised}+1",
                 // left -= 1; the segment's last event takes the next one
                 "lds r24, {e}+{left}", "lds r25, {e}+{left}+1",
                 "sbiw r24, 1",
@@ -195,7 +199,10 @@ macro_rules! step_vector {
                 "sts {e}+{late}+1, r25", "sts {e}+{late}, r24",
                 "4:",
                 "sts 0x99, r27", "sts 0x98, r26", // OCR3A, high byte first
-                // Hold the pulse: TCNT3 - raised >= pulse_ticks.
+                // Hold the pulse: TCNT3 - raised >= pulse_ticks. `raised` is
+                // read here, not kept from the entry: taking the next
+                // segment above uses Z (r31:r30) to address it.
+                "lds r30, {e}+{raised}", "lds r31, {e}+{raised}+1",
                 "lds r20, {e}+{pulse}", "lds r21, {e}+{pulse}+1",
                 "5:",
                 "lds r18, 0x94", "lds r19, 0x95",

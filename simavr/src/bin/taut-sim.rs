@@ -86,7 +86,8 @@ usage: taut-sim ELF [options]
                   power cut outlasts it: the run lasts until the cut
   --vcd PATH      write a VCD trace of every probed pin, named by the
                   machine's channels (base_, radial_, drill_; x_, y_;
-                  left_, right_; shoulder_, elbow_) and pen_pwm
+                  left_, right_; shoulder_, elbow_), the ULN2003 coil
+                  inputs (x_in1..x_in4, y_in*, z_in*) and pen_pwm
   --png PATH      draw from the step pulses alone: the string-art job (the
                   board from the card's param.txt; needs --sd), or a
                   plotter's drawing (pen down dark, travel faint blue)

@@ -4,12 +4,13 @@
 //! faint blue while it travels up.
 
 use super::{write_png, Canvas, SIZE};
+use crate::coils::CoilTrack;
 use crate::vcd::Signal;
 use serde::Serialize;
 use std::io;
 use std::path::Path;
 use taut_logic::axis::{Axis, AXES};
-use taut_logic::config::MachineConfig;
+use taut_logic::config::{Driver, MachineConfig};
 use taut_logic::kinematics::{AnyKinematics, Kinematics};
 
 /// What the picture shows, counted.
@@ -60,6 +61,21 @@ pub fn plot_points(
     // Every STEP rise of the two drawing motors, with its direction.
     let mut events: Vec<(u64, usize, i32)> = Vec::new();
     for (i, axis) in [Axis::Base, Axis::Radial].into_iter().enumerate() {
+        // A motor on a ULN2003 board: its half-steps from its coils.
+        if cfg.axes[axis.index()].driver == Driver::Uln2003 {
+            let coils = CoilTrack::from_signals(signals, i).map_err(io::Error::other)?;
+            let mut last = 0;
+            for &(t, pos) in &coils.steps {
+                let d = if cfg.axes[axis.index()].dir_high_is_positive {
+                    pos - last
+                } else {
+                    last - pos
+                };
+                events.push((t, i, d as i32));
+                last = pos;
+            }
+            continue;
+        }
         let channel = cfg.machine.channel(axis).to_string();
         let step = find(&format!("{channel}_step")).ok_or_else(|| missing(&channel))?;
         let dir = find(&format!("{channel}_dir")).ok_or_else(|| missing(&channel))?;

@@ -140,6 +140,41 @@ fn drivers_and_buttons_over_time() {
 }
 
 #[test]
+fn steps_to_a_driver_held_off_are_listed() {
+    let mut p = Pulses::new();
+    // Base steps with its driver on, then twice after it went off; the
+    // drill steps with its own never switched on.
+    p.enable(0, true)
+        .to(0, 2)
+        .enable(0, false)
+        .to(0, 4)
+        .to(2, 1);
+    let trace = Trace::from_signals(&p.signals, &CONFIG).unwrap();
+    let off = trace.steps_while_off();
+    // Rise and fall of each of the three late pulses.
+    assert_eq!(off.len(), 6, "{off:?}");
+    assert_eq!(off.iter().filter(|s| s.0 == Axis::Base).count(), 4);
+    assert_eq!(off.iter().filter(|s| s.0 == Axis::Drill).count(), 2);
+    assert!(off.windows(2).all(|w| w[0].1 <= w[1].1));
+    // Read active-low, the first two are the off ones.
+    let mut low = CONFIG;
+    low.axes[0].enable_active_high = false;
+    let trace = Trace::from_signals(&p.signals, &low).unwrap();
+    assert_eq!(
+        trace
+            .steps_while_off()
+            .iter()
+            .filter(|s| s.0 == Axis::Base)
+            .count(),
+        4
+    );
+    let mut on = Pulses::new();
+    on.enable(0, true).to(0, 3).to(0, -1);
+    let trace = Trace::from_signals(&on.signals, &CONFIG).unwrap();
+    assert!(trace.steps_while_off().is_empty());
+}
+
+#[test]
 fn a_missing_signal_is_named() {
     let mut p = Pulses::new();
     p.signals.retain(|s| s.name != "radial_dir");

@@ -84,6 +84,8 @@ impl MachineIo for Timed {
 
     fn drivers(&mut self, _on: bool) {}
 
+    fn idle_delay(&mut self, _ms: u32) {}
+
     fn pause(&mut self) {}
 
     fn report_position(&mut self) {}

@@ -54,6 +54,10 @@ impl Interpreter {
                     None
                 }),
                 todo::WAIT => self.after_motion(io),
+                todo::IDLE_DELAY => {
+                    io.idle_delay(self.run.idle_delay_ms);
+                    None
+                }
                 _ => {
                     io.report_position();
                     None

@@ -17,6 +17,7 @@ enum Did {
     Move(Steps, Feed),
     Pen(u8),
     Drivers(bool),
+    IdleDelay(u32),
     Pause,
     Report,
     End,
@@ -53,6 +54,9 @@ impl MachineIo for Recorder {
     }
     fn drivers(&mut self, on: bool) {
         self.did.push(Did::Drivers(on))
+    }
+    fn idle_delay(&mut self, ms: u32) {
+        self.did.push(Did::IdleDelay(ms))
     }
     fn pause(&mut self) {
         self.did.push(Did::Pause)
@@ -487,6 +491,54 @@ fn program_end_resets_what_grbl_resets() {
     assert_eq!(b.io.did, [Did::Pause]);
 }
 
+/// `M17` on, `M18`/`M84` off once the motion is done; Marlin's `M18 S`/
+/// `M84 S` only set the seconds until the drivers go off after motion
+/// stands (0: never), and that `S` is no spindle speed.
+#[test]
+fn drivers_on_off_and_their_idle_delay() {
+    let mut b = Bench::flatbed_at(70, 0);
+    b.ok("S100");
+    for (text, did) in [
+        ("M17", Did::Drivers(true)),
+        ("M18", Did::Drivers(false)),
+        ("M84", Did::Drivers(false)),
+        ("M18 S2.5", Did::IdleDelay(2500)),
+        ("M84 S0", Did::IdleDelay(0)),
+        ("M84 S7200", Did::IdleDelay(7_200_000)),
+    ] {
+        b.io.did.clear();
+        b.ok(text);
+        assert_eq!(b.io.did, [did], "{text}");
+    }
+    assert_eq!(b.gc(), "G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S100");
+    // Negative seconds are Grbl's error 4, one on/off per line its 21.
+    assert_eq!(b.err("M18 S-1"), 4);
+    assert_eq!(b.err("M17 M18"), 21);
+    // Marlin's `M18 X` (that driver only) is no move here: Grbl's 31.
+    b.io.did.clear();
+    assert_eq!(b.err("M18 X1"), 31);
+    assert_eq!(b.err("M17 Y2"), 31);
+    assert!(b.io.did.is_empty());
+    // `$C`: checked, nothing switched.
+    let mut p = Parser::new();
+    let block = match p.push_all_test(b"M18 S5\n") {
+        Some(Ok(Input::Block(block))) => block,
+        other => panic!("{other:?}"),
+    };
+    let env = Env {
+        kin: &b.kin,
+        cfg: &b.cfg,
+        allowed: Allowed {
+            motion: true,
+            checking: true,
+        },
+    };
+    b.io.did.clear();
+    b.interp.accept(&block, false, &env, &mut b.io).unwrap();
+    assert_eq!(b.interp.run(&env, &mut b.io), Progress::Done);
+    assert!(b.io.did.is_empty());
+}
+
 #[test]
 fn g_shows_grbl_s_modes_feed_in_mm_per_minute() {
     let mut b = Bench::flatbed_at(70, 0);
@@ -570,6 +622,8 @@ fn a_job_owns_the_motion() {
         ("G0 X1", true),
         ("G92 X0", true),
         ("M17", true),
+        ("M18", true),
+        ("M84 S5", true),
         ("G91", false),
         ("M114", false),
     ] {

@@ -31,9 +31,17 @@ fn names_round_trip_and_channels_are_named_by_the_machine() {
 fn the_seeds_figures() {
     let drum = MachineConfig::defaults(Machine::Drum);
     let k = AnyKinematics::of(&drum).unwrap();
-    // 40 mm of belt and a whole turn of the 90 mm drum are 2048 steps each.
-    assert_eq!(k.inverse(&at(40_000, 282_743)).unwrap()[..2], [2048, 2048]);
+    // 40 mm of belt and a whole turn of the 90 mm drum are a 28BYJ-48's
+    // turn each: 4096 half-steps on its coils, at most 1000 a second.
+    assert_eq!(k.inverse(&at(40_000, 282_743)).unwrap()[..2], [4096, 4096]);
     assert_eq!(drum.axes[0].travel.1, Milli(200_000));
+    for axis in &drum.axes[..2] {
+        assert_eq!(axis.driver, crate::config::Driver::Uln2003);
+        assert_eq!(axis.max_rate, crate::config::COIL_MAX_RATE);
+    }
+    assert_eq!(drum.axes[2].driver, crate::config::Driver::StepDir);
+    assert_eq!(drum.idle_delay_ms, 250);
+    assert_eq!(flatbed_idle(), crate::config::KEEP_DRIVERS_ON);
     let flatbed = MachineConfig::defaults(Machine::Flatbed);
     let k = AnyKinematics::of(&flatbed).unwrap();
     assert_eq!(k.inverse(&at(140_000, -1_000)).unwrap()[..2], [5600, -40]);
@@ -87,4 +95,8 @@ fn bad_geometry_is_refused_not_used() {
     let mut cfg = MachineConfig::defaults(Machine::Whiteboard);
     cfg.geometry.origin[1] = Milli(10_000); // above the motors
     assert!(AnyKinematics::of(&cfg).is_err());
+}
+
+fn flatbed_idle() -> u8 {
+    MachineConfig::defaults(Machine::Flatbed).idle_delay_ms
 }

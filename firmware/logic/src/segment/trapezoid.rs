@@ -371,7 +371,12 @@ impl Trapezoid {
 
     /// Time to cruise `q + r / (2a)` events (`r` below `2a`): the
     /// fraction's quotient fits 32 bits when the interval does (a `u64`
-    /// division is ~3 000 cycles on the AVR).
+    /// division is ~3 000 cycles on the AVR). Always inlined: called, its
+    /// arguments and result take 20 bytes, past the 18 of registers, and
+    /// LLVM's AVR back end reads stack arguments one byte off on the
+    /// ATmega2560, whose calls push a 3-byte return address (the cruise
+    /// then ran at 54 000 steps/s).
+    #[inline(always)]
     fn cruise_span(&self, q: u64, r: u64) -> u64 {
         let part = r * self.cruise_iv;
         let frac = match self.two_a as u32 {

@@ -88,14 +88,14 @@ const SMALL: usize = 22;
 
 /// Grbl's settings taut's named ones do not hold, and the rates as typed
 /// in Grbl's units. Kept in EEPROM with the named settings, the same for
-/// every machine.
+/// every machine. (`$1` is the named `step_idle_delay_ms`: the drivers
+/// task reads it, and each machine has its own.)
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Extras {
-    /// `$1` step idle delay (ms; 255: the drivers always on), `$2` step
-    /// invert mask, the `FLAG_` bits (`$5`, `$6`, `$21`, `$22` off,
-    /// `$32`), `$23` homing direction invert mask, `$26` homing debounce
-    /// (ms): by the `BYTE_` indices.
-    pub bytes: [u8; 5],
+    /// `$2` step invert mask, the `FLAG_` bits (`$5`, `$6`, `$21`, `$22`
+    /// off, `$32`), `$23` homing direction invert mask, `$26` homing
+    /// debounce (ms): by the `BYTE_` indices.
+    pub bytes: [u8; BYTES],
     /// `$30`, `$31`: rpm at the spindle output's top and bottom.
     pub spindle: [u32; 2],
     /// The rates as last typed in Grbl's units, thousandths of a unit per
@@ -106,11 +106,11 @@ pub struct Extras {
     pub typed: [u32; TYPED],
 }
 
-pub const BYTE_IDLE_DELAY: usize = 0;
-pub const BYTE_STEP_INVERT: usize = 1;
-pub const BYTE_FLAGS: usize = 2;
-pub const BYTE_HOMING_DIR: usize = 3;
-pub const BYTE_DEBOUNCE: usize = 4;
+pub const BYTE_STEP_INVERT: usize = 0;
+pub const BYTE_FLAGS: usize = 1;
+pub const BYTE_HOMING_DIR: usize = 2;
+pub const BYTE_DEBOUNCE: usize = 3;
+pub const BYTES: usize = 4;
 
 /// `typed[TYPED_MAX_RATE + channel]`, `typed[TYPED_ACCEL + channel]`.
 pub const TYPED_MAX_RATE: usize = 0;
@@ -131,13 +131,12 @@ pub const FLAG_HOMING_OFF: u8 = 8;
 pub const FLAG_LASER: u8 = 16;
 
 /// Bytes of [`Extras`] in EEPROM.
-pub const EXTRAS_BYTES: u16 = 5 + 2 * 4 + TYPED as u16 * 4;
+pub const EXTRAS_BYTES: u16 = BYTES as u16 + 2 * 4 + TYPED as u16 * 4;
 
 impl Extras {
-    /// Grbl's defaults (`defaults.h`), but `$1`: taut's drivers hold the
-    /// machine still between moves.
+    /// Grbl's defaults (`defaults.h`).
     pub const DEFAULT: Extras = Extras {
-        bytes: [255, 0, 0, 0, 250],
+        bytes: [0, 0, 0, 250],
         spindle: [1000, 0],
         typed: [0; TYPED],
     };
@@ -145,17 +144,11 @@ impl Extras {
     /// [`Extras::DEFAULT`] in place, a field at a time: a copy of the
     /// constant would sit in the AVR's SRAM.
     pub fn reset(&mut self) {
-        self.bytes = [0; 5];
-        self.bytes[BYTE_IDLE_DELAY] = 255;
+        self.bytes = [0; BYTES];
         self.bytes[BYTE_DEBOUNCE] = 250;
         self.spindle = [0; 2];
         self.spindle[0] = 1000;
         self.typed = [0; TYPED];
-    }
-
-    /// `$1`: ms the drivers stay on after motion; 255: always.
-    pub fn idle_delay_ms(&self) -> u8 {
-        self.bytes[BYTE_IDLE_DELAY]
     }
 
     pub fn flags(&self) -> u8 {
@@ -173,7 +166,7 @@ impl Extras {
         let k = k as usize;
         if k == 0 {
             let b = self.bytes;
-            return Some(([b[0], b[1], b[2], b[3], b[4], 0, 0, 0], 5));
+            return Some(([b[0], b[1], b[2], b[3], 0, 0, 0, 0], BYTES as u8));
         }
         let word = |i: usize| match i {
             0 | 1 => self.spindle.get(i).copied(),
@@ -190,7 +183,7 @@ impl Extras {
     /// none is refused by the machine.
     pub fn decode(byte: impl Fn(u16) -> u8) -> Extras {
         let word = |n: usize| {
-            let i = 5 + 4 * n as u16;
+            let i = (BYTES + 4 * n) as u16;
             u32::from_le_bytes([byte(i), byte(i + 1), byte(i + 2), byte(i + 3)])
         };
         Extras {
@@ -206,8 +199,6 @@ impl Default for Extras {
         Extras::DEFAULT
     }
 }
-
-const _: () = assert!(Extras::DEFAULT.bytes[BYTE_IDLE_DELAY] == 255);
 
 /// The channel in each of Grbl's X, Y, Z places: a plotter's X Y Z
 /// channels in order; on the string-art machine the radial carriage
@@ -365,7 +356,7 @@ impl Numbered {
         let global = |g| Setting::Global(g);
         let axis = |p: u8| places[p as usize];
         match self {
-            IdleDelay => Held::Byte(BYTE_IDLE_DELAY),
+            IdleDelay => Held::Named(global(GlobalField::StepIdleDelay)),
             StepInvert => Held::Byte(BYTE_STEP_INVERT),
             HomingDirInvert => Held::Byte(BYTE_HOMING_DIR),
             HomingDebounce => Held::Byte(BYTE_DEBOUNCE),

@@ -10,9 +10,9 @@
 
 use super::grbl::{Extras, EXTRAS_BYTES};
 use super::record::Part;
-use super::{all, Setting, Value, COUNT};
+use super::{all, AxisField, GlobalField, Setting, Value, COUNT};
 use crate::axis::AXES;
-use crate::config::MachineConfig;
+use crate::config::{Driver, MachineConfig};
 use crate::machine::Machine;
 use crate::units::{Milli, StepsPerUnit};
 
@@ -66,6 +66,7 @@ fn value_array(v: Value) -> ([u8; 8], usize) {
         Value::Number(n) => (widen(n.to_le_bytes()), 4),
         Value::Milli(m) => (widen(m.0.to_le_bytes()), 4),
         Value::Machine(m) => (widen((m as u32).to_le_bytes()), 4),
+        Value::Driver(d) => (widen((d as u32).to_le_bytes()), 4),
         Value::Ratio(r) => {
             let mut b = [0; 8];
             b[..4].copy_from_slice(&r.num.to_le_bytes());
@@ -93,17 +94,22 @@ pub fn decode_into(
     cfg: &mut MachineConfig,
     ex: &mut Extras,
 ) -> Result<(), Unusable> {
-    take_named(&byte, cfg)?;
+    take_named(&byte, cfg, false)?;
     *ex = Extras::decode(|i| byte(NAMED_BYTES as u16 + i));
     Ok(())
 }
 
 /// The named settings from bytes 0… of `byte` (a version-6 image's from
-/// its byte 5), each checked, then the set.
-pub fn take_named(byte: &impl Fn(u16) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
+/// its byte 5: `v6`, without the settings it had not), each checked, then
+/// the set.
+pub fn take_named(
+    byte: &impl Fn(u16) -> u8,
+    cfg: &mut MachineConfig,
+    v6: bool,
+) -> Result<(), Unusable> {
     for take in [false, true] {
         let mut at = 0;
-        for s in all() {
+        for s in all().filter(|&s| !v6 || legacy::had(s)) {
             let value = value(byte, s.get(cfg), at).ok_or(Unusable::Refused(s))?;
             at += width(s) as u16;
             s.check(value).map_err(|_| Unusable::Refused(s))?;
@@ -123,6 +129,7 @@ fn value(byte: &impl Fn(u16) -> u8, like: Value, at: u16) -> Option<Value> {
         Value::Number(_) => Value::Number(word(at)),
         Value::Milli(_) => Value::Milli(Milli(word(at) as i32)),
         Value::Machine(_) => Value::Machine(Machine::from_index(u8::try_from(word(at)).ok()?)?),
+        Value::Driver(_) => Value::Driver(Driver::from_index(word(at))?),
         Value::Ratio(_) => Value::Ratio(StepsPerUnit::new(word(at), word(at + 4))),
     })
 }
@@ -139,9 +146,20 @@ pub mod legacy {
     pub const VERSION: u8 = 6;
     const HEADER: usize = MAGIC.len() + 1;
 
-    /// Bytes of a version-6 image.
+    /// Bytes of a version-6 image: its settings had no driver per axis
+    /// and no step idle delay ([`had`]).
     pub const fn len() -> usize {
-        HEADER + NAMED_BYTES + 2
+        HEADER + NAMED_BYTES - 4 * (AXES + 1) + 2
+    }
+
+    /// Whether a version-6 image holds setting `s`. Those it does not
+    /// keep what the version-6 firmware did: STEP/DIR drivers, always on
+    /// (the string-art defaults the reader starts from).
+    pub fn had(s: Setting) -> bool {
+        !matches!(
+            s,
+            Setting::Axis(_, AxisField::Driver) | Setting::Global(GlobalField::StepIdleDelay)
+        )
     }
 
     /// The version byte at byte 4 when bytes 0…3 are `taut`.
@@ -156,7 +174,7 @@ pub mod legacy {
         let body = MAGIC
             .into_iter()
             .chain([VERSION])
-            .chain(all().flat_map(move |s| {
+            .chain(all().filter(|&s| had(s)).flat_map(move |s| {
                 let (b, n) = value_array(s.get(cfg));
                 b.into_iter().take(n)
             }));
@@ -200,7 +218,7 @@ pub mod legacy {
     /// entry), as [`super::decode_into`].
     pub fn decode_into(read: impl Fn(u16) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
         check(&read)?;
-        take_named(&|i| read(BODY + i), cfg)
+        take_named(&|i| read(BODY + i), cfg, true)
     }
 
     /// Fletcher-16: two running sums mod 255.

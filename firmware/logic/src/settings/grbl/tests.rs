@@ -81,6 +81,11 @@ fn dollar_dollar_lists_grbl_s_34_numbers_then_the_named_settings() {
     assert!(flatbed.contains(&"$100=40.000".into()));
     assert!(flatbed.contains(&"$110=3000.000".into()));
     assert!(flatbed.contains(&"$130=140.000".into()));
+    // The drum's 28BYJ-48s: 4096 half-steps per 40 mm, their coils
+    // released 250 ms after it stands.
+    let drum = listing(&MachineConfig::defaults(Machine::Drum), &Extras::DEFAULT);
+    assert_eq!(drum[1], "$1=250");
+    assert!(drum.contains(&"$100=102.400".into()));
 }
 
 #[test]
@@ -156,6 +161,12 @@ fn writes_in_grbl_s_units_land_in_the_named_settings() {
     assert_eq!(inverted, [false, true, true]);
     set(&mut cfg, &mut ex, "4", "0").unwrap();
     assert!(cfg.axes.iter().all(|a| !a.enable_active_high));
+    set(&mut cfg, &mut ex, "4", "1").unwrap();
+    assert!(cfg.axes.iter().all(|a| a.enable_active_high));
+    // The step idle delay is the named setting the drivers read (Grbl
+    // truncates a whole-number setting's decimals).
+    set(&mut cfg, &mut ex, "1", "25.9").unwrap();
+    assert_eq!(cfg.idle_delay_ms, 25);
     // The travel keeps its upper end.
     set(&mut cfg, &mut ex, "130", "400").unwrap();
     assert_eq!(cfg.axes[1].travel, (Milli(-370_000), Milli(30_000)));
@@ -180,7 +191,6 @@ fn writes_in_grbl_s_units_land_in_the_named_settings() {
     // Grbl's settings with no name here are kept as given (Grbl
     // truncates a whole-number setting's decimals).
     for (k, v) in [
-        ("1", "25.9"),
         ("2", "5"),
         ("5", "1"),
         ("6", "1"),
@@ -193,7 +203,6 @@ fn writes_in_grbl_s_units_land_in_the_named_settings() {
     ] {
         set(&mut cfg, &mut ex, k, v).unwrap();
     }
-    assert_eq!(ex.idle_delay_ms(), 25);
     assert_eq!(ex.bytes[BYTE_STEP_INVERT], 5);
     assert_eq!(
         ex.flags(),
@@ -308,7 +317,7 @@ fn extras_read_back_from_their_bytes() {
 #[test]
 fn reset_is_the_default() {
     let mut ex = Extras::DEFAULT;
-    ex.bytes = [1; 5];
+    ex.bytes = [1; BYTES];
     ex.spindle = [7, 7];
     ex.typed = [9; TYPED];
     ex.reset();

@@ -51,7 +51,7 @@ fn a_payload_with_a_refused_value_is_refused() {
     assert!(matches!(read(&p), Err(Unusable::Refused(_))));
     // Each value fine, the set not: a pulse too long for the rate.
     let mut p = payload(&BASE, &Extras::DEFAULT);
-    let pulse = 4 + 3 * (8 + 7 * 4);
+    let pulse = 4 + 3 * (8 + 8 * 4);
     p[pulse..pulse + 4].copy_from_slice(&255u32.to_le_bytes());
     assert_eq!(read(&p), Err(Unusable::Inconsistent));
 }
@@ -80,4 +80,16 @@ fn a_version_6_image_is_carried_over() {
         bad[i] ^= 0x10;
         assert_eq!(decode(&bad), Err(Unusable::Checksum), "byte {i}");
     }
+    // The version-6 firmware drove STEP/DIR drivers, always on: a drum
+    // carried over keeps that, not the coils and idle delay of today's
+    // drum defaults.
+    let drum = MachineConfig::defaults(Machine::Drum);
+    let mut was = drum;
+    for a in &mut was.axes {
+        a.driver = crate::config::Driver::StepDir;
+    }
+    was.idle_delay_ms = crate::config::KEEP_DRIVERS_ON;
+    let img: Vec<u8> = legacy::bytes(&drum).collect();
+    assert_eq!(img.len(), 215);
+    assert_eq!(decode(&img), Ok(was));
 }

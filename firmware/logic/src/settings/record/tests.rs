@@ -237,8 +237,11 @@ fn the_layout_marker_and_a_version_6_image() {
     let v6: Vec<u8> = image::legacy::bytes(&MachineConfig::defaults(Machine::Drum)).collect();
     e[..v6.len()].copy_from_slice(&v6);
     assert_eq!(read(&e), Layout::Legacy);
-    e[4] = 7;
+    e[4] = 8;
     assert_eq!(read(&e), Layout::Current);
+    // The layout before the driver and idle delay settings joined.
+    e[4] = 7;
+    assert_eq!(read(&e), Layout::Foreign);
     e[4] = 5;
     assert_eq!(read(&e), Layout::Foreign);
     // Grbl's own EEPROM: its version byte first.
