@@ -68,14 +68,7 @@ fn taut_bin() -> PathBuf {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let status = Command::new(cargo)
             .current_dir(&root)
-            .args([
-                "build",
-                "--quiet",
-                "-p",
-                "taut-studio",
-                "--bin",
-                "taut",
-            ])
+            .args(["build", "--quiet", "-p", "taut-studio", "--bin", "taut"])
             .status()
             .unwrap();
         assert!(status.success(), "building taut");
