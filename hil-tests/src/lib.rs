@@ -279,6 +279,14 @@ pub fn reported_steps(sim: &mut sim::Sim) -> [i64; 3] {
     out
 }
 
+/// Whether a console line is one of taut's log lines (`[MSG:I 1234
+/// module: …]`), not a reply; Grbl's own messages (`[MSG:Caution: …]`)
+/// are replies.
+pub fn is_log_line(l: &str) -> bool {
+    let b = l.as_bytes();
+    l.starts_with("[MSG:") && b.get(6) == Some(&b' ') && b.get(7).is_some_and(u8::is_ascii_digit)
+}
+
 /// The last 2000 characters of the serial log, for failure messages.
 pub fn log_tail(sim: &sim::Sim) -> String {
     let t = sim.uart_text();

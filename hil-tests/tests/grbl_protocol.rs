@@ -25,15 +25,8 @@ fn bytes_then(sim: &mut Sim, bytes: &[u8], ms: u64) -> String {
 /// The reply lines of a command, its `ok` included: no log lines, nor the
 /// end of one under way when the command was sent.
 fn replies(text: &str) -> Vec<&str> {
-    // Ours read `[MSG:I 1234 module: …]`; Grbl's own (`[MSG:Caution: …]`) stay.
-    let log = |l: &str| {
-        let b = l.as_bytes();
-        l.starts_with("[MSG:")
-            && b.get(6) == Some(&b' ')
-            && b.get(7).is_some_and(u8::is_ascii_digit)
-    };
     text.lines()
-        .filter(|l| (l.starts_with('[') && !log(l)) || *l == "ok")
+        .filter(|l| (l.starts_with('[') && !hil_tests::is_log_line(l)) || *l == "ok")
         .collect()
 }
 

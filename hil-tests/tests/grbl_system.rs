@@ -27,14 +27,8 @@ fn transcript(sim: &mut Sim, line: &str) -> Vec<String> {
 }
 
 fn lines(text: &str) -> Vec<String> {
-    let log = |l: &str| {
-        let b = l.as_bytes();
-        l.starts_with("[MSG:")
-            && b.get(6) == Some(&b' ')
-            && b.get(7).is_some_and(u8::is_ascii_digit)
-    };
     text.lines()
-        .filter(|l| !l.is_empty() && !log(l) && !l.starts_with('<'))
+        .filter(|l| !l.is_empty() && !hil_tests::is_log_line(l) && !l.starts_with('<'))
         .map(String::from)
         .collect()
 }

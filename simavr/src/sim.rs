@@ -106,21 +106,7 @@ impl Sim {
     /// Loads a firmware ELF built for the ATmega2560.
     pub fn load(elf_path: &Path) -> Result<Sim> {
         let info = elf::read(elf_path)?;
-        let c_path = CString::new(elf_path.to_string_lossy().as_bytes())
-            .map_err(|_| Error::Elf(format!("{}: NUL in path", elf_path.display())))?;
-        // SAFETY: elf_firmware_t is plain C data that simavr requires zeroed
-        // before reading; all-zero is valid for its integers and pointers.
-        let mut firmware: ffi::elf_firmware_t = unsafe { std::mem::zeroed() };
-        // SAFETY: valid NUL-terminated path and a zeroed firmware struct.
-        if unsafe { ffi::elf_read_firmware(c_path.as_ptr(), &mut firmware) } != 0 {
-            return Err(Error::Elf(format!(
-                "simavr could not read {}",
-                elf_path.display()
-            )));
-        }
-        let avr = new_mcu()?;
-        // SAFETY: `avr` is initialised; `firmware` was filled by simavr.
-        unsafe { ffi::avr_load_firmware(avr.as_ptr(), &mut firmware) };
+        let avr = flashed_mcu(elf_path)?;
         let ranges = elf::code_ranges(elf_path)?;
         let mut sim = Sim::attach(avr, Some(info), info.static_ram_end);
         sim.set_traps(ranges);
@@ -130,21 +116,7 @@ impl Sim {
     /// Loads a firmware ELF's flash bytes as they are, without the
     /// harness's traps (a board flashed with it: `boot`).
     pub(crate) fn load_plain(elf_path: &Path) -> Result<Sim> {
-        let c_path = CString::new(elf_path.to_string_lossy().as_bytes())
-            .map_err(|_| Error::Elf(format!("{}: NUL in path", elf_path.display())))?;
-        // SAFETY: as in `load`.
-        let mut firmware: ffi::elf_firmware_t = unsafe { std::mem::zeroed() };
-        // SAFETY: valid NUL-terminated path and a zeroed firmware struct.
-        if unsafe { ffi::elf_read_firmware(c_path.as_ptr(), &mut firmware) } != 0 {
-            return Err(Error::Elf(format!(
-                "simavr could not read {}",
-                elf_path.display()
-            )));
-        }
-        let avr = new_mcu()?;
-        // SAFETY: `avr` is initialised; `firmware` was filled by simavr.
-        unsafe { ffi::avr_load_firmware(avr.as_ptr(), &mut firmware) };
-        Ok(Sim::attach(avr, None, RAM_START))
+        Ok(Sim::attach(flashed_mcu(elf_path)?, None, RAM_START))
     }
 
     /// A part with its flash erased.
@@ -825,6 +797,26 @@ impl Drop for Sim {
 }
 
 /// A fresh, initialised ATmega2560 at 16 MHz.
+/// A new MCU with an ELF's image loaded by simavr.
+fn flashed_mcu(elf_path: &Path) -> Result<NonNull<ffi::avr_t>> {
+    let c_path = CString::new(elf_path.to_string_lossy().as_bytes())
+        .map_err(|_| Error::Elf(format!("{}: NUL in path", elf_path.display())))?;
+    // SAFETY: elf_firmware_t is plain C data that simavr requires zeroed
+    // before reading; all-zero is valid for its integers and pointers.
+    let mut firmware: ffi::elf_firmware_t = unsafe { std::mem::zeroed() };
+    // SAFETY: valid NUL-terminated path and a zeroed firmware struct.
+    if unsafe { ffi::elf_read_firmware(c_path.as_ptr(), &mut firmware) } != 0 {
+        return Err(Error::Elf(format!(
+            "simavr could not read {}",
+            elf_path.display()
+        )));
+    }
+    let avr = new_mcu()?;
+    // SAFETY: `avr` is initialised; `firmware` was filled by simavr.
+    unsafe { ffi::avr_load_firmware(avr.as_ptr(), &mut firmware) };
+    Ok(avr)
+}
+
 fn new_mcu() -> Result<NonNull<ffi::avr_t>> {
     static QUIET: std::sync::Once = std::sync::Once::new();
     // SAFETY: `hooks::log` has the logger signature simavr expects.
