@@ -741,9 +741,9 @@ impl Console {
             return Poll::After(1);
         }
         let before = *path;
-        match path.next().map(|p| kin.inverse(&p)) {
-            Some(Ok(steps)) => {
-                if m.stage(steps, *feed).is_err() {
+        match path.next_piece(kin) {
+            Some(Ok(piece)) => {
+                if m.stage_piece(&piece, *feed).is_err() {
                     *path = before;
                     return Poll::Wait(Signal::Motion);
                 }

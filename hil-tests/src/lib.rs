@@ -10,6 +10,7 @@ use std::sync::Once;
 pub use taut_simavr as sim;
 
 pub mod drawing;
+pub mod feed;
 pub mod senders;
 
 /// A tiny seeded generator (xorshift): the same draws on every run.

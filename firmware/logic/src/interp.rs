@@ -18,7 +18,7 @@
 use crate::arc::{self, Arc, ArcError, Circle, Sweep};
 use crate::config::MachineConfig;
 use crate::gcode::{AxisWord, Command, Distance, ErrorKind, Line, Plane, Units, MIN_FEED};
-use crate::kinematics::{Kinematics, Position, Segmenter, Steps};
+use crate::kinematics::{KinError, Kinematics, Piece, Position, Segmenter, Steps};
 use crate::planner::Feed;
 use crate::units::Milli;
 
@@ -67,10 +67,6 @@ pub enum Order {
     ReportPosition,
 }
 
-/// Longest piece of a straight move on a machine whose kinematics are
-/// not linear, µm: within it the path bends far less than a step.
-pub const SEGMENT_UM: u32 = 1000;
-
 /// A move cut into pieces: an arc's chords, or a straight move's pieces
 /// on a machine whose kinematics are not linear.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,6 +84,28 @@ impl Iterator for Path {
             Path::Arc(arc) => arc.next(),
             Path::Line(line) => line.next(),
         }
+    }
+}
+
+impl Path {
+    /// Where the next piece starts.
+    pub fn at(&self) -> Position {
+        match self {
+            Path::Arc(arc) => arc.at(),
+            Path::Line(line) => line.at(),
+        }
+    }
+
+    /// The next piece, its end converted with the kinematics.
+    pub fn next_piece(&mut self, kin: &impl Kinematics) -> Option<Result<Piece, KinError>> {
+        let from = self.at();
+        let to = self.next()?;
+        Some(kin.inverse_fine(&to).map(|(steps, frac)| Piece {
+            from,
+            to,
+            steps,
+            frac,
+        }))
     }
 }
 
@@ -400,7 +418,7 @@ impl Interpreter {
     /// Out of line: its pieces stay off the stack of the other moves.
     #[inline(never)]
     fn pieces(&self, feed: Feed, kin: &impl Kinematics, next: Modal) -> Result<Planned, ErrorKind> {
-        let line = Segmenter::new(kin, self.modal.target, &next.target, SEGMENT_UM);
+        let line = Segmenter::new(kin, self.modal.target, &next.target, kin.piece_um());
         // Called for the machines that are not linear only.
         match kin.reaches_line(&line.start(), &line.end()) {
             true => Ok(Planned {

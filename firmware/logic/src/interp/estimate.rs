@@ -11,7 +11,7 @@
 use super::{Allowed, Interpreter, Order};
 use crate::config::MachineConfig;
 use crate::gcode::{Input, Parser};
-use crate::kinematics::{AnyKinematics, Kinematics};
+use crate::kinematics::AnyKinematics;
 use crate::planner::{Feed, Planner};
 use crate::segment::SUBTICKS_PER_S;
 
@@ -86,11 +86,15 @@ impl GcodeTime {
     fn carry_out(&mut self, order: Order) {
         match order {
             Order::Move { steps, feed } => self.push_move(steps, feed),
-            Order::Path { path, feed } => {
-                for piece in path {
+            Order::Path { mut path, feed } => {
+                while let Some(piece) = path.next_piece(&self.kin) {
                     // Pieces were checked to be within reach with the line.
-                    if let Ok(steps) = self.kin.inverse(&piece) {
-                        self.push_move(steps, feed);
+                    if let Ok(piece) = piece {
+                        if self.planner.is_full() {
+                            self.take();
+                        }
+                        // Not full: cannot fail.
+                        let _ = self.planner.push_piece(&piece, feed);
                     }
                 }
             }

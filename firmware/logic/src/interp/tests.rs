@@ -307,10 +307,10 @@ fn straight_moves_of_an_arm_are_cut_into_pieces_that_it_reaches() {
         }) => line.collect(),
         other => panic!("{other:?}"),
     };
-    // 50 mm in pieces of at most 1 mm, on the line, the last one exact.
-    assert_eq!(ends.len(), 50);
-    assert_eq!(ends[24][..2], [Milli(115_000), Milli(130_000)]);
-    assert_eq!(ends[49][..2], [Milli(130_000), Milli(110_000)]);
+    // 50 mm in pieces of at most 2 mm, on the line, the last one exact.
+    assert_eq!(ends.len(), 25);
+    assert_eq!(ends[11][..2], [Milli(114_400), Milli(130_800)]);
+    assert_eq!(ends[24][..2], [Milli(130_000), Milli(110_000)]);
     // Out of the arms' reach (300 mm from the shoulder at 100, −56): refused
     // whole, nothing changes.
     assert_eq!(plan(&mut i, "G1 X100 Y250"), Err(ErrorKind::InvalidTarget));

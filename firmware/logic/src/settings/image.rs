@@ -16,7 +16,7 @@ use crate::units::{Milli, StepsPerUnit};
 
 pub const MAGIC: [u8; 4] = *b"taut";
 /// Bumped whenever the settings or their kinds change.
-pub const VERSION: u8 = 6;
+pub const VERSION: u8 = 7;
 const HEADER: usize = MAGIC.len() + 1;
 
 /// Why the image was not taken.
