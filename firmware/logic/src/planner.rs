@@ -506,7 +506,7 @@ impl Planner {
         let step = b.step.block();
         let (mut accel, mut rate) = self.geometry.limits(&step);
         if let (true, Some(pen)) = (b.step.is_pen(), &self.pen) {
-            (accel, rate) = pen.within(accel, rate, ev_per_milli);
+            pen.cap(&mut accel, &mut rate, ev_per_milli);
         }
         let k2 = ev_per_milli * ev_per_milli;
         let overrides = self.overrides.unwrap_or(Overrides::NONE);
@@ -609,10 +609,10 @@ impl Planner {
         self.overrides = Some(overrides);
         for i in 0..self.len {
             let b = &mut self.blocks[(self.head + i) % PLANNER_BLOCKS];
-            let (accel, mut rate) = self.geometry.limits(&b.step.block());
+            let (mut accel, mut rate) = self.geometry.limits(&b.step.block());
             let ev_per_milli = crate::fmath::sqrt(b.ev_per_milli_sqr);
             if let (true, Some(pen)) = (b.step.is_pen(), &self.pen) {
-                rate = pen.within(accel, rate, ev_per_milli).1;
+                pen.cap(&mut accel, &mut rate, ev_per_milli);
             }
             let nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
             b.nominal_sqr = down(nominal_sqr, self.shift);

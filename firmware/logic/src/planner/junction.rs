@@ -92,12 +92,14 @@ impl PenLimits {
     }
 
     /// A block's acceleration (events/s²) and top speed (events/s) that
-    /// the joints allow, within the pen's own too.
-    pub fn within(&self, accel: u32, rate: u32, ev_per_milli: f32) -> (u32, u32) {
+    /// the joints allow, brought within the pen's own too. In place: on
+    /// the AVR a pair of them returned came back as garbage.
+    pub fn cap(&self, accel: &mut u32, rate: &mut u32, ev_per_milli: f32) {
         // Saturating conversions.
         let pen_accel = (self.accel * ev_per_milli) as u32;
         let pen_rate = (self.max_speed * ev_per_milli) as u32;
-        (accel.min(pen_accel).max(1), rate.min(pen_rate).max(1))
+        *accel = (*accel).min(pen_accel).max(1);
+        *rate = (*rate).min(pen_rate).max(1);
     }
 }
 

@@ -228,3 +228,4 @@ proptest! {
         prop_assert!((s / ideal - 1.0).abs() < 0.01, "{s} s, ideal {ideal}");
     }
 }
+
