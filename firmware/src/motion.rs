@@ -135,6 +135,7 @@ impl Motion {
 
     /// [`Motion::stage`] of a piece of a path: on the whiteboard and the
     /// arm its speeds are the pen's along it.
+    #[inline(never)]
     pub fn stage_piece(&mut self, piece: &Piece, feed: Feed) -> Result<(), Full> {
         let from = self.target();
         PLANNER.with(|p| p.stage_piece(piece, feed))?;

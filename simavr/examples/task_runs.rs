@@ -8,12 +8,17 @@
 //! its work area instead (each cut into pieces, each piece converted and
 //! planned along the pen).
 //! Run from the workspace root after `cargo xtask build`:
-//! `cargo run --release -p taut-simavr --example task_runs [scara|whiteboard]`.
+//! `cargo run --release -p taut-simavr --example task_runs [scara|whiteboard]`
+//! (`TAUT_ELF=path` for another image).
 use std::path::Path;
 use std::time::Duration;
 use taut_simavr::Sim;
 fn main() {
-    let elf = Path::new("firmware/target/avr-none/release/taut.elf");
+    // Another image (an older build, to compare) from `TAUT_ELF`.
+    let elf = std::env::var_os("TAUT_ELF").map(std::path::PathBuf::from);
+    let elf = elf
+        .as_deref()
+        .unwrap_or(Path::new("firmware/target/avr-none/release/taut.elf"));
     let f = |p: &str| taut_simavr::elf::function_address(elf, p).unwrap();
     let names = [
         "4taut7console",
@@ -31,6 +36,8 @@ fn main() {
         "5ScaraNtB6_10Kinematics12inverse_fine",
         "10PolargraphNtB6_10Kinematics12inverse_fine",
         "Planner13plan_pen_path",
+        "Planner15plan_pen_joints",
+        "5ScaraNtB6_10Kinematics7inverse",
         "4taut8realtime",
         "realtime6status",
         // The motion task: a block's profile and segments cut in parts.

@@ -295,20 +295,6 @@ impl Arc {
             let [x, y] = *vector;
             *vector = [x * c - y * s, x * s + y * c];
         }
-        Some(self.point(k, vector))
-    }
-
-    /// Where the next chord starts: the last chord's end.
-    pub fn at(&self) -> Position {
-        match self.done {
-            0 => self.start,
-            k if k >= self.chords => self.end,
-            k => self.point(k, &self.vector),
-        }
-    }
-
-    /// The end of chord `k` (not the last) at radius vector `vector`.
-    fn point(&self, k: u32, vector: &[f32; 2]) -> Position {
         let p = &self.plane;
         let mut at: Position = self.start;
         at[p.axis_0] = Milli(round(self.centre[0] + vector[0]));
@@ -322,7 +308,7 @@ impl Arc {
                 *a = *e;
             }
         }
-        at
+        Some(at)
     }
 }
 

@@ -88,20 +88,17 @@ impl Iterator for Path {
 }
 
 impl Path {
-    /// Where the next piece starts.
-    pub fn at(&self) -> Position {
-        match self {
-            Path::Arc(arc) => arc.at(),
-            Path::Line(line) => line.at(),
-        }
-    }
-
-    /// The next piece, its end converted with the kinematics.
+    /// The next piece, its end converted with the kinematics. Out of
+    /// line: one copy for the console and the estimate.
+    #[inline(never)]
     pub fn next_piece(&mut self, kin: &impl Kinematics) -> Option<Result<Piece, KinError>> {
-        let from = self.at();
+        let start = match self {
+            Path::Arc(arc) => arc.start(),
+            Path::Line(line) => line.start(),
+        };
         let to = self.next()?;
         Some(kin.inverse_fine(&to).map(|(steps, frac)| Piece {
-            from,
+            start,
             to,
             steps,
             frac,

@@ -189,6 +189,14 @@ enum Stage {
     /// Direction, the axes' jumps and asked speed worked out; the
     /// junction's speed comes next.
     Turned { ev_per_milli: f32 },
+    /// A piece's direction along the pen and its turn worked out, and
+    /// the joints' shares of the pen's speed (`PenLast`); the joints'
+    /// limits at the junction come next, then as `Turned`.
+    PenTurned {
+        ev_per_milli: f32,
+        joint: [f32; AXES],
+        len: f32,
+    },
     /// Its junction too; the axes' limits come next.
     Path { ev_per_milli: f32 },
     /// Its figures are complete; the look-ahead passes come next.
@@ -313,13 +321,15 @@ impl Planner {
 
     /// Records a piece of a path, its speeds along the pen where the
     /// machine's kinematics are not linear (else as [`Planner::stage`]):
-    /// `feed` is then the pen's. A piece of no step is dropped, and the
-    /// next measures the pen's path from where this one's started.
+    /// `feed` is then the pen's. The pen's path is measured from the last
+    /// piece's end, or the path's start after the position was set; a
+    /// piece of no step is dropped, and the next measures from where this
+    /// one started.
     pub fn stage_piece(&mut self, piece: &Piece, feed: Feed) -> Result<(), Full> {
         if self.pen.is_none() {
             return self.stage(piece.steps, feed);
         }
-        let from = self.pen_at.unwrap_or(piece.from);
+        let from = self.pen_at.unwrap_or(piece.start);
         self.stage_steps(piece.steps, feed, PEN)?;
         if self.stage == Stage::Done {
             // No step: dropped.
@@ -394,6 +404,11 @@ impl Planner {
             Stage::Done => return false,
             Stage::Pushed(feed) => self.plan_path(feed),
             Stage::Turned { ev_per_milli } => self.plan_junction(ev_per_milli),
+            Stage::PenTurned {
+                ev_per_milli,
+                joint,
+                len,
+            } => self.plan_pen_joints(ev_per_milli, &PenLast { joint, len }),
             Stage::Path { ev_per_milli } => self.plan_limits(ev_per_milli),
             Stage::Limits => {
                 self.len += 1;
@@ -444,9 +459,8 @@ impl Planner {
     }
 
     /// [`Planner::plan_path`] of a piece: its direction and length along
-    /// the pen, the joints' share of the pen's speed, and at the junction
-    /// with the piece before it the joints' jumps, their acceleration
-    /// where the share changes, and the pen's turn.
+    /// the pen, the joints' shares of the pen's speed, and the pen's turn
+    /// at the junction with the piece before it.
     #[inline(never)]
     fn plan_pen_path(&mut self) {
         let slot = (self.head + self.len) % PLANNER_BLOCKS;
@@ -454,33 +468,42 @@ impl Planner {
             .geometry
             .pen_path(&self.blocks[slot].step.block(), &self.pen_staged);
         let b = &mut self.blocks[slot];
-        (b.junction_sqr, (b.entry_sqr, b.delta_sqr)) = match (self.last, self.pen_last, &self.pen)
-        {
-            (Some(prev), Some(before), Some(pen)) => {
-                let jumps = self.jumps.limit_sqr(&before.joint, &path.joint);
-                // The junction low enough that the speed a piece reaches
-                // between two junctions (at most (v₀² + v₁²)/2 + a·len)
-                // stays within the joints' curvature limit.
-                let mean = 0.5 * (before.len + path.len);
-                let curve = self
-                    .geometry
-                    .curve_sqr(&before.joint, &path.joint, mean)
-                    .saturating_sub(pen.accel_len_sqr(path.len));
-                (
-                    down(jumps.min(curve), self.shift),
-                    self.geometry.turn_pen(&prev, &path.unit, pen).pack(),
-                )
+        // The turn waits in `entry_sqr` and `delta_sqr`, as a move's.
+        (b.entry_sqr, b.delta_sqr) = match (self.last, self.pen_last, &self.pen) {
+            (Some(prev), Some(_), Some(pen)) => {
+                self.geometry.turn_pen(&prev, &path.unit, pen).pack()
             }
-            _ => (0, (0, 0)),
+            _ => (0, 0),
         };
         self.last = Some(path.unit);
-        self.pen_last = Some(PenLast {
+        self.stage = Stage::PenTurned {
+            ev_per_milli: path.ev_per_milli,
             joint: path.joint,
             len: path.len,
-        });
-        self.stage = Stage::Turned {
-            ev_per_milli: path.ev_per_milli,
         };
+    }
+
+    /// The joints' limits at a piece's junction with the piece before
+    /// it: their jumps, and their acceleration where their shares of the
+    /// pen's speed change (0: the first piece).
+    #[inline(never)]
+    fn plan_pen_joints(&mut self, ev_per_milli: f32, this: &PenLast) {
+        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        b.junction_sqr = match (self.pen_last, &self.pen) {
+            (Some(before), Some(pen)) => {
+                // The junction low enough that the speed a piece reaches
+                // between two junctions (at most (v₀² + v₁²)/2 + a·len)
+                // stays within the joints' limits.
+                let mean = 0.5 * (before.len + this.len);
+                let joints = self.geometry.joints_sqr(&self.jumps, &before.joint, &this.joint, mean);
+                // Shifted as the speeds² kept; saturating (∞: none, < 0: 0).
+                let shift = f32::from_bits((127 - self.shift as u32) << 23);
+                ((joints - pen.accel_len_sqr(this.len)) * shift) as u32
+            }
+            _ => 0,
+        };
+        self.pen_last = Some(*this);
+        self.stage = Stage::Turned { ev_per_milli };
     }
 
     /// The staged move's junction speed: Grbl's, within the axes' jumps.

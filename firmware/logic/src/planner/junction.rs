@@ -2,6 +2,7 @@
 //! direction in milli-units (or along the pen, for a piece), the axes'
 //! limits in events, and Grbl's junction-deviation speed at a corner.
 
+use super::axis_jump::AxisJumps;
 use crate::axis::AXES;
 use crate::config::MachineConfig;
 use crate::kinematics::Frac;
@@ -87,8 +88,8 @@ impl PenLimits {
 
     /// What the pen's acceleration adds to its speed² over `len` µm, half
     /// of it ((µm/s)²).
-    pub fn accel_len_sqr(&self, len: f32) -> u64 {
-        (self.accel * len) as u64
+    pub fn accel_len_sqr(&self, len: f32) -> f32 {
+        self.accel * len
     }
 
     /// A block's acceleration (events/s²) and top speed (events/s) that
@@ -265,21 +266,29 @@ impl Geometry {
     }
 
     /// The pen's speed², (µm/s)², at which the joints' shares of it
-    /// changing from `prev` to `next` (joint milli-units per µm) over
-    /// `len` µm of its path accelerate no joint past its own limit: a
-    /// joint's speed changes by v·Δshare over the time len / v.
-    pub fn curve_sqr(&self, prev: &[f32; AXES], next: &[f32; AXES], len: f32) -> u64 {
-        let mut worst = 0.0f32;
+    /// changing from `prev` to `next` (joint milli-units per µm) keep
+    /// every joint within its jump (`AxisJumps`: v·Δshare) and within its
+    /// acceleration over `len` µm of the pen's path (its speed changes
+    /// by v·Δshare over the time len / v). Infinite: no limit.
+    pub fn joints_sqr(&self, jumps: &AxisJumps, prev: &[f32; AXES], next: &[f32; AXES], len: f32) -> f32 {
+        let (mut jump, mut curve) = (0.0f32, 0.0f32);
         for i in 0..AXES {
-            let used = (next[i] - prev[i]).abs() * self.per_accel_milli[i];
-            if used > worst {
-                worst = used;
+            let change = (next[i] - prev[i]).abs();
+            let j = change * jumps.per_milli[i];
+            if j > jump {
+                jump = j;
+            }
+            let c = change * self.per_accel_milli[i];
+            if c > curve {
+                curve = c;
             }
         }
-        if worst == 0.0 {
-            return u64::MAX;
+        // The lower of 1 / jump² and len / curve, one division.
+        let jump_sqr = jump * jump;
+        match curve > len * jump_sqr {
+            true => len / curve,
+            false => 1.0 / jump_sqr,
         }
-        (len / worst) as u64
     }
 
     /// [`Geometry::turn`] of the pen, whose acceleration is the same in

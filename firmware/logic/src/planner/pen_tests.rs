@@ -153,7 +153,7 @@ fn linear_machines_plan_pieces_as_moves() {
         let (mut a, mut b) = (Planner::new(&cfg), Planner::new(&cfg));
         for (k, target) in [[400, 0, 0], [400, 300, 0], [-100, 20, 7]].iter().enumerate() {
             let piece = Piece {
-                from: at(k as f64, 0.0),
+                start: at(k as f64, 0.0),
                 to: at(k as f64 + 1.0, 3.0),
                 steps: *target,
                 frac: [5, -7, 0],
@@ -171,18 +171,25 @@ fn linear_machines_plan_pieces_as_moves() {
 }
 
 /// The curvature limit: a joint whose share of the pen's speed changes by
-/// Δ over `len` is accelerated by v²·Δ / len.
+/// Δ over `len` is accelerated by v²·Δ / len; a sudden change of Δ is
+/// the joint's jump, v·Δ.
 #[test]
 fn a_joints_share_changing_limits_the_speed_to_its_acceleration() {
     let cfg = MachineConfig::defaults(Machine::Scara);
     let g = junction::Geometry::new(&cfg);
+    let j = axis_jump::AxisJumps::new(&cfg);
     // 26.67 steps per degree: 0.0375 mdeg a step. The shoulder's share
     // changes by 0.01 mdeg/µm over 2000 µm; its 2000 steps/s² are
     // 75 000 mdeg/s²: v² = 75 000 · 2000 / 0.01 (µm/s)².
-    let v2 = g.curve_sqr(&[0.2, 0.1, 0.0], &[0.21, 0.1, 0.0], 2000.0);
+    let v2 = g.joints_sqr(&j, &[0.2, 0.1, 0.0], &[0.21, 0.1, 0.0], 2000.0);
     let want = 75_000.0 * 2000.0 / 0.01;
     assert!((v2 as f64 / want - 1.0).abs() < 1e-4, "{v2} vs {want}");
-    assert_eq!(g.curve_sqr(&[0.2, 0.1, 0.0], &[0.2, 0.1, 0.0], 2000.0), u64::MAX);
+    // Spread over 100 mm, the jump binds: √(2·2000·8) = 179 steps/s,
+    // 6708 mdeg/s, at v·0.01 mdeg/µm.
+    let v2 = g.joints_sqr(&j, &[0.2, 0.1, 0.0], &[0.21, 0.1, 0.0], 100_000.0);
+    let want = (6708.2 / 0.01f64).powi(2);
+    assert!((v2 as f64 / want - 1.0).abs() < 1e-3, "{v2} vs {want}");
+    assert_eq!(g.joints_sqr(&j, &[0.2, 0.1, 0.0], &[0.2, 0.1, 0.0], 2000.0), f32::INFINITY);
 }
 
 fn reachable() -> impl Strategy<Value = (f64, f64)> {
