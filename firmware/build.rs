@@ -55,6 +55,12 @@ fn main() {
         .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
         .unwrap_or_else(|| "unknown".into());
     println!("cargo:rustc-env=TAUT_GIT_HASH={hash}");
+    // The image's end mark (src/board/early.rs): a hash of every source
+    // the image is built from, so a different build has a different mark.
+    println!("cargo:rustc-env=TAUT_BUILD_MARK={}", source_hash());
+    for dir in ["src", "logic/src", "progmem/src", "examples", "Cargo.lock"] {
+        println!("cargo:rerun-if-changed={dir}");
+    }
     println!("cargo:rerun-if-changed=../.git/HEAD");
     println!("cargo:rerun-if-changed=../.git/index");
 
@@ -113,4 +119,34 @@ fn extract(archive: &Path, members: &[&str], into: &Path) {
         .status()
         .expect("avr-ar (Debian binutils-avr) is needed to link the firmware");
     assert!(st.success(), "avr-ar x {} {members:?}", archive.display());
+}
+
+/// FNV-1a (32 bits) over the sources' paths and bytes, in path order.
+fn source_hash() -> u32 {
+    fn walk(dir: &Path, files: &mut Vec<PathBuf>) {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            files.push(dir.to_path_buf());
+            return;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            match p.is_dir() {
+                true => walk(&p, files),
+                false => files.push(p),
+            }
+        }
+    }
+    let mut files = Vec::new();
+    for dir in ["src", "logic/src", "progmem/src", "examples", "Cargo.lock"] {
+        walk(Path::new(dir), &mut files);
+    }
+    files.sort();
+    let mut h: u32 = 0x811c_9dc5;
+    for f in files {
+        let bytes = std::fs::read(&f).unwrap_or_default();
+        for b in f.to_string_lossy().bytes().chain(bytes) {
+            h = (h ^ u32::from(b)).wrapping_mul(0x0100_0193);
+        }
+    }
+    h
 }

@@ -3,7 +3,11 @@
 # says what it installs. Idempotent: a second run installs nothing.
 #   Debian packages: gcc-avr avr-libc (AVR linker and libc), libelf-dev
 #   libclang-dev zlib1g-dev libzstd-dev pkg-config make (simavr-ffi builds
-#   simavr and its bindings); the firmware's pinned nightly (the channel in
+#   simavr and its bindings), avrdude (flashing a Mega, and the flashing
+#   tests), arduino-core-avr (the Mega's stock bootloader, which the
+#   simulator powers on with), libudev-dev (ravedude's serial ports);
+#   ravedude from crates.io (`cargo run` in firmware/ flashes through it);
+#   the firmware's pinned nightly (the channel in
 #   firmware/rust-toolchain.toml, e.g. nightly-2026-05-20) with rust-src
 #   (core is rebuilt for avr-none). The project's machines are not meant to
 #   download toolchains, so an installed toolchain that is exactly the pinned
@@ -13,7 +17,8 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 
-APT_PACKAGES=(gcc-avr avr-libc libelf-dev libclang-dev zlib1g-dev libzstd-dev pkg-config make)
+APT_PACKAGES=(gcc-avr avr-libc libelf-dev libclang-dev zlib1g-dev libzstd-dev pkg-config make
+    avrdude arduino-core-avr libudev-dev)
 
 missing=()
 for p in "${APT_PACKAGES[@]}"; do
@@ -82,7 +87,7 @@ if [ ! -d "$PIN_DIR" ]; then
     if ! rustup toolchain install "$PIN" --profile minimal --component rust-src; then
         echo "setup: cannot install $PIN, and no installed toolchain is its commit ${PIN_HASH:-(none named)}." >&2
         echo "setup: installed: $(rustup toolchain list | tr '\n' ' ')" >&2
-        echo "setup: install it where a download works, or move the pin to an installed nightly (README, \"Toolchains\")." >&2
+        echo "setup: install it where a download works, or move the pin to an installed nightly (docs/toolchain.md)." >&2
         exit 1
     fi
     if [ -n "$PIN_HASH" ] && [ "$(commit_of "$PIN_DIR")" != "$PIN_HASH" ]; then
@@ -93,4 +98,10 @@ fi
 if [ ! -d "$("$PIN_DIR/bin/rustc" --print sysroot)/lib/rustlib/src/rust/library/core" ]; then
     echo "setup: installing rust-src for $PIN (core is rebuilt for avr-none)"
     rustup component add rust-src --toolchain "$PIN"
+fi
+
+# ravedude (the firmware's cargo runner), with the host's stable toolchain.
+if ! command -v ravedude >/dev/null && [ ! -x "${CARGO_HOME:-$HOME/.cargo}/bin/ravedude" ]; then
+    echo "setup: installing ravedude from crates.io (cargo install --locked ravedude)"
+    cargo install --locked --quiet ravedude
 fi

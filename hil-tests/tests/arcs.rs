@@ -1,4 +1,4 @@
-//! Issue 11: `G2`/`G3` arcs, checked from the pulses alone. On the
+//! `G2`/`G3` arcs, checked from the pulses alone. On the
 //! string-art machine the plane with two linear axes is `G18`: the drill
 //! (Z) and the radial carriage (X).
 

@@ -1,4 +1,4 @@
-//! Issue 2: the release firmware boots in simavr, prints its banner within
+//! The release firmware boots in simavr, prints its banner within
 //! 50 ms of machine time, and blinks its status LED exactly as designed.
 
 use hil_tests::{firmware_elf, firmware_version, sim::Outcome, sim::Sim};

@@ -1,4 +1,4 @@
-//! Issue 6: the buttons on the release image — a zeroing button's two
+//! The buttons on the release image — a zeroing button's two
 //! presses take the current position as that axis's zero (driver off in
 //! between); a long press of green pauses drilling after the current hole
 //! and a short one resumes. (The serial `!`, `~` and Ctrl-X: `realtime.rs`.)

@@ -1,4 +1,4 @@
-//! Issue 5: the release firmware reads its job from a virtual SD card: a
+//! The release firmware reads its job from a virtual SD card: a
 //! good card is read and checked, a late card is found, every bad file ends
 //! in its one message with nothing moved, and a card pulled while being
 //! read is reported and read again when it is back.

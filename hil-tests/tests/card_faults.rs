@@ -1,4 +1,4 @@
-//! Issue 10: the card as users treat it — a block that never reads, a
+//! The card as users treat it — a block that never reads, a
 //! card pulled during a jog, swapped for another pattern mid-winding, not
 //! FAT at all — and patterns of the sizes real jobs have, up to the
 //! documented limit and past it.
@@ -17,7 +17,7 @@ use taut_logic::pinmap::Button;
 
 const PARAM: &[u8] = b"tvar = 6\npocet_hrebiku = 24\npolomer_matrice = 20.0\n";
 
-/// How many wraps the big-pattern test follows from the VCD: the issue's
+/// How many wraps the big-pattern test follows from the VCD: all
 /// 100 under `cargo xtask soak` (`TAUT_SOAK=1`), 20 in the everyday run.
 fn wraps_to_check() -> usize {
     if std::env::var_os("TAUT_SOAK").is_some() {

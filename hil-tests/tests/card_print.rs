@@ -1,4 +1,4 @@
-//! Issue 11: a plotter prints G-code from the SD card without a PC, as
+//! A plotter prints G-code from the SD card without a PC, as
 //! Marlin does (`M20`, `M23`, `M24`, `M25`, `M27`, `M524`, the green
 //! button), through the same interpreter as the serial line; the drawing
 //! is rebuilt from the pulses alone. Files are named as PCs save them

@@ -1,4 +1,4 @@
-//! Issue 12: the real CNCjs (npm, pinned, installed under `target/`)
+//! The real CNCjs (npm, pinned, installed under `target/`)
 //! drives the simulated Mega through a pseudo-terminal, as it would drive
 //! `/dev/ttyACM0`. Its server opens the terminal as a Grbl controller,
 //! loads a job from its watch directory and streams it; a feed hold from

@@ -1,4 +1,4 @@
-//! Issue 12: Grbl 1.1 on the wire, in the formats its interface document
+//! Grbl 1.1 on the wire, in the formats its interface document
 //! gives (the lines quoted there are checked byte for byte): the banner at
 //! power-on and after Ctrl-X, `$I`, `$G`, `$#` and the status report's
 //! buffer state, which senders size their streams by.

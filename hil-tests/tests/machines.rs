@@ -1,4 +1,4 @@
-//! Issue 11: one image, five machines. Each plotter and the arm is chosen
+//! One image, five machines. Each plotter and the arm is chosen
 //! with `$machine=`, draws over the serial port, and its drawing is rebuilt
 //! from the step, direction and pen pulses alone through its own forward
 //! kinematics, point by point against the toolpath the G-code defines:

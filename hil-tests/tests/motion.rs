@@ -1,4 +1,4 @@
-//! Issue 4: moves sent over the serial console produce exactly the expected
+//! Moves sent over the serial console produce exactly the expected
 //! pulses, with the configured pulse width and DIR set-up, and a velocity
 //! profile within the configured acceleration.
 

@@ -1,4 +1,4 @@
-//! Issue 11: what plotter users send, at random. From a list of seeds,
+//! What plotter users send, at random. From a list of seeds,
 //! streams of tiny moves, longer ones and arcs of random radius and sweep
 //! at random feeds, on the two machines whose kinematics are not linear
 //! (the whiteboard's strings, the SCARA arm: every straight move is cut

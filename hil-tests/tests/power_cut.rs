@@ -1,4 +1,4 @@
-//! Power cuts during a string-art job (issue #15), on the release image.
+//! Power cuts during a string-art job, on the release image.
 //!
 //! One job (12 nails, 30 wraps) is cut again and again at seeded moments —
 //! some in the middle of a checkpoint's EEPROM write — each time keeping

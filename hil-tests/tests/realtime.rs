@@ -1,4 +1,4 @@
-//! Issue 10: stopping works at any moment — `!` brakes on the path and
+//! Stopping works at any moment — `!` brakes on the path and
 //! `~` finishes at the exact target, Ctrl-X stops at once and locks motion
 //! until the position is set, `?` is answered within 10 ms whatever the
 //! console is doing — and nothing moves that was not asked for: soft

@@ -1,4 +1,4 @@
-//! Issue 3: the scheduler under load, the watchdog, and the RAM budget.
+//! The scheduler under load, the watchdog, and the RAM budget.
 
 use hil_tests::{
     assert_ram_budget, assert_step_interrupt_never_masked_long, example_elf, firmware_elf,

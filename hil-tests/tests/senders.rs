@@ -1,4 +1,4 @@
-//! Issue 12: a real sender drives the simulated Mega through a
+//! A real sender drives the simulated Mega through a
 //! pseudo-terminal, as it would drive `/dev/ttyACM0`: grbl-streamer (PyPI,
 //! pinned, installed into a venv under `target/`) connects, streams a
 //! 2 000-line file in character-counting mode while polling `?`, and ends

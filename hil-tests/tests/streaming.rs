@@ -1,4 +1,4 @@
-//! Issue 10: what senders stream never resets the board, loses a line or
+//! What senders stream never resets the board, loses a line or
 //! loses a step. Each test streams moves the documented way (each line
 //! after the previous `ok`) at the configured maximum rate and checks: no
 //! watchdog reset, every line answered `ok`, and the final `M114` equal to
@@ -295,7 +295,7 @@ fn stream_counting(sim: &mut Sim, lines: &[String]) -> Counted {
     out
 }
 
-/// Issue 12: the receive buffer kept full by character counting for a
+/// The receive buffer kept full by character counting for a
 /// whole file of short moves, with `?` every 100 ms and a feed hold and
 /// cycle start in the middle: every line answered `ok` once, no byte
 /// refused by the receive ring, the hold stands, the end exact.

@@ -1,4 +1,4 @@
-//! Issue 14 end to end: what the host tools (`taut-studio`) make, run by
+//! End to end: what the host tools (`taut-studio`) make, run by
 //! the release firmware in simavr and judged from the pulses alone.
 //!
 //! - `taut stringart` → its card → the string-art job (drilling, winding,

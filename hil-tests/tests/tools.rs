@@ -1,4 +1,4 @@
-//! The operator's tools (issue #15) on the release image, checked from the
+//! The operator's tools on the release image, checked from the
 //! step pulses: `$wrap_test` wraps the one nail asked for and comes back,
 //! `$drift` goes to a nail's angle and says where the base is, `$wrap_step=1`
 //! winds exactly one wrap while paused, `$wrap_step=-1` has the last wrap

@@ -1,4 +1,4 @@
-//! What a ready console waits for (issue #13's `dispatch_latency_cycles`):
+//! What a ready console waits for (the bench's `dispatch_latency_cycles`):
 //! the bench's load — the sample card in the slot, 0.1 mm moves at the
 //! maximum feed, each line after the previous `ok`, a byte every 5 ms —
 //! then the three longest waits (receive interrupt → `Console` task) with

@@ -4,8 +4,8 @@
 //! for SECONDS (default 60) of machine time, the deepest stack kept from
 //! second FROM on (default 0: a later phase's own peak, past the card's
 //! checks); with a G-code file, its lines are
-//! sent one by one, each after the last one's `ok`. For RAM work (issue
-//! #13's budget), after `cargo xtask build`:
+//! sent one by one, each after the last one's `ok`. For RAM work (static
+//! RAM + deepest stack within 5.5 KiB), after `cargo xtask build`:
 //! `cargo run --release -p taut-simavr --example stack_trace -- \
 //!    firmware/target/avr-none/release/taut.elf --card examples/card 120`.
 //! How the chain is read: `taut_simavr::stack_chain`. A whole HIL run's

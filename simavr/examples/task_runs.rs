@@ -1,5 +1,5 @@
 //! Where the console's longest runs go (the wait a `?` or a line may have,
-//! issue #13's dispatch latency): the string-art machine streams 300
+//! the bench's dispatch latency): the string-art machine streams 300
 //! random 3-axis moves, a `?` every tenth, no card in the slot; prints the
 //! three longest console runs with the calls inside them, then each
 //! watched function's run count, longest and 99th percentile (cycles),

@@ -44,7 +44,10 @@ pub fn read(path: &Path) -> Result<ElfInfo, Error> {
     let bad = |e: object::Error| Error::Elf(format!("{}: {e}", path.display()));
     let file = object::File::parse(&*bytes).map_err(bad)?;
     let size = |name: &str| file.section_by_name(name).map_or(0, |s| s.size() as u32);
-    let (text_bytes, data_bytes) = (size(".text"), size(".data"));
+    // `.endmark`: the build's mark after `.data`'s values
+    // (firmware/avr-link.sh).
+    let text_bytes = size(".text") + size(".endmark");
+    let data_bytes = size(".data");
     let bss_bytes = size(".bss") + size(".noinit");
     // The linker script marks the end of statics; prefer the most inclusive name.
     let symbol_end = ["__heap_start", "_end", "__bss_end"]
@@ -78,6 +81,18 @@ pub fn function_address(path: &Path, part: &str) -> Result<Option<u32>, Error> {
         .map(|s| s.address() as u32))
 }
 
+/// The address of the symbol named `name` exactly.
+pub fn symbol_address(path: &Path, name: &str) -> Result<Option<u32>, Error> {
+    use object::ObjectSymbol;
+    let bytes = std::fs::read(path).map_err(|e| Error::Io(path.to_owned(), e))?;
+    let file =
+        object::File::parse(&*bytes).map_err(|e| Error::Elf(format!("{}: {e}", path.display())))?;
+    Ok(file
+        .symbols()
+        .find(|s| s.name() == Ok(name))
+        .map(|s| s.address() as u32))
+}
+
 /// The byte ranges of flash holding code (end exclusive): each code
 /// symbol's, to the next symbol when it has no size (the C runtime's
 /// labels). Constants in flash are data symbols and never inside one.
@@ -85,37 +100,37 @@ pub(crate) fn code_ranges(path: &Path) -> Result<Vec<(u32, u32)>, Error> {
     let bytes = std::fs::read(path).map_err(|e| Error::Io(path.to_owned(), e))?;
     let file =
         object::File::parse(&*bytes).map_err(|e| Error::Elf(format!("{}: {e}", path.display())))?;
-    let Some(text) = file.section_by_name(".text") else {
-        return Ok(Vec::new());
-    };
-    let text_end = (text.address() + text.size()) as u32;
-    let mut symbols: Vec<(u32, u32, bool)> = file
-        .symbols()
-        .filter(|s| s.section_index() == Some(text.index()))
-        .map(|s| {
-            // Functions, and the untyped labels of the C runtime's and
-            // libgcc's assembly (`__prologue_saves__`, `_exit`…); objects
-            // (constants in flash) only end the range before them.
-            let code = s.kind() != object::SymbolKind::Data;
-            (s.address() as u32, s.size() as u32, code)
-        })
-        .collect();
-    symbols.sort_unstable();
     let mut ranges = Vec::new();
-    for (i, &(at, size, code)) in symbols.iter().enumerate() {
-        if !code {
-            continue;
+    if let Some(text) = file.section_by_name(".text") {
+        let text_end = (text.address() + text.size()) as u32;
+        let mut symbols: Vec<(u32, u32, bool)> = file
+            .symbols()
+            .filter(|s| s.section_index() == Some(text.index()))
+            .map(|s| {
+                // Functions, and the untyped labels of the C runtime's and
+                // libgcc's assembly (`__prologue_saves__`, `_exit`…);
+                // objects (constants in flash) only end the range before
+                // them.
+                let code = s.kind() != object::SymbolKind::Data;
+                (s.address() as u32, s.size() as u32, code)
+            })
+            .collect();
+        symbols.sort_unstable();
+        for (i, &(at, size, code)) in symbols.iter().enumerate() {
+            if !code {
+                continue;
+            }
+            let end = if size > 0 {
+                at + size
+            } else {
+                symbols[i + 1..]
+                    .iter()
+                    .map(|s| s.0)
+                    .find(|&a| a > at)
+                    .unwrap_or(text_end)
+            };
+            ranges.push((at, end.min(text_end)));
         }
-        let end = if size > 0 {
-            at + size
-        } else {
-            symbols[i + 1..]
-                .iter()
-                .map(|s| s.0)
-                .find(|&a| a > at)
-                .unwrap_or(text_end)
-        };
-        ranges.push((at, end.min(text_end)));
     }
     ranges.sort_unstable();
     ranges.dedup();

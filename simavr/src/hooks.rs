@@ -56,6 +56,10 @@ pub(crate) struct Shared {
     /// A batch saw the interrupts unmasked that began with them on and
     /// never saw them masked: code the traps missed masked them.
     pub unseen_mask: bool,
+    /// SPMs the part refused (`boot`).
+    pub spm_refused: u32,
+    /// A sleep keeps the run loop's deadline (`Sim::run_to`).
+    pub hard_deadline: bool,
     /// The I flag before the last SREG write (simavr has unpacked the new
     /// value by the time the write hook runs).
     i_on: bool,
@@ -91,6 +95,8 @@ impl Shared {
             deadline_at: None,
             reset_at: None,
             unseen_mask: false,
+            spm_refused: 0,
+            hard_deadline: false,
             i_on: false,
         }
     }
@@ -338,7 +344,7 @@ pub(crate) unsafe extern "C" fn run(avr: *mut avr_t) {
         }
         (*avr).pc = pc;
     }
-    if state(avr) == cpu_Sleeping {
+    if state(avr) == cpu_Sleeping && !(*shared).hard_deadline {
         simavr_ffi::avr_cycle_timer_cancel(avr, DEADLINE, shared as *mut c_void);
         (*shared).deadline_at = None;
     }
@@ -384,9 +390,10 @@ pub(crate) unsafe extern "C" fn no_sleep(_avr: *mut avr_t, _how_long: u64) {}
 /// "Loaded N bytes", printed whatever the log level) is dropped.
 ///
 /// # Safety
-/// Called by simavr with a printf format and its matching argument list.
+/// Called by simavr with a printf format and its matching argument list,
+/// and `avr` null or live, its `custom.data` null or its `Shared`.
 pub(crate) unsafe extern "C" fn log(
-    _avr: *mut avr_t,
+    avr: *mut avr_t,
     level: std::os::raw::c_int,
     format: *const std::os::raw::c_char,
     args: *mut simavr_ffi::__va_list_tag,
@@ -397,6 +404,16 @@ pub(crate) unsafe extern "C" fn log(
     let mut buf = [0u8; 256];
     simavr_ffi::vsnprintf(buf.as_mut_ptr() as *mut _, buf.len() as _, format, args);
     let text = std::ffi::CStr::from_bytes_until_nul(&buf).unwrap_or_default();
+    // After an SPM the part refused (`boot`), simavr's flash module says
+    // the SPM never came: it did, and was refused on purpose.
+    let shared = match avr.is_null() {
+        true => std::ptr::null_mut(),
+        false => (*avr).custom.data as *mut Shared,
+    };
+    let refused = !shared.is_null() && (*shared).spm_refused > 0;
+    if refused && text.to_bytes().starts_with(b"FLASH: avr_progen_clear") {
+        return;
+    }
     eprintln!("simavr: {}", plain(&text.to_string_lossy()).trim_end());
 }
 

@@ -5,6 +5,7 @@
 //! stack. Every `unsafe` call into simavr, and every raw pointer to its
 //! objects, stays in `sim` and `hooks`.
 
+pub mod boot;
 mod calls;
 mod card_slot;
 pub mod clock;
@@ -18,23 +19,21 @@ mod input;
 mod masked;
 pub mod operator;
 mod outcome;
-pub mod picture;
 pub mod power;
 pub mod probe;
 pub mod profile;
 pub mod pty;
-pub mod replay;
 pub mod report;
 mod run;
 pub mod scenario;
 pub mod sdcard;
 pub mod sdimage;
 mod serial;
+pub mod session;
 mod sim;
 pub mod stack_chain;
 mod traps;
 pub mod uart;
-pub mod vcd;
 
 pub use console::{Reply, SendError};
 pub use elf::ElfInfo;
@@ -43,3 +42,6 @@ pub use outcome::Outcome;
 pub use probe::{Edge, Probe};
 pub use report::{PinReport, Report};
 pub use sim::Sim;
+/// The trace code (VCD, pulse replay, pictures) lives in `taut-trace`,
+/// free of simavr: re-exported here for the harness's users.
+pub use taut_trace::{picture, replay, vcd};

@@ -44,6 +44,8 @@ pub struct Operator {
     /// Resume offers taken (green at `>>> resume …`).
     pub resumes: u32,
     pub state: Option<String>,
+    /// The last progress line: phase, done, total.
+    pub progress: Option<(String, u32, u32)>,
     /// The job reached its end (`done: press green`).
     pub finished: bool,
 }
@@ -94,6 +96,9 @@ impl Operator {
                 self.prompt(sim, msg);
                 seen.push(Seen::Prompt(prompt.to_string()));
             } else if let Some(p) = progress(msg) {
+                if let Seen::Progress(phase, done, total) = &p {
+                    self.progress = Some((phase.clone(), *done, *total));
+                }
                 seen.push(p);
             }
         }

@@ -44,6 +44,22 @@ impl Sim {
         self.run_until_cycles(|_| false, cycles)
     }
 
+    /// Runs to cycle `at` since power-on exactly: it stops on the first
+    /// instruction boundary at or past it, a sleep included (a sleep
+    /// stretch otherwise runs on to the next timer event, the deadline
+    /// taken out so the stretch is the same with or without the harness
+    /// looking). For the end of a run, such as a power cut.
+    pub fn run_to(&mut self, at: u64) -> Outcome {
+        let now = self.cycles();
+        if at <= now {
+            return self.ended.unwrap_or(Outcome::Running);
+        }
+        self.shared_mut().hard_deadline = true;
+        let o = self.run_until_cycles(|_| false, at - now);
+        self.shared_mut().hard_deadline = false;
+        o
+    }
+
     /// `run_until` with the timeout in cycles.
     pub fn run_until_cycles(
         &mut self,
@@ -84,7 +100,10 @@ impl Sim {
             }
         };
         self.clear_deadline();
-        if std::mem::take(&mut self.shared_mut().unseen_mask) && !self.warned_unseen_mask {
+        // Without traps (a board with a bootloader) nothing is watched.
+        let trapped = !self.code.is_empty();
+        if std::mem::take(&mut self.shared_mut().unseen_mask) && trapped && !self.warned_unseen_mask
+        {
             self.warned_unseen_mask = true;
             eprintln!(
                 "taut-simavr: interrupts were masked by code outside the ELF's code symbols \
@@ -152,11 +171,8 @@ impl Sim {
             // Only a reset sets simavr's counter back, and in a run only the
             // watchdog resets.
             let last = self.last_avr_cycle;
-            let shared = self.shared_mut();
-            shared.cycle_base += shared.reset_at.take().unwrap_or(last);
-            shared.uart.rx_ready = false;
-            // The reset emptied simavr's timers.
-            shared.deadline_at = None;
+            let before = self.shared_mut().reset_at.take().unwrap_or(last);
+            self.after_reset(before);
             self.last_avr_cycle = cycle;
             self.resets += 1;
             return Some(Outcome::WatchdogReset { count: self.resets });
@@ -184,7 +200,7 @@ impl Sim {
         if let Some(pc) = self.shared().bad_opcode_pc {
             return Some(Outcome::Crashed { pc });
         }
-        if pc == 0 {
+        if pc == 0 && self.shared().zero_trap {
             let from = match budget {
                 None => pc_before,
                 Some(_) => ZeroOrigin {

@@ -93,6 +93,11 @@ pub struct Sim {
     pub(crate) code_ranges: Vec<(u32, u32)>,
     /// `unseen_mask` was reported once.
     pub(crate) warned_unseen_mask: bool,
+    /// The lock bits' and the boot section's rules on SPM, on a board with
+    /// a bootloader (`boot`).
+    pub(crate) spm_guard: Option<Box<crate::boot::SpmGuard>>,
+    /// RESET pin pulses so far (`Sim::reset_external`).
+    pub(crate) external_resets: u32,
 }
 
 impl Sim {
@@ -118,6 +123,50 @@ impl Sim {
         let mut sim = Sim::attach(avr, Some(info), info.static_ram_end);
         sim.set_traps(ranges);
         Ok(sim)
+    }
+
+    /// Loads a firmware ELF's flash bytes as they are, without the
+    /// harness's traps (a board flashed with it: `boot`).
+    pub(crate) fn load_plain(elf_path: &Path) -> Result<Sim> {
+        let c_path = CString::new(elf_path.to_string_lossy().as_bytes())
+            .map_err(|_| Error::Elf(format!("{}: NUL in path", elf_path.display())))?;
+        // SAFETY: as in `load`.
+        let mut firmware: ffi::elf_firmware_t = unsafe { std::mem::zeroed() };
+        // SAFETY: valid NUL-terminated path and a zeroed firmware struct.
+        if unsafe { ffi::elf_read_firmware(c_path.as_ptr(), &mut firmware) } != 0 {
+            return Err(Error::Elf(format!(
+                "simavr could not read {}",
+                elf_path.display()
+            )));
+        }
+        let avr = new_mcu()?;
+        // SAFETY: `avr` is initialised; `firmware` was filled by simavr.
+        unsafe { ffi::avr_load_firmware(avr.as_ptr(), &mut firmware) };
+        Ok(Sim::attach(avr, None, RAM_START))
+    }
+
+    /// A part with its flash erased.
+    pub(crate) fn blank() -> Result<Sim> {
+        Ok(Sim::attach(new_mcu()?, None, RAM_START))
+    }
+
+    /// Puts `bytes` into flash at byte address `at`.
+    pub(crate) fn load_flash(&mut self, at: u32, bytes: &mut [u8]) {
+        let avr = self.avr.as_ptr();
+        // SAFETY: `avr` is live; simavr checks the range against the
+        // flash's size (callers pass ranges `boot::read_hex` checked).
+        unsafe { ffi::avr_loadcode(avr, bytes.as_mut_ptr(), bytes.len() as u32, at) };
+    }
+
+    /// The harness's books after simavr reset the MCU (its cycle counter
+    /// back to 0 from `before`).
+    pub(crate) fn after_reset(&mut self, before: u64) {
+        let shared = self.shared_mut();
+        shared.cycle_base += before;
+        shared.uart.rx_ready = false;
+        // The reset emptied simavr's timers.
+        shared.deadline_at = None;
+        self.last_avr_cycle = self.avr_cycle();
     }
 
     /// Loads the firmware, probes the string-art axes' STEP and DIR pins
@@ -238,6 +287,8 @@ impl Sim {
             code: Vec::new(),
             code_ranges: Vec::new(),
             warned_unseen_mask: false,
+            spm_guard: None,
+            external_resets: 0,
         }
     }
 
@@ -544,7 +595,8 @@ impl Sim {
             match budget {
                 Some(cycles) if !from_reset => {
                     (*avr).run_cycle_limit = u64::MAX;
-                    if (*avr).state == ffi::cpu_Running as std::os::raw::c_int {
+                    let running = (*avr).state == ffi::cpu_Running as std::os::raw::c_int;
+                    if running || (*self.shared.as_ptr()).hard_deadline {
                         ffi::avr_cycle_timer_register(avr, cycles.max(1), hooks::DEADLINE, shared);
                     }
                 }

@@ -1,6 +1,6 @@
 //! The call chain at a run's deepest stack ([`Sim::keep_peak_stack`]),
-//! innermost first, with each frame's bytes: for RAM work (issue #13's
-//! budget). A function's prologue (its pushes and the frame it reserves,
+//! innermost first, with each frame's bytes: for RAM work (static RAM +
+//! deepest stack within 5.5 KiB). A function's prologue (its pushes and the frame it reserves,
 //! from `avr-objdump -d`) says how far up the stack its return address
 //! lies, and so on outwards. An interrupt's return address is the
 //! interrupted instruction's, not a call's.

@@ -1,4 +1,4 @@
-//! `taut bench [--json FILE]`: the string-art figures of the README, on
+//! `taut bench [--json FILE]`: the string-art figures of docs/benchmarks.md, on
 //! the host — for each example image, a 250-nail circle (R 40.2 cm, the
 //! spec's board), 3000 lines of 0.3 mm thread at 512 px: our generator,
 //! the plain greedy and random chords, side by side. With `--json` the

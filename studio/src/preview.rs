@@ -15,8 +15,8 @@ use crate::toolpath::{self, Toolpath};
 use std::path::{Path, PathBuf};
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
-use taut_simavr::replay::{board_from_param, JobReplay};
-use taut_simavr::vcd;
+use taut_trace::replay::{board_from_param, JobReplay};
+use taut_trace::vcd;
 
 pub const USAGE: &str = "\
 taut preview FILE.gcode|TRACE.vcd --machine flatbed|drum|whiteboard|scara|string_art -o out.png|svg

@@ -9,7 +9,7 @@ use taut_logic::gcode::{Input, Parser};
 use taut_logic::interp::{Allowed, Interpreter, Order};
 use taut_logic::kinematics::{AnyKinematics, Kinematics, Position};
 use taut_logic::machine::Machine;
-use taut_simavr::vcd::Signal;
+use taut_trace::vcd::Signal;
 
 /// A straight piece of the path, mm in the G-code's frame (y up).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -131,7 +131,7 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
 pub fn from_vcd(signals: &[Signal], machine: Machine) -> Result<Toolpath, String> {
     let cfg = MachineConfig::defaults(machine);
     let points =
-        taut_simavr::picture::plot_points(signals, &cfg, [0, 0]).map_err(|e| e.to_string())?;
+        taut_trace::picture::plot_points(signals, &cfg, [0, 0]).map_err(|e| e.to_string())?;
     let mut path = Toolpath::default();
     for w in points.windows(2) {
         path.push([w[0].0 .0, w[0].0 .1], [w[1].0 .0, w[1].0 .1], w[1].1);

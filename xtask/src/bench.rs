@@ -1,7 +1,8 @@
 //! `cargo xtask bench`: figures from simavr's cycle counter (`taut-bench`
 //! in simavr/), written to target/bench.json and printed as a table, the
 //! string-art job's machine time worked out on the host (`cargo xtask
-//! estimate`), then the host tools' string-art figures (`taut bench`).
+//! estimate`), then the host tools' string-art figures (`taut bench`);
+//! last, docs/benchmarks.md generated from them all (`bench_page`).
 
 use crate::firmware;
 use crate::run::{self, root, Result};
@@ -9,11 +10,21 @@ use serde_json::{json, Map, Value};
 use taut_logic::files::FileName;
 use taut_logic::stringart::estimate::{self, CardEstimate};
 
-pub fn run() -> Result<()> {
+pub fn run(args: &[String]) -> Result<()> {
+    let out = root().join("target/bench.json");
+    match args {
+        [] => {}
+        [page] if page == "--page" => return write_page(&out),
+        _ => {
+            return Err(
+                "bench: `bench` or `bench --page` (the page again from target/bench.json)".into(),
+            )
+        }
+    }
+    let host = host_figures();
     let img = firmware::build_release()?;
     firmware::build_examples()?;
     let busy = firmware::release_dir().join("examples/busy.elf");
-    let out = root().join("target/bench.json");
     println!("== benchmarks (simulated ATmega2560, cycle-exact)");
     let args = [
         img.elf.display().to_string(),
@@ -22,6 +33,10 @@ pub fn run() -> Result<()> {
     ];
     run::bin("taut-bench", &args)?;
     let mut figures: Map<String, Value> = serde_json::from_str(&std::fs::read_to_string(&out)?)?;
+    let ram = ["ram_static_bytes", "stack_peak_bytes"]
+        .map(|k| figures.get(k).and_then(Value::as_u64).unwrap_or(0));
+    figures.insert("ram_static_plus_stack_bytes".into(), json!(ram[0] + ram[1]));
+    figures.extend(host);
     println!("\n== machine time of the string-art job (host, the firmware's own planner)");
     let demo = crate::estimate::estimate(&root().join("examples/card"))?;
     let seed = seed_size_job()?;
@@ -43,7 +58,39 @@ pub fn run() -> Result<()> {
     }
     std::fs::write(&out, serde_json::to_string_pretty(&figures)?)?;
     println!("\n== string art on the host (taut bench)");
-    run::studio(&["bench".into(), "--json".into(), out.display().to_string()])
+    run::studio(&["bench".into(), "--json".into(), out.display().to_string()])?;
+    write_page(&out)
+}
+
+/// The host's cores and load when the bench starts: the wall-clock
+/// figures depend on them.
+fn host_figures() -> Map<String, Value> {
+    let mut m = Map::new();
+    if let Ok(n) = std::thread::available_parallelism() {
+        m.insert("host_cores".into(), json!(n.get()));
+    }
+    let load = std::fs::read_to_string("/proc/loadavg").ok();
+    if let Some(l) = load
+        .as_deref()
+        .and_then(|t| t.split(' ').next()?.parse::<f64>().ok())
+    {
+        m.insert("host_load_average".into(), json!(l));
+    }
+    m
+}
+
+/// docs/benchmarks.md from every figure in `json`; the bars missed are
+/// named (the page marks them too).
+fn write_page(json: &std::path::Path) -> Result<()> {
+    let figures: Map<String, Value> = serde_json::from_str(&std::fs::read_to_string(json)?)?;
+    let (page, missed) = crate::bench_page::render(&figures);
+    let path = root().join("docs/benchmarks.md");
+    std::fs::write(&path, page)?;
+    println!("\n== written: {}", path.display());
+    for m in &missed {
+        println!("bar missed: {m}");
+    }
+    Ok(())
 }
 
 /// EEPROM wear of a 250-hole, 3 000-wrap job (datasheet endurance

@@ -15,7 +15,7 @@ use std::time::Instant;
 pub const TARGETS: [&str; 4] = ["gcode", "fat", "param", "poradi"];
 
 /// Seconds per target in `cargo xtask test`. Measured from the committed
-/// seeds (README, "Fuzzing"): `gcode`, `param` and `poradi` reach their final
+/// seeds (docs/fuzzing.md): `gcode`, `param` and `poradi` reach their final
 /// edge coverage of a 2-minute run within 20 s, `fat` 97 % of its 90 s figure
 /// by 40 s. Four targets, two at a time on two cores, take 80 s plus the
 /// build (about 70 s from nothing). Longer runs: `cargo xtask fuzz --seconds N`.

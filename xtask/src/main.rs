@@ -3,9 +3,11 @@
 //! the idempotent bootstrap (`scripts/setup.sh`).
 
 mod bench;
+mod bench_page;
 mod demo;
 mod estimate;
 mod firmware;
+mod flashmap;
 mod fuzz;
 mod run;
 
@@ -16,22 +18,39 @@ use std::time::Instant;
 const HELP: &str = "\
 usage: cargo xtask <command> [args]
 
-  demo              build everything and run the main job on the simulated machine
-  test              host unit tests of every crate, the fuzz targets (40 s each), simtest
+  demo              build everything and run the string-art machine's whole job
+                    on the simulated Mega (target/demo/: trace, report, picture)
+  demo plotter [MACHINE]
+                    a plotter (flatbed, drum, whiteboard, scara; default flatbed)
+                    draws examples/plotter/star.gcode streamed over its serial port
+  test              host unit tests of every crate, the fuzz targets (40 s each),
+                    then simtest
   fuzz [TARGET] [--seconds N] [--seed N]
-                    build the libFuzzer targets and run each N seconds (default all, 40 s)
+                    build the libFuzzer targets and run each N seconds (default all,
+                    40 s); `cargo xtask fuzz --help` lists the targets
   simtest           build the firmware images and run the HIL tests in simavr
   soak              the HIL tests at full size (5000-move streams, 100 wraps of a
                     10 000-connection job, a 1 000 000-connection pattern, fuzzing
                     10 min a target): tens of minutes
-  build             release ELF + Intel HEX + size report
-  sim [args]        run the firmware in simavr (see `cargo xtask sim --help`)
-  sdimage DIR -o IMG  build a FAT card image from a folder (dd it to a real card)
+  build             release ELF + Intel HEX, the size and the flash map checked
+                    (fails past 224 KiB, without the watchdog entry at 0x20000,
+                    or with a function pointer out of a 16-bit pointer's reach)
+  sim [OPTIONS]     run the release image in simavr; `cargo xtask sim --help`
+                    lists the options (docs/simulator.md)
+  sim --bootloader HEX --pty PATH [OPTIONS]
+                    a Mega holding only that bootloader, its serial port on PATH:
+                    flash it with avrdude -c wiring or ravedude (docs/hardware.md)
+  sdimage DIR -o IMG
+                    build a FAT card image from a folder (dd it to a real card)
   estimate DIR      the machine time of a card folder's job: this firmware's (its
                     own job, planner and trapezoids, on the host) and the original's
-  bench             measure, write target/bench.json, print a table
-  flash             flash a Mega 2560 through ravedude
-  setup             install what is missing (apt packages, the pinned nightly)
+  bench [--page]    measure, write target/bench.json and docs/benchmarks.md
+                    (--page: only the page again, from target/bench.json)
+  flash             build, then flash a Mega 2560 through ravedude (`cargo run
+                    --release` in firmware/; RAVEDUDE_PORT=PATH picks the port)
+  setup             install what is missing (apt packages, the pinned nightly,
+                    avrdude, the stock bootloader, ravedude)
+  help              this text
 ";
 
 fn main() -> ExitCode {
@@ -63,7 +82,7 @@ fn main() -> ExitCode {
             Some("plotter") => demo::plotter(rest.get(1).map_or("flatbed", String::as_str)),
             Some(other) => Err(format!("demo {other}: `demo` or `demo plotter [MACHINE]`").into()),
         }),
-        "bench" => run::setup().and_then(|_| bench::run()),
+        "bench" => run::setup().and_then(|_| bench::run(rest)),
         "estimate" => estimate::run(rest),
         "flash" => run::setup().and_then(|_| firmware::flash()),
         "help" | "--help" | "-h" => {
@@ -117,14 +136,12 @@ fn simtest() -> Result<()> {
     let _ = std::fs::remove_file(root().join("target/hil-stack-chains.txt"));
     let mut test = run::cargo_cmd(&["test", "-p", "hil-tests"], &root());
     run::status(test.env("TAUT_STACK_CHAINS", "1"))?;
-    print_ram(&img, &peaks);
-    Ok(())
+    print_ram(&img, &peaks)
 }
 
 /// The run's RAM figure: static data plus the deepest stack any HIL test
-/// saw (each test checks its own against 6 KiB; issue #13's bar is
-/// 4.5 KiB).
-fn print_ram(img: &firmware::Image, peaks: &std::path::Path) {
+/// saw, checked against the budget (each test also checks its own).
+fn print_ram(img: &firmware::Image, peaks: &std::path::Path) -> Result<()> {
     let text = std::fs::read_to_string(peaks).unwrap_or_default();
     let deepest = text
         .lines()
@@ -135,13 +152,22 @@ fn print_ram(img: &firmware::Image, peaks: &std::path::Path) {
         })
         .max();
     if let Some((stack, test)) = deepest {
+        let total = img.ram_static_bytes + stack;
         println!(
-            "== RAM: static {} B + deepest stack {stack} B ({test}) = {} B of 8192 \
+            "== RAM: static {} B + deepest stack {stack} B ({test}) = {total} B of the {} B budget \
              (each test's call chain: target/hil-stack-chains.txt)",
             img.ram_static_bytes,
-            img.ram_static_bytes + stack
+            firmware::RAM_BUDGET
         );
+        if total > firmware::RAM_BUDGET {
+            return Err(format!(
+                "static RAM + deepest stack {total} B is over the {} B budget",
+                firmware::RAM_BUDGET
+            )
+            .into());
+        }
     }
+    Ok(())
 }
 
 /// The campaigns too long for CI: every HIL test at its full size
@@ -162,8 +188,40 @@ fn soak() -> Result<()> {
     ])?)
 }
 
-/// Run `taut-sim` (the simulator CLI in simavr/) on the release image.
+/// Run `taut-sim` (the simulator CLI in simavr/) on the release image;
+/// with `--bootloader HEX`, on a Mega whose flash holds only that
+/// bootloader (the release image built, for avrdude to write).
 fn sim(args: &[String]) -> Result<()> {
     let img = firmware::build_release()?;
+    if args.iter().any(|a| a == "--bootloader") {
+        println!(
+            "== a Mega with only its bootloader; flash {}",
+            img.hex.display()
+        );
+        return run::bin("taut-sim", args);
+    }
     run::taut_sim(&img.elf, args)
+}
+
+#[cfg(test)]
+mod tests {
+    /// Every command `main` answers is in the help, with its arguments.
+    #[test]
+    fn the_help_lists_every_command() {
+        let source = include_str!("main.rs");
+        let commands: Vec<&str> = source
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix('"')?.split('"').next())
+            .filter(|c| c.chars().all(|c| c.is_ascii_lowercase()) && !c.is_empty())
+            .collect();
+        assert!(commands.len() >= 12, "{commands:?}");
+        for c in commands {
+            assert!(
+                super::HELP.contains(&format!("\n  {c}")),
+                "{c} missing from the help"
+            );
+        }
+        assert!(super::HELP.contains("demo plotter [MACHINE]"));
+        assert!(super::HELP.contains("sdimage DIR -o IMG"));
+    }
 }

@@ -1,4 +1,4 @@
-//! The string-art job's checkpoint in EEPROM (issue #15): where a power
+//! The string-art job's checkpoint in EEPROM: where a power
 //! cut, a brown-out or a watchdog reset left the job, so that the next
 //! boot can offer to go on from there.
 //!

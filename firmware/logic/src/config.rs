@@ -1,5 +1,5 @@
 //! The machine's figures in one typed structure. Defaults are the
-//! string-art machine's (`docs/string-art-machine.md`); `machine.txt`
+//! string-art machine's (`docs/string-art.md`); `machine.txt`
 //! on the card and `$` settings override them.
 
 use crate::axis::{Axis, PerAxis};

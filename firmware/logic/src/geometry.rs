@@ -1,4 +1,4 @@
-//! Nail geometry of the string-art board (`docs/string-art-machine.md`) and
+//! Nail geometry of the string-art board (`docs/string-art.md`) and
 //! its conversion to absolute step targets.
 //!
 //! Nail `i` of `N` sits at `f(i/N)·(R − 1.5 cm)`: on a circle (shape 0) or on

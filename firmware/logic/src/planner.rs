@@ -422,7 +422,7 @@ impl Planner {
     /// The staged move's direction, the axes' jumps at the junction with
     /// the move before it and the speed asked (in events/s by
     /// `plan_limits`). Out of line, as each part: the parts are measured
-    /// apart (issue #13's `task_runs`).
+    /// apart (`simavr/examples/task_runs.rs`).
     #[inline(never)]
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_path(&mut self, feed: Feed) {

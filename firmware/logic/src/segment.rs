@@ -15,9 +15,9 @@
 //! preparer, not once per step; per-axis timers would need one division or
 //! table look-up per axis and step instead.
 //!
-//! Times are in *sub-ticks*: 1/256 of a Timer1 tick (16 MHz, clk/1). The
-//! interrupt keeps a 24.8 fixed-point time and programs the compare
-//! register with its integer part (bytes 1–2: free on AVR). The fraction
+//! Times are in *sub-ticks*: 1/256 of a step-timer (Timer3) tick (16 MHz,
+//! clk/1). The interrupt keeps a 24.8 fixed-point time and programs the
+//! compare register with its integer part (bytes 1–2: free on AVR). The fraction
 //! keeps rounding from accumulating: with whole ticks a 5333.3-tick cruise
 //! interval drifts a tick every three steps.
 
@@ -36,7 +36,7 @@ pub use trapezoid::{cbrt_floor_approx, div_to_u32, isqrt, Speeds, Trapezoid, MAX
 
 use crate::axis::PerAxis;
 
-/// Timer1 ticks per second (16 MHz, prescaler 1).
+/// Step-timer (Timer3) ticks per second (16 MHz, prescaler 1).
 pub const TICK_HZ: u32 = 16_000_000;
 /// Fraction bits of [`Segment::interval`] and [`Segment::add`].
 pub const FRAC_BITS: u32 = 8;

@@ -3,6 +3,7 @@
 
 pub mod clock;
 pub mod delay;
+pub mod early;
 pub mod eeprom;
 pub mod flash;
 pub mod gpio;
@@ -23,31 +24,39 @@ pub enum ResetCause {
     BrownOut,
     Watchdog,
     Jtag,
-    /// No flag set: a jump to the reset vector (e.g. a crash into address 0).
+    /// No flag set: a start through the stock bootloader (which clears
+    /// them), or a jump to the reset vector (a crash into address 0).
     Unknown,
 }
 
 impl ResetCause {
-    /// Read and clear MCUSR. The watchdog flag must be cleared before the
-    /// watchdog can be switched off or reconfigured.
-    pub fn take(cpu: &avr_device::atmega2560::CPU) -> ResetCause {
-        let r = cpu.mcusr().read();
-        let cause = if r.wdrf().bit_is_set() {
+    /// Why this start: MCUSR as `.init3` found it (`early`), or, when that
+    /// is 0 because the stock bootloader read and cleared it, the value it
+    /// read, if it came in through the watchdog entry. (A start through the
+    /// bootloader's other ways, power-on or the RESET pin, is `Unknown`:
+    /// it leaves no trace of the flags.) MCUSR itself is cleared already,
+    /// so the watchdog can be reconfigured.
+    pub fn take(_cpu: &avr_device::atmega2560::CPU) -> ResetCause {
+        let at_start = early::mcusr_at_start();
+        let bits = match (at_start, early::take_bootloader_mcusr()) {
+            (0, Some(read_by_bootloader)) => read_by_bootloader,
+            _ => at_start,
+        };
+        // MCUSR: JTRF 4, WDRF 3, BORF 2, EXTRF 1, PORF 0.
+        let set = |bit: u8| bits & (1 << bit) != 0;
+        if set(3) {
             ResetCause::Watchdog
-        } else if r.borf().bit_is_set() {
+        } else if set(2) {
             ResetCause::BrownOut
-        } else if r.extrf().bit_is_set() {
+        } else if set(1) {
             ResetCause::External
-        } else if r.porf().bit_is_set() {
+        } else if set(0) {
             ResetCause::PowerOn
-        } else if r.jtrf().bit_is_set() {
+        } else if set(4) {
             ResetCause::Jtag
         } else {
             ResetCause::Unknown
-        };
-        // SAFETY: 0 is a valid MCUSR value: every reset flag cleared.
-        cpu.mcusr().write(|w| unsafe { w.bits(0) });
-        cause
+        }
     }
 
     pub fn name(self) -> flash::FlashStr {

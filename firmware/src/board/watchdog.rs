@@ -24,7 +24,8 @@ impl Watchdog {
         avr_device::asm::wdr();
     }
 
-    /// Switch off (needs MCUSR.WDRF cleared first, which `ResetCause::take` does).
+    /// Switch off (needs MCUSR.WDRF cleared first, which the start-up does:
+    /// `board::early`).
     pub fn stop(self) -> WDT {
         avr_device::interrupt::free(|_| {
             avr_device::asm::wdr();

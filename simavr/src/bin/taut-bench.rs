@@ -374,7 +374,7 @@ fn job_figures(elf: &Path, card: &Path) -> (f64, f64, u64) {
 
 /// The sample job simulated whole as `cargo xtask demo` runs it (the
 /// operator pressing green at once): simulated MHz per wall second and
-/// the wall seconds it took (issue #13: at least 750 MHz, at most 15 s).
+/// the wall seconds it took (bars: at least 750 MHz, at most 15 s).
 fn demo_job(elf: &Path, card: &Path) -> (f64, f64) {
     let mut sim = Sim::boot(elf);
     sim.insert_sd(SdImage::from_path(card).expect("sample card"));

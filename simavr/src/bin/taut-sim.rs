@@ -12,15 +12,19 @@ use std::time::{Duration, Instant};
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
 use taut_logic::settings::image;
-use taut_simavr::operator::{Operator, Seen};
-use taut_simavr::pty::Pty;
+use taut_simavr::clock::{cycles_in, FREQ_HZ};
+use taut_simavr::operator::Seen;
+use taut_simavr::pty::{Pace, Pty};
 use taut_simavr::scenario::{self, FaultSpec, TimedBytes};
 use taut_simavr::sdcard::{SdCard, SdImage};
+use taut_simavr::session::{self, Ending, Plan, Session};
 use taut_simavr::{picture, replay};
 use taut_simavr::{Outcome, Reply, Sim};
 
 const USAGE: &str = "\
-usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
+usage: taut-sim ELF [options]
+       taut-sim [ELF] --bootloader HEX --pty [PATH] [options]
+       [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                    [--pull-card-at SECONDS]... [--reinsert-at SECONDS]...
                    [--card-fault SPEC]...] [--auto-confirm] [--send FILE]
                    [--at SECONDS:BYTES]... [--for SECONDS] [--vcd PATH]
@@ -28,6 +32,21 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                    [--power-cut-at SECONDS | --power-cut-on TEXT
                    [--power-cut-delay SECONDS]]
                    [--machine NAME [--endstop-mm MM]] [--pty [PATH]]
+                   [--bootloader HEX]
+  ELF             the firmware, loaded into flash as a debugger would (reset
+                  at address 0); with --bootloader, the application already
+                  flashed beside the bootloader (optional)
+  --bootloader HEX
+                  a Mega 2560 as sold: the bootloader (Intel hex, e.g.
+                  /usr/share/arduino/hardware/arduino/avr/bootloaders/
+                  stk500v2/stk500boot_v2_mega2560.hex) in the boot section,
+                  its fuses (BOOTRST: every reset starts the bootloader) and
+                  lock bits (SPM cannot write the boot section); each open
+                  of the --pty terminal resets the board, as the Mega's
+                  auto-reset does on DTR, so avrdude -c wiring (and
+                  ravedude) flash it through the terminal; time runs as
+                  fast as the host can while bytes are on the line and in
+                  step with the wall clock when it is idle
   --sd PATH       put a virtual SD card in the slot: an image file, or a
                   folder, imaged on the fly (FAT16 or FAT32 by size)
   --sd-insert-at SECONDS
@@ -60,9 +79,11 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                   A whole G-code line sent so gets its own ok, which --send
                   may take for its line's: use lines without --send
   --for SECONDS   simulated time to run (default 5; with --send: extra time
-                  after motion is idle, default 0). Without --for the run
-                  also goes on until 1 s after the last planned event
-                  (--at, --pull-card-at, --reinsert-at, crc-once-at)
+                  after motion is idle, default 0; with --auto-confirm or
+                  --pty: no limit). Without --for the run also goes on
+                  until 1 s after the last planned event (--at,
+                  --pull-card-at, --reinsert-at, crc-once-at). A planned
+                  power cut outlasts it: the run lasts until the cut
   --vcd PATH      write a VCD trace of every probed pin, named by the
                   machine's channels (base_, radial_, drill_; x_, y_;
                   left_, right_; shoulder_, elbow_) and pen_pwm
@@ -85,26 +106,41 @@ usage: taut-sim ELF [--sd DIR_OR_IMAGE [--sd-insert-at SECONDS]
                   file exists, saved when the run ends (a power cycle keeps
                   only the EEPROM: run again with the same file)
   --power-cut-at SECONDS
-                  cut the power at that simulated time: the run ends where
-                  it is, the VCD and the report are written (\"ended\":
-                  \"power cut\") and --eeprom saves the EEPROM as the cut
-                  leaves it (a byte still being written, within its 3.4 ms,
-                  left erased); run again with the same --eeprom to resume
+                  cut the power at that simulated time, to the cycle (the
+                  MCU stops on the first instruction boundary at or past
+                  it): the run ends there, the VCD and the report are
+                  written (\"ended\": \"power cut\", with the cycle) and
+                  --eeprom saves the EEPROM as the cut leaves it (a byte
+                  still being written, within its 3.4 ms, left erased); run
+                  again with the same --eeprom to resume
   --power-cut-on TEXT
-                  cut the power when the firmware's serial output first
-                  holds TEXT (seen within 1 ms), plus --power-cut-delay
+                  cut the power --power-cut-delay after the firmware's
+                  serial output first holds TEXT (from the cycle its last
+                  byte left the UART; under --pty, within 10 ms); the run
+                  lasts until the cut. A run whose TEXT never appears ends
+                  with an error
   --power-cut-delay SECONDS
                   simulated seconds from TEXT to the cut (default 0)
   --auto-confirm  press the green button whenever the job asks for it, take
                   a resume offer and zero the axes again after a power cut
                   (in the simulator they are still at the zero pose), and
-                  run until the job is done (or --for SECONDS, default 7200)
+                  run until the job (the string-art job, or a print from
+                  the card) is done, however long; --for SECONDS limits it
+                  (a job cut short by it is exit status 3)
   --echo          print the firmware's serial output as it runs
   --help, -h      this text
-Times are simulated seconds since power-on (0.25, 3).";
+Times are simulated seconds since power-on (0.25, 3).
+The last line says how the run ended: job finished, time limit reached,
+stopped by the time limit at (how far the job got), power cut at cycle N,
+alarm (ALARM:n, under a job), firmware fault, stopped by a signal.
+Exit status: 0 as asked (job finished, cut made, limit of a run with no job
+under way, a signal); 1 a firmware fault, a cut that never came, or an
+error; 2 bad options; 3 a job cut short by the limit; 4 an alarm under a
+job.";
 
 struct Args {
-    elf: PathBuf,
+    elf: Option<PathBuf>,
+    bootloader: Option<PathBuf>,
     sd: Option<PathBuf>,
     sd_insert_at: Option<Duration>,
     pulls: Vec<Duration>,
@@ -135,10 +171,12 @@ enum Cut {
     On(String),
 }
 
-fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
-    let elf = it.next().ok_or("missing ELF")?.into();
+fn parse(it: impl Iterator<Item = String>) -> Result<Args, String> {
+    let mut it = it.peekable();
+    let elf = it.next_if(|a| !a.starts_with("--")).map(PathBuf::from);
     let mut args = Args {
         elf,
+        bootloader: None,
         sd: None,
         sd_insert_at: None,
         pulls: Vec::new(),
@@ -160,12 +198,12 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
         cut: None,
         cut_delay: Duration::ZERO,
     };
-    let mut it = it.peekable();
     while let Some(a) = it.next() {
         let mut value = || it.next().ok_or(format!("{a} needs a value"));
         let time = |text: String| scenario::seconds(&text).map_err(|e| format!("{a}: {e}"));
         match a.as_str() {
             "--for" => args.seconds = Some(time(value()?)?),
+            "--bootloader" => args.bootloader = Some(value()?.into()),
             "--sd" => args.sd = Some(value()?.into()),
             "--sd-insert-at" => args.sd_insert_at = Some(time(value()?)?),
             "--pull-card-at" => args.pulls.push(time(value()?)?),
@@ -219,17 +257,25 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, String> {
     if args.cut_delay > Duration::ZERO && !matches!(args.cut, Some(Cut::On(_))) {
         return Err("--power-cut-delay needs --power-cut-on".into());
     }
+    if args.elf.is_none() && args.bootloader.is_none() {
+        return Err("missing ELF (or --bootloader HEX)".into());
+    }
+    if args.bootloader.is_some() && args.pty.is_none() {
+        return Err("--bootloader needs --pty: the bootloader talks over the serial port".into());
+    }
+    if args.auto_confirm && args.sd.is_none() {
+        return Err("--auto-confirm needs --sd: the job comes from the card".into());
+    }
+    if args.profile.is_some() && args.bootloader.is_some() {
+        return Err("--profile needs the ELF loaded as is (not with --bootloader)".into());
+    }
     Ok(args)
 }
 
 impl Args {
     /// The simulated time of the last planned event.
     fn last_planned(&self) -> Option<Duration> {
-        let cut = match self.cut {
-            Some(Cut::At(at)) => Some(at),
-            _ => None,
-        };
-        let times = self.at.iter().map(|t| t.at).chain(cut);
+        let times = self.at.iter().map(|t| t.at);
         let faults = self.faults.iter().filter_map(FaultSpec::at);
         (times.chain(self.pulls.iter().copied()))
             .chain(self.reinserts.iter().copied())
@@ -306,8 +352,12 @@ fn put_card(sim: &mut Sim, path: &Path, args: &Args) -> Result<Option<Vec<u8>>, 
     Ok(param)
 }
 
-fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
-    let mut sim = Sim::load(&args.elf)?;
+fn run(args: Args) -> Result<Ending, Box<dyn std::error::Error>> {
+    let mut sim = match (&args.bootloader, &args.elf) {
+        (Some(hex), app) => Sim::with_bootloader(hex, app.as_deref())?,
+        (None, Some(elf)) => Sim::load(elf)?,
+        (None, None) => unreachable!("parse asks for one"),
+    };
     if args.profile.is_some() {
         sim.enable_profile();
     }
@@ -338,16 +388,13 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     if let Some(file) = &args.send {
         stream(&mut sim, file, args.echo, &mut printed)?;
     }
-    let default = match (args.auto_confirm, args.send.is_some(), args.pty.is_some()) {
-        // Until SIGINT or SIGTERM.
-        (_, _, true) => f64::from(u32::MAX),
-        (true, _, _) => 7200.0,
-        (false, true, _) => 0.0,
-        (false, false, _) => 5.0,
-    };
     let mut pty = match &args.pty {
         Some(link) => {
-            let pty = Pty::open(link.as_deref())?;
+            let mut pty = Pty::open(link.as_deref())?;
+            if args.bootloader.is_some() {
+                pty.reset_on_open()?;
+                pty.set_pace(Pace::BusyLink);
+            }
             eprintln!(
                 "taut-sim: serial port on {}{}",
                 pty.path().display(),
@@ -359,66 +406,25 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         }
         None => None,
     };
-    let mut operator = if args.auto_confirm {
-        Operator::confirming()
-    } else {
-        Operator::default()
-    };
+    let plan = plan(&args, sim.cycles());
+    let mut session = Session::new(&mut sim, &plan);
     let mut bar = Bar::default();
-    let mut total = args.seconds.unwrap_or(Duration::from_secs_f64(default));
-    if let (None, Some(last)) = (args.seconds, args.last_planned()) {
-        let now = Duration::from_secs_f64(sim.time_s());
-        total = total.max((last + Duration::from_secs(1)).saturating_sub(now));
-    }
-    let slice = Duration::from_millis(10);
-    let mut outcome = Outcome::Running;
-    let mut elapsed = Duration::ZERO;
-    // The simulated time of the cut, once known; set when it happened.
-    let mut cut_at = match args.cut {
-        Some(Cut::At(at)) => Some(at),
-        _ => None,
-    };
-    let mut cut = None;
-    while elapsed < total && !STOP.load(Ordering::Relaxed) {
-        let now = Duration::from_secs_f64(sim.time_s());
-        if let (None, Some(Cut::On(text))) = (cut_at, &args.cut) {
-            if sim.uart_text().contains(text.as_str()) {
-                cut_at = Some(now + args.cut_delay);
-            }
-        }
-        if cut_at.is_some_and(|at| now >= at) {
-            cut = Some(now);
-            break;
-        }
-        let mut step = slice.min(total - elapsed);
-        match (cut_at, &args.cut) {
-            (Some(at), _) => step = step.min(at - now),
-            (None, Some(Cut::On(_))) => step = step.min(Duration::from_millis(1)),
-            _ => {}
-        }
-        match pty.as_mut() {
-            Some(pty) => {
-                pty.serve(&mut sim, step)?;
-                outcome = Outcome::Running;
-            }
-            None => outcome = sim.run_for(step),
-        }
-        elapsed += step;
+    let ending = session.run(&plan, pty.as_mut(), &STOP, |sim, seen| {
         if args.echo {
             let text = &sim.uart_bytes()[printed..];
-            bar.suspend(|| std::io::stdout().write_all(text))?;
+            let _ = bar.suspend(|| std::io::stdout().write_all(text));
             printed += text.len();
         }
-        if outcome != Outcome::Running {
-            break;
-        }
-        bar.show(&operator.step(&mut sim));
-        if args.auto_confirm && operator.finished {
-            break;
-        }
-    }
+        bar.show(seen);
+    })?;
     bar.finish();
+    let operator = std::mem::take(&mut session.operator);
+    let print = session.print.clone();
     let wall_s = wall.elapsed().as_secs_f64();
+    let cut = match ending {
+        Ending::PowerCut { cycle } => Some(cycle),
+        _ => None,
+    };
     let (eeprom, torn) = match cut {
         Some(_) => sim.eeprom_after_cut(0xFF),
         None => (sim.eeprom(), None),
@@ -426,10 +432,10 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
     if let Some(path) = &args.eeprom {
         std::fs::write(path, eeprom)?;
     }
-    if let Some(at) = cut {
+    if let Some(cycle) = cut {
         eprintln!(
-            "taut-sim: power cut at {:.3} s{}",
-            at.as_secs_f64(),
+            "taut-sim: power cut at cycle {cycle} ({:.6} s){}",
+            cycle as f64 / FREQ_HZ as f64,
             torn.map_or(String::new(), |a| format!(
                 " during the write of EEPROM byte {a}: left erased"
             ))
@@ -467,8 +473,8 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         );
         picture = Some(serde_json::to_value(&s)?);
     }
-    if let (Some(n), Some(profile)) = (args.profile, sim.profile()) {
-        let by_function = profile.by_function(&args.elf)?;
+    if let (Some(n), Some(profile), Some(elf)) = (args.profile, sim.profile(), &args.elf) {
+        let by_function = profile.by_function(elf)?;
         let total: u64 = by_function.iter().map(|(c, _)| c).sum();
         eprintln!("taut-sim: cycles by function ({total} in all)");
         if std::env::var_os("TAUT_PROFILE_PCS").is_some() {
@@ -481,22 +487,36 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
             eprintln!("{share:6.2} % {cycles:>12} {name}");
         }
     }
+    let outcome = match &ending {
+        Ending::Fault(o) => *o,
+        _ => Outcome::Running,
+    };
     if let Some(path) = &args.report {
         let mut report = serde_json::to_value(sim.report(outcome))?;
         let extra = json!({
-            "ended": if cut.is_some() { "power cut".to_string() } else { format!("{outcome:?}") },
-            "power_cut": cut.map(|at| json!({
-                "at_s": at.as_secs_f64(),
+            "ended": ending.kind(),
+            "ending": ending.words(),
+            "exit_status": ending.exit_code(),
+            "power_cut": cut.map(|cycle| json!({
+                "cycle": cycle,
+                "at_s": cycle as f64 / FREQ_HZ as f64,
                 "eeprom_byte_torn": torn,
             })),
             "wall_seconds": wall_s,
             "sim_mhz": sim.cycles() as f64 / wall_s / 1e6,
+            "external_resets": sim.external_resets(),
             "job": {
                 "state": operator.state,
+                "progress": operator.progress,
                 "finished": operator.finished,
                 "green_presses": operator.presses,
                 "resumes": operator.resumes,
                 "picture": picture,
+            },
+            "print": {
+                "file": print.opened,
+                "started": print.running,
+                "done": print.done,
             },
         });
         report
@@ -510,12 +530,41 @@ fn run(args: Args) -> Result<Outcome, Box<dyn std::error::Error>> {
         sim.time_s(),
         wall_s,
         sim.cycles() as f64 / wall_s / 1e6,
-        match cut {
-            Some(_) => "power cut".to_string(),
-            None => format!("{outcome:?}"),
-        }
+        ending.words()
     );
-    Ok(outcome)
+    Ok(ending)
+}
+
+/// The run's limit and cut, in cycles since power-on, from the options
+/// and where the machine stands (after `--send`'s stream).
+fn plan(args: &Args, now: u64) -> Plan {
+    let seconds = |d: Duration| cycles_in(d);
+    let limit = match (args.seconds, args.send.is_some()) {
+        (Some(d), true) => Some(now + seconds(d)),
+        (Some(d), false) => Some(seconds(d)),
+        (None, true) => Some(now),
+        (None, false) if args.pty.is_some() || args.auto_confirm => None,
+        (None, false) => Some(seconds(Duration::from_secs(5))),
+    };
+    // Without --for, the run also covers every planned event.
+    let limit = match (args.seconds, args.last_planned()) {
+        (None, Some(last)) => limit.map(|l| l.max(seconds(last + Duration::from_secs(1)))),
+        _ => limit,
+    };
+    let cut = match &args.cut {
+        Some(Cut::At(at)) => Some(session::Cut::At(seconds(*at))),
+        Some(Cut::On(text)) => Some(session::Cut::On {
+            text: text.clone(),
+            delay: seconds(args.cut_delay),
+        }),
+        None => None,
+    };
+    Plan {
+        limit,
+        cut,
+        auto_confirm: args.auto_confirm,
+        file_sent: args.send.is_some(),
+    }
 }
 
 /// The job's progress lines (`drill 3/24`, `wind 10/30`) as a bar per
@@ -598,8 +647,7 @@ fn main() -> ExitCode {
         }
     };
     match run(args) {
-        Ok(o) if !o.is_fatal() => ExitCode::SUCCESS,
-        Ok(_) => ExitCode::FAILURE,
+        Ok(ending) => ExitCode::from(ending.exit_code()),
         Err(e) => {
             eprintln!("taut-sim: {e}");
             ExitCode::FAILURE
@@ -656,6 +704,42 @@ mod tests {
         assert_eq!(a.at[1].bytes, [0x18]);
         assert_eq!(a.seconds, Some(Duration::from_secs(8)));
         assert_eq!(a.last_planned(), Some(Duration::from_secs(6)));
+    }
+
+    /// A cut's time, as written, becomes one exact cycle: whole seconds
+    /// and any decimals alike (a float compared against the simulated
+    /// clock once missed 40 and 45).
+    #[test]
+    fn cut_times_are_exact_cycles() {
+        let cut = |line: &str| plan(&args(line).unwrap(), 0).cut;
+        for (text, cycle) in [
+            ("40", 640_000_000),
+            ("45", 720_000_000),
+            ("0.1", 1_600_000),
+            ("2.5", 40_000_000),
+            ("0.25", 4_000_000),
+        ] {
+            assert_eq!(
+                cut(&format!("fw.elf --power-cut-at {text}")),
+                Some(session::Cut::At(cycle)),
+                "{text}"
+            );
+        }
+        assert_eq!(
+            cut("fw.elf --power-cut-on x --power-cut-delay 7200"),
+            Some(session::Cut::On {
+                text: "x".into(),
+                delay: 115_200_000_000
+            })
+        );
+        let p = plan(&args("fw.elf --power-cut-at 45").unwrap(), 0);
+        assert_eq!(
+            p.limit,
+            Some(80_000_000),
+            "the plain 5 s: the cut outlasts it"
+        );
+        let p = plan(&args("fw.elf --sd c --auto-confirm").unwrap(), 0);
+        assert_eq!(p.limit, None, "--auto-confirm runs the job to its end");
     }
 
     #[test]

@@ -97,7 +97,7 @@ impl<'a> Loom<'a> {
     /// its self term left out. (Counting it would weigh the chord as a
     /// second copy of itself and favour moves the check then refuses;
     /// taking out its whole share of F, twice the self term, misses good
-    /// moves: 0.1157 against 0.1133 on the README's figure.)
+    /// moves: 0.1157 against 0.1133 on the bench's camera.jpg.)
     fn worth(&self, a: u16, b: u16) -> f32 {
         self.weigh(a, b, 0.0)
     }
@@ -180,7 +180,7 @@ pub fn wind(
 }
 
 /// Every candidate is first weighed on every [`SAMPLE`]-th column of its
-/// chord; the [`SHORTLIST`] best are then weighed whole. (On the README's
+/// chord; the [`SHORTLIST`] best are then weighed whole. (On the bench's
 /// figure: the same RMSE to ±0.0005 as weighing all whole, a third less
 /// time.)
 const SAMPLE: usize = 3;

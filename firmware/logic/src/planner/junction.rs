@@ -174,7 +174,7 @@ impl Geometry {
     /// runs at `n / e` of the event rate. The tightest axis is found by
     /// comparing the fractions crosswise, then divided once: a `u64`
     /// division is ~1 000–2 500 cycles on the AVR, a multiply ~350, and
-    /// a move planned in parts waits for the slowest (issue #13).
+    /// a move planned in parts keeps a ready task waiting for the slowest.
     pub fn limits(&self, step: &StepBlock) -> (u32, u32) {
         let (mut accel, mut rate) = (None::<usize>, None::<usize>);
         for i in 0..AXES {

@@ -7,7 +7,7 @@ use crate::axis::{PerAxis, AXES};
 /// One step event.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Event {
-    /// Timer1 tick of the event (the compare match), counted from 0.
+    /// Step-timer (Timer3) tick of the event (the compare match), counted from 0.
     pub tick: u64,
     /// Bit `i`: axis `i` steps.
     pub axes: u8,

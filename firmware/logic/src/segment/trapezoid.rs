@@ -172,7 +172,7 @@ impl Trapezoid {
         match self.part {
             0 => return true,
             // The roots (~6 000 cycles each on the AVR), two parts: three
-            // in one kept a ready task waiting ~19 000 (issue #13). The
+            // in one kept a ready task waiting ~19 000 cycles. The
             // peak's scaled speed waits in `cruise_iv`.
             1 => {
                 self.cruise_iv = self.scaled_speed(self.v0_sqr + self.acc2);

@@ -466,7 +466,7 @@ mod tests {
         out
     }
 
-    /// The target: the demo card in at most 70 % of the original's
+    /// The bar: the demo card in at most 70 % of the original's
     /// sequential time, at the same limits.
     #[test]
     fn the_demo_card_takes_at_most_70_percent_of_the_original() {

@@ -1,4 +1,4 @@
-//! The string-art job as a state machine (`docs/string-art-machine.md`):
+//! The string-art job as a state machine (`docs/string-art.md`):
 //! waiting for card → reading → prep drill → drilling → waiting for nails →
 //! winding → end → waiting for card, with `paused` inside drilling and
 //! winding and `bad files` when the card's files are unusable.

@@ -1,4 +1,4 @@
-//! The operator's tools (serial `$` lines, issue #15), refused while the
+//! The operator's tools (serial `$` lines), refused while the
 //! job moves:
 //!
 //! | line | when | what |

@@ -69,11 +69,9 @@ impl Canvas {
     ) {
         let (a, b) = (self.px(p), self.px(q));
         let r = width / 2.0;
-        let lo = (a.0.min(b.0) - r, a.1.min(b.1) - r);
-        let hi = (a.0.max(b.0) + r, a.1.max(b.1) + r);
         let (dx, dy) = (b.0 - a.0, b.1 - a.1);
         let len2 = dx * dx + dy * dy;
-        self.paint(lo, hi, color, |x, y| {
+        let coverage = |x: f64, y: f64| {
             let t = if len2 > 0.0 {
                 (((x - a.0) * dx + (y - a.1) * dy) / len2).clamp(0.0, 1.0)
             } else {
@@ -81,7 +79,32 @@ impl Canvas {
             };
             let d = (x - a.0 - t * dx).hypot(y - a.1 - t * dy);
             (r + 0.5 - d).clamp(0.0, 1.0) * alpha
-        });
+        };
+        // Row by row, only the pixels the line can touch: a long diagonal's
+        // bounding box is mostly empty.
+        let n = i64::from(self.size);
+        let reach = r + 2.0;
+        let (y0, y1) = (a.1.min(b.1) - reach, a.1.max(b.1) + reach);
+        for y in (y0.floor() as i64).max(0)..=(y1.ceil() as i64).min(n - 1) {
+            let yc = y as f64 + 0.5;
+            // The segment's x where it crosses this row, widened.
+            let (xa, xb) = match dy.abs() > 1e-9 {
+                true => {
+                    let x_at = |yy: f64| a.0 + dx * ((yy - a.1) / dy).clamp(0.0, 1.0);
+                    let slope = (dx / dy).abs();
+                    let (u, v) = (x_at(yc - reach), x_at(yc + reach));
+                    (
+                        u.min(v) - reach * (1.0 + slope),
+                        u.max(v) + reach * (1.0 + slope),
+                    )
+                }
+                false => (a.0.min(b.0) - reach, a.0.max(b.0) + reach),
+            };
+            for x in (xa.floor() as i64).max(0)..=(xb.ceil() as i64).min(n - 1) {
+                let c = coverage(x as f64 + 0.5, yc);
+                self.blend(x, y, color, c);
+            }
+        }
     }
 
     /// A filled disc of `r` px.

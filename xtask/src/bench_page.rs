@@ -1,0 +1,399 @@
+//! `docs/benchmarks.md`, written by `cargo xtask bench` from
+//! `target/bench.json`: the method, then every figure with its unit, what
+//! it measures and its bar where one exists. The README and the other
+//! pages cite figures from this page only, so none goes stale in prose.
+
+use serde_json::{Map, Value};
+
+/// A bar a figure must meet.
+#[derive(Clone, Copy)]
+enum Bar {
+    AtMost(f64),
+    AtLeast(f64),
+}
+
+impl Bar {
+    fn met(self, v: f64) -> bool {
+        match self {
+            Bar::AtMost(b) => v <= b,
+            Bar::AtLeast(b) => v >= b,
+        }
+    }
+
+    fn text(self) -> String {
+        match self {
+            Bar::AtMost(b) => format!("≤ {}", number(b)),
+            Bar::AtLeast(b) => format!("≥ {}", number(b)),
+        }
+    }
+}
+
+/// A figure of `target/bench.json`: its key, unit, what it measures, bar.
+struct Figure {
+    key: &'static str,
+    unit: &'static str,
+    what: &'static str,
+    bar: Option<Bar>,
+}
+
+const fn fig(key: &'static str, unit: &'static str, what: &'static str) -> Figure {
+    Figure {
+        key,
+        unit,
+        what,
+        bar: None,
+    }
+}
+
+const fn barred(key: &'static str, unit: &'static str, what: &'static str, bar: Bar) -> Figure {
+    Figure {
+        key,
+        unit,
+        what,
+        bar: Some(bar),
+    }
+}
+
+/// The flash the firmware may use: the bootloader owns the top.
+pub const FLASH_BUDGET: f64 = crate::firmware::FLASH_BUDGET as f64;
+/// Static RAM plus the deepest stack.
+pub const RAM_BUDGET: f64 = crate::firmware::RAM_BUDGET as f64;
+
+/// The sections of the page, in order, with their figures.
+const SECTIONS: &[(&str, &[Figure])] = &[
+    (
+        "Size",
+        &[
+            barred("flash_bytes", "B", "flash of the release image (`.text` + `.data`)", Bar::AtMost(FLASH_BUDGET)),
+            fig("ram_static_bytes", "B", "static RAM (`.data` + `.bss` + `.noinit`)"),
+            fig("data_bytes", "B", "`.data`, the part of static RAM that is also in flash"),
+            fig("stack_peak_bytes", "B", "deepest stack of the bench's runs (the cruise, the loaded console); `cargo xtask test` prints the HIL run's deepest"),
+            barred("ram_static_plus_stack_bytes", "B", "static RAM + `stack_peak_bytes`", Bar::AtMost(RAM_BUDGET)),
+        ],
+    ),
+    (
+        "Step timing",
+        &[
+            fig("step_rate_1axis_hz", "steps/s", "highest one-axis cruise rate (to 1 kHz) at which every pulse of a 1 s cruise lands within 2 µs of a uniform grid"),
+            barred("step_rate_1axis_error_us", "µs", "worst pulse deviation from that grid at that rate", Bar::AtMost(2.0)),
+            fig("step_rate_1axis_rate_error_ppm", "ppm", "that grid's rate against the nominal rate (a crystal is good to ±50 ppm)"),
+            fig("isr_cycles_per_step", "cycles", "the step interrupt's mean cycles per event, one axis"),
+            fig("step_rate_3axis_hz", "steps/s", "as `step_rate_1axis_hz`, three axes stepping at every event (aggregate: 3 × the event rate)"),
+            barred("step_rate_3axis_error_us", "µs", "worst pulse deviation at that rate", Bar::AtMost(2.0)),
+            fig("step_rate_3axis_rate_error_ppm", "ppm", "that grid's rate against the nominal rate"),
+            fig("isr_cycles_per_event_3axis", "cycles", "the step interrupt's mean cycles per event, three axes"),
+            fig("timing_error_max_us", "µs", "a default-speed `G0 C360` (2000 steps/s, 500 steps/s²): worst pulse against the exact trapezoid"),
+            barred("step_isr_max_masked_cycles", "cycles", "longest stretch with the step interrupt masked during that move", Bar::AtMost(80.0)),
+        ],
+    ),
+    (
+        "Latency under load",
+        &[
+            fig("status_latency_cycles", "cycles", "`?` received (its receive interrupt) → the `Realtime` task starts, worst"),
+            fig("status_latency_p90_cycles", "cycles", "the same, 90th percentile"),
+            barred("status_report_latency_us", "µs", "`?` received → the status report's last byte queued, worst (a `?` every 25 ms)", Bar::AtMost(10_000.0)),
+            fig("status_report_latency_p90_us", "µs", "the same, 90th percentile"),
+            fig("dispatch_latency_cycles", "cycles", "a line's byte received → the `Console` task starts, worst"),
+            fig("dispatch_latency_p90_cycles", "cycles", "the same, 90th percentile"),
+            fig("segment_prep_max_cycles", "cycles", "the motion task's longest run during the demo job (segment preparation)"),
+        ],
+    ),
+    (
+        "Streaming",
+        &[
+            fig("stream_lines_per_s", "lines/s", "1 mm moves at the maximum feed streamed by character counting (Grbl's 128 bytes), answered per second"),
+            fig("stream_uart_bound_lines_per_s", "lines/s", "what 115 200 baud could carry of those lines"),
+            fig("stream_estimate_lines_per_s", "lines/s", "the host estimate of the same stream (the firmware's planner on the host)"),
+            fig("stream_planner_free_blocks_mean", "blocks", "mean free planner blocks in the stream's `?` reports (`Bf:`)"),
+            fig("stream_lines_always_waiting", "", "whether a whole line always waited in the receive buffer"),
+            fig("stream_limit", "", "what limits the stream: the planner, the UART or the firmware's line intake"),
+        ],
+    ),
+    (
+        "Maths on the AVR",
+        &[
+            fig("polargraph_inverse_cycles", "cycles", "one whiteboard (polargraph) inverse kinematics (`fmath`)"),
+            fig("scara_inverse_cycles", "cycles", "one SCARA inverse kinematics"),
+            fig("arc_segments_per_s", "chords/s", "chords of a 1 mm circle cut, converted and planned on the flatbed"),
+            fig("isqrt64_cycles", "cycles", "one 64-bit integer square root"),
+            fig("trapezoid_new_cycles", "cycles", "one trapezoid made (`Trapezoid::new`)"),
+            fig("trapezoid_time_cycles", "cycles", "one event time read off a trapezoid"),
+            fig("segment_cycles_mean", "cycles", "one segment of a default-speed move cut, mean"),
+            fig("segments_per_default_move", "segments", "segments of that move"),
+        ],
+    ),
+    (
+        "Card",
+        &[
+            fig("sd_read_kib_per_s", "KiB/s", "a 256 KiB file streamed through the card reader into its queue (`firmware/examples/sd_read.rs`)"),
+            fig("sd_poradi_parse_ms", "ms", "reading and checking a card with a 3 000-connection `poradi.txt`, `state: reading` → `files ok`, by the firmware's clock"),
+        ],
+    ),
+    (
+        "The string-art job",
+        &[
+            fig("cpu_busy_percent_drilling", "%", "share of cycles the MCU is awake while the demo job drills"),
+            fig("cpu_busy_percent_winding", "%", "the same, its first 30 s of winding"),
+            fig("job_time_s", "s", "the demo card's machine time (host, the firmware's own job, planner and trapezoids)"),
+            fig("job_time_sequential_s", "s", "the same card with the original firmware's blocking moves, one axis after another"),
+            barred("job_time_ratio", "", "`job_time_s` / `job_time_sequential_s`", Bar::AtMost(0.70)),
+            fig("job_250x3000_time_s", "s", "the seed's example size: 250 nails on a 40.2 cm circle, 3 000 connections"),
+            fig("job_250x3000_time_sequential_s", "s", "the same, one axis after another"),
+            fig("job_250x3000_time_ratio", "", "their ratio"),
+            fig("eeprom_writes_per_job", "B", "EEPROM bytes the checkpoint writes in a 250-hole, 3 000-wrap job"),
+            fig("eeprom_cell_writes_per_job", "writes", "writes of the most written EEPROM cell in that job"),
+            fig("jobs_before_wear_out", "jobs", "such jobs before that cell reaches the datasheet's 100 000 writes"),
+            fig("resume_prompt_ms", "ms", "simulated time from power-on to the `>>> resume …` prompt after a cut while winding"),
+        ],
+    ),
+    (
+        "The simulator",
+        &[
+            barred("sim_mhz", "MHz", "simulated MHz per wall second, the demo job run whole as `cargo xtask demo` runs it", Bar::AtLeast(750.0)),
+            barred("demo_wall_s", "s", "wall seconds that took", Bar::AtMost(15.0)),
+            fig("sim_mhz_idle", "MHz", "simulated MHz per wall second, the firmware idle"),
+            fig("sim_mhz_busy", "MHz", "the same, an MCU that never sleeps (`firmware/examples/busy.rs`)"),
+            fig("host_cores", "cores", "the host's cores the bench ran on"),
+            fig("host_load_average", "", "the host's 1-minute load average when the bench started: the wall-clock figures shrink as it grows"),
+        ],
+    ),
+];
+
+const METHOD: &str = "\
+Every figure is measured by `cargo xtask bench` and written to
+`target/bench.json`; this page is generated from that file by the same
+command (`xtask/src/bench_page.rs`). Do not edit it by hand: run the bench
+and commit the page.
+
+- **Firmware figures** come from the release image (`taut.elf`, the one
+  that is flashed) in simavr, whose cycle counter is exact and repeatable
+  (`simavr/src/bin/taut-bench.rs`). Special images in `firmware/examples/`
+  time the maths (`kin_cycles`, `segment_cycles`), the card reader
+  (`sd_read`) and an MCU that never sleeps (`busy`).
+- **Step rates** are searched to 1 kHz: the highest cruise rate at which
+  every STEP pulse of a one-second cruise lands within 2 µs of a uniform
+  grid fitted to it. The search is not monotonic (a rate fails when a step
+  falls on another interrupt's masked entry), so the rate moves by a few
+  thousand from build to build as the code's layout moves.
+- **Latencies** are measured under load: the console streams 0.1 mm moves
+  at the maximum feed (the planner full, a segment to cut every few ms)
+  while the job reads the sample card, and a byte arrives every 5 ms (a `?`
+  every 25 ms for the report).
+- **Machine times** of the string-art job are worked out on the host with
+  the firmware's own job state machine, planner and trapezoids (`cargo
+  xtask estimate`), which the HIL job test holds to the simulation within
+  1 %.
+- **Host string art** (`cargo taut bench`): a 250-nail circle of R 40.2 cm,
+  3 000 lines of 0.3 mm thread, 512 px, on the test images in
+  `examples/images/`: ours, the plain greedy chord choice and random
+  chords; RMSE of darkness (0–1) after a σ = 2 px blur of both. Wall
+  seconds depend on the machine and its load.
+- **Wall-clock figures** (`sim_mhz*`, `demo_wall_s`, `stringart_seconds_*`)
+  depend on the machine and what else runs on it.
+- **Bars** are the project's rules: flash ≤ 224 KiB (229 376 B; the
+  bootloader owns the top); static RAM + deepest stack ≤ 5.5 KiB (5 632 B;
+  `cargo xtask test` checks every HIL test's stack against it and prints
+  the deepest); every pulse within 2 µs; the step interrupt masked at most
+  80 cycles (5 µs); a `?` answered within 10 ms; the demo card in at most
+  70 % of the original firmware's time; the simulator at least 750 MHz and
+  the demo job in at most 15 s of wall time; our string art at least 25 %
+  below random chords' error and below the plain greedy's.
+
+For comparison: Grbl steps at more than 30 kHz, Marlin on the Mega at about
+40 kHz, Klipper on a 16 MHz AVR at about 99 k steps/s on three steppers.
+";
+
+/// The page for `figures` (`target/bench.json`), and the bars missed.
+pub fn render(figures: &Map<String, Value>) -> (String, Vec<String>) {
+    let mut out = String::from("# Benchmarks\n\n");
+    out += METHOD;
+    let mut missed = Vec::new();
+    let mut shown = std::collections::BTreeSet::new();
+    for (title, figs) in SECTIONS {
+        let rows: Vec<Row> = figs
+            .iter()
+            .filter_map(|f| {
+                let v = figures.get(f.key)?;
+                shown.insert(f.key.to_string());
+                Some(Row {
+                    key: f.key.to_string(),
+                    value: v.clone(),
+                    unit: f.unit.to_string(),
+                    what: f.what.to_string(),
+                    bar: f
+                        .bar
+                        .map(|b| (b.text(), v.as_f64().is_some_and(|x| b.met(x)))),
+                })
+            })
+            .collect();
+        table(&mut out, title, &rows, &mut missed);
+    }
+    let stringart = stringart_rows(figures, &mut shown);
+    table(&mut out, "Host string art", &stringart, &mut missed);
+    let other: Vec<Row> = figures
+        .iter()
+        .filter(|(k, _)| !shown.contains(*k))
+        .map(|(k, v)| Row {
+            key: k.clone(),
+            value: v.clone(),
+            unit: String::new(),
+            what: "(not described yet: add it to `xtask/src/bench_page.rs`)".into(),
+            bar: None,
+        })
+        .collect();
+    table(&mut out, "Other", &other, &mut missed);
+    (out, missed)
+}
+
+struct Row {
+    key: String,
+    value: Value,
+    unit: String,
+    what: String,
+    /// The bar's text and whether it is met.
+    bar: Option<(String, bool)>,
+}
+
+fn table(out: &mut String, title: &str, rows: &[Row], missed: &mut Vec<String>) {
+    if rows.is_empty() {
+        return;
+    }
+    *out += &format!("\n## {title}\n\n| figure | value | unit | what it measures | bar |\n| --- | ---: | --- | --- | --- |\n");
+    for r in rows {
+        let bar = match &r.bar {
+            None => String::new(),
+            Some((text, true)) => format!("{text} (met)"),
+            Some((text, false)) => {
+                missed.push(format!("{} = {} (bar {text})", r.key, value(&r.value)));
+                format!("{text} (**missed**)")
+            }
+        };
+        *out += &format!(
+            "| `{}` | {} | {} | {} | {} |\n",
+            r.key,
+            value(&r.value),
+            r.unit,
+            r.what,
+            bar
+        );
+    }
+}
+
+/// The host string-art figures, per image (`stringart_<figure>_<image>`):
+/// ours, the plain greedy's and random chords', with their bars.
+fn stringart_rows(
+    figures: &Map<String, Value>,
+    shown: &mut std::collections::BTreeSet<String>,
+) -> Vec<Row> {
+    let images: Vec<String> = figures
+        .keys()
+        .filter_map(|k| k.strip_prefix("stringart_rmse_random_"))
+        .map(String::from)
+        .collect();
+    let mut rows = Vec::new();
+    for image in &images {
+        let get = |k: &str| figures.get(&format!("stringart_{k}_{image}"));
+        let random = get("rmse_random").and_then(Value::as_f64);
+        let plain = get("rmse_plain").and_then(Value::as_f64);
+        let kinds: [(&str, &str, String); 7] = [
+            ("rmse", "", format!("RMSE of our generator on `{image}`")),
+            ("seconds", "s", "its wall seconds".into()),
+            ("thread_m", "m", "its thread length".into()),
+            (
+                "rmse_plain",
+                "",
+                "RMSE of the plain greedy chord choice".into(),
+            ),
+            ("seconds_plain", "s", "its wall seconds".into()),
+            ("thread_m_plain", "m", "its thread length".into()),
+            ("rmse_random", "", "RMSE of random chords".into()),
+        ];
+        for (kind, unit, what) in kinds {
+            let key = format!("stringart_{kind}_{image}");
+            let Some(v) = figures.get(&key) else { continue };
+            shown.insert(key.clone());
+            let bar = match (kind, v.as_f64(), random, plain) {
+                ("rmse", Some(x), Some(r), Some(p)) => Some((
+                    format!(
+                        "≤ 0.75 × random ({}), < plain",
+                        number((7500.0 * r).round() / 1e4)
+                    ),
+                    x <= 0.75 * r && x < p,
+                )),
+                _ => None,
+            };
+            rows.push(Row {
+                key,
+                value: v.clone(),
+                unit: unit.into(),
+                what,
+                bar,
+            });
+        }
+    }
+    rows
+}
+
+fn value(v: &Value) -> String {
+    match v {
+        Value::Number(n) => number(n.as_f64().unwrap_or(f64::NAN)),
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// `x` with its integer digits grouped by three (`229 376`), as the docs
+/// write figures.
+fn number(x: f64) -> String {
+    let text = format!("{x}");
+    let (int, frac) = text.split_once('.').unwrap_or((&text, ""));
+    let (sign, digits) = int.strip_prefix('-').map_or(("", int), |d| ("-", d));
+    let mut grouped = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 && digits.len() > 4 {
+            grouped.push(' ');
+        }
+        grouped.push(c);
+    }
+    match frac {
+        "" => format!("{sign}{grouped}"),
+        f => format!("{sign}{grouped}.{f}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn numbers_are_grouped_as_the_docs_write_them() {
+        assert_eq!(number(229_376.0), "229 376");
+        assert_eq!(number(4_480.0), "4480");
+        assert_eq!(number(1_234_567.5), "1 234 567.5");
+        assert_eq!(number(-12_345.0), "-12 345");
+        assert_eq!(number(0.645), "0.645");
+    }
+
+    #[test]
+    fn every_figure_is_shown_with_its_bar_and_a_missed_bar_is_named() {
+        let figures = json!({
+            "flash_bytes": 300_000,
+            "ram_static_bytes": 3844,
+            "sim_mhz": 1600.5,
+            "stringart_rmse_camera": 0.11,
+            "stringart_rmse_plain_camera": 0.23,
+            "stringart_rmse_random_camera": 0.32,
+            "something_new": 7,
+        });
+        let (page, missed) = render(figures.as_object().unwrap());
+        assert!(page.contains("| `flash_bytes` | 300 000 | B |"), "{page}");
+        assert!(page.contains("≤ 229 376 (**missed**)"), "{page}");
+        assert!(page.contains("| `sim_mhz` | 1600.5 | MHz |"), "{page}");
+        assert!(page.contains("≥ 750 (met)"), "{page}");
+        assert!(page.contains("`stringart_rmse_camera` | 0.11 |"), "{page}");
+        assert!(page.contains("< plain (met)"), "{page}");
+        assert!(page.contains("| `something_new` | 7 |"), "{page}");
+        assert_eq!(missed, ["flash_bytes = 300 000 (bar ≤ 229 376)"]);
+    }
+}
