@@ -103,6 +103,16 @@ impl Profile {
 /// The ideal profile of the straight line `from → to` (mm) at `feed`
 /// mm/min on the machine `cfg`, from rest to rest.
 pub fn ideal(cfg: &MachineConfig, from: [f64; 2], to: [f64; 2], feed: f64) -> Profile {
+    profile(cfg, from, to, feed, true)
+}
+
+/// The pen's trapezoid alone along the line (its feed, `pen_max_feed`
+/// and `pen_accel`; the joints' limits left out), as [`ideal`]'s profile.
+pub fn cartesian(cfg: &MachineConfig, from: [f64; 2], to: [f64; 2], feed: f64) -> Profile {
+    profile(cfg, from, to, feed, false)
+}
+
+fn profile(cfg: &MachineConfig, from: [f64; 2], to: [f64; 2], feed: f64, with_joints: bool) -> Profile {
     let joints = Joints::new(cfg);
     let length = (to[0] - from[0]).hypot(to[1] - from[1]);
     let n = (length / DS).ceil().max(1.0) as usize;
@@ -120,7 +130,7 @@ pub fn ideal(cfg: &MachineConfig, from: [f64; 2], to: [f64; 2], feed: f64) -> Pr
         let s = k as f64 * ds;
         let (q0, q1, q2) = (joints.at(at(s - e)), joints.at(at(s)), joints.at(at(s + e)));
         let (mut v, mut a) = (vmax, accel);
-        for j in 0..2 {
+        for j in (0..2).filter(|_| with_joints) {
             let r = ((q2[j] - q0[j]) / (2.0 * e)).abs();
             let r2 = ((q2[j] - 2.0 * q1[j] + q0[j]) / (e * e)).abs();
             if r > 0.0 {
@@ -204,6 +214,9 @@ pub struct Measured {
     pub seconds: f64,
     /// The ideal time of the same span, s.
     pub ideal: f64,
+    /// The pen's trapezoid over the same span (the joints' limits left
+    /// out: [`cartesian`]), s; the ideal where no joint's limit binds.
+    pub cartesian: f64,
     /// The closed-form trapezoid of the whole line (feed and `pen_accel`
     /// alone), s.
     pub trapezoid: f64,
@@ -243,6 +256,8 @@ pub fn draw_line(sim: &mut Sim, cfg: &MachineConfig, from: [f64; 2], to: [f64; 2
     let profile = ideal(cfg, from, to, feed);
     let (first, last) = step_span(cfg, from, to);
     let ideal = profile.time_at(last) - profile.time_at(first);
+    let pen = cartesian(cfg, from, to, feed);
+    let cartesian = pen.time_at(last) - pen.time_at(first);
     let rate = [0, 1].map(|j| {
         let mut at = line[0].1[j];
         let mut rises = Vec::new();
@@ -266,6 +281,7 @@ pub fn draw_line(sim: &mut Sim, cfg: &MachineConfig, from: [f64; 2], to: [f64; 2
     Measured {
         seconds,
         ideal,
+        cartesian,
         trapezoid,
         rate,
     }

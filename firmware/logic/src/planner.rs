@@ -13,7 +13,7 @@
 //! each piece is slowed where a joint would pass its own `max_rate` or
 //! `accel` — along the piece, and where the joints' share of the pen's
 //! speed changes from piece to piece (the path's curvature in joint space,
-//! `Geometry::curve_sqr`).
+//! `Geometry::joints_sqr`).
 //! Floats are used once per block when it is added (its length, the
 //! junction cosine); the look-ahead passes are additions and comparisons of
 //! squared speeds, `u32` (µm/s)² shifted right by [`Planner`]'s `shift`
