@@ -225,7 +225,10 @@ fn status_reports_the_pens_feed() {
         let t = Duration::from_secs(60);
         send_ok(&mut sim, &format!("G0 X{} Y{}", a[0], a[1]), t);
         send_ok(&mut sim, "M400", t);
-        send_ok(&mut sim, &format!("G1 X{} Y{} F1200", b[0], b[1]), t);
+        // Not waiting for its `ok`: that comes once its last pieces are
+        // queued, near its end.
+        let sent = sim.uart_bytes().len();
+        sim.uart_send(format!("G1 X{} Y{} F1200\n", b[0], b[1]).as_bytes());
         sim.run_for(Duration::from_secs(1));
         let mut last = feed_and_place(&mut sim);
         for _ in 0..3 {
@@ -239,6 +242,7 @@ fn status_reports_the_pens_feed() {
             assert!((speed / 1200.0 - 1.0).abs() < 0.02, "{m:?} at {pos:?}: {speed} mm/min");
             last = now;
         }
+        sim.run_until(|s| s.uart_text_from(sent).contains("ok\n"), t);
         send_ok(&mut sim, "M400", t);
         assert_eq!(feed_and_place(&mut sim).0, 0.0, "{m:?} standing");
     }
