@@ -70,9 +70,11 @@ impl Joints {
                     0 => 0.0,
                     n => ecr.den as f64 / n as f64,
                 };
-                let elbow =
-                    shoulder * crosstalk + acos((h2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2));
-                [shoulder.to_degrees() * self.spu(0), elbow.to_degrees() * self.spu(1)]
+                let elbow = shoulder * crosstalk + acos((h2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2));
+                [
+                    shoulder.to_degrees() * self.spu(0),
+                    elbow.to_degrees() * self.spu(1),
+                ]
             }
         }
     }
@@ -112,7 +114,13 @@ pub fn cartesian(cfg: &MachineConfig, from: [f64; 2], to: [f64; 2], feed: f64) -
     profile(cfg, from, to, feed, false)
 }
 
-fn profile(cfg: &MachineConfig, from: [f64; 2], to: [f64; 2], feed: f64, with_joints: bool) -> Profile {
+fn profile(
+    cfg: &MachineConfig,
+    from: [f64; 2],
+    to: [f64; 2],
+    feed: f64,
+    with_joints: bool,
+) -> Profile {
     let joints = Joints::new(cfg);
     let length = (to[0] - from[0]).hypot(to[1] - from[1]);
     let n = (length / DS).ceil().max(1.0) as usize;
@@ -238,16 +246,18 @@ pub fn rate_bound(max_rate: f64) -> f64 {
 
 /// Moves the pen up to `from`, then draws the line to `to` at `feed`
 /// mm/min and measures it from the pulses.
-pub fn draw_line(sim: &mut Sim, cfg: &MachineConfig, from: [f64; 2], to: [f64; 2], feed: f64) -> Measured {
+pub fn draw_line(
+    sim: &mut Sim,
+    cfg: &MachineConfig,
+    from: [f64; 2],
+    to: [f64; 2],
+    feed: f64,
+) -> Measured {
     let t = Duration::from_secs(120);
     send_ok(sim, &format!("G0 X{:.3} Y{:.3}", from[0], from[1]), t);
     send_ok(sim, "M400", t);
     let before = track(sim).len();
-    send_ok(
-        sim,
-        &format!("G1 X{:.3} Y{:.3} F{feed}", to[0], to[1]),
-        t,
-    );
+    send_ok(sim, &format!("G1 X{:.3} Y{:.3} F{feed}", to[0], to[1]), t);
     send_ok(sim, "M400", t);
     let path = track(sim);
     let line = &path[before..];

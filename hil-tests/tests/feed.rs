@@ -49,7 +49,12 @@ fn at(p: [f64; 2]) -> [Milli; 3] {
 /// Seeded lines centred on `places`, `per_place` each: a random
 /// direction, 10–100 mm (shortened while the machine cannot draw it
 /// whole), F300–F3000. Each line's feed is a whole number.
-fn lines(cfg: &MachineConfig, places: &[[f64; 2]], per_place: usize, seed: u64) -> Vec<([f64; 2], [f64; 2], f64)> {
+fn lines(
+    cfg: &MachineConfig,
+    places: &[[f64; 2]],
+    per_place: usize,
+    seed: u64,
+) -> Vec<([f64; 2], [f64; 2], f64)> {
     let kin = AnyKinematics::of(cfg).unwrap();
     let mut rng = Rng::new(seed);
     let mut out = Vec::new();
@@ -76,7 +81,12 @@ fn lines(cfg: &MachineConfig, places: &[[f64; 2]], per_place: usize, seed: u64) 
 
 /// Draws every line; each takes its ideal time within the tolerance and
 /// no joint steps faster than its limit.
-fn every_line_at_its_feed(m: Machine, settings: &[&str], places: &[[f64; 2]], seed: u64) -> Vec<Measured> {
+fn every_line_at_its_feed(
+    m: Machine,
+    settings: &[&str],
+    places: &[[f64; 2]],
+    seed: u64,
+) -> Vec<Measured> {
     let (mut sim, cfg) = machine(m, settings);
     let per_place = soak_or(12, 2);
     let mut out = Vec::new();
@@ -125,7 +135,10 @@ fn mostly_the_pens_trapezoid(m: Machine, lines: &[Measured]) {
         .filter(|l| (l.ideal / l.cartesian - 1.0).abs() < 0.005)
         .collect();
     for l in &free {
-        assert!((l.seconds / l.cartesian - 1.0).abs() <= TOLERANCE, "{m:?}: {l:?}");
+        assert!(
+            (l.seconds / l.cartesian - 1.0).abs() <= TOLERANCE,
+            "{m:?}: {l:?}"
+        );
     }
     assert!(
         3 * free.len() >= 2 * lines.len(),
@@ -163,7 +176,12 @@ fn whiteboard_lines_slow_where_a_chain_would_exceed_its_limits() {
         [450.0, -450.0],
         [0.0, 300.0],
     ];
-    let slow = ["$left_max_rate=800", "$right_max_rate=800", "$left_accel=400", "$right_accel=400"];
+    let slow = [
+        "$left_max_rate=800",
+        "$right_max_rate=800",
+        "$left_accel=400",
+        "$right_accel=400",
+    ];
     let lines = every_line_at_its_feed(Machine::Whiteboard, &slow, &places, 4);
     // At least one line was held back by a chain: slower than its
     // trapezoid along the pen's path.
@@ -193,10 +211,16 @@ fn feed_and_place(sim: &mut Sim) -> (f64, [f64; 2], u64) {
     sim.uart_send(b"?");
     let report = |s: &Sim| {
         let text = s.uart_text_from(from);
-        let line = text.lines().find(|l| l.starts_with('<') && l.ends_with('>'))?;
+        let line = text
+            .lines()
+            .find(|l| l.starts_with('<') && l.ends_with('>'))?;
         let field = |name: &str| {
             let f = line.split(['|', '>']).find_map(|f| f.strip_prefix(name))?;
-            Some(f.split(',').map(|v| v.parse::<f64>().unwrap()).collect::<Vec<_>>())
+            Some(
+                f.split(',')
+                    .map(|v| v.parse::<f64>().unwrap())
+                    .collect::<Vec<_>>(),
+            )
         };
         Some((field("FS:")?[0], field("MPos:")?))
     };
@@ -221,7 +245,10 @@ fn status_reports_the_pens_feed() {
         let length = (b[0] - a[0]).hypot(b[1] - a[1]);
         let trapezoid = trapezoid_s(length, 1200.0, cfg.pen_accel as f64);
         let free = ideal(&cfg, a, b, 1200.0).total();
-        assert!((free / trapezoid - 1.0).abs() < 0.005, "{m:?}: {free} s, trapezoid {trapezoid} s");
+        assert!(
+            (free / trapezoid - 1.0).abs() < 0.005,
+            "{m:?}: {free} s, trapezoid {trapezoid} s"
+        );
         let t = Duration::from_secs(60);
         send_ok(&mut sim, &format!("G0 X{} Y{}", a[0], a[1]), t);
         send_ok(&mut sim, "M400", t);
@@ -238,8 +265,14 @@ fn status_reports_the_pens_feed() {
             let moved = (pos[0] - last.1[0]).hypot(pos[1] - last.1[1]);
             let speed = moved / ((cycle - last.2) as f64 / 16e6) * 60.0;
             eprintln!("{m:?} at {pos:?}: FS {feed}, the pen at {speed:.1} mm/min");
-            assert!((feed / 1200.0 - 1.0).abs() < 0.01, "{m:?} at {pos:?}: FS:{feed}");
-            assert!((speed / 1200.0 - 1.0).abs() < 0.02, "{m:?} at {pos:?}: {speed} mm/min");
+            assert!(
+                (feed / 1200.0 - 1.0).abs() < 0.01,
+                "{m:?} at {pos:?}: FS:{feed}"
+            );
+            assert!(
+                (speed / 1200.0 - 1.0).abs() < 0.02,
+                "{m:?} at {pos:?}: {speed} mm/min"
+            );
             last = now;
         }
         sim.run_until(|s| s.uart_text_from(sent).contains("ok\n"), t);
@@ -261,7 +294,11 @@ fn scara_refuses_a_move_behind_its_base_before_anything_moves() {
     send_ok(&mut sim, "G0 X60 Y-150", t);
     send_ok(&mut sim, "M400", t);
     let before = track(&sim).len();
-    for line in ["G1 X140 Y-150 F600", "G3 X140 Y-150 I40 J94 F600", "G0 X140 Y-150"] {
+    for line in [
+        "G1 X140 Y-150 F600",
+        "G3 X140 Y-150 I40 J94 F600",
+        "G0 X140 Y-150",
+    ] {
         match sim.send_line(line, t) {
             Ok(Reply::Error(e)) => assert!(e.starts_with("error:33"), "{line}: {e}"),
             other => panic!("{line}: {other:?}\n{}", log_tail(&sim)),

@@ -45,10 +45,8 @@ fn main() {
     ];
     let machine = std::env::args().nth(1);
     // Those the build has (inlined functions have no symbol).
-    let (names, pcs): (Vec<&str>, Vec<u32>) = names
-        .iter()
-        .filter_map(|n| Some((*n, f(n)?)))
-        .unzip();
+    let (names, pcs): (Vec<&str>, Vec<u32>) =
+        names.iter().filter_map(|n| Some((*n, f(n)?))).unzip();
     let mut sim = Sim::load(elf).unwrap();
     for &pc in &pcs {
         sim.watch_calls(pc);

@@ -495,7 +495,9 @@ impl Planner {
                 // between two junctions (at most (v₀² + v₁²)/2 + a·len)
                 // stays within the joints' limits.
                 let mean = 0.5 * (before.len + this.len);
-                let joints = self.geometry.joints_sqr(&self.jumps, &before.joint, &this.joint, mean);
+                let joints =
+                    self.geometry
+                        .joints_sqr(&self.jumps, &before.joint, &this.joint, mean);
                 // Shifted as the speeds² kept; saturating (∞: none, < 0: 0).
                 let shift = f32::from_bits((127 - self.shift as u32) << 23);
                 ((joints - pen.accel_len_sqr(this.len)) * shift) as u32

@@ -623,7 +623,9 @@ fn feed_figures(elf: &Path, f: &mut Map<String, Value>) {
     ] {
         let r = feed_ratios(elf, machine, lines);
         let name = machine.name().to_string();
-        let (lo, hi) = r.iter().fold((f64::MAX, 0.0f64), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+        let (lo, hi) = r
+            .iter()
+            .fold((f64::MAX, 0.0f64), |(lo, hi), &x| (lo.min(x), hi.max(x)));
         f.insert(format!("feed_ratio_{name}_min"), json!(round(lo, 3)));
         f.insert(format!("feed_ratio_{name}_max"), json!(round(hi, 3)));
     }
@@ -635,7 +637,10 @@ fn main() {
         if flag == "--feed" {
             let mut f = Map::new();
             feed_figures(Path::new(fw), &mut f);
-            println!("{}", serde_json::to_string_pretty(&Value::Object(f)).unwrap());
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&Value::Object(f)).unwrap()
+            );
             return;
         }
     }

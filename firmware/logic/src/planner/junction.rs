@@ -270,7 +270,13 @@ impl Geometry {
     /// every joint within its jump (`AxisJumps`: v·Δshare) and within its
     /// acceleration over `len` µm of the pen's path (its speed changes
     /// by v·Δshare over the time len / v). Infinite: no limit.
-    pub fn joints_sqr(&self, jumps: &AxisJumps, prev: &[f32; AXES], next: &[f32; AXES], len: f32) -> f32 {
+    pub fn joints_sqr(
+        &self,
+        jumps: &AxisJumps,
+        prev: &[f32; AXES],
+        next: &[f32; AXES],
+        len: f32,
+    ) -> f32 {
         let (mut jump, mut curve) = (0.0f32, 0.0f32);
         for i in 0..AXES {
             let change = (next[i] - prev[i]).abs();

@@ -79,7 +79,10 @@ fn assert_within_limits(cfg: &MachineConfig, blocks: &[(Taken, f64)], feed: f64)
         let pen = cruise / k / 1000.0;
         assert!(pen <= feed / 60.0 * 1.0001 + 1e-3, "{pen} mm/s");
         let accel = t.accel as f64 / k / 1000.0;
-        assert!(accel <= cfg.pen_accel as f64 * 1.0001 + 1e-3, "{accel} mm/s²");
+        assert!(
+            accel <= cfg.pen_accel as f64 * 1.0001 + 1e-3,
+            "{accel} mm/s²"
+        );
     }
 }
 
@@ -90,10 +93,16 @@ fn assert_within_limits(cfg: &MachineConfig, blocks: &[(Taken, f64)], feed: f64)
 fn the_arms_40_mm_at_f600_take_the_pens_trapezoid() {
     let cfg = MachineConfig::defaults(Machine::Scara);
     let ideal = trapezoid_s(40.0, 600.0, cfg.pen_accel as f64);
-    for (from, to) in [((80.0, 150.0), (80.0, 190.0)), ((60.0, 200.0), (100.0, 200.0))] {
+    for (from, to) in [
+        ((80.0, 150.0), (80.0, 190.0)),
+        ((60.0, 200.0), (100.0, 200.0)),
+    ] {
         let blocks = line(&cfg, at(from.0, from.1), at(to.0, to.1), 600);
         let s = seconds(&blocks);
-        assert!((s / ideal - 1.0).abs() < 0.002, "{from:?} → {to:?}: {s} s, not {ideal}");
+        assert!(
+            (s / ideal - 1.0).abs() < 0.002,
+            "{from:?} → {to:?}: {s} s, not {ideal}"
+        );
         assert_within_limits(&cfg, &blocks, 600.0);
     }
 }
@@ -107,7 +116,10 @@ fn the_whiteboards_lines_take_the_pens_trapezoid() {
         let length = (to.0 as f64).hypot(to.1);
         let ideal = trapezoid_s(length, feed, cfg.pen_accel as f64);
         let s = seconds(&blocks);
-        assert!((s / ideal - 1.0).abs() < 0.002, "{to:?}: {s} s, not {ideal}");
+        assert!(
+            (s / ideal - 1.0).abs() < 0.002,
+            "{to:?}: {s} s, not {ideal}"
+        );
         assert_within_limits(&cfg, &blocks, feed);
     }
 }
@@ -135,13 +147,21 @@ fn near_full_reach_the_elbow_holds_the_pen_back() {
     assert_within_limits(&cfg, &blocks, 3000.0);
     let ideal = trapezoid_s(99.0, 3000.0, cfg.pen_accel as f64);
     let s = seconds(&blocks);
-    assert!(s > 1.1 * ideal, "{s} s: the elbow did not hold it back ({ideal} s)");
+    assert!(
+        s > 1.1 * ideal,
+        "{s} s: the elbow did not hold it back ({ideal} s)"
+    );
     // The elbow at its top rate somewhere.
     let top = blocks
         .iter()
-        .map(|(t, _)| (t.speeds.cruise_sqr as f64).sqrt() * t.block.steps[1] as f64 / t.block.events as f64)
+        .map(|(t, _)| {
+            (t.speeds.cruise_sqr as f64).sqrt() * t.block.steps[1] as f64 / t.block.events as f64
+        })
         .fold(0.0, f64::max);
-    assert!(top > 0.9 * cfg.axes[1].max_rate as f64, "elbow at most {top} steps/s");
+    assert!(
+        top > 0.9 * cfg.axes[1].max_rate as f64,
+        "elbow at most {top} steps/s"
+    );
 }
 
 /// On a machine whose kinematics are linear a piece is planned as the
@@ -151,7 +171,10 @@ fn linear_machines_plan_pieces_as_moves() {
     for m in [Machine::Flatbed, Machine::Drum, Machine::StringArt] {
         let cfg = MachineConfig::defaults(m);
         let (mut a, mut b) = (Planner::new(&cfg), Planner::new(&cfg));
-        for (k, target) in [[400, 0, 0], [400, 300, 0], [-100, 20, 7]].iter().enumerate() {
+        for (k, target) in [[400, 0, 0], [400, 300, 0], [-100, 20, 7]]
+            .iter()
+            .enumerate()
+        {
             let piece = Piece {
                 start: at(k as f64, 0.0),
                 to: at(k as f64 + 1.0, 3.0),
@@ -189,7 +212,10 @@ fn a_joints_share_changing_limits_the_speed_to_its_acceleration() {
     let v2 = g.joints_sqr(&j, &[0.2, 0.1, 0.0], &[0.21, 0.1, 0.0], 100_000.0);
     let want = (6708.2 / 0.01f64).powi(2);
     assert!((v2 as f64 / want - 1.0).abs() < 1e-3, "{v2} vs {want}");
-    assert_eq!(g.joints_sqr(&j, &[0.2, 0.1, 0.0], &[0.2, 0.1, 0.0], 2000.0), f32::INFINITY);
+    assert_eq!(
+        g.joints_sqr(&j, &[0.2, 0.1, 0.0], &[0.2, 0.1, 0.0], 2000.0),
+        f32::INFINITY
+    );
 }
 
 fn reachable() -> impl Strategy<Value = (f64, f64)> {
@@ -235,4 +261,3 @@ proptest! {
         prop_assert!((s / ideal - 1.0).abs() < 0.01, "{s} s, ideal {ideal}");
     }
 }
-
