@@ -321,7 +321,7 @@ fn scara_refuses_a_move_behind_its_base_before_anything_moves() {
         "ended at {end:?}, not {to:?}"
     );
     // Every shoulder pulse on the way there: none spent going round.
-    let expected = (to[0] - from[0]).abs() as usize;
+    let expected = (to[0] - from[0]).unsigned_abs() as usize;
     let pulses = path.windows(2).filter(|w| w[0].1[0] != w[1].1[0]).count() + 1;
     assert!(
         expected > 8000 && pulses <= expected + 4,

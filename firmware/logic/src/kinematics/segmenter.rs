@@ -227,7 +227,7 @@ mod tests {
         #[test]
         fn pieces_stray_from_the_line_by_far_less_than_a_step(
             x in -500_000i32..500_000, y in -500_000i32..300_000,
-            r in 60_000i32..250_000, b in -1.5f32..1.5, angle in 0.0f32..6.283,
+            r in 60_000i32..250_000, b in -1.5f32..1.5, angle in 0.0f32..core::f32::consts::TAU,
         ) {
             use crate::machine::Machine;
             let k = fine(Machine::Whiteboard);

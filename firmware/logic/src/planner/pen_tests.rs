@@ -113,7 +113,7 @@ fn the_whiteboards_lines_take_the_pens_trapezoid() {
     let cfg = MachineConfig::defaults(Machine::Whiteboard);
     for (to, feed) in [((40.0, 0.0), 600.0), ((-200.0, 150.0), 3000.0)] {
         let blocks = line(&cfg, at(0.0, 0.0), at(to.0, to.1), feed as i32);
-        let length = (to.0 as f64).hypot(to.1);
+        let length = to.0.hypot(to.1);
         let ideal = trapezoid_s(length, feed, cfg.pen_accel as f64);
         let s = seconds(&blocks);
         assert!(
