@@ -61,8 +61,20 @@ fn main() {
     for dir in ["src", "logic/src", "progmem/src", "examples", "Cargo.lock"] {
         println!("cargo:rerun-if-changed={dir}");
     }
-    println!("cargo:rerun-if-changed=../.git/HEAD");
-    println!("cargo:rerun-if-changed=../.git/index");
+    // The commit (and `--dirty`) change with HEAD and the index: where git
+    // keeps them, in a clone (`../.git/HEAD`) or a worktree (`.git` is a
+    // file there). A path that does not exist would rerun this every build.
+    for name in ["HEAD", "index"] {
+        let at = Command::new("git")
+            .args(["rev-parse", "--git-path", name])
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+        if let Some(at) = at.filter(|a| Path::new(a).exists()) {
+            println!("cargo:rerun-if-changed={at}");
+        }
+    }
 
     // rustc links every executable for a GNU cc-style linker with `-no-pie`
     // (avr-none: linker avr-gcc, flavor gnu-cc, static relocation). avr-gcc 5

@@ -13,28 +13,27 @@
 //! and settings are refused here; reads are answered.
 #![deny(unsafe_code)]
 
+mod system;
+
 use crate::board::clock;
 use crate::endstop;
 use crate::motion::Motion;
 use crate::print::Print;
 use crate::queues::{Signal, BUTTONS, JOB_CLAIMS_TX, RX};
 use crate::reply;
-use crate::rt::{stack, Poll};
+use crate::rt::Poll;
+use crate::store::Store;
 use crate::{flash_str, info};
 use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::AXES;
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::config::{MachineConfig, PenConfig};
-use taut_logic::gcode::{
-    CardLine, Error, ErrorKind, Input, Line, Parser, Read, Restore, SystemLine,
-};
+use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Line, Parser, Read};
 use taut_logic::homing::{self, Homing, HomingError, Leg, Next};
 use taut_logic::interp::{Allowed, Interpreter, Order, Path};
 use taut_logic::kinematics::Kinematics;
-use taut_logic::patterns;
 use taut_logic::pinmap::Button;
 use taut_logic::planner::Feed;
-use taut_logic::settings;
 use taut_logic::units::{Decimal, Milli};
 use taut_progmem::{text, Text};
 use ufmt::uwrite;
@@ -67,6 +66,15 @@ pub struct Console {
     /// `$C`: lines are checked and answered, nothing moves.
     checking: bool,
     sleep: Sleep,
+    /// Startup lines still to run (a bit each): at boot, after a reset,
+    /// after `$H`.
+    startup: u8,
+    /// The startup line being answered: where its text is.
+    echo: u16,
+    /// The line waiting in `pending` is a `$N0=`'s, to check and keep.
+    storing: bool,
+    /// A `$N0=` or `$I=` is being written: answered `ok` once it is.
+    saving: bool,
 }
 
 /// `$SLP`: until a reset.
@@ -82,6 +90,8 @@ enum Sleep {
 enum Source {
     Serial,
     Card,
+    /// A startup line from EEPROM.
+    Startup,
 }
 
 enum Pending {
@@ -105,6 +115,7 @@ enum Listing {
     Settings(usize),
     Queues(u8),
     Offsets(u8),
+    Startup(u8),
 }
 
 /// What the console is doing, for the status report.
@@ -146,6 +157,10 @@ impl Console {
             jogging: false,
             checking: false,
             sleep: Sleep::Awake,
+            startup: system::STARTUP,
+            echo: 0,
+            storing: false,
+            saving: false,
         }
     }
 
@@ -169,6 +184,9 @@ impl Console {
         self.jogging = false;
         self.checking = false;
         self.sleep = Sleep::Awake;
+        self.startup = system::STARTUP;
+        self.storing = false;
+        self.saving = false;
         RX.clear();
     }
 
@@ -218,6 +236,7 @@ impl Console {
         kin: &impl Kinematics,
         cfg: &mut MachineConfig,
         owner: Owner,
+        store: &mut Store,
     ) -> Poll<Signal> {
         if self.epoch != m.epoch() {
             self.epoch = m.epoch();
@@ -261,8 +280,18 @@ impl Console {
                 }
             }
             if let Some(listing) = self.listing {
-                self.list(listing, cfg);
+                self.list(listing, cfg, store);
                 return Poll::Again;
+            }
+            // A kept text is answered once written, as Grbl's; lines wait
+            // until then, after a Ctrl-X too (the text being written is
+            // where the store would stage the next one).
+            if store.text_saving() {
+                return Poll::After(4);
+            }
+            if self.saving {
+                self.saving = false;
+                self.ok();
             }
             // A card command waits for the reader.
             if !cfg.machine.is_string_art() && self.card_news(m) {
@@ -273,7 +302,7 @@ impl Console {
             // still hear `M24`.
             if self.pending.is_some() && self.source == Some(Source::Card) && serial_line_waits() {
                 self.source = Some(Source::Serial);
-                let read = self.read(m, cfg, owner);
+                let read = self.read(m, cfg, owner, store);
                 self.source = Some(Source::Card);
                 if let Err(wait) = read {
                     return wait;
@@ -295,13 +324,21 @@ impl Console {
                     }
                     self.jogging = false;
                 }
-                if let Some(wait) = self.run_line(jog, m, kin, cfg, owner) {
+                if let Some(wait) = self.run_line(jog, m, kin, cfg, owner, store) {
                     return wait;
                 }
                 // One line per run: the other tasks get their turn.
                 return Poll::Again;
             }
-            if let Err(wait) = self.read(m, cfg, owner) {
+            // The startup lines first, each read whole from EEPROM.
+            if self.startup != 0 && !self.parser.mid_line() && !self.print.busy() {
+                if store.busy() {
+                    return Poll::After(4);
+                }
+                self.next_startup_line(m, store);
+                continue;
+            }
+            if let Err(wait) = self.read(m, cfg, owner, store) {
                 return wait;
             }
             // A line read whole is carried out in a run of its own: reading
@@ -326,6 +363,7 @@ impl Console {
         kin: &impl Kinematics,
         cfg: &MachineConfig,
         owner: Owner,
+        store: &mut Store,
     ) -> Option<Poll<Signal>> {
         let allowed = Allowed {
             motion: owner == Owner::Console,
@@ -337,12 +375,18 @@ impl Console {
             }
             _ => return None,
         };
+        // A `$N0=` line: checked, kept, not carried out.
+        if self.storing {
+            self.pending = None;
+            self.stored_checked(planned.is_ok(), store);
+        }
         let planned = match planned {
             Err(kind) => {
                 self.pending = None;
                 self.error(&Error::new(kind, 0));
                 return None;
             }
+            Ok(_) if self.saving => return None,
             Ok(planned) => planned,
         };
         if self.checking {
@@ -382,6 +426,7 @@ impl Console {
         m: &mut Motion,
         cfg: &mut MachineConfig,
         owner: Owner,
+        store: &mut Store,
     ) -> Result<(), Poll<Signal>> {
         let mut budget = READ_PER_RUN;
         loop {
@@ -408,7 +453,7 @@ impl Console {
                 },
             };
             if self.parser.read(byte) == Read::LineEnd {
-                self.line_end(m, cfg, owner);
+                self.line_end(m, cfg, owner, store);
                 return Ok(());
             }
         }
@@ -417,7 +462,13 @@ impl Console {
     /// A line has ended: its result, acted on. Out of line, so the line
     /// (~100 B) is on the stack only here, not while bytes are read.
     #[inline(never)]
-    fn line_end(&mut self, m: &mut Motion, cfg: &mut MachineConfig, owner: Owner) {
+    fn line_end(
+        &mut self,
+        m: &mut Motion,
+        cfg: &mut MachineConfig,
+        owner: Owner,
+        store: &mut Store,
+    ) {
         if self.source == Some(Source::Card) {
             self.print.line_done();
         }
@@ -434,7 +485,7 @@ impl Console {
                 self.error(&Error::new(ErrorKind::NotIdle, 0))
             }
             Ok(Input::Jog(line)) => self.pending = Some(Pending::Jog(line)),
-            Ok(Input::System(s)) => self.system(s, m, cfg, owner),
+            Ok(Input::System(ref s)) => self.system(s, m, cfg, owner, store),
             Ok(Input::Card(c)) => self.card_line(c, m, cfg),
         }
     }
@@ -656,6 +707,8 @@ impl Console {
                 let reply = *reply;
                 self.pending = None;
                 self.resync_next_run(m);
+                // Grbl runs the startup lines after a homing cycle.
+                self.startup = system::STARTUP;
                 match reply {
                     true => self.ok(),
                     false => info!("homed"),
@@ -683,10 +736,13 @@ impl Console {
     }
 
     /// `ok` to a line, unless it is a pattern's (answered at its end) or
-    /// the card's.
+    /// the card's; a startup line's `>line:ok`.
     fn ok(&self) {
-        if self.pattern.is_none() && self.source != Some(Source::Card) {
-            reply::ok();
+        match self.source {
+            Some(Source::Startup) => system::startup_reply(self.echo, None),
+            Some(Source::Card) => {}
+            _ if self.pattern.is_some() => {}
+            _ => reply::ok(),
         }
     }
 
@@ -700,6 +756,7 @@ impl Console {
         self.pattern = None;
         match self.source {
             Some(Source::Card) => self.print.line_failed(e, why),
+            Some(Source::Startup) => system::startup_reply(self.echo, Some(e)),
             _ => reply::error_because(e, why),
         }
     }
@@ -761,177 +818,6 @@ impl Console {
         }
         Poll::Again
     }
-
-    #[inline(never)]
-    #[optimize(size)]
-    fn system(&mut self, s: SystemLine, m: &mut Motion, cfg: &mut MachineConfig, owner: Owner) {
-        match s {
-            SystemLine::PrintSettings => {
-                self.listing = Some(Listing::Settings(0));
-                return;
-            }
-            SystemLine::QueueStats => {
-                self.listing = Some(Listing::Queues(0));
-                return;
-            }
-            SystemLine::Stack => {
-                let mut r = reply::line();
-                let _ = uwrite!(
-                    r,
-                    "{}{}{}{}{}",
-                    flash_str!("[stack peak "),
-                    stack::peak(),
-                    flash_str!(" B, headroom "),
-                    stack::headroom(),
-                    flash_str!(" B]")
-                );
-                r.send();
-            }
-            SystemLine::Unlock
-            | SystemLine::Home
-            | SystemLine::Pattern(_)
-            | SystemLine::Set { .. }
-            | SystemLine::Restore(_)
-            | SystemLine::Sleep
-                if self.printing_from_serial() =>
-            {
-                return self.error(&Error::new(ErrorKind::Printing, 0));
-            }
-            // The job's tools: it answers them itself, in its log (and
-            // refuses them while it moves).
-            SystemLine::Set { ref key, ref value } if crate::tools::is_tool(key) => {
-                if let Err(col) = crate::tools::send(key, value) {
-                    return self.error(&Error::new(ErrorKind::InvalidStatement, col));
-                }
-            }
-            // What moves the machine or changes its settings: not while a
-            // job owns it; in check mode Grbl's "not idle".
-            SystemLine::Home
-            | SystemLine::Pattern(_)
-            | SystemLine::Set { .. }
-            | SystemLine::Restore(_)
-            | SystemLine::Sleep
-                if owner == Owner::Job =>
-            {
-                return self.error(&Error::new(ErrorKind::JobOwnsMotion, 0));
-            }
-            SystemLine::Home
-            | SystemLine::Pattern(_)
-            | SystemLine::Set { .. }
-            | SystemLine::Restore(_)
-            | SystemLine::Sleep
-                if self.checking =>
-            {
-                return self.error(&Error::new(ErrorKind::NotIdle, 0));
-            }
-            // Settings are written with the planner empty, as Grbl's.
-            SystemLine::Home | SystemLine::Set { .. } | SystemLine::Restore(_) if !m.is_idle() => {
-                return self.error(&Error::new(ErrorKind::NotIdle, 0));
-            }
-            SystemLine::Unlock => {
-                m.unlock();
-                message(text!("Caution: Unlocked"));
-            }
-            SystemLine::BuildInfo => build_info(cfg),
-            SystemLine::ParserState => {
-                let pen_down = m.pen.pulse_us() == PenConfig::pulse_us(cfg.pen.down_deg);
-                let mut r = reply::line();
-                let _ = uwrite!(r, "[GC:{}]", self.interp.parser_state(pen_down));
-                r.send();
-            }
-            SystemLine::Offsets => {
-                self.listing = Some(Listing::Offsets(0));
-                return;
-            }
-            SystemLine::Home if cfg.homing.axes == 0 => {
-                return self.error(&Error::new(ErrorKind::NoHoming, 0));
-            }
-            SystemLine::Home => return self.start_homing(cfg.homing.axes, m, true),
-            // Answered at its end.
-            SystemLine::Pattern(n) => {
-                self.pattern = patterns::pattern(n).map(|t| (t, 0));
-                return;
-            }
-            SystemLine::Set { key, value } => {
-                let machine = cfg.machine;
-                if let Err(e) = settings::set(cfg, &key, &value) {
-                    // `$key=value`: the value starts after `$`, the key, `=`.
-                    let col = (key.len() + 3 + e.at).min(u8::MAX as usize) as u8;
-                    let invalid = Error::new(ErrorKind::InvalidStatement, col);
-                    return self.error_because(&invalid, Some(e.kind));
-                }
-                m.configure(cfg);
-                if cfg.machine != machine {
-                    // Another machine: where it stands is its zero, and its
-                    // modal state starts afresh.
-                    m.set_position([0; AXES]);
-                    self.interp = Interpreter::new();
-                    self.resync_next_run(m);
-                }
-                self.settings_changed = true;
-            }
-            // The machine's defaults; taut keeps no offsets to clear.
-            SystemLine::Restore(what) => {
-                if what != Restore::Offsets {
-                    restore_defaults(cfg);
-                    m.configure(cfg);
-                    self.settings_changed = true;
-                }
-                message(text!("Restoring defaults"));
-            }
-            // Asleep once it stands (`poll`).
-            SystemLine::Sleep => {
-                m.cancel();
-                self.sleep = Sleep::Falling;
-            }
-            // taut keeps no startup lines: both empty, as a fresh Grbl's.
-            SystemLine::StartupLines => {
-                for n in 0..2 {
-                    let mut r = reply::line();
-                    let _ = uwrite!(r, "{}{}=", flash_str!("$N"), n);
-                    r.send();
-                }
-            }
-            // Grbl leaves check mode with a soft reset: the modal state
-            // afresh, the position read back, the greeting.
-            SystemLine::CheckMode if self.checking => {
-                self.checking = false;
-                message(text!("Disabled"));
-                self.ok();
-                self.interp.reset();
-                self.resync_next_run(m);
-                return reply::banner();
-            }
-            SystemLine::CheckMode if owner == Owner::Job || !m.is_idle() || !m.position_known() => {
-                return self.error(&Error::new(ErrorKind::NotIdle, 0));
-            }
-            SystemLine::CheckMode => {
-                self.checking = true;
-                message(text!("Enabled"));
-            }
-        }
-        self.ok();
-    }
-
-    /// One line of a listing per call: the TX ring never overflows.
-    #[inline(never)]
-    fn list(&mut self, listing: Listing, cfg: &MachineConfig) {
-        self.listing = match listing {
-            Listing::Settings(next) => settings::listed(next, cfg).map(|line| {
-                let mut r = reply::line();
-                let _ = uwrite!(r, "{}", line);
-                r.send();
-                Listing::Settings(next + 1)
-            }),
-            Listing::Queues(line) => {
-                crate::report::queue_line(line).then_some(Listing::Queues(line + 1))
-            }
-            Listing::Offsets(line) => offsets_line(line).then_some(Listing::Offsets(line + 1)),
-        };
-        if self.listing.is_none() {
-            reply::ok();
-        }
-    }
 }
 
 impl Default for Console {
@@ -940,32 +826,10 @@ impl Default for Console {
     }
 }
 
-/// `$I`: `[VER:1.1h.taut-0.1.0:flatbed]` (UGS wants `[VER:1.1`) and
-/// `[OPT:,<planner blocks>,<receive bytes>]`.
-#[inline(never)]
-fn build_info(cfg: &MachineConfig) {
-    let mut r = reply::line();
-    let _ = uwrite!(
-        r,
-        "{}{}]",
-        flash_str!(concat!("[VER:1.1h.taut-", env!("CARGO_PKG_VERSION"), ":")),
-        cfg.machine.name()
-    );
-    r.send();
-    let mut r = reply::line();
-    let _ = uwrite!(
-        r,
-        "{}{},{}]",
-        flash_str!("[OPT:,"),
-        taut_logic::planner::PLANNER_BLOCKS,
-        RX.capacity()
-    );
-    r.send();
-}
-
-/// Line `line` of `$#`; `false` past the last. taut keeps no work
-/// offsets, tool length or probe: every one is zero, in Grbl's format.
-fn offsets_line(line: u8) -> bool {
+/// Line `line` of `$#`; `false` past the last: the work coordinate data
+/// the store keeps; taut keeps no `G92` offset, tool length or probe yet:
+/// zeros, in Grbl's format.
+fn offsets_line(line: u8, coords: &taut_logic::coords::CoordData) -> bool {
     use taut_progmem::text;
     // A table in flash: a `match` costs ~15 B of code an arm.
     const NAMES: usize = 11;
@@ -986,20 +850,30 @@ fn offsets_line(line: u8) -> bool {
         return false;
     }
     let name = names.get(line as usize);
-    let zeros = match line {
-        9 => flash_str!(":0.000]"),
-        10 => flash_str!(":0.000,0.000,0.000:0]"),
-        _ => flash_str!(":0.000,0.000,0.000]"),
-    };
     let mut r = reply::line();
-    let _ = uwrite!(r, "[{}{}", name, zeros);
+    let _ = uwrite!(r, "[{}", name);
+    match taut_logic::coords::Slot::at(line as usize) {
+        Some(slot) => {
+            let v = coords.get(slot);
+            let _ = uwrite!(
+                r,
+                ":{},{},{}]",
+                Decimal(v[0].0, 3),
+                Decimal(v[1].0, 3),
+                Decimal(v[2].0, 3)
+            );
+        }
+        None => {
+            let zeros = match line {
+                9 => flash_str!(":0.000]"),
+                10 => flash_str!(":0.000,0.000,0.000:0]"),
+                _ => flash_str!(":0.000,0.000,0.000]"),
+            };
+            let _ = uwrite!(r, "{}", zeros);
+        }
+    }
     r.send();
     true
-}
-
-/// The machine's defaults in place of `cfg`.
-fn restore_defaults(cfg: &mut MachineConfig) {
-    cfg.load_defaults(cfg.machine);
 }
 
 /// Grbl's feedback message: `[MSG:<text>]`.

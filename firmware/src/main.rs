@@ -23,7 +23,7 @@
 //! | `Card` SD reader: one block per run | software | 1 | `CARD_IN`, every 1 s | `CARD_OUT` |
 //! | `Motion` planner → segments, background | software | 1 | planner | as `Refill` |
 //! | `Logger` deferred reports | software | 0 | every 1 s | `TX` |
-//! | `Store` checkpoint, settings → EEPROM, a changed byte per run | software | 0 | the job's checkpoint, signal `Settings` | EEPROM |
+//! | `Store` checkpoint, settings, coordinates, startup lines → EEPROM (two copies each), a changed byte per run | software | 0 | the job's checkpoint, signal `Settings` | EEPROM |
 #![no_std]
 #![no_main]
 #![feature(abi_avr_interrupt, asm_experimental_arch, optimize_attribute)]
@@ -306,9 +306,13 @@ fn init() -> Watchdog {
     spawn(Task::Card);
     // A machine that homes at power-on (the flatbed's X) does so first.
     let homing = CONFIG.with(|c| c.homing);
-    if homing.at_start && homing.axes != 0 {
+    let enabled = CONFIG.with(|c| STORE.with(|s| s.as_ref().unwrap().extras().homing_enabled(c)));
+    if homing.at_start && enabled {
         info!("homing");
         MOTION.with(|m| CONSOLE.with(|c| c.start_homing(homing.axes, m.as_mut().unwrap(), false)));
+    }
+    // The startup lines (after the homing, if any).
+    if homing.at_start && enabled || startup_lines() {
         spawn(Task::Console);
     }
     // Last: the blinks are timed from here, the dispatcher's start.
@@ -339,15 +343,17 @@ fn init_cells() {
 #[inline(never)]
 #[optimize(size)]
 fn load_store(eeprom: Eeprom) -> (bool, Found) {
-    let mut store = Store::new(eeprom);
-    // CONFIG starts as the defaults, read from flash (a starting value in
-    // `.data` would be a second copy of them in flash), in place: a copy
-    // would sit on init's stack.
+    // The store made in its cell (~300 B: not on init's stack), CONFIG
+    // as the defaults, read from flash (a starting value in `.data` would
+    // be a second copy of them in flash), in place: a copy would sit on
+    // init's stack.
+    STORE.with(|s| *s = Some(Store::new(eeprom)));
     CONFIG.init_with(|c| MachineConfig::init_defaults(Machine::StringArt, c));
-    let store_now = CONFIG.with(|c| store.load(c));
-    let found = store.load_checkpoint();
-    STORE.with(|s| *s = Some(store));
-    (store_now, found)
+    STORE.with(|s| {
+        let store = s.as_mut().unwrap();
+        let store_now = CONFIG.with(|c| store.load(c));
+        (store_now, store.load_checkpoint())
+    })
 }
 
 #[inline(never)]
@@ -455,14 +461,22 @@ fn console() {
         true => Owner::Job,
         false => Owner::Console,
     };
-    let poll = MOTION.with(|m| {
+    let (poll, store_due) = MOTION.with(|m| {
         CONFIG.with(|cfg| {
             KIN.with(|kin| {
                 let kin = kin.as_ref().unwrap();
-                CONSOLE.with(|c| c.poll(m.as_mut().unwrap(), kin, cfg, owner))
+                STORE.with(|s| {
+                    let s = s.as_mut().unwrap();
+                    let poll = CONSOLE.with(|c| c.poll(m.as_mut().unwrap(), kin, cfg, owner, s));
+                    (poll, s.wants_run())
+                })
             })
         })
     });
+    // A `$` change or a coordinate write goes to EEPROM.
+    if store_due {
+        signal(Signal::Settings);
+    }
     // New moves may be queued: the motion task feeds them to the stepper.
     spawn(Task::Motion);
     reschedule(Task::Console, poll);
@@ -482,12 +496,11 @@ fn console() {
     }
 }
 
-/// A `$` line changed the settings. Out of line: the kinematics it makes
-/// stay off the console's frame.
+/// A `$` line changed the settings (the store has them to write). Out of
+/// line: the kinematics it makes stay off the console's frame.
 #[inline(never)]
 fn console_settings_changed() {
     CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
-    settings_changed();
     // The string-art job runs only on its machine.
     spawn(Task::Job);
 }
@@ -508,6 +521,10 @@ fn realtime() {
             m.set_overrides(Overrides::NONE);
             control_job(Control::Abort);
             realtime::after_reset(m, activity == Activity::Homing, moving);
+            // Its startup lines.
+            if startup_lines() {
+                spawn(Task::Console);
+            }
         }
         // `!` while jogging cancels the jog; while homing only the door
         // stops (Grbl's alarm 7).
@@ -557,6 +574,11 @@ fn realtime() {
     // frees the planner for whoever waits.
     spawn(Task::Refill);
     signal(Signal::Motion);
+}
+
+/// A startup line is kept: the console runs it.
+fn startup_lines() -> bool {
+    STORE.with(|s| s.as_ref().unwrap().has_startup_lines())
 }
 
 fn control_job(c: Control) {
@@ -645,7 +667,8 @@ fn settings_changed() {
     signal(Signal::Settings);
 }
 
-/// Checkpoint and settings into EEPROM, a changed byte per run.
+/// Checkpoint, settings, coordinates and kept lines into EEPROM, a changed
+/// byte per run.
 #[inline(never)]
 #[optimize(size)]
 fn store() {

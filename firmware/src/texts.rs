@@ -133,6 +133,7 @@ pub fn error(e: ErrorKind) -> FlashStr {
         PenWithMove,
         NoHoming,
         InvalidJogCommand,
+        LineLengthExceeded,
         NoCard,
         CardFailed,
         FileNotFound,

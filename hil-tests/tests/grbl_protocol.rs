@@ -156,7 +156,7 @@ fn numbered_settings_list_and_write_through_to_the_named_ones() {
     let listing = replies_all(&send(&mut sim, "$$"));
     assert_eq!(
         listing[..4],
-        ["$0=5", "$1=255", "$3=0", "$10=3"],
+        ["$0=5", "$1=255", "$2=0", "$3=0"],
         "{listing:?}"
     );
     for line in [
@@ -181,9 +181,9 @@ fn numbered_settings_list_and_write_through_to_the_named_ones() {
         "{listing:?}"
     );
     let from = sim.uart_bytes().len();
-    match sim.send_line("$21=1", Duration::from_secs(2)) {
+    match sim.send_line("$3=8", Duration::from_secs(2)) {
         Ok(hil_tests::sim::Reply::Error(e)) => {
-            assert_eq!(e, "error:3 Invalid statement: expected 0 to 0 (col 5)")
+            assert_eq!(e, "error:3 Invalid statement: expected 0 to 7 (col 4)")
         }
         other => panic!("{other:?}\n{}", log_tail(&sim)),
     }
@@ -191,7 +191,7 @@ fn numbered_settings_list_and_write_through_to_the_named_ones() {
     // what follows `error:` as the number), the words in a message before.
     assert_eq!(
         sim.uart_text_from(from),
-        "[MSG:Invalid statement: expected 0 to 0 (col 5)]\nerror:3\n"
+        "[MSG:Invalid statement: expected 0 to 7 (col 4)]\nerror:3\n"
     );
 }
 

@@ -271,10 +271,14 @@ fn the_picture_counts_from_the_homed_zero_not_from_power_on() {
     use hil_tests::wait_for;
     use taut_logic::config::MachineConfig;
     use taut_logic::pinmap::Button;
-    use taut_logic::settings::image;
+    use taut_logic::settings::record::host;
     let cfg = MachineConfig::defaults(Machine::Flatbed);
     let mut sim = Sim::load(&hil_tests::firmware_elf()).unwrap();
-    sim.set_eeprom(&image::bytes(&cfg).collect::<Vec<u8>>());
+    sim.set_eeprom(&host::eeprom(
+        &cfg,
+        &Default::default(),
+        &Default::default(),
+    ));
     sim.probe_machine(Machine::Flatbed);
     for b in Button::ALL {
         sim.release(b.pin());

@@ -1,20 +1,25 @@
-//! The settings survive a power cycle in EEPROM; a blank or corrupt EEPROM
-//! gives the defaults with one warning line, never garbage.
+//! The settings survive a power cycle in EEPROM, two copies each; a blank
+//! EEPROM gives the defaults with one warning line, a copy gone bad is
+//! passed over in silence for the other, both gone bad give the defaults
+//! with one warning, never garbage; a board flashed with format version 6
+//! keeps its settings. (A cut in the middle of a write: `settings_cut.rs`.)
 
 use hil_tests::sim::Sim;
 use hil_tests::{boot_machine, firmware_elf, log_tail, send_ok, wait_for};
 use std::time::Duration;
 use taut_logic::config::MachineConfig;
-use taut_logic::settings::image;
+use taut_logic::machine::Machine;
+use taut_logic::settings::image::legacy;
+use taut_logic::settings::record::{host, MARKER, SETTINGS};
+use taut_logic::settings::set;
 
 fn send(sim: &mut Sim, line: &str) {
     send_ok(sim, line, Duration::from_secs(2));
 }
 
 /// The settings the EEPROM holds, decoded as the firmware would.
-fn stored(sim: &Sim) -> Result<MachineConfig, image::Unusable> {
-    let ee = sim.eeprom();
-    image::decode(|i| ee[i], &MachineConfig::STRING_ART)
+fn stored(sim: &Sim) -> Option<MachineConfig> {
+    host::settings(&sim.eeprom()).map(|(cfg, _)| cfg)
 }
 
 /// The same image powered up again with `eeprom` (all a power cut keeps).
@@ -44,18 +49,19 @@ fn settings_survive_a_power_cycle() {
         "settings: EEPROM blank: defaults",
         Duration::from_millis(100),
     );
-    // 199 bytes at 3.4 ms each, a byte a run of the lowest task.
-    sim.run_for(Duration::from_secs(2));
+    // Every record once, a byte a run of the lowest task, then the marker.
+    sim.run_for(Duration::from_secs(3));
     assert_eq!(
         stored(&sim),
-        Ok(MachineConfig::STRING_ART),
+        Some(MachineConfig::STRING_ART),
         "defaults written"
     );
+    assert_eq!(sim.eeprom()[..5], MARKER);
     send(&mut sim, "$base_max_rate=1500");
     send(&mut sim, "$radial_travel_min=-300");
-    sim.run_for(Duration::from_millis(500));
+    sim.run_for(Duration::from_millis(800));
     let mut again = power_on(&sim.eeprom());
-    sim.run_for(Duration::from_millis(100));
+    again.run_for(Duration::from_millis(100));
     assert!(
         !again.uart_text().contains("settings:"),
         "{}",
@@ -79,26 +85,83 @@ fn settings_survive_a_power_cycle() {
 }
 
 #[test]
-fn a_corrupt_eeprom_gives_the_defaults_with_one_warning() {
+fn a_bad_copy_is_passed_over_and_two_give_the_defaults_with_one_warning() {
     let mut sim = boot_machine();
+    sim.run_for(Duration::from_secs(3));
     send(&mut sim, "$base_accel=750");
     sim.run_for(Duration::from_secs(1));
-    let mut ee = sim.eeprom();
-    ee[20] ^= 0x04;
-    let mut again = power_on(&ee);
-    again.run_for(Duration::from_secs(1));
-    let text = again.uart_text();
+    send(&mut sim, "$base_accel=740");
+    sim.run_for(Duration::from_secs(1));
+    let good = sim.eeprom();
+    // The newer copy (740) flipped in its payload: the older (750) holds,
+    // and nothing is said.
+    let newer = (0..2u8)
+        .max_by_key(|&c| {
+            let at = SETTINGS.copy(c) as usize;
+            u16::from_le_bytes([good[at + 3], good[at + 4]])
+        })
+        .unwrap();
+    let mut one = good.clone();
+    one[SETTINGS.copy(newer) as usize + 40] ^= 0x04;
+    let mut again = power_on(&one);
+    again.run_for(Duration::from_millis(300));
+    assert!(
+        !again.uart_text().contains("settings:"),
+        "{}",
+        log_tail(&again)
+    );
+    assert_eq!(listed(&mut again, "base_accel"), "750");
+    // Both: the defaults, one warning line, written back whole.
+    let mut both = one.clone();
+    both[SETTINGS.copy(1 - newer) as usize + 40] ^= 0x04;
+    let mut third = power_on(&both);
+    third.run_for(Duration::from_secs(2));
+    let text = third.uart_text();
     assert_eq!(
         text.matches("settings: EEPROM corrupt (checksum): defaults")
             .count(),
         1,
         "{}",
-        log_tail(&again)
+        log_tail(&third)
     );
-    assert_eq!(listed(&mut again, "base_accel"), "500");
-    assert_eq!(
-        stored(&again),
-        Ok(MachineConfig::STRING_ART),
-        "rewritten whole"
+    assert_eq!(listed(&mut third, "base_accel"), "500");
+    assert_eq!(stored(&third), Some(MachineConfig::STRING_ART), "rewritten");
+}
+
+/// A board flashed before kept its settings in one copy of format 6 at
+/// byte 0: the first boot takes them (and says so once), writes them in
+/// two copies, then marks the EEPROM; a stale checkpoint area is dropped
+/// without a word; the next boot is silent.
+#[test]
+fn a_version_6_board_keeps_its_settings() {
+    let mut cfg = MachineConfig::defaults(Machine::Drum);
+    set(&mut cfg, "x_max_rate", "700").unwrap();
+    set(&mut cfg, "pen_down", "25").unwrap();
+    let mut ee = vec![0xFF; 4096];
+    let v6: Vec<u8> = legacy::bytes(&cfg).collect();
+    ee[..v6.len()].copy_from_slice(&v6);
+    // Records of the old checkpoint ring where the new records go.
+    for (i, b) in ee[576..1600].iter_mut().enumerate() {
+        *b = (i * 37 % 251) as u8;
+    }
+    let mut sim = power_on(&ee);
+    sim.run_for(Duration::from_secs(3));
+    let text = sim.uart_text();
+    assert!(
+        text.contains("settings: carried over from format version 6"),
+        "{text}"
     );
+    assert!(!text.contains("corrupt"), "{text}");
+    assert_eq!(listed(&mut sim, "x_max_rate"), "700");
+    assert_eq!(listed(&mut sim, "pen_down"), "25");
+    assert_eq!(sim.eeprom()[..5], MARKER);
+    assert_eq!(stored(&sim), Some(cfg));
+    let mut again = power_on(&sim.eeprom());
+    again.run_for(Duration::from_millis(300));
+    let text = again.uart_text();
+    assert!(
+        !text.contains("settings:") && !text.contains("checkpoint"),
+        "{text}"
+    );
+    assert_eq!(listed(&mut again, "machine"), "drum");
 }

@@ -2,7 +2,7 @@
 //! cut, a brown-out or a watchdog reset left the job, so that the next
 //! boot can offer to go on from there.
 //!
-//! Layout, above the settings image (`settings::image`, bytes 0..len):
+//! Layout, above the settings' records (`settings::record`, bytes 0..END):
 //!
 //! | bytes | what |
 //! | --- | --- |
@@ -30,8 +30,8 @@
 use crate::files::check::{CardId, FileSum};
 use crate::stringart::job::Phase;
 
-/// First byte of the checkpoint area (the settings image ends below it).
-pub const START: u16 = 512;
+/// First byte of the checkpoint area (the settings' records end below it).
+pub const START: u16 = 1536;
 /// The ATmega2560's EEPROM size.
 pub const END: u16 = 4096;
 pub const HEADER_BYTES: u16 = 32;

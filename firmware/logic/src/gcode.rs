@@ -45,4 +45,4 @@ pub use line::{
 pub use number::parse_milli;
 pub use parser::{Parser, Read, MAX_LINE};
 pub use status::{Extra, Overrides, Refresh, State, Status, OVERRIDE_BYTES};
-pub use system::{Restore, SystemLine, SystemText, SYSTEM_TEXT};
+pub use system::{Restore, SystemLine, SystemText, SystemValue, SYSTEM_TEXT, SYSTEM_VALUE};

@@ -23,6 +23,7 @@ pub mod axis;
 pub mod buttons;
 pub mod checkpoint;
 pub mod config;
+pub mod coords;
 pub mod fat;
 pub mod files;
 /// Table-free `sin_cos`, `atan2` and `sqrt`: no constant tables in the AVR's SRAM.

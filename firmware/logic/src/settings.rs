@@ -17,6 +17,7 @@ use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
 pub mod grbl;
 pub mod image;
+pub mod record;
 
 /// A setting value that did not fit: what, and at which byte of the value.
 pub type SettingError = NumError;
@@ -285,11 +286,11 @@ pub fn for_each(cfg: &MachineConfig, mut f: impl FnMut(Setting, Value)) {
 }
 
 /// Line `index` of `$$`: Grbl's numbered settings, then ours by name.
-pub fn listed(index: usize, cfg: &MachineConfig) -> Option<Listed> {
+pub fn listed(index: usize, cfg: &MachineConfig, ex: &grbl::Extras) -> Option<Listed> {
     Some(match index.checked_sub(grbl::COUNT) {
         None => {
             let n = grbl::Numbered::at(index)?;
-            Listed(Key::Number(n.number()), n.get(cfg))
+            Listed(Key::Number(n.number()), n.get(cfg, ex))
         }
         Some(i) => {
             let s = Setting::at(i)?;
@@ -315,12 +316,9 @@ impl uDisplay for Listed {
     }
 }
 
-/// Sets a setting from its text: by Grbl's number (`110`) or by name (in
-/// any case, axes named as `cfg`'s machine names them).
+/// Sets a setting from its text, by name (in any case, axes named as
+/// `cfg`'s machine names them). Grbl's numbers: [`grbl::Numbered::set`].
 pub fn set(cfg: &mut MachineConfig, key: &str, value: &str) -> Result<(), SettingError> {
-    if let Some(n) = grbl::Numbered::parse(key.as_bytes()) {
-        return n.set(cfg, value.as_bytes());
-    }
     let setting = Setting::parse(key.as_bytes(), cfg.machine).ok_or(NumError {
         at: 0,
         kind: ErrorKind::UnknownKey,

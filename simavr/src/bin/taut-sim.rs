@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
-use taut_logic::settings::image;
+use taut_logic::settings::record::host;
 use taut_simavr::clock::{cycles_in, FREQ_HZ};
 use taut_simavr::operator::Seen;
 use taut_simavr::pty::{Pace, Pty};
@@ -367,13 +367,16 @@ fn run(args: Args) -> Result<Ending, Box<dyn std::error::Error>> {
     // A cut may fall in the middle of an EEPROM write.
     sim.watch_eeprom();
     if let Some(m) = args.machine {
-        let image: Vec<u8> = image::bytes(&MachineConfig::defaults(m)).collect();
-        sim.set_eeprom(&image);
+        let cfg = MachineConfig::defaults(m);
+        sim.set_eeprom(&host::eeprom(
+            &cfg,
+            &Default::default(),
+            &Default::default(),
+        ));
     }
     // The machine the EEPROM holds: its channel names and switches.
     let eeprom = sim.eeprom();
-    let cfg = image::decode(|i| eeprom[i], &MachineConfig::STRING_ART)
-        .unwrap_or(MachineConfig::STRING_ART);
+    let cfg = host::settings(&eeprom).map_or(MachineConfig::STRING_ART, |(c, _)| c);
     sim.probe_machine(cfg.machine);
     let endstops = sim.fit_machine_endstops(&cfg, args.endstop_mm);
     let param = match &args.sd {

@@ -75,7 +75,7 @@ fn the_listing_gives_the_machine_s_figures() {
     assert_ne!(cfg, MachineConfig::defaults(Machine::Flatbed));
     let mut listing = vec!["[MSG:a note]".to_string()];
     for i in 0.. {
-        let Some(listed) = settings::listed(i, &cfg) else {
+        let Some(listed) = settings::listed(i, &cfg, &Default::default()) else {
             break;
         };
         let mut line = Line(String::new());

@@ -79,6 +79,9 @@ pub enum ErrorKind {
     /// `G28`/`$H` on a machine with no axis set to home (Grbl's "setting
     /// disabled").
     NoHoming = 5,
+    /// A startup line or build info line (`$N0=`, `$I=`) longer than is
+    /// kept.
+    LineLengthExceeded = 14,
 }
 
 /// The slowest feed rate accepted, thousandths of a unit per minute.
@@ -121,6 +124,7 @@ impl ErrorKind {
             ErrorKind::PenWithMove => "Pen Z with X/Y: one line each",
             ErrorKind::NoHoming => "Homing not enabled (homing_axes)",
             ErrorKind::InvalidJogCommand => "Invalid jog command",
+            ErrorKind::LineLengthExceeded => "Line length exceeded",
         }
     }
 }

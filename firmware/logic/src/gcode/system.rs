@@ -1,17 +1,24 @@
-//! `$` lines (Grbl's system commands): spaces are ignored, every error is
-//! Grbl's 3 "Invalid statement".
+//! `$` lines (Grbl's system commands, `system.c`): spaces are ignored,
+//! every error is Grbl's 3 "Invalid statement".
 
 use super::error::{Error, ErrorKind};
 use heapless::String;
 
-/// Longest `$` key and value, characters.
+/// Longest `$` key, characters.
 pub const SYSTEM_TEXT: usize = 24;
+/// Longest `$` value: a startup line (`$N0=`) as Grbl keeps one
+/// (`EEPROM_LINE_SIZE`, 80, with `$N0=` and its end).
+pub const SYSTEM_VALUE: usize = 75;
 
-/// A key or value of a `$` line.
+/// A key of a `$` line.
 pub type SystemText = String<SYSTEM_TEXT, u8>;
+/// A value of a `$` line.
+pub type SystemValue = String<SYSTEM_VALUE, u8>;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum SystemLine {
+    /// `$`: Grbl's help line (`[HLP:…]`).
+    Help,
     /// `$$`: print the settings.
     PrintSettings,
     /// `$Q`: planner queue statistics.
@@ -31,10 +38,12 @@ pub enum SystemLine {
     ParserState,
     /// `$#`: the coordinate offsets (`[G54:…]` … `[PRB:…]`).
     Offsets,
-    /// `$<key>=<value>`, both as typed; the settings module interprets
-    /// them (e.g. with [`parse_milli`](super::parse_milli)).
-    Set { key: SystemText, value: SystemText },
-    /// `$N`: the startup lines (taut keeps none: `$N0=` `$N1=`).
+    /// `$<key>=<value>`, both as typed (spaces and comments dropped); the
+    /// settings module interprets them (e.g. with
+    /// [`parse_milli`](super::parse_milli)). `$N0=`, `$N1=` (a startup
+    /// line) and `$I=` (the build info line) may have an empty value.
+    Set { key: SystemText, value: SystemValue },
+    /// `$N`: the startup lines.
     StartupLines,
     /// `$C`: check mode on, or off (with a soft reset).
     CheckMode,
@@ -49,7 +58,7 @@ pub enum SystemLine {
 pub enum Restore {
     /// `$`: the settings (the machine's defaults).
     Settings,
-    /// `#`: the offsets (taut keeps none).
+    /// `#`: the work coordinate data.
     Offsets,
     /// `*`: both.
     All,
@@ -61,7 +70,7 @@ pub(super) struct SystemBuilder {
     /// Column of the `$`: where errors found at the end point.
     dollar: u8,
     key: SystemText,
-    value: SystemText,
+    value: SystemValue,
     equals: bool,
     error: Option<Error>,
 }
@@ -79,7 +88,13 @@ impl SystemBuilder {
 
     pub(super) fn feed(&mut self, c: u8, column: u8) {
         if self.error.is_none() && !matches!(c, b' ' | b'\t') && self.take(c).is_err() {
-            self.error = Some(Error::new(ErrorKind::InvalidStatement, column));
+            // A text to keep longer than is kept: Grbl's 14.
+            let kind =
+                match self.equals && may_be_empty(&self.key) && self.value.len() == SYSTEM_VALUE {
+                    true => ErrorKind::LineLengthExceeded,
+                    false => ErrorKind::InvalidStatement,
+                };
+            self.error = Some(Error::new(kind, column));
         }
     }
 
@@ -129,7 +144,7 @@ impl SystemBuilder {
             };
         }
         if self.equals {
-            return if self.value.is_empty() {
+            return if self.value.is_empty() && !may_be_empty(&self.key) {
                 Err(Error::new(ErrorKind::InvalidStatement, end))
             } else {
                 Ok(SystemLine::Set {
@@ -141,6 +156,7 @@ impl SystemBuilder {
         // Byte patterns, not string ones: those compare with constant
         // strings, which the AVR keeps in SRAM.
         match self.key.as_bytes() {
+            [] => Ok(SystemLine::Help),
             [b'$'] => Ok(SystemLine::PrintSettings),
             [b'Q' | b'q'] => Ok(SystemLine::QueueStats),
             [b'S' | b's'] => Ok(SystemLine::Stack),
@@ -158,6 +174,12 @@ impl SystemBuilder {
             _ => Err(Error::new(ErrorKind::InvalidStatement, self.dollar)),
         }
     }
+}
+
+/// `N0`, `N1` and `I`: a text to keep, which may be empty (Grbl clears it
+/// so).
+fn may_be_empty(key: &str) -> bool {
+    matches!(key.as_bytes(), [b'N' | b'n', b'0' | b'1'] | [b'I' | b'i'])
 }
 
 /// `RST`, in any case (compared with a text in flash).

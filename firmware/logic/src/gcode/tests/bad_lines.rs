@@ -19,6 +19,13 @@ const BAD: &[(&str, u8, u8)] = &[
     ("$key=", 3, 6),
     ("$a-b=1", 3, 3),
     ("$abcdefghijklmnopqrstuvwxy=1", 3, 26),
+    // A startup line longer than Grbl keeps (`$N0=` and 75 characters).
+    (
+        "$N0=G1X1234567890123456789012345678901234567890123456789012345678901234567890123",
+        14,
+        80,
+    ),
+    ("$N2=", 3, 5),
     ("G1 X1 F-5", 4, 7),
     ("G4 P-1", 4, 4),
     ("G5 X1", 20, 1),

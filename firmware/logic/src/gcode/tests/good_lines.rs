@@ -164,6 +164,12 @@ fn system_lines() {
         assert_eq!(parse(&line), Ok(Input::System(SystemLine::Restore(what))));
     }
     assert_eq!(parse("$N0=G20"), set("N0", "G20"));
+    // Grbl's help, and the texts `$N0=`, `$N1=`, `$I=` cleared.
+    assert_eq!(parse("$"), Ok(Input::System(SystemLine::Help)));
+    assert_eq!(parse("$N0="), set("N0", ""));
+    assert_eq!(parse("$n1="), set("n1", ""));
+    assert_eq!(parse("$I="), set("I", ""));
+    assert_eq!(parse("$N1=G20 (inches) G90"), set("N1", "G20G90"));
     assert_eq!(parse("$ steps_c = 26.667"), set("steps_c", "26.667"));
     assert_eq!(parse("$100=80"), set("100", "80"));
     assert_eq!(parse("$Q=-1"), set("Q", "-1"));

@@ -1,158 +1,136 @@
 use super::*;
-use crate::settings::set;
-use std::vec;
+use crate::settings::grbl::Numbered;
+use crate::settings::{all, set};
 use std::vec::Vec;
 
 const BASE: MachineConfig = MachineConfig::STRING_ART;
 
-fn image(cfg: &MachineConfig) -> Vec<u8> {
-    bytes(cfg).collect()
+fn payload(cfg: &MachineConfig, ex: &Extras) -> Vec<u8> {
+    (0..)
+        .map_while(|k| part(cfg, ex, k))
+        .flat_map(|(b, n)| b.into_iter().take(n as usize))
+        .collect()
 }
 
-fn read(img: &[u8]) -> Result<MachineConfig, Unusable> {
-    decode(|i| img[i], &BASE)
+fn read(p: &[u8]) -> Result<(MachineConfig, Extras), Unusable> {
+    let (mut cfg, mut ex) = (BASE, Extras::DEFAULT);
+    decode_into(|i| p[i as usize], &mut cfg, &mut ex).map(|()| (cfg, ex))
 }
 
 #[test]
-fn an_image_reads_back_as_the_settings_it_was_made_of() {
+fn a_payload_reads_back_as_the_settings_it_was_made_of() {
     let mut cfg = BASE;
+    let mut ex = Extras::DEFAULT;
     set(&mut cfg, "base_max_rate", "1500").unwrap();
     set(&mut cfg, "drill_steps_per_unit", "1600/10").unwrap();
     set(&mut cfg, "radial_travel_min", "-201.5").unwrap();
     set(&mut cfg, "step_pulse_us", "7").unwrap();
-    let img = image(&cfg);
-    assert_eq!(img.len(), len());
-    assert_eq!(len(), HEADER + all().map(width).sum::<usize>() + 2);
-    assert_eq!(&img[..4], b"taut");
-    assert_eq!(read(&img), Ok(cfg));
-    assert_eq!(read(&image(&BASE)), Ok(BASE));
+    Numbered::MaxRate(0)
+        .set(&mut cfg, &mut ex, b"2345")
+        .unwrap();
+    Numbered::SpindleMax
+        .set(&mut cfg, &mut ex, b"24000")
+        .unwrap();
+    Numbered::HardLimits.set(&mut cfg, &mut ex, b"1").unwrap();
+    let p = payload(&cfg, &ex);
+    assert_eq!(p.len(), PAYLOAD as usize);
+    for n in [V6, STORED] {
+        let widths = (0..n).map(|k| width(stored(k).unwrap())).sum::<usize>();
+        assert_eq!(named_bytes(n), widths);
+    }
+    assert_eq!(read(&p), Ok((cfg, ex)));
+    assert_eq!(
+        read(&payload(&BASE, &Extras::DEFAULT)),
+        Ok((BASE, Extras::DEFAULT))
+    );
 }
 
 #[test]
-fn blank_other_and_corrupt_images_give_reasons_not_garbage() {
-    assert_eq!(read(&[0xFF; 512]), Err(Unusable::Blank));
-    let mut img = image(&BASE);
-    img[4] = VERSION + 1;
-    assert_eq!(read(&img), Err(Unusable::OtherVersion(VERSION + 1)));
-    // Any single byte changed, or two swapped, is caught.
-    let good = image(&BASE);
-    for i in 5..good.len() {
-        let mut bad = good.clone();
+fn a_payload_with_a_refused_value_is_refused() {
+    // A max rate of 0: the base's, after the count, the extras, the
+    // machine (4 bytes) and the base's steps per unit (8).
+    let named = NAMED_AT as usize;
+    let mut p = payload(&BASE, &Extras::DEFAULT);
+    p[named + 12..named + 16].copy_from_slice(&0u32.to_le_bytes());
+    assert!(matches!(read(&p), Err(Unusable::Refused(_))));
+    // Each value fine, the set not: a pulse too long for the rate.
+    let mut p = payload(&BASE, &Extras::DEFAULT);
+    let pulse = named + 4 + 3 * (8 + 7 * 4);
+    p[pulse..pulse + 4].copy_from_slice(&255u32.to_le_bytes());
+    assert_eq!(read(&p), Err(Unusable::Inconsistent));
+}
+
+#[test]
+fn a_version_6_image_is_carried_over() {
+    let mut cfg = BASE;
+    set(&mut cfg, "base_accel", "750").unwrap();
+    set(&mut cfg, "machine", "flatbed").unwrap();
+    set(&mut cfg, "x_travel_max", "150").unwrap();
+    let img: Vec<u8> = legacy::bytes(&cfg).collect();
+    assert_eq!(img.len(), legacy::len());
+    assert_eq!(img.len(), 215, "what boards flashed before hold");
+    let decode = |img: &[u8]| {
+        let mut out = BASE;
+        legacy::decode_into(|i| img.get(i as usize).copied().unwrap_or(0xFF), &mut out)
+            .map(|()| out)
+    };
+    assert_eq!(decode(&img), Ok(cfg));
+    assert_eq!(decode(&[0xFF; 300]), Err(Unusable::Blank));
+    let mut other = img.clone();
+    other[4] = 5;
+    assert_eq!(decode(&other), Err(Unusable::OtherVersion(5)));
+    for i in 5..img.len() {
+        let mut bad = img.clone();
         bad[i] ^= 0x10;
-        assert_eq!(read(&bad), Err(Unusable::Checksum), "byte {i}");
-    }
-    let mut swapped = good.clone();
-    swapped.swap(10, 20);
-    assert_eq!(read(&swapped), Err(Unusable::Checksum));
-    // A cut mid-write: the first half new, the rest old.
-    let mut new = BASE;
-    set(&mut new, "base_accel", "750").unwrap();
-    let newer = image(&new);
-    let mut half: Vec<u8> = newer[..30].to_vec();
-    half.extend_from_slice(&good[30..]);
-    assert_ne!(half, good);
-    assert_eq!(read(&half), Err(Unusable::Checksum));
-}
-
-#[test]
-fn a_consistent_image_with_a_refused_value_is_refused() {
-    // Hand-made: a max rate of 0, with a checksum that matches.
-    let mut body: Vec<u8> = image(&BASE);
-    body.truncate(len() - 2);
-    let at = 5 + 8; // base_max_rate follows base_steps_per_unit (8 bytes)
-    body[at..at + 4].copy_from_slice(&0u32.to_le_bytes());
-    let mut sum = Fletcher::new();
-    body.iter().for_each(|&b| sum.add(b));
-    body.extend_from_slice(&sum.value().to_le_bytes());
-    assert!(matches!(read(&body), Err(Unusable::Refused(_))));
-    // In place: a refused value leaves every setting as it was, those
-    // before it in the image too.
-    let mut cfg = BASE;
-    set(&mut cfg, "radial_accel", "321").unwrap();
-    let before = cfg;
-    let found = decode_into(|i| body[i], &mut cfg);
-    assert!(matches!(found, Err(Unusable::Refused(_))));
-    assert_eq!(cfg, before);
-    assert_eq!(decode_into(|i| image(&before)[i], &mut cfg), Ok(()));
-    assert_eq!(cfg, before);
-}
-
-#[test]
-fn the_machine_and_its_geometry_are_kept() {
-    let mut cfg = BASE;
-    set(&mut cfg, "machine", "scara").unwrap();
-    set(&mut cfg, "length_2", "120").unwrap();
-    set(&mut cfg, "crosstalk", "62/20").unwrap();
-    set(&mut cfg, "elbow_max_rate", "1500").unwrap();
-    assert_eq!(read(&image(&cfg)), Ok(cfg));
-    // A machine number no firmware has: refused whole.
-    let mut img = image(&cfg);
-    img[HEADER] = 9;
-    let n = img.len();
-    let mut sum = Fletcher::new();
-    img[..n - 2].iter().for_each(|&b| sum.add(b));
-    img[n - 2..].copy_from_slice(&sum.value().to_le_bytes());
-    assert!(matches!(read(&img), Err(Unusable::Refused(_))));
-}
-
-/// What `bytes` says differs first, the slow way.
-fn first_difference_by_bytes(cfg: &MachineConfig, eeprom: &[u8]) -> Option<(usize, u8)> {
-    bytes(cfg).enumerate().find(|&(i, b)| eeprom[i] != b)
-}
-
-/// A scan run to its first difference (or its end), `parts` at a time.
-fn first_difference(cfg: &MachineConfig, eeprom: &[u8], parts: u8) -> Option<(usize, u8)> {
-    let mut scan = Scan::new();
-    loop {
-        match scan.step(cfg, |i| eeprom[i], parts) {
-            Step::Write(i, b) => return Some((i, b)),
-            Step::More => {}
-            Step::Same => return None,
-        }
+        assert_eq!(decode(&bad), Err(Unusable::Checksum), "byte {i}");
     }
 }
 
 #[test]
-fn the_first_difference_is_the_image_s_and_writing_it_converges() {
-    use crate::machine::Machine;
-    let mut tuned = BASE;
-    set(&mut tuned, "base_max_rate", "1500").unwrap();
-    set(&mut tuned, "step_pulse_us", "7").unwrap();
-    let configs: Vec<MachineConfig> = Machine::ALL
-        .into_iter()
-        .map(MachineConfig::defaults)
-        .chain([tuned])
-        .collect();
-    for cfg in &configs {
-        let mut eeproms = vec![vec![0xFF; len()], image(&BASE), image(cfg)];
-        for i in 0..len() {
-            let mut flipped = image(cfg);
-            flipped[i] ^= 0x41;
-            eeproms.push(flipped);
-        }
-        for (k, mut eeprom) in eeproms.into_iter().enumerate() {
-            let want = first_difference_by_bytes(cfg, &eeprom);
-            for parts in [1, 3, u8::MAX] {
-                assert_eq!(first_difference(cfg, &eeprom, parts), want);
-            }
-            // The store task: a bounded part a run, resumed, writing each
-            // difference as it comes, until they agree.
-            let mut scan = Scan::new();
-            let (mut writes, mut runs) = (0, 0);
-            loop {
-                match scan.step(cfg, |i| eeprom[i], 1 + k as u8 % 4) {
-                    Step::Write(i, b) => {
-                        eeprom[i] = b;
-                        writes += 1;
-                    }
-                    Step::More => {}
-                    Step::Same => break,
-                }
-                runs += 1;
-                assert!(writes <= len() && runs < 10 * len(), "never converges");
-            }
-            assert_eq!(eeprom, image(cfg));
-            assert_eq!(scan.step(cfg, |i| eeprom[i], 1), Step::Same);
-        }
+fn every_setting_is_stored_once() {
+    let mut seen: Vec<Setting> = (0..STORED).map(|k| stored(k).unwrap()).collect();
+    assert_eq!(stored(STORED), None);
+    // Version 6's in its own order: `$$`'s as it was then.
+    for k in 0..V6 {
+        assert_eq!(seen[k].index(), k, "setting {k}");
     }
+    seen.sort_by_key(|s| s.index());
+    seen.dedup();
+    assert_eq!(seen.len(), crate::settings::COUNT);
+    assert!(all().all(|s| seen.contains(&s)));
+}
+
+#[test]
+fn a_record_written_before_a_setting_was_added_gives_it_the_machines_default() {
+    // A whiteboard record as a firmware with only version 6's settings
+    // wrote it: the count says 48, zeros after them.
+    let mut cfg = MachineConfig::defaults(Machine::Whiteboard);
+    set(&mut cfg, "left_max_rate", "1500").unwrap();
+    let mut p = payload(&cfg, &Extras::DEFAULT);
+    p[0] = V6 as u8;
+    let end = named_bytes(V6) + NAMED_AT as usize;
+    p[end..].fill(0);
+    let got = read(&p).unwrap().0;
+    assert_eq!(got, cfg);
+    assert_eq!(got.pen_accel, 50, "the whiteboard's, not the string-art machine's");
+    // A newer firmware's record with a setting this one does not know:
+    // the known ones are read, the rest left.
+    let mut p = payload(&cfg, &Extras::DEFAULT);
+    p[0] = STORED as u8 + 1;
+    assert_eq!(read(&p).unwrap().0, cfg);
+    // A count the room cannot hold.
+    p[0] = 200;
+    assert_eq!(read(&p), Err(Unusable::Checksum));
+}
+
+#[test]
+fn a_version_6_image_is_read_with_version_6_settings_only() {
+    let mut cfg = MachineConfig::defaults(Machine::Scara);
+    set(&mut cfg, "shoulder_accel", "30").unwrap();
+    let img: Vec<u8> = legacy::bytes(&cfg).collect();
+    assert_eq!(img.len(), 215);
+    let mut out = BASE;
+    legacy::decode_into(|i| img.get(i as usize).copied().unwrap_or(0xFF), &mut out).unwrap();
+    assert_eq!(out, cfg);
+    assert_eq!(out.pen_max_feed, MachineConfig::defaults(Machine::Scara).pen_max_feed);
 }
