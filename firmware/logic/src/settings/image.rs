@@ -44,7 +44,6 @@ pub enum Unusable {
     Inconsistent,
 }
 
-
 /// Named settings of version 6 (and of the settings record's version 7):
 /// the machine, 8 fields an axis, 23 more machine-wide.
 pub const V6: usize = 1 + AXES * V6_AXIS_FIELDS + V6_GLOBALS;

@@ -112,7 +112,10 @@ fn a_record_written_before_a_setting_was_added_gives_it_the_machines_default() {
     p[end..].fill(0);
     let got = read(&p).unwrap().0;
     assert_eq!(got, cfg);
-    assert_eq!(got.pen_accel, 50, "the whiteboard's, not the string-art machine's");
+    assert_eq!(
+        got.pen_accel, 50,
+        "the whiteboard's, not the string-art machine's"
+    );
     // A newer firmware's record with a setting this one does not know:
     // the known ones are read, the rest left.
     let mut p = payload(&cfg, &Extras::DEFAULT);
@@ -132,5 +135,8 @@ fn a_version_6_image_is_read_with_version_6_settings_only() {
     let mut out = BASE;
     legacy::decode_into(|i| img.get(i as usize).copied().unwrap_or(0xFF), &mut out).unwrap();
     assert_eq!(out, cfg);
-    assert_eq!(out.pen_max_feed, MachineConfig::defaults(Machine::Scara).pen_max_feed);
+    assert_eq!(
+        out.pen_max_feed,
+        MachineConfig::defaults(Machine::Scara).pen_max_feed
+    );
 }
