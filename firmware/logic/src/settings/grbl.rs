@@ -212,7 +212,7 @@ impl Default for Extras {
 
 const _: () = assert!(Extras::DEFAULT.bytes[BYTE_IDLE_DELAY] == 255);
 // The words pair up into parts.
-const _: () = assert!(TYPED % 2 == 0);
+const _: () = assert!(TYPED.is_multiple_of(2));
 
 /// The channel in each of Grbl's X, Y, Z places: a plotter's X Y Z
 /// channels in order; on the string-art machine the radial carriage
