@@ -36,7 +36,7 @@ use crate::gcode::{
     group, word, AxisCommand, AxisWord, Block, Distance, ErrorKind, FeedMode, Flow, MotionMode,
     NonModal, Plane, Spindle, TautCode, ToolLength, Units, MIN_FEED,
 };
-use crate::kinematics::{Kinematics, Position, Segmenter, Steps};
+use crate::kinematics::{Kinematics, Piece, Position, Segmenter, Steps};
 use crate::planner::Feed;
 use crate::units::{div_round, Milli};
 
@@ -100,6 +100,12 @@ pub trait MachineIo {
     /// Queue a move to the absolute motor `steps`; false when the planner
     /// is full.
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool;
+    /// Queue a piece of a path on a machine whose kinematics are not
+    /// linear: `feed` is the pen's speed along it (the planner's
+    /// `stage_piece`). By default, its steps as [`MachineIo::queue`].
+    fn queue_piece(&mut self, piece: &Piece, feed: Feed) -> bool {
+        self.queue(&piece.steps, feed)
+    }
     /// Every queued move is done.
     fn idle(&mut self) -> bool;
     /// The pen servo to `deg`; true if it moves (motion then waits for it
@@ -215,10 +221,6 @@ impl Run {
     }
 }
 
-/// Longest piece of a straight move on a machine whose kinematics are
-/// not linear, µm: within it the path bends far less than a step.
-pub const SEGMENT_UM: u32 = 1000;
-
 /// A move cut into pieces: an arc's chords, or a straight move's pieces
 /// on a machine whose kinematics are not linear.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -235,6 +237,16 @@ impl Iterator for Path {
         match self {
             Path::Arc(arc) => arc.next(),
             Path::Line(line) => line.next(),
+        }
+    }
+}
+
+impl Path {
+    /// Where the path began (its first piece's start).
+    fn start(&self) -> Position {
+        match self {
+            Path::Arc(arc) => arc.start(),
+            Path::Line(line) => line.start(),
         }
     }
 }

@@ -83,6 +83,10 @@ pub enum GlobalField {
     /// which the needle's clearance from the nails is worked out from.
     NailDiameter,
     NeedleDiameter,
+    /// The pen's top speed (mm/min) and acceleration (mm/s²) on the
+    /// whiteboard and the arm, whose joints keep their own limits too.
+    PenMaxFeed,
+    PenAccel,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -112,7 +116,7 @@ const AXIS_FIELDS: [AxisField; 8] = [
     AxisField::TravelMax,
 ];
 
-const GLOBAL_FIELDS: [GlobalField; 24] = [
+const GLOBAL_FIELDS: [GlobalField; 26] = [
     GlobalField::Machine,
     GlobalField::StepPulseUs,
     GlobalField::DirSetupUs,
@@ -137,6 +141,8 @@ const GLOBAL_FIELDS: [GlobalField; 24] = [
     GlobalField::ReportInches,
     GlobalField::NailDiameter,
     GlobalField::NeedleDiameter,
+    GlobalField::PenMaxFeed,
+    GlobalField::PenAccel,
 ];
 
 // The tables above in order of discriminant: `at` works them out.
@@ -183,6 +189,8 @@ impl GlobalField {
             21 => ReportInches,
             22 => NailDiameter,
             23 => NeedleDiameter,
+            24 => PenMaxFeed,
+            25 => PenAccel,
             _ => return None,
         })
     }
@@ -256,6 +264,8 @@ impl GlobalField {
             ReportInches => "report_inches",
             NailDiameter => "nail_diameter",
             NeedleDiameter => "needle_diameter",
+            PenMaxFeed => "pen_max_feed",
+            PenAccel => "pen_accel",
         ])
         .get(self as usize)
     }
@@ -447,6 +457,8 @@ impl Setting {
             Setting::Global(GlobalField::NeedleDiameter) => {
                 return Value::Milli(Milli(i32::from(cfg.winding.needle_um)))
             }
+            Setting::Global(GlobalField::PenMaxFeed) => cfg.pen_max_feed,
+            Setting::Global(GlobalField::PenAccel) => cfg.pen_accel,
         })
     }
 
@@ -507,6 +519,8 @@ impl Setting {
             SWITCH,
             spec(Milli, MIN_UM, MAX_UM),
             spec(Milli, MIN_UM, MAX_UM),
+            number(1, 1_000_000),
+            number(1, 100_000),
         ]);
         specs.get(match self {
             Setting::Axis(_, f) => f as usize,
@@ -638,6 +652,8 @@ impl Setting {
             (Setting::Global(GlobalField::HomingLocate), _) => cfg.homing.locate = n as u16,
             (Setting::Global(GlobalField::StatusReport), _) => cfg.status_report = n as u8,
             (Setting::Global(GlobalField::ReportInches), _) => cfg.report_inches = n == 1,
+            (Setting::Global(GlobalField::PenMaxFeed), _) => cfg.pen_max_feed = n,
+            (Setting::Global(GlobalField::PenAccel), _) => cfg.pen_accel = n,
             (Setting::Global(_), Value::Number(_)) => {}
         }
     }

@@ -161,7 +161,7 @@ pub enum Layout {
 /// Byte `i` of [`MARKER`], read from flash (an array would be copied
 /// into the AVR's SRAM).
 pub fn marker_byte(i: usize) -> u8 {
-    taut_progmem::text!("taut\x07").byte(i)
+    taut_progmem::text!("taut\x08").byte(i)
 }
 
 /// Record `i`: 0 the settings, 1 the coordinates, 2 and 3 the startup
@@ -341,11 +341,11 @@ impl Writer {
     }
 }
 
-/// `taut` and the layout's version, at byte 0 (where the settings image
+/// `taut` and the layout's version (8: the settings record's room), at byte 0 (where the settings image
 /// of version 6 began: its magic and version byte). Written last on a new
 /// or an upgraded chip, once every record below is: until then a record
 /// that fails its checks is stale data of an older layout, not corruption.
-pub const MARKER: [u8; 5] = *b"taut\x07";
+pub const MARKER: [u8; 5] = *b"taut\x08";
 /// The settings image of version 6 (one copy, at byte 0) ends below this:
 /// read once to migrate it.
 pub const LEGACY_END: u16 = 256;
@@ -355,7 +355,9 @@ pub const LEGACY_END: u16 = 256;
 pub const SETTINGS: Area = Area {
     start: LEGACY_END,
     kind: b'S',
-    version: 7,
+    // 8: a fixed room, the count of named settings first (7 had no room:
+    // a setting added moved every record after it).
+    version: 8,
     payload: super::image::PAYLOAD,
 };
 

@@ -237,8 +237,12 @@ fn the_layout_marker_and_a_version_6_image() {
     let v6: Vec<u8> = image::legacy::bytes(&MachineConfig::defaults(Machine::Drum)).collect();
     e[..v6.len()].copy_from_slice(&v6);
     assert_eq!(read(&e), Layout::Legacy);
-    e[4] = 7;
+    e[4] = 8;
     assert_eq!(read(&e), Layout::Current);
+    // Layout 7 (the settings record without room): its records stand
+    // elsewhere.
+    e[4] = 7;
+    assert_eq!(read(&e), Layout::Foreign);
     e[4] = 5;
     assert_eq!(read(&e), Layout::Foreign);
     // Grbl's own EEPROM: its version byte first.
@@ -253,6 +257,9 @@ fn the_records_fit_between_the_legacy_image_and_the_checkpoint() {
     assert_eq!(COORDS.start, SETTINGS.end());
     assert_eq!(INFO.start, LINES[1].end());
     assert!(END <= crate::checkpoint::START);
+    // The settings' room takes all there is: a setting added later moves
+    // nothing.
+    assert_eq!(END, crate::checkpoint::START);
     // A whole board's EEPROM as the host helper makes it reads back.
     let (mut cfg, mut ex) = (MachineConfig::defaults(Machine::Scara), Extras::DEFAULT);
     Numbered::MaxRate(0)
