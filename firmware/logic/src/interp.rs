@@ -36,7 +36,7 @@ use crate::gcode::{
     group, word, AxisCommand, AxisWord, Block, Distance, ErrorKind, FeedMode, Flow, MotionMode,
     NonModal, Plane, Spindle, TautCode, ToolLength, Units, MIN_FEED,
 };
-use crate::kinematics::{Kinematics, Piece, Position, Segmenter, Steps};
+use crate::kinematics::{KinError, Kinematics, Piece, Position, Segmenter, Steps};
 use crate::planner::Feed;
 use crate::units::{div_round, Milli};
 
@@ -242,12 +242,24 @@ impl Iterator for Path {
 }
 
 impl Path {
-    /// Where the path began (its first piece's start).
-    fn start(&self) -> Position {
-        match self {
+    /// The next piece for the planner on a machine whose kinematics are
+    /// not linear: from the path's start, its end converted with the
+    /// kinematics; the channels without a motor at 0 (`motors`). Out of
+    /// line, the piece built whole in its frame: on the AVR a returned
+    /// pair came back as garbage elsewhere.
+    #[inline(never)]
+    fn next_piece(&mut self, kin: &impl Kinematics, motors: u8) -> Option<Result<Piece, KinError>> {
+        let start = match self {
             Path::Arc(arc) => arc.start(),
             Path::Line(line) => line.start(),
-        }
+        };
+        let to = motor_only(&self.next()?, motors);
+        Some(kin.inverse_fine(&to).map(|(steps, frac)| Piece {
+            start: motor_only(&start, motors),
+            to,
+            steps,
+            frac,
+        }))
     }
 }
 
@@ -748,7 +760,9 @@ impl Interpreter {
         }
 
         // Step 4: the line is good. Its state, then its actions.
-        let mut run = Run::new();
+        // Built in place: a copy would be ~170 B more of this frame, under
+        // which the arc's reach is checked.
+        self.run = Run::new();
         let pen_deg = |down: bool| {
             if down {
                 cfg.pen.down_deg
@@ -757,7 +771,7 @@ impl Interpreter {
             }
         };
         if jog {
-            run.feed = Feed::PerMinute(feed);
+            self.run.feed = Feed::PerMinute(feed);
         } else {
             self.feed = feed;
             self.speed = speed;
@@ -766,8 +780,8 @@ impl Interpreter {
             if b.has(group::SPINDLE) {
                 self.modal.spindle = b.spindle;
                 if plotter {
-                    run.pen = pen_deg(b.spindle != Spindle::Off);
-                    run.todo |= todo::PEN;
+                    self.run.pen = pen_deg(b.spindle != Spindle::Off);
+                    self.run.todo |= todo::PEN;
                     self.servo_off = false;
                 }
             }
@@ -775,8 +789,8 @@ impl Interpreter {
             if servo {
                 self.servo_off = b.s.0 > 180_000;
                 if !self.servo_off {
-                    run.pen = (b.s.0 / 1000) as u8;
-                    run.todo |= todo::PEN;
+                    self.run.pen = (b.s.0 / 1000) as u8;
+                    self.run.todo |= todo::PEN;
                 }
             }
             // [8] Coolant: kept for `$G`.
@@ -788,8 +802,8 @@ impl Interpreter {
                 };
             }
             if b.non_modal == NonModal::Dwell {
-                run.dwell_ms = dwell_ms(b.p, cfg);
-                run.todo |= todo::DWELL;
+                self.run.dwell_ms = dwell_ms(b.p, cfg);
+                self.run.todo |= todo::DWELL;
             }
             self.modal.plane = m.plane;
             self.modal.units = m.units;
@@ -837,7 +851,8 @@ impl Interpreter {
         }
         if count > 0 {
             if !jog {
-                run.feed = match (home.is_some() || m.motion == MotionMode::Seek, m.feed_mode) {
+                self.run.feed = match (home.is_some() || m.motion == MotionMode::Seek, m.feed_mode)
+                {
                     (true, _) => Feed::Rapid,
                     (false, FeedMode::PerMinute) => Feed::PerMinute(feed),
                     (false, FeedMode::InverseTime) => {
@@ -852,18 +867,18 @@ impl Interpreter {
             // A plotter's Z is its pen, set before the moves.
             if plotter && given >> Z & 1 != 0 && !self.servo_off {
                 let work_z = legs[count - 1][Z] - self.work_offset(Z);
-                run.pen_z = pen_deg(work_z <= 0);
-                run.todo |= todo::PEN_Z;
+                self.run.pen_z = pen_deg(work_z <= 0);
+                self.run.todo |= todo::PEN_Z;
             }
-            run.legs = legs;
-            run.from = self.position;
-            run.todo |= match count {
+            self.run.legs = legs;
+            self.run.from = self.position;
+            self.run.todo |= match count {
                 1 => todo::LEG_0,
                 _ => todo::LEG_0 | todo::LEG_1,
             };
             if let Some(a) = arc {
-                run.path = Some(Path::Arc(a));
-                run.todo = run.todo & !todo::LEG_0 | todo::PATH;
+                self.run.path = Some(Path::Arc(a));
+                self.run.todo = self.run.todo & !todo::LEG_0 | todo::PATH;
             }
             self.position = legs[count - 1];
         }
@@ -871,16 +886,16 @@ impl Interpreter {
             // [21] Program flow.
             if b.has(group::STOPPING) {
                 match b.flow {
-                    Flow::Pause => run.todo |= todo::PAUSE,
+                    Flow::Pause => self.run.todo |= todo::PAUSE,
                     Flow::OptionalStop => {}
                     Flow::End | Flow::EndRewind => {
                         self.program_end(io);
-                        run.todo |= todo::END;
+                        self.run.todo |= todo::END;
                     }
                 }
             }
             if b.has(group::TAUT) {
-                run.todo |= match b.taut {
+                self.run.todo |= match b.taut {
                     TautCode::EnableDrivers => todo::DRIVERS_ON,
                     TautCode::DisableDrivers => todo::DRIVERS_OFF,
                     TautCode::ReportPosition => todo::REPORT,
@@ -891,9 +906,8 @@ impl Interpreter {
         }
         // Checked, not carried out: only reads are answered.
         if env.allowed.checking {
-            run.todo &= todo::REPORT;
+            self.run.todo &= todo::REPORT;
         }
-        self.run = run;
         self.dwell_until = None;
         Ok(())
     }
@@ -1086,7 +1100,13 @@ fn check_travel(cfg: &MachineConfig, lo: &Exact, hi: &Exact, motors: u8) -> Resu
 
 /// `pos` in thousandths, the channels without a motor at 0.
 fn motor_milli(pos: &Exact, motors: u8) -> Position {
-    let mut p = coords::milli(pos);
+    motor_only(&coords::milli(pos), motors)
+}
+
+/// `pos` with the channels without a motor at 0 (a path's piece: no
+/// 64-bit division on the way, as [`motor_milli`] of it would take).
+fn motor_only(pos: &Position, motors: u8) -> Position {
+    let mut p = *pos;
     for (i, v) in p.iter_mut().enumerate() {
         if motors >> i & 1 == 0 {
             *v = Milli::ZERO;

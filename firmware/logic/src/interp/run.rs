@@ -3,10 +3,10 @@
 //! planner would, and goes on at the next call.
 
 use super::{
-    coords, motor_channels, motor_milli, motor_steps, todo, Env, Interpreter, MachineIo, Path,
+    motor_channels, motor_milli, motor_only, motor_steps, todo, Env, Interpreter, MachineIo, Path,
     Progress, Wait,
 };
-use crate::kinematics::{Kinematics, Piece, Segmenter};
+use crate::kinematics::{Kinematics, Segmenter};
 
 impl Interpreter {
     /// Carry out what is left of the accepted line, as far as the
@@ -152,32 +152,31 @@ impl Interpreter {
         }
         let before = *path;
         let motors = motor_channels(env.cfg);
-        let Some(end) = path.next() else {
-            self.run.path = None;
-            return None;
-        };
-        let to = motor_milli(&coords::exact(&end), motors);
-        // Every piece was checked when the line was accepted.
         let queued = if env.kin.is_linear() {
+            let Some(end) = path.next() else {
+                self.run.path = None;
+                return None;
+            };
             // An arc's last chord ends on the exact target (the steps
             // from it, rounded once).
             let steps = match matches!(path, Path::Arc(a) if a.remaining() == 0) {
                 true => motor_steps(&self.run.legs[0], motors, env.kin, env.cfg),
                 false => env
                     .kin
-                    .inverse(&to)
+                    .inverse(&motor_only(&end, motors))
                     .map_err(|_| crate::gcode::ErrorKind::InvalidTarget),
             };
             io.queue(&steps.unwrap_or_default(), self.run.feed)
         } else {
-            let (steps, frac) = env.kin.inverse_fine(&to).unwrap_or_default();
-            let piece = Piece {
-                start: motor_milli(&coords::exact(&before.start()), motors),
-                to,
-                steps,
-                frac,
-            };
-            io.queue_piece(&piece, self.run.feed)
+            match path.next_piece(env.kin, motors) {
+                None => {
+                    self.run.path = None;
+                    return None;
+                }
+                Some(Ok(piece)) => io.queue_piece(&piece, self.run.feed),
+                // Every piece was checked when the line was accepted.
+                Some(Err(_)) => true,
+            }
         };
         if !queued {
             self.run.path = Some(before);
