@@ -11,7 +11,7 @@ use taut_logic::axis::AXES;
 use taut_logic::config::PenConfig;
 use taut_logic::coords::Slot;
 use taut_logic::interp::{coords, Exact, MachineIo, Wait};
-use taut_logic::kinematics::{Kinematics, Steps};
+use taut_logic::kinematics::{Kinematics, Piece, Steps};
 use taut_logic::planner::Feed;
 use taut_logic::units::Decimal;
 use ufmt::uwrite;
@@ -52,6 +52,10 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
 
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
         self.m.stage(*steps, feed).is_ok()
+    }
+
+    fn queue_piece(&mut self, piece: &Piece, feed: Feed) -> bool {
+        self.m.stage_piece(piece, feed).is_ok()
     }
 
     fn idle(&mut self) -> bool {

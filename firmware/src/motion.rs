@@ -12,6 +12,7 @@ use crate::stepper::{every_event, fast_segment, Stepper, FAST};
 use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
+use taut_logic::kinematics::Piece;
 use taut_logic::planner::{Feed, Full, Overrides, Planner};
 use taut_logic::prep::{Cut, Hold, Prep};
 use taut_logic::segment::{Buffered, Later};
@@ -128,10 +129,25 @@ impl Motion {
     pub fn stage(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
         let from = self.target();
         PLANNER.with(|p| p.stage(target, feed))?;
-        for (i, (a, b)) in from.iter().zip(&target).enumerate() {
+        self.moving(&from, &target);
+        Ok(())
+    }
+
+    /// [`Motion::stage`] of a piece of a path: on the whiteboard and the
+    /// arm its speeds are the pen's along it.
+    #[inline(never)]
+    pub fn stage_piece(&mut self, piece: &Piece, feed: Feed) -> Result<(), Full> {
+        let from = self.target();
+        PLANNER.with(|p| p.stage_piece(piece, feed))?;
+        self.moving(&from, &piece.steps);
+        Ok(())
+    }
+
+    /// The axes a move from `from` to `to` turns are busy.
+    fn moving(&mut self, from: &PerAxis<i32>, to: &PerAxis<i32>) {
+        for (i, (a, b)) in from.iter().zip(to).enumerate() {
             self.busy |= ((a != b) as u8) << i;
         }
-        Ok(())
     }
 
     /// One part of planning the staged move; false when none is left.

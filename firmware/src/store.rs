@@ -184,7 +184,7 @@ impl Store {
             extras.reset();
             let why = match (layout, loaded[0]) {
                 (Layout::Legacy, _) => match legacy::check(&read)
-                    .and_then(|()| image::take_named(&from(legacy::BODY, false), cfg, true))
+                    .and_then(|()| image::take_named(&from(legacy::BODY, false), image::V6, cfg))
                 {
                     Ok(()) => None,
                     Err(why) => {

@@ -12,6 +12,7 @@ pub use taut_simavr as sim;
 pub mod board;
 pub mod drawing;
 pub mod drivers;
+pub mod feed;
 pub mod reference;
 pub mod senders;
 

@@ -2,15 +2,19 @@
 //! EEPROM gives the defaults with one warning line, a copy gone bad is
 //! passed over in silence for the other, both gone bad give the defaults
 //! with one warning, never garbage; a board flashed with format version 6
-//! keeps its settings. (A cut in the middle of a write: `settings_cut.rs`.)
+//! keeps its settings, and one written before a setting was added keeps
+//! its own with the machine's default for the new one. (A cut in the
+//! middle of a write: `settings_cut.rs`.)
 
 use hil_tests::sim::Sim;
 use hil_tests::{boot_machine, log_tail, send_ok, wait_for};
 use std::time::Duration;
 use taut_logic::config::{Driver, MachineConfig, KEEP_DRIVERS_ON};
+use taut_logic::coords::CoordData;
 use taut_logic::machine::Machine;
-use taut_logic::settings::image::legacy;
-use taut_logic::settings::record::{host, MARKER, SETTINGS};
+use taut_logic::settings::grbl::Extras;
+use taut_logic::settings::image::{self, legacy};
+use taut_logic::settings::record::{host, Writer, HEAD, MARKER, SETTINGS};
 use taut_logic::settings::set;
 
 fn send(sim: &mut Sim, line: &str) {
@@ -173,4 +177,46 @@ fn a_version_6_board_keeps_its_settings() {
         "{text}"
     );
     assert_eq!(listed(&mut again, "machine"), "drum");
+}
+
+/// A whiteboard's settings record as a firmware with only version 6's
+/// settings wrote it (the count 48, no pen speed or acceleration): the
+/// board keeps its settings silently, the new ones its machine's
+/// defaults; the next change writes them all.
+#[test]
+fn a_record_from_before_a_setting_was_added_keeps_the_rest() {
+    let mut cfg = MachineConfig::defaults(Machine::Whiteboard);
+    set(&mut cfg, "left_max_rate", "1700").unwrap();
+    // Not in the record: a firmware that read past its count would find
+    // zeros (refused) or this.
+    let mut board = cfg;
+    set(&mut board, "pen_accel", "77").unwrap();
+    let mut ee = host::eeprom(&board, &Extras::DEFAULT, &CoordData::ZERO);
+    let named = 1 + Extras::PARTS;
+    host::write(&mut ee, Writer::new(SETTINGS, 1, 2), |k| {
+        let (b, n) = image::part(&board, &Extras::DEFAULT, k)?;
+        Some(match k as usize {
+            0 => ([image::V6 as u8, 0, 0, 0, 0, 0, 0, 0], 1),
+            k if k >= named + image::V6 => ([0; 8], n),
+            _ => (b, n),
+        })
+    });
+    // Only that copy committed.
+    ee[SETTINGS.copy(0) as usize] = 0xFF;
+    let ours = |ee: &[u8]| host::settings(ee).map(|(c, _)| c);
+    assert_eq!(ours(&ee), Some(cfg), "read as the firmware does");
+    let mut sim = power_on(&ee);
+    sim.run_for(Duration::from_millis(300));
+    let text = sim.uart_text();
+    assert!(!text.contains("settings:"), "{text}");
+    assert_eq!(listed(&mut sim, "left_max_rate"), "1700");
+    assert_eq!(listed(&mut sim, "pen_accel"), "50", "the whiteboard's");
+    send(&mut sim, "$pen_accel=40");
+    sim.run_for(Duration::from_secs(3));
+    let mut want = cfg;
+    set(&mut want, "pen_accel", "40").unwrap();
+    assert_eq!(ours(&sim.eeprom()), Some(want));
+    // Written into copy 0, with every setting this firmware knows.
+    let count = sim.eeprom()[(SETTINGS.copy(0) + HEAD) as usize];
+    assert_eq!(!count, image::STORED as u8);
 }

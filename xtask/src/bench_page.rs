@@ -123,6 +123,15 @@ const SECTIONS: &[(&str, &[Figure])] = &[
         ],
     ),
     (
+        "Feed along the pen",
+        &[
+            barred("feed_ratio_scara_min", "", "the arm's fixed lines (`SCARA_LINES` in `simavr/src/bin/taut-bench.rs`: 40 mm at F600 in two places, 120 mm at F1500 and F3000): time from first to last step over the pen's trapezoid (length at the feed, ramps at `pen_accel`), lowest; below 1 would be faster than asked", Bar::AtLeast(0.97)),
+            fig("feed_ratio_scara_max", "", "the same, highest: above 1 where a joint's own limits hold the pen back"),
+            barred("feed_ratio_whiteboard_min", "", "the whiteboard's (`WHITEBOARD_LINES`: 40 mm at F600, three of 410–500 mm at F900–F3000 across the board), lowest", Bar::AtLeast(0.97)),
+            fig("feed_ratio_whiteboard_max", "", "the same, highest"),
+        ],
+    ),
+    (
         "Card",
         &[
             fig("sd_read_kib_per_s", "KiB/s", "a 256 KiB file streamed through the card reader into its queue (`firmware/examples/sd_read.rs`)"),
@@ -179,6 +188,11 @@ and commit the page.
   at the maximum feed (the planner full, a segment to cut every few ms)
   while the job reads the sample card, and a byte arrives every 5 ms (a `?`
   every 25 ms for the report).
+- **Feed ratios** (`taut-bench --feed FIRMWARE_ELF` alone): fixed lines
+  drawn on the whiteboard and the arm, each line's time from its first
+  step to its last over its trapezoid along the pen; `F` is the pen's
+  speed, so 1 is the feed kept (a hair under: the first step comes a
+  fraction of a step's travel after the start).
 - **Machine times** of the string-art job are worked out on the host with
   the firmware's own job state machine, planner and trapezoids (`cargo
   xtask estimate`), which the HIL job test holds to the simulation within

@@ -102,6 +102,13 @@ pub struct MachineConfig {
     /// How far an arc's chords may stray from the circle, µm (Grbl's
     /// `$12`, 0.01 mm by default).
     pub arc_tolerance_um: u32,
+    /// The pen's top speed, mm/min, and its acceleration, mm/s², where
+    /// the kinematics are not linear (the whiteboard, the arm): `F` is
+    /// the pen's speed there, and each joint keeps its own `max_rate` and
+    /// `accel` too. The linear machines' axes are the pen's: theirs are
+    /// their own limits, as in Grbl.
+    pub pen_max_feed: u32,
+    pub pen_accel: u32,
     /// Which of the five machines this is.
     pub machine: Machine,
     /// The plotters' pen servo.
@@ -354,6 +361,9 @@ const fn seed(machine: Machine) -> MachineConfig {
         Machine::Whiteboard => {
             let chain = axis(StepsPerUnit::new(20_000, 1143), 2000, 1000, None);
             let mut cfg = plotter(machine, [chain, chain]);
+            // A chain carries at most the pen's speed and acceleration
+            // (114 mm/s and 57 mm/s² here): the pen's keep within them.
+            cfg.pen_accel = 50;
             cfg.geometry = Geometry {
                 lengths: [Milli::from_units(1200), Milli(0)],
                 origin: [Milli::from_units(600), Milli::from_units(-600)],
@@ -362,7 +372,9 @@ const fn seed(machine: Machine) -> MachineConfig {
             cfg
         }
         // Marlin's MORGAN_SCARA figures: 150 mm arms, the shoulder at
-        // (100, −56); 200 × 16 steps and a 3:1 belt a turn, ECR 3.
+        // (100, −56); 200 × 16 steps and a 3:1 belt a turn, ECR 3. The
+        // pen's 100 mm/s² keeps the joints (75 °/s²) within theirs over
+        // most of the reach.
         Machine::Scara => {
             let joint = axis(StepsPerUnit::new(9600, 360), 2000, 2000, None);
             let mut cfg = plotter(machine, [joint, joint]);
@@ -408,6 +420,8 @@ const fn plotter(machine: Machine, xy: [AxisConfig; 2]) -> MachineConfig {
         pulse: TB6600,
         junction_deviation_um: 10,
         arc_tolerance_um: 10,
+        pen_max_feed: 6000,
+        pen_accel: 100,
         machine,
         pen: PenConfig::UNICORN,
         homing: HomingConfig::NONE,

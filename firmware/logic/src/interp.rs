@@ -36,7 +36,7 @@ use crate::gcode::{
     group, word, AxisCommand, AxisWord, Block, Distance, ErrorKind, FeedMode, Flow, MotionMode,
     NonModal, Plane, Spindle, TautCode, ToolLength, Units, MIN_FEED,
 };
-use crate::kinematics::{Kinematics, Position, Segmenter, Steps};
+use crate::kinematics::{KinError, Kinematics, Piece, Position, Segmenter, Steps};
 use crate::planner::Feed;
 use crate::units::{div_round, Milli};
 
@@ -100,6 +100,12 @@ pub trait MachineIo {
     /// Queue a move to the absolute motor `steps`; false when the planner
     /// is full.
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool;
+    /// Queue a piece of a path on a machine whose kinematics are not
+    /// linear: `feed` is the pen's speed along it (the planner's
+    /// `stage_piece`). By default, its steps as [`MachineIo::queue`].
+    fn queue_piece(&mut self, piece: &Piece, feed: Feed) -> bool {
+        self.queue(&piece.steps, feed)
+    }
     /// Every queued move is done.
     fn idle(&mut self) -> bool;
     /// The pen servo to `deg`; true if it moves (motion then waits for it
@@ -223,10 +229,6 @@ impl Run {
     }
 }
 
-/// Longest piece of a straight move on a machine whose kinematics are
-/// not linear, µm: within it the path bends far less than a step.
-pub const SEGMENT_UM: u32 = 1000;
-
 /// A move cut into pieces: an arc's chords, or a straight move's pieces
 /// on a machine whose kinematics are not linear.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -244,6 +246,28 @@ impl Iterator for Path {
             Path::Arc(arc) => arc.next(),
             Path::Line(line) => line.next(),
         }
+    }
+}
+
+impl Path {
+    /// The next piece for the planner on a machine whose kinematics are
+    /// not linear: from the path's start, its end converted with the
+    /// kinematics; the channels without a motor at 0 (`motors`). Out of
+    /// line, the piece built whole in its frame: on the AVR a returned
+    /// pair came back as garbage elsewhere.
+    #[inline(never)]
+    fn next_piece(&mut self, kin: &impl Kinematics, motors: u8) -> Option<Result<Piece, KinError>> {
+        let start = match self {
+            Path::Arc(arc) => arc.start(),
+            Path::Line(line) => line.start(),
+        };
+        let to = motor_only(&self.next()?, motors);
+        Some(kin.inverse_fine(&to).map(|(steps, frac)| Piece {
+            start: motor_only(&start, motors),
+            to,
+            steps,
+            frac,
+        }))
     }
 }
 
@@ -754,7 +778,9 @@ impl Interpreter {
         }
 
         // Step 4: the line is good. Its state, then its actions.
-        let mut run = Run::new();
+        // Built in place: a copy would be ~170 B more of this frame, under
+        // which the arc's reach is checked.
+        self.run = Run::new();
         let pen_deg = |down: bool| {
             if down {
                 cfg.pen.down_deg
@@ -763,7 +789,7 @@ impl Interpreter {
             }
         };
         if jog {
-            run.feed = Feed::PerMinute(feed);
+            self.run.feed = Feed::PerMinute(feed);
         } else {
             self.feed = feed;
             self.speed = speed;
@@ -772,8 +798,8 @@ impl Interpreter {
             if b.has(group::SPINDLE) {
                 self.modal.spindle = b.spindle;
                 if plotter {
-                    run.pen = pen_deg(b.spindle != Spindle::Off);
-                    run.todo |= todo::PEN;
+                    self.run.pen = pen_deg(b.spindle != Spindle::Off);
+                    self.run.todo |= todo::PEN;
                     self.servo_off = false;
                 }
             }
@@ -781,8 +807,8 @@ impl Interpreter {
             if servo {
                 self.servo_off = b.s.0 > 180_000;
                 if !self.servo_off {
-                    run.pen = (b.s.0 / 1000) as u8;
-                    run.todo |= todo::PEN;
+                    self.run.pen = (b.s.0 / 1000) as u8;
+                    self.run.todo |= todo::PEN;
                 }
             }
             // [8] Coolant: kept for `$G`.
@@ -794,8 +820,8 @@ impl Interpreter {
                 };
             }
             if b.non_modal == NonModal::Dwell {
-                run.dwell_ms = dwell_ms(b.p, cfg);
-                run.todo |= todo::DWELL;
+                self.run.dwell_ms = dwell_ms(b.p, cfg);
+                self.run.todo |= todo::DWELL;
             }
             self.modal.plane = m.plane;
             self.modal.units = m.units;
@@ -843,7 +869,8 @@ impl Interpreter {
         }
         if count > 0 {
             if !jog {
-                run.feed = match (home.is_some() || m.motion == MotionMode::Seek, m.feed_mode) {
+                self.run.feed = match (home.is_some() || m.motion == MotionMode::Seek, m.feed_mode)
+                {
                     (true, _) => Feed::Rapid,
                     (false, FeedMode::PerMinute) => Feed::PerMinute(feed),
                     (false, FeedMode::InverseTime) => {
@@ -858,18 +885,18 @@ impl Interpreter {
             // A plotter's Z is its pen, set before the moves.
             if plotter && given >> Z & 1 != 0 && !self.servo_off {
                 let work_z = legs[count - 1][Z] - self.work_offset(Z);
-                run.pen_z = pen_deg(work_z <= 0);
-                run.todo |= todo::PEN_Z;
+                self.run.pen_z = pen_deg(work_z <= 0);
+                self.run.todo |= todo::PEN_Z;
             }
-            run.legs = legs;
-            run.from = self.position;
-            run.todo |= match count {
+            self.run.legs = legs;
+            self.run.from = self.position;
+            self.run.todo |= match count {
                 1 => todo::LEG_0,
                 _ => todo::LEG_0 | todo::LEG_1,
             };
             if let Some(a) = arc {
-                run.path = Some(Path::Arc(a));
-                run.todo = run.todo & !todo::LEG_0 | todo::PATH;
+                self.run.path = Some(Path::Arc(a));
+                self.run.todo = self.run.todo & !todo::LEG_0 | todo::PATH;
             }
             self.position = legs[count - 1];
         }
@@ -877,22 +904,22 @@ impl Interpreter {
             // [21] Program flow.
             if b.has(group::STOPPING) {
                 match b.flow {
-                    Flow::Pause => run.todo |= todo::PAUSE,
+                    Flow::Pause => self.run.todo |= todo::PAUSE,
                     Flow::OptionalStop => {}
                     Flow::End | Flow::EndRewind => {
                         self.program_end(io);
-                        run.todo |= todo::END;
+                        self.run.todo |= todo::END;
                     }
                 }
             }
             if b.has(group::TAUT) {
-                run.todo |= match b.taut {
+                self.run.todo |= match b.taut {
                     TautCode::EnableDrivers => todo::DRIVERS_ON,
                     // Marlin's `M18 S`/`M84 S`: the drivers go off this many
                     // seconds (thousandths: ms) after motion stands, 0
                     // never; nothing is switched now.
                     TautCode::DisableDrivers if b.has_word(word::S) => {
-                        run.idle_delay_ms = b.s.0.max(0) as u32;
+                        self.run.idle_delay_ms = b.s.0.max(0) as u32;
                         todo::IDLE_DELAY
                     }
                     TautCode::DisableDrivers => todo::DRIVERS_OFF,
@@ -904,9 +931,8 @@ impl Interpreter {
         }
         // Checked, not carried out: only reads are answered.
         if env.allowed.checking {
-            run.todo &= todo::REPORT;
+            self.run.todo &= todo::REPORT;
         }
-        self.run = run;
         self.dwell_until = None;
         Ok(())
     }
@@ -1099,7 +1125,13 @@ fn check_travel(cfg: &MachineConfig, lo: &Exact, hi: &Exact, motors: u8) -> Resu
 
 /// `pos` in thousandths, the channels without a motor at 0.
 fn motor_milli(pos: &Exact, motors: u8) -> Position {
-    let mut p = coords::milli(pos);
+    motor_only(&coords::milli(pos), motors)
+}
+
+/// `pos` with the channels without a motor at 0 (a path's piece: no
+/// 64-bit division on the way, as [`motor_milli`] of it would take).
+fn motor_only(pos: &Position, motors: u8) -> Position {
+    let mut p = *pos;
     for (i, v) in p.iter_mut().enumerate() {
         if motors >> i & 1 == 0 {
             *v = Milli::ZERO;

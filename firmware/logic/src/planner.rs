@@ -1,11 +1,19 @@
 //! Look-ahead planner: a ring of moves in steps with Grbl's junction
 //! deviation and trapezoidal speed profiles.
 //!
-//! Speeds are compared across blocks along the *path*: each axis's steps
-//! are divided by its steps per unit, so the path is measured in thousandths
-//! of the axes' units (µm, millidegrees) — the same scale as
-//! `junction_deviation_um`. A base turn of 1° and a radial move of 1 mm are
-//! thus equally long; that is the only way to compare degrees with mm.
+//! Speeds are compared across blocks along the *path*. On a machine whose
+//! kinematics are linear each axis's steps are divided by its steps per
+//! unit, so the path is measured in thousandths of the axes' units (µm,
+//! millidegrees) — the same scale as `junction_deviation_um`. A base turn
+//! of 1° and a radial move of 1 mm are thus equally long; that is the only
+//! way to compare degrees with mm. On the whiteboard and the arm a move
+//! comes as [`Piece`]s of the pen's straight path, and the path is the
+//! pen's, in µm: the feed, `pen_max_feed`, `pen_accel` and the junction
+//! deviation are the pen's (Klipper's and Marlin's meaning of `F`), and
+//! each piece is slowed where a joint would pass its own `max_rate` or
+//! `accel` — along the piece, and where the joints' share of the pen's
+//! speed changes from piece to piece (the path's curvature in joint space,
+//! `Geometry::joints_sqr`).
 //! Floats are used once per block when it is added (its length, the
 //! junction cosine); the look-ahead passes are additions and comparisons of
 //! squared speeds, `u32` (µm/s)² shifted right by [`Planner`]'s `shift`
@@ -17,14 +25,17 @@ mod axis_jump;
 mod junction;
 
 #[cfg(test)]
+mod pen_tests;
+#[cfg(test)]
 mod tests;
 
 use crate::axis::{PerAxis, AXES};
 use crate::config::MachineConfig;
+use crate::kinematics::{Frac, Piece, Position};
 use crate::segment::{Speeds, StepBlock, Trapezoid};
 use crate::units::Milli;
 use axis_jump::AxisJumps;
-use junction::{Geometry, Turn};
+use junction::{Geometry, PenLimits, PenMove, PenPath, Turn};
 
 /// Number of moves the planner holds.
 pub const PLANNER_BLOCKS: usize = 12;
@@ -70,16 +81,26 @@ pub struct Taken {
 #[derive(Clone, Copy, Debug)]
 struct Steps {
     steps: [u32; AXES],
+    /// [`StepBlock::dir`], and [`PEN`].
     dir: u8,
 }
+
+/// Bit of [`Steps::dir`] past the channels': the block is a [`Piece`],
+/// its path the pen's.
+const PEN: u8 = 0x80;
+const _: () = assert!(AXES < 8);
 
 impl Steps {
     fn block(&self) -> StepBlock {
         StepBlock {
             steps: self.steps,
             events: self.steps.iter().copied().max().unwrap_or(0),
-            dir: self.dir,
+            dir: self.dir & !PEN,
         }
+    }
+
+    fn is_pen(&self) -> bool {
+        self.dir & PEN != 0
     }
 }
 
@@ -168,10 +189,26 @@ enum Stage {
     /// Direction, the axes' jumps and asked speed worked out; the
     /// junction's speed comes next.
     Turned { ev_per_milli: f32 },
+    /// A piece's direction along the pen and its turn worked out, and
+    /// the joints' shares of the pen's speed (`PenLast`); the joints'
+    /// limits at the junction come next, then as `Turned`.
+    PenTurned {
+        ev_per_milli: f32,
+        joint: [f32; AXES],
+        len: f32,
+    },
     /// Its junction too; the axes' limits come next.
     Path { ev_per_milli: f32 },
     /// Its figures are complete; the look-ahead passes come next.
     Limits,
+}
+
+/// The pen's last piece, for the junction with the next: each joint's
+/// share of the pen's speed (joint milli-units per µm) and its length, µm.
+#[derive(Clone, Copy, Debug)]
+struct PenLast {
+    joint: [f32; AXES],
+    len: f32,
 }
 
 pub struct Planner {
@@ -189,8 +226,20 @@ pub struct Planner {
     position: PerAxis<i32>,
     geometry: Geometry,
     jumps: AxisJumps,
-    /// Direction of the last move, for the next junction.
+    /// Direction of the last move, for the next junction: the pen's if
+    /// `pen_last` is some, else in the axes' units.
     last: Option<[f32; AXES]>,
+    /// The pen's limits where moves come as pieces; `None` on a machine
+    /// whose kinematics are linear, whose path is the axes'.
+    pen: Option<PenLimits>,
+    pen_last: Option<PenLast>,
+    /// Where the last piece with steps left the pen (a piece of no step
+    /// is dropped: the next measures from here), and the joints' rounding
+    /// at `position`.
+    pen_at: Option<Position>,
+    frac: Frac,
+    /// The piece staged ([`Planner::stage_piece`]).
+    pen_staged: PenMove,
     /// `None`: none (100 %). An `Option`, so that `EMPTY` is all zeros: a
     /// static of it then costs no initial image in flash.
     overrides: Option<Overrides>,
@@ -210,6 +259,11 @@ impl Planner {
         geometry: Geometry::EMPTY,
         jumps: AxisJumps::EMPTY,
         last: None,
+        pen: None,
+        pen_last: None,
+        pen_at: None,
+        frac: [0; AXES],
+        pen_staged: PenMove::NONE,
         overrides: None,
         stage: Stage::Done,
     };
@@ -221,10 +275,15 @@ impl Planner {
         self.len = 0;
         self.carry_sqr = 0;
         self.geometry = Geometry::new(config);
-        self.shift = shift_for(self.geometry.max_speed_sqr());
+        self.pen = PenLimits::of(config);
+        let top = match &self.pen {
+            Some(pen) => pen.max_speed_sqr().max(self.geometry.max_speed_sqr()),
+            None => self.geometry.max_speed_sqr(),
+        };
+        self.shift = shift_for(top);
         self.jumps = AxisJumps::new(config);
-        self.last = None;
         self.stage = Stage::Done;
+        self.set_position(self.position);
     }
 
     pub fn new(config: &MachineConfig) -> Self {
@@ -253,18 +312,61 @@ impl Planner {
         Ok(())
     }
 
+    /// [`Planner::push`] of a piece of a path ([`Planner::stage_piece`]).
+    pub fn push_piece(&mut self, piece: &Piece, feed: Feed) -> Result<(), Full> {
+        self.stage_piece(piece, feed)?;
+        while self.plan_part() {}
+        Ok(())
+    }
+
+    /// Records a piece of a path, its speeds along the pen where the
+    /// machine's kinematics are not linear (else as [`Planner::stage`]):
+    /// `feed` is then the pen's. The pen's path is measured from the last
+    /// piece's end, or the path's start after the position was set; a
+    /// piece of no step is dropped, and the next measures from where this
+    /// one started.
+    pub fn stage_piece(&mut self, piece: &Piece, feed: Feed) -> Result<(), Full> {
+        if self.pen.is_none() {
+            return self.stage(piece.steps, feed);
+        }
+        let from = self.pen_at.unwrap_or(piece.start);
+        self.stage_steps(piece.steps, feed, PEN)?;
+        if self.stage == Stage::Done {
+            // No step: dropped.
+            return Ok(());
+        }
+        self.pen_staged = PenMove {
+            delta: core::array::from_fn(|i| piece.to[i].0.saturating_sub(from[i].0)),
+            frac: [self.frac, piece.frac],
+        };
+        self.pen_at = Some(piece.to);
+        self.frac = piece.frac;
+        Ok(())
+    }
+
     /// Records a move to the absolute step position `target`, to be
     /// planned by [`Planner::plan_part`]; the next move waits for it
     /// (`Full`). A move of no step is dropped.
+    pub fn stage(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
+        self.stage_steps(target, feed, 0)?;
+        if self.stage != Stage::Done {
+            // Moved off the pen's path: a piece after it starts afresh.
+            self.pen_at = None;
+            self.frac = [0; AXES];
+        }
+        Ok(())
+    }
+
+    /// [`Planner::stage`] with the flags `kind` ([`PEN`]).
     // Indexed: zipping the two arrays costs ~270 B of flash at `z`.
     #[allow(clippy::needless_range_loop)]
-    pub fn stage(&mut self, target: PerAxis<i32>, feed: Feed) -> Result<(), Full> {
+    fn stage_steps(&mut self, target: PerAxis<i32>, feed: Feed, kind: u8) -> Result<(), Full> {
         if self.is_full() {
             return Err(Full);
         }
         let mut step = Steps {
             steps: [0; AXES],
-            dir: 0,
+            dir: kind,
         };
         for i in 0..AXES {
             let delta = target[i] as i64 - self.position[i] as i64;
@@ -302,6 +404,11 @@ impl Planner {
             Stage::Done => return false,
             Stage::Pushed(feed) => self.plan_path(feed),
             Stage::Turned { ev_per_milli } => self.plan_junction(ev_per_milli),
+            Stage::PenTurned {
+                ev_per_milli,
+                joint,
+                len,
+            } => self.plan_pen_joints(ev_per_milli, &PenLast { joint, len }),
             Stage::Path { ev_per_milli } => self.plan_limits(ev_per_milli),
             Stage::Limits => {
                 self.len += 1;
@@ -320,17 +427,25 @@ impl Planner {
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_path(&mut self, feed: Feed) {
         let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
-        let path = self.geometry.path(&b.step.block());
         // Scaled to events/s by `plan_limits`: this part is the longer.
         b.feed_ev = match feed {
             Feed::Rapid => 0.0,
             // Never 0, which means a rapid.
             Feed::PerMinute(f) => f.0.max(1) as f32,
         };
+        if b.step.is_pen() {
+            return self.plan_pen_path();
+        }
+        let path = self.geometry.path(&b.step.block());
         // The axes' jumps now, the junction's roots in the next part: the
         // turn waits in `entry_sqr` and `delta_sqr`, which `plan_limits`
-        // and `recalculate` write before anything reads them.
-        (b.junction_sqr, (b.entry_sqr, b.delta_sqr)) = match self.last {
+        // and `recalculate` write before anything reads them. After a
+        // piece of the pen's path, whose direction is the pen's: from rest.
+        let last = match self.pen_last.take() {
+            None => self.last,
+            Some(_) => None,
+        };
+        (b.junction_sqr, (b.entry_sqr, b.delta_sqr)) = match last {
             Some(prev) => (
                 down(self.jumps.limit_sqr(&prev, &path.unit), self.shift),
                 self.geometry.turn(&prev, &path.unit).pack(),
@@ -341,6 +456,56 @@ impl Planner {
         self.stage = Stage::Turned {
             ev_per_milli: path.ev_per_milli,
         };
+    }
+
+    /// [`Planner::plan_path`] of a piece: its direction and length along
+    /// the pen, the joints' shares of the pen's speed, and the pen's turn
+    /// at the junction with the piece before it.
+    #[inline(never)]
+    fn plan_pen_path(&mut self) {
+        let slot = (self.head + self.len) % PLANNER_BLOCKS;
+        let path: PenPath = self
+            .geometry
+            .pen_path(&self.blocks[slot].step.block(), &self.pen_staged);
+        let b = &mut self.blocks[slot];
+        // The turn waits in `entry_sqr` and `delta_sqr`, as a move's.
+        (b.entry_sqr, b.delta_sqr) = match (self.last, self.pen_last, &self.pen) {
+            (Some(prev), Some(_), Some(pen)) => {
+                self.geometry.turn_pen(&prev, &path.unit, pen).pack()
+            }
+            _ => (0, 0),
+        };
+        self.last = Some(path.unit);
+        self.stage = Stage::PenTurned {
+            ev_per_milli: path.ev_per_milli,
+            joint: path.joint,
+            len: path.len,
+        };
+    }
+
+    /// The joints' limits at a piece's junction with the piece before
+    /// it: their jumps, and their acceleration where their shares of the
+    /// pen's speed change (0: the first piece).
+    #[inline(never)]
+    fn plan_pen_joints(&mut self, ev_per_milli: f32, this: &PenLast) {
+        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        b.junction_sqr = match (self.pen_last, &self.pen) {
+            (Some(before), Some(pen)) => {
+                // The junction low enough that the speed a piece reaches
+                // between two junctions (at most (v₀² + v₁²)/2 + a·len)
+                // stays within the joints' limits.
+                let mean = 0.5 * (before.len + this.len);
+                let joints =
+                    self.geometry
+                        .joints_sqr(&self.jumps, &before.joint, &this.joint, mean);
+                // Shifted as the speeds² kept; saturating (∞: none, < 0: 0).
+                let shift = f32::from_bits((127 - self.shift as u32) << 23);
+                ((joints - pen.accel_len_sqr(this.len)) * shift) as u32
+            }
+            _ => 0,
+        };
+        self.pen_last = Some(*this);
+        self.stage = Stage::Turned { ev_per_milli };
     }
 
     /// The staged move's junction speed: Grbl's, within the axes' jumps.
@@ -364,7 +529,10 @@ impl Planner {
     fn plan_limits(&mut self, ev_per_milli: f32) {
         let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
         let step = b.step.block();
-        let (accel, rate) = self.geometry.limits(&step);
+        let (mut accel, mut rate) = self.geometry.limits(&step);
+        if let (true, Some(pen)) = (b.step.is_pen(), &self.pen) {
+            pen.cap(&mut accel, &mut rate, ev_per_milli);
+        }
         let k2 = ev_per_milli * ev_per_milli;
         let overrides = self.overrides.unwrap_or(Overrides::NONE);
         b.feed_ev = b.feed_ev / 60.0 * ev_per_milli;
@@ -394,6 +562,9 @@ impl Planner {
     pub fn set_position(&mut self, position: PerAxis<i32>) {
         self.position = position;
         self.last = None;
+        self.pen_last = None;
+        self.pen_at = None;
+        self.frac = [0; AXES];
     }
 
     /// Hands the oldest block to the segment preparer. Its exit speed is
@@ -463,8 +634,11 @@ impl Planner {
         self.overrides = Some(overrides);
         for i in 0..self.len {
             let b = &mut self.blocks[(self.head + i) % PLANNER_BLOCKS];
-            let (_, rate) = self.geometry.limits(&b.step.block());
+            let (mut accel, mut rate) = self.geometry.limits(&b.step.block());
             let ev_per_milli = crate::fmath::sqrt(b.ev_per_milli_sqr);
+            if let (true, Some(pen)) = (b.step.is_pen(), &self.pen) {
+                pen.cap(&mut accel, &mut rate, ev_per_milli);
+            }
             let nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
             b.nominal_sqr = down(nominal_sqr, self.shift);
         }

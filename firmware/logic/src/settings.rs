@@ -85,6 +85,10 @@ pub enum GlobalField {
     /// which the needle's clearance from the nails is worked out from.
     NailDiameter,
     NeedleDiameter,
+    /// The pen's top speed (mm/min) and acceleration (mm/s²) on the
+    /// whiteboard and the arm, whose joints keep their own limits too.
+    PenMaxFeed,
+    PenAccel,
     /// Grbl's `$1`: ms the drivers stay on once motion stands (255: on).
     StepIdleDelay,
 }
@@ -118,7 +122,7 @@ const AXIS_FIELDS: [AxisField; 9] = [
     AxisField::Driver,
 ];
 
-const GLOBAL_FIELDS: [GlobalField; 25] = [
+const GLOBAL_FIELDS: [GlobalField; 27] = [
     GlobalField::Machine,
     GlobalField::StepPulseUs,
     GlobalField::DirSetupUs,
@@ -143,6 +147,8 @@ const GLOBAL_FIELDS: [GlobalField; 25] = [
     GlobalField::ReportInches,
     GlobalField::NailDiameter,
     GlobalField::NeedleDiameter,
+    GlobalField::PenMaxFeed,
+    GlobalField::PenAccel,
     GlobalField::StepIdleDelay,
 ];
 
@@ -190,7 +196,9 @@ impl GlobalField {
             21 => ReportInches,
             22 => NailDiameter,
             23 => NeedleDiameter,
-            24 => StepIdleDelay,
+            24 => PenMaxFeed,
+            25 => PenAccel,
+            26 => StepIdleDelay,
             _ => return None,
         })
     }
@@ -265,6 +273,8 @@ impl GlobalField {
             ReportInches => "report_inches",
             NailDiameter => "nail_diameter",
             NeedleDiameter => "needle_diameter",
+            PenMaxFeed => "pen_max_feed",
+            PenAccel => "pen_accel",
             StepIdleDelay => "step_idle_delay_ms",
         ])
         .get(self as usize)
@@ -459,6 +469,8 @@ impl Setting {
             Setting::Global(GlobalField::NeedleDiameter) => {
                 return Value::Milli(Milli(i32::from(cfg.winding.needle_um)))
             }
+            Setting::Global(GlobalField::PenMaxFeed) => cfg.pen_max_feed,
+            Setting::Global(GlobalField::PenAccel) => cfg.pen_accel,
             Setting::Global(GlobalField::StepIdleDelay) => cfg.idle_delay_ms as u32,
         })
     }
@@ -521,6 +533,8 @@ impl Setting {
             SWITCH,
             spec(Milli, MIN_UM, MAX_UM),
             spec(Milli, MIN_UM, MAX_UM),
+            number(1, 1_000_000),
+            number(1, 100_000),
             number(0, 255),
         ]);
         specs.get(match self {
@@ -670,6 +684,8 @@ impl Setting {
             (Setting::Global(GlobalField::HomingLocate), _) => cfg.homing.locate = n as u16,
             (Setting::Global(GlobalField::StatusReport), _) => cfg.status_report = n as u8,
             (Setting::Global(GlobalField::ReportInches), _) => cfg.report_inches = n == 1,
+            (Setting::Global(GlobalField::PenMaxFeed), _) => cfg.pen_max_feed = n,
+            (Setting::Global(GlobalField::PenAccel), _) => cfg.pen_accel = n,
             (Setting::Global(GlobalField::StepIdleDelay), _) => cfg.idle_delay_ms = n as u8,
             (Setting::Global(_), Value::Number(_)) => {}
         }

@@ -1,6 +1,7 @@
 //! `taut-bench FIRMWARE_ELF BUSY_ELF OUT_JSON`: the figures of `cargo xtask
 //! bench`, from simavr's cycle counter (exact and repeatable), written as
-//! JSON and printed as a table.
+//! JSON and printed as a table. `taut-bench --feed FIRMWARE_ELF` measures
+//! the feed ratios alone (any image, an older one too).
 //!
 //! Step rates: the highest cruise rate at which every STEP pulse of a
 //! one-second cruise lands within 2 µs of its ideal time: a uniform grid,
@@ -13,6 +14,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 use taut_logic::axis::Axis;
 use taut_logic::config::MachineConfig;
+use taut_logic::machine::Machine;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
@@ -547,8 +549,101 @@ fn stream_lines_per_s(elf: &Path) -> (f64, f64, f64, f64, bool) {
     )
 }
 
+/// A line: from, to (mm), feed (mm/min).
+type Line = ([f64; 2], [f64; 2], f64);
+
+/// The arm's lines: the two a user timed at 2.38 s and 1.11 s (40 mm at
+/// F600, 4.1 s on the flatbed), and two long ones at higher feeds.
+const SCARA_LINES: [Line; 4] = [
+    ([80.0, 150.0], [80.0, 190.0], 600.0),
+    ([60.0, 200.0], [100.0, 200.0], 600.0),
+    ([40.0, 100.0], [160.0, 100.0], 3000.0),
+    ([100.0, 60.0], [100.0, 180.0], 1500.0),
+];
+
+/// The whiteboard's: 40 mm at F600 from its origin, and three across
+/// the board.
+const WHITEBOARD_LINES: [Line; 4] = [
+    ([0.0, 0.0], [40.0, 0.0], 600.0),
+    ([-200.0, -100.0], [200.0, 100.0], 3000.0),
+    ([0.0, -300.0], [0.0, 200.0], 1500.0),
+    ([-400.0, 200.0], [-300.0, -200.0], 900.0),
+];
+
+/// Each line's time on `machine`, from its first step to its last, over
+/// its trapezoid along the pen (its length at the feed, ramps at the
+/// machine's `pen_accel`, from rest to rest): 1 is the feed kept (a hair
+/// under: the first step comes a fraction of a step's travel after the
+/// start), above 1 where a joint's limits hold the pen back, below 1
+/// faster than asked.
+fn feed_ratios(elf: &Path, machine: Machine, lines: &[Line]) -> Vec<f64> {
+    let cfg = MachineConfig::defaults(machine);
+    let mut sim = Sim::boot(elf);
+    let t = Duration::from_secs(120);
+    send(&mut sim, &format!("$machine={}", machine.name()), t);
+    send(&mut sim, "M17", t);
+    lines
+        .iter()
+        .map(|(a, b, feed)| {
+            send(&mut sim, &format!("G0 X{} Y{}", a[0], a[1]), t);
+            send(&mut sim, "M400", t);
+            let before = [Axis::Base, Axis::Radial].map(|j| rises(&sim, j).len());
+            send(&mut sim, &format!("G1 X{} Y{} F{feed}", b[0], b[1]), t);
+            send(&mut sim, "M400", t);
+            let (mut first, mut last) = (u64::MAX, 0);
+            for (j, n) in [Axis::Base, Axis::Radial].iter().zip(before) {
+                let r = rises(&sim, *j);
+                if let (Some(f), Some(l)) = (r[n..].first(), r[n..].last()) {
+                    (first, last) = (first.min(*f), last.max(*l));
+                }
+            }
+            let seconds = (last - first) as f64 / 16e6;
+            let v = feed.min(cfg.pen_max_feed as f64) / 60.0;
+            let accel = cfg.pen_accel as f64;
+            let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+            let ideal = match v * v / accel >= length {
+                true => 2.0 * (length / accel).sqrt(),
+                false => v / accel + length / v,
+            };
+            println!(
+                "{:<10} {a:?} → {b:?} F{feed}: {seconds:.3} s, trapezoid {ideal:.3} s, ratio {:.3}",
+                machine.name().to_string(),
+                seconds / ideal
+            );
+            seconds / ideal
+        })
+        .collect()
+}
+
+/// `feed_ratio_<machine>_min` / `_max` of the machines' lines.
+fn feed_figures(elf: &Path, f: &mut Map<String, Value>) {
+    for (machine, lines) in [
+        (Machine::Scara, &SCARA_LINES),
+        (Machine::Whiteboard, &WHITEBOARD_LINES),
+    ] {
+        let r = feed_ratios(elf, machine, lines);
+        let name = machine.name().to_string();
+        let (lo, hi) = r
+            .iter()
+            .fold((f64::MAX, 0.0f64), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+        f.insert(format!("feed_ratio_{name}_min"), json!(round(lo, 3)));
+        f.insert(format!("feed_ratio_{name}_max"), json!(round(hi, 3)));
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if let [flag, fw] = &args[..] {
+        if flag == "--feed" {
+            let mut f = Map::new();
+            feed_figures(Path::new(fw), &mut f);
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&Value::Object(f)).unwrap()
+            );
+            return;
+        }
+    }
     let [fw, busy, out] = &args[..] else {
         eprintln!("usage: taut-bench FIRMWARE_ELF BUSY_ELF OUT_JSON");
         std::process::exit(2);
@@ -645,6 +740,7 @@ fn main() {
     );
     f.insert("cpu_busy_percent_winding".into(), json!(round(winding, 1)));
     f.insert("segment_prep_max_cycles".into(), json!(prep));
+    feed_figures(fw, &mut f);
     let (mhz, wall) = demo_job(fw, &card);
     f.insert("sim_mhz".into(), json!(round(mhz, 1)));
     f.insert("demo_wall_s".into(), json!(round(wall, 2)));

@@ -11,7 +11,7 @@ use super::{coords, Allowed, Env, Exact, Interpreter, MachineIo, Progress, Wait}
 use crate::config::MachineConfig;
 use crate::coords::CoordData;
 use crate::gcode::{Input, Parser};
-use crate::kinematics::{AnyKinematics, Steps};
+use crate::kinematics::{AnyKinematics, Piece, Steps};
 use crate::planner::{Feed, Planner};
 use crate::segment::SUBTICKS_PER_S;
 
@@ -71,6 +71,10 @@ impl MachineIo for Timed {
 
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
         self.planner.push(*steps, feed).is_ok()
+    }
+
+    fn queue_piece(&mut self, piece: &Piece, feed: Feed) -> bool {
+        self.planner.push_piece(piece, feed).is_ok()
     }
 
     fn idle(&mut self) -> bool {
@@ -219,5 +223,34 @@ mod tests {
         let (arm, r) = time_of(Machine::Scara, "G1 X90 Y140 F600\nG1 X60 Y140\n");
         assert_eq!(r, 0);
         assert!(arm > 3.0, "{arm}");
+    }
+
+    /// On the arm and the whiteboard `F` is the pen's speed: a line takes
+    /// the pen's trapezoid (its feed, `pen_accel`), as on the flatbed.
+    #[test]
+    fn the_pens_lines_take_the_pens_trapezoid() {
+        for (machine, from, to, feed) in [
+            (Machine::Scara, (80.0, 150.0), (80.0, 190.0), 600.0),
+            (Machine::Scara, (60.0, 200.0), (100.0, 200.0), 600.0),
+            (Machine::Whiteboard, (0.0, 0.0), (-200.0, 150.0), 3000.0),
+        ] {
+            let cfg = MachineConfig::defaults(machine);
+            let mut t = GcodeTime::new(&cfg).unwrap();
+            t.push(std::format!("G0 X{} Y{}\nG4 P0\n", from.0, from.1).as_bytes());
+            let before = t.seconds();
+            t.push(std::format!("G1 X{} Y{} F{feed}\n", to.0, to.1).as_bytes());
+            assert_eq!(t.refused, 0);
+            let s = t.finish() - before;
+            let length = f64::hypot(to.0 - from.0, to.1 - from.1);
+            let (v, a) = (feed / 60.0, cfg.pen_accel as f64);
+            let ideal = match v * v / a >= length {
+                true => 2.0 * (length / a).sqrt(),
+                false => v / a + length / v,
+            };
+            assert!(
+                (s / ideal - 1.0).abs() < 0.002,
+                "{machine:?}: {s} s, not {ideal}"
+            );
+        }
     }
 }

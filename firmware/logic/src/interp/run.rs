@@ -3,8 +3,8 @@
 //! planner would, and goes on at the next call.
 
 use super::{
-    coords, motor_channels, motor_steps, todo, Env, Interpreter, MachineIo, Path, Progress, Wait,
-    SEGMENT_UM,
+    motor_channels, motor_milli, motor_only, motor_steps, todo, Env, Interpreter, MachineIo, Path,
+    Progress, Wait,
 };
 use crate::kinematics::{Kinematics, Segmenter};
 
@@ -112,8 +112,8 @@ impl Interpreter {
     }
 
     /// A straight leg: one move on a linear machine, from the exact
-    /// target; on the others, pieces (then the leg's bit is off and the
-    /// path's on).
+    /// target; on the others, pieces no longer than the kinematics'
+    /// `piece_um` (then the leg's bit is off and the path's on).
     fn leg<K: Kinematics>(
         &mut self,
         second: bool,
@@ -123,9 +123,10 @@ impl Interpreter {
         let to = self.run.legs[second as usize];
         let motors = motor_channels(env.cfg);
         if !env.kin.is_linear() {
-            let from = super::motor_milli(&self.run.from, motors);
-            let end = super::motor_milli(&to, motors);
-            self.run.path = Some(Path::Line(Segmenter::new(env.kin, from, &end, SEGMENT_UM)));
+            let from = motor_milli(&self.run.from, motors);
+            let end = motor_milli(&to, motors);
+            let line = Segmenter::new(env.kin, from, &end, env.kin.piece_um());
+            self.run.path = Some(Path::Line(line));
             self.run.from = to;
             let bit = if second { todo::LEG_1 } else { todo::LEG_0 };
             self.run.todo = self.run.todo & !bit | todo::PATH;
@@ -144,7 +145,10 @@ impl Interpreter {
         None
     }
 
-    /// The path's next piece; `None` once its last is queued.
+    /// The path's next piece; `None` once its last is queued. On a
+    /// machine whose kinematics are not linear the piece goes to the
+    /// planner as the pen's ([`MachineIo::queue_piece`]): `F` is the
+    /// pen's speed along the path.
     fn piece<K: Kinematics>(&mut self, env: &Env<K>, io: &mut impl MachineIo) -> Option<Wait> {
         let path = self.run.path.as_mut()?;
         if let Some(wait) = io.room(true) {
@@ -152,28 +156,33 @@ impl Interpreter {
         }
         let before = *path;
         let motors = motor_channels(env.cfg);
-        let steps = match path.next() {
-            None => {
+        let queued = if env.kin.is_linear() {
+            let Some(end) = path.next() else {
                 self.run.path = None;
                 return None;
-            }
-            // An arc's last chord ends on the exact target (a linear
-            // machine's steps from it, rounded once).
-            Some(_)
-                if matches!(path, Path::Arc(a) if a.remaining() == 0) && env.kin.is_linear() =>
-            {
-                motor_steps(&self.run.legs[0], motors, env.kin, env.cfg)
-            }
-            Some(p) => {
-                let p = super::motor_milli(&coords::exact(&p), motors);
-                env.kin
-                    .inverse(&p)
-                    .map_err(|_| crate::gcode::ErrorKind::InvalidTarget)
+            };
+            // An arc's last chord ends on the exact target (the steps
+            // from it, rounded once).
+            let steps = match matches!(path, Path::Arc(a) if a.remaining() == 0) {
+                true => motor_steps(&self.run.legs[0], motors, env.kin, env.cfg),
+                false => env
+                    .kin
+                    .inverse(&motor_only(&end, motors))
+                    .map_err(|_| crate::gcode::ErrorKind::InvalidTarget),
+            };
+            io.queue(&steps.unwrap_or_default(), self.run.feed)
+        } else {
+            match path.next_piece(env.kin, motors) {
+                None => {
+                    self.run.path = None;
+                    return None;
+                }
+                Some(Ok(piece)) => io.queue_piece(&piece, self.run.feed),
+                // Every piece was checked when the line was accepted.
+                Some(Err(_)) => true,
             }
         };
-        // Every piece was checked when the line was accepted.
-        let steps = steps.unwrap_or_default();
-        if !io.queue(&steps, self.run.feed) {
+        if !queued {
             self.run.path = Some(before);
             return Some(Wait::Motion);
         }

@@ -15,6 +15,8 @@ use std::{format, string::String, string::ToString, vec::Vec};
 #[derive(Clone, Debug, PartialEq)]
 enum Did {
     Move(Steps, Feed),
+    /// A piece of a path on the whiteboard or the arm.
+    Piece(Piece, Feed),
     Pen(u8),
     Drivers(bool),
     IdleDelay(u32),
@@ -43,6 +45,10 @@ impl MachineIo for Recorder {
     }
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
         self.did.push(Did::Move(*steps, feed));
+        true
+    }
+    fn queue_piece(&mut self, piece: &Piece, feed: Feed) -> bool {
+        self.did.push(Did::Piece(*piece, feed));
         true
     }
     fn idle(&mut self) -> bool {
@@ -159,9 +165,22 @@ impl Bench {
             .rev()
             .find_map(|d| match d {
                 Did::Move(s, _) => Some(*s),
+                Did::Piece(p, _) => Some(p.steps),
                 _ => None,
             })
             .expect("no move")
+    }
+
+    /// The pieces queued, in order.
+    fn pieces(&self) -> Vec<(Piece, Feed)> {
+        self.io
+            .did
+            .iter()
+            .filter_map(|d| match d {
+                Did::Piece(p, f) => Some((*p, *f)),
+                _ => None,
+            })
+            .collect()
     }
 
     fn moves(&self) -> usize {
@@ -643,4 +662,67 @@ fn a_job_owns_the_motion() {
         assert_eq!(r.is_err(), refused, "{text}: {r:?}");
     }
     let _ = "".to_string();
+}
+
+/// On the arm a straight move goes to the planner as pieces of at most
+/// 2 mm along the pen's line, each with the path's start and the
+/// inverse of its end: `F` is the pen's speed along them. The last ends
+/// exactly on the target.
+#[test]
+fn the_arms_straight_moves_are_the_pens_pieces() {
+    let mut b = Bench::new(Machine::Scara);
+    b.ok("G0 X100 Y150");
+    b.io.did.clear();
+    b.ok("G1 X130 Y110 F600");
+    let pieces = b.pieces();
+    // 50 mm in pieces of at most 2 mm.
+    assert_eq!(pieces.len(), 25);
+    assert_eq!(b.moves(), 0);
+    let mm = |x: i32, y: i32| [Milli(x), Milli(y), Milli(0)];
+    for (p, feed) in &pieces {
+        assert_eq!(p.start, mm(100_000, 150_000));
+        assert_eq!(*feed, Feed::PerMinute(Milli(600_000)));
+        assert_eq!(Ok((p.steps, p.frac)), b.kin.inverse_fine(&p.to));
+    }
+    assert_eq!(pieces[11].0.to, mm(114_400, 130_800));
+    assert_eq!(pieces[24].0.to, mm(130_000, 110_000));
+    // A rapid too, at the pen's top speed.
+    b.ok("G0 X100 Y150");
+    assert_eq!(b.pieces().last().unwrap().1, Feed::Rapid);
+}
+
+/// The arm's shoulder cannot follow round behind its base (x = 100,
+/// y < −56): a move across there is refused whole with error:33 before
+/// anything moves, straight or as an arc; round the front it goes.
+#[test]
+fn the_arm_refuses_a_move_behind_its_base() {
+    let mut b = Bench::new(Machine::Scara);
+    b.ok("G0 X50 Y-100");
+    let queued = b.io.did.len();
+    assert_eq!(b.err("G1 X150 Y-100 F600"), 33);
+    assert_eq!(b.err("G0 X150 Y-100"), 33);
+    // Half a circle round (100, −100) passes under the shoulder.
+    assert_eq!(b.err("G3 X150 Y-100 I50 J0 F600"), 33);
+    assert_eq!(b.io.did.len(), queued);
+    assert_eq!(b.mpos()[..2], [50_000, -100_000]);
+    // Out of reach altogether (300 mm from the shoulder).
+    assert_eq!(b.err("G1 X100 Y250 F600"), 33);
+    // Round the front: the other way round the same circle, then lines.
+    b.ok("G2 X150 Y-100 I50 J0 F600");
+    assert_eq!(b.err("G0 X50 Y-100"), 33);
+    for line in ["G1 X150 Y100", "G1 X50 Y100", "G1 X50 Y-100"] {
+        b.ok(line);
+    }
+    assert_eq!(b.mpos()[..2], [50_000, -100_000]);
+}
+
+/// The whiteboard's straight moves: pieces of at most 5 mm.
+#[test]
+fn the_whiteboards_straight_moves_are_the_pens_pieces() {
+    let mut b = Bench::new(Machine::Whiteboard);
+    b.ok("G1 X-200 Y150 F3000");
+    let pieces = b.pieces();
+    assert_eq!(pieces.len(), 50);
+    assert_eq!(pieces[49].0.to[..2], [Milli(-200_000), Milli(150_000)]);
+    assert!(pieces.iter().all(|(p, _)| p.start == [Milli(0); 3]));
 }

@@ -23,7 +23,7 @@ mod segmenter;
 pub use linear::Linear;
 pub use polargraph::Polargraph;
 pub use scara::Scara;
-pub use segmenter::Segmenter;
+pub use segmenter::{Piece, Segmenter};
 
 use crate::axis::{PerAxis, AXES};
 use crate::config::MachineConfig;
@@ -34,6 +34,11 @@ use crate::units::{div_round, Milli, StepsPerUnit};
 pub type Position = PerAxis<Milli>;
 /// Absolute motor positions, one per channel.
 pub type Steps = PerAxis<i32>;
+/// What rounding took off each channel's step count: the exact position
+/// is `steps + frac / 256` (|frac| ≤ 128, saturated to `i8`). The
+/// planner reads a path's curvature in joint space from it, not from the
+/// rounded counts, whose ±½ step would look like a change of speed.
+pub type Frac = PerAxis<i8>;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum KinError {
@@ -55,6 +60,10 @@ impl KinError {
 pub trait Kinematics {
     /// Absolute step targets of an absolute position.
     fn inverse(&self, pos: &Position) -> Result<Steps, KinError>;
+    /// [`Kinematics::inverse`] with what rounding took off each channel.
+    fn inverse_fine(&self, pos: &Position) -> Result<(Steps, Frac), KinError> {
+        self.inverse(pos).map(|s| (s, [0; AXES]))
+    }
     /// The position the motors are at.
     fn forward(&self, steps: &Steps) -> Position;
     /// True when a straight line in space is a straight line in joint
@@ -69,6 +78,12 @@ pub trait Kinematics {
     /// the AVR would cost ms each.
     fn reaches_line(&self, a: &Position, b: &Position) -> bool {
         self.inverse(a).is_ok() && self.inverse(b).is_ok()
+    }
+    /// Longest piece a straight move is cut into, µm, where the
+    /// kinematics are not linear: the pen then strays from the line by
+    /// far less than a step (`Segmenter`'s tests measure it).
+    fn piece_um(&self) -> u32 {
+        u32::MAX
     }
 }
 
@@ -94,12 +109,15 @@ impl ChannelScale {
         self.0[axis].milli(steps)
     }
 
-    /// Steps of a joint value computed in floating point (mm or degrees).
-    fn steps_f32(&self, axis: usize, value: f32) -> Result<i32, KinError> {
-        let s = libm::roundf(value * self.0[axis].as_f32());
+    /// Steps of a joint value computed in floating point (mm or degrees),
+    /// and what the rounding took off, in 1/256 step.
+    fn steps_fine(&self, axis: usize, value: f32) -> Result<(i32, i8), KinError> {
+        let exact = value * self.0[axis].as_f32();
+        let s = libm::roundf(exact);
         // 2^31 is exact in f32; NaN fails both comparisons.
         if (-2_147_483_648.0..2_147_483_648.0).contains(&s) {
-            Ok(s as i32)
+            // Saturating: ±½ step is ±128.
+            Ok((s as i32, ((exact - s) * 256.0) as i8))
         } else {
             Err(KinError::Overflow)
         }
@@ -168,6 +186,22 @@ impl Kinematics for AnyKinematics {
             AnyKinematics::Linear(k) => k.inverse(pos),
             AnyKinematics::Polargraph(k) => k.inverse(pos),
             AnyKinematics::Scara(k) => k.inverse(pos),
+        }
+    }
+
+    fn inverse_fine(&self, pos: &Position) -> Result<(Steps, Frac), KinError> {
+        match self {
+            AnyKinematics::Linear(k) => k.inverse_fine(pos),
+            AnyKinematics::Polargraph(k) => k.inverse_fine(pos),
+            AnyKinematics::Scara(k) => k.inverse_fine(pos),
+        }
+    }
+
+    fn piece_um(&self) -> u32 {
+        match self {
+            AnyKinematics::Linear(k) => k.piece_um(),
+            AnyKinematics::Polargraph(k) => k.piece_um(),
+            AnyKinematics::Scara(k) => k.piece_um(),
         }
     }
 

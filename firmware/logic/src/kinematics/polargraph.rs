@@ -5,7 +5,7 @@
 //! lifts the pen. The user's (0, 0) is `origin` in that frame, and the step
 //! counts are zero there (the pen is parked at the origin when zeroed).
 
-use super::{milli, mm, ChannelScale, KinError, Kinematics, Position, Steps};
+use super::{milli, mm, ChannelScale, Frac, KinError, Kinematics, Position, Steps};
 use crate::axis::AXES;
 use crate::config::Geometry;
 use crate::fmath;
@@ -49,16 +49,27 @@ impl Polargraph {
 }
 
 impl Kinematics for Polargraph {
+    fn inverse(&self, pos: &Position) -> Result<Steps, KinError> {
+        self.inverse_fine(pos).map(|(steps, _)| steps)
+    }
+
     // Out of line: one copy of the float maths, whoever calls.
     #[inline(never)]
-    fn inverse(&self, pos: &Position) -> Result<Steps, KinError> {
+    fn inverse_fine(&self, pos: &Position) -> Result<(Steps, Frac), KinError> {
         let p = [self.origin[0] + mm(pos[0]), self.origin[1] + mm(pos[1])];
         let len = self.lengths(p)?;
         let mut steps = self.scale.all_steps(pos)?;
+        let mut frac = [0; AXES];
         for i in 0..2 {
-            steps[i] = self.scale.steps_f32(i, len[i] - self.home[i])?;
+            (steps[i], frac[i]) = self.scale.steps_fine(i, len[i] - self.home[i])?;
         }
-        Ok(steps)
+        Ok((steps, frac))
+    }
+
+    /// 5 mm: the strings' lengths bend so gently along a line that the pen
+    /// strays under 0.01 mm from it (a step of chain is 0.057 mm).
+    fn piece_um(&self) -> u32 {
+        5000
     }
 
     /// Below the motors is a half-plane: the ends are enough.

@@ -1,21 +1,53 @@
 //! Cuts a straight move into pieces no longer than `segment_len` for
 //! kinematics that are not linear (Marlin's and Klipper's approach). Each
 //! piece's endpoint is interpolated from the absolute start and end in
-//! integers and converted by the inverse from scratch, so no error piles up
-//! from piece to piece; the last piece ends exactly on the target. Each
-//! piece's end goes through the kinematics' inverse where it is queued.
+//! integers — `from + round(delta·k / n)`, kept as a whole and a remainder
+//! that each piece adds to, so no division per piece (three 64-bit ones
+//! were ~9 000 cycles of a piece's run on the AVR) — and converted by the
+//! inverse from scratch, so no error piles up from piece to piece; the
+//! last piece ends exactly on the target. Each piece's end goes through
+//! the kinematics' inverse where it is queued.
 
-use super::{Kinematics, Position};
+use super::{Frac, Kinematics, Position, Steps};
 use crate::axis::AXES;
 use crate::segment::isqrt;
-use crate::units::{div_round, Milli};
+use crate::units::Milli;
+
+/// One piece of a path on a machine whose kinematics are not linear: the
+/// pen's straight move (machine coordinates) and the motors' target. The
+/// planner measures its speeds along the pen's path, from the last
+/// piece's end to `to`, and keeps each motor within its own limits over
+/// `steps`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Piece {
+    /// Where the path began: the first piece's start (a piece's own is
+    /// the last one's end, which the planner keeps).
+    pub start: Position,
+    pub to: Position,
+    /// The inverse of `to`, and what its rounding took off.
+    pub steps: Steps,
+    pub frac: Frac,
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Segmenter {
     from: Position,
-    delta: [i64; AXES],
+    to: Position,
+    share: [Share; AXES],
+    /// Bit `i`: coordinate `i` decreases.
+    down: u8,
     pieces: u32,
     done: u32,
+}
+
+/// One coordinate's way along the line: |delta| = step·n + rest, and
+/// after `k` pieces |delta|·k = whole·n + part (part < n).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Share {
+    step: u32,
+    rest: u32,
+    whole: u32,
+    part: u32,
 }
 
 impl Segmenter {
@@ -23,19 +55,36 @@ impl Segmenter {
     /// gets a single piece. The length counts every coordinate.
     pub fn new(kin: &impl Kinematics, from: Position, to: &Position, segment_len: u32) -> Self {
         let delta: [i64; AXES] = core::array::from_fn(|i| to[i].0 as i64 - from[i].0 as i64);
-        let pieces = if kin.is_linear() {
+        let pieces: u32 = if kin.is_linear() {
             1
         } else {
             // Rounded up, so no piece is longer than asked.
-            let len2: u64 = delta.iter().map(|d| (d * d) as u64).sum();
+            let len2 = delta
+                .iter()
+                .map(|d| d.unsigned_abs().saturating_mul(d.unsigned_abs()))
+                .fold(0u64, u64::saturating_add);
             let root = isqrt(len2);
             let len = if root * root < len2 { root + 1 } else { root };
             let seg = segment_len.max(1) as u64;
             len.div_ceil(seg).clamp(1, u32::MAX as u64) as u32
         };
+        let mut down = 0;
+        let share = core::array::from_fn(|i| {
+            down |= ((delta[i] < 0) as u8) << i;
+            // Two i32s differ by less than 2³²: 32-bit divisions.
+            let d = delta[i].unsigned_abs() as u32;
+            Share {
+                step: d / pieces,
+                rest: d % pieces,
+                whole: 0,
+                part: 0,
+            }
+        });
         Segmenter {
             from,
-            delta,
+            to: *to,
+            share,
+            down,
             pieces,
             done: 0,
         }
@@ -50,7 +99,7 @@ impl Segmenter {
     }
 
     pub fn end(&self) -> Position {
-        core::array::from_fn(|i| Milli(self.from[i].0 + self.delta[i] as i32))
+        self.to
     }
 }
 
@@ -62,9 +111,20 @@ impl Iterator for Segmenter {
             return None;
         }
         self.done += 1;
-        let (k, n) = (self.done as i64, self.pieces as i64);
+        let n = self.pieces;
+        // Rounded half away from zero: up from n − ⌊n/2⌋ of n.
+        let half = n - n / 2;
         let point: Position = core::array::from_fn(|i| {
-            Milli(self.from[i].0 + div_round(self.delta[i] * k, n) as i32)
+            let s = &mut self.share[i];
+            s.whole += s.step;
+            s.part += s.rest;
+            if s.part >= n {
+                s.part -= n;
+                s.whole += 1;
+            }
+            let way = (s.whole + (s.part >= half) as u32) as i64;
+            let way = if self.down >> i & 1 != 0 { -way } else { way };
+            Milli((self.from[i].0 as i64 + way) as i32)
         });
         Some(point)
     }
@@ -117,7 +177,76 @@ mod tests {
         assert_eq!(Segmenter::new(&k, pos(5, 5), &pos(5, 5), 1000).count(), 1);
     }
 
+    /// A machine's kinematics with 1000 times its steps: a joint's
+    /// rounding then moves the pen by well under a µm.
+    fn fine(machine: crate::machine::Machine) -> super::super::AnyKinematics {
+        let mut cfg = MachineConfig::defaults(machine);
+        for a in &mut cfg.axes {
+            a.steps_per_unit.num *= 1000;
+        }
+        super::super::AnyKinematics::of(&cfg).unwrap()
+    }
+
+    /// How far the pen strays from a piece `a → b` (µm) while the joints
+    /// run straight from one end's steps to the other's: at its middle.
+    fn stray(k: &impl Kinematics, a: &Position, b: &Position) -> f64 {
+        let (sa, sb) = (k.inverse(a).unwrap(), k.inverse(b).unwrap());
+        let mid = k.forward(&core::array::from_fn(|i| (sa[i] + sb[i]) / 2));
+        let (dx, dy) = ((b[0].0 - a[0].0) as f64, (b[1].0 - a[1].0) as f64);
+        let (mx, my) = ((mid[0].0 - a[0].0) as f64, (mid[1].0 - a[1].0) as f64);
+        (mx * dy - my * dx).abs() / dx.hypot(dy)
+    }
+
     proptest! {
+        /// Each piece's end is `from + round(delta·k / n)`, rounded half
+        /// away from zero, as it was worked out with a division a piece.
+        #[test]
+        fn pieces_without_dividing_are_the_divided_ones(
+            a in prop::array::uniform3(-(1i32 << 30)..1 << 30),
+            b in prop::array::uniform3(-(1i32 << 30)..1 << 30),
+            seg in prop_oneof![1u32..10, 1000u32..5000, 1u32 << 30..u32::MAX],
+        ) {
+            let k = polargraph();
+            let (a, b) = (a.map(Milli), b.map(Milli));
+            let s = Segmenter::new(&k, a, &b, seg);
+            let n = s.pieces() as i64;
+            prop_assume!(n <= 5000);
+            for (k, p) in s.enumerate() {
+                for i in 0..AXES {
+                    let d = b[i].0 as i64 - a[i].0 as i64;
+                    let want = a[i].0 as i64 + crate::units::div_round(d * (k as i64 + 1), n);
+                    prop_assert_eq!(p[i].0 as i64, want, "piece {} axis {}", k, i);
+                }
+            }
+        }
+
+        /// What the kinematics' `piece_um` promise: a whiteboard piece
+        /// strays under 10 µm anywhere on the board, an arm's under 30 µm
+        /// within 60–250 mm of the shoulder (under 0.1 mm further out,
+        /// the arm near straight).
+        #[test]
+        fn pieces_stray_from_the_line_by_far_less_than_a_step(
+            x in -500_000i32..500_000, y in -500_000i32..300_000,
+            r in 60_000i32..250_000, b in -1.5f32..1.5, angle in 0.0f32..core::f32::consts::TAU,
+        ) {
+            use crate::machine::Machine;
+            let k = fine(Machine::Whiteboard);
+            let len = k.piece_um() as f32;
+            let step = |x: i32, y: i32| pos(
+                x + libm::roundf(len * libm::cosf(angle)) as i32,
+                y + libm::roundf(len * libm::sinf(angle)) as i32,
+            );
+            prop_assert!(stray(&k, &pos(x, y), &step(x, y)) < 10.0);
+            let k = fine(Machine::Scara);
+            let len = k.piece_um() as f32;
+            let (x, y) = (100_000 - (r as f32 * libm::sinf(b)) as i32, -56_000 + (r as f32 * libm::cosf(b)) as i32);
+            let to = pos(
+                x + libm::roundf(len * libm::cosf(angle)) as i32,
+                y + libm::roundf(len * libm::sinf(angle)) as i32,
+            );
+            prop_assert!(stray(&k, &pos(x, y), &to) < 30.0);
+        }
+
         /// Every piece endpoint lies on the straight line (within a step of
         /// it, after the round trip) and the last is exactly the target's.
         #[test]

@@ -25,7 +25,7 @@ pub const LAG_STEPS: u32 = 8;
 /// kept as its reciprocal: one division per junction, not one per axis
 /// (~1 300 cycles each on the AVR).
 pub struct AxisJumps {
-    per_milli: [f32; AXES],
+    pub(super) per_milli: [f32; AXES],
 }
 
 impl AxisJumps {

@@ -1,9 +1,12 @@
 //! Per-block geometry, in floats once per block: the path length and
-//! direction in milli-units, the axes' limits in events, and Grbl's
-//! junction-deviation speed at a corner.
+//! direction in milli-units (or along the pen, for a piece), the axes'
+//! limits in events, and Grbl's junction-deviation speed at a corner.
 
+use super::axis_jump::AxisJumps;
 use crate::axis::AXES;
 use crate::config::MachineConfig;
+use crate::kinematics::Frac;
+use crate::machine::Machine;
 use crate::segment::{StepBlock, MAX_ACCEL};
 /// 1/√x for the positive, finite values used here, without libm's
 /// 256-byte table (which the AVR would copy into SRAM) and without a
@@ -44,6 +47,87 @@ pub struct Geometry {
 /// Direction and events per milli-unit of a block's path.
 pub struct Path {
     pub unit: [f32; AXES],
+    pub ev_per_milli: f32,
+}
+
+/// The pen's limits where moves come as pieces of its path (the
+/// whiteboard, the arm), in µm: Klipper's toolhead `max_velocity` and
+/// `max_accel`, on top of each joint's own.
+#[derive(Clone, Copy, Debug)]
+pub struct PenLimits {
+    /// µm/s².
+    accel: f32,
+    /// s²/µm.
+    per_accel: f32,
+    /// µm/s.
+    max_speed: f32,
+}
+
+impl PenLimits {
+    /// The pen's limits of a machine whose kinematics are not linear;
+    /// `None` where the axes are the pen's (their own limits are then the
+    /// pen's, as in Grbl).
+    pub fn of(config: &MachineConfig) -> Option<PenLimits> {
+        match config.machine {
+            Machine::Whiteboard | Machine::Scara => {
+                let accel = config.pen_accel as f32 * 1000.0;
+                Some(PenLimits {
+                    accel,
+                    per_accel: 1.0 / accel,
+                    max_speed: config.pen_max_feed as f32 * (1000.0 / 60.0),
+                })
+            }
+            _ => None,
+        }
+    }
+
+    /// (µm/s)².
+    pub fn max_speed_sqr(&self) -> f32 {
+        self.max_speed * self.max_speed
+    }
+
+    /// What the pen's acceleration adds to its speed² over `len` µm, half
+    /// of it ((µm/s)²).
+    pub fn accel_len_sqr(&self, len: f32) -> f32 {
+        self.accel * len
+    }
+
+    /// A block's acceleration (events/s²) and top speed (events/s) that
+    /// the joints allow, brought within the pen's own too. In place: on
+    /// the AVR a pair of them returned came back as garbage.
+    pub fn cap(&self, accel: &mut u32, rate: &mut u32, ev_per_milli: f32) {
+        // Saturating conversions.
+        let pen_accel = (self.accel * ev_per_milli) as u32;
+        let pen_rate = (self.max_speed * ev_per_milli) as u32;
+        *accel = (*accel).min(pen_accel).max(1);
+        *rate = (*rate).min(pen_rate).max(1);
+    }
+}
+
+/// A piece staged for planning: the pen's move, µm, and the rounding of
+/// the joints at its start and end.
+#[derive(Clone, Copy, Debug)]
+pub struct PenMove {
+    pub delta: [i32; AXES],
+    pub frac: [Frac; 2],
+}
+
+impl PenMove {
+    pub const NONE: PenMove = PenMove {
+        delta: [0; AXES],
+        frac: [[0; AXES]; 2],
+    };
+}
+
+/// A piece's path along the pen.
+pub struct PenPath {
+    /// The pen's direction.
+    pub unit: [f32; AXES],
+    /// Each joint's share of the pen's speed: its milli-units per µm of
+    /// the pen, exact (the joints' rounding put back).
+    pub joint: [f32; AXES],
+    /// µm.
+    pub len: f32,
     pub ev_per_milli: f32,
 }
 
@@ -142,6 +226,91 @@ impl Geometry {
             unit,
             ev_per_milli: step.events as f32 * per_len,
         }
+    }
+
+    /// The path of the piece `step` along the pen's move `pen`.
+    pub fn pen_path(&self, step: &StepBlock, pen: &PenMove) -> PenPath {
+        let mut unit = [0.0; AXES];
+        let mut len_sqr = 0.0;
+        for (u, d) in unit.iter_mut().zip(pen.delta) {
+            if d != 0 {
+                *u = d as f32;
+                len_sqr += *u * *u;
+            }
+        }
+        // Under a µm (a step's rounding, the position just set): 1 µm,
+        // the joints' own limits then set its speed.
+        if len_sqr < 1.0 {
+            len_sqr = 1.0;
+        }
+        let per_len = rsqrt(len_sqr);
+        unit.iter_mut().for_each(|u| *u *= per_len);
+        let mut joint = [0.0; AXES];
+        for (i, j) in joint.iter_mut().enumerate() {
+            let frac = i32::from(pen.frac[1][i]) - i32::from(pen.frac[0][i]);
+            if step.steps[i] == 0 && frac == 0 {
+                continue;
+            }
+            let steps = match step.dir >> i & 1 != 0 {
+                true => step.steps[i] as f32,
+                false => -(step.steps[i] as f32),
+            };
+            *j = (steps + frac as f32 * (1.0 / 256.0)) * self.milli_per_step[i] * per_len;
+        }
+        PenPath {
+            unit,
+            joint,
+            len: len_sqr * per_len,
+            ev_per_milli: step.events as f32 * per_len,
+        }
+    }
+
+    /// The pen's speed², (µm/s)², at which the joints' shares of it
+    /// changing from `prev` to `next` (joint milli-units per µm) keep
+    /// every joint within its jump (`AxisJumps`: v·Δshare) and within its
+    /// acceleration over `len` µm of the pen's path (its speed changes
+    /// by v·Δshare over the time len / v). Infinite: no limit.
+    pub fn joints_sqr(
+        &self,
+        jumps: &AxisJumps,
+        prev: &[f32; AXES],
+        next: &[f32; AXES],
+        len: f32,
+    ) -> f32 {
+        let (mut jump, mut curve) = (0.0f32, 0.0f32);
+        for i in 0..AXES {
+            let change = (next[i] - prev[i]).abs();
+            let j = change * jumps.per_milli[i];
+            if j > jump {
+                jump = j;
+            }
+            let c = change * self.per_accel_milli[i];
+            if c > curve {
+                curve = c;
+            }
+        }
+        // The lower of 1 / jump² and len / curve, one division.
+        let jump_sqr = jump * jump;
+        match curve > len * jump_sqr {
+            true => len / curve,
+            false => 1.0 / jump_sqr,
+        }
+    }
+
+    /// [`Geometry::turn`] of the pen, whose acceleration is the same in
+    /// every direction: `pen`'s.
+    pub fn turn_pen(&self, prev: &[f32; AXES], next: &[f32; AXES], pen: &PenLimits) -> Turn {
+        let mut cos = 0.0f32;
+        for i in 0..AXES {
+            cos -= prev[i] * next[i];
+        }
+        // `speed_sqr` divides by |next − prev| = √(2·(1 + cos)).
+        let change = 2.0 * (1.0 + cos);
+        let per_accel = match change > 0.0 {
+            true => pen.per_accel * change * rsqrt_rough(change),
+            false => 0.0,
+        };
+        Turn { cos, per_accel }
     }
 
     /// Grbl's junction speed² between moves along the unit vectors

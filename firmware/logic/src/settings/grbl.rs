@@ -160,6 +160,9 @@ impl Extras {
         self.flags() & FLAG_HOMING_OFF == 0 && cfg.homing.axes != 0
     }
 
+    /// Parts [`Extras::part`] gives: the bytes, then two words a part.
+    pub const PARTS: usize = 1 + (2 + TYPED) / 2;
+
     /// Part `k` of the EEPROM bytes: the bytes, then the two rpm figures,
     /// then the typed rates, little-endian.
     pub fn part(&self, k: u8) -> Option<Part> {
@@ -199,6 +202,9 @@ impl Default for Extras {
         Extras::DEFAULT
     }
 }
+
+// The words pair up into parts.
+const _: () = assert!(TYPED.is_multiple_of(2));
 
 /// The channel in each of Grbl's X, Y, Z places: a plotter's X Y Z
 /// channels in order; on the string-art machine the radial carriage

@@ -1,18 +1,32 @@
 //! The settings as the EEPROM keeps them: the payload of the settings
 //! record ([`record::SETTINGS`](super::record::SETTINGS), two copies,
-//! cut-safe): every named setting in `$$` order (whole numbers and millis
-//! as 4 bytes, ratios as 8, little-endian), then Grbl's [`Extras`]. Read
-//! back only whole: a value the firmware would refuse, or a set of values
-//! it refuses together, makes the copy unusable (the other is tried).
+//! cut-safe). A fixed room of [`PAYLOAD`] bytes, so that a setting added
+//! later moves no other record:
+//!
+//! | byte | what |
+//! | --- | --- |
+//! | 0 | how many named settings follow ([`STORED`] when this firmware wrote it) |
+//! | 1 … | Grbl's [`Extras`] ([`EXTRAS_BYTES`]) |
+//! | then | the named settings in stored order ([`stored`]): whole numbers and millis as 4 bytes, ratios as 8, little-endian |
+//! | rest | zeros (stored inverted: erased cells) |
+//!
+//! The stored order is the order settings were added in, never `$$`'s:
+//! a new setting goes at its end, and a record written before it came
+//! holds fewer: it reads back with what the firmware that wrote it did
+//! for the ones it lacks ([`before`]: STEP/DIR drivers, always on), or
+//! else the stored machine's defaults. Read back only whole: a value the firmware would
+//! refuse, or a set of values it refuses together, makes the copy
+//! unusable (the other is tried).
 //!
 //! [`legacy`]: the one-copy image of format version 6 that boards flashed
-//! before kept at byte 0, read once to carry its settings over.
+//! before kept at byte 0 (the first [`V6`] settings of the stored order),
+//! read once to carry its settings over.
 
 use super::grbl::{Extras, EXTRAS_BYTES};
 use super::record::Part;
-use super::{all, AxisField, GlobalField, Setting, Value, COUNT};
-use crate::axis::AXES;
-use crate::config::{Driver, MachineConfig};
+use super::{AxisField, GlobalField, Setting, Value};
+use crate::axis::{Axis, AXES};
+use crate::config::{Driver, MachineConfig, KEEP_DRIVERS_ON};
 use crate::machine::Machine;
 use crate::units::{Milli, StepsPerUnit};
 
@@ -31,33 +45,100 @@ pub enum Unusable {
     Inconsistent,
 }
 
+/// Named settings of version 6 (and of the settings record's version 7):
+/// the machine, 8 fields an axis, 23 more machine-wide.
+pub const V6: usize = 1 + AXES * V6_AXIS_FIELDS + V6_GLOBALS;
+const V6_AXIS_FIELDS: usize = 8;
+const V6_GLOBALS: usize = 23;
+
+/// Named settings this firmware stores: [`V6`], then those added since.
+pub const STORED: usize = V6 + ADDED;
+const ADDED: usize = 3 + AXES;
+
+/// Setting `k` of the stored order: version 6's in its order (the
+/// machine, each axis's first 8 fields, the machine-wide fields 1…23),
+/// then each added one: the pen's top speed and acceleration, each
+/// axis's driver, the step idle delay. Worked out: a table would sit in
+/// SRAM on the AVR.
+pub fn stored(k: usize) -> Option<Setting> {
+    let per_axis = AXES * V6_AXIS_FIELDS;
+    Some(match k {
+        0 => Setting::Global(GlobalField::Machine),
+        k if k <= per_axis => {
+            let (axis, field) = ((k - 1) / V6_AXIS_FIELDS, (k - 1) % V6_AXIS_FIELDS);
+            Setting::Axis(Axis::ALL[axis], AxisField::at(field))
+        }
+        k if k < V6 => Setting::Global(GlobalField::at(k - per_axis)?),
+        // Added since version 6: append only.
+        k => match k - V6 {
+            0 => Setting::Global(GlobalField::PenMaxFeed),
+            1 => Setting::Global(GlobalField::PenAccel),
+            k if k < 2 + AXES => Setting::Axis(Axis::ALL[k - 2], AxisField::Driver),
+            k if k == 2 + AXES => Setting::Global(GlobalField::StepIdleDelay),
+            _ => return None,
+        },
+    })
+}
+
+/// What a firmware before setting `s` did, for a record written without
+/// it: drove STEP/DIR drivers and kept them on. `None`: the stored
+/// machine's default (the pen's limits, which planned nothing before).
+fn before(s: Setting) -> Option<Value> {
+    match s {
+        Setting::Axis(_, AxisField::Driver) => Some(Value::Driver(Driver::StepDir)),
+        Setting::Global(GlobalField::StepIdleDelay) => Some(Value::Number(KEEP_DRIVERS_ON as u32)),
+        _ => None,
+    }
+}
+
 fn width(s: Setting) -> usize {
     match s {
-        Setting::Axis(_, super::AxisField::StepsPerUnit) => 8,
-        Setting::Global(super::GlobalField::Crosstalk) => 8,
+        Setting::Axis(_, AxisField::StepsPerUnit) => 8,
+        Setting::Global(GlobalField::Crosstalk) => 8,
         _ => 4,
     }
 }
 
-/// Bytes of the named settings: 4 a setting, 4 more for each ratio
-/// ([`width`]: the steps per unit of every axis, the crosstalk). A
-/// constant: summed over the settings at run time it took 248 bytes of
-/// flash on the AVR.
-pub const NAMED_BYTES: usize = 4 * COUNT + 4 * (AXES + 1);
+/// Bytes of the first `n` stored settings: 4 a setting, 4 more for each
+/// ratio among them ([`width`]: the steps per unit of every axis, the
+/// crosstalk, all in version 6's). A constant expression: summed over
+/// the settings at run time it took 248 bytes of flash on the AVR.
+pub const fn named_bytes(n: usize) -> usize {
+    4 * n + 4 * (AXES + 1)
+}
 
-/// Bytes of the settings record's payload.
-pub const PAYLOAD: u16 = NAMED_BYTES as u16 + EXTRAS_BYTES;
+/// Where the named settings begin in the payload.
+const NAMED_AT: u16 = 1 + EXTRAS_BYTES;
 
-/// Part `k` of the payload: setting `k`'s value, then the extras' parts.
+/// Bytes of the settings record's payload: its fixed room, all the
+/// EEPROM holds below the checkpoint (what is not used is zeros). The
+/// settings added later must fit ([`ROOM`]).
+pub const PAYLOAD: u16 = 281;
+
+/// Bytes of the payload still free for settings added later.
+pub const ROOM: usize = PAYLOAD as usize - NAMED_AT as usize - named_bytes(STORED);
+const _: () = assert!(named_bytes(STORED) + NAMED_AT as usize <= PAYLOAD as usize);
+
+/// Part `k` of the payload: the count, the extras' parts, each stored
+/// setting's value, then zeros to [`PAYLOAD`] bytes.
 pub fn part(cfg: &MachineConfig, ex: &Extras, k: u8) -> Option<Part> {
+    let extras = Extras::PARTS;
     let k = k as usize;
-    match Setting::at(k) {
-        Some(s) => {
-            let (b, n) = value_array(s.get(cfg));
-            Some((b, n as u8))
-        }
-        None => ex.part((k - COUNT) as u8),
+    if k == 0 {
+        return Some(([STORED as u8, 0, 0, 0, 0, 0, 0, 0], 1));
     }
+    if k <= extras {
+        return ex.part((k - 1) as u8);
+    }
+    let k = k - 1 - extras;
+    if let Some(s) = (k < STORED).then(|| stored(k)).flatten() {
+        let (b, n) = value_array(s.get(cfg));
+        return Some((b, n as u8));
+    }
+    // Zeros to the room's end, 8 bytes a part.
+    let used = NAMED_AT as usize + named_bytes(STORED) + 8 * (k - STORED);
+    let left = (PAYLOAD as usize).checked_sub(used).filter(|&n| n > 0)?;
+    Some(([0; 8], left.min(8) as u8))
 }
 
 /// A value's bytes and how many of them count.
@@ -94,27 +175,45 @@ pub fn decode_into(
     cfg: &mut MachineConfig,
     ex: &mut Extras,
 ) -> Result<(), Unusable> {
-    take_named(&byte, cfg, false)?;
-    *ex = Extras::decode(|i| byte(NAMED_BYTES as u16 + i));
+    let n = byte(0) as usize;
+    // A count the room cannot hold is corruption (the CRC passed).
+    if n == 0 || NAMED_AT as usize + named_bytes(n) > PAYLOAD as usize {
+        return Err(Unusable::Checksum);
+    }
+    take_named(&|i| byte(NAMED_AT + i), n, cfg)?;
+    *ex = Extras::decode(|i| byte(1 + i));
     Ok(())
 }
 
-/// The named settings from bytes 0… of `byte` (a version-6 image's from
-/// its byte 5: `v6`, without the settings it had not), each checked, then
-/// the set.
+/// The first `n` stored settings from bytes 0… of `byte` (a version-6
+/// image's from its byte 5), each checked, then the set. Those past `n`
+/// (added after `byte` was written) take what the firmware before them
+/// did ([`before`]) or else the stored machine's defaults; past
+/// [`STORED`] (written by a newer firmware) are left unread.
 pub fn take_named(
     byte: &impl Fn(u16) -> u8,
+    n: usize,
     cfg: &mut MachineConfig,
-    v6: bool,
 ) -> Result<(), Unusable> {
     for take in [false, true] {
         let mut at = 0;
-        for s in all().filter(|&s| !v6 || legacy::had(s)) {
+        for s in (0..n.min(STORED)).filter_map(stored) {
             let value = value(byte, s.get(cfg), at).ok_or(Unusable::Refused(s))?;
             at += width(s) as u16;
             s.check(value).map_err(|_| Unusable::Refused(s))?;
             if take {
+                // The machine comes first: its defaults under the rest.
+                if let Value::Machine(m) = value {
+                    cfg.load_defaults(m);
+                }
                 s.force(cfg, value);
+            }
+        }
+        if take {
+            for s in (n..STORED).filter_map(stored) {
+                if let Some(v) = before(s) {
+                    s.force(cfg, v);
+                }
             }
         }
     }
@@ -146,20 +245,9 @@ pub mod legacy {
     pub const VERSION: u8 = 6;
     const HEADER: usize = MAGIC.len() + 1;
 
-    /// Bytes of a version-6 image: its settings had no driver per axis
-    /// and no step idle delay ([`had`]).
+    /// Bytes of a version-6 image: its [`V6`] settings.
     pub const fn len() -> usize {
-        HEADER + NAMED_BYTES - 4 * (AXES + 1) + 2
-    }
-
-    /// Whether a version-6 image holds setting `s`. Those it does not
-    /// keep what the version-6 firmware did: STEP/DIR drivers, always on
-    /// (the string-art defaults the reader starts from).
-    pub fn had(s: Setting) -> bool {
-        !matches!(
-            s,
-            Setting::Axis(_, AxisField::Driver) | Setting::Global(GlobalField::StepIdleDelay)
-        )
+        HEADER + named_bytes(V6) + 2
     }
 
     /// The version byte at byte 4 when bytes 0…3 are `taut`.
@@ -174,7 +262,7 @@ pub mod legacy {
         let body = MAGIC
             .into_iter()
             .chain([VERSION])
-            .chain(all().filter(|&s| had(s)).flat_map(move |s| {
+            .chain((0..V6).filter_map(stored).flat_map(move |s| {
                 let (b, n) = value_array(s.get(cfg));
                 b.into_iter().take(n)
             }));
@@ -193,8 +281,8 @@ pub mod legacy {
     }
 
     /// Whether `read` (byte `i` of the EEPROM) holds a whole version-6
-    /// image; its settings are then [`super::take_named`] from byte
-    /// [`BODY`].
+    /// image; its [`V6`] settings are then [`super::take_named`] from
+    /// byte [`BODY`].
     pub fn check(read: &impl Fn(u16) -> u8) -> Result<(), Unusable> {
         match version(read) {
             Some(VERSION) => {}
@@ -218,7 +306,7 @@ pub mod legacy {
     /// entry), as [`super::decode_into`].
     pub fn decode_into(read: impl Fn(u16) -> u8, cfg: &mut MachineConfig) -> Result<(), Unusable> {
         check(&read)?;
-        take_named(&|i| read(BODY + i), cfg, true)
+        take_named(&|i| read(BODY + i), V6, cfg)
     }
 
     /// Fletcher-16: two running sums mod 255.

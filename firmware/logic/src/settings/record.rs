@@ -341,8 +341,9 @@ impl Writer {
     }
 }
 
-/// `taut` and the layout's version, at byte 0 (where the settings image
-/// of version 6 began: its magic and version byte). Written last on a new
+/// `taut` and the layout's version (8: the settings record's room), at
+/// byte 0 (where the settings image of version 6 began: its magic and
+/// version byte). Written last on a new
 /// or an upgraded chip, once every record below is: until then a record
 /// that fails its checks is stale data of an older layout, not corruption.
 pub const MARKER: [u8; 5] = *b"taut\x08";
@@ -355,6 +356,8 @@ pub const LEGACY_END: u16 = 256;
 pub const SETTINGS: Area = Area {
     start: LEGACY_END,
     kind: b'S',
+    // 8: a fixed room, the count of named settings first (7 had no room:
+    // a setting added moved every record after it).
     version: 8,
     payload: super::image::PAYLOAD,
 };

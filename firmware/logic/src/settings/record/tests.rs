@@ -239,7 +239,8 @@ fn the_layout_marker_and_a_version_6_image() {
     assert_eq!(read(&e), Layout::Legacy);
     e[4] = 8;
     assert_eq!(read(&e), Layout::Current);
-    // The layout before the driver and idle delay settings joined.
+    // Layout 7 (the settings record without room): its records stand
+    // elsewhere.
     e[4] = 7;
     assert_eq!(read(&e), Layout::Foreign);
     e[4] = 5;
@@ -256,6 +257,9 @@ fn the_records_fit_between_the_legacy_image_and_the_checkpoint() {
     assert_eq!(COORDS.start, SETTINGS.end());
     assert_eq!(INFO.start, LINES[1].end());
     assert!(END <= crate::checkpoint::START);
+    // The settings' room takes all there is: a setting added later moves
+    // nothing.
+    assert_eq!(END, crate::checkpoint::START);
     // A whole board's EEPROM as the host helper makes it reads back.
     let (mut cfg, mut ex) = (MachineConfig::defaults(Machine::Scara), Extras::DEFAULT);
     Numbered::MaxRate(0)
