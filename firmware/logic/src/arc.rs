@@ -155,13 +155,10 @@ impl Arc {
     #[inline(never)]
     pub fn new(sweep: &Sweep, circle: &Circle) -> Arc {
         let Circle { centre, radius: r } = *circle;
-        let Sweep {
-            start,
-            end,
-            plane,
-            clockwise,
-            tolerance,
-        } = *sweep;
+        // The ends read where they are: a copy of them would sit in the
+        // frame under the sines (the console's deepest stack).
+        let (start, end) = (&sweep.start, &sweep.end);
+        let (plane, clockwise, tolerance) = (sweep.plane, sweep.clockwise, sweep.tolerance);
         let v0 = [
             start[plane.axis_0].0 as f32 - centre[0],
             start[plane.axis_1].0 as f32 - centre[1],
@@ -187,8 +184,8 @@ impl Arc {
         let (sin, cos) = fmath::sin_cos(step);
         Arc {
             plane,
-            start,
-            end,
+            start: *start,
+            end: *end,
             centre,
             radius: r,
             start_angle: fmath::atan2(v0[1], v0[0]),

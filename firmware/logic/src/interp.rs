@@ -1080,18 +1080,33 @@ fn check_arc(
     kin: &impl Kinematics,
     cfg: &MachineConfig,
 ) -> Result<(), ErrorKind> {
-    let (lo, hi) = arc.bounds();
-    check_travel(cfg, &coords::exact(&lo), &coords::exact(&hi), motors)?;
+    check_arc_travel(arc, motors, cfg)?;
     let reached = match kin.is_linear() {
         // A linear kinematics reaches the whole box if it reaches its
         // corners.
-        true => kin.inverse(&lo).is_ok() && kin.inverse(&hi).is_ok(),
+        true => corners_reached(arc, kin),
         false => every_chord_reached(arc, kin),
     };
     match reached {
         true => Ok(()),
         false => Err(ErrorKind::InvalidTarget),
     }
+}
+
+/// Refuses an arc whose box leaves a motor channel's soft limits. Out of
+/// line: its boxes would sit in the frame under the chords' check.
+#[inline(never)]
+fn check_arc_travel(arc: &Arc, motors: u8, cfg: &MachineConfig) -> Result<(), ErrorKind> {
+    let (lo, hi) = arc.bounds();
+    check_travel(cfg, &coords::exact(&lo), &coords::exact(&hi), motors)
+}
+
+/// Whether the machine reaches both corners of `arc`'s box. Out of line,
+/// as [`check_arc_travel`].
+#[inline(never)]
+fn corners_reached(arc: &Arc, kin: &impl Kinematics) -> bool {
+    let (lo, hi) = arc.bounds();
+    kin.inverse(&lo).is_ok() && kin.inverse(&hi).is_ok()
 }
 
 /// Whether the machine reaches every chord of `arc`. Out of line: the
