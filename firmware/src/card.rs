@@ -171,6 +171,12 @@ fn data_waits() -> bool {
     CARD_OUT.any(|m| matches!(m.what, What::Data { .. }))
 }
 
+/// A pull waits in `CARD_OUT`: the file bytes queued before it (which
+/// their reader leaves there until it wants them) can be dropped.
+pub fn removal_waits() -> bool {
+    CARD_OUT.any(|m| matches!(m.what, What::Removed))
+}
+
 // The FAT reader fills `Block::contents` through a `[u8; 512]` view.
 const _: () = assert!(size_of::<Block>() == BLOCK && offset_of!(Block, contents) == 0);
 

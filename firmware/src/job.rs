@@ -213,7 +213,7 @@ impl JobTask {
             // pattern is read again from its start once it is back).
             let winding = matches!(self.stream, Stream::Pattern(_));
             if matches!(msg.what, What::Data { .. }) && winding && msg.ticket == self.ticket {
-                return CARD_OUT.any(|m| matches!(m.what, What::Removed));
+                return crate::card::removal_waits();
             }
             self.card(msg, m, config, now);
             true

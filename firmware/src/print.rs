@@ -272,7 +272,7 @@ impl Print {
             // card went out behind them: the print stops at its last whole
             // line now (the line being carried out may wait on a long move).
             if data && ours && self.state != State::Idle {
-                if !CARD_OUT.any(|m| matches!(m.what, What::Removed)) {
+                if !crate::card::removal_waits() {
                     return None;
                 }
                 self.lost();

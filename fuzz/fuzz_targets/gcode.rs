@@ -40,6 +40,7 @@ impl MachineIo for Yes {
         true
     }
     fn drivers(&mut self, _on: bool) {}
+    fn idle_delay(&mut self, _ms: u32) {}
     fn pause(&mut self) {}
     fn report_position(&mut self) {}
     fn program_end(&mut self) {}

@@ -204,15 +204,14 @@ pub fn check(elf: &Path) -> Result<FlashMap> {
         }
     }
     // Functions reading stack arguments, which the AVR back end misreads.
-    let functions: Vec<(&str, u64, u64)> = file
+    let code = file
         .symbols()
         .filter(|s| s.kind() == object::SymbolKind::Text && s.size() > 0)
         .filter(|s| s.address() + s.size() <= BOOT_START)
-        .map(|s| (s.name().unwrap_or("?"), s.address(), s.size()))
-        .collect();
-    let code = functions
-        .iter()
-        .map(|&(n, at, size)| (n, &flash[at as usize..(at + size) as usize]));
+        .map(|s| {
+            let (at, end) = (s.address() as usize, (s.address() + s.size()) as usize);
+            (s.name().unwrap_or("?"), &flash[at..end])
+        });
     for (function, q) in crate::stackargs::readers(code) {
         problems.push(format!(
             "{function} reads arguments from the stack (ldd Y+{q}), which LLVM's AVR back end \
