@@ -84,7 +84,7 @@ if [ ! -d "$PIN_DIR" ] && [ -n "$PIN_HASH" ]; then
 fi
 if [ ! -d "$PIN_DIR" ]; then
     echo "setup: installing the firmware's pinned toolchain $PIN"
-    if ! rustup toolchain install "$PIN" --profile minimal --component rust-src; then
+    if ! rustup toolchain install "$PIN" --profile minimal --component rust-src --component clippy; then
         echo "setup: cannot install $PIN, and no installed toolchain is its commit ${PIN_HASH:-(none named)}." >&2
         echo "setup: installed: $(rustup toolchain list | tr '\n' ' ')" >&2
         echo "setup: install it where a download works, or move the pin to an installed nightly (docs/toolchain.md)." >&2
@@ -98,6 +98,10 @@ fi
 if [ ! -d "$("$PIN_DIR/bin/rustc" --print sysroot)/lib/rustlib/src/rust/library/core" ]; then
     echo "setup: installing rust-src for $PIN (core is rebuilt for avr-none)"
     rustup component add rust-src --toolchain "$PIN"
+fi
+if [ ! -x "$PIN_DIR/bin/cargo-clippy" ]; then
+    echo "setup: installing clippy for $PIN (the firmware's lints)"
+    rustup component add clippy --toolchain "$PIN"
 fi
 
 # ravedude (the firmware's cargo runner), with the host's stable toolchain.

@@ -6,7 +6,7 @@
 
 use crate::board::gpio::{Pin, PullUp};
 use crate::queues::{BUTTONS, SAMPLES};
-use core::cell::UnsafeCell;
+use crate::rt::IsrCell;
 use embedded_hal::digital::InputPin;
 use taut_logic::buttons::{Debouncer, DEBOUNCE_MS};
 use taut_logic::pinmap::Button;
@@ -39,19 +39,11 @@ impl ButtonPins {
 
 /// The tick's side: the pins, the last sample, and how many quiet
 /// milliseconds (all released, unchanged) have passed since.
-struct Sampler(UnsafeCell<Option<(ButtonPins, u8, u8)>>);
-
-// SAFETY: written once by `start` before interrupts are enabled, then used
-// only by `sample`, which only the tick interrupt calls (and a tick never
-// lasts the millisecond it would take to re-enter).
-unsafe impl Sync for Sampler {}
-
-static SAMPLER: Sampler = Sampler(UnsafeCell::new(None));
+static SAMPLER: IsrCell<(ButtonPins, u8, u8)> = IsrCell::new();
 
 /// Hand the pins to the tick; call before interrupts are enabled.
 pub fn start(pins: ButtonPins) {
-    // SAFETY: see `Sampler`; interrupts are masked besides.
-    avr_device::interrupt::free(|_| unsafe { *SAMPLER.0.get() = Some((pins, 0, u8::MAX)) });
+    SAMPLER.init((pins, 0, u8::MAX));
 }
 
 /// The tick's millisecond sample: queued while a button is down and until
@@ -59,18 +51,18 @@ pub fn start(pins: ButtonPins) {
 /// a sample was queued (spawn the buttons task); and the inputs read (bit =
 /// button), which are also the homing switches.
 pub fn sample() -> (bool, u8) {
-    // SAFETY: see `Sampler`.
-    let Some((pins, last, quiet)) = (unsafe { &mut *SAMPLER.0.get() }) else {
-        return (false, 0);
-    };
-    let raw = pins.raw();
-    *quiet = if raw == 0 && raw == *last {
-        quiet.saturating_add(1)
-    } else {
-        0
-    };
-    *last = raw;
-    (*quiet <= DEBOUNCE_MS && SAMPLES.push(raw).is_ok(), raw)
+    SAMPLER
+        .with(|(pins, last, quiet)| {
+            let raw = pins.raw();
+            *quiet = if raw == 0 && raw == *last {
+                quiet.saturating_add(1)
+            } else {
+                0
+            };
+            *last = raw;
+            (*quiet <= DEBOUNCE_MS && SAMPLES.push(raw).is_ok(), raw)
+        })
+        .unwrap_or((false, 0))
 }
 
 /// The buttons task's state: the debouncer.

@@ -14,15 +14,14 @@
 
 use crate::board::delay::Delay;
 use crate::board::flash::FlashStr;
-use crate::board::spi::CardSpi;
+use crate::board::spi::{self, CardSpi};
 use crate::queues::{CardMsg, Request, Signal, What, CARD_IN, CARD_OUT, CHUNK, TX};
 use crate::rt::{Poll, TaskCell};
 use crate::{error, flash_str, info, warn};
-use core::mem::{offset_of, size_of};
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{Operation, SpiDevice};
 use embedded_sdmmc::sdcard::spi::AcquireOpts;
-use embedded_sdmmc::{Block, BlockDevice, BlockIdx, SdCard, SdCardError};
+use embedded_sdmmc::{BlockDevice, BlockIdx, SdCard, SdCardError};
 use taut_logic::fat::{
     BlockRead, Dir, Entry, FatError, File, Name, Scan, Slot as DirSlot, Volume, BLOCK,
 };
@@ -177,9 +176,6 @@ pub fn removal_waits() -> bool {
     CARD_OUT.any(|m| matches!(m.what, What::Removed))
 }
 
-// The FAT reader fills `Block::contents` through a `[u8; 512]` view.
-const _: () = assert!(size_of::<Block>() == BLOCK && offset_of!(Block, contents) == 0);
-
 /// The card as the FAT reader's block device; remembers the last block
 /// asked for, to name it when it fails.
 struct Device<'a> {
@@ -191,9 +187,8 @@ impl BlockRead for Device<'_> {
     type Error = SdCardError;
     fn read_block(&mut self, lba: u32, buf: &mut [u8; BLOCK]) -> Result<(), Self::Error> {
         self.lba = lba;
-        // SAFETY: `Block` is exactly one `[u8; 512]` at offset 0 (asserted above).
-        let block = unsafe { &mut *(buf as *mut [u8; BLOCK] as *mut Block) };
-        self.sd.read(core::slice::from_mut(block), BlockIdx(lba))
+        self.sd
+            .read(core::slice::from_mut(spi::as_block(buf)), BlockIdx(lba))
     }
 }
 

@@ -2,7 +2,6 @@
 //! the reset that stopped the job (a power cut shows as `power-on`, a sag
 //! as `brown-out` with the BOD fuse set, a stuck task as `watchdog`). The
 //! job task logs it once there is room (the boot fills the TX ring).
-#![deny(unsafe_code)]
 
 use crate::board::ResetCause;
 use crate::{flash_str, warn};

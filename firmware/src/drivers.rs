@@ -10,7 +10,6 @@
 //! through any wait (it holds); `M18`/`M84`, `$SLP` and the job switch
 //! drivers off, and the job never moves an axis it holds off (the drill
 //! while winding, an axis freed for zeroing by hand).
-#![deny(unsafe_code)]
 
 use crate::board::delay::Delay;
 use crate::board::gpio::{Output, Pin};

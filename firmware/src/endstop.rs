@@ -3,7 +3,6 @@
 //! the buttons that share them. While homing watches one, the tick stops
 //! the steps at once when it closes, as Ctrl-X does: a homing leg is then
 //! over wherever the switch caught it.
-#![deny(unsafe_code)]
 
 use crate::stepper;
 use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};

@@ -5,7 +5,6 @@
 //!
 //! Log lines wait for room in the TX ring rather than being dropped: the
 //! prompts and the bad-file messages must reach the user.
-#![deny(unsafe_code)]
 
 use crate::checkpoint::BootNote;
 use crate::motion::Motion;

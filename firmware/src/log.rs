@@ -259,25 +259,6 @@ fn count_drop() {
     });
 }
 
-/// The module path without the crate name, at compile time, in flash.
-#[macro_export]
-#[doc(hidden)]
-macro_rules! __log_module {
-    () => {{
-        const FULL: &str = module_path!();
-        const SKIP: usize = $crate::board::flash::after_crate_name(FULL);
-        const LEN: usize = FULL.len() - SKIP;
-        // Allowed here: the modules using the macro deny unsafe code.
-        #[allow(unsafe_code)]
-        #[link_section = ".progmem.data"]
-        static S: [u8; LEN] = $crate::board::flash::bytes::<LEN>(FULL, SKIP);
-        #[allow(unsafe_code)]
-        // SAFETY: S is a progmem static of LEN bytes.
-        let s = unsafe { $crate::board::flash::FlashStr::from_static(&S) };
-        s
-    }};
-}
-
 #[macro_export]
 #[doc(hidden)]
 macro_rules! __log_parts {

@@ -1,7 +1,6 @@
 //! The executor's machine (`taut_logic::interp::MachineIo`) on the board:
 //! moves into the motion task's planner, the pen servo, the drivers, the
 //! clock, and the work coordinate data (the store's, kept in EEPROM).
-#![deny(unsafe_code)]
 
 use crate::board::clock;
 use crate::motion::{self, Motion};

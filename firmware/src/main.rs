@@ -26,6 +26,7 @@
 //! | `Store` checkpoint, settings, coordinates, startup lines → EEPROM (two copies each), a changed byte per run | software | 0 | the job's checkpoint, signal `Settings` | EEPROM |
 #![no_std]
 #![no_main]
+#![deny(unsafe_code)]
 #![feature(abi_avr_interrupt, asm_experimental_arch, optimize_attribute)]
 
 use embedded_hal::digital::OutputPin;
@@ -47,7 +48,7 @@ use taut_firmware::motion::{self, Motion};
 use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL, SIGNALS};
 use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
-use taut_firmware::rt::{stack, Poll, TaskCell};
+use taut_firmware::rt::{self, stack, Poll, TaskCell};
 use taut_firmware::stepper::{self, CoilPins, StepDirPins, Stepper};
 use taut_firmware::store::Store;
 use taut_firmware::{
@@ -312,8 +313,7 @@ fn init() -> Watchdog {
         zero_radial: pins.d14.into_pull_up_input(),
         zero_drill: pins.d18.into_pull_up_input(),
     });
-    // SAFETY: every interrupt handler and the state it touches is ready.
-    unsafe { avr_device::interrupt::enable() };
+    rt::enable_interrupts();
     reply::banner();
 
     boot_log(reset);

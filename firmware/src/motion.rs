@@ -2,7 +2,6 @@
 //! interrupt's queues. Grbl's `planner` and `st_prep_buffer` in one place,
 //! with its feed hold (`!`/`~`), its stop at once (Ctrl-X) and a stop that
 //! abandons the rest of the queued motion (a pulled card).
-#![deny(unsafe_code)]
 
 use crate::board::servo::PenServo;
 use crate::drivers::Drivers;

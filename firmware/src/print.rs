@@ -9,7 +9,6 @@
 //! the end of the last whole line: the moves already queued finish, and
 //! once the card is back, `M24` or the green button opens the file again
 //! and goes on from the next line.
-#![deny(unsafe_code)]
 
 use crate::board::flash::FlashStr;
 use crate::log::Level;

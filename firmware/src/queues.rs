@@ -3,7 +3,6 @@
 //! ring is back-pressure — the producer keeps its message and tries again
 //! — and every ring counts what it sent, refused, and its high-water mark
 //! (`$Q`, and the end of a job).
-#![deny(unsafe_code)]
 
 use crate::rt::{Flags, Ring, Tally};
 use core::sync::atomic::AtomicBool;

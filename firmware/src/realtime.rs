@@ -4,7 +4,6 @@
 //! steps there and then; the rest is flagged for the `Realtime` task (the
 //! highest software priority), which also writes the status report
 //! (formatted by `taut_logic::gcode::Status`).
-#![deny(unsafe_code)]
 
 use crate::console::{Activity, Frame};
 use crate::endstop;

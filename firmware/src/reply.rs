@@ -1,7 +1,6 @@
 //! Console replies: `ok`, `error:<code>` after its message, reports. A reply line is
 //! assembled on the stack and queued whole, never cut: it runs only once
 //! the TX ring has [`ROOM`] free bytes, and no reply is longer.
-#![deny(unsafe_code)]
 
 use crate::board::usart;
 use crate::log::Line;

@@ -1,7 +1,6 @@
 //! Figures read out over the serial console (`$Q`) and logged at the end of
 //! a job: how full each queue got, what it refused, what the step interrupt
 //! missed.
-#![deny(unsafe_code)]
 
 use crate::queues::{BLOCKS, BUTTONS, CARD_IN, CARD_OUT, JOB_CONTROL, RX, SAMPLES, SEGMENTS, TX};
 use crate::{flash_str, info};

@@ -13,7 +13,6 @@
 //! The G-code executor reads the coordinate data with [`Store::coords`]
 //! and changes it with [`Store::set_coords`] (`G10 L2`/`L20`, `G28.1`,
 //! `G30.1`): written in the background, in force at once.
-#![deny(unsafe_code)]
 
 use crate::board::eeprom::Eeprom;
 use crate::queues::{Signal, TX};

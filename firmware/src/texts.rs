@@ -1,7 +1,6 @@
 //! The job's log texts, copied into flash at compile time from the logic
 //! crate's own (`as_str`/`name` are `const fn`): used at run time, those
 //! would sit in SRAM for the firmware's whole life.
-#![deny(unsafe_code)]
 
 use crate::board::flash::FlashStr;
 use crate::flash_str;

@@ -2,7 +2,6 @@
 //! `$wrap_step=1`, `$wrap_jump=<k>`, `$drift=<nail>`;
 //! `taut_logic::stringart::job::tools`): the console passes them to the
 //! job, which refuses them while it moves and logs what they did.
-#![deny(unsafe_code)]
 
 use crate::queues::{Control, JOB_CONTROL};
 use taut_logic::stringart::job::tools;

@@ -61,6 +61,29 @@ pub fn build_release() -> Result<Image> {
     Ok(img)
 }
 
+/// The firmware's lints: unsafe code only in `rt/`, `board/` and
+/// `stepper/` (`unsafe_code`, denied at the crate root), each unsafe block
+/// with its SAFETY note, and clippy clean.
+pub fn lint() -> Result<()> {
+    println!("== firmware lints (clippy, unsafe code)");
+    cargo(
+        &[
+            "clippy",
+            "--release",
+            "--quiet",
+            "--lib",
+            "--bin",
+            "taut",
+            "--",
+            "-D",
+            "warnings",
+            "-D",
+            "clippy::undocumented_unsafe_blocks",
+        ],
+        &dir(),
+    )
+}
+
 /// The special-purpose images in firmware/examples (crash, hang, …).
 /// Those built on the firmware's crate (its start-up, its runtime) have
 /// their flash map checked like the firmware's (the watchdog entry, the

@@ -130,6 +130,7 @@ fn test() -> Result<()> {
 }
 
 fn simtest() -> Result<()> {
+    firmware::lint()?;
     let img = firmware::build_release()?;
     firmware::build_examples()?;
     img.print_size();

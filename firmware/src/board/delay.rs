@@ -1,6 +1,5 @@
 //! Busy-wait delays for the few places that need microsecond set-up times
 //! (driver enable, SD card power-up). Never used for waits a task could yield.
-#![deny(unsafe_code)]
 
 use embedded_hal::delay::DelayNs;
 

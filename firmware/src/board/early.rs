@@ -64,9 +64,11 @@ const fn const_parse(s: &str) -> u32 {
 /// library crate (no SRAM, no ELPM, no JMP), so those instructions are
 /// spelled as words: `st Z, r24` 0x8380, `st Z, r1` 0x8210, `elpm r24, Z+`
 /// 0x9187, `jmp 0x3E000` 0x940D 0xF000.
-// SAFETY: placed in `.init3` by the linker script and never called: the
-// start-up runs into it with interrupts off, the stack set, r1 = 0; it
-// touches r24, r30, r31 and RAMPZ, which the start-up sets again after.
+///
+/// # Safety
+/// Placed in `.init3` by the linker script and never called: the
+/// start-up runs into it with interrupts off, the stack set, r1 = 0; it
+/// touches r24, r30, r31 and RAMPZ, which the start-up sets again after.
 #[unsafe(naked)]
 #[unsafe(no_mangle)]
 #[unsafe(link_section = ".init3")]
@@ -115,8 +117,10 @@ pub unsafe extern "C" fn taut_init3() {
 /// bootloader's path has no interrupt source enabled since the reset, and
 /// the reset vector's start-up sets SREG and the stack afresh. (`st Z+,
 /// r25` is 0x9391, `st Z, r25` 0x8390, `jmp 0` 0x940C 0x0000.)
-// SAFETY: reached only from the bootloader's `eicall` (never from Rust):
-// it keeps r25 in a static and jumps to the reset vector.
+///
+/// # Safety
+/// Reached only from the bootloader's `eicall` (never from Rust):
+/// it keeps r25 in a static and jumps to the reset vector.
 #[unsafe(naked)]
 #[unsafe(no_mangle)]
 #[unsafe(link_section = ".watchdog_entry")]

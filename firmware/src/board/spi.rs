@@ -7,6 +7,7 @@ use avr_device::atmega2560::SPI;
 use core::convert::Infallible;
 use embedded_hal::digital::OutputPin;
 use embedded_hal::spi::{Operation, SpiBus};
+use embedded_sdmmc::Block;
 use taut_logic::pinmap::{SD_CS, SD_MISO, SD_MOSI, SD_SCK};
 
 pub struct Spi {
@@ -141,4 +142,14 @@ impl embedded_hal::spi::SpiDevice<u8> for CardSpi {
         let _ = self.cs.set_high();
         Ok(())
     }
+}
+
+// The FAT reader fills `Block::contents` through a `[u8; 512]` view.
+const _: () =
+    assert!(core::mem::size_of::<Block>() == 512 && core::mem::offset_of!(Block, contents) == 0);
+
+/// A sector buffer seen as the card driver's block.
+pub fn as_block(buf: &mut [u8; 512]) -> &mut Block {
+    // SAFETY: `Block` is exactly one `[u8; 512]` at offset 0 (asserted above).
+    unsafe { &mut *(buf as *mut [u8; 512] as *mut Block) }
 }

@@ -4,6 +4,7 @@
 
 pub mod dispatch;
 pub mod flags;
+pub mod isr_cell;
 pub mod nested;
 pub mod ring;
 pub mod stack;
@@ -23,5 +24,13 @@ pub enum Poll<S> {
     /// Run again when the app signals `S`.
     Wait(S),
 }
+pub use isr_cell::IsrCell;
 pub use ring::Ring;
 pub use task_cell::TaskCell;
+
+/// Let the interrupts in: the app's init calls it once, when every handler
+/// and the state it touches is ready.
+pub fn enable_interrupts() {
+    // SAFETY: the caller's init has set up every handler's state.
+    unsafe { avr_device::interrupt::enable() };
+}
