@@ -497,7 +497,12 @@ impl Console {
                 self.error(&Error::new(ErrorKind::Locked, 0))
             }
             Err(e) => self.error(&e),
-            // While a print runs, the serial line may only look.
+            // While a print runs, the serial line may only look: `M114`
+            // is answered at once, beside the print's own line.
+            Ok(Input::Block(_)) if self.printing_from_serial() && reads => {
+                crate::machine_io::report_position(m, kin);
+                self.ok()
+            }
             Ok(Input::Block(_)) if self.printing_from_serial() => {
                 self.error(&Error::new(ErrorKind::Printing, 0))
             }

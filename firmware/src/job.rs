@@ -25,7 +25,7 @@ use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::planner::{Feed, Full};
 use taut_logic::stringart::job::{
-    Action, Actions, Event, Feeder, Feeding, Job, Machine, Phase, State,
+    Action, Actions, BadBoard, Event, Feeder, Feeding, Job, Machine, Msg, Phase, State,
 };
 use taut_logic::stringart::Save;
 
@@ -430,6 +430,9 @@ impl JobTask {
                         self.stream = Stream::None;
                         self.report_line = Some(0);
                     }
+                }
+                Action::Log(Msg::BadBoard(BadBoard::Gap(nail))) => {
+                    info!(texts::msg(Msg::BadBoard(BadBoard::Gap(nail))), nail)
                 }
                 Action::Log(msg) => info!(texts::msg(msg)),
                 Action::Prompt(p) => info!(texts::prompt(p)),

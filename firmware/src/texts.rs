@@ -6,7 +6,7 @@ use crate::board::flash::FlashStr;
 use crate::flash_str;
 use taut_logic::axis::Axis;
 use taut_logic::gcode::ErrorKind;
-use taut_logic::stringart::job::{Msg, Phase, Prompt, State};
+use taut_logic::stringart::job::{BadBoard as Why, Msg, Phase, Prompt, State};
 
 /// `match value { pattern => the flash copy of representative.method() }`.
 macro_rules! in_flash {
@@ -71,7 +71,11 @@ pub fn prompt(p: Prompt) -> FlashStr {
 pub fn msg(m: Msg) -> FlashStr {
     use Msg::*;
     in_flash!(m, as_str, [
-        BadBoard => BadBoard,
+        BadBoard(Why::Shape) => BadBoard(Why::Shape),
+        BadBoard(Why::Nails) => BadBoard(Why::Nails),
+        BadBoard(Why::Radius) => BadBoard(Why::Radius),
+        BadBoard(Why::Centre) => BadBoard(Why::Centre),
+        BadBoard(Why::Gap(_)) => BadBoard(Why::Gap(0)),
         Loose(Axis::Base) => Loose(Axis::Base),
         Loose(Axis::Radial) => Loose(Axis::Radial),
         Loose(_) => Loose(Axis::Drill),

@@ -114,6 +114,24 @@ fn a_card_without_fat_says_format_it() {
     assert_eq!(count(&sim, "no FAT16/FAT32 volume"), 1, "said once");
 }
 
+/// A board the needle cannot wind (nails too close) is refused with its
+/// reason, the file to change and what to change, said once; nothing moves.
+#[test]
+fn a_board_too_dense_for_the_needle_says_why_and_where() {
+    let image = card(&[
+        ("param.txt", b"shape = 0\nnails = 3000\nradius_cm = 30\n"),
+        ("poradi.txt", b"3,0,7,13"),
+    ]);
+    let mut sim = boot_machine();
+    sim.insert_sd(image);
+    let why = "bad board: nails too close for the needle to pass \
+               (fewer nails or a larger radius in param.txt), the first after nail 0";
+    wait_for(&mut sim, why, Duration::from_secs(5));
+    sim.run_for(Duration::from_secs(3));
+    assert_eq!(count(&sim, "bad board"), 1, "said once");
+    assert_eq!(steps_on_pins(&sim), [0, 0, 0], "nothing moved");
+}
+
 /// The card pulled while a console jog runs (before drilling): the jog
 /// brakes to a stop first, and only then do the drivers go off.
 #[test]

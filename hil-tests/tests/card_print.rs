@@ -113,6 +113,14 @@ fn m20_lists_m23_selects_by_long_name_and_m24_prints_the_drawing() {
         error(&mut sim, "M23 notes.txt").split(' ').next(),
         Some("error:67")
     );
+    // `M114` only reads: answered while the print goes on.
+    let from = sim.uart_bytes().len();
+    send(&mut sim, "M114");
+    assert!(
+        sim.uart_text_from(from).contains(" Count X:"),
+        "{}",
+        sim.uart_text_from(from)
+    );
     let from = sim.uart_bytes().len();
     send(&mut sim, "M27");
     assert!(

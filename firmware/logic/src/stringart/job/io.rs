@@ -107,11 +107,50 @@ pub enum Event<'c> {
     Tool(super::tools::Tool),
 }
 
+/// Why the board of `param.txt` cannot be drilled or wound.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BadBoard {
+    /// Shape 1 or 2: neither a circle nor a polygon.
+    Shape,
+    /// Fewer than 3 nails.
+    Nails,
+    /// The radius is no larger than the nails' margin (or past any
+    /// machine's reach).
+    Radius,
+    /// The winding's inner radius, the needle's clearance inside the
+    /// nails, would reach the centre.
+    Centre,
+    /// The needle cannot pass between this nail and the next.
+    Gap(u16),
+}
+
+impl From<crate::geometry::BoardError> for BadBoard {
+    fn from(e: crate::geometry::BoardError) -> Self {
+        use crate::geometry::BoardError;
+        match e {
+            BoardError::Shape => BadBoard::Shape,
+            BoardError::Nails => BadBoard::Nails,
+            BoardError::Radius => BadBoard::Radius,
+        }
+    }
+}
+
+impl From<crate::stringart::WindError> for BadBoard {
+    fn from(e: crate::stringart::WindError) -> Self {
+        use crate::stringart::WindError;
+        match e {
+            WindError::GapTooNarrow(g) => BadBoard::Gap(g),
+            // BadNail is not a board's: a check names no nail past the end.
+            WindError::BoardTooSmall | WindError::BadNail(_) => BadBoard::Centre,
+        }
+    }
+}
+
 /// Something the firmware logs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Msg {
-    /// The board in `param.txt` cannot be drilled or wound.
-    BadBoard,
+    /// The board in `param.txt` cannot be drilled or wound, and why.
+    BadBoard(BadBoard),
     /// A zeroing button's first press: that driver is off.
     Loose(Axis),
     /// Its second press: the current position is that axis's zero.
@@ -150,7 +189,19 @@ pub enum Msg {
 impl Msg {
     pub const fn as_str(self) -> &'static str {
         match self {
-            Msg::BadBoard => "bad board",
+            Msg::BadBoard(BadBoard::Shape) => {
+                "bad board: param.txt's shape must be 0 (a circle) or 3 and more (a polygon)"
+            }
+            Msg::BadBoard(BadBoard::Nails) => "bad board: param.txt must have 3 nails or more",
+            Msg::BadBoard(BadBoard::Radius) => {
+                "bad board: param.txt's radius leaves no room for the nails: a larger radius"
+            }
+            Msg::BadBoard(BadBoard::Centre) => {
+                "bad board: winding would reach the centre past the needle's clearance: a larger radius (param.txt)"
+            }
+            Msg::BadBoard(BadBoard::Gap(_)) => {
+                "bad board: nails too close for the needle to pass (fewer nails or a larger radius in param.txt), the first after nail "
+            }
             Msg::Loose(Axis::Base) => "base free",
             Msg::Loose(Axis::Radial) => "radial free",
             Msg::Loose(_) => "drill free",

@@ -48,7 +48,7 @@ mod progress;
 pub mod tools;
 
 pub use feed::{Feeder, Feeding, Machine, SAVE_POLL_MS};
-pub use io::{Action, Actions, Event, Msg, Prompt, State, PROMPT_MARK};
+pub use io::{Action, Actions, BadBoard, Event, Msg, Prompt, State, PROMPT_MARK};
 pub use phase::Phase;
 pub use phase_steps::FEED;
 pub use progress::{left_s, Progress};
@@ -449,16 +449,16 @@ impl Job {
             o.push(Action::Configure);
             // The gaps are checked on the plan in place, from this frame:
             // no winder or plan on the stack under their trigonometry.
-            let planned = self.plan(params, count, id, config)
-                && self
-                    .plan
+            let planned = self.plan(params, count, id, config).and_then(|()| {
+                self.plan
                     .as_ref()
-                    .is_some_and(|p| p.winder.check_gaps().is_ok());
-            if !planned {
+                    .map_or(Ok(()), |p| p.winder.check_gaps().map_err(BadBoard::from))
+            });
+            if planned.is_err() {
                 self.plan = None;
             }
             match planned {
-                true => {
+                Ok(()) => {
                     self.card = Card::Present;
                     if let Some(s) = self.saved {
                         let h = s.header;
@@ -473,8 +473,8 @@ impl Job {
                     o.drivers(MACHINE_DRIVERS, true);
                     self.enter(State::PrepDrill, o);
                 }
-                false => {
-                    o.log(Msg::BadBoard);
+                Err(why) => {
+                    o.log(Msg::BadBoard(why));
                     self.card = Card::Present;
                     self.enter(State::BadFiles, o);
                 }
@@ -507,24 +507,24 @@ impl Job {
     /// board cannot be made. Out of line: the plan it builds is not on the
     /// stack under the checks.
     #[inline(never)]
-    fn plan(&mut self, params: Params, count: u32, id: CardId, config: &MachineConfig) -> bool {
+    fn plan(
+        &mut self,
+        params: Params,
+        count: u32,
+        id: CardId,
+        config: &MachineConfig,
+    ) -> Result<(), BadBoard> {
         self.plan = None;
-        let Ok(radius) = i32::try_from(params.radius_um) else {
-            return false;
-        };
-        let Ok(board) = Board::new(params.shape, params.nails, Milli(radius)) else {
-            return false;
-        };
-        let Ok(winder) = BlendWinder::unchecked(board, config) else {
-            return false;
-        };
+        let radius = i32::try_from(params.radius_um).map_err(|_| BadBoard::Radius)?;
+        let board = Board::new(params.shape, params.nails, Milli(radius))?;
+        let winder = BlendWinder::unchecked(board, config)?;
         self.plan = Some(Plan {
             count,
             id,
             depths: Depths::blended(config),
             winder,
         });
-        true
+        Ok(())
     }
 
     fn files_invalid(&mut self, o: &mut Out) {

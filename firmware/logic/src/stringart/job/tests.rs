@@ -581,7 +581,7 @@ fn bad_files_wait_without_moving() {
         b.send(valid(tiny, 5)),
         [
             Action::Configure,
-            Action::Log(Msg::BadBoard),
+            Action::Log(Msg::BadBoard(BadBoard::Gap(0))),
             Action::Enter(State::BadFiles),
             Action::Prompt(Prompt::ReplaceCard)
         ]
@@ -591,6 +591,35 @@ fn bad_files_wait_without_moving() {
         a,
         Action::NextMoves | Action::DriversOn(_) | Action::SetZero(_)
     )));
+}
+
+/// Each board that cannot be made is refused with its reason: what to
+/// change in `param.txt`.
+#[test]
+fn a_bad_board_is_refused_with_its_reason() {
+    let cases = [
+        (3, 30, 50_000, BadBoard::Gap(0)),
+        (0, 3, 16_000, BadBoard::Centre),
+        (2, 200, 300_000, BadBoard::Shape),
+        (0, 2, 300_000, BadBoard::Nails),
+        (0, 200, 1_000, BadBoard::Radius),
+        (0, 200, u32::MAX, BadBoard::Radius),
+        // 3 000 nails 0.6 mm apart on a 300 mm ring: the needle is wider.
+        (0, 3000, 300_000, BadBoard::Gap(0)),
+    ];
+    for (shape, nails, radius_um, why) in cases {
+        let mut b = Bench::new(HEX, &PATTERN);
+        b.send(Event::PowerOn);
+        b.send(Event::CardInserted);
+        let params = Params {
+            shape,
+            nails,
+            radius_um,
+        };
+        let out = b.send(valid(params, 5));
+        assert_eq!(out[1], Action::Log(Msg::BadBoard(why)), "{params:?}");
+        assert_eq!(out[2], Action::Enter(State::BadFiles), "{params:?}");
+    }
 }
 
 #[test]
