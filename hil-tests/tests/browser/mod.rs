@@ -78,6 +78,30 @@ impl Studio {
     }
 }
 
+/// The studio on the simulated `machine` and a browser on its page,
+/// connected from the page to the simulator (the first port it offers),
+/// its settings read: where every browser test starts.
+pub async fn open_connected(machine: Machine, name: &str) -> (Studio, Browser) {
+    let (studio, b) = tokio::join!(Studio::start(machine, name), Browser::open());
+    b.client.goto(&studio.url).await.unwrap();
+    b.until(
+        "the page",
+        Duration::from_secs(10),
+        "return document.getElementById('ports').options.length > 0",
+    )
+    .await;
+    let port = b.js("return document.getElementById('ports').value").await;
+    assert_eq!(port.as_str().unwrap(), studio.sim.tty.display().to_string());
+    b.click("connect").await;
+    b.until(
+        "connected",
+        Duration::from_secs(40),
+        "return S.connected && S.settings.length > 0 && S.status.state !== 'Connecting'",
+    )
+    .await;
+    (studio, b)
+}
+
 /// The browser's log (chromedriver's `se/log`, type `browser`).
 #[derive(Debug)]
 struct BrowserLog;
@@ -225,6 +249,39 @@ impl Browser {
              e.dispatchEvent(new Event('input')); e.dispatchEvent(new Event('change')); return true"
         );
         self.js(&script).await;
+    }
+
+    /// Opens a file with the page's Open button.
+    pub async fn open_file(&self, path: &Path) {
+        let path = path.canonicalize().unwrap().display().to_string();
+        self.by_id("open").await.send_keys(&path).await.unwrap();
+    }
+
+    /// Changes a setting in the `$$` table as a maker does (the cell
+    /// edited, then left) and waits for the machine's `ok` beside it.
+    pub async fn edit_setting(&self, key: &str, value: &str) {
+        let cell = format!("document.querySelector('[data-setting=\"{key}\"]')");
+        self.until(
+            &format!("${key} in the table"),
+            Duration::from_secs(10),
+            &format!("return !!{cell}"),
+        )
+        .await;
+        self.js(&format!(
+            "const e = {cell}; e.parentElement.nextElementSibling.textContent = ''; \
+             e.value = '{value}'; e.dispatchEvent(new Event('change')); return true"
+        ))
+        .await;
+        self.until(
+            &format!("${key}={value} taken"),
+            Duration::from_secs(10),
+            &format!("const s = {cell}.parentElement.nextElementSibling.textContent; return s === 'ok' || (s && 'refused: ' + s)"),
+        )
+        .await;
+        let said = self
+            .js(&format!("return {cell}.parentElement.nextElementSibling.textContent"))
+            .await;
+        assert_eq!(said, "ok", "${key}={value}");
     }
 
     pub async fn screenshot(&self, name: &str) -> PathBuf {
