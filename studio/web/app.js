@@ -19,6 +19,7 @@ const S = {
   simulator: null,
   travelled: [],     // machine positions seen while running, [x, y]
   settings: [],
+  said: {},          // the machine's answer to each setting changed in the table
 };
 
 // ---- the API ------------------------------------------------------------
@@ -152,7 +153,8 @@ async function vectorize() {
   if (n !== vectorizing) return;
   if (!d) { $('v-figures').textContent = ''; return; }
   notice('');
-  if (d.width_mm && Number($('v-width').value) !== d.width_mm) $('v-width').value = d.width_mm;
+  const width = Math.round(d.width_mm * 100) / 100;
+  if (width && Number($('v-width').value) !== width) $('v-width').value = width;
   showDrawing(d, d.svg ? `${d.strokes} strokes in ${d.layers} pass${d.layers === 1 ? '' : 'es'}` : `${d.strokes} strokes`);
 }
 const liveVectorize = debounce(() => { if (S.file && S.file.kind !== 'gcode') vectorize(); }, 350);
@@ -382,6 +384,16 @@ async function readSettings() {
 }
 $('settings-read').addEventListener('click', readSettings);
 
+// The machine's answer beside a setting (found anew: the table may have
+// been drawn again while the line was out).
+function showSaid(key) {
+  const input = document.querySelector(`[data-setting="${key}"]`);
+  if (!input) return;
+  const said = input.parentElement.nextElementSibling;
+  said.textContent = S.said[key] || '';
+  said.className = S.said[key] === 'ok' ? 'ok' : 'bad';
+}
+
 function renderSettings() {
   const t = $('settings');
   t.innerHTML = '';
@@ -398,14 +410,19 @@ function renderSettings() {
     input.dataset.setting = key;
     const said = document.createElement('td');
     input.addEventListener('change', async () => {
-      const r = await line(`$${key}=${input.value}`);
+      delete S.said[key];
+      showSaid(key);
+      const value = input.value;
+      const r = await line(`$${key}=${value}`);
       const ok = r && r.replies.includes('ok');
-      said.textContent = ok ? 'ok' : (r ? r.replies[r.replies.length - 1] : 'refused');
-      said.className = ok ? 'ok' : 'bad';
+      S.said[key] = ok ? 'ok' : (r ? r.replies[r.replies.length - 1] : 'refused');
+      if (ok) S.settings = S.settings.map((x) => (x.startsWith(`$${key}=`) ? `$${key}=${value}` : x));
+      showSaid(key);
     });
     v.appendChild(input);
     tr.append(k, v, said);
     t.appendChild(tr);
+    showSaid(key);
   }
   const m = S.settings.find((s) => s.startsWith('$machine='));
   if (m) $('machine-select').value = m.slice('$machine='.length);
@@ -565,7 +582,8 @@ function showJob(job) {
 function applySnapshot(s) {
   showLink(s.connected, s.port, s.lost);
   showStatus(s.status);
-  if (s.settings) { S.settings = s.settings; renderSettings(); }
+  // Drawn again only when changed: a cell being edited stays.
+  if (s.settings && JSON.stringify(s.settings) !== JSON.stringify(S.settings)) { S.settings = s.settings; renderSettings(); }
   if (s.job) showJob(s.job);
   if (s.run) showRun(s.run);
   if ('controller' in s) S.controller = s.controller;

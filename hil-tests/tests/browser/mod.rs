@@ -275,7 +275,7 @@ impl Browser {
         self.until(
             &format!("${key}={value} taken"),
             Duration::from_secs(10),
-            &format!("const s = {cell}.parentElement.nextElementSibling.textContent; return s === 'ok' || (s && 'refused: ' + s)"),
+            &format!("const s = {cell}.parentElement.nextElementSibling.textContent; return s === 'ok' || (s ? 'refused: ' + s : null)"),
         )
         .await;
         let said = self
@@ -293,17 +293,27 @@ impl Browser {
 
     /// The browser's log since the last call; panics on any error in it.
     pub async fn assert_no_console_errors(&mut self) {
+        self.assert_no_console_errors_but(None).await;
+    }
+
+    /// The same, but for one error the test asked for (its message holds
+    /// `expected`), which must be there: a request the API refuses (a
+    /// 4xx) is logged by the browser as a failed resource.
+    pub async fn assert_no_console_errors_but(&mut self, expected: Option<&str>) {
         let log = self
             .client
             .issue_cmd(BrowserLog)
             .await
             .expect("the browser's log");
         let entries = log.as_array().cloned().unwrap_or_default();
-        let errors: Vec<&Value> = entries
+        let (asked, errors): (Vec<&Value>, Vec<&Value>) = entries
             .iter()
             .filter(|e| e["level"] == "SEVERE" || e["level"] == "ERROR")
-            .collect();
+            .partition(|e| {
+                expected.is_some_and(|x| e["message"].as_str().unwrap_or("").contains(x))
+            });
         assert!(errors.is_empty(), "the browser logged errors: {errors:#?}");
+        assert_eq!(asked.len(), usize::from(expected.is_some()), "{expected:?}");
         self.log.extend(entries);
     }
 
