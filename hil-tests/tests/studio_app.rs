@@ -50,6 +50,14 @@ async fn run_until(app: &axum::Router, state: &str, limit: Duration) -> Value {
     }
 }
 
+/// An interrupted run's reason, which must start with `why`.
+fn reason<'a>(run: &'a Value, why: &str) -> &'a str {
+    assert_eq!(run["state"], "interrupted", "{run}");
+    let reason = run["reason"].as_str().unwrap();
+    assert!(reason.starts_with(why), "{reason}");
+    reason
+}
+
 /// The lines sent, in a `GET /api/machine` answer's log.
 fn sent(machine: &Value) -> usize {
     let log = machine["log"].as_array().unwrap();
@@ -208,11 +216,9 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
         tokio::time::sleep(Duration::from_millis(20)).await;
     }
     let r = ok(&app, "POST", "/api/run/stop", "").await;
-    assert_eq!(r["state"], "interrupted");
-    let reason = r["reason"].as_str().unwrap();
-    assert!(
-        reason.starts_with("stopped: Ctrl-X sent, the machine reset (last acknowledged line: "),
-        "{reason}"
+    reason(
+        &r,
+        "stopped: Ctrl-X sent, the machine reset (last acknowledged line: ",
     );
     // The machine lost its position (ALARM:3) and says what to do.
     let until = Instant::now() + Duration::from_secs(3);
@@ -242,11 +248,7 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     let r = ok(&app, "POST", "/api/sim/power_cut", "").await;
     assert_eq!(r["power_cuts"], 1);
     let r = run_until(&app, "interrupted", Duration::from_secs(5)).await;
-    let reason = r["reason"].as_str().unwrap();
-    assert!(
-        reason.starts_with("the machine reset (last acknowledged line: "),
-        "{reason}"
-    );
+    reason(&r, "the machine reset (last acknowledged line: ");
     let until = Instant::now() + Duration::from_secs(30);
     loop {
         let m = ok(&app, "GET", "/api/machine", "").await;
@@ -274,11 +276,7 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     sim.stop().unwrap();
     let r = run_until(&app, "interrupted", Duration::from_secs(2)).await;
     let shown = ended.elapsed();
-    let reason = r["reason"].as_str().unwrap();
-    assert!(
-        reason.starts_with(&format!("connection to {tty} lost")),
-        "{reason}"
-    );
+    let reason = reason(&r, &format!("connection to {tty} lost"));
     let last: u64 = reason
         .rsplit(": ")
         .next()

@@ -36,8 +36,7 @@ fn example(folder: &str, name: &str) -> PathBuf {
 }
 
 /// The console's lines as the page shows them (each line's own text).
-const LOG: &str =
-    "[...document.querySelectorAll('#log div')].map(d => d.firstChild.textContent)";
+const LOG: &str = "[...document.querySelectorAll('#log div')].map(d => d.firstChild.textContent)";
 
 /// How many lines the console shows.
 async fn logged(b: &Browser) -> usize {
@@ -85,8 +84,7 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
     b.set("v-width", "30").await;
     b.set("v-feed", "1500").await;
     b.open_file(&example("images", "horse.png")).await;
-    b.click("vectorize").await;
-    b.until("the toolpath", Duration::from_secs(30),
+    b.click_until("vectorize", "the toolpath", 30,
         "return S.drawing && S.drawing.width_mm === 30 && document.getElementById('v-figures').textContent.includes('G-code lines')").await;
     let figures = b.text("drawing-figures").await;
     assert!(
@@ -96,10 +94,10 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
     b.screenshot("vectorised.png").await;
 
     // Send; pause once mid-run, resume.
-    b.click("send").await;
-    b.until(
+    b.click_until(
+        "send",
         "running",
-        Duration::from_secs(10),
+        10,
         "return S.run && S.run.state === 'running' && S.run.line > 10",
     )
     .await;
@@ -108,13 +106,8 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
         progress.starts_with("running: line ") && progress.contains(" %, ETA "),
         "{progress}"
     );
-    b.click("pause").await;
-    b.until(
-        "held",
-        Duration::from_secs(10),
-        "return S.status.state === 'Hold:0'",
-    )
-    .await;
+    b.click_until("pause", "held", 10, "return S.status.state === 'Hold:0'")
+        .await;
     let held_at = b.js("return S.status.mpos").await;
     tokio::time::sleep(Duration::from_millis(800)).await;
     assert_eq!(
@@ -125,13 +118,8 @@ async fn a_picture_is_vectorised_sent_paused_resumed_and_drawn_on_its_toolpath()
     let progress = b.text("progress").await;
     assert!(progress.starts_with("paused: line "), "{progress}");
     b.screenshot("paused.png").await;
-    b.click("resume").await;
-    b.until(
-        "done",
-        Duration::from_secs(120),
-        "return S.run.state === 'done'",
-    )
-    .await;
+    b.click_until("resume", "done", 120, "return S.run.state === 'done'")
+        .await;
     let progress = b.text("progress").await;
     assert!(progress.starts_with("done: "), "{progress}");
     let travelled = b.js("return S.travelled.length").await.as_u64().unwrap();
@@ -233,13 +221,7 @@ async fn a_string_art_card_made_in_the_page_survives_a_power_cut_and_is_wound_to
     b.set("s-radius", "8").await;
     b.set("s-lines", "6").await;
     b.open_file(&example("images", "horse.png")).await;
-    b.click("stringart").await;
-    b.until(
-        "the card",
-        Duration::from_secs(60),
-        "return S.card && S.card.lines === 6 && document.getElementById('s-figures').textContent.includes('machine time')",
-    )
-    .await;
+    b.click_until("stringart", "the card", 60, "return S.card && S.card.lines === 6 && document.getElementById('s-figures').textContent.includes('machine time')").await;
     let figures = b.text("card-figures").await;
     assert!(
         figures.contains("machine time") && figures.contains("thread"),
@@ -293,10 +275,10 @@ async fn a_string_art_card_made_in_the_page_survives_a_power_cut_and_is_wound_to
                     tokio::time::sleep(Duration::from_millis(400)).await;
                 }
             }
-            b.click("green").await;
-            b.until(
+            b.click_until(
+                "green",
                 "the axes zeroed",
-                Duration::from_secs(20),
+                20,
                 &format!("return S.job.prompt !== {prompt:?} || null"),
             )
             .await;
@@ -385,7 +367,12 @@ async fn the_console_and_buttons_answer_a_second_window_watches_and_an_svg_opens
     assert!(notice.as_str().unwrap().contains("What to do:"), "{notice}");
 
     // The buttons: each sends what a Grbl user expects.
-    for (button, line) in [("unlock", "$X"), ("home", "$H"), ("pen-down", "M3"), ("pen-up", "M5")] {
+    for (button, line) in [
+        ("unlock", "$X"),
+        ("home", "$H"),
+        ("pen-down", "M3"),
+        ("pen-up", "M5"),
+    ] {
         let from = logged(&b).await;
         b.click(button).await;
         answered(&b, from, line, "ok").await;
@@ -440,11 +427,15 @@ async fn the_console_and_buttons_answer_a_second_window_watches_and_an_svg_opens
     b.until("watching", Duration::from_secs(10),
         "return S.connected && S.controller && S.controller !== S.client && !document.getElementById('take-over').hidden").await;
     assert!(b.text("control").await.starts_with("watching"));
-    assert!(b.js("return document.getElementById('send').disabled").await == true);
-    b.click("take-over").await;
-    b.until(
+    assert!(
+        b.js("return document.getElementById('send').disabled")
+            .await
+            == true
+    );
+    b.click_until(
+        "take-over",
         "controlling",
-        Duration::from_secs(10),
+        10,
         "return S.controller === S.client && document.getElementById('take-over').hidden",
     )
     .await;
@@ -462,13 +453,7 @@ async fn the_console_and_buttons_answer_a_second_window_watches_and_an_svg_opens
     // Machine selection: `$machine=`, the table read again.
     b.js("document.getElementById('machine-select').value = 'drum'; return true")
         .await;
-    b.click("machine-switch").await;
-    b.until(
-        "the drum",
-        Duration::from_secs(60),
-        "return S.settings.includes('$machine=drum') && document.getElementById('machine-select').value === 'drum'",
-    )
-    .await;
+    b.click_until("machine-switch", "the drum", 60, "return S.settings.includes('$machine=drum') && document.getElementById('machine-select').value === 'drum'").await;
 
     // An SVG (Inkscape's layers) opens at its own size: the drawing on
     // the left, its toolpath on the right, a pass a layer.
@@ -495,7 +480,8 @@ async fn the_console_and_buttons_answer_a_second_window_watches_and_an_svg_opens
         "vectorise: SVG: expected 'path' tag, not 'svg' at 1:56"
     );
     // The refusal (400) is the one error the browser logged.
-    b.assert_no_console_errors_but(Some("/api/vectorize?")).await;
+    b.assert_no_console_errors_but(Some("/api/vectorize?"))
+        .await;
     b.close().await;
     studio.end().await;
 }

@@ -205,10 +205,18 @@ async fn an_svg_is_drawn_from_its_shapes_at_its_own_size_or_scaled() {
         example_svg("inkscape-layers.svg"),
     )
     .await;
-    assert_eq!((v["svg"].clone(), v["layers"].clone()), (true.into(), 3.into()), "{}", v["note"]);
+    assert_eq!(
+        (v["svg"].clone(), v["layers"].clone()),
+        (true.into(), 3.into()),
+        "{}",
+        v["note"]
+    );
     let own = v["width_mm"].as_f64().unwrap();
     assert!((own - 120.0).abs() < 0.01, "{own}");
-    assert!(v["gcode"].as_str().unwrap().contains("M0 (MSG, change the pen: pass 2 of 3"));
+    assert!(v["gcode"]
+        .as_str()
+        .unwrap()
+        .contains("M0 (MSG, change the pen: pass 2 of 3"));
     let moves = v["toolpath"].as_array().unwrap();
     assert!(moves.iter().any(|m| m[4] == 1) && v["estimate_s"].as_f64().unwrap() > 1.0);
     // Scaled, in one pass.
@@ -218,11 +226,18 @@ async fn an_svg_is_drawn_from_its_shapes_at_its_own_size_or_scaled() {
         example_svg("inkscape-layers.svg"),
     )
     .await;
-    assert_eq!((half["width_mm"].clone(), half["layers"].clone()), (60.0.into(), 1.into()));
+    assert_eq!(
+        (half["width_mm"].clone(), half["layers"].clone()),
+        (60.0.into(), 1.into())
+    );
     // The ink's box scales with the page (the hatching's spacing does not).
-    let wide = |v: &Value| v["bounds"][1][0].as_f64().unwrap() - v["bounds"][0][0].as_f64().unwrap();
+    let wide =
+        |v: &Value| v["bounds"][1][0].as_f64().unwrap() - v["bounds"][0][0].as_f64().unwrap();
     let (a, b) = (wide(&v), wide(&half));
-    assert!((a / b - 2.0).abs() < 0.02, "the ink {a} mm wide at 120 mm, {b} at 60");
+    assert!(
+        (a / b - 2.0).abs() < 0.02,
+        "the ink {a} mm wide at 120 mm, {b} at 60"
+    );
     // Text not converted to paths is left out, and said so.
     let t = posted(
         &app,
@@ -232,7 +247,14 @@ async fn an_svg_is_drawn_from_its_shapes_at_its_own_size_or_scaled() {
            <text x='8' y='12'>hi</text></svg>"[..],
     )
     .await;
-    assert!(t["note"].as_str().unwrap().starts_with("1 text element(s) not drawn"), "{}", t["note"]);
+    assert!(
+        t["note"]
+            .as_str()
+            .unwrap()
+            .starts_with("1 text element(s) not drawn"),
+        "{}",
+        t["note"]
+    );
 }
 
 #[tokio::test]
@@ -317,7 +339,13 @@ async fn broken_pictures_and_options_are_refused_with_what_is_wrong() {
     // Too big: refused by its declared length and by what came.
     let big = vec![b'x'; app::UPLOAD_LIMIT + 1];
     let r = post(&app, "/api/vectorize", big.clone()).await;
-    refused(r, "too big", 413, "the file is over 25 MB, the most the studio takes").await;
+    refused(
+        r,
+        "too big",
+        413,
+        "the file is over 25 MB, the most the studio takes",
+    )
+    .await;
     let length = (big.len() + (1 << 20)).to_string();
     let header = [("content-length", length.as_str())];
     let r = call(&app, "POST", "/api/stringart", big, &header).await;
@@ -488,7 +516,14 @@ async fn on_another_address_a_token_is_made_and_needed() {
     let page = get(&app, &format!("/?token={token}")).await;
     assert_eq!(page.status, 200);
     let auth = format!("Bearer {token}");
-    let r = call(&app, "GET", "/api/run", Vec::new(), &[("authorization", &auth)]).await;
+    let r = call(
+        &app,
+        "GET",
+        "/api/run",
+        Vec::new(),
+        &[("authorization", &auth)],
+    )
+    .await;
     assert_eq!(r.json()["state"], "idle");
 }
 
@@ -499,11 +534,25 @@ async fn one_window_controls_the_machine_and_taking_over_is_explicit() {
     let b = [("x-taut-client", "tab-b")];
     let watching = "another window controls the machine";
     // Tab A acts first: it controls (its connect fails: no such port).
-    let r = call(&app, "POST", "/api/connect?port=/nonexistent", Vec::new(), &a).await;
+    let r = call(
+        &app,
+        "POST",
+        "/api/connect?port=/nonexistent",
+        Vec::new(),
+        &a,
+    )
+    .await;
     assert_eq!(r.status, 502);
     let who = get(&app, "/api/controller").await.json();
     assert_eq!(who["controller"], "tab-a");
-    let r = call(&app, "POST", "/api/machine/realtime?cmd=hold", Vec::new(), &b).await;
+    let r = call(
+        &app,
+        "POST",
+        "/api/machine/realtime?cmd=hold",
+        Vec::new(),
+        &b,
+    )
+    .await;
     refused(r, "B acts", 409, watching).await;
     // B takes over; now A watches.
     let r = call(&app, "POST", "/api/controller", Vec::new(), &b).await;

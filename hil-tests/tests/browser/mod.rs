@@ -92,13 +92,9 @@ pub async fn open_connected(machine: Machine, name: &str) -> (Studio, Browser) {
     .await;
     let port = b.js("return document.getElementById('ports').value").await;
     assert_eq!(port.as_str().unwrap(), studio.sim.tty.display().to_string());
-    b.click("connect").await;
-    b.until(
-        "connected",
-        Duration::from_secs(40),
-        "return S.connected && S.settings.length > 0 && S.status.state !== 'Connecting'",
-    )
-    .await;
+    let connected =
+        "return S.connected && S.settings.length > 0 && S.status.state !== 'Connecting'";
+    b.click_until("connect", "connected", 40, connected).await;
     (studio, b)
 }
 
@@ -236,6 +232,12 @@ impl Browser {
         }
     }
 
+    /// Clicks `testid`, then waits (up to `secs`) for `script` to hold.
+    pub async fn click_until(&self, testid: &str, what: &str, secs: u64, script: &str) -> Value {
+        self.click(testid).await;
+        self.until(what, Duration::from_secs(secs), script).await
+    }
+
     /// Types `text` into the element and presses Enter.
     pub async fn type_line(&self, testid: &str, text: &str) {
         let e = self.by_id(testid).await;
@@ -279,7 +281,9 @@ impl Browser {
         )
         .await;
         let said = self
-            .js(&format!("return {cell}.parentElement.nextElementSibling.textContent"))
+            .js(&format!(
+                "return {cell}.parentElement.nextElementSibling.textContent"
+            ))
             .await;
         assert_eq!(said, "ok", "${key}={value}");
     }

@@ -494,7 +494,8 @@ async fn power_cut(State(app): State<App>, headers: HeaderMap, uri: axum::http::
     })?;
     {
         let mut inner = app.hub.lock();
-        let note = "power cut (simulator): the machine keeps its EEPROM and its card, and starts again";
+        let note =
+            "power cut (simulator): the machine keeps its EEPROM and its card, and starts again";
         app.hub.log(&mut inner, "note", note);
     }
     let cuts = blocking(move || sim.power_cut().map_err(Bad::conflict)).await?;

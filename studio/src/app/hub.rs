@@ -90,7 +90,10 @@ impl JobStatus {
         let Some(msg) = message(line) else {
             return false;
         };
-        let module = line[5..].split(": ").next().and_then(|h| h.rsplit(' ').next());
+        let module = line[5..]
+            .split(": ")
+            .next()
+            .and_then(|h| h.rsplit(' ').next());
         if module == Some("checkpoint") || msg.starts_with("checkpoint: ") {
             let what = msg.trim_start_matches("checkpoint: ");
             self.checkpoint = Some(format!("checkpoint: {what}"));

@@ -171,14 +171,17 @@ fn serve(
         let endstops = sim.fit_machine_endstops(&cfg, 3.0);
         Ok::<_, String>((sim, endstops))
     };
-    let (mut sim, mut endstops) =
-        match power_on(&host::eeprom(&cfg, &Default::default(), &Default::default())) {
-            Ok(s) => s,
-            Err(e) => {
-                let _ = ready.send(Err(e));
-                return;
-            }
-        };
+    let (mut sim, mut endstops) = match power_on(&host::eeprom(
+        &cfg,
+        &Default::default(),
+        &Default::default(),
+    )) {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = ready.send(Err(e));
+            return;
+        }
+    };
     let mut pty = match Pty::open(Some(link)) {
         Ok(p) => p,
         Err(e) => {
