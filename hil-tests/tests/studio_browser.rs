@@ -336,17 +336,25 @@ async fn a_string_art_card_made_in_the_page_survives_a_power_cut_and_is_wound_to
 async fn the_console_and_buttons_answer_a_second_window_watches_and_an_svg_opens() {
     let (mut studio, mut b) = open_connected(Machine::Flatbed, "console").await;
     idle(&b).await;
+    // The buttons send what a Grbl user expects; typed into the console,
     // `$X` unlocks ([MSG:Caution: Unlocked] where it was locked), `$H`
     // homes, the jog moves, `?` reports where it stands: each line shown
     // first, its replies after.
-    for (line, want) in [
-        ("$X", "ok"),
-        ("$H", "ok"),
-        ("$J=G91 X5 Y2 F600", "ok"),
-        ("?", "<"),
+    for (how, line, want) in [
+        ("unlock", "$X", "ok"),
+        ("home", "$H", "ok"),
+        ("pen-down", "M3", "ok"),
+        ("pen-up", "M5", "ok"),
+        ("type", "$X", "ok"),
+        ("type", "$H", "ok"),
+        ("type", "$J=G91 X5 Y2 F600", "ok"),
+        ("type", "?", "<"),
     ] {
         let from = logged(&b).await;
-        b.type_line("console-input", line).await;
+        match how {
+            "type" => b.type_line("console-input", line).await,
+            button => b.click(button).await,
+        }
         let got = answered(&b, from, line, want).await;
         if want == "<" {
             let status = got.iter().find(|l| l.starts_with('<')).unwrap();
@@ -365,18 +373,6 @@ async fn the_console_and_buttons_answer_a_second_window_watches_and_an_svg_opens
     let notice = b.until("the refusal", Duration::from_secs(10),
         "const n = document.getElementById('notice'); return !n.hidden && n.textContent.includes('error:15') ? n.textContent : null").await;
     assert!(notice.as_str().unwrap().contains("What to do:"), "{notice}");
-
-    // The buttons: each sends what a Grbl user expects.
-    for (button, line) in [
-        ("unlock", "$X"),
-        ("home", "$H"),
-        ("pen-down", "M3"),
-        ("pen-up", "M5"),
-    ] {
-        let from = logged(&b).await;
-        b.click(button).await;
-        answered(&b, from, line, "ok").await;
-    }
     // Work zero: G10 L20 as CNCjs sends it, or G92 where it is refused.
     let from = logged(&b).await;
     b.click("zero").await;

@@ -277,6 +277,16 @@ async fn broken_pictures_and_options_are_refused_with_what_is_wrong() {
             "the picture: ",
         ),
         (
+            "/api/vectorize",
+            b"<svg xmlns='http://www.w3.org/2000/svg'>\n<path d='M0 0 L5 5'></svg>".to_vec(),
+            "SVG: expected 'path' tag, not 'svg' at 2:",
+        ),
+        (
+            "/api/vectorize",
+            b"<svg xmlns='http://www.w3.org/2000/svg' width='10mm' height='10mm'/>".to_vec(),
+            "nothing to draw: the SVG has no visible shapes",
+        ),
+        (
             "/api/vectorize?width_mm=abc",
             example("horse.png"),
             "width_mm=abc: not a number",
