@@ -50,6 +50,20 @@ async fn run_until(app: &axum::Router, state: &str, limit: Duration) -> Value {
     }
 }
 
+/// An interrupted run's reason, which must start with `why`.
+fn reason<'a>(run: &'a Value, why: &str) -> &'a str {
+    assert_eq!(run["state"], "interrupted", "{run}");
+    let reason = run["reason"].as_str().unwrap();
+    assert!(reason.starts_with(why), "{reason}");
+    reason
+}
+
+/// The lines sent, in a `GET /api/machine` answer's log.
+fn sent(machine: &Value) -> usize {
+    let log = machine["log"].as_array().unwrap();
+    log.iter().filter(|l| l["dir"] == "tx").count()
+}
+
 /// A square of 40 mm drawn in 1 mm moves: long enough to pause in.
 fn square() -> String {
     let mut g = String::from("G21\nG90\nM17\nM5\nG0 X10 Y10\nM3\nG1 F2400\n");
@@ -133,12 +147,7 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
         .any(|l| l["dir"] == "tx" && l["text"] == "$I"));
 
     // A broken file: refused with where and why, nothing sent.
-    let sent_before = m["log"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter(|l| l["dir"] == "tx")
-        .count();
+    let sent_before = sent(&m);
     let (status, v) = call(
         &app,
         "POST",
@@ -152,13 +161,7 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
         "the G-code, line 3: error:15 Travel exceeded (soft limit): nothing was sent to the flatbed"
     );
     let m = ok(&app, "GET", "/api/machine", "").await;
-    let sent_after = m["log"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter(|l| l["dir"] == "tx")
-        .count();
-    assert_eq!(sent_before, sent_after, "a line went out");
+    assert_eq!(sent_before, sent(&m), "a line went out");
 
     // A run: counts, pause (the machine holds), resume, the end.
     let r = ok(&app, "POST", "/api/run?name=square", &square()).await;
@@ -213,11 +216,9 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
         tokio::time::sleep(Duration::from_millis(20)).await;
     }
     let r = ok(&app, "POST", "/api/run/stop", "").await;
-    assert_eq!(r["state"], "interrupted");
-    let reason = r["reason"].as_str().unwrap();
-    assert!(
-        reason.starts_with("stopped: Ctrl-X sent, the machine reset (last acknowledged line: "),
-        "{reason}"
+    reason(
+        &r,
+        "stopped: Ctrl-X sent, the machine reset (last acknowledged line: ",
     );
     // The machine lost its position (ALARM:3) and says what to do.
     let until = Instant::now() + Duration::from_secs(3);
@@ -239,6 +240,31 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     ok(&app, "POST", "/api/machine/line", "$X").await;
     ok(&app, "POST", "/api/machine/realtime?cmd=status", "").await;
 
+    // The power cut mid-run (the simulator's): the board starts again
+    // behind the same terminal, the run is over at its last acknowledged
+    // line, nothing is sent again.
+    ok(&app, "POST", "/api/run?name=square", &square()).await;
+    tokio::time::sleep(Duration::from_millis(800)).await;
+    let r = ok(&app, "POST", "/api/sim/power_cut", "").await;
+    assert_eq!(r["power_cuts"], 1);
+    let r = run_until(&app, "interrupted", Duration::from_secs(5)).await;
+    reason(&r, "the machine reset (last acknowledged line: ");
+    let until = Instant::now() + Duration::from_secs(30);
+    loop {
+        let m = ok(&app, "GET", "/api/machine", "").await;
+        assert_eq!(m["connected"], true);
+        if matches!(m["status"]["state"].as_str(), Some("Idle" | "Alarm")) {
+            break;
+        }
+        assert!(Instant::now() < until, "not back: {}", m["status"]);
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    let sent_then = sent(&ok(&app, "GET", "/api/machine", "").await);
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    let m = ok(&app, "GET", "/api/machine", "").await;
+    assert_eq!(sent(&m), sent_then, "sent again after the cut");
+    ok(&app, "POST", "/api/machine/line", "$X").await;
+
     // The simulator ends mid-run: the link is lost at once, the run
     // interrupted at its last acknowledged line, nothing sent again.
     ok(&app, "POST", "/api/run?name=square", &square()).await;
@@ -250,11 +276,7 @@ async fn the_machine_endpoints_drive_the_simulated_flatbed() {
     sim.stop().unwrap();
     let r = run_until(&app, "interrupted", Duration::from_secs(2)).await;
     let shown = ended.elapsed();
-    let reason = r["reason"].as_str().unwrap();
-    assert!(
-        reason.starts_with(&format!("connection to {tty} lost")),
-        "{reason}"
-    );
+    let reason = reason(&r, &format!("connection to {tty} lost"));
     let last: u64 = reason
         .rsplit(": ")
         .next()

@@ -150,6 +150,14 @@ impl Pty {
         Ok(())
     }
 
+    /// The board behind the terminal was replaced (powered off and on
+    /// again): its UART output starts afresh, and the pace from now. The
+    /// terminal stays, as the USB cable does.
+    pub fn board_replaced(&mut self) {
+        self.sent = 0;
+        self.start = None;
+    }
+
     pub fn set_pace(&mut self, pace: Pace) {
         self.pace = pace;
     }

@@ -82,8 +82,35 @@ async fn get(app: &axum::Router, uri: &str) -> Reply {
     call(app, "GET", uri, Vec::new(), &[]).await
 }
 
-async fn post(app: &axum::Router, uri: &str, body: Vec<u8>) -> Reply {
-    call(app, "POST", uri, body, &[]).await
+async fn post(app: &axum::Router, uri: &str, body: impl Into<Vec<u8>>) -> Reply {
+    call(app, "POST", uri, body.into(), &[]).await
+}
+
+/// A POST that must succeed: its JSON.
+async fn posted(app: &axum::Router, uri: &str, body: impl Into<Vec<u8>>) -> Value {
+    let r = post(app, uri, body).await;
+    assert_eq!(r.status, 200, "{uri}: {}", r.error());
+    r.json()
+}
+
+/// A request that must be refused with `status` and an error holding
+/// `want`.
+async fn refused(reply: Reply, what: &str, status: u16, want: &str) {
+    assert_eq!(reply.status.as_u16(), status, "{what}: {}", reply.error());
+    assert!(
+        reply.error().contains(want),
+        "{what}: {:?} lacks {want:?}",
+        reply.error()
+    );
+}
+
+fn example_svg(name: &str) -> Vec<u8> {
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../examples/svg")
+            .join(name),
+    )
+    .unwrap()
 }
 
 fn png(b64: &Value) -> Vec<u8> {
@@ -133,14 +160,12 @@ async fn the_page_and_its_files_are_served_from_the_binary() {
 #[tokio::test]
 async fn a_picture_is_vectorised_with_its_time_travel_and_preview() {
     let app = studio(None).await;
-    let r = post(
+    let v = posted(
         &app,
         "/api/vectorize?machine=flatbed&width_mm=30&canny=60,160",
         example("horse.png"),
     )
     .await;
-    assert_eq!(r.status, 200, "{}", r.error());
-    let v = r.json();
     let gcode = v["gcode"].as_str().unwrap();
     assert!(gcode.contains("G1 X") && v["lines"].as_u64().unwrap() > 20);
     assert!(v["estimate_s"].as_f64().unwrap() > 1.0);
@@ -149,26 +174,87 @@ async fn a_picture_is_vectorised_with_its_time_travel_and_preview() {
     let moves = v["toolpath"].as_array().unwrap();
     assert!(moves.iter().any(|m| m[4] == 1) && moves.iter().any(|m| m[4] == 0));
     // Kept within the flatbed's 140 mm.
-    let wide = post(
+    let wide = posted(
         &app,
         "/api/vectorize?machine=flatbed&width_mm=500",
         example("horse.png"),
     )
-    .await
-    .json();
+    .await;
     assert_eq!(wide["width_mm"], 140.0);
     assert!(wide["note"]
         .as_str()
         .unwrap()
         .contains("kept within the flatbed's travel: 140 mm"));
     // Hatching, on another machine.
-    let h = post(
+    posted(
         &app,
         "/api/vectorize?machine=drum&width_mm=40&mode=hatch&hatch_mm=2",
         example("horse.png"),
     )
     .await;
-    assert_eq!(h.status, 200, "{}", h.error());
+}
+
+#[tokio::test]
+async fn an_svg_is_drawn_from_its_shapes_at_its_own_size_or_scaled() {
+    let app = studio(None).await;
+    // Inkscape's layers: one pass each (the hidden one left out), at the
+    // page's own 120 mm.
+    let v = posted(
+        &app,
+        "/api/vectorize?machine=flatbed&mode=edges",
+        example_svg("inkscape-layers.svg"),
+    )
+    .await;
+    assert_eq!(
+        (v["svg"].clone(), v["layers"].clone()),
+        (true.into(), 3.into()),
+        "{}",
+        v["note"]
+    );
+    let own = v["width_mm"].as_f64().unwrap();
+    assert!((own - 120.0).abs() < 0.01, "{own}");
+    assert!(v["gcode"]
+        .as_str()
+        .unwrap()
+        .contains("M0 (MSG, change the pen: pass 2 of 3"));
+    let moves = v["toolpath"].as_array().unwrap();
+    assert!(moves.iter().any(|m| m[4] == 1) && v["estimate_s"].as_f64().unwrap() > 1.0);
+    // Scaled, in one pass.
+    let half = posted(
+        &app,
+        "/api/vectorize?machine=flatbed&width_mm=60&one_pen=1",
+        example_svg("inkscape-layers.svg"),
+    )
+    .await;
+    assert_eq!(
+        (half["width_mm"].clone(), half["layers"].clone()),
+        (60.0.into(), 1.into())
+    );
+    // The ink's box scales with the page (the hatching's spacing does not).
+    let wide =
+        |v: &Value| v["bounds"][1][0].as_f64().unwrap() - v["bounds"][0][0].as_f64().unwrap();
+    let (a, b) = (wide(&v), wide(&half));
+    assert!(
+        (a / b - 2.0).abs() < 0.02,
+        "the ink {a} mm wide at 120 mm, {b} at 60"
+    );
+    // Text not converted to paths is left out, and said so.
+    let t = posted(
+        &app,
+        "/api/vectorize?machine=flatbed",
+        &b"<svg xmlns='http://www.w3.org/2000/svg' width='40mm' height='20mm' viewBox='0 0 40 20'>\
+           <rect x='5' y='5' width='30' height='10' fill='none' stroke='black'/>\
+           <text x='8' y='12'>hi</text></svg>"[..],
+    )
+    .await;
+    assert!(
+        t["note"]
+            .as_str()
+            .unwrap()
+            .starts_with("1 text element(s) not drawn"),
+        "{}",
+        t["note"]
+    );
 }
 
 #[tokio::test]
@@ -189,6 +275,16 @@ async fn broken_pictures_and_options_are_refused_with_what_is_wrong() {
             "/api/vectorize",
             example("horse.png")[..400].to_vec(),
             "the picture: ",
+        ),
+        (
+            "/api/vectorize",
+            b"<svg xmlns='http://www.w3.org/2000/svg'>\n<path d='M0 0 L5 5'></svg>".to_vec(),
+            "SVG: expected 'path' tag, not 'svg' at 2:",
+        ),
+        (
+            "/api/vectorize",
+            b"<svg xmlns='http://www.w3.org/2000/svg' width='10mm' height='10mm'/>".to_vec(),
+            "nothing to draw: the SVG has no visible shapes",
         ),
         (
             "/api/vectorize?width_mm=abc",
@@ -248,68 +344,50 @@ async fn broken_pictures_and_options_are_refused_with_what_is_wrong() {
         ),
     ];
     for (uri, body, want) in cases {
-        let r = post(&app, uri, body).await;
-        assert_eq!(r.status, 400, "{uri}: {}", String::from_utf8_lossy(&r.body));
-        assert!(
-            r.error().contains(want),
-            "{uri}: {:?} lacks {want:?}",
-            r.error()
-        );
+        refused(post(&app, uri, body).await, uri, 400, want).await;
     }
     // Too big: refused by its declared length and by what came.
     let big = vec![b'x'; app::UPLOAD_LIMIT + 1];
     let r = post(&app, "/api/vectorize", big.clone()).await;
-    assert_eq!(r.status, 413);
-    assert_eq!(
-        r.error(),
-        "the file is over 25 MB, the most the studio takes"
-    );
-    let length = (big.len() + (1 << 20)).to_string();
-    let r = call(
-        &app,
-        "POST",
-        "/api/stringart",
-        big,
-        &[("content-length", &length)],
+    refused(
+        r,
+        "too big",
+        413,
+        "the file is over 25 MB, the most the studio takes",
     )
     .await;
-    assert_eq!(r.status, 413);
-    assert_eq!(
-        r.error(),
-        "the file is 26.0 MB: the studio takes files up to 25 MB"
-    );
+    let length = (big.len() + (1 << 20)).to_string();
+    let header = [("content-length", length.as_str())];
+    let r = call(&app, "POST", "/api/stringart", big, &header).await;
+    let said = "the file is 26.0 MB: the studio takes files up to 25 MB";
+    refused(r, "declared too big", 413, said).await;
     // The server goes on.
-    let ok = post(&app, "/api/text?height_mm=5", b"ok".to_vec()).await;
-    assert_eq!(ok.status, 200);
+    posted(&app, "/api/text?height_mm=5", &b"ok"[..]).await;
 }
 
 #[tokio::test]
 async fn text_gcode_and_string_art_come_back_with_their_figures() {
     let app = studio(None).await;
-    let t = post(
+    let t = posted(
         &app,
         "/api/text?height_mm=8&font=scripts&machine=scara",
-        b"Hi".to_vec(),
+        &b"Hi"[..],
     )
     .await;
-    assert_eq!(t.status, 200, "{}", t.error());
-    assert!(t.json()["estimate_s"].as_f64().unwrap() > 0.0);
-    let g = post(
+    assert!(t["estimate_s"].as_f64().unwrap() > 0.0);
+    let g = posted(
         &app,
         "/api/gcode?machine=flatbed",
-        b"G21\nG90\nM5\nG0 X10 Y10\nM3\nG1 X20 F600\nM5\n".to_vec(),
+        &b"G21\nG90\nM5\nG0 X10 Y10\nM3\nG1 X20 F600\nM5\n"[..],
     )
     .await;
-    assert_eq!(g.status, 200, "{}", g.error());
-    assert_eq!(g.json()["pen_down_mm"], 10.0);
-    let s = post(
+    assert_eq!(g["pen_down_mm"], 10.0);
+    let s = posted(
         &app,
         "/api/stringart?nails=24&shape=6&radius_cm=10&lines=40&resolution=64&zoom=1.5&contrast=1.4",
         example("horse.png"),
     )
     .await;
-    assert_eq!(s.status, 200, "{}", s.error());
-    let s = s.json();
     assert_eq!(
         s["param"],
         "tvar = 6\npocet_hrebiku = 24\npolomer_matrice = 10\n"
@@ -327,13 +405,7 @@ async fn text_gcode_and_string_art_come_back_with_their_figures() {
         "/api/card?nails=24&shape=6&radius_cm=10&dir={}",
         dir.display()
     );
-    let c = post(
-        &app,
-        &uri,
-        s["poradi"].as_str().unwrap().as_bytes().to_vec(),
-    )
-    .await;
-    assert_eq!(c.status, 200, "{}", c.error());
+    posted(&app, &uri, s["poradi"].as_str().unwrap()).await;
     assert_eq!(
         std::fs::read_to_string(dir.join("poradi.txt")).unwrap(),
         s["poradi"].as_str().unwrap()
@@ -389,6 +461,7 @@ async fn without_a_machine_the_machine_endpoints_say_so_and_send_nothing() {
             "name=red: green, zero_base, zero_radial or zero_drill",
         ),
         ("/api/sim/card?nails=24", "1\n3\n", 409, "no simulator"),
+        ("/api/sim/power_cut", "", 409, "no simulator"),
         (
             "/api/connect?port=/nonexistent/tty",
             "",
@@ -397,9 +470,7 @@ async fn without_a_machine_the_machine_endpoints_say_so_and_send_nothing() {
         ),
         ("/api/connect", "", 400, "missing port"),
     ] {
-        let r = post(&app, uri, body.as_bytes().to_vec()).await;
-        assert_eq!(r.status.as_u16(), status, "{uri}: {}", r.error());
-        assert!(r.error().contains(want), "{uri}: {:?}", r.error());
+        refused(post(&app, uri, body).await, uri, status, want).await;
     }
     let r = post(&app, "/api/disconnect", Vec::new()).await;
     assert_eq!(r.json()["connected"], false);
@@ -408,54 +479,62 @@ async fn without_a_machine_the_machine_endpoints_say_so_and_send_nothing() {
 #[tokio::test]
 async fn with_a_token_every_request_needs_it() {
     let app = studio(Some("s3cret-token")).await;
+    let with = |uri: &'static str, header: (&'static str, &'static str)| {
+        let app = app.clone();
+        async move { call(&app, "GET", uri, Vec::new(), &[header]).await }
+    };
     for uri in ["/", "/app.js", "/api/machine", "/api/run"] {
-        let r = get(&app, uri).await;
-        assert_eq!(r.status, 401, "{uri}");
-        assert!(r.error().starts_with("a token is needed"), "{uri}");
+        refused(get(&app, uri).await, uri, 401, "a token is needed").await;
     }
-    let wrong = call(
-        &app,
-        "GET",
-        "/api/machine",
-        Vec::new(),
-        &[("authorization", "Bearer s3cret-tokem")],
-    )
-    .await;
-    assert_eq!(wrong.status, 401);
-    let r = call(
-        &app,
-        "GET",
-        "/api/machine",
-        Vec::new(),
-        &[("authorization", "Bearer s3cret-token")],
-    )
-    .await;
-    assert_eq!(r.status, 200);
+    let wrong = with("/api/machine", ("authorization", "Bearer s3cret-tokem")).await;
+    refused(wrong, "a wrong token", 401, "a token is needed").await;
+    let right = with("/api/machine", ("authorization", "Bearer s3cret-token")).await;
+    assert_eq!(right.status, 200);
     // Opened with ?token=, the page gets a cookie its files and calls use.
     let page = get(&app, "/?token=s3cret-token").await;
     assert_eq!(page.status, 200);
     let cookie = page.headers["set-cookie"].to_str().unwrap().to_string();
     assert!(cookie.starts_with("taut_token=s3cret-token;") && cookie.contains("HttpOnly"));
-    let js = call(
-        &app,
-        "GET",
-        "/app.js",
-        Vec::new(),
-        &[("cookie", "taut_token=s3cret-token")],
-    )
-    .await;
+    let js = with("/app.js", ("cookie", "taut_token=s3cret-token")).await;
     assert_eq!(js.status, 200);
-    let v = post(&app, "/api/text?token=s3cret-token", b"x".to_vec()).await;
-    assert_eq!(v.status, 200);
-    // Beyond 127.0.0.1 a token is made when none is given; a short one
-    // is refused.
+    posted(&app, "/api/text?token=s3cret-token", &b"x"[..]).await;
+    // A short token is refused; on 127.0.0.1 none is needed.
     let any = IpAddr::V4(Ipv4Addr::UNSPECIFIED);
-    assert_eq!(app::token_for(any, None).unwrap().unwrap().len(), 32);
+    assert!(app::token_for(any, Some("short".into())).is_err());
     assert_eq!(
         app::token_for(IpAddr::V4(Ipv4Addr::LOCALHOST), None).unwrap(),
         None
     );
-    assert!(app::token_for(any, Some("short".into())).is_err());
+}
+
+/// Bound beyond this computer without `--token`, the studio makes one up
+/// and prints it in its address: without it, 401.
+#[tokio::test]
+async fn on_another_address_a_token_is_made_and_needed() {
+    let o = Options {
+        bind: IpAddr::V4(Ipv4Addr::UNSPECIFIED),
+        port: 0,
+        ..Options::default()
+    };
+    let started = app::start(o).await.unwrap();
+    let token = started.url.split("?token=").nth(1).unwrap().to_string();
+    assert_eq!(token.len(), 32, "{}", started.url);
+    let app = started.router();
+    for uri in ["/", "/api/machine", "/api/ports"] {
+        refused(get(&app, uri).await, uri, 401, "a token is needed").await;
+    }
+    let page = get(&app, &format!("/?token={token}")).await;
+    assert_eq!(page.status, 200);
+    let auth = format!("Bearer {token}");
+    let r = call(
+        &app,
+        "GET",
+        "/api/run",
+        Vec::new(),
+        &[("authorization", &auth)],
+    )
+    .await;
+    assert_eq!(r.json()["state"], "idle");
 }
 
 #[tokio::test]
@@ -463,6 +542,7 @@ async fn one_window_controls_the_machine_and_taking_over_is_explicit() {
     let app = studio(None).await;
     let a = [("x-taut-client", "tab-a")];
     let b = [("x-taut-client", "tab-b")];
+    let watching = "another window controls the machine";
     // Tab A acts first: it controls (its connect fails: no such port).
     let r = call(
         &app,
@@ -473,10 +553,8 @@ async fn one_window_controls_the_machine_and_taking_over_is_explicit() {
     )
     .await;
     assert_eq!(r.status, 502);
-    assert_eq!(
-        get(&app, "/api/controller").await.json()["controller"],
-        "tab-a"
-    );
+    let who = get(&app, "/api/controller").await.json();
+    assert_eq!(who["controller"], "tab-a");
     let r = call(
         &app,
         "POST",
@@ -485,20 +563,15 @@ async fn one_window_controls_the_machine_and_taking_over_is_explicit() {
         &b,
     )
     .await;
-    assert_eq!(r.status, 409);
-    assert!(r.error().starts_with("another window controls the machine"));
+    refused(r, "B acts", 409, watching).await;
     // B takes over; now A watches.
     let r = call(&app, "POST", "/api/controller", Vec::new(), &b).await;
     assert_eq!(r.json()["controller"], "tab-b");
     let r = call(&app, "POST", "/api/run/stop", Vec::new(), &a).await;
-    assert!(r.error().starts_with("another window controls the machine"));
+    refused(r, "A acts", 409, watching).await;
     // Watching needs no control.
-    assert_eq!(
-        call(&app, "GET", "/api/machine", Vec::new(), &a)
-            .await
-            .status,
-        200
-    );
+    let r = call(&app, "GET", "/api/machine", Vec::new(), &a).await;
+    assert_eq!(r.status, 200);
 }
 
 /// The binary: prints its URL, serves, and ends on SIGINT with status 0.

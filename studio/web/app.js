@@ -19,6 +19,7 @@ const S = {
   simulator: null,
   travelled: [],     // machine positions seen while running, [x, y]
   settings: [],
+  said: {},          // the machine's answer to each setting changed in the table
 };
 
 // ---- the API ------------------------------------------------------------
@@ -90,7 +91,7 @@ function kindOf(name, bytes) {
 async function openFile(file) {
   const bytes = await file.arrayBuffer();
   const kind = kindOf(file.name, bytes);
-  S.file = { name: file.name, kind, bytes };
+  S.file = { name: file.name, kind, bytes, ownSize: kind === 'svg' };
   $('file-name').textContent = `${file.name} (${(bytes.byteLength / 1024).toFixed(0)} KB, ${kind === 'gcode' ? 'G-code' : kind})`;
   notice('');
   const img = $('input-image');
@@ -142,15 +143,19 @@ async function vectorize() {
   const query = {
     machine: plotter(), width_mm: $('v-width').value, mode,
     canny: `${$('v-low').value},${$('v-high').value}`, blur: $('v-blur').value,
-    feed: $('v-feed').value, name: S.file.name,
+    feed: $('v-feed').value, name: S.file.name, one_pen: $('v-one-pen').checked ? 1 : '',
   };
-  if (mode === 'hatch') { query.mode = 'hatch'; query.threshold = $('v-threshold').value; query.hatch_mm = $('v-hatch').value; }
+  // An SVG opens at its own size until the width is changed.
+  if (S.file.ownSize) delete query.width_mm;
+  if (mode !== 'edges') query.threshold = $('v-threshold').value;
+  query.hatch_mm = $('v-hatch').value;
   const d = await attempt('vectorise', () => api('/api/vectorize', { method: 'POST', body: S.file.bytes, query }));
   if (n !== vectorizing) return;
   if (!d) { $('v-figures').textContent = ''; return; }
   notice('');
-  if (d.width_mm && Number($('v-width').value) !== d.width_mm) $('v-width').value = d.width_mm;
-  showDrawing(d, `${d.strokes} strokes`);
+  const width = Math.round(d.width_mm * 100) / 100;
+  if (width && Number($('v-width').value) !== width) $('v-width').value = width;
+  showDrawing(d, d.svg ? `${d.strokes} strokes in ${d.layers} pass${d.layers === 1 ? '' : 'es'}` : `${d.strokes} strokes`);
 }
 const liveVectorize = debounce(() => { if (S.file && S.file.kind !== 'gcode') vectorize(); }, 350);
 
@@ -172,12 +177,16 @@ $('save-gcode').addEventListener('click', () => {
   const base = S.file ? S.file.name.replace(/\.[^.]*$/, '') : 'drawing';
   download(base + '.gcode', S.drawing.gcode, 'text/plain');
 });
-for (const id of ['v-machine', 'v-width', 'v-mode', 'v-low', 'v-high', 'v-threshold', 'v-hatch', 'v-blur', 'v-feed']) {
+for (const id of ['v-machine', 'v-width', 'v-mode', 'v-low', 'v-high', 'v-threshold', 'v-hatch', 'v-blur', 'v-feed', 'v-one-pen']) {
   $(id).addEventListener('input', liveVectorize);
 }
-$('v-mode').addEventListener('change', () => {
-  for (const e of document.querySelectorAll('.hatch')) e.hidden = $('v-mode').value !== 'hatch';
-});
+$('v-width').addEventListener('input', () => { if (S.file) S.file.ownSize = false; });
+function modeFields() {
+  const mode = $('v-mode').value;
+  for (const e of document.querySelectorAll('.hatch')) e.hidden = mode === 'edges';
+  for (const e of document.querySelectorAll('.edges')) e.hidden = mode !== 'edges';
+}
+$('v-mode').addEventListener('change', modeFields);
 
 // ---- the toolpath and where the machine went ---------------------------------
 
@@ -375,6 +384,16 @@ async function readSettings() {
 }
 $('settings-read').addEventListener('click', readSettings);
 
+// The machine's answer beside a setting (found anew: the table may have
+// been drawn again while the line was out).
+function showSaid(key) {
+  const input = document.querySelector(`[data-setting="${key}"]`);
+  if (!input) return;
+  const said = input.parentElement.nextElementSibling;
+  said.textContent = S.said[key] || '';
+  said.className = S.said[key] === 'ok' ? 'ok' : 'bad';
+}
+
 function renderSettings() {
   const t = $('settings');
   t.innerHTML = '';
@@ -391,14 +410,19 @@ function renderSettings() {
     input.dataset.setting = key;
     const said = document.createElement('td');
     input.addEventListener('change', async () => {
-      const r = await line(`$${key}=${input.value}`);
+      delete S.said[key];
+      showSaid(key);
+      const value = input.value;
+      const r = await line(`$${key}=${value}`);
       const ok = r && r.replies.includes('ok');
-      said.textContent = ok ? 'ok' : (r ? r.replies[r.replies.length - 1] : 'refused');
-      said.className = ok ? 'ok' : 'bad';
+      S.said[key] = ok ? 'ok' : (r ? r.replies[r.replies.length - 1] : 'refused');
+      if (ok) S.settings = S.settings.map((x) => (x.startsWith(`$${key}=`) ? `$${key}=${value}` : x));
+      showSaid(key);
     });
     v.appendChild(input);
     tr.append(k, v, said);
     t.appendChild(tr);
+    showSaid(key);
   }
   const m = S.settings.find((s) => s.startsWith('$machine='));
   if (m) $('machine-select').value = m.slice('$machine='.length);
@@ -423,6 +447,14 @@ async function press(name, long) {
 $('green').addEventListener('click', () => press('green', false));
 $('green-long').addEventListener('click', () => press('green', true));
 for (const b of document.querySelectorAll('[data-button]')) b.addEventListener('click', () => press(b.dataset.button, false));
+$('job-resume').addEventListener('click', () => press('green', false));
+$('job-discard').addEventListener('click', () => {
+  if (confirm('Discard the job the power cut stopped? It cannot be resumed after this.')) press('green', true);
+});
+$('power-cut').addEventListener('click', async () => {
+  const r = await attempt('power cut', () => api('/api/sim/power_cut', { method: 'POST' }));
+  if (r) notice(`power cut ${r.power_cuts} (simulator): the machine starts again with what its EEPROM and card kept`);
+});
 
 // ---- running ------------------------------------------------------------------
 
@@ -516,12 +548,28 @@ function showLink(connected, port, lost) {
   updateButtons();
 }
 
+// What the prompts that need more than green ask of the maker.
+const HINTS = {
+  '>>> axes were unpowered': 'Each white button twice: the first frees its axis (turn it to the zero pose by hand), '
+    + 'the second takes that as its zero. Then green.',
+  '>>> insert card': 'Put the card in the slot (on the simulator: Put the card in the simulated machine).',
+  '>>> bad files': 'The card\'s files are refused (the console says why): write the card again.',
+};
+
 function showJob(job) {
   S.job = job;
   $('job-state').textContent = job.state ? `state: ${job.state}` : 'no job';
   const p = $('job-prompt');
   p.hidden = !job.prompt;
   p.textContent = job.prompt || '';
+  const prompt = job.prompt || '';
+  // After a reset (a power cut): the checkpoint found, and its offer.
+  $('job-checkpoint').hidden = !job.checkpoint;
+  $('job-checkpoint').textContent = job.checkpoint || '';
+  $('job-offer').hidden = !prompt.startsWith('>>> resume ');
+  const hint = Object.keys(HINTS).find((k) => prompt.startsWith(k));
+  $('job-hint').hidden = !hint;
+  $('job-hint').textContent = hint ? HINTS[hint] : '';
   if (job.progress) {
     const [phase, done, of] = job.progress;
     $('job-progress').max = of;
@@ -534,7 +582,8 @@ function showJob(job) {
 function applySnapshot(s) {
   showLink(s.connected, s.port, s.lost);
   showStatus(s.status);
-  if (s.settings) { S.settings = s.settings; renderSettings(); }
+  // Drawn again only when changed: a cell being edited stays.
+  if (s.settings && JSON.stringify(s.settings) !== JSON.stringify(S.settings)) { S.settings = s.settings; renderSettings(); }
   if (s.job) showJob(s.job);
   if (s.run) showRun(s.run);
   if ('controller' in s) S.controller = s.controller;
@@ -598,7 +647,7 @@ for (const o of document.querySelectorAll('output')) {
     }
     $('v-machine').value = 'flatbed';
   }
-  for (const e of document.querySelectorAll('.hatch')) e.hidden = true;
+  modeFields();
   templateLink();
   await ports();
   events();

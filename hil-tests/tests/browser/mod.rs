@@ -78,6 +78,26 @@ impl Studio {
     }
 }
 
+/// The studio on the simulated `machine` and a browser on its page,
+/// connected from the page to the simulator (the first port it offers),
+/// its settings read: where every browser test starts.
+pub async fn open_connected(machine: Machine, name: &str) -> (Studio, Browser) {
+    let (studio, b) = tokio::join!(Studio::start(machine, name), Browser::open());
+    b.client.goto(&studio.url).await.unwrap();
+    b.until(
+        "the page",
+        Duration::from_secs(10),
+        "return document.getElementById('ports').options.length > 0",
+    )
+    .await;
+    let port = b.js("return document.getElementById('ports').value").await;
+    assert_eq!(port.as_str().unwrap(), studio.sim.tty.display().to_string());
+    let connected =
+        "return S.connected && S.settings.length > 0 && S.status.state !== 'Connecting'";
+    b.click_until("connect", "connected", 40, connected).await;
+    (studio, b)
+}
+
 /// The browser's log (chromedriver's `se/log`, type `browser`).
 #[derive(Debug)]
 struct BrowserLog;
@@ -212,6 +232,12 @@ impl Browser {
         }
     }
 
+    /// Clicks `testid`, then waits (up to `secs`) for `script` to hold.
+    pub async fn click_until(&self, testid: &str, what: &str, secs: u64, script: &str) -> Value {
+        self.click(testid).await;
+        self.until(what, Duration::from_secs(secs), script).await
+    }
+
     /// Types `text` into the element and presses Enter.
     pub async fn type_line(&self, testid: &str, text: &str) {
         let e = self.by_id(testid).await;
@@ -227,6 +253,41 @@ impl Browser {
         self.js(&script).await;
     }
 
+    /// Opens a file with the page's Open button.
+    pub async fn open_file(&self, path: &Path) {
+        let path = path.canonicalize().unwrap().display().to_string();
+        self.by_id("open").await.send_keys(&path).await.unwrap();
+    }
+
+    /// Changes a setting in the `$$` table as a maker does (the cell
+    /// edited, then left) and waits for the machine's `ok` beside it.
+    pub async fn edit_setting(&self, key: &str, value: &str) {
+        let cell = format!("document.querySelector('[data-setting=\"{key}\"]')");
+        self.until(
+            &format!("${key} in the table"),
+            Duration::from_secs(10),
+            &format!("return !!{cell}"),
+        )
+        .await;
+        self.js(&format!(
+            "const e = {cell}; e.parentElement.nextElementSibling.textContent = ''; \
+             e.value = '{value}'; e.dispatchEvent(new Event('change')); return true"
+        ))
+        .await;
+        self.until(
+            &format!("${key}={value} taken"),
+            Duration::from_secs(10),
+            &format!("const s = {cell}.parentElement.nextElementSibling.textContent; return s === 'ok' || (s ? 'refused: ' + s : null)"),
+        )
+        .await;
+        let said = self
+            .js(&format!(
+                "return {cell}.parentElement.nextElementSibling.textContent"
+            ))
+            .await;
+        assert_eq!(said, "ok", "${key}={value}");
+    }
+
     pub async fn screenshot(&self, name: &str) -> PathBuf {
         let png = self.client.screenshot().await.unwrap();
         let path = screenshots().join(name);
@@ -236,17 +297,27 @@ impl Browser {
 
     /// The browser's log since the last call; panics on any error in it.
     pub async fn assert_no_console_errors(&mut self) {
+        self.assert_no_console_errors_but(None).await;
+    }
+
+    /// The same, but for one error the test asked for (its message holds
+    /// `expected`), which must be there: a request the API refuses (a
+    /// 4xx) is logged by the browser as a failed resource.
+    pub async fn assert_no_console_errors_but(&mut self, expected: Option<&str>) {
         let log = self
             .client
             .issue_cmd(BrowserLog)
             .await
             .expect("the browser's log");
         let entries = log.as_array().cloned().unwrap_or_default();
-        let errors: Vec<&Value> = entries
+        let (asked, errors): (Vec<&Value>, Vec<&Value>) = entries
             .iter()
             .filter(|e| e["level"] == "SEVERE" || e["level"] == "ERROR")
-            .collect();
+            .partition(|e| {
+                expected.is_some_and(|x| e["message"].as_str().unwrap_or("").contains(x))
+            });
         assert!(errors.is_empty(), "the browser logged errors: {errors:#?}");
+        assert_eq!(asked.len(), usize::from(expected.is_some()), "{expected:?}");
         self.log.extend(entries);
     }
 

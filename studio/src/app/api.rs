@@ -58,6 +58,7 @@ pub fn router(app: App) -> Router {
         .route("/api/machine/realtime", post(realtime))
         .route("/api/machine/button", post(button))
         .route("/api/sim/card", post(sim_card))
+        .route("/api/sim/power_cut", post(power_cut))
         .route("/api/run", post(run_start).get(run_report))
         .route("/api/run/{action}", post(run_action))
         .route("/api/controller", get(controller).post(take_over))
@@ -480,6 +481,25 @@ async fn sim_card(
     Ok(Json(
         json!({ "inserted": true, "nails": spec.nails, "connections": pattern.len() }),
     ))
+}
+
+/// `POST /api/sim/power_cut`: the simulated machine's power cut and
+/// switched on again at once. Only its EEPROM (a byte being written left
+/// erased) and the card in its slot survive: a string-art job offers to
+/// resume from its checkpoint; a G-code run is over (the board reset).
+async fn power_cut(State(app): State<App>, headers: HeaderMap, uri: axum::http::Uri) -> Answer {
+    control(&app, &client(&headers, &uri))?;
+    let sim = app.sim.clone().ok_or_else(|| {
+        Bad::conflict("no simulator: start taut studio with --sim (cargo xtask studio)")
+    })?;
+    {
+        let mut inner = app.hub.lock();
+        let note =
+            "power cut (simulator): the machine keeps its EEPROM and its card, and starts again";
+        app.hub.log(&mut inner, "note", note);
+    }
+    let cuts = blocking(move || sim.power_cut().map_err(Bad::conflict)).await?;
+    Ok(Json(json!({ "power_cuts": cuts })))
 }
 
 /// `POST /api/run?name=…`: the body, a G-code file, checked as the

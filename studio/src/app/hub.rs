@@ -79,6 +79,9 @@ pub struct JobStatus {
     pub progress: Option<(String, u32, u32)>,
     /// The job's last error line.
     pub error: Option<String>,
+    /// What the boot found of a job a reset stopped (`checkpoint: winding
+    /// stopped at 12/40 by a reset: power-on`).
+    pub checkpoint: Option<String>,
 }
 
 impl JobStatus {
@@ -87,7 +90,14 @@ impl JobStatus {
         let Some(msg) = message(line) else {
             return false;
         };
-        if let Some(state) = msg.strip_prefix("state: ") {
+        let module = line[5..]
+            .split(": ")
+            .next()
+            .and_then(|h| h.rsplit(' ').next());
+        if module == Some("checkpoint") || msg.starts_with("checkpoint: ") {
+            let what = msg.trim_start_matches("checkpoint: ");
+            self.checkpoint = Some(format!("checkpoint: {what}"));
+        } else if let Some(state) = msg.strip_prefix("state: ") {
             self.state = Some(state.to_string());
             self.prompt = None;
         } else if msg.starts_with(">>> ") {
@@ -271,6 +281,9 @@ impl Hub {
             if let Some(w) = inner.waiter.take() {
                 let _ = w.done.send(Err("the machine reset".into()));
             }
+            // A reset ends the job the page knew; the boot tells anew.
+            inner.job = JobStatus::default();
+            self.emit("job", json!({ "job": inner.job }));
         }
         // A run takes every answer; otherwise the console's waiting line.
         if inner.run.as_ref().is_some_and(Run::active) {
@@ -426,6 +439,11 @@ mod tests {
         assert!(job.read("[MSG:I 123 job: state: winding]"));
         assert_eq!(job.prompt, None);
         assert!(!job.read("[MSG:Caution: Unlocked]"));
+        assert!(job.read("[MSG:W 9 checkpoint: winding stopped at 4/40 by a reset: power-on]"));
+        assert_eq!(
+            job.checkpoint.as_deref(),
+            Some("checkpoint: winding stopped at 4/40 by a reset: power-on")
+        );
         let mut settings = vec!["$machine=flatbed".to_string()];
         remember_setting(&mut settings, "x_max_rate=2000");
         remember_setting(&mut settings, "machine=drum");

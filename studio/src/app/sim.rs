@@ -3,8 +3,12 @@
 //! simavr, powered on as a machine, its serial port a pseudo-terminal that
 //! the app opens like any port, in real time. Being in the app's own
 //! process, the page can also do what a person at the machine does: put a
-//! card in the slot and press the machine's buttons. Every pin is probed,
-//! and the trace (VCD) is written when the app ends.
+//! card in the slot, press the machine's buttons, and cut the power (only
+//! the EEPROM, as the cut leaves it, and the card in the slot survive;
+//! the board starts again at once, behind the same terminal). Every pin
+//! is probed, and the trace (VCD) is written when the app ends; a power
+//! cut writes the trace up to it beside it (`studio.vcd`: `studio-cut1.vcd`
+//! …).
 //!
 //! The simulator (simavr, in C) is built into `taut` only with the `sim`
 //! feature, which `cargo xtask studio` and the HIL tests turn on: a maker's
@@ -25,6 +29,7 @@ enum Command {
     Press(Button, Duration),
     /// A folder holding the card's files (imaged, then removed).
     Card(PathBuf),
+    PowerCut(mpsc::Sender<Result<u32, String>>),
     Stop(mpsc::Sender<Result<Ended, String>>),
 }
 
@@ -33,7 +38,11 @@ enum Command {
 #[derive(Clone, Debug)]
 pub struct Ended {
     pub origin: [i32; 2],
+    /// Machine time over every power-on, s.
     pub seconds: f64,
+    /// The traces up to each power cut, in order (the last power-on's is
+    /// the VCD file asked for).
+    pub cut_traces: Vec<PathBuf>,
 }
 
 pub struct SimHost {
@@ -86,6 +95,15 @@ impl SimHost {
         self.send(Command::Card(dir))
     }
 
+    /// Cuts the power and switches it on again: what the EEPROM holds (a
+    /// byte being written is left erased) and the card in the slot
+    /// survive. Returns how many cuts there have been.
+    pub fn power_cut(&self) -> Result<u32, String> {
+        let (tx, rx) = mpsc::channel();
+        self.send(Command::PowerCut(tx))?;
+        rx.recv().map_err(|_| "the simulator ended".to_string())?
+    }
+
     /// Ends the simulation; the trace is written (if asked for).
     pub fn stop(&self) -> Result<Ended, String> {
         let (tx, rx) = mpsc::channel();
@@ -103,6 +121,13 @@ impl SimHost {
 fn unique() -> u64 {
     static N: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     N.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// The trace up to the `n`-th power cut: `studio.vcd` → `studio-cut1.vcd`.
+#[cfg_attr(not(feature = "sim"), allow(dead_code))]
+fn cut_trace(vcd: &Path, n: usize) -> PathBuf {
+    let stem = vcd.file_stem().unwrap_or_default().to_string_lossy();
+    vcd.with_file_name(format!("{stem}-cut{n}.vcd"))
 }
 
 /// Without the simulator built in: says how to get it.
@@ -135,18 +160,28 @@ fn serve(
     use taut_logic::config::MachineConfig;
     use taut_logic::settings::record::host;
     use taut_simavr::{pty::Pty, sdcard::SdImage, sdimage::FatChoice, Sim};
-    let mut sim = match Sim::load(elf) {
-        Ok(sim) => sim,
+    let cfg = MachineConfig::defaults(machine);
+    // A board powered on with `eeprom`: every pin probed, the endstops
+    // where the machine's are.
+    let power_on = |eeprom: &[u8]| {
+        let mut sim = Sim::load(elf).map_err(|e| format!("{}: {e}", elf.display()))?;
+        sim.set_eeprom(eeprom);
+        sim.watch_eeprom();
+        sim.probe_machine(machine);
+        let endstops = sim.fit_machine_endstops(&cfg, 3.0);
+        Ok::<_, String>((sim, endstops))
+    };
+    let (mut sim, mut endstops) = match power_on(&host::eeprom(
+        &cfg,
+        &Default::default(),
+        &Default::default(),
+    )) {
+        Ok(s) => s,
         Err(e) => {
-            let _ = ready.send(Err(format!("{}: {e}", elf.display())));
+            let _ = ready.send(Err(e));
             return;
         }
     };
-    let cfg = MachineConfig::defaults(machine);
-    let eeprom = host::eeprom(&cfg, &Default::default(), &Default::default());
-    sim.set_eeprom(&eeprom);
-    sim.probe_machine(machine);
-    let endstops = sim.fit_machine_endstops(&cfg, 3.0);
     let mut pty = match Pty::open(Some(link)) {
         Ok(p) => p,
         Err(e) => {
@@ -157,6 +192,9 @@ fn serve(
     let _ = ready.send(Ok(()));
     // Releases due: simulated second, pin.
     let mut releases: Vec<(f64, u8)> = Vec::new();
+    let mut cut_traces = Vec::new();
+    let mut seconds_before = 0.0;
+    let mut cuts = 0u32;
     let stop = loop {
         match inbox.try_recv() {
             Ok(Command::Press(b, hold)) => {
@@ -169,6 +207,33 @@ fn serve(
                     Err(e) => eprintln!("taut studio: simulator: the card image: {e}"),
                 }
                 let _ = std::fs::remove_dir_all(&dir);
+            }
+            Ok(Command::PowerCut(tx)) => {
+                let (eeprom, _) = sim.eeprom_after_cut(0xFF);
+                let card = sim.remove_sd();
+                if let Some(path) = &vcd {
+                    let cut = cut_trace(path, cuts as usize + 1);
+                    if let Err(e) = sim.write_vcd(&cut) {
+                        eprintln!("taut studio: simulator: {}: {e}", cut.display());
+                    }
+                    cut_traces.push(cut);
+                }
+                seconds_before += sim.time_s();
+                match power_on(&eeprom) {
+                    Ok((next, e)) => (sim, endstops) = (next, e),
+                    Err(e) => {
+                        let _ = tx.send(Err(e));
+                        break None;
+                    }
+                }
+                if let Some(card) = card {
+                    sim.insert_sd(card);
+                }
+                // Buttons held through the cut are let go.
+                releases.clear();
+                pty.board_replaced();
+                cuts += 1;
+                let _ = tx.send(Ok(cuts));
             }
             Ok(Command::Stop(tx)) => break Some(tx),
             Err(mpsc::TryRecvError::Empty) => {}
@@ -202,7 +267,8 @@ fn serve(
     };
     let ended = result.map(|()| Ended {
         origin: endstops.power_on_origin(&sim, &cfg),
-        seconds: sim.time_s(),
+        seconds: seconds_before + sim.time_s(),
+        cut_traces,
     });
     drop(pty);
     if let Some(tx) = stop {

@@ -13,7 +13,7 @@ use crate::send::Eta;
 use crate::stringart::card::{self, Spec};
 use crate::stringart::{self, picture};
 use crate::toolpath::{self, Toolpath};
-use crate::vectorize::{self, Mode};
+use crate::vectorize::{self, svgfile, Mode};
 use crate::{plot, preview, progress, template, text};
 use base64::Engine;
 use serde_json::{json, Value};
@@ -124,31 +124,36 @@ fn drawing(gcode: String, path: &Toolpath, machine: Machine) -> Value {
     })
 }
 
-/// Whether the bytes are an SVG document.
-fn is_svg(bytes: &[u8]) -> bool {
-    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(512)]).to_ascii_lowercase();
-    head.contains("<svg") || head.trim_start().starts_with("<?xml")
-}
-
 /// The modes `mode=` takes, as `taut vectorize --mode`.
 const MODES: &str = "edges, hatch, outline, centerline or auto";
 
-/// `POST /api/vectorize`: a picture to plotter G-code.
+/// `POST /api/vectorize`: a picture (PNG, JPEG) or an SVG drawing to
+/// plotter G-code. An SVG is drawn from its shapes at its own size unless
+/// `width_mm` scales its page; a picture needs `width_mm` (default 60).
 pub fn vectorize(bytes: &[u8], q: &Query) -> Result<Value, Bad> {
     if bytes.is_empty() {
         return Err(Bad::input("no picture: the body is empty".into()));
     }
-    if is_svg(bytes) {
-        return Err(Bad::input(
-            "an SVG is drawn from its paths, not vectorised here".into(),
-        ));
-    }
     let machine = q.plotter()?;
-    let mut width = q.number("width_mm", 60.0f64)?;
-    let mut note = None;
+    let source = match vectorize::is_svg(bytes) {
+        true => vectorize::Source::Svg(svgfile::read(bytes).map_err(Bad::input)?),
+        false => vectorize::Source::Picture(
+            Gray::decode(bytes).map_err(|e| Bad::input(format!("the picture: {e}")))?,
+        ),
+    };
+    let own = match &source {
+        vectorize::Source::Svg(d) => Some(d.size[0]),
+        vectorize::Source::Picture(_) => None,
+    };
+    let mut width = match (q.text("width_mm").filter(|w| !w.is_empty()), own) {
+        (None, Some(own)) => own,
+        _ => q.number("width_mm", 60.0f64)?,
+    };
+    let mut notes = Vec::new();
     if let Some(max) = width_max_mm(machine).filter(|&m| width > m) {
-        note = Some(format!(
-            "width {width} mm kept within the {}'s travel: {max} mm",
+        notes.push(format!(
+            "width {} mm kept within the {}'s travel: {max} mm",
+            (width * 10.0).round() / 10.0,
             machine.name()
         ));
         width = max;
@@ -176,18 +181,20 @@ pub fn vectorize(bytes: &[u8], q: &Query) -> Result<Value, Bad> {
     if q.text("min_length_mm").is_some_and(|t| !t.is_empty()) {
         o.min_length_mm = Some(q.number("min_length_mm", 0.0)?);
     }
+    o.one_pen = q.text("one_pen").is_some_and(|v| v == "1" || v == "true");
     o.layout.at = q.pair("at")?;
     o.feed = q.number("feed", o.feed)?;
-    let image = Gray::decode(bytes).map_err(|e| Bad::input(format!("the picture: {e}")))?;
-    let image = vectorize::Source::Picture(image);
     let title = format!("taut studio {}", q.text("name").unwrap_or("picture"));
-    let v = vectorize::vectorize(&image, &o, &title).map_err(Bad::input)?;
+    let v = vectorize::vectorize(&source, &o, &title).map_err(Bad::input)?;
+    notes.extend(v.warnings.iter().cloned());
     let mut out = drawing(v.gcode, &v.toolpath, machine);
     out["strokes"] = json!(v.strokes.len());
+    out["layers"] = json!(v.layers.len());
+    out["svg"] = json!(own.is_some());
     out["pen_up_traced_mm"] = json!(v.pen_up_traced_mm);
     out["width_mm"] = json!(width);
     out["width_max_mm"] = json!(width_max_mm(machine));
-    out["note"] = json!(note);
+    out["note"] = json!((!notes.is_empty()).then(|| notes.join("; ")));
     Ok(out)
 }
 
