@@ -432,7 +432,8 @@ impl JobTask {
                     }
                 }
                 Action::Log(Msg::BadBoard(BadBoard::Gap(nail))) => {
-                    info!(texts::msg(Msg::BadBoard(BadBoard::Gap(nail))), nail)
+                    let msg = texts::msg(Msg::BadBoard(BadBoard::Gap(nail)));
+                    info!(msg, nail, " too close: fewer nails or larger radius")
                 }
                 Action::Log(msg) => info!(texts::msg(msg)),
                 Action::Prompt(p) => info!(texts::prompt(p)),

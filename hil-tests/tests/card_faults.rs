@@ -124,8 +124,7 @@ fn a_board_too_dense_for_the_needle_says_why_and_where() {
     ]);
     let mut sim = boot_machine();
     sim.insert_sd(image);
-    let why = "bad board: nails too close for the needle to pass \
-               (fewer nails or a larger radius in param.txt), the first after nail 0";
+    let why = "bad board (param.txt): nail 0 too close: fewer nails or larger radius]";
     wait_for(&mut sim, why, Duration::from_secs(5));
     sim.run_for(Duration::from_secs(3));
     assert_eq!(count(&sim, "bad board"), 1, "said once");

@@ -189,19 +189,19 @@ pub enum Msg {
 impl Msg {
     pub const fn as_str(self) -> &'static str {
         match self {
+            // A log line holds ~74 characters of text.
             Msg::BadBoard(BadBoard::Shape) => {
-                "bad board: param.txt's shape must be 0 (a circle) or 3 and more (a polygon)"
+                "bad board (param.txt): shape must be 0 (circle) or 3+ (polygon)"
             }
-            Msg::BadBoard(BadBoard::Nails) => "bad board: param.txt must have 3 nails or more",
+            Msg::BadBoard(BadBoard::Nails) => "bad board (param.txt): 3 nails or more",
             Msg::BadBoard(BadBoard::Radius) => {
-                "bad board: param.txt's radius leaves no room for the nails: a larger radius"
+                "bad board (param.txt): radius too small for the nails"
             }
             Msg::BadBoard(BadBoard::Centre) => {
-                "bad board: winding would reach the centre past the needle's clearance: a larger radius (param.txt)"
+                "bad board (param.txt): radius too small for the needle"
             }
-            Msg::BadBoard(BadBoard::Gap(_)) => {
-                "bad board: nails too close for the needle to pass (fewer nails or a larger radius in param.txt), the first after nail "
-            }
+            // The nail's number and the rest follow (the firmware's log).
+            Msg::BadBoard(BadBoard::Gap(_)) => "bad board (param.txt): nail ",
             Msg::Loose(Axis::Base) => "base free",
             Msg::Loose(Axis::Radial) => "radial free",
             Msg::Loose(_) => "drill free",
