@@ -227,6 +227,21 @@ impl Run {
             path: None,
         }
     }
+
+    /// No actions, as [`Run::new`], written field by field: `*self =
+    /// Run::new()` built a whole `Run` (171 B) on the AVR's stack first,
+    /// in the frame under which every move is checked.
+    fn clear(&mut self) {
+        self.todo = 0;
+        self.pen = 0;
+        self.pen_z = 0;
+        self.dwell_ms = 0;
+        self.idle_delay_ms = 0;
+        self.legs = [[0; AXES]; 2];
+        self.from = [0; AXES];
+        self.feed = Feed::Rapid;
+        self.path = None;
+    }
 }
 
 /// A move cut into pieces: an arc's chords, or a straight move's pieces
@@ -405,7 +420,7 @@ impl Interpreter {
                 *p = at[i];
             }
         }
-        self.run = Run::new();
+        self.run.clear();
         self.dwell_until = None;
     }
 
@@ -439,7 +454,7 @@ impl Interpreter {
     /// The accepted line's motion was dropped (a jog cancel, a pulled
     /// card): its other actions too.
     pub fn drop_line(&mut self) {
-        self.run = Run::new();
+        self.run.clear();
         self.dwell_until = None;
     }
 
@@ -778,9 +793,7 @@ impl Interpreter {
         }
 
         // Step 4: the line is good. Its state, then its actions.
-        // Built in place: a copy would be ~170 B more of this frame, under
-        // which the arc's reach is checked.
-        self.run = Run::new();
+        self.run.clear();
         let pen_deg = |down: bool| {
             if down {
                 cfg.pen.down_deg
