@@ -601,9 +601,9 @@ impl Interpreter {
         }
         // [19] Coordinate data, offsets, and where the axis words go.
         let mut target = self.position;
-        let mut g10 = None;
-        let mut g92 = None;
-        let mut home = None;
+        // At most one of G10's data, G92's offset and G28/G30's position:
+        // one value, as each is ~25 B of a frame under every move's check.
+        let mut sets = Sets::Nothing;
         let tlo: Exact = [0, 0, self.tlo];
         match b.non_modal {
             NonModal::SetCoordData => {
@@ -631,10 +631,10 @@ impl Interpreter {
                     _ => [0; AXES],
                 };
                 let sign = if b.l == 20 { -1 } else { 1 };
-                g10 = Some((
+                sets = Sets::CoordData(
                     index,
                     pick(&io.coord(index), &sum(&base, &axes, sign), given),
-                ));
+                );
             }
             NonModal::SetCoordOffset => {
                 if given == 0 {
@@ -642,7 +642,7 @@ impl Interpreter {
                 }
                 // G92 = MPos - WCS - TLO - WPos.
                 let base = sum(&self.position, &sum(&block_coord, &tlo, 1), -1);
-                g92 = Some(pick(&self.coord_offset, &sum(&base, &axes, -1), given));
+                sets = Sets::Offset(pick(&self.coord_offset, &sum(&base, &axes, -1), given));
             }
             _ => {
                 if axis_command != AxisCommand::ToolLength {
@@ -667,7 +667,7 @@ impl Interpreter {
                             axis_command = AxisCommand::None;
                         }
                         let mask = if given == 0 { 0b111 } else { given };
-                        home = Some(pick(&self.position, &io.coord(index), mask));
+                        sets = Sets::Home(pick(&self.position, &io.coord(index), mask));
                     }
                     NonModal::AbsoluteOverride
                         if !matches!(m.motion, MotionMode::Seek | MotionMode::Linear) =>
@@ -771,25 +771,25 @@ impl Interpreter {
         let moving = axis_command == AxisCommand::Motion && m.motion != MotionMode::None;
         let mut legs = [self.position; 2];
         let mut count = 0;
-        if let Some(h) = home {
+        if let Sets::Home(h) = &sets {
             if axis_command != AxisCommand::None {
                 legs[0] = target;
                 count = 1;
             }
-            legs[count] = h;
+            legs[count] = *h;
             count += 1;
         } else if moving || jog {
             legs[0] = target;
             count = 1;
         }
-        let mut from = self.position;
+        let mut from = &self.position;
         for leg in &legs[..count] {
             if let Some(a) = &arc {
                 check_arc(a, motors, kin, cfg)?;
             } else {
-                check_leg(&from, leg, motors, kin, cfg)?;
+                check_leg(from, leg, motors, kin, cfg)?;
             }
-            from = *leg;
+            from = leg;
         }
 
         // Step 4: the line is good. Its state, then its actions.
@@ -857,10 +857,10 @@ impl Interpreter {
             }
             self.modal.distance = m.distance;
             // [19]
-            if let Some((index, data)) = g10 {
-                io.set_coord(index, &data);
-                if index == self.modal.coord {
-                    self.coord_system = data;
+            if let Sets::CoordData(index, data) = &sets {
+                io.set_coord(*index, data);
+                if *index == self.modal.coord {
+                    self.coord_system = *data;
                     self.wco_changed = true;
                 }
             }
@@ -873,8 +873,8 @@ impl Interpreter {
                 }
                 _ => {}
             }
-            if let Some(offset) = g92 {
-                self.coord_offset = offset;
+            if let Sets::Offset(offset) = &sets {
+                self.coord_offset = *offset;
                 self.wco_changed = true;
             }
             // [20]
@@ -882,8 +882,10 @@ impl Interpreter {
         }
         if count > 0 {
             if !jog {
-                self.run.feed = match (home.is_some() || m.motion == MotionMode::Seek, m.feed_mode)
-                {
+                self.run.feed = match (
+                    matches!(sets, Sets::Home(_)) || m.motion == MotionMode::Seek,
+                    m.feed_mode,
+                ) {
                     (true, _) => Feed::Rapid,
                     (false, FeedMode::PerMinute) => Feed::PerMinute(feed),
                     (false, FeedMode::InverseTime) => {
@@ -995,6 +997,17 @@ impl Interpreter {
         })?;
         Ok(Arc::new(&sweep, &circle))
     }
+}
+
+/// What a line's `[19]` sets or goes to besides its target.
+enum Sets {
+    Nothing,
+    /// `G10`: a work system's data (its index, the new data).
+    CoordData(u8, Exact),
+    /// `G92`: the coordinate offset.
+    Offset(Exact),
+    /// `G28`/`G30`: the stored position the line goes to.
+    Home(Exact),
 }
 
 /// An arc's figures besides its ends: by reference, as the AVR backend
