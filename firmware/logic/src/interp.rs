@@ -604,7 +604,6 @@ impl Interpreter {
         // At most one of G10's data, G92's offset and G28/G30's position:
         // one value, as each is ~25 B of a frame under every move's check.
         let mut sets = Sets::Nothing;
-        let tlo: Exact = [0, 0, self.tlo];
         match b.non_modal {
             NonModal::SetCoordData => {
                 if given == 0 {
@@ -627,7 +626,7 @@ impl Interpreter {
                 };
                 // L20: WCS = MPos - G92 - TLO - WPos; L2: the words.
                 let base = match b.l {
-                    20 => sum(&self.position, &sum(&self.coord_offset, &tlo, 1), -1),
+                    20 => sum(&self.position, &self.plus_tlo(&self.coord_offset), -1),
                     _ => [0; AXES],
                 };
                 let sign = if b.l == 20 { -1 } else { 1 };
@@ -641,7 +640,7 @@ impl Interpreter {
                     return Err(ErrorKind::NoAxisWords);
                 }
                 // G92 = MPos - WCS - TLO - WPos.
-                let base = sum(&self.position, &sum(&block_coord, &tlo, 1), -1);
+                let base = sum(&self.position, &self.plus_tlo(&block_coord), -1);
                 sets = Sets::Offset(pick(&self.coord_offset, &sum(&base, &axes, -1), given));
             }
             _ => {
@@ -649,7 +648,7 @@ impl Interpreter {
                     let from = match (b.non_modal, m.distance) {
                         (NonModal::AbsoluteOverride, _) => [0; AXES],
                         (_, Distance::Absolute) => {
-                            sum(&block_coord, &sum(&self.coord_offset, &tlo, 1), 1)
+                            sum(&block_coord, &self.plus_tlo(&self.coord_offset), 1)
                         }
                         (_, Distance::Relative) => self.position,
                     };
@@ -955,6 +954,16 @@ impl Interpreter {
     /// The work offset of channel `i`, millionths.
     fn work_offset(&self, i: usize) -> i64 {
         self.coord_system[i] + self.coord_offset[i] + if i == Z { self.tlo } else { 0 }
+    }
+
+    /// `offset` with the tool length offset on `Z`. A value of its own,
+    /// made where it is used: an `[0, 0, tlo]` kept for the sums was 24 B
+    /// more of [`Interpreter::accept`]'s frame.
+    #[inline(never)]
+    fn plus_tlo(&self, offset: &Exact) -> Exact {
+        let mut o = *offset;
+        o[Z] += self.tlo;
+        o
     }
 
     /// `M2`/`M30`: the modes LinuxCNC resets at a program's end (`gcode.c`
