@@ -216,6 +216,9 @@ fn arm(add: impl FnOnce(&mut Timers<Task, 8>, u32) -> bool) {
 #[avr_device::entry]
 fn main() -> ! {
     stack::paint();
+    // Before `init`: the cells' values are built on the stack (a console
+    // is ~480 B), not above `init`'s frame.
+    init_cells();
     let watchdog = init();
     dispatch::run(
         &SPAWNED,
@@ -243,7 +246,6 @@ fn main() -> ! {
 #[inline(never)]
 #[optimize(size)]
 fn init() -> Watchdog {
-    init_cells();
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
     let reset = ResetCause::take(&dp.CPU);
     let watchdog = Watchdog::start(dp.WDT);

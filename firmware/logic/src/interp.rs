@@ -227,6 +227,21 @@ impl Run {
             path: None,
         }
     }
+
+    /// No actions, as [`Run::new`], written field by field: `*self =
+    /// Run::new()` built a whole `Run` (171 B) on the AVR's stack first,
+    /// in the frame under which every move is checked.
+    fn clear(&mut self) {
+        self.todo = 0;
+        self.pen = 0;
+        self.pen_z = 0;
+        self.dwell_ms = 0;
+        self.idle_delay_ms = 0;
+        self.legs = [[0; AXES]; 2];
+        self.from = [0; AXES];
+        self.feed = Feed::Rapid;
+        self.path = None;
+    }
 }
 
 /// A move cut into pieces: an arc's chords, or a straight move's pieces
@@ -405,7 +420,7 @@ impl Interpreter {
                 *p = at[i];
             }
         }
-        self.run = Run::new();
+        self.run.clear();
         self.dwell_until = None;
     }
 
@@ -439,7 +454,7 @@ impl Interpreter {
     /// The accepted line's motion was dropped (a jog cancel, a pulled
     /// card): its other actions too.
     pub fn drop_line(&mut self) {
-        self.run = Run::new();
+        self.run.clear();
         self.dwell_until = None;
     }
 
@@ -586,10 +601,9 @@ impl Interpreter {
         }
         // [19] Coordinate data, offsets, and where the axis words go.
         let mut target = self.position;
-        let mut g10 = None;
-        let mut g92 = None;
-        let mut home = None;
-        let tlo: Exact = [0, 0, self.tlo];
+        // At most one of G10's data, G92's offset and G28/G30's position:
+        // one value, as each is ~25 B of a frame under every move's check.
+        let mut sets = Sets::Nothing;
         match b.non_modal {
             NonModal::SetCoordData => {
                 if given == 0 {
@@ -612,29 +626,29 @@ impl Interpreter {
                 };
                 // L20: WCS = MPos - G92 - TLO - WPos; L2: the words.
                 let base = match b.l {
-                    20 => sum(&self.position, &sum(&self.coord_offset, &tlo, 1), -1),
+                    20 => sum(&self.position, &self.plus_tlo(&self.coord_offset), -1),
                     _ => [0; AXES],
                 };
                 let sign = if b.l == 20 { -1 } else { 1 };
-                g10 = Some((
+                sets = Sets::CoordData(
                     index,
                     pick(&io.coord(index), &sum(&base, &axes, sign), given),
-                ));
+                );
             }
             NonModal::SetCoordOffset => {
                 if given == 0 {
                     return Err(ErrorKind::NoAxisWords);
                 }
                 // G92 = MPos - WCS - TLO - WPos.
-                let base = sum(&self.position, &sum(&block_coord, &tlo, 1), -1);
-                g92 = Some(pick(&self.coord_offset, &sum(&base, &axes, -1), given));
+                let base = sum(&self.position, &self.plus_tlo(&block_coord), -1);
+                sets = Sets::Offset(pick(&self.coord_offset, &sum(&base, &axes, -1), given));
             }
             _ => {
                 if axis_command != AxisCommand::ToolLength {
                     let from = match (b.non_modal, m.distance) {
                         (NonModal::AbsoluteOverride, _) => [0; AXES],
                         (_, Distance::Absolute) => {
-                            sum(&block_coord, &sum(&self.coord_offset, &tlo, 1), 1)
+                            sum(&block_coord, &self.plus_tlo(&self.coord_offset), 1)
                         }
                         (_, Distance::Relative) => self.position,
                     };
@@ -652,7 +666,7 @@ impl Interpreter {
                             axis_command = AxisCommand::None;
                         }
                         let mask = if given == 0 { 0b111 } else { given };
-                        home = Some(pick(&self.position, &io.coord(index), mask));
+                        sets = Sets::Home(pick(&self.position, &io.coord(index), mask));
                     }
                     NonModal::AbsoluteOverride
                         if !matches!(m.motion, MotionMode::Seek | MotionMode::Linear) =>
@@ -756,31 +770,29 @@ impl Interpreter {
         let moving = axis_command == AxisCommand::Motion && m.motion != MotionMode::None;
         let mut legs = [self.position; 2];
         let mut count = 0;
-        if let Some(h) = home {
+        if let Sets::Home(h) = &sets {
             if axis_command != AxisCommand::None {
                 legs[0] = target;
                 count = 1;
             }
-            legs[count] = h;
+            legs[count] = *h;
             count += 1;
         } else if moving || jog {
             legs[0] = target;
             count = 1;
         }
-        let mut from = self.position;
+        let mut from = &self.position;
         for leg in &legs[..count] {
             if let Some(a) = &arc {
                 check_arc(a, motors, kin, cfg)?;
             } else {
-                check_leg(&from, leg, motors, kin, cfg)?;
+                check_leg(from, leg, motors, kin, cfg)?;
             }
-            from = *leg;
+            from = leg;
         }
 
         // Step 4: the line is good. Its state, then its actions.
-        // Built in place: a copy would be ~170 B more of this frame, under
-        // which the arc's reach is checked.
-        self.run = Run::new();
+        self.run.clear();
         let pen_deg = |down: bool| {
             if down {
                 cfg.pen.down_deg
@@ -844,10 +856,10 @@ impl Interpreter {
             }
             self.modal.distance = m.distance;
             // [19]
-            if let Some((index, data)) = g10 {
-                io.set_coord(index, &data);
-                if index == self.modal.coord {
-                    self.coord_system = data;
+            if let Sets::CoordData(index, data) = &sets {
+                io.set_coord(*index, data);
+                if *index == self.modal.coord {
+                    self.coord_system = *data;
                     self.wco_changed = true;
                 }
             }
@@ -860,8 +872,8 @@ impl Interpreter {
                 }
                 _ => {}
             }
-            if let Some(offset) = g92 {
-                self.coord_offset = offset;
+            if let Sets::Offset(offset) = &sets {
+                self.coord_offset = *offset;
                 self.wco_changed = true;
             }
             // [20]
@@ -869,8 +881,10 @@ impl Interpreter {
         }
         if count > 0 {
             if !jog {
-                self.run.feed = match (home.is_some() || m.motion == MotionMode::Seek, m.feed_mode)
-                {
+                self.run.feed = match (
+                    matches!(sets, Sets::Home(_)) || m.motion == MotionMode::Seek,
+                    m.feed_mode,
+                ) {
                     (true, _) => Feed::Rapid,
                     (false, FeedMode::PerMinute) => Feed::PerMinute(feed),
                     (false, FeedMode::InverseTime) => {
@@ -942,6 +956,16 @@ impl Interpreter {
         self.coord_system[i] + self.coord_offset[i] + if i == Z { self.tlo } else { 0 }
     }
 
+    /// `offset` with the tool length offset on `Z`. A value of its own,
+    /// made where it is used: an `[0, 0, tlo]` kept for the sums was 24 B
+    /// more of [`Interpreter::accept`]'s frame.
+    #[inline(never)]
+    fn plus_tlo(&self, offset: &Exact) -> Exact {
+        let mut o = *offset;
+        o[Z] += self.tlo;
+        o
+    }
+
     /// `M2`/`M30`: the modes LinuxCNC resets at a program's end (`gcode.c`
     /// line 1077): `G1 G17 G90 G94 G54 M5 M9`; `F`, `S`, units and
     /// offsets stay.
@@ -982,6 +1006,17 @@ impl Interpreter {
         })?;
         Ok(Arc::new(&sweep, &circle))
     }
+}
+
+/// What a line's `[19]` sets or goes to besides its target.
+enum Sets {
+    Nothing,
+    /// `G10`: a work system's data (its index, the new data).
+    CoordData(u8, Exact),
+    /// `G92`: the coordinate offset.
+    Offset(Exact),
+    /// `G28`/`G30`: the stored position the line goes to.
+    Home(Exact),
 }
 
 /// An arc's figures besides its ends: by reference, as the AVR backend

@@ -120,19 +120,13 @@ impl Interpreter {
         env: &Env<K>,
         io: &mut impl MachineIo,
     ) -> Option<Wait> {
-        let to = self.run.legs[second as usize];
-        let motors = motor_channels(env.cfg);
         if !env.kin.is_linear() {
-            let from = motor_milli(&self.run.from, motors);
-            let end = motor_milli(&to, motors);
-            let line = Segmenter::new(env.kin, from, &end, env.kin.piece_um());
-            self.run.path = Some(Path::Line(line));
-            self.run.from = to;
-            let bit = if second { todo::LEG_1 } else { todo::LEG_0 };
-            self.run.todo = self.run.todo & !bit | todo::PATH;
+            self.line_path(second, env);
             // Its pieces next, from this same call.
             return self.piece(env, io);
         }
+        let to = self.run.legs[second as usize];
+        let motors = motor_channels(env.cfg);
         if let Some(wait) = io.room(false) {
             return Some(wait);
         }
@@ -143,6 +137,22 @@ impl Interpreter {
         }
         self.run.from = to;
         None
+    }
+
+    /// A straight leg as a path of pieces: the leg's bit off, the path's
+    /// on. Out of line: the path is built in this frame (~160 B), not in
+    /// the one under which its pieces are worked out.
+    #[inline(never)]
+    fn line_path<K: Kinematics>(&mut self, second: bool, env: &Env<K>) {
+        let to = self.run.legs[second as usize];
+        let motors = motor_channels(env.cfg);
+        let from = motor_milli(&self.run.from, motors);
+        let end = motor_milli(&to, motors);
+        let line = Segmenter::new(env.kin, from, &end, env.kin.piece_um());
+        self.run.path = Some(Path::Line(line));
+        self.run.from = to;
+        let bit = if second { todo::LEG_1 } else { todo::LEG_0 };
+        self.run.todo = self.run.todo & !bit | todo::PATH;
     }
 
     /// The path's next piece; `None` once its last is queued. On a

@@ -726,3 +726,16 @@ fn the_whiteboards_straight_moves_are_the_pens_pieces() {
     assert_eq!(pieces[49].0.to[..2], [Milli(-200_000), Milli(150_000)]);
     assert!(pieces.iter().all(|(p, _)| p.start == [Milli(0); 3]));
 }
+
+#[test]
+fn a_cleared_run_is_a_new_one() {
+    let mut run = Run::new();
+    run.todo = todo::LEG_0 | todo::PEN;
+    run.pen = 30;
+    run.dwell_ms = 5;
+    run.legs = [[1; AXES]; 2];
+    run.from = [2; AXES];
+    run.feed = Feed::PerMinute(Milli(1000));
+    run.clear();
+    assert_eq!(run, Run::new());
+}
