@@ -16,6 +16,7 @@
 
 mod homing;
 mod offsets;
+mod seed;
 mod system;
 
 use crate::flash_str;
@@ -455,7 +456,6 @@ impl Console {
         // The next line's words are the machine's (`$machine=` may change them).
         self.parser.set_axis_letters(axis_letters(&kin.words()));
         let first = self.parser.first_char();
-        let card = self.source == Some(Source::Card);
         let jog_state = self.jogging && !m.is_idle();
         let line = self.parser.take_line();
         // A `$N0=` line must be G-code.
@@ -472,10 +472,9 @@ impl Console {
             // Empty or comment only: for syncing, `ok`.
             _ if first == 0 => self.ok(),
             Ok(Input::System(ref s)) => self.system(s, m, cfg, owner, store),
-            Ok(Input::Jog(b))
+            Ok(Input::Jog(_))
                 if self.checking || !m.position_known() || !(m.is_idle() || jog_state) =>
             {
-                let _ = b;
                 self.error(&Error::new(ErrorKind::NotIdle, 0))
             }
             Ok(Input::Jog(_)) if self.printing_from_serial() => {
@@ -490,7 +489,7 @@ impl Console {
             Err(e) if first == b'$' => self.error(&e),
             // A program's `%` delimiters in a file: passed over (Grbl
             // answers a sender error 1).
-            _ if card && first == b'%' => {}
+            _ if first == b'%' && self.source == Some(Source::Card) => {}
             Ok(Input::Card(c)) => self.card_line(c, m, cfg),
             // Grbl's G-code lock: in alarm (the position lost) or while
             // jogs run; `M114` only reads.
@@ -498,6 +497,7 @@ impl Console {
                 self.error(&Error::new(ErrorKind::Locked, 0))
             }
             Err(e) => self.error(&e),
+            Ok(Input::Seed(s)) => self.seed(s, m, kin, cfg, owner, store),
             // While a print runs, the serial line may only look.
             Ok(Input::Block(_)) if self.printing_from_serial() => {
                 self.error(&Error::new(ErrorKind::Printing, 0))
