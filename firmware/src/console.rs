@@ -198,7 +198,7 @@ impl Console {
         self.startup = system::STARTUP;
         self.storing = false;
         self.saving = false;
-        RX.clear();
+        crate::board::usart::clear_input();
     }
 
     /// The work coordinates for the status report.
@@ -566,7 +566,7 @@ impl Console {
         }
         let byte = match self.source {
             Some(Source::Card) => self.print.next_byte(),
-            _ => RX.pop(),
+            _ => crate::board::usart::receive(),
         };
         if byte.is_none() {
             self.print.finished();
