@@ -20,7 +20,8 @@ use taut_logic::seed::SeedMove;
 const SEED_FULL: usize = 64;
 
 impl Console {
-    /// A seed line: malformed, `?` and nothing moves (the seed's answer);
+    /// A seed line: malformed, `?` and nothing moves (the seed's answer),
+    /// then `error:1`;
     /// refused as a G-code move would be (a print running from the
     /// serial line, a job, the soft limits, the reach), that error;
     /// else `ok` once queued, as every line here. Then `K` if the input
@@ -36,10 +37,15 @@ impl Console {
         store: &mut Store,
     ) {
         match mv {
-            None if self.source == Some(super::Source::Card) => {
+            // The seed's `?`, then Grbl's answer to a line with no
+            // command letter: a sender that counts characters gets its
+            // line's answer.
+            None => {
+                if self.source != Some(super::Source::Card) {
+                    send(b'?');
+                }
                 self.error(&Error::new(ErrorKind::ExpectedCommandLetter, 1))
             }
-            None => send(b'?'),
             Some(_) if self.printing_from_serial() => {
                 self.error(&Error::new(ErrorKind::Printing, 0))
             }
