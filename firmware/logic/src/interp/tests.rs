@@ -86,6 +86,18 @@ impl MachineIo for Recorder {
     }
 }
 
+/// The executor's view in check mode (`$C`).
+fn checking<'a>(kin: &'a AnyKinematics, cfg: &'a MachineConfig) -> Env<'a, AnyKinematics> {
+    Env {
+        kin,
+        cfg,
+        allowed: Allowed {
+            motion: true,
+            checking: true,
+        },
+    }
+}
+
 /// A machine with its executor.
 struct Bench {
     interp: Interpreter,
@@ -552,14 +564,7 @@ fn drivers_on_off_and_their_idle_delay() {
         Some(Ok(Input::Block(block))) => block,
         other => panic!("{other:?}"),
     };
-    let env = Env {
-        kin: &b.kin,
-        cfg: &b.cfg,
-        allowed: Allowed {
-            motion: true,
-            checking: true,
-        },
-    };
+    let env = checking(&b.kin, &b.cfg);
     b.io.did.clear();
     b.interp.accept(&block, false, &env, &mut b.io).unwrap();
     assert_eq!(b.interp.run(&env, &mut b.io), Progress::Done);
@@ -785,14 +790,7 @@ fn a_seed_line_is_refused_past_the_soft_limits_or_the_reach() {
 #[test]
 fn a_seed_line_in_check_mode_moves_nothing() {
     let mut b = Bench::new(Machine::Whiteboard);
-    let env = Env {
-        kin: &b.kin,
-        cfg: &b.cfg,
-        allowed: Allowed {
-            motion: true,
-            checking: true,
-        },
-    };
+    let env = checking(&b.kin, &b.cfg);
     let mv = crate::seed::parse(b"+0615-0950n").unwrap();
     b.interp.accept_steps(&mv, &env, &mut b.io).unwrap();
     assert_eq!(b.interp.run(&env, &mut b.io), Progress::Done);
