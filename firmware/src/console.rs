@@ -15,6 +15,7 @@
 
 mod homing;
 mod offsets;
+mod seed;
 mod system;
 
 use crate::flash_str;
@@ -196,7 +197,7 @@ impl Console {
         self.startup = system::STARTUP;
         self.storing = false;
         self.saving = false;
-        RX.clear();
+        crate::board::usart::clear_input();
     }
 
     /// The work coordinates for the status report.
@@ -454,7 +455,6 @@ impl Console {
         // The next line's words are the machine's (`$machine=` may change them).
         self.parser.set_axis_letters(axis_letters(&kin.words()));
         let first = self.parser.first_char();
-        let card = self.source == Some(Source::Card);
         let jog_state = self.jogging && !m.is_idle();
         let line = self.parser.take_line();
         // A `$N0=` line must be G-code.
@@ -471,10 +471,9 @@ impl Console {
             // Empty or comment only: for syncing, `ok`.
             _ if first == 0 => self.ok(),
             Ok(Input::System(ref s)) => self.system(s, m, cfg, owner, store),
-            Ok(Input::Jog(b))
+            Ok(Input::Jog(_))
                 if self.checking || !m.position_known() || !(m.is_idle() || jog_state) =>
             {
-                let _ = b;
                 self.error(&Error::new(ErrorKind::NotIdle, 0))
             }
             Ok(Input::Jog(_)) if self.printing_from_serial() => {
@@ -489,7 +488,7 @@ impl Console {
             Err(e) if first == b'$' => self.error(&e),
             // A program's `%` delimiters in a file: passed over (Grbl
             // answers a sender error 1).
-            _ if card && first == b'%' => {}
+            _ if first == b'%' && self.source == Some(Source::Card) => {}
             Ok(Input::Card(c)) => self.card_line(c, m, cfg),
             // Grbl's G-code lock: in alarm (the position lost) or while
             // jogs run; `M114` only reads.
@@ -497,6 +496,7 @@ impl Console {
                 self.error(&Error::new(ErrorKind::Locked, 0))
             }
             Err(e) => self.error(&e),
+            Ok(Input::Seed(s)) => self.seed(s, m, kin, cfg, owner, store),
             // While a print runs, the serial line may only look: `M114`
             // is answered at once, beside the print's own line.
             Ok(Input::Block(_)) if self.printing_from_serial() && reads => {
@@ -571,7 +571,7 @@ impl Console {
         }
         let byte = match self.source {
             Some(Source::Card) => self.print.next_byte(),
-            _ => RX.pop(),
+            _ => crate::board::usart::receive(),
         };
         if byte.is_none() {
             self.print.finished();

@@ -49,6 +49,10 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
         None
     }
 
+    fn steps(&self) -> Steps {
+        self.m.target()
+    }
+
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
         self.m.stage(*steps, feed).is_ok()
     }

@@ -377,6 +377,8 @@ fn load_store(eeprom: Eeprom) -> (bool, Found) {
     STORE.with(|s| {
         let store = s.as_mut().unwrap();
         let store_now = CONFIG.with(|c| store.load(c));
+        usart::set_xonxoff(store.extras().xonxoff());
+        usart::release_sender();
         (store_now, store.load_checkpoint())
     })
 }

@@ -1,8 +1,9 @@
 //! Arbitrary bytes into the G-code parser and the executor: neither may
 //! panic (overflow checks are on) or loop; every line end (`\n`, `\r`,
 //! `\r\n`) is answered exactly once; an error has a message; every block
-//! is carried out against a machine that takes anything, to its end;
-//! and a good line parses after any input.
+//! is carried out against a machine that takes anything, to its end; a
+//! seed-003 raw-step line reads back from its own text and is carried
+//! out too; and a good line parses after any input.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -18,6 +19,7 @@ use taut_logic::planner::Feed;
 struct Yes {
     coords: CoordData,
     clock: u32,
+    steps: Steps,
 }
 
 impl MachineIo for Yes {
@@ -30,7 +32,11 @@ impl MachineIo for Yes {
     fn room(&mut self, _piece: bool) -> Option<Wait> {
         None
     }
-    fn queue(&mut self, _steps: &Steps, _feed: Feed) -> bool {
+    fn steps(&self) -> Steps {
+        self.steps
+    }
+    fn queue(&mut self, steps: &Steps, _feed: Feed) -> bool {
+        self.steps = *steps;
         true
     }
     fn idle(&mut self) -> bool {
@@ -66,6 +72,7 @@ fuzz_target!(|data: &[u8]| {
     let mut io = Yes {
         coords: CoordData::ZERO,
         clock: 0,
+        steps: [0; 3],
     };
     let mut interp = Interpreter::new();
     let mut parser = Parser::new();
@@ -88,21 +95,21 @@ fuzz_target!(|data: &[u8]| {
                     }
                     Ok(Input::Block(block)) => (block, false),
                     Ok(Input::Jog(block)) => (block, true),
+                    Ok(Input::Seed(Some(mv))) => {
+                        let mut again = Parser::new();
+                        let text = mv.text();
+                        let back = text.iter().chain(b"\n").find_map(|&b| again.push(b));
+                        assert_eq!(back, Some(Ok(Input::Seed(Some(mv)))));
+                        let accepted = interp.accept_steps(&mv, &env, &mut io).is_ok();
+                        run_out(accepted, &mut interp, &env, &mut io);
+                        continue;
+                    }
                     Ok(_) => continue,
                 }
             }
         };
-        if interp.accept(&block, jog, &env, &mut io).is_ok() {
-            // Every action ends: a path has a bounded number of pieces.
-            for _ in 0..1_000_000 {
-                match interp.run(&env, &mut io) {
-                    Progress::Done => break,
-                    Progress::Wait(Wait::Ms(ms)) => io.clock = io.clock.wrapping_add(ms.into()),
-                    Progress::Wait(_) => {}
-                }
-            }
-            interp.drop_line();
-        }
+        let accepted = interp.accept(&block, jog, &env, &mut io).is_ok();
+        run_out(accepted, &mut interp, &env, &mut io);
     }
     let mut last = None;
     for &b in b"\rM400\n" {
@@ -115,3 +122,19 @@ fuzz_target!(|data: &[u8]| {
         other => panic!("no clean line after the input: {other:?}"),
     }
 });
+
+/// An accepted line's actions carried out to their end.
+fn run_out(accepted: bool, interp: &mut Interpreter, env: &Env<AnyKinematics>, io: &mut Yes) {
+    if !accepted {
+        return;
+    }
+    // Every action ends: a path has a bounded number of pieces.
+    for _ in 0..1_000_000 {
+        match interp.run(env, io) {
+            Progress::Done => break,
+            Progress::Wait(Wait::Ms(ms)) => io.clock = io.clock.wrapping_add(ms.into()),
+            Progress::Wait(_) => {}
+        }
+    }
+    interp.drop_line();
+}

@@ -154,6 +154,11 @@ pub(crate) unsafe extern "C" fn on_pin(_irq: *mut avr_irq_t, value: u32, param: 
 /// `param` is the `Shared` of the simulation (module invariants).
 pub(crate) unsafe extern "C" fn on_uart_tx(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
     let shared = &mut *(param as *mut Shared);
+    match value as u8 {
+        crate::serial::XOFF => shared.uart.xoff = true,
+        crate::serial::XON => shared.uart.xoff = false,
+        _ => {}
+    }
     shared.uart.tx.push(value as u8);
     shared.events += 1;
     shared.end_batch();
@@ -163,6 +168,10 @@ pub(crate) unsafe extern "C" fn on_uart_tx(_irq: *mut avr_irq_t, value: u32, par
 /// As `on_uart_tx`.
 pub(crate) unsafe extern "C" fn on_uart_xon(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
     let shared = &mut *(param as *mut Shared);
+    if value != 0 {
+        // Raised when the FIFO was read empty.
+        shared.uart.in_fifo = 0;
+    }
     if value != 0 && !shared.uart.rx_ready {
         shared.uart.rx_ready = true;
         shared.events += 1;

@@ -232,8 +232,15 @@ impl Pty {
         Ok(outcome)
     }
 
-    /// What the client wrote, queued for the UART: how many bytes.
+    /// What the client wrote, queued for the UART: how many bytes. The
+    /// line honours XON/XOFF while the client's terminal has `IXON` on.
     fn take_input(&mut self, sim: &mut Sim) -> io::Result<usize> {
+        // SAFETY: a termios filled by the call, on a descriptor this Pty owns.
+        let ixon = unsafe {
+            let mut tio: libc::termios = std::mem::zeroed();
+            libc::tcgetattr(self._slave.as_raw_fd(), &mut tio) == 0 && tio.c_iflag & libc::IXON != 0
+        };
+        sim.set_uart_xonxoff(ixon);
         let mut buf = [0u8; 256];
         let mut got = 0;
         loop {

@@ -145,11 +145,16 @@ impl Sim {
         let mut next = self.schedule.next_due().unwrap_or(u64::MAX);
         next = next.min(card_due).min(bytes_due);
         let uart = &self.shared().uart;
-        if uart.rx_ready && !uart.rx.is_empty() {
+        if uart.rx_ready && !uart.rx.is_empty() && uart.flowing() {
             if now >= uart.next_rx_cycle {
                 let uart = &mut self.shared_mut().uart;
                 let byte = uart.rx.pop_front().unwrap_or_default();
                 uart.next_rx_cycle = now + CYCLES_PER_BYTE;
+                uart.in_fifo += 1;
+                if uart.in_fifo >= crate::serial::FIFO_BYTES {
+                    // The next waits for the firmware to read these.
+                    uart.rx_ready = false;
+                }
                 self.raise_uart_rx(byte);
             }
             next = next.min(self.shared().uart.next_rx_cycle);

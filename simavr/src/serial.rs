@@ -19,10 +19,40 @@ pub(crate) struct SerialLine {
     /// simavr's receive FIFO has room and the receiver is on (XON seen, no
     /// XOFF since): bytes raised now are not lost.
     pub rx_ready: bool,
+    /// Bytes raised into simavr's receive FIFO since it was last empty: at
+    /// most [`FIFO_BYTES`], the AVR's own receive buffer. simavr's FIFO
+    /// (64 bytes) is drained at 11 bits a byte (it counts a parity bit
+    /// that 8N1 has not), slower than the line's 10: left to fill, it
+    /// would hold bytes a real line never holds, which a flow control
+    /// stop (XOFF) could not hold back.
+    pub in_fifo: u8,
     /// Earliest cycle the next byte may start, one byte time after the last.
     pub next_rx_cycle: u64,
     /// Bytes planned for later cycles, earliest first.
     planned: Vec<(u64, Vec<u8>)>,
+    /// The host side honours XON/XOFF (software flow control: a tty with
+    /// `IXON` behind a USB-serial chip that stops at once, as an FTDI
+    /// does once its driver is told): after an XOFF from the firmware no
+    /// byte starts until an XON.
+    pub honour_xoff: bool,
+    /// The firmware's last flow byte was XOFF.
+    pub xoff: bool,
+}
+
+/// Bytes of simavr's receive FIFO in use at most: UDR and the byte
+/// behind it, as an ATmega's USART holds.
+pub const FIFO_BYTES: u8 = 2;
+
+/// Software flow control's bytes (DC1, DC3).
+pub const XON: u8 = 0x11;
+pub const XOFF: u8 = 0x13;
+
+impl SerialLine {
+    /// Whether a byte for the firmware may start now: the host is not
+    /// paused by an XOFF it honours.
+    pub fn flowing(&self) -> bool {
+        !(self.honour_xoff && self.xoff)
+    }
 }
 
 impl SerialLine {

@@ -43,6 +43,12 @@ impl Sim {
         self.shared_mut().uart.plan(cycles_in(at), bytes);
     }
 
+    /// Whether the host side honours the firmware's XOFF and XON (a tty
+    /// with `IXON`): bytes waiting to be sent then wait while it is off.
+    pub fn set_uart_xonxoff(&mut self, on: bool) {
+        self.shared_mut().uart.honour_xoff = on;
+    }
+
     /// Bytes queued by `uart_send` (or planned and due) not yet delivered.
     pub fn uart_pending(&self) -> usize {
         self.shared().uart.rx.len()

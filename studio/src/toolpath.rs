@@ -71,6 +71,8 @@ struct Drawing<'a> {
     coords: CoordData,
     path: Toolpath,
     at: [f64; 2],
+    /// Where the moves queued end, in steps (a seed-003 line counts from it).
+    steps: Steps,
     down: bool,
 }
 
@@ -84,7 +86,11 @@ impl MachineIo for Drawing<'_> {
     fn room(&mut self, _piece: bool) -> Option<Wait> {
         None
     }
+    fn steps(&self) -> Steps {
+        self.steps
+    }
     fn queue(&mut self, steps: &Steps, _feed: Feed) -> bool {
+        self.steps = *steps;
         let p = self.kin.forward(steps);
         let to = [f64::from(p[0].0) / 1000.0, f64::from(p[1].0) / 1000.0];
         self.path.push(self.at, to, self.down);
@@ -127,6 +133,7 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
         coords: CoordData::ZERO,
         path: Toolpath::default(),
         at: [0.0; 2],
+        steps: Default::default(),
         down: false,
     };
     let mut line_no = 1;
@@ -150,6 +157,15 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
             }
             // A program's `%` delimiters, as a card print passes them over.
             Err(_) if first == b'%' => continue,
+            // Seed 003's raw-step line.
+            Ok(Input::Seed(Some(mv))) => {
+                interp
+                    .accept_steps(&mv, &env, &mut io)
+                    .map_err(|e| fail(e as u8, e.message()))?;
+                while interp.run(&env, &mut io) != Progress::Done {}
+                continue;
+            }
+            Ok(Input::Seed(None)) => return Err(format!("line {here}: ? (not a seed-003 line)")),
             Ok(_) => return Err(format!("line {here}: a $ or card command is not a drawing")),
             Err(e) => return Err(fail(e.code(), e.message())),
         };

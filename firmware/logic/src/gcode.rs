@@ -25,7 +25,8 @@
 //!   ([`crate::interp`]).
 //! - `*<0..=255>` is Marlin's checksum, the XOR of every byte before it;
 //!   after it only spaces and a `;` comment may follow.
-//! - A line whose first character is `$` is a [`SystemLine`]; `$J=` a jog.
+//! - A line whose first character is `$` is a [`SystemLine`]; `$J=` a jog;
+//!   `+` or `-`, seed 003's raw-step line ([`crate::seed`]).
 //! - `?`, `!`, `~` and Ctrl-X are [`Realtime`] wherever they appear.
 //!
 //! Errors carry Grbl's numbers (see [`ErrorKind`]) and, where the parser

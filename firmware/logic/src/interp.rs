@@ -20,6 +20,7 @@
 
 pub mod coords;
 pub mod estimate;
+mod raw;
 mod run;
 mod state;
 
@@ -97,6 +98,8 @@ pub trait MachineIo {
     /// Whether a move may be queued now (`piece`: one piece of a path):
     /// `None`, or what to wait for.
     fn room(&mut self, piece: bool) -> Option<Wait>;
+    /// Where the moves queued end, in motor steps.
+    fn steps(&self) -> Steps;
     /// Queue a move to the absolute motor `steps`; false when the planner
     /// is full.
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool;
@@ -245,11 +248,13 @@ impl Run {
 }
 
 /// A move cut into pieces: an arc's chords, or a straight move's pieces
-/// on a machine whose kinematics are not linear.
+/// on a machine whose kinematics are not linear; or a raw move to these
+/// motor steps, one piece.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Path {
     Arc(Arc),
     Line(Segmenter),
+    Steps(Steps),
 }
 
 impl Iterator for Path {
@@ -260,6 +265,7 @@ impl Iterator for Path {
         match self {
             Path::Arc(arc) => arc.next(),
             Path::Line(line) => line.next(),
+            Path::Steps(_) => None,
         }
     }
 }
@@ -275,6 +281,7 @@ impl Path {
         let start = match self {
             Path::Arc(arc) => arc.start(),
             Path::Line(line) => line.start(),
+            Path::Steps(_) => return None,
         };
         let to = motor_only(&self.next()?, motors);
         Some(kin.inverse_fine(&to).map(|(steps, frac)| Piece {

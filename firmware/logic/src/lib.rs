@@ -41,6 +41,7 @@ pub mod pinmap;
 pub mod planner;
 pub mod prep;
 pub mod sched;
+pub mod seed;
 pub mod segment;
 pub mod settings;
 pub mod stringart;

@@ -295,18 +295,27 @@ pub fn for_each(cfg: &MachineConfig, mut f: impl FnMut(Setting, Value)) {
     }
 }
 
-/// Line `index` of `$$`: Grbl's numbered settings, then ours by name.
+/// Line `index` of `$$`: Grbl's numbered settings, then ours by name,
+/// the console's `$flow` last.
 pub fn listed(index: usize, cfg: &MachineConfig, ex: &grbl::Extras) -> Option<Listed> {
     Some(match index.checked_sub(grbl::COUNT) {
         None => {
             let n = grbl::Numbered::at(index)?;
             Listed(Key::Number(n.number()), n.get(cfg, ex))
         }
+        Some(COUNT) => Listed(Key::Flow, Value::Number(ex.xonxoff() as u32)),
         Some(i) => {
             let s = Setting::at(i)?;
             Listed(Key::Named(Named(s, cfg.machine)), s.get(cfg))
         }
     })
+}
+
+/// Whether `key` is `$flow`'s (any case): the console's flow control,
+/// kept with Grbl's extras ([`grbl::Extras::set_flow`]), the same on
+/// every machine.
+pub fn is_flow(key: &[u8]) -> bool {
+    text!("flow").eq_ignore_ascii_case(key)
 }
 
 /// A line of `$$`: `$110=3750.000`, `$radial_max_rate=2000`.
@@ -315,6 +324,8 @@ pub struct Listed(Key, Value);
 enum Key {
     Number(u8),
     Named(Named),
+    /// `$flow=xonxoff` (value 1) or `$flow=off`.
+    Flow,
 }
 
 impl uDisplay for Listed {
@@ -322,6 +333,10 @@ impl uDisplay for Listed {
         match &self.0 {
             Key::Number(n) => uwrite!(f, "${}={}", n, self.1),
             Key::Named(name) => uwrite!(f, "${}={}", name, self.1),
+            Key::Flow => match self.1 {
+                Value::Number(0) => text!("$flow=off").fmt(f),
+                _ => text!("$flow=xonxoff").fmt(f),
+            },
         }
     }
 }

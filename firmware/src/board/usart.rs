@@ -1,7 +1,9 @@
 //! USART0, the serial console: 115200 8N1. Transmit goes through the `TX`
 //! ring drained by the data-register-empty interrupt, so writing never waits
 //! for the wire; received bytes go into the `RX` ring, filled by the receive
-//! interrupt (`queues`).
+//! interrupt (`queues`). With `$flow=xonxoff` the receive side sends XOFF
+//! when `RX` holds [`XOFF_AT`] bytes and XON once it is down to
+//! [`XON_AT`], each ahead of the bytes waiting in `TX`.
 
 use crate::queues::{RX, TX};
 use avr_device::atmega2560::USART0;
@@ -39,6 +41,94 @@ pub fn send(bytes: &[u8]) -> bool {
         wake();
     }
     ok
+}
+
+/// XON/XOFF flow control (`$flow=xonxoff`): the [`FLOW_ON`],
+/// [`FLOW_STOPPED`] and [`FLOW_DUE`] bits.
+static FLOW: AtomicU8 = AtomicU8::new(0);
+/// Flow control is on.
+const FLOW_ON: u8 = 1;
+/// XOFF is sent or due: the sender is to pause.
+const FLOW_STOPPED: u8 = 2;
+/// The byte of the state (XOFF when stopped, else XON) goes out next,
+/// ahead of `TX`'s.
+const FLOW_DUE: u8 = 4;
+pub const XON: u8 = 0x11;
+pub const XOFF: u8 = 0x13;
+/// `RX` bytes at which XOFF goes out: the 32 still free take the bytes
+/// already on the wire (2.8 ms at 115200 baud: the byte being sent
+/// before the XOFF, the XOFF itself, the sender's reaction).
+pub const XOFF_AT: usize = 96;
+/// `RX` bytes at which XON goes out again (Grbl 0.8's figures, 96 and
+/// 64 of 128).
+pub const XON_AT: usize = 64;
+
+/// `$flow`: XON/XOFF on or off; switched off while the sender is
+/// paused, XON releases it.
+pub fn set_xonxoff(on: bool) {
+    avr_device::interrupt::free(|_| {
+        let f = FLOW.load(Relaxed);
+        let f = match on {
+            true => f | FLOW_ON,
+            false if f & FLOW_STOPPED != 0 => FLOW_DUE,
+            false => f & FLOW_DUE,
+        };
+        FLOW.store(f, Relaxed);
+    });
+    wake();
+}
+
+/// At power-on with flow control on: XON, which lets a sender go on
+/// that the board paused before it was reset.
+pub fn release_sender() {
+    if FLOW.load(Relaxed) & FLOW_ON != 0 {
+        FLOW.store(FLOW_ON | FLOW_DUE, Relaxed);
+        wake();
+    }
+}
+
+/// Pause the sender (`stop`) or let it go on, if flow control is on and
+/// it is not so already.
+fn flow_to(stop: bool) {
+    let changed = avr_device::interrupt::free(|_| {
+        let f = FLOW.load(Relaxed);
+        if f & FLOW_ON == 0 || (f & FLOW_STOPPED != 0) == stop {
+            return false;
+        }
+        let stopped = if stop { FLOW_STOPPED } else { 0 };
+        FLOW.store(f & !FLOW_STOPPED | stopped | FLOW_DUE, Relaxed);
+        true
+    });
+    if changed {
+        wake();
+    }
+}
+
+/// The next received byte for the console; XON once `RX` has room again.
+pub fn receive() -> Option<u8> {
+    let b = RX.pop();
+    if FLOW.load(Relaxed) & FLOW_STOPPED != 0 && RX.len() <= XON_AT {
+        flow_to(false);
+    }
+    b
+}
+
+/// Ctrl-X: the bytes not yet read are dropped; a paused sender goes on.
+pub fn clear_input() {
+    RX.clear();
+    flow_to(false);
+}
+
+/// The flow byte due, taken.
+fn flow_byte() -> Option<u8> {
+    avr_device::interrupt::free(|_| {
+        let f = FLOW.load(Relaxed);
+        if f & FLOW_DUE == 0 {
+            return None;
+        }
+        FLOW.store(f & !FLOW_DUE, Relaxed);
+        Some(if f & FLOW_STOPPED != 0 { XOFF } else { XON })
+    })
 }
 
 /// Data-register-empty interrupt on: it drains the ring and turns itself
@@ -89,10 +179,10 @@ pub const UDRIE0: u8 = 5;
 /// The `USART0_UDRE` handler, entered with its interrupt switched off:
 /// send one byte, and switch it back on while more are waiting.
 pub fn on_data_register_empty() {
-    if let Some(b) = TX.pop() {
+    if let Some(b) = flow_byte().or_else(|| TX.pop()) {
         // SAFETY: UDR0 takes any byte.
         regs().udr0().write(|w| unsafe { w.bits(b) });
-        if !TX.is_empty() {
+        if !TX.is_empty() || FLOW.load(Relaxed) & FLOW_DUE != 0 {
             avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.udrie0().set_bit()));
         }
     }
@@ -107,6 +197,9 @@ pub fn on_receive(take: impl FnOnce(u8) -> bool) -> bool {
     if !taken {
         // A full ring counts the lost byte (the sender ignored flow control).
         let _ = RX.push(b);
+        if FLOW.load(Relaxed) & FLOW_ON != 0 && RX.len() >= XOFF_AT {
+            flow_to(true);
+        }
     }
     avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.rxcie0().set_bit()));
     taken

@@ -6,6 +6,7 @@
 //! tools). What they keep, the store keeps (`crate::store`).
 
 use super::{message, Console, Listing, Owner, Sleep, Source};
+use crate::board::usart;
 use crate::motion::Motion;
 use crate::queues::RX;
 use crate::reply;
@@ -187,6 +188,15 @@ impl Console {
                 at: 0,
                 why: None,
             }),
+            None if settings::is_flow(key.as_bytes()) => {
+                let set = store.extras_mut().set_flow(value.as_bytes());
+                usart::set_xonxoff(store.extras().xonxoff());
+                set.map_err(|e| SetError {
+                    code: ErrorKind::InvalidStatement,
+                    at: e.at,
+                    why: Some(e.kind),
+                })
+            }
             None => settings::set(cfg, key, value).map_err(|e| SetError {
                 code: ErrorKind::InvalidStatement,
                 at: e.at,
@@ -228,6 +238,7 @@ impl Console {
             cfg.load_defaults(cfg.machine);
             m.configure(cfg);
             store.extras_mut().reset();
+            usart::set_xonxoff(false);
             store.settings_changed();
             self.settings_changed = true;
         }

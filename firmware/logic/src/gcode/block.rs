@@ -449,4 +449,6 @@ pub enum Input {
     Card(CardLine),
     /// A real-time byte (no `ok`).
     Realtime(Realtime),
+    /// Seed 003's raw-step line; `None`: malformed (the seed's `?`).
+    Seed(Option<crate::seed::SeedMove>),
 }

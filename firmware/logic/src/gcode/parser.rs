@@ -11,6 +11,7 @@ use super::block::{Input, Realtime};
 use super::error::{Error, ErrorKind};
 use super::system::SystemBuilder;
 use super::words::Words;
+use crate::seed::SeedBuilder;
 
 /// Most characters a line keeps (Grbl's `LINE_BUFFER_SIZE` of 80 with its
 /// terminator): comments, spaces and control bytes do not count, so a
@@ -54,6 +55,8 @@ enum Statement {
     /// G-code words, or a jog's after `$J=`.
     GCode(Words),
     System(SystemBuilder),
+    /// Seed 003's raw-step line (`+0615-0950n`, [`crate::seed`]).
+    Seed(SeedBuilder),
 }
 
 /// The streaming command-line parser: push every received byte, act on
@@ -256,12 +259,17 @@ impl Parser {
                     self.feed(c, column)
                 }
                 b'$' => self.statement = Statement::System(SystemBuilder::new(column)),
+                b'+' | b'-' => {
+                    self.statement = Statement::Seed(SeedBuilder::new());
+                    self.feed(c, column)
+                }
                 _ => {
                     self.start_words(false);
                     self.feed(c, column);
                 }
             },
             Statement::GCode(words) => words.feed(c, column),
+            Statement::Seed(seed) => seed.feed(c),
             Statement::System(system) => {
                 system.feed(c, column);
                 if system.jog_starts() {
@@ -329,6 +337,7 @@ impl Parser {
                 }
             }
             Statement::System(system) => system.finish(end).map(Input::System),
+            Statement::Seed(seed) => Ok(Input::Seed(seed.finish())),
             // Made G-code above.
             Statement::Start => unreachable!(),
         }

@@ -477,3 +477,25 @@ proptest! {
         prop_assert_eq!(out.last().cloned(), Some(Ok(Input::Block(block("M400")))));
     }
 }
+
+/// A line starting with `+` or `-` is seed 003's raw-step line, read
+/// beside G-code and `$` lines in the same stream.
+#[test]
+fn a_seed_line_is_read_beside_gcode() {
+    use crate::seed::SeedMove;
+    let seed = |steps, pen_up| Ok(Input::Seed(Some(SeedMove { steps, pen_up })));
+    assert_eq!(parse("+0615-0950n"), seed([615, -950], false));
+    assert_eq!(parse("  -0615+0950U ; back"), seed([-615, 950], true));
+    assert_eq!(
+        parse("+0615-0950n*58"),
+        Err(Error::new(ErrorKind::BadChecksum, 12))
+    );
+    for bad in ["+0615-0950", "+0615-0950k", "-", "+0615-0950nG1"] {
+        assert_eq!(parse(bad), Ok(Input::Seed(None)), "{bad:?}");
+    }
+    let mut p = Parser::new();
+    let out = push_all(&mut p, b"G1 X1\r\n+0001+0001u\n$$\n");
+    assert!(matches!(out[0], Ok(Input::Block(_))));
+    assert_eq!(out[1], seed([1, 1], true));
+    assert!(matches!(out[2], Ok(Input::System(_))));
+}

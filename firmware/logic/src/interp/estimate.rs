@@ -69,6 +69,10 @@ impl MachineIo for Timed {
         None
     }
 
+    fn steps(&self) -> Steps {
+        self.planner.position()
+    }
+
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
         self.planner.push(*steps, feed).is_ok()
     }

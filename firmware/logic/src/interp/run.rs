@@ -165,6 +165,13 @@ impl Interpreter {
             return Some(wait);
         }
         let before = *path;
+        if let Path::Steps(steps) = before {
+            if !io.queue(&steps, self.run.feed) {
+                return Some(Wait::Motion);
+            }
+            self.run.path = None;
+            return None;
+        }
         let motors = motor_channels(env.cfg);
         let queued = if env.kin.is_linear() {
             let Some(end) = path.next() else {

@@ -43,6 +43,14 @@ impl MachineIo for Recorder {
     fn room(&mut self, _piece: bool) -> Option<Wait> {
         None
     }
+    fn steps(&self) -> Steps {
+        let last = self.did.iter().rev().find_map(|d| match d {
+            Did::Move(s, _) => Some(*s),
+            Did::Piece(p, _) => Some(p.steps),
+            _ => None,
+        });
+        last.unwrap_or_default()
+    }
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
         self.did.push(Did::Move(*steps, feed));
         true
@@ -75,6 +83,18 @@ impl MachineIo for Recorder {
     }
     fn millis(&self) -> u32 {
         self.clock
+    }
+}
+
+/// The executor's view in check mode (`$C`).
+fn checking<'a>(kin: &'a AnyKinematics, cfg: &'a MachineConfig) -> Env<'a, AnyKinematics> {
+    Env {
+        kin,
+        cfg,
+        allowed: Allowed {
+            motion: true,
+            checking: true,
+        },
     }
 }
 
@@ -123,20 +143,20 @@ impl Bench {
             .filter_map(|b| p.push(b))
             .collect();
         assert_eq!(out.len(), 1, "{text:?}");
-        let (block, jog) = match out.remove(0) {
-            Ok(Input::Block(b)) => (b, false),
-            Ok(Input::Jog(b)) => (b, true),
-            Ok(other) => panic!("{text:?}: {other:?}"),
-            Err(e) => return Err(e.code()),
-        };
         let env = Env {
             kin: &self.kin,
             cfg: &self.cfg,
             allowed: Allowed::ALL,
         };
-        self.interp
-            .accept(&block, jog, &env, &mut self.io)
-            .map_err(|e| e as u8)?;
+        let (interp, io) = (&mut self.interp, &mut self.io);
+        match out.remove(0) {
+            Ok(Input::Block(b)) => interp.accept(&b, false, &env, io),
+            Ok(Input::Jog(b)) => interp.accept(&b, true, &env, io),
+            Ok(Input::Seed(Some(mv))) => interp.accept_steps(&mv, &env, io),
+            Ok(other) => panic!("{text:?}: {other:?}"),
+            Err(e) => return Err(e.code()),
+        }
+        .map_err(|e| e as u8)?;
         loop {
             match self.interp.run(&env, &mut self.io) {
                 Progress::Done => return Ok(()),
@@ -544,14 +564,7 @@ fn drivers_on_off_and_their_idle_delay() {
         Some(Ok(Input::Block(block))) => block,
         other => panic!("{other:?}"),
     };
-    let env = Env {
-        kin: &b.kin,
-        cfg: &b.cfg,
-        allowed: Allowed {
-            motion: true,
-            checking: true,
-        },
-    };
+    let env = checking(&b.kin, &b.cfg);
     b.io.did.clear();
     b.interp.accept(&block, false, &env, &mut b.io).unwrap();
     assert_eq!(b.interp.run(&env, &mut b.io), Progress::Done);
@@ -738,4 +751,72 @@ fn a_cleared_run_is_a_new_one() {
     run.feed = Feed::PerMinute(Milli(1000));
     run.clear();
     assert_eq!(run, Run::new());
+}
+
+/// Seed 003's raw-step lines: the pen first (only when it changes), then
+/// one rapid move of the two motors by their steps from where the moves
+/// before end; G-code after it starts where it ended.
+#[test]
+fn a_seed_line_moves_the_motors_by_raw_steps() {
+    let mut b = Bench::new(Machine::Whiteboard);
+    b.ok("+0615-0950n");
+    let down = b.cfg.pen.down_deg;
+    assert_eq!(
+        b.io.did,
+        [Did::Pen(down), Did::Move([615, -950, 0], Feed::Rapid)]
+    );
+    b.ok("-0015+0050N");
+    assert_eq!(b.steps(), [600, -900, 0]);
+    assert_eq!(b.io.did.len(), 4, "{:?}", b.io.did);
+    b.ok("+0000+0000u");
+    let n = b.io.did.len();
+    assert_eq!(b.io.did[n - 2], Did::Pen(b.cfg.pen.up_deg));
+    // The programmed position is where the chains now hold the pen: a
+    // G-code move back to it moves nothing, one to 0 goes back to zero.
+    let at = b.kin.forward(&[600, -900, 0]);
+    let before = b.io.did.len();
+    let mm = |m: Milli| m.0 as f64 / 1000.0;
+    b.ok(&format!("G1 X{:.3} Y{:.3} F1000", mm(at[0]), mm(at[1])));
+    assert!(b.pieces().len() <= 1 && b.io.did.len() <= before + 1);
+    b.ok("G0 X0 Y0");
+    let end = b.steps();
+    assert!(end[0].abs() <= 1 && end[1].abs() <= 1, "{end:?}");
+}
+
+#[test]
+fn a_seed_line_is_refused_past_the_soft_limits_or_the_reach() {
+    let mut b = Bench::new(Machine::Whiteboard);
+    b.cfg.axes[0].soft_limits = true;
+    b.cfg.axes[0].travel = (Milli(-10_000), Milli(10_000));
+    // 615 steps of the left chain alone move the pen ~25 mm right.
+    assert_eq!(b.err("+0615+0000n"), ErrorKind::TravelExceeded as u8);
+    assert_eq!(b.io.did, []);
+    b.ok("+0100+0000n");
+    // Neither chain can be longer than both together (1.2 m apart, ~0.85
+    // m each at the origin: 9999 steps are 571 mm).
+    let mut b = Bench::new(Machine::Whiteboard);
+    b.ok("+9999-9999n");
+    assert_eq!(b.err("+9999-9999n"), ErrorKind::InvalidTarget as u8);
+    assert_eq!(b.steps(), [9999, -9999, 0]);
+}
+
+#[test]
+fn a_seed_line_in_check_mode_moves_nothing() {
+    let mut b = Bench::new(Machine::Whiteboard);
+    let env = checking(&b.kin, &b.cfg);
+    let mv = crate::seed::parse(b"+0615-0950n").unwrap();
+    b.interp.accept_steps(&mv, &env, &mut b.io).unwrap();
+    assert_eq!(b.interp.run(&env, &mut b.io), Progress::Done);
+    assert_eq!(b.io.did, []);
+    let refused = Env {
+        allowed: Allowed {
+            motion: false,
+            checking: false,
+        },
+        ..env
+    };
+    assert_eq!(
+        b.interp.accept_steps(&mv, &refused, &mut b.io),
+        Err(ErrorKind::JobOwnsMotion)
+    );
 }

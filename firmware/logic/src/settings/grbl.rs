@@ -129,6 +129,9 @@ pub const FLAG_HARD_LIMITS: u8 = 4;
 pub const FLAG_HOMING_OFF: u8 = 8;
 /// `$32`: laser mode.
 pub const FLAG_LASER: u8 = 16;
+/// `$flow=xonxoff`: the console sends XOFF and XON (taut's, by name: a
+/// record from before it has the bit clear, flow control off).
+pub const FLAG_XONXOFF: u8 = 32;
 
 /// Bytes of [`Extras`] in EEPROM.
 pub const EXTRAS_BYTES: u16 = BYTES as u16 + 2 * 4 + TYPED as u16 * 4;
@@ -153,6 +156,29 @@ impl Extras {
 
     pub fn flags(&self) -> u8 {
         self.bytes[BYTE_FLAGS]
+    }
+
+    /// `$flow=xonxoff`: the console's XON/XOFF flow control is on.
+    pub fn xonxoff(&self) -> bool {
+        self.flags() & FLAG_XONXOFF != 0
+    }
+
+    /// `$flow=`: `xonxoff` or `off` (any case); else the value's error.
+    pub fn set_flow(&mut self, value: &[u8]) -> Result<(), NumError> {
+        // Flash texts: literals would sit in the AVR's SRAM.
+        let on = match value {
+            v if text!("xonxoff").eq_ignore_ascii_case(v) => true,
+            v if text!("off").eq_ignore_ascii_case(v) => false,
+            _ => {
+                return Err(NumError {
+                    at: 0,
+                    kind: ErrorKind::Invalid(text!("flow")),
+                })
+            }
+        };
+        let flags = &mut self.bytes[BYTE_FLAGS];
+        *flags = *flags & !FLAG_XONXOFF | if on { FLAG_XONXOFF } else { 0 };
+        Ok(())
     }
 
     /// Whether `$H` may home: `$22` on and a channel to home.

@@ -26,8 +26,9 @@ fn set(cfg: &mut MachineConfig, ex: &mut Extras, key: &str, value: &str) -> Resu
 #[test]
 fn dollar_dollar_lists_grbl_s_34_numbers_then_the_named_settings() {
     let lines = listing(&MachineConfig::STRING_ART, &Extras::DEFAULT);
-    assert_eq!(lines.len(), COUNT + NAMED);
+    assert_eq!(lines.len(), COUNT + NAMED + 1);
     assert_eq!(COUNT, 34);
+    assert_eq!(lines.last().unwrap(), "$flow=off");
     assert_eq!(
         lines[..COUNT],
         [
@@ -322,4 +323,29 @@ fn reset_is_the_default() {
     ex.typed = [9; TYPED];
     ex.reset();
     assert_eq!(ex, Extras::DEFAULT);
+}
+
+/// `$flow` (XON/XOFF flow control) is off unless set, kept in a flag bit
+/// of the extras: a record from before it reads back with it off.
+#[test]
+fn flow_control_is_a_flag_of_the_extras() {
+    let mut ex = Extras::DEFAULT;
+    assert!(!ex.xonxoff());
+    ex.set_flow(b"XonXoff").unwrap();
+    assert!(ex.xonxoff());
+    let cfg = MachineConfig::STRING_ART;
+    assert_eq!(listing(&cfg, &ex).last().unwrap(), "$flow=xonxoff");
+    assert_eq!(ex.flags(), FLAG_XONXOFF, "the other flags untouched");
+    assert!(ex.set_flow(b"rtscts").is_err());
+    assert!(ex.xonxoff(), "a refused value changes nothing");
+    ex.set_flow(b"off").unwrap();
+    assert_eq!(ex, Extras::DEFAULT);
+    ex.set_flow(b"xonxoff").unwrap();
+    // Through the stored bytes and back.
+    let mut bytes = std::vec::Vec::new();
+    for k in 0..Extras::PARTS as u8 {
+        let (b, n) = ex.part(k).unwrap();
+        bytes.extend_from_slice(&b[..n as usize]);
+    }
+    assert!(Extras::decode(|i| bytes[i as usize]).xonxoff());
 }
