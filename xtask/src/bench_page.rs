@@ -125,7 +125,7 @@ const SECTIONS: &[(&str, &[Figure])] = &[
     (
         "Feed along the pen",
         &[
-            barred("feed_ratio_scara_min", "", "the arm's fixed lines (`SCARA_LINES` in `simavr/src/bin/taut-bench.rs`: 40 mm at F600 in two places, 120 mm at F1500 and F3000): time from first to last step over the pen's trapezoid (length at the feed, ramps at `pen_accel`), lowest; below 1 would be faster than asked", Bar::AtLeast(0.97)),
+            barred("feed_ratio_scara_min", "", "the arm's fixed lines (`SCARA_LINES` in `simavr/src/bin/taut-bench/main.rs`: 40 mm at F600 in two places, 120 mm at F1500 and F3000): time from first to last step over the pen's trapezoid (length at the feed, ramps at `pen_accel`), lowest; below 1 would be faster than asked", Bar::AtLeast(0.97)),
             fig("feed_ratio_scara_max", "", "the same, highest: above 1 where a joint's own limits hold the pen back"),
             barred("feed_ratio_whiteboard_min", "", "the whiteboard's (`WHITEBOARD_LINES`: 40 mm at F600, three of 410–500 mm at F900–F3000 across the board), lowest", Bar::AtLeast(0.97)),
             fig("feed_ratio_whiteboard_max", "", "the same, highest"),
@@ -176,7 +176,7 @@ and commit the page.
 
 - **Firmware figures** come from the release image (`taut.elf`, the one
   that is flashed) in simavr, whose cycle counter is exact and repeatable
-  (`simavr/src/bin/taut-bench.rs`). Special images in `firmware/examples/`
+  (`simavr/src/bin/taut-bench/main.rs`). Special images in `firmware/examples/`
   time the maths (`kin_cycles`, `segment_cycles`), the card reader
   (`sd_read`) and an MCU that never sleeps (`busy`).
 - **Step rates** are searched to 1 kHz: the highest cruise rate at which
