@@ -180,6 +180,11 @@ impl Sim {
         if let Some(profile) = &mut self.profile {
             profile.add(pc_before, cycle - self.last_avr_cycle);
         }
+        if self.profile.is_some() {
+            let sp = self.sp();
+            let profile = self.profile.as_mut().unwrap();
+            profile.after(cycle - self.last_avr_cycle, pc, sp);
+        }
         self.last_avr_cycle = cycle;
         let now = self.shared().cycle_base + cycle;
         self.masked.observe(now, pc, interrupts_on);

@@ -169,6 +169,15 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
                 let with_card = (source == "card").then(|| card(&text));
                 let mut sim = ready(elf, machine, points[0], with_card);
                 let before = underruns(&sim);
+                let profile = std::env::var("TAUT_BENCH_PROFILE").ok();
+                let tasks = ["4taut7console", "4taut6motion"]
+                    .map(|t| taut_simavr::elf::function_address(elf, t).unwrap().unwrap());
+                if profile.is_some() {
+                    sim.enable_call_profile(elf).unwrap();
+                    for t in tasks {
+                        sim.watch_calls(t);
+                    }
+                }
                 let rate = match source {
                     "serial" => over_serial(&mut sim, &lines),
                     _ => from_card(&mut sim, lines.len()),
@@ -178,9 +187,47 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
                 sim.run_for(Duration::from_millis(1100));
                 let under = underruns(&sim) - before;
                 println!("{key:<36} {rate:>7.1} lines/s, {under} underruns");
+                if let Ok(dir) = std::env::var("TAUT_BENCH_UART") {
+                    std::fs::write(Path::new(&dir).join(format!("{key}.txt")), sim.uart_text()).unwrap();
+                }
+                if profile.is_some() {
+                    for t in tasks {
+                        let mut runs = sim.call_runs(t).to_vec();
+                        runs.sort_by_key(|r| std::cmp::Reverse(r.1));
+                        let longest: Vec<String> = runs.iter().take(6).map(|(at, n)| format!("{n} at {:.3} s", *at as f64 / 16e6)).collect();
+                        println!("  longest runs of {t:#x}: {}", longest.join(", "));
+                    }
+                }
+                if let (Some(n), Some(p)) = (profile, sim.profile()) {
+                    print_profile(elf, p, n.parse().unwrap_or(30));
+                }
                 f.insert(format!("{key}_lines_per_s"), json!((rate * 10.0).round() / 10.0));
                 f.insert(format!("{key}_underruns"), json!(under));
             }
+        }
+    }
+}
+
+/// `TAUT_BENCH_PROFILE=N`: the N functions the case spent the most
+/// cycles in (their own instructions, callees apart), with their share.
+fn print_profile(elf: &Path, p: &taut_simavr::profile::Profile, n: usize) {
+    let total = p.total() as f64;
+    println!("  own cycles:");
+    for (cycles, name) in p.by_function(elf).unwrap().iter().take(n) {
+        println!("  {:>5.1} % {cycles:>11} {name}", *cycles as f64 * 100.0 / total);
+    }
+    println!("  hottest words:");
+    for (pc, cycles) in p.hottest(n) {
+        println!("  {:>5.1} % {cycles:>11} {pc:#x}", cycles as f64 * 100.0 / total);
+    }
+    println!("  with callees (calls):");
+    for (cycles, calls, name) in p.inclusive().iter().take(n) {
+        println!("  {:>5.1} % {cycles:>11} {calls:>8} {name}", *cycles as f64 * 100.0 / total);
+    }
+    for callee in ["memcpy", "__muldi3", "memset", "__udivdi3", "__divdi3", "__mulsf3", "__divsf3"] {
+        println!("  callers of {callee}:");
+        for (cycles, name) in p.callers_of(callee).iter().take(8) {
+            println!("  {:>5.1} % {cycles:>11} {name}", *cycles as f64 * 100.0 / total);
         }
     }
 }
