@@ -174,11 +174,24 @@ impl Trapezoid {
             // The roots (~6 000 cycles each on the AVR), two parts: three
             // in one kept a ready task waiting ~19 000 cycles. The
             // peak's scaled speed waits in `cruise_iv`.
+            // A block that cruises through (a stream of short moves at
+            // speed) has one root, not three.
             1 => {
                 self.cruise_iv = self.scaled_speed(self.v0_sqr + self.acc2);
-                self.s0 = self.scaled_speed(self.v0_sqr);
+                self.s0 = match self.acc2 {
+                    0 => self.cruise_iv,
+                    _ => self.scaled_speed(self.v0_sqr),
+                };
             }
-            2 => self.s1 = self.scaled_speed(self.v1_sqr),
+            2 => {
+                self.s1 = if self.dec2 == 0 {
+                    self.cruise_iv
+                } else if self.v1_sqr == self.v0_sqr {
+                    self.s0
+                } else {
+                    self.scaled_speed(self.v1_sqr)
+                }
+            }
             3 => {
                 let sp = self.cruise_iv;
                 let (per_speed, per_speed_shift) = per_speed(self.accel as u32, self.shift);
