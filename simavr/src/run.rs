@@ -180,9 +180,8 @@ impl Sim {
         if let Some(profile) = &mut self.profile {
             profile.add(pc_before, cycle - self.last_avr_cycle);
         }
-        if self.profile.is_some() {
-            let sp = self.sp();
-            let profile = self.profile.as_mut().unwrap();
+        let sp = self.profile.is_some().then(|| self.sp());
+        if let (Some(profile), Some(sp)) = (&mut self.profile, sp) {
             profile.after(cycle - self.last_avr_cycle, pc, sp);
         }
         self.last_avr_cycle = cycle;

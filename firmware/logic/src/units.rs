@@ -275,7 +275,20 @@ mod tests {
     fn exact_steps_at_the_fast_path_s_edges() {
         for (num, den) in [(80, 1), (1600, 12), (u32::MAX, 1), (1, 4294), (7, 4295)] {
             let s = StepsPerUnit::new(num, den);
-            for t in [0, 1, -1, 499_999, 500_000, -500_000, (1 << 31) - 1, -(1 << 31) + 1, 1 << 31, -(1 << 31), i64::MAX, i64::MIN] {
+            for t in [
+                0,
+                1,
+                -1,
+                499_999,
+                500_000,
+                -500_000,
+                (1 << 31) - 1,
+                -(1 << 31) + 1,
+                1 << 31,
+                -(1 << 31),
+                i64::MAX,
+                i64::MIN,
+            ] {
                 assert_eq!(s.steps_exact(t), s.steps_exact_wide(t), "{num}/{den} {t}");
             }
         }

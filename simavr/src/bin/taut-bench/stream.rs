@@ -6,6 +6,12 @@
 //! second and the step-queue underruns the firmware counted (the logger's
 //! `underruns:N`), which must stay 0: the queue running dry inside a
 //! planned move is a fault.
+//!
+//! To see why: `TAUT_BENCH_PROFILE=N` prints where each case's cycles go
+//! and the tasks' longest runs; `TAUT_BENCH_WATCH=<hex address>` the
+//! times the firmware reached that address (an underrun's count, say)
+//! with the console's and the motion task's runs just before;
+//! `TAUT_BENCH_UART=DIR` keeps each case's UART text.
 
 use serde_json::{json, Map, Value};
 use std::path::Path;
@@ -44,7 +50,8 @@ fn chords(centre: [f64; 2], r: f64, segment: f64, n: usize) -> Vec<[f64; 2]> {
     (0..=n)
         .map(|k| {
             let a = step * k as f64;
-            [centre[0] + r * a.cos(), centre[1] + r * a.sin()].map(|v| (v * 1000.0).round() / 1000.0)
+            [centre[0] + r * a.cos(), centre[1] + r * a.sin()]
+                .map(|v| (v * 1000.0).round() / 1000.0)
         })
         .collect()
 }
@@ -55,7 +62,11 @@ fn lines(points: &[[f64; 2]]) -> Vec<String> {
         .iter()
         .enumerate()
         .map(|(k, p)| {
-            let feed = if k == 0 { format!(" F{FEED}") } else { String::new() };
+            let feed = if k == 0 {
+                format!(" F{FEED}")
+            } else {
+                String::new()
+            };
             format!("G1 X{} Y{}{feed}", p[0], p[1])
         })
         .collect()
@@ -74,8 +85,41 @@ fn underruns(sim: &Sim) -> u64 {
     sim.uart_text()
         .lines()
         .rfind(|l| l.contains("underruns:"))
-        .and_then(|l| l.split("underruns:").nth(1)?.trim_end_matches(']').trim().parse().ok())
+        .and_then(|l| {
+            l.split("underruns:")
+                .nth(1)?
+                .trim_end_matches(']')
+                .trim()
+                .parse()
+                .ok()
+        })
         .unwrap_or(0)
+}
+
+/// What the planner allows: the lines per second of the same stream
+/// from the first tenth to the last on the host (`GcodeTime`: the
+/// firmware's parser, executor and planner, a block timed when the full
+/// planner hands it on), with no limit from the CPU or the UART. Short
+/// moves at speed are bound by the look-ahead: the machine must be able
+/// to stop within the planned blocks.
+fn planner_bound(machine: Machine, start: [f64; 2], lines: &[String]) -> f64 {
+    let cfg = taut_logic::config::MachineConfig::defaults(machine);
+    let mut timing = taut_logic::interp::estimate::GcodeTime::new(&cfg).expect("kinematics");
+    timing.push(format!("G90 G21\nG0 X{} Y{}\n", start[0], start[1]).as_bytes());
+    let n = lines.len();
+    let (from, to) = (n / 10, n - n / 10);
+    let mut at = [0.0; 2];
+    for (k, l) in lines.iter().enumerate() {
+        if k == from {
+            at[0] = timing.seconds();
+        }
+        if k == to {
+            at[1] = timing.seconds();
+        }
+        timing.push(format!("{l}\n").as_bytes());
+    }
+    assert_eq!(timing.refused, 0);
+    (to - from) as f64 / (at[1] - at[0])
 }
 
 /// A machine at the circle's start, drivers on; with `card` inserted.
@@ -108,7 +152,7 @@ fn over_serial(sim: &mut Sim, lines: &[String]) -> f64 {
     let mut in_flight = std::collections::VecDeque::new();
     let (mut t_from, mut t_to) = (0.0, 0.0);
     while answered < n {
-        while next < n && in_flight.iter().sum::<usize>() + lines[next].len() + 1 <= 128 {
+        while next < n && in_flight.iter().sum::<usize>() + lines[next].len() < 128 {
             sim.uart_send(format!("{}\n", lines[next]).as_bytes());
             in_flight.push_back(lines[next].len() + 1);
             next += 1;
@@ -160,6 +204,15 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
         for (segment, len) in SEGMENTS {
             let points = chords(centre, r, segment, line_count(segment));
             let lines = lines(&points);
+            let bound = planner_bound(machine, points[0], &lines);
+            let key = format!("stream_{}_{len}", machine.name());
+            if only.is_none_or(|o| key.contains(o)) {
+                println!("{key:<36} {bound:>7.1} lines/s the planner allows");
+                f.insert(
+                    format!("{key}_planner_bound_lines_per_s"),
+                    json!((bound * 10.0).round() / 10.0),
+                );
+            }
             for source in ["serial", "card"] {
                 let key = format!("stream_{}_{len}_{source}", machine.name());
                 if only.is_some_and(|o| !key.contains(o)) {
@@ -169,6 +222,12 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
                 let with_card = (source == "card").then(|| card(&text));
                 let mut sim = ready(elf, machine, points[0], with_card);
                 let before = underruns(&sim);
+                let watch = std::env::var("TAUT_BENCH_WATCH")
+                    .ok()
+                    .map(|w| u32::from_str_radix(w.trim_start_matches("0x"), 16).unwrap());
+                if let Some(w) = watch {
+                    sim.watch_pc(w);
+                }
                 let profile = std::env::var("TAUT_BENCH_PROFILE").ok();
                 let tasks = ["4taut7console", "4taut6motion"]
                     .map(|t| taut_simavr::elf::function_address(elf, t).unwrap().unwrap());
@@ -188,20 +247,42 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
                 let under = underruns(&sim) - before;
                 println!("{key:<36} {rate:>7.1} lines/s, {under} underruns");
                 if let Ok(dir) = std::env::var("TAUT_BENCH_UART") {
-                    std::fs::write(Path::new(&dir).join(format!("{key}.txt")), sim.uart_text()).unwrap();
+                    std::fs::write(Path::new(&dir).join(format!("{key}.txt")), sim.uart_text())
+                        .unwrap();
+                }
+                if let Some(w) = watch {
+                    for &hit in sim.pc_hits(w) {
+                        println!("hit at {:.4} s", hit as f64 / 16e6);
+                        for t in tasks {
+                            let runs: Vec<String> = sim
+                                .call_runs(t)
+                                .iter()
+                                .filter(|(at, _)| *at + 400_000 > hit && *at < hit + 16_000)
+                                .map(|(at, n)| format!("{:.4}+{n}", *at as f64 / 16e6))
+                                .collect();
+                            println!("   {t:#x}: {}", runs.join(" "));
+                        }
+                    }
                 }
                 if profile.is_some() {
                     for t in tasks {
                         let mut runs = sim.call_runs(t).to_vec();
                         runs.sort_by_key(|r| std::cmp::Reverse(r.1));
-                        let longest: Vec<String> = runs.iter().take(6).map(|(at, n)| format!("{n} at {:.3} s", *at as f64 / 16e6)).collect();
+                        let longest: Vec<String> = runs
+                            .iter()
+                            .take(6)
+                            .map(|(at, n)| format!("{n} at {:.3} s", *at as f64 / 16e6))
+                            .collect();
                         println!("  longest runs of {t:#x}: {}", longest.join(", "));
                     }
                 }
                 if let (Some(n), Some(p)) = (profile, sim.profile()) {
                     print_profile(elf, p, n.parse().unwrap_or(30));
                 }
-                f.insert(format!("{key}_lines_per_s"), json!((rate * 10.0).round() / 10.0));
+                f.insert(
+                    format!("{key}_lines_per_s"),
+                    json!((rate * 10.0).round() / 10.0),
+                );
                 f.insert(format!("{key}_underruns"), json!(under));
             }
         }
@@ -214,20 +295,40 @@ fn print_profile(elf: &Path, p: &taut_simavr::profile::Profile, n: usize) {
     let total = p.total() as f64;
     println!("  own cycles:");
     for (cycles, name) in p.by_function(elf).unwrap().iter().take(n) {
-        println!("  {:>5.1} % {cycles:>11} {name}", *cycles as f64 * 100.0 / total);
+        println!(
+            "  {:>5.1} % {cycles:>11} {name}",
+            *cycles as f64 * 100.0 / total
+        );
     }
     println!("  hottest words:");
     for (pc, cycles) in p.hottest(n) {
-        println!("  {:>5.1} % {cycles:>11} {pc:#x}", cycles as f64 * 100.0 / total);
+        println!(
+            "  {:>5.1} % {cycles:>11} {pc:#x}",
+            cycles as f64 * 100.0 / total
+        );
     }
     println!("  with callees (calls):");
     for (cycles, calls, name) in p.inclusive().iter().take(n) {
-        println!("  {:>5.1} % {cycles:>11} {calls:>8} {name}", *cycles as f64 * 100.0 / total);
+        println!(
+            "  {:>5.1} % {cycles:>11} {calls:>8} {name}",
+            *cycles as f64 * 100.0 / total
+        );
     }
-    for callee in ["memcpy", "__muldi3", "memset", "__udivdi3", "__divdi3", "__mulsf3", "__divsf3"] {
+    for callee in [
+        "memcpy",
+        "__muldi3",
+        "memset",
+        "__udivdi3",
+        "__divdi3",
+        "__mulsf3",
+        "__divsf3",
+    ] {
         println!("  callers of {callee}:");
         for (cycles, name) in p.callers_of(callee).iter().take(8) {
-            println!("  {:>5.1} % {cycles:>11} {name}", *cycles as f64 * 100.0 / total);
+            println!(
+                "  {:>5.1} % {cycles:>11} {name}",
+                *cycles as f64 * 100.0 / total
+            );
         }
     }
 }
