@@ -185,6 +185,10 @@ impl Sim {
         if let Some(profile) = &mut self.profile {
             profile.add(pc_before, cycle - self.last_avr_cycle);
         }
+        let sp = self.profile.is_some().then(|| self.sp());
+        if let (Some(profile), Some(sp)) = (&mut self.profile, sp) {
+            profile.after(cycle - self.last_avr_cycle, pc, sp);
+        }
         self.last_avr_cycle = cycle;
         let now = self.shared().cycle_base + cycle;
         self.masked.observe(now, pc, interrupts_on);

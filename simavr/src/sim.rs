@@ -356,6 +356,13 @@ impl Sim {
         self.profile.get_or_insert_with(Default::default);
     }
 
+    /// As [`Sim::enable_profile`], and each function's cycles with its
+    /// callees (`Profile::inclusive`).
+    pub fn enable_call_profile(&mut self, elf: &Path) -> Result<()> {
+        self.enable_profile();
+        self.profile.as_mut().unwrap().with_calls(elf)
+    }
+
     /// The cycle counts, if [`Sim::enable_profile`] was called.
     pub fn profile(&self) -> Option<&crate::profile::Profile> {
         self.profile.as_ref()

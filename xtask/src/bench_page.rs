@@ -107,6 +107,36 @@ const SECTIONS: &[(&str, &[Figure])] = &[
             fig("stream_planner_free_blocks_mean", "blocks", "mean free planner blocks in the stream's `?` reports (`Bf:`)"),
             fig("stream_lines_always_waiting", "", "whether a whole line always waited in the receive buffer"),
             fig("stream_limit", "", "what limits the stream: the planner, the UART or the firmware's line intake"),
+            fig("stream_flatbed_50um_planner_bound_lines_per_s", "lines/s", "0.05 mm chords of a circle at F1500 on the flatbed: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
+            barred("stream_flatbed_50um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second", Bar::AtLeast(300.0)),
+            barred("stream_flatbed_50um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            barred("stream_flatbed_50um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second", Bar::AtLeast(450.0)),
+            barred("stream_flatbed_50um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            fig("stream_flatbed_200um_planner_bound_lines_per_s", "lines/s", "0.2 mm chords of a circle at F1500 on the flatbed: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
+            fig("stream_flatbed_200um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second (at most 125 at that feed)"),
+            barred("stream_flatbed_200um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            fig("stream_flatbed_200um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second (at most 125 at that feed)"),
+            barred("stream_flatbed_200um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            fig("stream_whiteboard_50um_planner_bound_lines_per_s", "lines/s", "0.05 mm chords of a circle at F1500 on the whiteboard: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
+            barred("stream_whiteboard_50um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second", Bar::AtLeast(200.0)),
+            barred("stream_whiteboard_50um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            barred("stream_whiteboard_50um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second", Bar::AtLeast(200.0)),
+            barred("stream_whiteboard_50um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            fig("stream_whiteboard_200um_planner_bound_lines_per_s", "lines/s", "0.2 mm chords of a circle at F1500 on the whiteboard: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
+            fig("stream_whiteboard_200um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second (at most 125 at that feed)"),
+            barred("stream_whiteboard_200um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            fig("stream_whiteboard_200um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second (at most 125 at that feed)"),
+            barred("stream_whiteboard_200um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            fig("stream_scara_50um_planner_bound_lines_per_s", "lines/s", "0.05 mm chords of a circle at F1500 on the SCARA arm: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
+            barred("stream_scara_50um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second", Bar::AtLeast(200.0)),
+            barred("stream_scara_50um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            barred("stream_scara_50um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second", Bar::AtLeast(200.0)),
+            barred("stream_scara_50um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            fig("stream_scara_200um_planner_bound_lines_per_s", "lines/s", "0.2 mm chords of a circle at F1500 on the SCARA arm: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
+            fig("stream_scara_200um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second (at most 125 at that feed)"),
+            barred("stream_scara_200um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            fig("stream_scara_200um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second (at most 125 at that feed)"),
+            barred("stream_scara_200um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
         ],
     ),
     (
@@ -125,7 +155,7 @@ const SECTIONS: &[(&str, &[Figure])] = &[
     (
         "Feed along the pen",
         &[
-            barred("feed_ratio_scara_min", "", "the arm's fixed lines (`SCARA_LINES` in `simavr/src/bin/taut-bench.rs`: 40 mm at F600 in two places, 120 mm at F1500 and F3000): time from first to last step over the pen's trapezoid (length at the feed, ramps at `pen_accel`), lowest; below 1 would be faster than asked", Bar::AtLeast(0.97)),
+            barred("feed_ratio_scara_min", "", "the arm's fixed lines (`SCARA_LINES` in `simavr/src/bin/taut-bench/main.rs`: 40 mm at F600 in two places, 120 mm at F1500 and F3000): time from first to last step over the pen's trapezoid (length at the feed, ramps at `pen_accel`), lowest; below 1 would be faster than asked", Bar::AtLeast(0.97)),
             fig("feed_ratio_scara_max", "", "the same, highest: above 1 where a joint's own limits hold the pen back"),
             barred("feed_ratio_whiteboard_min", "", "the whiteboard's (`WHITEBOARD_LINES`: 40 mm at F600, three of 410–500 mm at F900–F3000 across the board), lowest", Bar::AtLeast(0.97)),
             fig("feed_ratio_whiteboard_max", "", "the same, highest"),
@@ -176,7 +206,7 @@ and commit the page.
 
 - **Firmware figures** come from the release image (`taut.elf`, the one
   that is flashed) in simavr, whose cycle counter is exact and repeatable
-  (`simavr/src/bin/taut-bench.rs`). Special images in `firmware/examples/`
+  (`simavr/src/bin/taut-bench/main.rs`). Special images in `firmware/examples/`
   time the maths (`kin_cycles`, `segment_cycles`), the card reader
   (`sd_read`) and an MCU that never sleeps (`busy`).
 - **Step rates** are searched to 1 kHz: the highest cruise rate at which
@@ -188,6 +218,18 @@ and commit the page.
   at the maximum feed (the planner full, a segment to cut every few ms)
   while the job reads the sample card, and a byte arrives every 5 ms (a `?`
   every 25 ms for the report).
+- **Streams of short segments** (`taut-bench --stream FIRMWARE_ELF
+  [name part]` alone, in `simavr/src/bin/taut-bench/stream.rs`): a circle
+  (R 20 mm; 10 mm on the arm) cut into 1 200 chords of 0.05 mm or 400 of
+  0.2 mm at F1500, absolute coordinates to the µm, sent over the serial
+  port by character counting (lines per second answered from the first
+  tenth to the last) or printed from the card (`M24` answered → `Done
+  printing file`). Underruns are the firmware's own count (its logger's
+  `underruns:N`) over the stream. Beside each, what the planner allows:
+  short moves at speed are bound by the look-ahead (the machine must be
+  able to stop within the planned blocks), however fast the CPU.
+  `TAUT_BENCH_PROFILE=N` prints where a case's cycles go: per function,
+  with callees (a shadow call stack), the callers of the maths library.
 - **Feed ratios** (`taut-bench --feed FIRMWARE_ELF` alone): fixed lines
   drawn on the whiteboard and the arm, each line's time from its first
   step to its last over its trapezoid along the pen; `F` is the pen's

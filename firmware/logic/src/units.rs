@@ -86,6 +86,26 @@ impl StepsPerUnit {
     /// as the programmed position keeps it: rounded once, half away from
     /// zero; `None` when the count does not fit an `i32`.
     pub fn steps_exact(self, target: i64) -> Option<i32> {
+        // Every line's target on a linear machine: within ±2.1 m and a
+        // denominator below 4 295, one product and a division with a
+        // 32-bit quotient (the checked 64-bit product and the general
+        // 64-bit division cost ~3 000 cycles an axis on the AVR).
+        let a = target.unsigned_abs();
+        if a >> 31 == 0 && self.den <= u32::MAX / 1_000_000 {
+            let d = self.den * 1_000_000;
+            // Below 2^63 + 2^31: no overflow; even `d`, so `d / 2` exact.
+            let n = a * self.num as u64 + (d / 2) as u64;
+            if n >> 32 >= d as u64 {
+                return None;
+            }
+            let q = crate::segment::div_to_u32(n, d) as i64;
+            return i32::try_from(if target < 0 { -q } else { q }).ok();
+        }
+        self.steps_exact_wide(target)
+    }
+
+    /// [`StepsPerUnit::steps_exact`] for any target, in 64 bits.
+    fn steps_exact_wide(self, target: i64) -> Option<i32> {
         let n = target.checked_mul(self.num as i64)?;
         let d = self.den as i64 * 1_000_000;
         i32::try_from(div_round(n, d)).ok()
@@ -236,6 +256,41 @@ mod tests {
         #[test]
         fn any_decimal_prints_as_std_does(v in any::<i32>(), places in 0u8..=9) {
             prop_assert_eq!(decimal(v, places), decimal_by_std(v, places));
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn exact_steps_are_the_wide_division_s(
+            target in prop_oneof![-(1i64 << 31)..(1i64 << 31), any::<i64>()],
+            num in prop_oneof![1u32..100_000, any::<u32>()],
+            den in prop_oneof![1u32..5000, 1u32..=u32::MAX],
+        ) {
+            let s = StepsPerUnit::new(num.max(1), den.max(1));
+            prop_assert_eq!(s.steps_exact(target), s.steps_exact_wide(target));
+        }
+    }
+
+    #[test]
+    fn exact_steps_at_the_fast_path_s_edges() {
+        for (num, den) in [(80, 1), (1600, 12), (u32::MAX, 1), (1, 4294), (7, 4295)] {
+            let s = StepsPerUnit::new(num, den);
+            for t in [
+                0,
+                1,
+                -1,
+                499_999,
+                500_000,
+                -500_000,
+                (1 << 31) - 1,
+                -(1 << 31) + 1,
+                1 << 31,
+                -(1 << 31),
+                i64::MAX,
+                i64::MIN,
+            ] {
+                assert_eq!(s.steps_exact(t), s.steps_exact_wide(t), "{num}/{den} {t}");
+            }
         }
     }
 

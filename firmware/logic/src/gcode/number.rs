@@ -114,11 +114,18 @@ impl Number {
         let mut v = self.sig as u64;
         if exp >= 0 {
             for _ in 0..exp {
-                v = v.saturating_mul(10);
+                // Shifts and an add, not a `u64` product (a library call
+                // on the AVR); below `limit` ≤ 2^60, ×10 cannot overflow.
+                v = (v << 3) + (v << 1);
                 if v >= limit {
                     return limit;
                 }
             }
+        } else if exp >= -9 {
+            // `sig` ≤ 10^9 and 10^9 + 10^9 / 2 fit 32 bits: a 32-bit
+            // division.
+            let p = 10u32.pow((-exp) as u32);
+            v = ((self.sig + p / 2) / p) as u64;
         } else {
             // At most 9 significant digits: past 10 decimals it is 0.
             let down = (-exp).min(11) as u32;
@@ -162,14 +169,19 @@ impl Number {
         if exp >= 0 {
             return self.scaled(0, u32::MAX as u64) as u32;
         }
-        let down = (-exp).min(10) as u32;
-        (self.sig as u64 / 10u64.pow(down)) as u32
+        match (-exp) as u32 {
+            // `sig` fits 32 bits, and so do powers of ten up to 10^9.
+            down @ 0..=9 => self.sig / 10u32.pow(down),
+            _ => 0,
+        }
     }
 }
 
 /// Largest axis value in nanometres: ±9.2 × 10^15, far past any machine
 /// and still summable without overflow.
 pub const NANO_LIMIT: i64 = i64::MAX >> 10;
+// `scaled` multiplies values below its limit by ten unchecked.
+const _: () = assert!(NANO_LIMIT as u64 <= u64::MAX / 10);
 
 /// Reads a whole fixed-point number such as a `$` setting's value
 /// (`"-2.5"` → `Milli(-2500)`); `None` if it is not one.
@@ -272,5 +284,32 @@ mod tests {
         assert_eq!(read("1.5").whole(), 1);
         assert_eq!(read("12345678901").whole(), u32::MAX);
         assert_eq!(read("255.9").whole(), 255);
+    }
+
+    /// `value × 10^shift` rounded half away from zero and saturated,
+    /// worked out in 128 bits.
+    fn scaled_wide(n: &Number, shift: i8, limit: u64) -> u64 {
+        let exp = n.exp as i32 + shift as i32;
+        let v = n.sig as u128;
+        let r = if exp >= 0 {
+            v.saturating_mul(10u128.saturating_pow(exp as u32))
+        } else if exp < -30 {
+            0
+        } else {
+            let p = 10u128.pow((-exp) as u32);
+            (v + p / 2) / p
+        };
+        r.min(limit as u128) as u64
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn scaled_is_the_wide_product_s(sig in 0u32..=1_000_000_000, exp in -60i8..=60, shift in 0i8..=6, wide in proptest::bool::ANY) {
+            let n = Number { sig, exp, flags: DIGITS };
+            let limit = if wide { NANO_LIMIT as u64 } else { u32::MAX as u64 };
+            proptest::prop_assert_eq!(n.scaled(shift, limit), scaled_wide(&n, shift, limit));
+            let trunc = if exp >= 0 { scaled_wide(&n, 0, u32::MAX as u64) } else if exp < -10 { 0 } else { (sig as u64 / 10u64.pow((-exp) as u32)).min(u32::MAX as u64) };
+            proptest::prop_assert_eq!(n.whole() as u64, trunc);
+        }
     }
 }

@@ -290,3 +290,23 @@ proptest! {
         prop_assert_eq!(totals, steps);
     }
 }
+
+proptest! {
+    /// A profile made over the one before (the preparer's, in place,
+    /// keeping what depends on the acceleration alone) is the profile
+    /// made afresh.
+    #[test]
+    fn a_profile_made_in_place_over_another_is_made_afresh(
+        events in 1u32..5000,
+        accel in 1u32..20_000,
+        speeds in proptest::array::uniform3(0u64..4_000_000_000),
+        before in proptest::array::uniform3(0u64..4_000_000_000),
+        same_accel in proptest::bool::ANY,
+    ) {
+        let s = |v: [u64; 3]| Speeds { entry_sqr: v[0], cruise_sqr: v[1], exit_sqr: v[2] };
+        let mut t = Trapezoid::new(events / 2 + 1, if same_accel { accel } else { accel + 7 }, &s(before));
+        t.begin_in_place(events, accel, &s(speeds));
+        while !t.advance() {}
+        prop_assert_eq!(t, Trapezoid::new(events, accel, &s(speeds)));
+    }
+}

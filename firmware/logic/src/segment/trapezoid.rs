@@ -151,13 +151,22 @@ impl Trapezoid {
             .min((v0_sqr + v1_sqr + two_ae) / 2)
             .max(v0_sqr)
             .max(v1_sqr);
+        let shift = (64 - (64 - peak.leading_zeros())) / 2;
+        // `per_speed` depends on the acceleration alone, its shift also
+        // on the scale: kept from the block before when the acceleration
+        // is the same (a `u64` division less a block); 0 asks for it.
+        if self.accel == a && self.per_speed != 0 {
+            self.per_speed_shift = self.per_speed_shift - self.shift + shift;
+        } else {
+            self.per_speed = 0;
+        }
         self.events = events;
         self.accel = a;
         self.two_a = two_a;
         self.v0_sqr = v0_sqr;
         self.v1_sqr = v1_sqr;
         self.cruise_sqr = cruise_sqr;
-        self.shift = (64 - (64 - peak.leading_zeros())) / 2;
+        self.shift = shift;
         self.acc2 = peak - v0_sqr;
         self.dec2 = peak - v1_sqr;
         // The rest is made by `advance`, in order.
@@ -174,16 +183,31 @@ impl Trapezoid {
             // The roots (~6 000 cycles each on the AVR), two parts: three
             // in one kept a ready task waiting ~19 000 cycles. The
             // peak's scaled speed waits in `cruise_iv`.
+            // A block that cruises through (a stream of short moves at
+            // speed) has one root, not three.
             1 => {
                 self.cruise_iv = self.scaled_speed(self.v0_sqr + self.acc2);
-                self.s0 = self.scaled_speed(self.v0_sqr);
+                self.s0 = match self.acc2 {
+                    0 => self.cruise_iv,
+                    _ => self.scaled_speed(self.v0_sqr),
+                };
             }
-            2 => self.s1 = self.scaled_speed(self.v1_sqr),
+            2 => {
+                self.s1 = if self.dec2 == 0 {
+                    self.cruise_iv
+                } else if self.v1_sqr == self.v0_sqr {
+                    self.s0
+                } else {
+                    self.scaled_speed(self.v1_sqr)
+                }
+            }
             3 => {
                 let sp = self.cruise_iv;
-                let (per_speed, per_speed_shift) = per_speed(self.accel as u32, self.shift);
-                self.per_speed = per_speed;
-                self.per_speed_shift = per_speed_shift;
+                if self.per_speed == 0 {
+                    (self.per_speed, self.per_speed_shift) =
+                        per_speed(self.accel as u32, self.shift);
+                }
+                let (per_speed, per_speed_shift) = (self.per_speed, self.per_speed_shift);
                 // Q / a = per_speed / 2^(per_speed_shift - shift), below 2^33.
                 self.stop_per_speed =
                     (per_speed >> (per_speed_shift - self.shift)).min(u32::MAX as u64) as u32;
@@ -196,8 +220,16 @@ impl Trapezoid {
                 let sp = self.t_end;
                 self.t_dec = self.t_acc + self.cruise_time(two_ae - self.acc2 - self.dec2);
                 self.t_end = self.t_dec + self.ramp_time(sp, self.s1);
-                self.k_acc = (self.acc2 / self.two_a) as u32;
-                self.k_dec = self.events - self.dec2.div_ceil(self.two_a) as u32;
+                // Quotients below `events`, by `2a` < 2^26: 32-bit
+                // divisions, none for a block without that ramp.
+                self.k_acc = match self.acc2 {
+                    0 => 0,
+                    acc2 => div_to_u32(acc2, self.two_a as u32),
+                };
+                self.k_dec = match self.dec2 {
+                    0 => self.events,
+                    dec2 => self.events - div_to_u32(dec2 + self.two_a - 1, self.two_a as u32),
+                };
                 self.part = 0;
                 return true;
             }

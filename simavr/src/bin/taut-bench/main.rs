@@ -18,6 +18,8 @@ use taut_logic::machine::Machine;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
+mod stream;
+
 /// Timer3 COMPA vector (byte address): the step interrupt.
 const STEP_VECTOR: u32 = 0x80;
 const TOLERANCE_US: f64 = 2.0;
@@ -633,6 +635,17 @@ fn feed_figures(elf: &Path, f: &mut Map<String, Value>) {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if let [flag, fw, rest @ ..] = &args[..] {
+        if flag == "--stream" {
+            let mut f = Map::new();
+            stream::stream_figures(Path::new(fw), &mut f, rest.first().map(String::as_str));
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&Value::Object(f)).unwrap()
+            );
+            return;
+        }
+    }
     if let [flag, fw] = &args[..] {
         if flag == "--feed" {
             let mut f = Map::new();
@@ -741,6 +754,7 @@ fn main() {
     f.insert("cpu_busy_percent_winding".into(), json!(round(winding, 1)));
     f.insert("segment_prep_max_cycles".into(), json!(prep));
     feed_figures(fw, &mut f);
+    stream::stream_figures(fw, &mut f, None);
     let (mhz, wall) = demo_job(fw, &card);
     f.insert("sim_mhz".into(), json!(round(mhz, 1)));
     f.insert("demo_wall_s".into(), json!(round(wall, 2)));
