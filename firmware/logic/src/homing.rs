@@ -7,30 +7,6 @@
 use crate::axis::{PerAxis, AXES};
 use crate::config::MachineConfig;
 
-/// Homing's figures (Grbl's `$24`–`$27`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct HomingConfig {
-    /// Bit `i`: channel `i` homes against its MIN switch.
-    pub axes: u8,
-    /// Home them at power-on (the flatbed's X).
-    pub at_start: bool,
-    /// Seeking and locating rates, steps/s.
-    pub seek: u16,
-    pub locate: u16,
-    /// How far off the switch the axis ends, µm.
-    pub pull_off_um: u16,
-}
-
-impl HomingConfig {
-    pub const NONE: HomingConfig = HomingConfig {
-        axes: 0,
-        at_start: false,
-        seek: 1000,
-        locate: 100,
-        pull_off_um: 1000,
-    };
-}
-
 /// A move of one axis, `steps` from where it stands, at `rate` steps/s;
 /// with `until_closed` it stops at once when its switch closes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
