@@ -1,7 +1,7 @@
 //! What the job hears ([`Event`]) and what it asks the firmware to do
 //! ([`Action`]), with the texts the firmware logs.
 
-use super::phase::Phase;
+use crate::stringart::Phase;
 use super::progress::Progress;
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;

@@ -3,7 +3,7 @@
 //! machine in a safe pose (drill raised, needle inside the ring) with a
 //! whole number of units done, and a pause stops there at the latest.
 
-use super::phase::Phase;
+use crate::stringart::Phase;
 use super::progress::Reporter;
 use crate::checkpoint::Record;
 use crate::stringart::{BlendWinder, BlendWrap, Drilling, MachineStep, Save};
