@@ -7,7 +7,7 @@
 //! request changes, never across an `await`.
 
 use super::job::Run;
-use super::link::Link;
+use super::link::{Link, Listener};
 use super::words;
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -400,6 +400,15 @@ fn remember_setting(settings: &mut Vec<String>, setting: &str) {
     {
         Some(old) => *old = line,
         None => settings.push(line),
+    }
+}
+
+impl Listener for Hub {
+    fn on_line(&self, line: &str) {
+        Hub::on_line(self, line)
+    }
+    fn lost_now(&self, why: &str) {
+        Hub::lost_now(self, why)
     }
 }
 

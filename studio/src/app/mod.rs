@@ -20,7 +20,7 @@ pub mod tools;
 mod web;
 mod words;
 
-use crate::cli::AnyMachine;
+use crate::args::AnyMachine;
 pub use api::UPLOAD_LIMIT;
 use hub::Hub;
 use serde_json::json;

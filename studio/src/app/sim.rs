@@ -133,7 +133,7 @@ fn serve(
     ready: &mpsc::Sender<Result<(), String>>,
 ) {
     use taut_logic::config::MachineConfig;
-    use taut_logic::settings::record::host;
+    use taut_logic::settings::eeprom::host;
     use taut_simavr::{pty::Pty, sdcard::SdImage, sdimage::FatChoice, Sim};
     let mut sim = match Sim::load(elf) {
         Ok(sim) => sim,

@@ -14,7 +14,7 @@ use crate::stringart::card::{self, Spec};
 use crate::stringart::{self, picture};
 use crate::toolpath::{self, Toolpath};
 use crate::vectorize::{self, Mode};
-use crate::{plot, preview, progress, template, text};
+use crate::{plot, progress, template, text};
 use base64::Engine;
 use serde_json::{json, Value};
 use std::collections::HashMap;
@@ -119,7 +119,7 @@ fn drawing(gcode: String, path: &Toolpath, machine: Machine) -> Value {
         "pen_up_mm": up,
         "bounds": [lo, hi],
         "toolpath": moves,
-        "preview_png": png_base64(&preview::png(path, 600)),
+        "preview_png": png_base64(&crate::render::png(path, 600)),
         "gcode": gcode,
     })
 }

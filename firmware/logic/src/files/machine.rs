@@ -39,7 +39,8 @@ impl MachineFile {
 
     pub fn push(&mut self, chunk: &[u8]) -> Result<(), FileError> {
         let (cfg, seen) = (&mut self.cfg, &mut self.seen);
-        self.kv.push_chunk(chunk, &mut |item| apply(cfg, seen, item))
+        self.kv
+            .push_chunk(chunk, &mut |item| apply(cfg, seen, item))
     }
 
     /// The configuration with the file's overrides, checked as a whole.
@@ -65,11 +66,7 @@ impl MachineFile {
     }
 }
 
-fn apply(
-    cfg: &mut MachineConfig,
-    seen: &mut [u8; SEEN],
-    item: Item<'_>,
-) -> Result<(), FileError> {
+fn apply(cfg: &mut MachineConfig, seen: &mut [u8; SEEN], item: Item<'_>) -> Result<(), FileError> {
     let at_key = |kind| FileError::at(FILE, item.line, item.key_col, kind);
     let Some(setting) = Setting::parse(item.key, cfg.machine) else {
         return Err(at_key(ErrorKind::UnknownKey));
