@@ -26,7 +26,7 @@ use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::planner::{Feed, Full};
 use taut_logic::stringart::job::{
-    Action, Actions, Event, Feeder, Feeding, Job, Machine, Phase, State,
+    Action, Actions, Event, Feeder, Feeding, Hardware, Job, Phase, State,
 };
 use taut_logic::stringart::Save;
 
@@ -532,7 +532,7 @@ struct Rig<'a> {
     store: &'a mut Store,
 }
 
-impl Machine for Rig<'_> {
+impl Hardware for Rig<'_> {
     fn target(&self) -> PerAxis<i32> {
         self.m.target()
     }

@@ -47,7 +47,7 @@ mod progress;
 pub mod tools;
 
 pub use super::Phase;
-pub use feed::{Feeder, Feeding, Machine, SAVE_POLL_MS};
+pub use feed::{Feeder, Feeding, Hardware, SAVE_POLL_MS};
 pub use io::{Action, Actions, Event, Msg, Prompt, State, PROMPT_MARK};
 pub use phase_steps::FEED;
 pub use progress::{left_s, Progress};
