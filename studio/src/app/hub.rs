@@ -6,8 +6,8 @@
 //! One lock (`Inner`) guards it all; it is held only for what a reply or a
 //! request changes, never across an `await`.
 
-use super::job::Run;
 use super::link::{Link, Listener};
+use super::run::Run;
 use super::words;
 use serde::Serialize;
 use serde_json::{json, Value};
