@@ -22,7 +22,6 @@ use crate::hooks::SpmGuard;
 use crate::sim::Sim;
 use crate::{Error, Result};
 use simavr_ffi as ffi;
-use std::os::raw::{c_int, c_void};
 use std::path::Path;
 
 /// Bytes of flash of the ATmega2560.
