@@ -25,7 +25,7 @@ use taut_logic::files::poradi::PoradiReader;
 use taut_logic::files::{FileError, FileName};
 use taut_logic::planner::{Feed, Full};
 use taut_logic::stringart::job::{
-    Action, Actions, BadBoard, Event, Feeder, Feeding, Job, Machine, Msg, Phase, State,
+    Action, Actions, BadBoard, Event, Feeder, Feeding, Hardware, Job, Msg, Phase, State,
 };
 use taut_logic::stringart::Save;
 
@@ -535,7 +535,7 @@ struct Rig<'a> {
     store: &'a mut Store,
 }
 
-impl Machine for Rig<'_> {
+impl Hardware for Rig<'_> {
     fn target(&self) -> PerAxis<i32> {
         self.m.target()
     }

@@ -24,11 +24,10 @@ use taut_logic::config::MachineConfig;
 use taut_logic::coords::{CoordData, Slot};
 use taut_logic::files::check::CardId;
 use taut_logic::machine::Machine;
+use taut_logic::settings::eeprom::{self, area, marker_byte, text_part, Layout, MARKER, TEXT};
 use taut_logic::settings::grbl::Extras;
 use taut_logic::settings::image::{self, legacy, Unusable};
-use taut_logic::settings::record::{
-    self, area, marker_byte, text_part, Layout, Loaded, Part, Step, Writer, MARKER, TEXT,
-};
+use taut_logic::settings::record::{self, Loaded, Part, Step, Writer};
 use taut_logic::stringart::job::Phase;
 use taut_logic::units::Milli;
 
@@ -36,9 +35,9 @@ use taut_logic::units::Milli;
 /// short, as every task waits behind it.
 const PARTS_PER_RUN: u8 = 2;
 
-/// The records, by index ([`record::area`]): a bit each in
+/// The records, by index ([`eeprom::area`]): a bit each in
 /// [`Store::due`].
-const RECORDS: usize = record::RECORDS;
+const RECORDS: usize = eeprom::RECORDS;
 const SETTINGS_I: u8 = 0;
 const COORDS_I: u8 = 1;
 /// The layout marker: written last on a new or upgraded chip.
@@ -167,7 +166,7 @@ impl Store {
         // the records and the version-6 image.
         let from =
             |at: u16, inverted: bool| move |i: u16| read(at + i) ^ if inverted { 0xFF } else { 0 };
-        let layout = record::layout(&read);
+        let layout = eeprom::layout(&read);
         let current = layout == Layout::Current;
         *upgrading = !current;
         extras.reset();

@@ -270,7 +270,7 @@ fn the_picture_counts_from_the_homed_zero_not_from_power_on() {
     use hil_tests::wait_for;
     use taut_logic::config::MachineConfig;
     use taut_logic::pinmap::Button;
-    use taut_logic::settings::record::host;
+    use taut_logic::settings::eeprom::host;
     let cfg = MachineConfig::defaults(Machine::Flatbed);
     let mut sim = hil_tests::load();
     sim.set_eeprom(&host::eeprom(

@@ -12,9 +12,10 @@ use std::time::Duration;
 use taut_logic::config::{Driver, MachineConfig, KEEP_DRIVERS_ON};
 use taut_logic::coords::CoordData;
 use taut_logic::machine::Machine;
+use taut_logic::settings::eeprom::{host, MARKER, SETTINGS};
 use taut_logic::settings::grbl::Extras;
 use taut_logic::settings::image::{self, legacy};
-use taut_logic::settings::record::{host, Writer, HEAD, MARKER, SETTINGS};
+use taut_logic::settings::record::{Writer, HEAD};
 use taut_logic::settings::set;
 
 fn send(sim: &mut Sim, line: &str) {

@@ -18,9 +18,10 @@ use std::time::Duration;
 use taut_logic::config::MachineConfig;
 use taut_logic::coords::{CoordData, Slot};
 use taut_logic::machine::Machine;
+use taut_logic::settings::eeprom::{host, COORDS, SETTINGS};
 use taut_logic::settings::grbl::{Extras, Numbered};
 use taut_logic::settings::image;
-use taut_logic::settings::record::{host, Writer, COORDS, SETTINGS};
+use taut_logic::settings::record::Writer;
 use taut_logic::units::Milli;
 
 /// The store task's longest run (0.5 ms at 16 MHz): it compares a few

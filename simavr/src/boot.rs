@@ -18,23 +18,15 @@
 //! programmed word: a board without an application is back in its
 //! bootloader a few milliseconds after the bootloader gives up waiting.
 
+use crate::hooks::SpmGuard;
 use crate::sim::Sim;
 use crate::{Error, Result};
 use simavr_ffi as ffi;
-use std::os::raw::{c_int, c_void};
 use std::path::Path;
 
 /// Bytes of flash of the ATmega2560.
 pub const FLASH_BYTES: u32 = 0x4_0000;
 
-/// SPMCSR in data space, and its bits.
-const SPMCSR: usize = 0x57;
-const SPMEN: u8 = 1 << 0;
-const PGERS: u8 = 1 << 1;
-const PGWRT: u8 = 1 << 2;
-/// RAMPZ and Z in data space.
-const RAMPZ: usize = 0x5B;
-const ZL: usize = 30;
 /// MCUSR in data space, and its external reset flag.
 const MCUSR: usize = 0x54;
 const EXTRF: u8 = 1 << 1;
@@ -107,62 +99,6 @@ pub fn read_hex(path: &Path) -> Result<Vec<(u32, Vec<u8>)>> {
     Ok(runs)
 }
 
-/// The simavr I/O module that sees each SPM before simavr's flash module.
-/// `repr(C)` with the module first: simavr hands its ioctl a pointer to it.
-#[repr(C)]
-pub(crate) struct SpmGuard {
-    io: ffi::avr_io_t,
-    boot_start: u32,
-    locked: bool,
-}
-
-/// simavr's ioctl code of an SPM (`AVR_IOCTL_DEF('f','s','p','m')`).
-const IOCTL_SPM: u32 = u32::from_be_bytes(*b"fspm");
-
-/// # Safety
-/// Called by simavr's `avr_ioctl` with `port` the `io` of a live,
-/// boxed `SpmGuard` attached to a live avr_t whose `custom.data` is its
-/// `Shared` (the `hooks` invariants).
-unsafe extern "C" fn guard_ioctl(port: *mut ffi::avr_io_t, ctl: u32, _p: *mut c_void) -> c_int {
-    if ctl != IOCTL_SPM {
-        return -1;
-    }
-    let guard = &mut *(port as *mut SpmGuard);
-    let avr = (*port).avr;
-    let data = (*avr).data;
-    let spmcsr = *data.add(SPMCSR);
-    if spmcsr & SPMEN == 0 {
-        // Not enabled: simavr's module does nothing either.
-        return -1;
-    }
-    let z = u32::from_le_bytes([*data.add(ZL), *data.add(ZL + 1), *data.add(RAMPZ), 0]);
-    let from_application = (*avr).pc < guard.boot_start;
-    let writes_boot = spmcsr & (PGERS | PGWRT) != 0 && z >= guard.boot_start;
-    if from_application || (guard.locked && writes_boot) {
-        // As the part: the SPM does nothing (SPMEN then clears itself; the
-        // flash module's own 4-cycle timer clears it too, and says so).
-        *data.add(SPMCSR) = spmcsr & !SPMEN;
-        (*((*avr).custom.data as *mut crate::hooks::Shared)).spm_refused += 1;
-        return 0;
-    }
-    -1
-}
-
-impl SpmGuard {
-    fn new(fuses: Fuses) -> Box<SpmGuard> {
-        // SAFETY: avr_io_t is plain C data: null pointers and no callbacks
-        // are valid, and simavr fills `next` and `avr` when it is attached.
-        let mut io: ffi::avr_io_t = unsafe { std::mem::zeroed() };
-        io.kind = c"spm-guard".as_ptr();
-        io.ioctl = Some(guard_ioctl);
-        Box::new(SpmGuard {
-            io,
-            boot_start: fuses.boot_start(),
-            locked: fuses.boot_section_locked(),
-        })
-    }
-}
-
 impl Sim {
     /// A Mega 2560 with the stock fuses and lock bits ([`Fuses::MEGA2560`]):
     /// `bootloader` (an Intel hex file, e.g. Debian's
@@ -192,7 +128,7 @@ impl Sim {
         for (at, mut bytes) in runs {
             sim.load_flash(at, &mut bytes);
         }
-        let mut guard = SpmGuard::new(fuses);
+        let mut guard = SpmGuard::new(boot_start, fuses.boot_section_locked());
         let avr = sim.avr_raw();
         // SAFETY: `avr` is live; the guard is boxed (stable address) and
         // kept in the Sim until it drops, after avr_terminate has unlinked

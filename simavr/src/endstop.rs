@@ -3,12 +3,7 @@
 //! pins, stands at or below a position, as a MIN end-stop does when the
 //! carriage reaches it.
 
-use crate::sim::Sim;
-use taut_logic::axis::Axis;
-use taut_logic::config::MachineConfig;
-use taut_logic::machine::Machine;
-use taut_logic::pinmap::{self, Button};
-use taut_logic::units::Milli;
+use crate::probe::Probe;
 
 pub(crate) struct Endstop {
     switch: u8,
@@ -26,14 +21,18 @@ pub(crate) struct Endstop {
     tripped: bool,
 }
 
-impl Sim {
-    /// Fits a MIN end-stop on board pin `switch`: closed while the axis
-    /// driven by the STEP/DIR pair `step`/`dir` (both probed) stands at or
-    /// below `at` steps, counted from where it stood when they were probed.
-    pub fn endstop(&mut self, switch: u8, step: u8, dir: u8, dir_high_is_positive: bool, at: i64) {
+impl Endstop {
+    /// A MIN end-stop on board pin `switch`: closed while the axis driven
+    /// by the STEP/DIR pair `step`/`dir` stands at or below `at` steps.
+    pub(crate) fn new(
+        switch: u8,
+        step: u8,
+        dir: u8,
+        dir_high_is_positive: bool,
+        at: i64,
+    ) -> Endstop {
         let closed = at >= 0;
-        self.drive(switch, !closed);
-        self.endstops.push(Endstop {
+        Endstop {
             switch,
             step,
             dir,
@@ -43,139 +42,56 @@ impl Sim {
             position: 0,
             closed,
             tripped: closed,
-        });
-        self.update_endstops();
+        }
     }
 
-    /// Whether the end-stop on `switch` has ever closed (the axis was
-    /// homed against it, or stood on it).
-    pub fn endstop_tripped(&self, switch: u8) -> bool {
-        self.endstops
+    pub(crate) fn switch(&self) -> u8 {
+        self.switch
+    }
+
+    /// The STEP and DIR pins its axis is counted from.
+    pub(crate) fn pins(&self) -> (u8, u8) {
+        (self.step, self.dir)
+    }
+
+    pub(crate) fn closed(&self) -> bool {
+        self.closed
+    }
+
+    /// The switch has ever closed (the axis was homed against it, or
+    /// stood on it).
+    pub(crate) fn tripped(&self) -> bool {
+        self.tripped
+    }
+
+    /// The STEP edges since the last look, and the steps they moved the
+    /// axis by.
+    pub(crate) fn moved(&self, step: &Probe, dir: &Probe) -> (usize, i64) {
+        let edges = &step.edges()[self.seen..];
+        let moved = edges
             .iter()
-            .any(|e| e.switch == switch && e.tripped)
+            .filter(|edge| edge.high)
+            .map(
+                |edge| match dir.level_at(edge.cycle) == self.dir_high_is_positive {
+                    true => 1,
+                    false => -1,
+                },
+            )
+            .sum();
+        (edges.len(), moved)
     }
 
-    /// Moves every end-stop's axis by the STEP edges since the last look,
-    /// and opens or closes its switch.
-    pub(crate) fn update_endstops(&mut self) {
-        for i in 0..self.endstops.len() {
-            let e = &self.endstops[i];
-            let (step, dir) = (self.probe_of(e.step), self.probe_of(e.dir));
-            let edges = &step.edges()[e.seen..];
-            if edges.is_empty() {
-                continue;
-            }
-            let moved: i64 = edges
-                .iter()
-                .filter(|edge| edge.high)
-                .map(
-                    |edge| match dir.level_at(edge.cycle) == e.dir_high_is_positive {
-                        true => 1,
-                        false => -1,
-                    },
-                )
-                .sum();
-            let n = edges.len();
-            let e = &mut self.endstops[i];
-            e.seen += n;
-            e.position += moved;
-            let closed = e.position <= e.at;
-            if closed != e.closed {
-                e.closed = closed;
-                e.tripped |= closed;
-                let pin = e.switch;
-                self.drive(pin, !closed);
-            }
+    /// Counts `edges` STEP edges that moved the axis `moved` steps; the
+    /// switch's new state when it opened or closed.
+    pub(crate) fn advance(&mut self, edges: usize, moved: i64) -> Option<bool> {
+        self.seen += edges;
+        self.position += moved;
+        let closed = self.position <= self.at;
+        if closed == self.closed {
+            return None;
         }
-    }
-}
-
-/// The MIN switches fitted for a machine's homing axes: per drawing motor,
-/// its switch pin and where it closes (steps from power-on).
-pub struct MachineEndstops([Option<(u8, i32)>; 2]);
-
-impl Sim {
-    /// Probes with the documented signal names: `<channel>_step|dir|en`
-    /// (the machine's channel names), `btn_<button>`, `pen_pwm`, `led`.
-    pub fn probe_machine(&mut self, machine: Machine) {
-        for axis in [Axis::Base, Axis::Radial, Axis::Drill] {
-            let d = pinmap::driver(axis);
-            let name = machine.channel(axis).to_string();
-            self.probe_step_dir(&name, d.step, d.dir, true);
-            self.probe(d.enable, &format!("{name}_en"));
-        }
-        for b in Button::ALL {
-            self.probe(b.pin(), &format!("btn_{}", b.name()));
-        }
-        self.probe(pinmap::PEN_SERVO, "pen_pwm");
-        self.probe(pinmap::STATUS_LED, "led");
-        self.probe_coils();
-    }
-
-    /// Probes every channel's ULN2003 inputs as `x_in1`..`x_in4`,
-    /// `y_in*`, `z_in*` ([`crate::coils`] reads them back).
-    pub fn probe_coils(&mut self) {
-        for (axis, pins) in pinmap::COILS.iter().enumerate() {
-            for (pin, name) in pins.iter().zip(crate::coils::names(axis)) {
-                self.probe(*pin, &name);
-            }
-        }
-    }
-
-    /// The half-steps of channel `axis`'s coils (0 X, 1 Y, 2 Z), probed
-    /// by [`Sim::probe_coils`].
-    pub fn coil_track(&self, axis: usize) -> crate::coils::CoilTrack {
-        let names = crate::coils::names(axis);
-        let probes: [&crate::probe::Probe; 4] = std::array::from_fn(|k| self.probed(&names[k]));
-        let edges = probes.map(|p| {
-            p.edges()
-                .iter()
-                .map(|e| (e.cycle, e.high))
-                .collect::<Vec<_>>()
-        });
-        crate::coils::CoilTrack::decode(std::array::from_fn(|k| {
-            (probes[k].initial(), edges[k].as_slice())
-        }))
-    }
-
-    /// The MIN switches of `cfg`'s homing axes, `mm` below where each
-    /// stands at power-on (a plotter's X_MIN, Y_MIN, Z_MIN inputs); its
-    /// pins probed first.
-    pub fn fit_machine_endstops(&mut self, cfg: &MachineConfig, mm: f64) -> MachineEndstops {
-        let min_inputs = [Button::ZeroBase, Button::ZeroRadial, Button::ZeroDrill];
-        let mut fitted = [None; 2];
-        for (i, input) in min_inputs.into_iter().enumerate() {
-            if cfg.homing.axes & (1 << i) == 0 {
-                continue;
-            }
-            let d = pinmap::driver(Axis::ALL[i]);
-            let at = cfg.axes[i]
-                .steps_per_unit
-                .steps(Milli((-mm * 1000.0) as i32));
-            self.endstop(input.pin(), d.step, d.dir, true, i64::from(at));
-            if let Some(f) = fitted.get_mut(i) {
-                *f = Some((input.pin(), at));
-            }
-        }
-        MachineEndstops(fitted)
-    }
-}
-
-impl MachineEndstops {
-    /// Where the drawing motors stood at power-on in the machine's own
-    /// coordinates: a motor homed against its switch counts from the end
-    /// of its travel there (as the firmware does once homed), the others
-    /// from zero.
-    pub fn power_on_origin(&self, sim: &Sim, cfg: &MachineConfig) -> [i32; 2] {
-        let mut origin = [0; 2];
-        for (i, f) in self.0.iter().enumerate() {
-            if let Some((switch, at)) = *f {
-                if sim.endstop_tripped(switch) {
-                    let a = &cfg.axes[i];
-                    origin[i] = a.steps_per_unit.steps(a.travel.0) - at;
-                }
-            }
-        }
-        origin
+        self.closed = closed;
+        self.tripped |= closed;
+        Some(closed)
     }
 }

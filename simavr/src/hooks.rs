@@ -15,8 +15,9 @@
 use crate::probe::Probe;
 use crate::sdcard::slot::Slot;
 use crate::serial::SerialLine;
+use simavr_ffi as ffi;
 use simavr_ffi::{avr_irq_t, avr_t};
-use std::os::raw::c_void;
+use std::os::raw::{c_int, c_void};
 
 pub(crate) struct Shared {
     avr: *mut avr_t,
@@ -438,6 +439,116 @@ fn plain(text: &str) -> String {
         }
     }
     out
+}
+
+// The EEPROM watch of `power`.
+
+/// EEAR's data address.
+const EEARL: usize = 0x41;
+const EEARH: usize = 0x42;
+/// EECR: EEMPE and EEPE together start a byte's write.
+const START_WRITE: u8 = 0b110;
+
+/// What the EECR hook saw.
+#[derive(Default)]
+pub(crate) struct EepromWatch {
+    /// Byte writes started.
+    pub writes: u64,
+    /// The last one: address, and simavr's cycle counter then.
+    pub last: Option<(u16, u64)>,
+}
+
+/// Called after simavr's own EEPROM module for every write to EECR.
+///
+/// # Safety
+/// `param` is the `EepromWatch` boxed in the `Sim` that owns `avr`, which
+/// outlives the avr_t's callbacks; `avr` is that live avr_t.
+pub(crate) unsafe extern "C" fn on_eecr(
+    avr: *mut ffi::avr_t,
+    _addr: u16,
+    v: u8,
+    param: *mut c_void,
+) {
+    if v & START_WRITE != START_WRITE {
+        return;
+    }
+    // SAFETY: see the function's contract; `data` spans the I/O space.
+    unsafe {
+        let w = &mut *(param as *mut EepromWatch);
+        let data = (*avr).data;
+        let at = u16::from_le_bytes([*data.add(EEARL), *data.add(EEARH)]) & 0x0FFF;
+        w.writes += 1;
+        w.last = Some((at, (*avr).cycle));
+    }
+}
+
+// The SPM guard of `boot`.
+
+/// SPMCSR in data space, and its bits.
+const SPMCSR: usize = 0x57;
+const SPMEN: u8 = 1 << 0;
+const PGERS: u8 = 1 << 1;
+const PGWRT: u8 = 1 << 2;
+/// RAMPZ and Z in data space.
+const RAMPZ: usize = 0x5B;
+const ZL: usize = 30;
+
+/// The simavr I/O module that sees each SPM before simavr's flash module.
+/// `repr(C)` with the module first: simavr hands its ioctl a pointer to it.
+#[repr(C)]
+pub(crate) struct SpmGuard {
+    pub(crate) io: ffi::avr_io_t,
+    boot_start: u32,
+    locked: bool,
+}
+
+/// simavr's ioctl code of an SPM (`AVR_IOCTL_DEF('f','s','p','m')`).
+const IOCTL_SPM: u32 = u32::from_be_bytes(*b"fspm");
+
+/// # Safety
+/// Called by simavr's `avr_ioctl` with `port` the `io` of a live,
+/// boxed `SpmGuard` attached to a live avr_t whose `custom.data` is its
+/// `Shared` (the `hooks` invariants).
+unsafe extern "C" fn guard_ioctl(port: *mut ffi::avr_io_t, ctl: u32, _p: *mut c_void) -> c_int {
+    if ctl != IOCTL_SPM {
+        return -1;
+    }
+    let guard = &mut *(port as *mut SpmGuard);
+    let avr = (*port).avr;
+    let data = (*avr).data;
+    let spmcsr = *data.add(SPMCSR);
+    if spmcsr & SPMEN == 0 {
+        // Not enabled: simavr's module does nothing either.
+        return -1;
+    }
+    let z = u32::from_le_bytes([*data.add(ZL), *data.add(ZL + 1), *data.add(RAMPZ), 0]);
+    let from_application = (*avr).pc < guard.boot_start;
+    let writes_boot = spmcsr & (PGERS | PGWRT) != 0 && z >= guard.boot_start;
+    if from_application || (guard.locked && writes_boot) {
+        // As the part: the SPM does nothing (SPMEN then clears itself; the
+        // flash module's own 4-cycle timer clears it too, and says so).
+        *data.add(SPMCSR) = spmcsr & !SPMEN;
+        (*((*avr).custom.data as *mut Shared)).spm_refused += 1;
+        return 0;
+    }
+    -1
+}
+
+impl SpmGuard {
+    /// Refuses an SPM from below `boot_start`, and (when `locked`) one
+    /// that erases or writes a page at or above it.
+    pub(crate) fn new(boot_start: u32, locked: bool) -> Box<SpmGuard> {
+        // SAFETY: avr_io_t is plain C data: null pointers and no callbacks
+        // are valid, and simavr fills `next` and `avr` when it is attached.
+        let mut io: ffi::avr_io_t = unsafe { std::mem::zeroed() };
+        io.kind = c"spm-guard".as_ptr();
+        io.ioctl = Some(guard_ioctl);
+        Box::new(SpmGuard {
+            io,
+            boot_start,
+            locked,
+        })
+    }
 }
 
 #[cfg(test)]

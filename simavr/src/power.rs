@@ -9,46 +9,15 @@
 //! byte's start, which leaves that byte torn: [`Sim::eeprom_after_cut`]
 //! puts the value given (erased 0xFF, a half-written pattern) in its place.
 
+use crate::hooks::{on_eecr, EepromWatch};
 use crate::Sim;
 use simavr_ffi as ffi;
 use std::os::raw::c_void;
 
-/// EECR's data address, and EEAR's.
+/// EECR's data address.
 const EECR: u16 = 0x3F;
-const EEARL: usize = 0x41;
-const EEARH: usize = 0x42;
-/// EECR: EEMPE and EEPE together start a byte's write.
-const START_WRITE: u8 = 0b110;
 /// Cycles an EEPROM byte takes to erase and write (3.4 ms at 16 MHz).
 pub const WRITE_CYCLES: u64 = 54_400;
-
-/// What the EECR hook saw.
-#[derive(Default)]
-pub(crate) struct EepromWatch {
-    /// Byte writes started.
-    pub writes: u64,
-    /// The last one: address, and simavr's cycle counter then.
-    pub last: Option<(u16, u64)>,
-}
-
-/// Called after simavr's own EEPROM module for every write to EECR.
-///
-/// # Safety
-/// `param` is the `EepromWatch` boxed in the `Sim` that owns `avr`, which
-/// outlives the avr_t's callbacks; `avr` is that live avr_t.
-unsafe extern "C" fn on_eecr(avr: *mut ffi::avr_t, _addr: u16, v: u8, param: *mut c_void) {
-    if v & START_WRITE != START_WRITE {
-        return;
-    }
-    // SAFETY: see the function's contract; `data` spans the I/O space.
-    unsafe {
-        let w = &mut *(param as *mut EepromWatch);
-        let data = (*avr).data;
-        let at = u16::from_le_bytes([*data.add(EEARL), *data.add(EEARH)]) & 0x0FFF;
-        w.writes += 1;
-        w.last = Some((at, (*avr).cycle));
-    }
-}
 
 impl Sim {
     /// Watch the EEPROM's byte writes from now on (for power cuts in the

@@ -86,7 +86,7 @@ pub struct Sim {
     /// Cycles per program word, when asked for ([`Sim::enable_profile`]).
     pub(crate) profile: Option<crate::profile::Profile>,
     /// EEPROM byte writes, when watched (`power`).
-    pub(crate) eeprom_watch: Option<Box<crate::power::EepromWatch>>,
+    pub(crate) eeprom_watch: Option<Box<crate::hooks::EepromWatch>>,
     /// The code as loaded (flash words from address 0, before any trap)
     /// and its function ranges: where a jump to 0 is traced back to.
     pub(crate) code: Vec<u16>,
@@ -97,7 +97,7 @@ pub struct Sim {
     end_checks: Vec<fn(&Sim)>,
     /// The lock bits' and the boot section's rules on SPM, on a board with
     /// a bootloader (`boot`).
-    pub(crate) spm_guard: Option<Box<crate::boot::SpmGuard>>,
+    pub(crate) spm_guard: Option<Box<crate::hooks::SpmGuard>>,
     /// RESET pin pulses so far (`Sim::reset_external`).
     pub(crate) external_resets: u32,
 }

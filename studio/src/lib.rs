@@ -9,6 +9,7 @@
 //! the web app over all of them and the machine's serial port.
 
 pub mod app;
+pub mod args;
 pub mod bench;
 pub mod board;
 pub mod cli;
@@ -19,6 +20,7 @@ pub mod plot;
 pub mod preview;
 pub mod progress;
 pub mod raster;
+pub mod render;
 pub mod send;
 pub mod stringart;
 pub mod svg;

@@ -146,6 +146,22 @@ fn temporary(path: &Path, bytes: &[u8]) -> Result<tempfile::NamedTempFile, Strin
     Ok(tmp)
 }
 
+/// `png` or `svg`, from the picture's name; anything else is refused.
+pub fn picture_extension(out: &Path) -> Result<String, String> {
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "png" | "svg" => Ok(ext),
+        _ => Err(format!(
+            "{}: the picture must be .png or .svg",
+            out.display()
+        )),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -19,7 +19,7 @@
 mod port;
 pub mod stream;
 
-use crate::cli::AnyMachine;
+use crate::args::AnyMachine;
 use indicatif::{ProgressBar, ProgressStyle};
 use port::Port;
 use std::io::Read;

@@ -77,7 +77,7 @@ pub struct Cli {
     #[arg(long, default_value_t = 1.0)]
     pub zoom: f64,
     /// Move the ring over the picture X,Y, fractions of its shorter side (x right, y up)
-    #[arg(long, value_parser = crate::cli::pair, default_value = "0,0", allow_hyphen_values = true)]
+    #[arg(long, value_parser = crate::args::pair, default_value = "0,0", allow_hyphen_values = true)]
     pub offset: [f64; 2],
     /// Contrast about mid-grey (1: as it is; 2: twice)
     #[arg(long, default_value_t = 1.0)]
@@ -103,7 +103,7 @@ pub struct BoardArgs {
     #[arg(long, value_parser = shape)]
     pub shape: u16,
     /// The board's radius (the ring's; a polygon's corner), cm
-    #[arg(long, value_parser = crate::cli::positive)]
+    #[arg(long, value_parser = crate::args::positive)]
     pub radius_cm: f64,
 }
 

@@ -68,6 +68,14 @@ pub fn escape(text: &str) -> String {
         .replace('>', "&gt;")
 }
 
+/// An SVG document, by its bytes (not its name).
+pub fn is_svg(bytes: &[u8]) -> bool {
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(512)]).to_ascii_lowercase();
+    head.contains("<svg")
+        || (head.trim_start().starts_with("<?xml")
+            && String::from_utf8_lossy(bytes).contains("<svg"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

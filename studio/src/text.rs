@@ -8,11 +8,11 @@
 //! glyph to the bottom of the deepest). The pen lifts between strokes; the
 //! text's ink starts at `--at` (its lower left corner).
 
-use crate::cli::{pair, Plotter};
+use crate::args::{pair, Plotter};
 use crate::hershey::{Font, Shape, BASE_LINE, CAP_LINE};
+use crate::plot;
 use crate::toolpath::Toolpath;
 use crate::vectorize::trace::Polyline;
-use crate::{plot, preview};
 use std::path::PathBuf;
 use taut_logic::machine::Machine;
 
@@ -31,7 +31,7 @@ pub struct Cli {
     #[arg(long, default_value = "futural")]
     pub font: String,
     /// Height of the capitals, mm
-    #[arg(long, value_parser = crate::cli::positive)]
+    #[arg(long, value_parser = crate::args::positive)]
     pub height_mm: f64,
     /// The G-code file
     #[arg(short = 'o', long = "output")]
@@ -40,7 +40,7 @@ pub struct Cli {
     #[arg(long, value_enum, default_value_t = Plotter::Flatbed)]
     pub machine: Plotter,
     /// Break lines between words before they pass this width, mm
-    #[arg(long, value_parser = crate::cli::positive)]
+    #[arg(long, value_parser = crate::args::positive)]
     pub wrap_mm: Option<f64>,
     /// The text's lower left corner X,Y, mm [default: the origin; the whiteboard: centred]
     #[arg(long, value_parser = pair, allow_hyphen_values = true)]
@@ -164,7 +164,7 @@ pub fn run(cli: Cli) -> Result<(), String> {
         .preview
         .unwrap_or_else(|| crate::output::derived(&out, "preview", "png"));
     crate::output::refuse_overwriting(&[], &[&out, &preview_path])?;
-    preview::extension(&preview_path)?;
+    crate::output::picture_extension(&preview_path)?;
     let placed = strokes(&font, &text, height, wrap, [0.0, 0.0])?;
     let (_, size) = crate::vectorize::bounds(&placed);
     let corner = at.unwrap_or_else(|| plot::default_corner(machine, size));
@@ -172,7 +172,10 @@ pub fn run(cli: Cli) -> Result<(), String> {
     let (gcode, path) = plot::plot(&shifted, machine, feed, &format!("taut text {text}"))?;
     let mut files = crate::output::Batch::new();
     files.add(&out, gcode.as_bytes());
-    files.add(&preview_path, preview::bytes(&path, &preview_path, 1000)?);
+    files.add(
+        &preview_path,
+        crate::render::bytes(&path, &preview_path, 1000)?,
+    );
     files.commit()?;
     report(&path, &out, &preview_path);
     Ok(())

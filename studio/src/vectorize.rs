@@ -25,11 +25,11 @@ pub mod svgfile;
 pub mod tone;
 pub mod trace;
 
-use crate::cli::{pair, positive, Plotter};
+use crate::args::{pair, positive, Plotter};
 use crate::gray::Gray;
 use crate::plot::Layer;
 use crate::toolpath::Toolpath;
-use crate::{plot, preview, progress};
+use crate::{plot, progress};
 use place::{Layout, Place};
 use std::path::{Path, PathBuf};
 use taut_logic::machine::Machine;
@@ -193,7 +193,7 @@ impl Source {
     /// A PNG, JPEG or SVG file, told apart by its bytes.
     pub fn open(path: &Path) -> Result<Source, String> {
         let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let source = match is_svg(&bytes) {
+        let source = match crate::svg::is_svg(&bytes) {
             true => svgfile::read(&bytes).map(Source::Svg),
             false => Gray::decode(&bytes)
                 .map(Source::Picture)
@@ -201,14 +201,6 @@ impl Source {
         };
         source.map_err(|e| format!("{}: {e}", path.display()))
     }
-}
-
-/// An SVG document, by its bytes (not its name).
-pub fn is_svg(bytes: &[u8]) -> bool {
-    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(512)]).to_ascii_lowercase();
-    head.contains("<svg")
-        || (head.trim_start().starts_with("<?xml")
-            && String::from_utf8_lossy(bytes).contains("<svg"))
 }
 
 /// What came out.
@@ -627,7 +619,7 @@ pub fn run(cli: Cli) -> Result<(), String> {
         .preview
         .unwrap_or_else(|| crate::output::derived(&out, "preview", "png"));
     crate::output::refuse_overwriting(&[&input], &[&out, &preview_path])?;
-    preview::extension(&preview_path)?;
+    crate::output::picture_extension(&preview_path)?;
 
     let source = Source::open(&input)?;
     let title = format!(
@@ -641,7 +633,7 @@ pub fn run(cli: Cli) -> Result<(), String> {
     files.add(&out, v.gcode.as_bytes());
     files.add(
         &preview_path,
-        preview::bytes(&v.toolpath, &preview_path, 1000)?,
+        crate::render::bytes(&v.toolpath, &preview_path, 1000)?,
     );
     files.commit()?;
     for w in &v.warnings {

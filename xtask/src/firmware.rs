@@ -6,7 +6,7 @@ use std::process::Command;
 
 /// Flash the firmware may use: 224 KiB of the 256, the bootloader owns
 /// the top.
-pub const FLASH_BUDGET: u64 = 229_376;
+pub const FLASH_BUDGET: u64 = crate::flashmap::BUDGET;
 /// Static RAM plus the deepest stack a HIL test sees: 5.5 KiB of the 8
 /// (the same bar as `hil_tests::RAM_BUDGET`, which each test checks).
 pub const RAM_BUDGET: u64 = 5_632;

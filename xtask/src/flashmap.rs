@@ -21,7 +21,7 @@ use object::{Object, ObjectSection, ObjectSymbol, RelocationFlags, RelocationTar
 use std::path::Path;
 
 /// Flash the image may use: 224 KiB.
-pub const BUDGET: u64 = crate::firmware::FLASH_BUDGET;
+pub const BUDGET: u64 = 229_376;
 /// The stock bootloader's section.
 pub const BOOT_START: u64 = 0x3_E000;
 /// Where the bootloader's watchdog path lands (word 0x10000).

@@ -4,6 +4,7 @@
 
 mod bench;
 mod bench_page;
+mod cycles;
 mod demo;
 mod estimate;
 mod firmware;
@@ -30,6 +31,7 @@ usage: cargo xtask <command> [args]
   fuzz [TARGET] [--seconds N] [--seed N]
                     build the libFuzzer targets and run each N seconds (default all,
                     40 s); `cargo xtask fuzz --help` lists the targets
+  cycles            the import cycles between each crate's modules (test runs it)
   simtest           build the firmware images and run the HIL tests in simavr
   soak              the HIL tests at full size (5000-move streams, 100 wraps of a
                     10 000-connection job, a 1 000 000-connection pattern, fuzzing
@@ -70,6 +72,7 @@ fn main() -> ExitCode {
         "setup" => run::setup(),
         "build" => run::setup().and_then(|_| firmware::build_release().map(|img| img.print_size())),
         "test" => test(),
+        "cycles" => cycles::check(),
         "simtest" => run::setup().and_then(|_| simtest()),
         "soak" => run::setup().and_then(|_| soak()),
         "fuzz" if rest.iter().any(|a| a == "-h" || a == "--help") => {
@@ -114,6 +117,7 @@ fn test() -> Result<()> {
         &root().join("hil-tests/clients/install.sh"),
         &root().join("target/clients/install.log"),
     )?;
+    cycles::check()?;
     println!("== host unit tests");
     cargo(&["test", "--workspace", "--exclude", "hil-tests"], &root())?;
     let host = start.elapsed().as_secs();

@@ -28,7 +28,7 @@
 //! and the newest — is corruption: [`Found::Corrupt`], never trusted.
 
 use crate::files::check::{CardId, FileSum};
-use crate::stringart::job::Phase;
+use crate::stringart::Phase;
 
 /// First byte of the checkpoint area (the settings' records end below it).
 pub const START: u16 = 1536;

@@ -3,11 +3,34 @@
 //! on the card and `$` settings override them.
 
 use crate::axis::{Axis, PerAxis};
-use crate::homing::HomingConfig;
 use crate::machine::Machine;
 use crate::text::ErrorKind;
 use crate::units::{Milli, StepsPerUnit};
 use core::mem::MaybeUninit;
+
+/// Homing's figures (Grbl's `$24`–`$27`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HomingConfig {
+    /// Bit `i`: channel `i` homes against its MIN switch.
+    pub axes: u8,
+    /// Home them at power-on (the flatbed's X).
+    pub at_start: bool,
+    /// Seeking and locating rates, steps/s.
+    pub seek: u16,
+    pub locate: u16,
+    /// How far off the switch the axis ends, µm.
+    pub pull_off_um: u16,
+}
+
+impl HomingConfig {
+    pub const NONE: HomingConfig = HomingConfig {
+        axes: 0,
+        at_start: false,
+        seek: 1000,
+        locate: 100,
+        pull_off_um: 1000,
+    };
+}
 
 /// Per-axis figures. Rates are in steps so the step generator never converts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -7,30 +7,6 @@
 use crate::axis::{PerAxis, AXES};
 use crate::config::MachineConfig;
 
-/// Homing's figures (Grbl's `$24`–`$27`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct HomingConfig {
-    /// Bit `i`: channel `i` homes against its MIN switch.
-    pub axes: u8,
-    /// Home them at power-on (the flatbed's X).
-    pub at_start: bool,
-    /// Seeking and locating rates, steps/s.
-    pub seek: u16,
-    pub locate: u16,
-    /// How far off the switch the axis ends, µm.
-    pub pull_off_um: u16,
-}
-
-impl HomingConfig {
-    pub const NONE: HomingConfig = HomingConfig {
-        axes: 0,
-        at_start: false,
-        seek: 1000,
-        locate: 100,
-        pull_off_um: 1000,
-    };
-}
-
 /// A move of one axis, `steps` from where it stands, at `rate` steps/s;
 /// with `until_closed` it stops at once when its switch closes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -64,7 +40,7 @@ pub enum Next {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Phase {
+enum Stage {
     Seek,
     Release,
     Locate,
@@ -76,7 +52,7 @@ pub struct Homing {
     /// Axes still to home (bits).
     left: u8,
     axis: usize,
-    phase: Option<Phase>,
+    stage: Option<Stage>,
 }
 
 impl Homing {
@@ -84,7 +60,7 @@ impl Homing {
         Homing {
             left: axes & ((1 << AXES) - 1),
             axis: 0,
-            phase: None,
+            stage: None,
         }
     }
 
@@ -109,13 +85,13 @@ impl Homing {
                 until_closed,
             })
         };
-        match self.phase {
+        match self.stage {
             None => {
                 if self.left == 0 {
                     return Next::Done;
                 }
                 self.axis = self.left.trailing_zeros() as usize;
-                self.phase = Some(Phase::Seek);
+                self.stage = Some(Stage::Seek);
                 let a = &cfg.axes[self.axis];
                 // Past the whole travel (or 200 units when it has none).
                 let span = match a.travel.1 .0 - a.travel.0 .0 {
@@ -130,26 +106,26 @@ impl Homing {
                     until_closed: true,
                 })
             }
-            Some(Phase::Seek) if !hit => self.fail(HomingError::NotFound),
-            Some(Phase::Seek) => {
-                self.phase = Some(Phase::Release);
+            Some(Stage::Seek) if !hit => self.fail(HomingError::NotFound),
+            Some(Stage::Seek) => {
+                self.stage = Some(Stage::Release);
                 leg(pull_off, h.locate, false)
             }
-            Some(Phase::Release) if closed => self.fail(HomingError::Stuck),
-            Some(Phase::Release) => {
-                self.phase = Some(Phase::Locate);
+            Some(Stage::Release) if closed => self.fail(HomingError::Stuck),
+            Some(Stage::Release) => {
+                self.stage = Some(Stage::Locate);
                 leg(-2 * pull_off, h.locate, true)
             }
-            Some(Phase::Locate) if !hit => self.fail(HomingError::NotFound),
-            Some(Phase::Locate) => {
-                self.phase = Some(Phase::PullOff);
+            Some(Stage::Locate) if !hit => self.fail(HomingError::NotFound),
+            Some(Stage::Locate) => {
+                self.stage = Some(Stage::PullOff);
                 leg(pull_off, h.locate, false)
             }
-            Some(Phase::PullOff) if closed => self.fail(HomingError::Stuck),
-            Some(Phase::PullOff) => {
+            Some(Stage::PullOff) if closed => self.fail(HomingError::Stuck),
+            Some(Stage::PullOff) => {
                 let steps = mm(a.travel.0 .0.saturating_add(i32::from(h.pull_off_um)));
                 self.left &= !(1 << self.axis);
-                self.phase = None;
+                self.stage = None;
                 Next::Zero {
                     axis: self.axis,
                     steps,
@@ -160,7 +136,7 @@ impl Homing {
 
     fn fail(&mut self, e: HomingError) -> Next {
         self.left = 0;
-        self.phase = None;
+        self.stage = None;
         Next::Failed(e)
     }
 }

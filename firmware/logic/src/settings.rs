@@ -15,6 +15,7 @@ use crate::units::{Decimal, Milli, StepsPerUnit};
 use taut_progmem::{text, Text};
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
+pub mod eeprom;
 pub mod grbl;
 pub mod image;
 pub mod record;

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
-use taut_logic::settings::record::host;
+use taut_logic::settings::eeprom::host;
 use taut_simavr::clock::{cycles_in, FREQ_HZ};
 use taut_simavr::operator::Seen;
 use taut_simavr::pty::{Pace, Pty};

@@ -4,8 +4,8 @@
 //! and the one-controller rule are checked here.
 
 use super::hub::Hub;
-use super::job::Run;
 use super::link::{self, Link};
+use super::run::Run;
 use super::tools::{self, Query};
 use super::{web, Bad, Studio};
 use axum::body::{Body, Bytes};

@@ -6,8 +6,8 @@
 //! One lock (`Inner`) guards it all; it is held only for what a reply or a
 //! request changes, never across an `await`.
 
-use super::job::Run;
-use super::link::Link;
+use super::link::{Link, Listener};
+use super::run::Run;
 use super::words;
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -413,6 +413,15 @@ fn remember_setting(settings: &mut Vec<String>, setting: &str) {
     {
         Some(old) => *old = line,
         None => settings.push(line),
+    }
+}
+
+impl Listener for Hub {
+    fn on_line(&self, line: &str) {
+        Hub::on_line(self, line)
+    }
+    fn lost_now(&self, why: &str) {
+        Hub::lost_now(self, why)
     }
 }
 

@@ -1,8 +1,6 @@
 //! The serial link to the machine (`serialport`, 115 200 8N1 raw): a Mega
 //! on USB or the simulator's pseudo-terminal. A reader thread hands every
 //! line to the hub; a read or write error is a lost link, shown at once.
-
-use super::hub::Hub;
 use serde::Serialize;
 use serialport::SerialPort;
 use std::io::Read;
@@ -56,9 +54,15 @@ pub fn ports(sim: Option<&str>) -> Vec<PortInfo> {
     out
 }
 
+/// What the reader thread hands each line and a lost link to (the hub).
+pub trait Listener: Send + Sync + 'static {
+    fn on_line(&self, line: &str);
+    fn lost_now(&self, why: &str);
+}
+
 impl Link {
     /// Opens `path` and starts reading it into `hub`.
-    pub fn open(path: &str, hub: Arc<Hub>) -> Result<Arc<Link>, String> {
+    pub fn open(path: &str, hub: Arc<impl Listener>) -> Result<Arc<Link>, String> {
         let port = serialport::new(path, 115_200)
             .timeout(Duration::from_millis(100))
             .open()

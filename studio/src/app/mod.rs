@@ -3,7 +3,7 @@
 //! the page and scripts use ([`api`], documented in `docs/studio.md`):
 //! the host tools as library calls ([`tools`]), the serial link to the
 //! machine ([`link`]) with its console, status and events ([`hub`]), the
-//! G-code run over `taut send`'s stream ([`job`]), and, with `--sim`, the
+//! G-code run over `taut send`'s stream ([`run`]), and, with `--sim`, the
 //! simulated Mega in the same process ([`sim`]).
 //!
 //! Safety: it listens on 127.0.0.1 unless told otherwise; on any other
@@ -13,14 +13,14 @@
 
 mod api;
 mod hub;
-mod job;
 mod link;
+mod run;
 pub mod sim;
 pub mod tools;
 mod web;
 mod words;
 
-use crate::cli::AnyMachine;
+use crate::args::AnyMachine;
 pub use api::UPLOAD_LIMIT;
 use hub::Hub;
 use serde_json::json;

@@ -158,7 +158,7 @@ fn serve(
     ready: &mpsc::Sender<Result<(), String>>,
 ) {
     use taut_logic::config::MachineConfig;
-    use taut_logic::settings::record::host;
+    use taut_logic::settings::eeprom::host;
     use taut_simavr::{pty::Pty, sdcard::SdImage, sdimage::FatChoice, Sim};
     let cfg = MachineConfig::defaults(machine);
     // A board powered on with `eeprom`: every pin probed, the endstops

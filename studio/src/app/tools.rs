@@ -14,7 +14,7 @@ use crate::stringart::card::{self, Spec};
 use crate::stringart::{self, picture};
 use crate::toolpath::{self, Toolpath};
 use crate::vectorize::{self, svgfile, Mode};
-use crate::{plot, preview, progress, template, text};
+use crate::{plot, progress, template, text};
 use base64::Engine;
 use serde_json::{json, Value};
 use std::collections::HashMap;
@@ -119,7 +119,7 @@ fn drawing(gcode: String, path: &Toolpath, machine: Machine) -> Value {
         "pen_up_mm": up,
         "bounds": [lo, hi],
         "toolpath": moves,
-        "preview_png": png_base64(&preview::png(path, 600)),
+        "preview_png": png_base64(&crate::render::png(path, 600)),
         "gcode": gcode,
     })
 }
@@ -135,7 +135,7 @@ pub fn vectorize(bytes: &[u8], q: &Query) -> Result<Value, Bad> {
         return Err(Bad::input("no picture: the body is empty".into()));
     }
     let machine = q.plotter()?;
-    let source = match vectorize::is_svg(bytes) {
+    let source = match crate::svg::is_svg(bytes) {
         true => vectorize::Source::Svg(svgfile::read(bytes).map_err(Bad::input)?),
         false => vectorize::Source::Picture(
             Gray::decode(bytes).map_err(|e| Bad::input(format!("the picture: {e}")))?,

@@ -3,7 +3,6 @@
 //! (at most [`MAX_LINE`] bytes). Accepts `#` comments, blank lines, LF, CR
 //! or CRLF line ends, blanks around `=` and a byte-order mark at the start.
 
-use crate::config::MachineConfig;
 use crate::files::cursor::{Cursor, Feed};
 use crate::files::error::{FileError, FileName};
 use crate::text::num::trim;
@@ -20,15 +19,6 @@ pub struct Item<'a> {
     pub line: u32,
     pub key_col: u32,
     pub value_col: u32,
-}
-
-/// What takes the items of a file: `param.txt`'s values or
-/// `machine.txt`'s settings. An enum, not a generic: one copy of the
-/// reading loop ([`KvReader::push_chunk`]) for both files (two cost
-/// ~300 bytes more on the AVR).
-pub(super) enum Taker<'a> {
-    Param(&'a mut super::param::Seen),
-    Machine(&'a mut MachineConfig, &'a mut [u8; super::machine::SEEN]),
 }
 
 pub struct KvReader {
@@ -76,18 +66,18 @@ impl KvReader {
         }
     }
 
-    /// Feeds `chunk`, each line's item to `taker`.
-    pub(super) fn push_chunk(
+    /// Feeds `chunk`, each line's item to `take` (`param.txt`'s values or
+    /// `machine.txt`'s settings). Through `dyn`, not a generic: one copy
+    /// of the reading loop for both files (two cost ~300 bytes more on
+    /// the AVR).
+    pub fn push_chunk(
         &mut self,
         chunk: &[u8],
-        mut taker: Taker<'_>,
+        take: &mut dyn FnMut(Item<'_>) -> Result<(), FileError>,
     ) -> Result<(), FileError> {
         for &b in chunk {
             if let Some(item) = self.push(b)? {
-                match &mut taker {
-                    Taker::Param(seen) => seen.take(item)?,
-                    Taker::Machine(cfg, seen) => super::machine::apply(cfg, seen, item)?,
-                }
+                take(item)?;
             }
         }
         Ok(())

@@ -10,7 +10,7 @@
 
 use crate::config::MachineConfig;
 use crate::files::error::{FileError, FileName};
-use crate::files::kv::{Item, KvReader, Taker};
+use crate::files::kv::{Item, KvReader};
 use crate::settings::{GlobalField, Setting, SettingError, COUNT};
 use crate::text::ErrorKind;
 
@@ -25,7 +25,7 @@ pub struct MachineFile {
     seen: [u8; SEEN],
 }
 
-pub(super) const SEEN: usize = COUNT.div_ceil(8);
+const SEEN: usize = COUNT.div_ceil(8);
 
 impl MachineFile {
     /// Starts from `base`, the configuration in force.
@@ -38,8 +38,9 @@ impl MachineFile {
     }
 
     pub fn push(&mut self, chunk: &[u8]) -> Result<(), FileError> {
+        let (cfg, seen) = (&mut self.cfg, &mut self.seen);
         self.kv
-            .push_chunk(chunk, Taker::Machine(&mut self.cfg, &mut self.seen))
+            .push_chunk(chunk, &mut |item| apply(cfg, seen, item))
     }
 
     /// The configuration with the file's overrides, checked as a whole.
@@ -65,11 +66,7 @@ impl MachineFile {
     }
 }
 
-pub(super) fn apply(
-    cfg: &mut MachineConfig,
-    seen: &mut [u8; SEEN],
-    item: Item<'_>,
-) -> Result<(), FileError> {
+fn apply(cfg: &mut MachineConfig, seen: &mut [u8; SEEN], item: Item<'_>) -> Result<(), FileError> {
     let at_key = |kind| FileError::at(FILE, item.line, item.key_col, kind);
     let Some(setting) = Setting::parse(item.key, cfg.machine) else {
         return Err(at_key(ErrorKind::UnknownKey));

@@ -9,7 +9,7 @@
 //! `nails`, `radius_cm`), in any case. Each must appear exactly once.
 
 use crate::files::error::{FileError, FileName};
-use crate::files::kv::{Item, KvReader, Taker};
+use crate::files::kv::{Item, KvReader};
 use crate::text::num::{parse_fixed, parse_u32};
 use crate::text::ErrorKind;
 use taut_progmem::{text, Text};
@@ -73,7 +73,7 @@ const KEYS: usize = 3;
 
 /// Values seen so far, by the index of their key in [`KEYS`].
 #[derive(Default)]
-pub(super) struct Seen {
+struct Seen {
     shape: Option<u16>,
     nails: Option<u16>,
     /// The radius is checked at the end (its limit depends on the shape),
@@ -103,7 +103,8 @@ impl ParamFile {
     }
 
     pub fn push(&mut self, chunk: &[u8]) -> Result<(), FileError> {
-        self.kv.push_chunk(chunk, Taker::Param(&mut self.seen))
+        let seen = &mut self.seen;
+        self.kv.push_chunk(chunk, &mut |item| seen.take(item))
     }
 
     /// The file ended: its values, checked as a whole.

@@ -13,7 +13,7 @@
 //! - lag carried from the previous segment ≤ 66; the interrupt's tick
 //!   truncation < 256.
 
-use super::trapezoid::{cbrt_floor_approx, div_to_u32, Phase, Speeds, Trapezoid};
+use super::trapezoid::{cbrt_floor_approx, div_to_u32, Slope, Speeds, Trapezoid};
 use super::{Segment, NEW_BLOCK, STOP, SUBTICKS_PER_S as Q};
 use crate::units::div_round;
 
@@ -304,9 +304,9 @@ impl Preparer {
             return Ok(None);
         }
         let k0 = self.done;
-        let mut seg = match self.profile.phase_after(k0) {
+        let mut seg = match self.profile.slope_after(k0) {
             None => self.fit(k0, 1)?,
-            Some((Phase::Cruise, end)) => {
+            Some((Slope::Cruise, end)) => {
                 let n = (end - k0).min(MAX_CRUISE_EVENTS).min(
                     self.profile
                         .cruise_events_in((Q / MAX_SEGMENT_PER_S) as u32),
@@ -314,15 +314,15 @@ impl Preparer {
                 self.cruise(k0, n.max(1))?
             }
             // A call that ran out of budget sized this segment already.
-            Some((Phase::Accel | Phase::Decel, _)) if self.shorter.0 == k0 => {
+            Some((Slope::Accel | Slope::Decel, _)) if self.shorter.0 == k0 => {
                 self.fit(k0, self.shorter.1)?
             }
-            Some((Phase::Accel, end)) => {
+            Some((Slope::Accel, end)) => {
                 self.spend(SIZE_COST)?;
                 let n = self.ramp_run(k0).min(end - k0);
                 self.fit(k0, n)?
             }
-            Some((Phase::Decel, end)) => {
+            Some((Slope::Decel, end)) => {
                 self.spend(SIZE_COST)?;
                 // The slow end of a deceleration is the segment's end.
                 let first = self.ramp_run(k0).min(end - k0);

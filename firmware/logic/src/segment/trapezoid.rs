@@ -5,9 +5,9 @@
 
 use super::SUBTICKS_PER_S as Q;
 
-/// Part of a block's profile.
+/// Part of a block's profile, by the slope of its speed: rising, flat, falling.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Phase {
+pub enum Slope {
     Accel,
     Cruise,
     Decel,
@@ -330,16 +330,16 @@ impl Trapezoid {
     /// The phase that holds the whole step from event `k0` to `k0 + 1`, and
     /// the last event of that phase; `None` if a phase boundary falls
     /// strictly inside the step.
-    pub fn phase_after(&self, k0: u32) -> Option<(Phase, u32)> {
+    pub fn slope_after(&self, k0: u32) -> Option<(Slope, u32)> {
         if k0 < self.k_acc {
-            return Some((Phase::Accel, self.k_acc));
+            return Some((Slope::Accel, self.k_acc));
         }
         let past_accel = k0 > self.k_acc || self.two_a * self.k_acc as u64 == self.acc2;
         if past_accel && k0 < self.k_dec {
-            return Some((Phase::Cruise, self.k_dec));
+            return Some((Slope::Cruise, self.k_dec));
         }
         if self.two_a * (self.events - k0) as u64 <= self.dec2 {
-            return Some((Phase::Decel, self.events));
+            return Some((Slope::Decel, self.events));
         }
         None
     }

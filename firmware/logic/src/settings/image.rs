@@ -1,5 +1,5 @@
 //! The settings as the EEPROM keeps them: the payload of the settings
-//! record ([`record::SETTINGS`](super::record::SETTINGS), two copies,
+//! record ([`eeprom::SETTINGS`](super::eeprom::SETTINGS), two copies,
 //! cut-safe). A fixed room of [`PAYLOAD`] bytes, so that a setting added
 //! later moves no other record:
 //!
@@ -237,7 +237,7 @@ fn value(byte: &impl Fn(u16) -> u8, like: Value, at: u16) -> Option<Value> {
 /// the named settings as [`decode_into`] reads them (not inverted), a
 /// Fletcher-16 checksum. Read once, when no settings record is usable,
 /// to carry a board's settings over; its header then becomes the layout
-/// marker ([`MARKER`](super::record::MARKER)).
+/// marker ([`MARKER`](super::eeprom::MARKER)).
 pub mod legacy {
     use super::*;
 

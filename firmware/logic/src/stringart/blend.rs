@@ -40,7 +40,8 @@
 //! trigonometry), three square roots and divisions; nothing per block.
 
 use super::clearance::{around, turns_to, Blocked, Clearance, Window};
-use super::{bit, MachineStep, WindError, MACHINE_DRIVERS};
+use super::winding::{WindError, Wraps};
+use super::{bit, MachineStep, MACHINE_DRIVERS};
 use crate::axis::Axis;
 use crate::config::MachineConfig;
 use crate::geometry::{Board, StepScale};
@@ -132,6 +133,25 @@ impl Iterator for BlendWrap {
 /// Base and carriage together to `(base, radial)`.
 fn to(base: i32, radial: i32) -> MachineStep {
     MachineStep::Move([Some(base), Some(radial), None])
+}
+
+impl Wraps for BlendWinder {
+    type Wrap = BlendWrap;
+    fn entry_step(&mut self, resume: Option<u16>, i: u8) -> Option<MachineStep> {
+        BlendWinder::entry_step(self, resume, i)
+    }
+    fn wrap(&mut self, j: u16) -> Result<BlendWrap, WindError> {
+        BlendWinder::wrap(self, j)
+    }
+    fn finish(&self) -> MachineStep {
+        BlendWinder::finish(self)
+    }
+    fn base(&self) -> i32 {
+        BlendWinder::base(self)
+    }
+    fn lead_in(&self, from: i32, wrap: &BlendWrap) -> Option<MachineStep> {
+        wrap.half_turn(from)
+    }
 }
 
 impl BlendWinder {

@@ -13,7 +13,7 @@
 //! per 4 ms run, the job looking again every 4 ms), and the crossing
 //! after it waits until it is durable.
 
-use super::job::{Action, Actions, Event, Feeder, Feeding, Job, Machine, State, SAVE_POLL_MS};
+use super::job::{Action, Actions, Event, Feeder, Feeding, Hardware, Job, State, SAVE_POLL_MS};
 #[cfg(test)]
 use super::BlendWinder;
 use super::{machine_time, Drilling, Overlap, Save, Winder, Winding};
@@ -118,7 +118,7 @@ impl Timed {
     }
 }
 
-impl Machine for Timed {
+impl Hardware for Timed {
     fn target(&self) -> PerAxis<i32> {
         self.planner.position()
     }

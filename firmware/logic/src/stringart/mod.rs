@@ -10,12 +10,14 @@ mod clearance;
 mod drilling;
 pub mod estimate;
 pub mod job;
+mod phase;
 mod timing;
 mod winding;
 
 pub use blend::{BlendWinder, BlendWrap};
 pub use clearance::Clearance;
 pub use drilling::{Depths, Drilling};
+pub use phase::Phase;
 pub use timing::{machine_time, Overlap};
 pub use winding::{WindError, Winder, Winding, Wrap, Wraps};
 
@@ -66,7 +68,7 @@ pub enum MachineStep {
 pub enum Save {
     /// A phase starts: a new checkpoint header ([`job::Job::card`] names
     /// the job).
-    Begin(job::Phase),
+    Begin(Phase),
     Record(crate::checkpoint::Record),
 }
 

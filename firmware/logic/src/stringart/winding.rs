@@ -57,25 +57,6 @@ impl Wraps for Winder {
     }
 }
 
-impl Wraps for super::BlendWinder {
-    type Wrap = super::BlendWrap;
-    fn entry_step(&mut self, resume: Option<u16>, i: u8) -> Option<MachineStep> {
-        super::BlendWinder::entry_step(self, resume, i)
-    }
-    fn wrap(&mut self, j: u16) -> Result<super::BlendWrap, WindError> {
-        super::BlendWinder::wrap(self, j)
-    }
-    fn finish(&self) -> MachineStep {
-        super::BlendWinder::finish(self)
-    }
-    fn base(&self) -> i32 {
-        super::BlendWinder::base(self)
-    }
-    fn lead_in(&self, from: i32, wrap: &super::BlendWrap) -> Option<MachineStep> {
-        wrap.half_turn(from)
-    }
-}
-
 /// Plans the wraps one nail at a time, so the pattern can be streamed from
 /// the card.
 pub struct Winder {

@@ -1,8 +1,9 @@
-use super::host::write;
 use super::*;
 use crate::config::MachineConfig;
 use crate::coords::{CoordData, Slot};
 use crate::machine::Machine;
+use crate::settings::eeprom::host::write;
+use crate::settings::eeprom::*;
 use crate::settings::grbl::{Extras, Numbered};
 use crate::settings::{image, set};
 use crate::units::Milli;

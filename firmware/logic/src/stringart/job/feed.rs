@@ -26,8 +26,9 @@ use crate::files::check::CardId;
 use crate::planner::Full;
 use crate::stringart::{MachineStep, Save};
 
-/// What the job's steps need of the machine.
-pub trait Machine {
+/// What the job's steps need of the machine's hardware: the planner,
+/// the drivers, the checkpoint's EEPROM.
+pub trait Hardware {
     /// Where the last move handed over ends (the position if none), steps.
     fn target(&self) -> PerAxis<i32>;
     /// Plans a move to `to` at the axes' own speeds.
@@ -137,7 +138,7 @@ impl Feeder {
     pub fn run(
         &mut self,
         job: &mut Job,
-        m: &mut impl Machine,
+        m: &mut impl Hardware,
         now_ms: u32,
         mut budget: u8,
     ) -> Feeding {
@@ -232,7 +233,7 @@ impl Feeder {
     /// While held: a record waits for the machine to pass its mark (it
     /// wakes the job as it begins a block, not a poll through a long
     /// rotation), or for the last checkpoint to be written.
-    fn held(&self, m: &impl Machine) -> Feeding {
+    fn held(&self, m: &impl Hardware) -> Feeding {
         match self.wait {
             Wait::Marked(after) if !passed(after, m) => Feeding::Motion,
             _ => Feeding::After(SAVE_POLL_MS),
@@ -243,7 +244,7 @@ impl Feeder {
     /// move handed over since has begun, so every one before it is done,
     /// or the machine stands) and the last checkpoint is written. True
     /// while the steps must wait for a record to be durable.
-    fn record_due(&mut self, job: &Job, m: &mut impl Machine) -> bool {
+    fn record_due(&mut self, job: &Job, m: &mut impl Hardware) -> bool {
         if let Wait::Marked(after) = self.wait {
             if passed(after, m) && !m.saving() {
                 self.wait = Wait::None;
@@ -262,6 +263,6 @@ impl Feeder {
 
 /// The machine has passed a mark with `after` moves handed over since: one
 /// of them has begun, so every one before it is done, or it stands.
-fn passed(after: u8, m: &impl Machine) -> bool {
+fn passed(after: u8, m: &impl Hardware) -> bool {
     after > m.unbegun() || m.is_idle()
 }

@@ -1,7 +1,6 @@
 //! What the job hears ([`Event`]) and what it asks the firmware to do
 //! ([`Action`]), with the texts the firmware logs.
 
-use super::phase::Phase;
 use super::progress::Progress;
 use crate::axis::Axis;
 use crate::buttons::ButtonEvent;
@@ -9,6 +8,7 @@ use crate::checkpoint::Saved;
 use crate::config::MachineConfig;
 use crate::files::check::CardId;
 use crate::files::param::Params;
+use crate::stringart::Phase;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum State {

@@ -42,14 +42,13 @@
 
 mod feed;
 mod io;
-mod phase;
 mod phase_steps;
 mod progress;
 pub mod tools;
 
-pub use feed::{Feeder, Feeding, Machine, SAVE_POLL_MS};
+pub use super::Phase;
+pub use feed::{Feeder, Feeding, Hardware, SAVE_POLL_MS};
 pub use io::{Action, Actions, BadBoard, Event, Msg, Prompt, State, PROMPT_MARK};
-pub use phase::Phase;
 pub use phase_steps::FEED;
 pub use progress::{left_s, Progress};
 

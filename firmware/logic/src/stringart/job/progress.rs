@@ -3,7 +3,7 @@
 //! spent so far (pauses excluded). Integer maths, a division or two per
 //! line, never per step.
 
-use super::phase::Phase;
+use crate::stringart::Phase;
 use ufmt::{uDisplay, uWrite, uwrite, Formatter};
 
 /// One progress line: `wind 1234/3000 left 3720s`.

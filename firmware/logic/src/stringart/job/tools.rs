@@ -9,10 +9,10 @@
 //! | `$wrap_jump=<k>` | paused while winding | go on at wrap k+1 (k wraps counted done): the pattern is read on from there, the needle goes there from inside the ring (the safe path), the checkpoint says so |
 //! | `$drift=<nail>` | paused while winding, waiting for nails | the base to that nail's angle, the count of base steps said against the nail's, and back |
 
-use super::phase::Phase;
 use super::{Action, Job, Msg, Out, State};
 use crate::axis::Axis;
 use crate::checkpoint::Record;
+use crate::stringart::Phase;
 use crate::stringart::{bit, BlendWrap, MachineStep, Save};
 
 /// A tool asked for on the console.

@@ -39,7 +39,7 @@ struct Cramped {
     did: Vec<Did>,
 }
 
-impl Machine for Cramped {
+impl Hardware for Cramped {
     fn target(&self) -> PerAxis<i32> {
         self.target
     }

@@ -79,7 +79,7 @@ impl Timeline {
     }
 }
 
-impl Machine for Timeline {
+impl Hardware for Timeline {
     fn target(&self) -> PerAxis<i32> {
         self.target
     }

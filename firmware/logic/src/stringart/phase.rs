@@ -1,5 +1,5 @@
 //! The two phases of the job that move the machine: shared by its events,
-//! its progress lines and its batches of steps.
+//! its progress lines, its batches of steps and its checkpoint.
 
 /// The two phases that move the machine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
