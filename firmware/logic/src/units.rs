@@ -178,12 +178,21 @@ fn power_of_ten(p: u8) -> u32 {
     }
 }
 
-/// `n / d` rounded half away from zero; `d > 0`.
+/// `n / d` rounded half away from zero; `d > 0`. Any `n`: where adding
+/// the half would overflow, the same quotient is taken a `d` lower (or
+/// higher) and one added back.
 pub fn div_round(n: i64, d: i64) -> i64 {
+    let half = d / 2;
     if n >= 0 {
-        (n + d / 2) / d
+        match n.checked_add(half) {
+            Some(m) => m / d,
+            None => (n - (d - half)) / d + 1,
+        }
     } else {
-        -((-n + d / 2) / d)
+        match n.checked_sub(half) {
+            Some(m) => m / d,
+            None => (n + (d - half)) / d - 1,
+        }
     }
 }
 
@@ -268,6 +277,26 @@ mod tests {
         ) {
             let s = StepsPerUnit::new(num.max(1), den.max(1));
             prop_assert_eq!(s.steps_exact(target), s.steps_exact_wide(target));
+        }
+    }
+
+    #[test]
+    fn div_round_is_half_away_from_zero_to_the_extremes() {
+        for d in [1, 2, 3, 7, 1_000_000, i64::MAX] {
+            for n in [
+                0,
+                1,
+                -1,
+                5,
+                -5,
+                i64::MAX,
+                i64::MIN,
+                i64::MAX - 1,
+                i64::MIN + 1,
+            ] {
+                let want = (n as i128 * 2 + (n.signum() as i128) * d as i128) / (2 * d as i128);
+                assert_eq!(div_round(n, d) as i128, want, "{n} / {d}");
+            }
         }
     }
 
