@@ -40,11 +40,19 @@ impl Message {
         self.len == 0
     }
 
+    /// The text, printable ASCII, its trailing spaces cut (by hand: on
+    /// the AVR `str`'s checks and trims bring tables into SRAM).
+    pub fn text(&self) -> &[u8] {
+        let mut len = usize::from(self.len);
+        while len > 0 && self.text[len - 1] == b' ' {
+            len -= 1;
+        }
+        &self.text[..len]
+    }
+
     pub fn as_str(&self) -> &str {
         // Only printable ASCII is kept (`push`).
-        core::str::from_utf8(&self.text[..usize::from(self.len)])
-            .unwrap_or("")
-            .trim_end()
+        core::str::from_utf8(self.text()).unwrap_or("")
     }
 
     fn push(&mut self, c: u8) {
@@ -169,8 +177,8 @@ impl Parser {
         }
     }
 
-    /// The `(MSG, …)` text of the line read so far (empty if none); read
-    /// before [`Parser::take_line`], which starts the next line.
+    /// The `(MSG, …)` text of the line read so far, or of the line just
+    /// taken until the next one begins (empty if none).
     pub fn message(&self) -> &Message {
         &self.message
     }
@@ -228,6 +236,9 @@ impl Parser {
                 Read::More
             }
             _ => {
+                if self.column == 0 {
+                    self.message = Message::NONE;
+                }
                 self.column = self.column.saturating_add(1);
                 if self.lexeme != Lexeme::Overflow {
                     self.take(byte);
@@ -250,6 +261,9 @@ impl Parser {
         *self = Parser {
             after_cr,
             letters: self.letters,
+            // The line's message outlives its end: the console says it
+            // once the line is accepted. The next line's first byte clears it.
+            message: self.message,
             ..Parser::new()
         };
     }

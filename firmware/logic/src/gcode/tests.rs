@@ -122,9 +122,12 @@ fn message_of(text: &str) -> String {
     for &b in text.as_bytes() {
         assert!(parser.push(b).is_none());
     }
-    let said = parser.message().as_str().into();
+    let said: String = parser.message().as_str().into();
     assert!(parser.push(b'\n').is_some());
-    // The next line starts with none.
+    // Kept after the line's end (the console says it once the line is
+    // accepted); the next line starts with none.
+    assert_eq!(parser.message().as_str(), said);
+    assert!(parser.push(b'G').is_none());
     assert!(parser.message().is_empty());
     said
 }
@@ -139,7 +142,13 @@ fn a_msg_comment_is_kept_for_the_console() {
     assert_eq!(block(pen), block("M0"));
     assert_eq!(message_of("( msg ,Hello )G0X1"), "Hello");
     assert_eq!(message_of("(MSG,a)(MSG,b)"), "b");
-    for none in ["(MESSAGE, no)", "(MSG no comma)", "; MSG, no", "(SMG,x)", "G0 X1"] {
+    for none in [
+        "(MESSAGE, no)",
+        "(MSG no comma)",
+        "; MSG, no",
+        "(SMG,x)",
+        "G0 X1",
+    ] {
         assert_eq!(message_of(none), "", "{none}");
     }
     // Cut at its length; bytes outside printable ASCII read `?`.
