@@ -469,7 +469,10 @@ impl Console {
             Ok(Input::Realtime(_)) => {}
             Err(e) if e.kind() == ErrorKind::LineOverflow => self.error(&e),
             // Empty or comment only: for syncing, `ok`.
-            _ if first == 0 => self.ok(),
+            _ if first == 0 => {
+                self.say_message();
+                self.ok()
+            }
             Ok(Input::System(ref s)) => self.system(s, m, cfg, owner, store),
             Ok(Input::Jog(_))
                 if self.checking || !m.position_known() || !(m.is_idle() || jog_state) =>
@@ -509,6 +512,9 @@ impl Console {
             Ok(Input::Block(b)) => {
                 self.jogging = false;
                 let accepted = self.accept(&b, false, m, kin, cfg, owner, store);
+                if accepted {
+                    self.say_message();
+                }
                 // A `$N0=` line: carried out, and kept if it passed.
                 if self.storing {
                     self.stored_checked(accepted, store);
@@ -580,6 +586,18 @@ impl Console {
     }
 
     /// A serial line while a print runs.
+    /// An accepted line's `(MSG, …)` text, as grblHAL says it: before
+    /// the line's `ok` (a pen change's `M0` names the next pen so).
+    #[inline(never)]
+    fn say_message(&self) {
+        let text = self.parser.message().text();
+        if !text.is_empty() {
+            let mut r = crate::log::Line::message();
+            r.push_all(text);
+            r.send();
+        }
+    }
+
     fn printing_from_serial(&self) -> bool {
         self.print.busy() && self.source != Some(Source::Card)
     }

@@ -93,7 +93,7 @@ impl Line {
     }
 
     #[inline(never)]
-    fn push_all(&mut self, bytes: &[u8]) {
+    pub fn push_all(&mut self, bytes: &[u8]) {
         for &b in bytes {
             self.push(b);
         }

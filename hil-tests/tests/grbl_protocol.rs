@@ -508,3 +508,39 @@ fn startup_lines_restore_and_sleep() {
     send(&mut sim, "$X");
     assert!(status(&mut sim).starts_with("<Idle|"));
 }
+
+/// LinuxCNC's operator message `(MSG, text)`, as grblHAL says it: a line's
+/// `[MSG:text]` before its `ok`, on a line alone or beside G-code (a
+/// plotter file's pen change names the next pen so); cut at 40
+/// characters; another comment says nothing, and a refused line neither.
+#[test]
+fn a_msg_comment_is_said_before_its_line_s_ok() {
+    let mut sim = boot_machine();
+    send(&mut sim, "$machine=flatbed");
+    send(&mut sim, "$homing_at_start=0");
+    assert_eq!(
+        replies(&send(&mut sim, "(MSG, load the red pen)")),
+        ["[MSG:load the red pen]", "ok"]
+    );
+    assert_eq!(
+        replies(&send(&mut sim, "G1 X2 F600 (msg,first pass)")),
+        ["[MSG:first pass]", "ok"]
+    );
+    let long = "x".repeat(60);
+    assert_eq!(
+        replies(&send(&mut sim, &format!("(MSG,{long})"))),
+        [format!("[MSG:{}]", &long[..40]).as_str(), "ok"]
+    );
+    assert_eq!(replies(&send(&mut sim, "(a comment) G1 X3")), ["ok"]);
+    let from = sim.uart_bytes().len();
+    let refused = sim.send_line("G1 X-1000 (MSG, never)", Duration::from_secs(2));
+    assert!(
+        matches!(refused, Ok(hil_tests::sim::Reply::Error(_))),
+        "{refused:?}"
+    );
+    assert!(
+        !sim.uart_text_from(from).contains("never"),
+        "{}",
+        log_tail(&sim)
+    );
+}

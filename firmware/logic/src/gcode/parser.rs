@@ -18,6 +18,61 @@ use crate::seed::SeedBuilder;
 /// comment may be of any length.
 pub const MAX_LINE: u8 = 79;
 
+/// Most characters of a `(MSG, …)` text kept; the rest is cut.
+pub const MSG_LEN: usize = 40;
+
+/// The text of a line's `(MSG, text)` comment: LinuxCNC's operator message,
+/// which grblHAL and senders show as `[MSG:text]` (a plotter file's pen
+/// change names the next pen so). Printable ASCII; another byte reads `?`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Message {
+    len: u8,
+    text: [u8; MSG_LEN],
+}
+
+impl Message {
+    pub const NONE: Message = Message {
+        len: 0,
+        text: [0; MSG_LEN],
+    };
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The text, printable ASCII, its trailing spaces cut (by hand: on
+    /// the AVR `str`'s checks and trims bring tables into SRAM).
+    pub fn text(&self) -> &[u8] {
+        let mut len = usize::from(self.len);
+        while len > 0 && self.text[len - 1] == b' ' {
+            len -= 1;
+        }
+        &self.text[..len]
+    }
+
+    pub fn as_str(&self) -> &str {
+        // Only printable ASCII is kept (`push`).
+        core::str::from_utf8(self.text()).unwrap_or("")
+    }
+
+    fn push(&mut self, c: u8) {
+        if usize::from(self.len) < MSG_LEN {
+            self.text[usize::from(self.len)] = match c {
+                b' '..=b'~' => c,
+                _ => b'?',
+            };
+            self.len += 1;
+        }
+    }
+}
+
+/// How far a `( … )` comment matched `MSG,`.
+const MSG_WORD: &[u8; 3] = b"MSG";
+/// The comment is not a message.
+const NOT_MSG: u8 = u8::MAX;
+/// After `MSG,`: the text follows.
+const MSG_TEXT: u8 = 4;
+
 /// The UTF-8 byte-order mark an editor may put before a file's first line.
 const BOM: [u8; 3] = [0xEF, 0xBB, 0xBF];
 
@@ -83,6 +138,9 @@ pub struct Parser {
     lexeme: Lexeme,
     checksum: Option<Checksum>,
     statement: Statement,
+    /// In a `( … )` comment: letters of `MSG,` matched so far.
+    msg_at: u8,
+    message: Message,
 }
 
 /// What a byte did ([`Parser::read`]).
@@ -114,7 +172,15 @@ impl Parser {
             lexeme: Lexeme::Code,
             checksum: None,
             statement: Statement::Start,
+            msg_at: NOT_MSG,
+            message: Message::NONE,
         }
+    }
+
+    /// The `(MSG, …)` text of the line read so far, or of the line just
+    /// taken until the next one begins (empty if none).
+    pub fn message(&self) -> &Message {
+        &self.message
     }
 
     /// Some of a line has been read, not yet its end.
@@ -170,6 +236,9 @@ impl Parser {
                 Read::More
             }
             _ => {
+                if self.column == 0 {
+                    self.message = Message::NONE;
+                }
                 self.column = self.column.saturating_add(1);
                 if self.lexeme != Lexeme::Overflow {
                     self.take(byte);
@@ -192,6 +261,9 @@ impl Parser {
         *self = Parser {
             after_cr,
             letters: self.letters,
+            // The line's message outlives its end: the console says it
+            // once the line is accepted. The next line's first byte clears it.
+            message: self.message,
             ..Parser::new()
         };
     }
@@ -206,7 +278,10 @@ impl Parser {
             self.xor ^= c;
         }
         match (self.lexeme, c) {
-            (Lexeme::Code, b'(') => self.lexeme = Lexeme::Comment,
+            (Lexeme::Code, b'(') => {
+                self.lexeme = Lexeme::Comment;
+                self.msg_at = 0;
+            }
             (Lexeme::Code, b';') => self.lexeme = Lexeme::LineComment,
             // Whitespace and control bytes are dropped (a space still
             // reaches `M23`'s file name); `/` too (Grbl has no block
@@ -229,6 +304,7 @@ impl Parser {
                 self.feed(c, column)
             }
             (Lexeme::Comment, b')') => self.lexeme = Lexeme::Code,
+            (Lexeme::Comment, _) if self.msg_at != NOT_MSG => self.message_byte(c),
             (Lexeme::Checksum, b' ' | b'\t') | (Lexeme::AfterChecksum, b' ' | b'\t') => {
                 self.lexeme = Lexeme::AfterChecksum
             }
@@ -246,6 +322,28 @@ impl Parser {
             }
             (Lexeme::Comment, _) | (Lexeme::LineComment, _) | (Lexeme::Overflow, _) => {}
         }
+    }
+
+    /// A byte of a `( … )` comment: `MSG` (any case, spaces around it),
+    /// `,`, then the text, its leading spaces dropped. A line's last
+    /// message is the one kept.
+    fn message_byte(&mut self, c: u8) {
+        let at = self.msg_at;
+        self.msg_at = match c {
+            b' ' if at == 0 || at == 3 => at,
+            b',' if at == 3 => {
+                self.message = Message::NONE;
+                MSG_TEXT
+            }
+            _ if at < 3 && c.to_ascii_uppercase() == MSG_WORD[usize::from(at)] => at + 1,
+            _ if at == MSG_TEXT => {
+                if c != b' ' || !self.message.is_empty() {
+                    self.message.push(c);
+                }
+                MSG_TEXT
+            }
+            _ => NOT_MSG,
+        };
     }
 
     /// Hands a character of the statement on; the first one decides

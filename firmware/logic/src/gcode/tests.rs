@@ -116,6 +116,47 @@ fn what_grbl_throws_away_before_the_words() {
     assert_eq!(block(""), Block::empty());
 }
 
+/// The text of the line's `(MSG, …)` comment, read before its end.
+fn message_of(text: &str) -> String {
+    let mut parser = Parser::new();
+    for &b in text.as_bytes() {
+        assert!(parser.push(b).is_none());
+    }
+    let said: String = parser.message().as_str().into();
+    assert!(parser.push(b'\n').is_some());
+    // Kept after the line's end (the console says it once the line is
+    // accepted); the next line starts with none.
+    assert_eq!(parser.message().as_str(), said);
+    assert!(parser.push(b'G').is_none());
+    assert!(parser.message().is_empty());
+    said
+}
+
+/// LinuxCNC's operator message `(MSG, text)`, which grblHAL prints as
+/// `[MSG:text]`: the line is G-code as before (a comment), its text kept
+/// for the console. Other comments, and `;`, are no message.
+#[test]
+fn a_msg_comment_is_kept_for_the_console() {
+    let pen = "M0 (MSG, change the pen: pass 2 of 3, Red fill)";
+    assert_eq!(message_of(pen), "change the pen: pass 2 of 3, Red fill");
+    assert_eq!(block(pen), block("M0"));
+    assert_eq!(message_of("( msg ,Hello )G0X1"), "Hello");
+    assert_eq!(message_of("(MSG,a)(MSG,b)"), "b");
+    for none in [
+        "(MESSAGE, no)",
+        "(MSG no comma)",
+        "; MSG, no",
+        "(SMG,x)",
+        "G0 X1",
+    ] {
+        assert_eq!(message_of(none), "", "{none}");
+    }
+    // Cut at its length; bytes outside printable ASCII read `?`.
+    let long = "x".repeat(100);
+    assert_eq!(message_of(&format!("(MSG,{long})")).len(), MSG_LEN);
+    assert_eq!(message_of("(MSG,caf\u{e9})"), "caf??");
+}
+
 /// protocol.c line 141: the limit counts the characters kept (79 fit the
 /// 80-byte buffer with its terminator), so a comment of any length is
 /// fine; past it, error 11 once the line ends.
