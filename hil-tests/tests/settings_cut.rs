@@ -57,7 +57,7 @@ fn cuts_of(before: Option<&[u8]>, line: Option<&str>, seed: u64) -> (Vec<Cut>, V
         .unwrap();
     sim.watch_calls(store);
     if line.is_some() {
-        wait_for(&mut sim, "reset:", Duration::from_millis(50));
+        wait_for(&mut sim, "reset:", Duration::from_millis(200));
         sim.run_for(Duration::from_millis(200));
     }
     let from = sim.eeprom_writes();
@@ -119,7 +119,8 @@ fn cuts_of(before: Option<&[u8]>, line: Option<&str>, seed: u64) -> (Vec<Cut>, V
 fn held(eeprom: &[u8]) -> (Vec<String>, String) {
     let mut sim = Sim::load(&hil_tests::firmware_elf()).unwrap();
     sim.set_eeprom(eeprom);
-    wait_for(&mut sim, "reset:", Duration::from_millis(50));
+    // The banner and its log line end some 45 ms after power-on.
+    wait_for(&mut sim, "reset:", Duration::from_millis(200));
     sim.run_for(Duration::from_millis(20));
     let mut listing = Vec::new();
     for line in ["$$", "$#", "$N"] {
