@@ -3,9 +3,10 @@
 //! gathers a line's words as its bytes come; the executor
 //! (`taut_logic::interp`, both host-tested) checks the line against the
 //! modal state and carries its actions out against the machine
-//! (`machine_io`), waiting where Grbl waits; this file reads bytes,
-//! hands whole lines on in Grbl's order (`protocol.c`: overflow, empty,
-//! `$`, the G-code lock, G-code) and answers. Real-time commands never
+//! (`machine_io`), waiting where Grbl waits; this file reads bytes
+//! (from the serial line or a card print: `source`), hands whole lines on
+//! in Grbl's order (`protocol.c`: overflow, empty, `$`, the G-code lock,
+//! G-code) and answers (`answer`). Real-time commands never
 //! get here (`realtime`). A line is answered `ok` once its last move is
 //! queued, as Grbl does.
 //!
@@ -13,24 +14,27 @@
 //! does: during a job the executor refuses motion, drivers, offsets and
 //! the pen, and settings are refused here; reads are answered.
 
+mod answer;
 mod homing;
 mod offsets;
 mod seed;
+mod source;
 mod system;
 
 use crate::flash_str;
 use crate::machine_io::Io;
 use crate::motion::Motion;
 use crate::print::Print;
-use crate::queues::{Signal, BUTTONS, JOB_CLAIMS_TX, RX};
+use crate::queues::{Signal, JOB_CLAIMS_TX};
 use crate::reply;
 use crate::rt::Poll;
 use crate::store::Store;
 use core::sync::atomic::Ordering::Relaxed;
 use homing::HomingRun;
+use source::serial_line_waits;
 use taut_logic::config::MachineConfig;
 use taut_logic::coords::CoordData;
-use taut_logic::gcode::{CardLine, Error, ErrorKind, Input, Parser, Read};
+use taut_logic::gcode::{Error, ErrorKind, Input, Parser, Read};
 use taut_logic::interp::{
     axis_letters, coords, motor_channels, Allowed, Env, Interpreter, Progress, Wait,
 };
@@ -558,81 +562,6 @@ impl Console {
         }
     }
 
-    /// The next byte of the line being read: a line from the card, or
-    /// from the serial line once it has arrived whole while a print runs
-    /// (its lines are not cut into by the card's).
-    #[inline(never)]
-    fn next_byte(&mut self) -> Option<u8> {
-        if self.source == Some(Source::Card) && !self.print.running() {
-            // The print stopped mid-line: the part read is dropped (a lost
-            // print reads the line again).
-            self.parser = Parser::new();
-            self.source = None;
-        }
-        if !self.parser.mid_line() {
-            self.source = Some(match self.print.running() && !serial_line_waits() {
-                true => Source::Card,
-                false => Source::Serial,
-            });
-        }
-        let byte = match self.source {
-            Some(Source::Card) => self.print.next_byte(),
-            _ => crate::board::usart::receive(),
-        };
-        if byte.is_none() {
-            self.print.finished();
-        }
-        byte
-    }
-
-    /// A serial line while a print runs.
-    /// An accepted line's `(MSG, …)` text, as grblHAL says it: before
-    /// the line's `ok` (a pen change's `M0` names the next pen so).
-    #[inline(never)]
-    fn say_message(&self) {
-        let text = self.parser.message().text();
-        if !text.is_empty() {
-            let mut r = crate::log::Line::message();
-            r.push_all(text);
-            r.send();
-        }
-    }
-
-    fn printing_from_serial(&self) -> bool {
-        self.print.busy() && self.source != Some(Source::Card)
-    }
-
-    /// A plotter's buttons and card messages; `true` while a card command
-    /// still waits for the reader.
-    #[inline(never)]
-    fn card_news(&mut self, m: &mut Motion) -> bool {
-        while let Some(event) = BUTTONS.pop() {
-            self.print.button(event, m);
-        }
-        let waited = self.print.waiting();
-        match self.print.take_messages() {
-            Some(Ok(())) => self.ok(),
-            Some(Err(kind)) => self.error(&Error::new(kind, 0)),
-            None => return waited,
-        }
-        false
-    }
-
-    /// `M20`, `M23`…: a plotter's card print (the string-art job owns the
-    /// card on its machine; a file cannot run card commands).
-    #[inline(never)]
-    fn card_line(&mut self, c: CardLine, m: &mut Motion, cfg: &MachineConfig) {
-        if cfg.machine.is_string_art() || self.source == Some(Source::Card) {
-            return self.error(&Error::new(ErrorKind::UnsupportedCommand, 1));
-        }
-        match self.print.command(c, m) {
-            Err(kind) => self.error(&Error::new(kind, 0)),
-            // Answered when the reader has.
-            Ok(()) if self.print.waiting() => {}
-            Ok(()) => self.ok(),
-        }
-    }
-
     /// What the console is doing.
     pub fn activity(&self) -> Activity {
         match self.homing {
@@ -641,37 +570,6 @@ impl Console {
             _ if self.checking => Activity::Checking,
             _ if self.jogging => Activity::Jogging,
             _ => Activity::Lines,
-        }
-    }
-
-    /// `ok` to a line, unless it is a pattern's (answered at its end) or
-    /// the card's.
-    fn ok(&self) {
-        if self.pattern.is_none() && self.source != Some(Source::Card) {
-            self.answer_ok();
-        }
-    }
-
-    /// `ok`, or a startup line's `>line:ok`.
-    fn answer_ok(&self) {
-        match self.source {
-            Some(Source::Startup) => system::startup_reply(self.echo, None),
-            _ => reply::ok(),
-        }
-    }
-
-    /// An error: the answer to the line, or to the pattern, which stops,
-    /// or in the log with the card's file and line.
-    fn error(&mut self, e: &Error) {
-        self.error_because(e, None);
-    }
-
-    fn error_because(&mut self, e: &Error, why: Option<taut_logic::text::ErrorKind>) {
-        self.pattern = None;
-        match self.source {
-            Some(Source::Card) => self.print.line_failed(e, why),
-            Some(Source::Startup) => system::startup_reply(self.echo, Some(e)),
-            _ => reply::error_because(e, why),
         }
     }
 
@@ -693,11 +591,6 @@ fn message(text: Text) {
     let mut r = reply::line();
     let _ = uwrite!(r, "{}{}]", flash_str!("[MSG:"), text);
     r.send();
-}
-
-/// A whole line has arrived on the serial line.
-fn serial_line_waits() -> bool {
-    RX.any(|&b| b == b'\n' || b == b'\r')
 }
 
 /// Bytes parsed in one run at most: ~0.06 ms a byte on average (0.1 ms
