@@ -12,17 +12,18 @@ use crate::config::MachineConfig;
 use crate::coords::CoordData;
 use crate::gcode::{Input, Parser};
 use crate::kinematics::{AnyKinematics, Piece, Steps};
-use crate::planner::{Feed, Planner};
+use crate::planner::{Feed, Lookahead, PLANNER_BLOCKS};
 use crate::segment::SUBTICKS_PER_S;
 
 /// Runs a stream of G-code through the firmware's parser, executor and
-/// planner.
-pub struct GcodeTime {
+/// planner, the planner `N` blocks deep (the firmware's unless asked:
+/// [`GcodeTime::with_depth`]).
+pub struct GcodeTime<const N: usize = PLANNER_BLOCKS> {
     parser: Parser,
     interp: Interpreter,
     kin: AnyKinematics,
     config: MachineConfig,
-    machine: Timed,
+    machine: Timed<N>,
     /// Lines read, and lines refused (they move nothing, as on the machine).
     pub lines: u32,
     pub refused: u32,
@@ -30,15 +31,15 @@ pub struct GcodeTime {
 
 /// The machine as the estimate sees it: the planner, a clock of
 /// sub-ticks, the pen's angle, the coordinate data.
-struct Timed {
-    planner: Planner,
+struct Timed<const N: usize> {
+    planner: Lookahead<N>,
     /// Sub-ticks of motion and waiting counted so far.
     subticks: u64,
     pen: Option<u8>,
     coords: CoordData,
 }
 
-impl Timed {
+impl<const N: usize> Timed<N> {
     fn take(&mut self) {
         if let Some(p) = self.planner.take() {
             self.subticks += p.profile.time(p.profile.events());
@@ -52,7 +53,7 @@ impl Timed {
     }
 }
 
-impl MachineIo for Timed {
+impl<const N: usize> MachineIo for Timed<N> {
     fn coord(&self, index: u8) -> Exact {
         coords::stored(&self.coords, index)
     }
@@ -108,13 +109,20 @@ impl MachineIo for Timed {
 impl GcodeTime {
     /// `None` when the configuration's kinematics cannot be made.
     pub fn new(config: &MachineConfig) -> Option<Self> {
+        Self::with_depth(config)
+    }
+}
+
+impl<const N: usize> GcodeTime<N> {
+    /// [`GcodeTime::new`] with a planner of `N` blocks.
+    pub fn with_depth(config: &MachineConfig) -> Option<Self> {
         Some(GcodeTime {
             parser: Parser::new(),
             interp: Interpreter::new(),
             kin: AnyKinematics::of(config).ok()?,
             config: *config,
             machine: Timed {
-                planner: Planner::new(config),
+                planner: Lookahead::new(config),
                 subticks: 0,
                 pen: None,
                 coords: CoordData::ZERO,
