@@ -310,6 +310,12 @@ impl<const N: usize> Lookahead<N> {
         self.len
     }
 
+    /// Blocks a move may still be pushed into (`Bf:`): the queue's free
+    /// slots, less the one a move being planned holds.
+    pub fn free(&self) -> usize {
+        N - self.len - (self.stage != Stage::Done) as usize
+    }
+
     /// No room for a move: the queue is full, or a move is still being
     /// planned.
     pub fn is_full(&self) -> bool {

@@ -105,8 +105,10 @@ fn gentle_corner_does_not_stop() {
 fn full_queue_pushes_back() {
     let mut p = Planner::new(&square());
     for k in 1..=PLANNER_BLOCKS as i32 {
+        assert_eq!(p.free(), PLANNER_BLOCKS + 1 - k as usize);
         p.push([k * 100, 0, 0], Feed::Rapid).unwrap();
     }
+    assert_eq!(p.free(), 0);
     assert_eq!(p.push([0, 0, 0], Feed::Rapid), Err(Full));
     assert!(p.take().is_some());
     assert_eq!(p.push([0, 0, 0], Feed::Rapid), Ok(()));
@@ -121,6 +123,8 @@ fn a_staged_move_is_planned_in_parts_and_queued_by_the_last() {
     whole.push([20_000, 0, 0], Feed::Rapid).unwrap();
     let second = ([20_000, 20_000, 0], Feed::PerMinute(Milli(600_000)));
     p.stage(second.0, second.1).unwrap();
+    // The move being planned holds a block.
+    assert_eq!(p.free(), PLANNER_BLOCKS - 2);
     whole.push(second.0, second.1).unwrap();
     assert_eq!(p.position(), second.0);
     let mut parts = 0;
