@@ -700,7 +700,9 @@ impl<const N: usize> Lookahead<N> {
         if self.planned == 0 {
             self.blocks[i].entry_sqr = self.carry_sqr;
         }
-        let mut reach = self.blocks[i].entry_sqr.saturating_add(self.blocks[i].delta_sqr);
+        let mut reach = self.blocks[i]
+            .entry_sqr
+            .saturating_add(self.blocks[i].delta_sqr);
         let mut nominal_sqr = self.blocks[i].nominal_sqr;
         for k in self.planned + 1..self.len {
             i = if i + 1 == N { 0 } else { i + 1 };
