@@ -224,7 +224,8 @@ pub struct Lookahead<const N: usize> {
     len: usize,
     /// Blocks from the oldest whose entry speeds are final: the look-ahead
     /// passes start after them (Grbl's "planned" pointer), so a push costs
-    /// what changed, not the queue's depth. 0: plan from the oldest.
+    /// the blocks whose entries may still change, not the whole queue.
+    /// 0: plan from the oldest.
     planned: usize,
     /// Entry speed² of the oldest block, fixed: the exit speed of the block
     /// the preparer took before it.
