@@ -528,7 +528,7 @@ proptest! {
             match p.push(b) {
                 Some(Ok(Input::Realtime(r))) => prop_assert_eq!(Realtime::from_byte(b), Some(r)),
                 Some(result) => {
-                    prop_assert!(b == b'\n' || b == b'\r');
+                    prop_assert!(b == b'\n' || b == b'\r' || b == LINE_CUT);
                     if let Err(e) = result {
                         prop_assert!(!e.message().is_empty());
                     }
