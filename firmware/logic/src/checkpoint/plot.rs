@@ -1,0 +1,213 @@
+//! A plotter's card print in the checkpoint area: which file, and the
+//! byte offset of the line whose moves the steppers were making, so that
+//! the next power-on can offer to go on from that line (Marlin's
+//! power-loss recovery, without its extra hardware).
+//!
+//! The header slot holds the file (its 8.3 name and size) under kind
+//! [`KIND`]; the ring's 8-byte records hold `n` (u16, its slot `n %
+//! SLOTS`), the line's offset (u32) and a CRC-16 over both and the
+//! header's sequence number. The newest record whose CRC holds is the
+//! checkpoint: a record torn by a cut fails its CRC and the one before
+//! it stands (an earlier line: more is drawn again, nothing is skipped).
+//!
+//! The modal state the line needs (units, distance mode, feed, offsets,
+//! the pen) is not stored: the file's lines before it are read again on
+//! resume, checked and taken without moving (as `$C` does), which leaves
+//! the executor exactly as they left it when the line was first read.
+//!
+//! [`Tracker`] says which line is moving: each planned block is counted
+//! by the step interrupt as it begins, and a line's first block has
+//! number `begun + unbegun` when the line is read (`Motion::unbegun`).
+//! Once the steppers have begun that block, every line before it is
+//! drawn, and that line's offset is safe to record.
+
+use super::{crc16, newer, CRC_START, END, HEADER_BYTES, MAGIC, RECORD_BYTES, RING, SLOTS, START};
+
+/// Header byte 4 of a print's checkpoint (the string-art phases are 1
+/// and 2, none 0).
+pub const KIND: u8 = 3;
+const VERSION: u8 = 1;
+
+/// Records at most this often: the redraw after a cut is at most this
+/// much of the drawing (and the planner's look-ahead), and the ring's
+/// cells last [`hours_before_wear_out`] of printing.
+pub const RECORD_EVERY_MS: u32 = 500;
+
+/// The print: its file, and the sequence number records are written
+/// under.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlotHeader {
+    pub seq: u16,
+    /// The 8.3 name as the directory holds it (`STARDR~1GCO`).
+    pub short: [u8; 11],
+    pub size: u32,
+}
+
+impl PlotHeader {
+    pub fn encode(&self) -> [u8; HEADER_BYTES as usize] {
+        let mut b = [0u8; HEADER_BYTES as usize];
+        b[0] = MAGIC;
+        b[1] = VERSION;
+        b[2..4].copy_from_slice(&self.seq.to_le_bytes());
+        b[4] = KIND;
+        b[5..16].copy_from_slice(&self.short);
+        b[16..20].copy_from_slice(&self.size.to_le_bytes());
+        let crc = crc16(CRC_START, &b[..30]);
+        b[30..].copy_from_slice(&crc.to_le_bytes());
+        b
+    }
+
+    /// The header, if `b` is a print's whose CRC holds.
+    pub fn decode(b: &[u8; HEADER_BYTES as usize]) -> Option<PlotHeader> {
+        let crc = u16::from_le_bytes([b[30], b[31]]);
+        if b[0] != MAGIC || b[1] != VERSION || b[4] != KIND || crc16(CRC_START, &b[..30]) != crc {
+            return None;
+        }
+        let mut short = [0u8; 11];
+        short.copy_from_slice(&b[5..16]);
+        Some(PlotHeader {
+            seq: u16::from_le_bytes([b[2], b[3]]),
+            short,
+            size: u32::from_le_bytes([b[16], b[17], b[18], b[19]]),
+        })
+    }
+}
+
+/// Record `n`: the line starting at byte `pos` was moving.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlotRecord {
+    pub n: u16,
+    pub pos: u32,
+}
+
+impl PlotRecord {
+    pub fn address(n: u16) -> u16 {
+        RING + (n % SLOTS) * RECORD_BYTES
+    }
+
+    pub fn encode(&self, seq: u16) -> [u8; RECORD_BYTES as usize] {
+        let mut b = [0u8; RECORD_BYTES as usize];
+        b[..2].copy_from_slice(&self.n.to_le_bytes());
+        b[2..6].copy_from_slice(&self.pos.to_le_bytes());
+        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..6]);
+        b[6..].copy_from_slice(&crc.to_le_bytes());
+        b
+    }
+
+    pub fn decode(b: &[u8; RECORD_BYTES as usize], seq: u16) -> Option<PlotRecord> {
+        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..6]);
+        (crc == u16::from_le_bytes([b[6], b[7]])).then(|| PlotRecord {
+            n: u16::from_le_bytes([b[0], b[1]]),
+            pos: u32::from_le_bytes([b[2], b[3], b[4], b[5]]),
+        })
+    }
+}
+
+/// A print a cut stopped: the file, and its newest record (`None`: none
+/// yet, the print goes on from the file's start).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlotSaved {
+    pub header: PlotHeader,
+    pub last: Option<PlotRecord>,
+}
+
+impl PlotSaved {
+    /// Where the print goes on: the start of the line that was moving.
+    pub fn pos(&self) -> u32 {
+        self.last.map_or(0, |r| r.pos)
+    }
+
+    /// The next record's number.
+    pub fn next_n(&self) -> u16 {
+        self.last.map_or(1, |r| r.n.wrapping_add(1))
+    }
+}
+
+/// The newest record under `header` (a record in another number's slot
+/// is stale or foreign: passed over).
+pub(super) fn scan_records(read: &mut impl FnMut(u16) -> u8, header: PlotHeader) -> PlotSaved {
+    let mut last: Option<PlotRecord> = None;
+    for slot in 0..SLOTS {
+        let at = RING + slot * RECORD_BYTES;
+        let mut b = [0u8; RECORD_BYTES as usize];
+        for (i, x) in b.iter_mut().enumerate() {
+            *x = read(at + i as u16);
+        }
+        let Some(r) = PlotRecord::decode(&b, header.seq) else {
+            continue;
+        };
+        if r.n % SLOTS != slot {
+            continue;
+        }
+        // Numbers wrap; all those under one header lie within a ring.
+        if last.is_none_or(|l| newer(r.n, l.n)) {
+            last = Some(r);
+        }
+    }
+    PlotSaved { header, last }
+}
+
+/// Which line of a print is moving, and when its record is due.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Tracker {
+    /// A line read: its offset and the number of its first block.
+    candidate: Option<(u32, u8)>,
+    /// When the last record was asked for (ms); `None`: none yet.
+    last_ms: Option<u32>,
+    /// The next record's number.
+    next: u16,
+}
+
+impl Tracker {
+    /// A new print (or one going on after a cut, whose records are
+    /// numbered from `next`).
+    pub const fn new(next: u16) -> Tracker {
+        Tracker {
+            candidate: None,
+            last_ms: None,
+            next,
+        }
+    }
+
+    /// A line of the file is about to be carried out: it starts at byte
+    /// `pos`, and its first block (if it has any) will be block number
+    /// `first` (blocks begun + blocks queued and not begun, read in that
+    /// order: a block begun between the reads makes `first` one too
+    /// high, which only waits a block longer). Taken as the next record's
+    /// line when none waits and the last record is old enough.
+    pub fn line(&mut self, pos: u32, first: u8, now_ms: u32) {
+        let rested = self
+            .last_ms
+            .is_none_or(|t| now_ms.wrapping_sub(t) >= RECORD_EVERY_MS);
+        if self.candidate.is_none() && rested {
+            self.candidate = Some((pos, first));
+        }
+    }
+
+    /// The record to write now, if the waiting line's first block has
+    /// begun (`begun` blocks so far): every line before it is drawn.
+    /// `writing`: the last record is not yet durable (the next waits).
+    pub fn due(&mut self, begun: u8, writing: bool, now_ms: u32) -> Option<PlotRecord> {
+        let (pos, first) = self.candidate?;
+        if writing || (begun.wrapping_sub(first) as i8) < 1 {
+            return None;
+        }
+        self.candidate = None;
+        self.last_ms = Some(now_ms);
+        let r = PlotRecord { n: self.next, pos };
+        self.next = self.next.wrapping_add(1);
+        Some(r)
+    }
+}
+
+/// Wear: hours of printing before the most-written cell of the ring
+/// reaches `endurance` writes, a record every [`RECORD_EVERY_MS`].
+pub fn hours_before_wear_out(endurance: u32) -> u32 {
+    let lap_ms = u64::from(SLOTS) * u64::from(RECORD_EVERY_MS);
+    (u64::from(endurance) * lap_ms / 3_600_000) as u32
+}
+
+const _: () = assert!(RING + SLOTS * RECORD_BYTES <= END && START < RING);
+
+#[cfg(test)]
+mod tests;

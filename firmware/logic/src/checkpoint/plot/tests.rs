@@ -1,0 +1,233 @@
+use super::super::{scan, Found, Header, Record};
+use super::*;
+use crate::stringart::Phase;
+use std::vec;
+use std::vec::Vec;
+
+const SHORT: [u8; 11] = *b"STARDR~1GCO";
+
+fn header(seq: u16) -> PlotHeader {
+    PlotHeader {
+        seq,
+        short: SHORT,
+        size: 2316,
+    }
+}
+
+/// The EEPROM as the firmware's writer leaves it.
+struct Eeprom(Vec<u8>);
+
+impl Eeprom {
+    fn blank() -> Self {
+        Eeprom(vec![0xFF; END as usize])
+    }
+    fn write(&mut self, at: u16, bytes: &[u8]) {
+        self.0[at as usize..at as usize + bytes.len()].copy_from_slice(bytes);
+    }
+    fn header(&mut self, h: PlotHeader) {
+        self.write(Header::address(h.seq), &h.encode());
+    }
+    fn record(&mut self, seq: u16, r: PlotRecord) {
+        self.write(PlotRecord::address(r.n), &r.encode(seq));
+    }
+    fn scan(&self) -> Found {
+        scan(|a| self.0[a as usize])
+    }
+}
+
+#[test]
+fn header_and_record_round_trip_and_a_flipped_bit_fails() {
+    let h = header(7);
+    assert_eq!(PlotHeader::decode(&h.encode()), Some(h));
+    // A string-art header is not a print's, nor the other way round.
+    assert_eq!(Header::decode(&h.encode()), None);
+    assert_eq!(PlotHeader::decode(&Header::idle(7).encode()), None);
+    let r = PlotRecord {
+        n: 513,
+        pos: 98_765,
+    };
+    assert_eq!(PlotRecord::decode(&r.encode(7), 7), Some(r));
+    // Under another header's number it is stale.
+    assert_eq!(PlotRecord::decode(&r.encode(7), 8), None);
+    for bit in 0..64 {
+        let mut b = r.encode(7);
+        b[bit / 8] ^= 1 << (bit % 8);
+        assert_eq!(PlotRecord::decode(&b, 7), None, "bit {bit}");
+        let mut b = h.encode();
+        b[bit / 8] ^= 1 << (bit % 8);
+        assert_eq!(PlotHeader::decode(&b), None, "bit {bit}");
+    }
+}
+
+#[test]
+fn a_print_with_no_record_goes_on_from_the_file_s_start() {
+    let mut e = Eeprom::blank();
+    e.header(header(3));
+    let Found::Plot(p) = e.scan() else {
+        panic!("{:?}", e.scan())
+    };
+    assert_eq!(
+        (p.header, p.last, p.pos(), p.next_n()),
+        (header(3), None, 0, 1)
+    );
+    assert_eq!(e.scan().next_seq(), 4);
+}
+
+#[test]
+fn the_newest_record_wins_across_laps_of_the_ring_and_number_wraps() {
+    let mut e = Eeprom::blank();
+    e.header(header(9));
+    // Three laps and a bit, numbers wrapping past u16::MAX.
+    let start = u16::MAX - 2 * SLOTS;
+    let mut n = start;
+    for k in 0..(3 * SLOTS as u32 + 17) {
+        e.record(9, PlotRecord { n, pos: 1000 + k });
+        let Found::Plot(p) = e.scan() else { panic!() };
+        assert_eq!(p.last, Some(PlotRecord { n, pos: 1000 + k }));
+        assert_eq!(p.next_n(), n.wrapping_add(1));
+        n = n.wrapping_add(1);
+    }
+}
+
+#[test]
+fn a_record_torn_at_any_byte_leaves_the_one_before() {
+    for torn in 0..RECORD_BYTES as usize {
+        for erased in [0xFF, 0x00] {
+            let mut e = Eeprom::blank();
+            e.header(header(1));
+            for n in 1..=(SLOTS + 4) {
+                e.record(
+                    1,
+                    PlotRecord {
+                        n,
+                        pos: 10 * n as u32,
+                    },
+                );
+            }
+            let next = PlotRecord {
+                n: SLOTS + 5,
+                pos: 99_999,
+            };
+            let mut b = next.encode(1);
+            // The bytes from `torn` on were not written (the slot held
+            // record 5's); the torn one holds `erased`.
+            let old = PlotRecord { n: 5, pos: 50 }.encode(1);
+            b[torn] = erased;
+            b[torn + 1..].copy_from_slice(&old[torn + 1..]);
+            e.write(PlotRecord::address(next.n), &b);
+            let Found::Plot(p) = e.scan() else { panic!() };
+            assert_eq!(p.pos(), 10 * (SLOTS as u32 + 4), "torn at {torn}");
+        }
+    }
+}
+
+#[test]
+fn a_new_header_hides_the_last_print_s_records_and_an_idle_one_ends_it() {
+    let mut e = Eeprom::blank();
+    e.header(header(1));
+    e.record(1, PlotRecord { n: 1, pos: 400 });
+    e.header(header(2));
+    let Found::Plot(p) = e.scan() else { panic!() };
+    assert_eq!(p.last, None);
+    e.write(Header::address(3), &Header::idle(3).encode());
+    assert_eq!(e.scan(), Found::Idle { seq: 3 });
+    // A string-art job after it still reads as a job.
+    let job = Header {
+        seq: 4,
+        phase: Some(Phase::Winding),
+        nails: 12,
+        count: 30,
+        id: Default::default(),
+    };
+    e.write(Header::address(4), &job.encode());
+    e.write(Record::address(1), &Record { n: 1, gap: 3 }.encode(4));
+    assert!(matches!(e.scan(), Found::Job(s) if s.header == job));
+}
+
+#[test]
+fn a_header_torn_mid_write_leaves_the_older_one() {
+    for torn in 0..HEADER_BYTES as usize {
+        let mut e = Eeprom::blank();
+        e.write(Header::address(5), &Header::idle(5).encode());
+        let mut b = header(6).encode();
+        for x in &mut b[torn..] {
+            *x = 0xFF;
+        }
+        e.write(Header::address(6), &b);
+        let whole = b == header(6).encode();
+        match e.scan() {
+            Found::Plot(p) => assert!(whole && p.header == header(6), "torn at {torn}"),
+            found => assert_eq!(found, Found::Idle { seq: 5 }, "torn at {torn}"),
+        }
+    }
+}
+
+/// Blocks as the firmware counts them: queued (in the planner and
+/// below) and begun by the step interrupt.
+struct Steppers {
+    queued: u8,
+    begun: u8,
+}
+
+#[test]
+fn the_record_names_a_line_only_once_its_first_block_has_begun() {
+    let mut s = Steppers {
+        queued: 250,
+        begun: 240,
+    };
+    let mut t = Tracker::new(1);
+    // Line at byte 100 is read with 10 blocks ahead of it; it queues 3.
+    t.line(100, s.begun.wrapping_add(s.queued - s.begun), 0);
+    s.queued = s.queued.wrapping_add(3);
+    for _ in 0..10 {
+        assert_eq!(t.due(s.begun, false, 5), None);
+        s.begun = s.begun.wrapping_add(1);
+    }
+    // Its first block now begins (the count wraps past 255).
+    assert_eq!(t.due(s.begun, false, 5), None);
+    s.begun = s.begun.wrapping_add(1);
+    assert_eq!(t.due(s.begun, true, 5), None, "the last write first");
+    assert_eq!(
+        t.due(s.begun, false, 5),
+        Some(PlotRecord { n: 1, pos: 100 })
+    );
+    assert_eq!(t.due(s.begun, false, 5), None);
+}
+
+#[test]
+fn records_come_no_oftener_than_the_wear_limit_and_number_on() {
+    let mut t = Tracker::new(41);
+    let mut at = Vec::new();
+    let mut begun = 0u8;
+    // A short line every 20 ms, each a block, moving at once.
+    for k in 0..200u32 {
+        let now = 20 * k;
+        t.line(k * 30, begun, now);
+        begun = begun.wrapping_add(1);
+        if let Some(r) = t.due(begun, false, now) {
+            at.push((now, r));
+        }
+    }
+    assert!(at.len() >= 7, "{at:?}");
+    for w in at.windows(2) {
+        assert!(w[1].0 - w[0].0 >= RECORD_EVERY_MS, "{at:?}");
+        assert_eq!(w[1].1.n, w[0].1.n + 1);
+    }
+    assert_eq!(at[0].1, PlotRecord { n: 41, pos: 0 });
+    // A cell is written once a lap of the ring.
+    assert!(
+        hours_before_wear_out(100_000) >= 4000,
+        "{}",
+        hours_before_wear_out(100_000)
+    );
+}
+
+#[test]
+fn a_line_that_queues_nothing_is_recorded_once_the_next_move_begins() {
+    let mut t = Tracker::new(1);
+    // `M3` at byte 50, nothing queued ahead: its "first block" is the
+    // next line's.
+    t.line(50, 7, 0);
+    assert_eq!(t.due(7, false, 0), None);
+    assert_eq!(t.due(8, false, 0), Some(PlotRecord { n: 1, pos: 50 }));
+}
