@@ -200,6 +200,86 @@ impl Tracker {
     }
 }
 
+/// Going on with a print a cut stopped, step by step: offered at
+/// power-on; taken (`M1000`, green), the machine homes if it has
+/// switches, the file opens from its start, its lines before the
+/// checkpoint's are read and taken without moving, then the pen goes up,
+/// the machine moves to where the checkpoint's line starts, the pen goes
+/// as it was there, and the print goes on with that line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Resume {
+    /// `M1000` or green resumes, `M1000 C` or green held 2 s discards.
+    Offered,
+    Homing,
+    Opening,
+    /// Lines before the checkpoint's offset: checked and taken, no motion.
+    Replaying,
+    /// The pen up and the move back to the line's start.
+    Travel,
+    /// The pen as the lines before left it.
+    Pen,
+}
+
+/// What happened, for [`Resume::on`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ResumeEvent {
+    /// `M1000` or green; `homes`: the machine has homing switches.
+    Take { homes: bool },
+    /// `M1000 C`, green held, or another print started.
+    Discard,
+    /// Homing is done (or not needed).
+    Homed,
+    /// The file is open from its start.
+    Opened,
+    /// A line of the file starting at this offset was read whole.
+    Line(u32),
+    /// The travel or the pen is done.
+    Done,
+}
+
+/// What the firmware does next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ResumeAction {
+    None,
+    /// Home the machine (`$H`).
+    Home,
+    /// Open the file from its start, as a print.
+    Open,
+    /// Take the line without moving (as `$C`).
+    Check,
+    /// Hold the line: pen up, then a rapid to the executor's position.
+    Travel,
+    /// The pen as the executor's state has it.
+    Pen,
+    /// Carry out the held line and the rest as a print.
+    Go,
+    /// Write an idle header: the checkpoint is done with.
+    Forget,
+}
+
+impl Resume {
+    /// The next state (`None`: no resume under way) and what to do, the
+    /// checkpoint's line starting at byte `at`.
+    pub fn on(self, e: ResumeEvent, at: u32) -> (Option<Resume>, ResumeAction) {
+        use Resume as S;
+        use ResumeAction as A;
+        use ResumeEvent as E;
+        match (self, e) {
+            (S::Offered, E::Take { homes: true }) => (Some(S::Homing), A::Home),
+            (S::Offered, E::Take { homes: false }) | (S::Homing, E::Homed) => {
+                (Some(S::Opening), A::Open)
+            }
+            (S::Offered, E::Discard) => (None, A::Forget),
+            (S::Opening, E::Opened) => (Some(S::Replaying), A::None),
+            (S::Replaying, E::Line(pos)) if pos < at => (Some(S::Replaying), A::Check),
+            (S::Replaying, E::Line(_)) => (Some(S::Travel), A::Travel),
+            (S::Travel, E::Done) => (Some(S::Pen), A::Pen),
+            (S::Pen, E::Done) => (None, A::Go),
+            (s, _) => (Some(s), A::None),
+        }
+    }
+}
+
 /// Wear: hours of printing before the most-written cell of the ring
 /// reaches `endurance` writes, a record every [`RECORD_EVERY_MS`].
 pub fn hours_before_wear_out(endurance: u32) -> u32 {

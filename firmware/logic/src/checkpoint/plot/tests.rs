@@ -231,3 +231,57 @@ fn a_line_that_queues_nothing_is_recorded_once_the_next_move_begins() {
     assert_eq!(t.due(7, false, 0), None);
     assert_eq!(t.due(8, false, 0), Some(PlotRecord { n: 1, pos: 50 }));
 }
+
+#[test]
+fn resume_homes_opens_replays_the_lines_before_then_travels_and_pens() {
+    use ResumeAction as A;
+    use ResumeEvent as E;
+    let at = 120;
+    let mut s = Some(Resume::Offered);
+    let mut did = Vec::new();
+    let events = [
+        E::Homed, // not asked: nothing
+        E::Take { homes: true },
+        E::Homed,
+        E::Opened,
+        E::Line(0),
+        E::Line(40),
+        E::Line(119),
+        E::Line(120),
+        E::Line(140), // held: nothing until the travel is done
+        E::Done,
+        E::Done,
+    ];
+    for e in events {
+        let (next, a) = s.unwrap().on(e, at);
+        did.push(a);
+        s = next;
+    }
+    assert_eq!(
+        did,
+        [
+            A::None,
+            A::Home,
+            A::Open,
+            A::None,
+            A::Check,
+            A::Check,
+            A::Check,
+            A::Travel,
+            A::None,
+            A::Pen,
+            A::Go
+        ]
+    );
+    assert_eq!(s, None);
+    // No switches: straight to the file; from the start: no line checked.
+    assert_eq!(
+        Resume::Offered.on(E::Take { homes: false }, 0),
+        (Some(Resume::Opening), A::Open)
+    );
+    assert_eq!(
+        Resume::Replaying.on(E::Line(0), 0),
+        (Some(Resume::Travel), A::Travel)
+    );
+    assert_eq!(Resume::Offered.on(E::Discard, at), (None, A::Forget));
+}
