@@ -319,6 +319,13 @@ fn init() -> Watchdog {
     reply::banner();
 
     boot_log(reset);
+    // A plotter's print a cut stopped: the console offers it.
+    if let Found::Plot(p) = found {
+        if !CONFIG.with(|c| c.machine.is_string_art()) {
+            CONSOLE.with(|c| c.offer_print(p.pos()));
+            spawn(Task::Console);
+        }
+    }
     let (saved, note) = checkpoint::found(found, reset);
     match store_now || STORE.with(|s| s.as_ref().unwrap().saving()) {
         true => spawn(Task::Store),

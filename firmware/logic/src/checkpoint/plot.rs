@@ -28,9 +28,10 @@ use super::{crc16, newer, CRC_START, END, HEADER_BYTES, MAGIC, RECORD_BYTES, RIN
 pub const KIND: u8 = 3;
 const VERSION: u8 = 1;
 
-/// Records at most this often: the redraw after a cut is at most this
-/// much of the drawing (and the planner's look-ahead), and the ring's
-/// cells last [`hours_before_wear_out`] of printing.
+/// Records at most this often: after a cut, the line that was moving is
+/// drawn again from its start, and before it at most this much of the
+/// drawing (and a few blocks, [`Tracker`]); the ring's cells last
+/// [`hours_before_wear_out`] of printing.
 pub const RECORD_EVERY_MS: u32 = 500;
 
 /// The print: its file, and the sequence number records are written
@@ -147,11 +148,25 @@ pub(super) fn scan_records(read: &mut impl FnMut(u16) -> u8, header: PlotHeader)
     PlotSaved { header, last }
 }
 
+/// Lines followed at once: spread over the blocks in flight, the newest
+/// begun of them is a block or two behind the one moving.
+pub const FOLLOWED: usize = 8;
+
 /// Which line of a print is moving, and when its record is due.
+///
+/// The planner and the step queue hold a score of blocks, and the file's
+/// lines are read as far ahead: the line read is not the one moving. A
+/// few lines read are kept with the number of their first block, spread
+/// over the blocks in flight; once blocks up to one of them have begun,
+/// that line is moving (or done), and every line before it is drawn.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Tracker {
-    /// A line read: its offset and the number of its first block.
-    candidate: Option<(u32, u8)>,
+    /// The oldest followed line's offset; the others' as bytes after it.
+    base: u32,
+    /// Lines followed, oldest first: offset after `base`, number of the
+    /// first block.
+    lines: [(u16, u8); FOLLOWED],
+    len: u8,
     /// When the last record was asked for (ms); `None`: none yet.
     last_ms: Option<u32>,
     /// The next record's number.
@@ -163,7 +178,9 @@ impl Tracker {
     /// numbered from `next`).
     pub const fn new(next: u16) -> Tracker {
         Tracker {
-            candidate: None,
+            base: 0,
+            lines: [(0, 0); FOLLOWED],
+            len: 0,
             last_ms: None,
             next,
         }
@@ -173,26 +190,73 @@ impl Tracker {
     /// `pos`, and its first block (if it has any) will be block number
     /// `first` (blocks begun + blocks queued and not begun, read in that
     /// order: a block begun between the reads makes `first` one too
-    /// high, which only waits a block longer). Taken as the next record's
-    /// line when none waits and the last record is old enough.
-    pub fn line(&mut self, pos: u32, first: u8, now_ms: u32) {
-        let rested = self
-            .last_ms
-            .is_none_or(|t| now_ms.wrapping_sub(t) >= RECORD_EVERY_MS);
-        if self.candidate.is_none() && rested {
-            self.candidate = Some((pos, first));
+    /// high, which only waits a block longer). Not followed: a line whose
+    /// first block is the last followed line's (that earlier one stands
+    /// for it), or one 64 KiB past the oldest. With all places taken, the
+    /// line closest after another gives its place up.
+    pub fn line(&mut self, pos: u32, first: u8) {
+        let len = self.len as usize;
+        if len == 0 {
+            self.base = pos;
+        }
+        let Ok(after) = u16::try_from(pos.wrapping_sub(self.base)) else {
+            return;
+        };
+        if len > 0 && self.lines[len - 1].1 == first {
+            return;
+        }
+        if len == FOLLOWED {
+            // The place whose line follows its neighbour's most closely
+            // (never the oldest: it is the next to begin).
+            let mut drop = len - 1;
+            let mut gap = first.wrapping_sub(self.lines[len - 1].1);
+            for i in 1..len {
+                let g = self.lines[i].1.wrapping_sub(self.lines[i - 1].1);
+                if g < gap {
+                    (drop, gap) = (i, g);
+                }
+            }
+            self.lines.copy_within(drop + 1..len, drop);
+            self.len -= 1;
+        }
+        self.lines[self.len as usize] = (after, first);
+        self.len += 1;
+    }
+
+    /// The `k` oldest followed lines are done with.
+    fn drop_oldest(&mut self, k: usize) {
+        if k == 0 {
+            return;
+        }
+        let len = self.len as usize;
+        let shift = self.lines.get(k).map_or(0, |l| l.0);
+        self.base = self.base.wrapping_add(u32::from(shift));
+        self.lines.copy_within(k..len, 0);
+        self.len -= k as u8;
+        for l in &mut self.lines[..self.len as usize] {
+            l.0 -= shift;
         }
     }
 
-    /// The record to write now, if the waiting line's first block has
-    /// begun (`begun` blocks so far): every line before it is drawn.
-    /// `writing`: the last record is not yet durable (the next waits).
+    /// The record to write now: the newest followed line whose first
+    /// block has begun (`begun` blocks so far), once the last record is
+    /// [`RECORD_EVERY_MS`] old. `writing`: the last record is not yet
+    /// durable (the next waits).
     pub fn due(&mut self, begun: u8, writing: bool, now_ms: u32) -> Option<PlotRecord> {
-        let (pos, first) = self.candidate?;
-        if writing || (begun.wrapping_sub(first) as i8) < 1 {
+        let len = self.len as usize;
+        let moving = self.lines[..len]
+            .iter()
+            .rposition(|&(_, first)| (begun.wrapping_sub(first) as i8) >= 1)?;
+        // The older ones are drawn: the newest begun stands for them.
+        self.drop_oldest(moving);
+        let rested = self
+            .last_ms
+            .is_none_or(|t| now_ms.wrapping_sub(t) >= RECORD_EVERY_MS);
+        if writing || !rested {
             return None;
         }
-        self.candidate = None;
+        let pos = self.base;
+        self.drop_oldest(1);
         self.last_ms = Some(now_ms);
         let r = PlotRecord { n: self.next, pos };
         self.next = self.next.wrapping_add(1);

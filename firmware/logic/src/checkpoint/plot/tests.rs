@@ -1,6 +1,7 @@
 use super::super::{scan, Found, Header, Record};
 use super::*;
 use crate::stringart::Phase;
+use std::eprintln;
 use std::vec;
 use std::vec::Vec;
 
@@ -162,58 +163,61 @@ fn a_header_torn_mid_write_leaves_the_older_one() {
     }
 }
 
-/// Blocks as the firmware counts them: queued (in the planner and
-/// below) and begun by the step interrupt.
-struct Steppers {
-    queued: u8,
-    begun: u8,
-}
-
 #[test]
 fn the_record_names_a_line_only_once_its_first_block_has_begun() {
-    let mut s = Steppers {
-        queued: 250,
-        begun: 240,
-    };
+    // 250 blocks begun so far, 10 queued: the line at byte 100 (3 blocks)
+    // has first block 260 = 4 after wrapping.
+    let mut begun = 250u8;
+    let first = begun.wrapping_add(10);
     let mut t = Tracker::new(1);
-    // Line at byte 100 is read with 10 blocks ahead of it; it queues 3.
-    t.line(100, s.begun.wrapping_add(s.queued - s.begun), 0);
-    s.queued = s.queued.wrapping_add(3);
+    t.line(100, first);
     for _ in 0..10 {
-        assert_eq!(t.due(s.begun, false, 5), None);
-        s.begun = s.begun.wrapping_add(1);
+        assert_eq!(t.due(begun, false, 5), None);
+        begun = begun.wrapping_add(1);
     }
-    // Its first block now begins (the count wraps past 255).
-    assert_eq!(t.due(s.begun, false, 5), None);
-    s.begun = s.begun.wrapping_add(1);
-    assert_eq!(t.due(s.begun, true, 5), None, "the last write first");
-    assert_eq!(
-        t.due(s.begun, false, 5),
-        Some(PlotRecord { n: 1, pos: 100 })
-    );
-    assert_eq!(t.due(s.begun, false, 5), None);
+    // Its first block begins now (the count wraps past 255).
+    assert_eq!(t.due(begun, false, 5), None);
+    begun = begun.wrapping_add(1);
+    assert_eq!(t.due(begun, true, 5), None, "the last write first");
+    assert_eq!(t.due(begun, false, 5), Some(PlotRecord { n: 1, pos: 100 }));
+    assert_eq!(t.due(begun, false, 5), None);
+}
+
+/// A print's lines through a planner `depth` blocks deep, one block
+/// each, `ms` each: the line moving when each record is asked for, and
+/// the record.
+fn run(depth: u8, ms: u32, lines: u32) -> Vec<(u32, PlotRecord)> {
+    let mut t = Tracker::new(41);
+    let mut out = Vec::new();
+    let (mut read, mut begun) = (0u32, 0u8);
+    for moving in 0..lines {
+        // The line `moving` begins: the reader keeps `depth` ahead.
+        begun = begun.wrapping_add(1);
+        while read < (moving + u32::from(depth)).min(lines) {
+            t.line(read * 30, read as u8);
+            read += 1;
+        }
+        if let Some(r) = t.due(begun, false, moving * ms) {
+            out.push((moving, r));
+        }
+    }
+    out
 }
 
 #[test]
-fn records_come_no_oftener_than_the_wear_limit_and_number_on() {
-    let mut t = Tracker::new(41);
-    let mut at = Vec::new();
-    let mut begun = 0u8;
-    // A short line every 20 ms, each a block, moving at once.
-    for k in 0..200u32 {
-        let now = 20 * k;
-        t.line(k * 30, begun, now);
-        begun = begun.wrapping_add(1);
-        if let Some(r) = t.due(begun, false, now) {
-            at.push((now, r));
-        }
-    }
-    assert!(at.len() >= 7, "{at:?}");
-    for w in at.windows(2) {
-        assert!(w[1].0 - w[0].0 >= RECORD_EVERY_MS, "{at:?}");
+fn records_come_no_oftener_than_the_wear_limit_and_name_a_line_just_begun() {
+    // Short lines, 20 ms each, 12 blocks ahead.
+    let out = run(12, 20, 400);
+    assert!(out.len() >= 14, "{out:?}");
+    for w in out.windows(2) {
+        assert!(20 * (w[1].0 - w[0].0) >= RECORD_EVERY_MS, "{out:?}");
         assert_eq!(w[1].1.n, w[0].1.n + 1);
     }
-    assert_eq!(at[0].1, PlotRecord { n: 41, pos: 0 });
+    assert_eq!(out[0].1, PlotRecord { n: 41, pos: 0 });
+    for (moving, r) in &out {
+        let line = r.pos / 30;
+        assert!(line <= *moving && moving - line <= 4, "{out:?}");
+    }
     // A cell is written once a lap of the ring.
     assert!(
         hours_before_wear_out(100_000) >= 4000,
@@ -223,11 +227,27 @@ fn records_come_no_oftener_than_the_wear_limit_and_number_on() {
 }
 
 #[test]
+fn long_lines_are_recorded_as_each_begins() {
+    // Two seconds a line, 14 blocks in flight: each line moving is
+    // recorded, or the one before it.
+    let out = run(14, 2000, 60);
+    assert!(out.len() >= 30, "{out:?}");
+    let exact = out.iter().filter(|(m, r)| r.pos == m * 30).count();
+    for (moving, r) in &out {
+        assert!(r.pos <= moving * 30 && moving * 30 - r.pos <= 30, "{out:?}");
+    }
+    eprintln!("{exact} of {} records name the line moving", out.len());
+}
+
+#[test]
 fn a_line_that_queues_nothing_is_recorded_once_the_next_move_begins() {
     let mut t = Tracker::new(1);
     // `M3` at byte 50, nothing queued ahead: its "first block" is the
-    // next line's.
-    t.line(50, 7, 0);
+    // next line's, which the next line (byte 53) does not take over.
+    t.line(50, 7);
+    t.line(53, 7);
+    // Too far after the oldest: not followed.
+    t.line(50 + 70_000, 9);
     assert_eq!(t.due(7, false, 0), None);
     assert_eq!(t.due(8, false, 0), Some(PlotRecord { n: 1, pos: 50 }));
 }
