@@ -175,10 +175,10 @@ impl Console {
         self.interp.reset(&coords::stored(coords, 0));
     }
 
-    /// At power-on: a card print a power cut stopped, to go on from the
-    /// line at byte `at` once asked (`M1000`, green).
-    pub fn offer_print(&mut self, at: u32) {
-        self.print.offer(at);
+    /// At power-on: a card print a power cut stopped, to go on with once
+    /// asked (`M1000`, green).
+    pub fn offer_print(&mut self) {
+        self.print.offer();
     }
 
     /// Whether a `$` setting changed since the last call (the app then has

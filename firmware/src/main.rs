@@ -320,9 +320,9 @@ fn init() -> Watchdog {
 
     boot_log(reset);
     // A plotter's print a cut stopped: the console offers it.
-    if let Found::Plot(p) = found {
+    if let Found::Plot(_) = found {
         if !CONFIG.with(|c| c.machine.is_string_art()) {
-            CONSOLE.with(|c| c.offer_print(p.pos()));
+            CONSOLE.with(|c| c.offer_print());
             spawn(Task::Console);
         }
     }

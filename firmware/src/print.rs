@@ -81,18 +81,19 @@ pub struct Print {
     read_start: u32,
     /// The print's checkpoint: which line moves (`None`: no print).
     tracker: Option<Tracker>,
-    /// A checkpoint header to write once the store is free.
+    /// A checkpoint header to write once the store is free, or the offer
+    /// to say once there is room.
     keep: Keep,
-    /// A power cut's print offered or being resumed, from the line at
-    /// this offset; the offer still to be said.
+    /// A power cut's print offered or being resumed (from the line at the
+    /// tracker's [`Tracker::resume_at`]).
     resume: Option<Resume>,
-    resume_at: u32,
-    say_offer: bool,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Keep {
     Nothing,
+    /// A power cut's print is offered: `>>> resume …`.
+    Offer,
     /// A print starts: its file.
     Begin,
     /// The print ended or was stopped: an idle header.
@@ -119,8 +120,6 @@ impl Print {
             tracker: None,
             keep: Keep::Nothing,
             resume: None,
-            resume_at: 0,
-            say_offer: false,
         }
     }
 
@@ -147,11 +146,10 @@ impl Print {
         self.resume == Some(Resume::Offered)
     }
 
-    /// At power-on: a print a cut stopped, to go on from the line at `at`.
-    pub fn offer(&mut self, at: u32) {
+    /// At power-on: a print a cut stopped.
+    pub fn offer(&mut self) {
         self.resume = Some(Resume::Offered);
-        self.resume_at = at;
-        self.say_offer = true;
+        self.keep = Keep::Offer;
     }
 
     /// The checkpoint's work, each console run: the offer said once there
@@ -159,8 +157,11 @@ impl Print {
     #[inline(never)]
     #[optimize(size)]
     pub fn keep(&mut self, store: &mut Store, now: u32) {
-        if self.say_offer && TX.free() >= crate::log::LINE {
-            self.say_offer = false;
+        if self.keep == Keep::Offer {
+            if TX.free() < crate::log::LINE {
+                return;
+            }
+            self.keep = Keep::Nothing;
             match store.plot_saved() {
                 Some(p) => info!(
                     ">>> resume ",
@@ -180,7 +181,7 @@ impl Print {
         match core::mem::replace(&mut self.keep, Keep::Nothing) {
             Keep::Begin => store.plot_begin(crate::card::opened_short(), self.size),
             Keep::Forget => store.forget(),
-            Keep::Nothing => {
+            Keep::Nothing | Keep::Offer => {
                 let begun = BEGUN.load(Relaxed);
                 if let Some(r) = self.tracker.as_mut().and_then(|t| t.due(begun, false, now)) {
                     store.plot_record(r);
@@ -201,8 +202,7 @@ impl Print {
             return Err(ErrorKind::Printing);
         }
         self.resume = next;
-        self.resume_at = p.pos();
-        self.tracker = Some(Tracker::new(p.next_n()));
+        self.tracker = Some(Tracker::resuming(&p));
         info!(
             "resuming: ",
             short_display(&p.header.short),
@@ -274,7 +274,8 @@ impl Print {
         };
         let action = match self.resume {
             Some(r) if r != Resume::Offered => {
-                let (next, action) = r.on(e, self.resume_at);
+                let at = self.tracker.as_ref().map_or(0, |t| t.resume_at());
+                let (next, action) = r.on(e, at);
                 self.resume = next;
                 action
             }
@@ -421,7 +422,7 @@ impl Print {
         self.state = State::Running;
         self.resume = None;
         self.keep = Keep::Begin;
-        self.tracker = Some(Tracker::new(1));
+        self.tracker = Some(Tracker::new());
     }
 
     /// `M27`: `SD printing byte 1234/5678`, Marlin's words.

@@ -213,6 +213,12 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
         wait_for(&mut sim, "Done printing file", Duration::from_secs(120));
         send(&mut sim, "M400");
         let second = pen_down_points(&sim, origin);
+        eprintln!(
+            "seed {seed}: resumed run's stack peak {} B at {:#x}",
+            sim.peak_stack_bytes(),
+            sim.peak_stack_pc()
+        );
+        hil_tests::assert_ram_budget(&sim);
         // The checkpoint is cleared once the print is done.
         sim.run_for(Duration::from_millis(300));
         let left = checkpoint::scan(|a| sim.eeprom()[a as usize]);

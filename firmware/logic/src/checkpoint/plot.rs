@@ -150,7 +150,7 @@ pub(super) fn scan_records(read: &mut impl FnMut(u16) -> u8, header: PlotHeader)
 
 /// Lines followed at once: spread over the blocks in flight, the newest
 /// begun of them is a block or two behind the one moving.
-pub const FOLLOWED: usize = 8;
+pub const FOLLOWED: usize = 7;
 
 /// Which line of a print is moving, and when its record is due.
 ///
@@ -161,29 +161,44 @@ pub const FOLLOWED: usize = 8;
 /// that line is moving (or done), and every line before it is drawn.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Tracker {
-    /// The oldest followed line's offset; the others' as bytes after it.
+    /// The oldest followed line's offset, the others' as bytes after it;
+    /// before any is followed, where a resumed print goes on.
     base: u32,
     /// Lines followed, oldest first: offset after `base`, number of the
     /// first block.
     lines: [(u16, u8); FOLLOWED],
     len: u8,
-    /// When the last record was asked for (ms); `None`: none yet.
-    last_ms: Option<u32>,
+    /// When the last record was asked for (ms, wrapping: a record at most
+    /// [`RECORD_EVERY_MS`] late after a minute without one).
+    last_ms: u16,
     /// The next record's number.
     next: u16,
 }
 
 impl Tracker {
-    /// A new print (or one going on after a cut, whose records are
-    /// numbered from `next`).
-    pub const fn new(next: u16) -> Tracker {
+    /// A new print.
+    pub const fn new() -> Tracker {
         Tracker {
             base: 0,
             lines: [(0, 0); FOLLOWED],
             len: 0,
-            last_ms: None,
-            next,
+            last_ms: 0,
+            next: 1,
         }
+    }
+
+    /// A print going on after a cut from the line at `saved.pos()`, its
+    /// records numbered on.
+    pub fn resuming(saved: &PlotSaved) -> Tracker {
+        let mut t = Tracker::new();
+        t.base = saved.pos();
+        t.next = saved.next_n();
+        t
+    }
+
+    /// Before any line is followed: where a resumed print goes on.
+    pub fn resume_at(&self) -> u32 {
+        self.base
     }
 
     /// A line of the file is about to be carried out: it starts at byte
@@ -249,15 +264,13 @@ impl Tracker {
             .rposition(|&(_, first)| (begun.wrapping_sub(first) as i8) >= 1)?;
         // The older ones are drawn: the newest begun stands for them.
         self.drop_oldest(moving);
-        let rested = self
-            .last_ms
-            .is_none_or(|t| now_ms.wrapping_sub(t) >= RECORD_EVERY_MS);
+        let rested = (now_ms as u16).wrapping_sub(self.last_ms) >= RECORD_EVERY_MS as u16;
         if writing || !rested {
             return None;
         }
         let pos = self.base;
         self.drop_oldest(1);
-        self.last_ms = Some(now_ms);
+        self.last_ms = now_ms as u16;
         let r = PlotRecord { n: self.next, pos };
         self.next = self.next.wrapping_add(1);
         Some(r)

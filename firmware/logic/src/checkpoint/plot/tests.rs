@@ -169,25 +169,32 @@ fn the_record_names_a_line_only_once_its_first_block_has_begun() {
     // has first block 260 = 4 after wrapping.
     let mut begun = 250u8;
     let first = begun.wrapping_add(10);
-    let mut t = Tracker::new(1);
+    let mut t = Tracker::new();
     t.line(100, first);
     for _ in 0..10 {
-        assert_eq!(t.due(begun, false, 5), None);
+        assert_eq!(t.due(begun, false, 700), None);
         begun = begun.wrapping_add(1);
     }
     // Its first block begins now (the count wraps past 255).
-    assert_eq!(t.due(begun, false, 5), None);
+    assert_eq!(t.due(begun, false, 700), None);
     begun = begun.wrapping_add(1);
-    assert_eq!(t.due(begun, true, 5), None, "the last write first");
-    assert_eq!(t.due(begun, false, 5), Some(PlotRecord { n: 1, pos: 100 }));
-    assert_eq!(t.due(begun, false, 5), None);
+    assert_eq!(t.due(begun, true, 700), None, "the last write first");
+    assert_eq!(
+        t.due(begun, false, 700),
+        Some(PlotRecord { n: 1, pos: 100 })
+    );
+    assert_eq!(t.due(begun, false, 700), None);
 }
 
 /// A print's lines through a planner `depth` blocks deep, one block
 /// each, `ms` each: the line moving when each record is asked for, and
 /// the record.
 fn run(depth: u8, ms: u32, lines: u32) -> Vec<(u32, PlotRecord)> {
-    let mut t = Tracker::new(41);
+    let mut t = Tracker::resuming(&PlotSaved {
+        header: header(1),
+        last: Some(PlotRecord { n: 40, pos: 0 }),
+    });
+    assert_eq!(t.resume_at(), 0);
     let mut out = Vec::new();
     let (mut read, mut begun) = (0u32, 0u8);
     for moving in 0..lines {
@@ -197,7 +204,7 @@ fn run(depth: u8, ms: u32, lines: u32) -> Vec<(u32, PlotRecord)> {
             t.line(read * 30, read as u8);
             read += 1;
         }
-        if let Some(r) = t.due(begun, false, moving * ms) {
+        if let Some(r) = t.due(begun, false, 1000 + moving * ms) {
             out.push((moving, r));
         }
     }
@@ -241,15 +248,15 @@ fn long_lines_are_recorded_as_each_begins() {
 
 #[test]
 fn a_line_that_queues_nothing_is_recorded_once_the_next_move_begins() {
-    let mut t = Tracker::new(1);
+    let mut t = Tracker::new();
     // `M3` at byte 50, nothing queued ahead: its "first block" is the
     // next line's, which the next line (byte 53) does not take over.
     t.line(50, 7);
     t.line(53, 7);
     // Too far after the oldest: not followed.
     t.line(50 + 70_000, 9);
-    assert_eq!(t.due(7, false, 0), None);
-    assert_eq!(t.due(8, false, 0), Some(PlotRecord { n: 1, pos: 50 }));
+    assert_eq!(t.due(7, false, 600), None);
+    assert_eq!(t.due(8, false, 600), Some(PlotRecord { n: 1, pos: 50 }));
 }
 
 #[test]
