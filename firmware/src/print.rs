@@ -266,20 +266,18 @@ impl Print {
     /// pen; go).
     #[inline(never)]
     pub fn line_ready(&mut self, first: u8) -> ResumeAction {
-        let e = match self.resume {
-            None | Some(Resume::Offered) => ResumeEvent::Line(self.read_start),
-            Some(Resume::Replaying) => ResumeEvent::Line(self.read_start),
-            Some(Resume::Travel | Resume::Pen) => ResumeEvent::Done,
-            _ => return ResumeAction::None,
-        };
         let action = match self.resume {
-            Some(r) if r != Resume::Offered => {
+            None | Some(Resume::Offered) => ResumeAction::Go,
+            Some(r) => {
+                let e = match r {
+                    Resume::Travel | Resume::Pen => ResumeEvent::Done,
+                    _ => ResumeEvent::Line(self.read_start),
+                };
                 let at = self.tracker.as_ref().map_or(0, |t| t.resume_at());
                 let (next, action) = r.on(e, at);
                 self.resume = next;
                 action
             }
-            _ => ResumeAction::Go,
         };
         if action == ResumeAction::Go {
             if let Some(t) = self.tracker.as_mut() {
