@@ -9,7 +9,7 @@ use crate::queues::{BUTTONS, RX};
 use crate::store::Store;
 use taut_logic::checkpoint::plot::ResumeAction;
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{CardLine, Error, ErrorKind, Parser};
+use taut_logic::gcode::{CardLine, Error, ErrorKind, Parser, LINE_CUT};
 use taut_logic::kinematics::Kinematics;
 use taut_logic::pinmap::Button;
 
@@ -133,5 +133,5 @@ impl Console {
 
 /// A whole line has arrived on the serial line.
 pub(super) fn serial_line_waits() -> bool {
-    RX.any(|&b| b == b'\n' || b == b'\r')
+    RX.any(|&b| b == b'\n' || b == b'\r' || b == LINE_CUT)
 }
