@@ -261,7 +261,9 @@ impl Console {
             self.interp
                 .resync(&kin.forward(&m.target()), motor_channels(cfg));
         }
-        if !cfg.machine.is_string_art() {
+        // Only while a print or an offer needs it: each run of a stream
+        // of tiny moves comes here.
+        if !cfg.machine.is_string_art() && self.print.keeps() {
             self.print.keep(store, crate::board::clock::millis());
             // Homing for a resume ended, the position read back.
             if self.print.homing_for_resume() && self.homing.is_none() && self.epoch == m.epoch() {

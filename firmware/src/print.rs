@@ -141,6 +141,12 @@ impl Print {
         self.resume == Some(Resume::Replaying)
     }
 
+    /// The checkpoint has work ([`Print::keep`]): a print under way, a
+    /// header to write, an offer.
+    pub fn keeps(&self) -> bool {
+        self.tracker.is_some() || self.keep != Keep::Nothing || self.resume.is_some()
+    }
+
     /// A power cut's print is offered.
     pub fn offered(&self) -> bool {
         self.resume == Some(Resume::Offered)

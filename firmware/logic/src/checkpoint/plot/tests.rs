@@ -1,8 +1,8 @@
-use super::super::{scan, Found, Header, Record};
+use super::super::tests::Eeprom;
+use super::super::{Found, Header, Record};
 use super::*;
 use crate::stringart::Phase;
 use std::eprintln;
-use std::vec;
 use std::vec::Vec;
 
 const SHORT: [u8; 11] = *b"STARDR~1GCO";
@@ -15,24 +15,18 @@ fn header(seq: u16) -> PlotHeader {
     }
 }
 
-/// The EEPROM as the firmware's writer leaves it.
-struct Eeprom(Vec<u8>);
+/// The print's header and records into the string-art tests' EEPROM.
+trait Plot {
+    fn header(&mut self, h: PlotHeader);
+    fn record(&mut self, seq: u16, r: PlotRecord);
+}
 
-impl Eeprom {
-    fn blank() -> Self {
-        Eeprom(vec![0xFF; END as usize])
-    }
-    fn write(&mut self, at: u16, bytes: &[u8]) {
-        self.0[at as usize..at as usize + bytes.len()].copy_from_slice(bytes);
-    }
+impl Plot for Eeprom {
     fn header(&mut self, h: PlotHeader) {
         self.write(Header::address(h.seq), &h.encode());
     }
     fn record(&mut self, seq: u16, r: PlotRecord) {
         self.write(PlotRecord::address(r.n), &r.encode(seq));
-    }
-    fn scan(&self) -> Found {
-        scan(|a| self.0[a as usize])
     }
 }
 
