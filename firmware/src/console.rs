@@ -181,6 +181,12 @@ impl Console {
         self.print.offer();
     }
 
+    /// A print's checkpoint header, idle header or offer is still to be
+    /// written or said.
+    pub fn checkpoint_waits(&self) -> bool {
+        self.print.waits_to_keep()
+    }
+
     /// Whether a `$` setting changed since the last call (the app then has
     /// the settings stored).
     pub fn take_settings_changed(&mut self) -> bool {

@@ -527,6 +527,12 @@ fn console() {
     }
     // New moves may be queued: the motion task feeds them to the stepper.
     spawn(Task::Motion);
+    // A print's checkpoint write (or its offer) waits for the store or for
+    // room: the console comes back for it, with no line to read too.
+    let poll = match poll {
+        Poll::Idle if CONSOLE.with(|c| c.checkpoint_waits()) => Poll::After(5),
+        p => p,
+    };
     reschedule(Task::Console, poll);
     // An operator's tool for the job.
     if !JOB_CONTROL.is_empty() {

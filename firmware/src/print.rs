@@ -147,6 +147,11 @@ impl Print {
         self.tracker.is_some() || self.keep != Keep::Nothing || self.resume.is_some()
     }
 
+    /// A header, an idle header or the offer waits ([`Print::keep`]).
+    pub fn waits_to_keep(&self) -> bool {
+        self.keep != Keep::Nothing
+    }
+
     /// A power cut's print is offered.
     pub fn offered(&self) -> bool {
         self.resume == Some(Resume::Offered)
