@@ -466,6 +466,7 @@ fn m114_alone_only_reads() {
 fn card_lines() {
     assert_eq!(parse("M20"), Ok(Input::Card(CardLine::List)));
     assert_eq!(parse("N5 M524"), Ok(Input::Card(CardLine::Abort)));
+    assert_eq!(parse("M1000"), Ok(Input::Card(CardLine::Recover)));
     match parse("M23 star drawing.gcode") {
         Ok(Input::Card(CardLine::Select(name))) => {
             assert_eq!(name.as_bytes(), b"star drawing.gcode")
