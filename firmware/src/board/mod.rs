@@ -10,7 +10,9 @@ pub mod gpio;
 pub mod servo;
 pub mod spi;
 pub mod step_timer;
+pub mod port;
 pub mod usart;
+pub mod usart1;
 pub mod watchdog;
 
 /// CPU clock of the Mega 2560.

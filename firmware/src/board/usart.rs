@@ -6,6 +6,7 @@
 //! [`XON_AT`], each ahead of the bytes waiting in `TX`.
 
 use crate::queues::{RX, TX};
+use crate::rt::Ring;
 use avr_device::atmega2560::USART0;
 use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
 use taut_logic::gcode::LINE_CUT;
@@ -194,29 +195,30 @@ pub fn on_data_register_empty() {
 /// end goes in as [`LINE_CUT`]. Written by the receive interrupt only.
 static CUT: AtomicBool = AtomicBool::new(false);
 
-/// A received byte into `RX`. The last slot is kept for a line's end, so
-/// however long a line, however late the console reads (power-on homing),
-/// every line ends in the ring and gets its reply: a line that lost bytes
-/// (a sender ignoring the count or the flow control) ends in
-/// [`LINE_CUT`], answered `error:11`. Each lost byte is counted.
-fn keep(b: u8) {
-    let cut = CUT.load(Relaxed);
+/// A received byte into `rx`, `cut` its line's state (each port's own).
+/// The last slot is kept for a line's end, so however long a line,
+/// however late the console reads (power-on homing), every line ends in
+/// the ring and gets its reply: a line that lost bytes (a sender
+/// ignoring the count or the flow control) ends in [`LINE_CUT`],
+/// answered `error:11`. Each lost byte is counted.
+pub(super) fn keep<const N: usize>(rx: &Ring<u8, N, true>, cut: &AtomicBool, b: u8) {
+    let was_cut = cut.load(Relaxed);
     if b == b'\n' || b == b'\r' {
         // While the console is behind by a whole line the end finds no
         // room: the next line is then dropped with this one.
-        if RX.push(if cut { LINE_CUT } else { b }).is_ok() {
-            CUT.store(false, Relaxed);
+        if rx.push(if was_cut { LINE_CUT } else { b }).is_ok() {
+            cut.store(false, Relaxed);
         }
         return;
     }
     // No 0xFF from the wire is taken for the marker (Grbl drops every
     // extended byte that is no real-time command).
-    if cut || b == LINE_CUT || RX.free() <= 1 {
-        CUT.store(cut || b != LINE_CUT, Relaxed);
-        RX.refuse();
+    if was_cut || b == LINE_CUT || rx.free() <= 1 {
+        cut.store(was_cut || b != LINE_CUT, Relaxed);
+        rx.refuse();
         return;
     }
-    let _ = RX.push(b);
+    let _ = rx.push(b);
 }
 
 /// The `USART0_RX` handler, entered with its interrupt switched off: the
@@ -226,7 +228,7 @@ pub fn on_receive(take: impl FnOnce(u8) -> bool) -> bool {
     let b = regs().udr0().read().bits();
     let taken = take(b);
     if !taken {
-        keep(b);
+        keep(&RX, &CUT, b);
         if FLOW.load(Relaxed) & FLOW_ON != 0 && RX.len() >= XOFF_AT {
             flow_to(true);
         }

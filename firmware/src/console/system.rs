@@ -188,6 +188,16 @@ impl Console {
                 at: 0,
                 why: None,
             }),
+            // In force from the next reset (Ctrl-X) or power-on: the
+            // `ok` goes out at the rate the sender speaks.
+            None if settings::is_uart1_baud(key.as_bytes()) => store
+                .extras_mut()
+                .set_uart1_baud(value.as_bytes())
+                .map_err(|e| SetError {
+                    code: ErrorKind::InvalidStatement,
+                    at: e.at,
+                    why: Some(e.kind),
+                }),
             None if settings::is_flow(key.as_bytes()) => {
                 let set = store.extras_mut().set_flow(value.as_bytes());
                 usart::set_xonxoff(store.extras().xonxoff());
