@@ -150,7 +150,8 @@ impl Line {
 
     /// Queue what is staged; false (counted as refused) if it was lost.
     fn queue(&self) -> bool {
-        self.port.publish(self.owner, usize::from(self.at), self.lost)
+        self.port
+            .publish(self.owner, usize::from(self.at), self.lost)
     }
 
     /// The newline, always, after a log line's `]`: a line that did not

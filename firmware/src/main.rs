@@ -37,8 +37,8 @@ use taut_firmware::board::gpio::{Output, Pin};
 use taut_firmware::board::servo::PenServo;
 use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{
-    self, clock, port::Port, step_timer::StepTimer, usart, usart1, watchdog::Watchdog,
-    ResetCause, F_CPU,
+    self, clock, port::Port, step_timer::StepTimer, usart, usart1, watchdog::Watchdog, ResetCause,
+    F_CPU,
 };
 use taut_firmware::buttons::{self, ButtonPins, ButtonsTask};
 use taut_firmware::card::{self, CardReader};

@@ -8,8 +8,8 @@
 use crate::board::port::Port;
 use crate::console::{Activity, Frame};
 use crate::endstop;
-use crate::motion::{self, Motion};
 use crate::log::Line;
+use crate::motion::{self, Motion};
 use crate::queues::{FEED_PRESSES, REALTIME};
 use crate::reply;
 use crate::rt::TaskCell;

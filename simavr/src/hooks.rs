@@ -195,7 +195,11 @@ pub(crate) unsafe extern "C" fn on_uart1_xon(_irq: *mut avr_irq_t, value: u32, p
 
 /// # Safety
 /// As `on_uart_tx`.
-pub(crate) unsafe extern "C" fn on_uart1_xoff(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
+pub(crate) unsafe extern "C" fn on_uart1_xoff(
+    _irq: *mut avr_irq_t,
+    value: u32,
+    param: *mut c_void,
+) {
     let shared = &mut *(param as *mut Shared);
     if value != 0 {
         shared.uart1.rx_ready = false;

@@ -17,7 +17,7 @@
 use crate::clock::cycles_in;
 use crate::elf::RAM_END;
 use crate::outcome::Outcome;
-use crate::serial::{SerialLine, self, CYCLES_PER_BYTE};
+use crate::serial::{self, SerialLine, CYCLES_PER_BYTE};
 use crate::sim::{Core, Executed, Sim};
 use crate::traps::ZeroOrigin;
 use std::time::{Duration, Instant};

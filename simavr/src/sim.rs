@@ -195,16 +195,34 @@ impl Sim {
             type Notify = unsafe extern "C" fn(*mut ffi::avr_irq_t, u32, *mut c_void);
             let mut inputs = [std::ptr::null_mut(); 2];
             let wiring: [(u8, [Notify; 3]); 2] = [
-                (b'0', [hooks::on_uart_tx, hooks::on_uart_xon, hooks::on_uart_xoff]),
-                (b'1', [hooks::on_uart1_tx, hooks::on_uart1_xon, hooks::on_uart1_xoff]),
+                (
+                    b'0',
+                    [hooks::on_uart_tx, hooks::on_uart_xon, hooks::on_uart_xoff],
+                ),
+                (
+                    b'1',
+                    [
+                        hooks::on_uart1_tx,
+                        hooks::on_uart1_xon,
+                        hooks::on_uart1_xoff,
+                    ],
+                ),
             ];
             for (input, (n, [tx, xon, xoff])) in inputs.iter_mut().zip(wiring) {
                 // No echo of UART output to our stdout, and no host usleep
                 // while the firmware polls an empty receiver.
                 let mut flags: u32 = 0;
-                ffi::avr_ioctl(a, ioctl(b'u', b'a', b'g', n), &mut flags as *mut u32 as *mut c_void);
+                ffi::avr_ioctl(
+                    a,
+                    ioctl(b'u', b'a', b'g', n),
+                    &mut flags as *mut u32 as *mut c_void,
+                );
                 flags &= !(ffi::AVR_UART_FLAG_STDIO | ffi::AVR_UART_FLAG_POLL_SLEEP);
-                ffi::avr_ioctl(a, ioctl(b'u', b'a', b's', n), &mut flags as *mut u32 as *mut c_void);
+                ffi::avr_ioctl(
+                    a,
+                    ioctl(b'u', b'a', b's', n),
+                    &mut flags as *mut u32 as *mut c_void,
+                );
                 let uart = |i: u32| ffi::avr_io_getirq(a, ioctl(b'u', b'a', b'r', n), i as i32);
                 ffi::avr_irq_register_notify(uart(ffi::UART_IRQ_OUTPUT), Some(tx), param);
                 ffi::avr_irq_register_notify(uart(ffi::UART_IRQ_OUT_XON), Some(xon), param);
@@ -643,7 +661,11 @@ impl Sim {
 
     /// Puts one byte on USART0's (`uart1`: USART1's) receive line now.
     pub(crate) fn raise_uart_rx(&mut self, uart1: bool, byte: u8) {
-        let input = if uart1 { self.uart1_input } else { self.uart_input };
+        let input = if uart1 {
+            self.uart1_input
+        } else {
+            self.uart_input
+        };
         // SAFETY: `input` is a UART's input IRQ of our live avr_t; the
         // caller holds no reference into `Shared` across the call.
         unsafe { ffi::avr_raise_irq(input, u32::from(byte)) };

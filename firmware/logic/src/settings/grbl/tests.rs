@@ -368,7 +368,11 @@ fn uart1_baud_is_a_code_in_the_flags() {
     for bad in [&b"4800"[..], b"", b"fast", b"-9600"] {
         assert!(ex.set_uart1_baud(bad).is_err());
     }
-    assert_eq!(ex.uart1_baud(), Uart1Baud::B115200, "a refused value changes nothing");
+    assert_eq!(
+        ex.uart1_baud(),
+        Uart1Baud::B115200,
+        "a refused value changes nothing"
+    );
     ex.set_uart1_baud(b"0").unwrap();
     assert_eq!(ex.uart1_baud(), Uart1Baud::Off);
     let mut bytes = std::vec::Vec::new();
@@ -376,7 +380,10 @@ fn uart1_baud_is_a_code_in_the_flags() {
         let (b, n) = ex.part(k).unwrap();
         bytes.extend_from_slice(&b[..n as usize]);
     }
-    assert_eq!(Extras::decode(|i| bytes[i as usize]).uart1_baud(), Uart1Baud::Off);
+    assert_eq!(
+        Extras::decode(|i| bytes[i as usize]).uart1_baud(),
+        Uart1Baud::Off
+    );
     ex.set_uart1_baud(b"9600").unwrap();
     ex.set_flow(b"off").unwrap();
     assert_eq!(ex, Extras::DEFAULT);
