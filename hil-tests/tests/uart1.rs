@@ -266,3 +266,30 @@ fn a_half_typed_usb_line_never_mixes_with_uart1_lines() {
         assert_ram_budget(&sim);
     }
 }
+
+/// `taut-sim --at1` sends to UART1 at a simulated time, and the report's
+/// `uart1` holds what UART1 said: on the flatbed (UART1 on from power-on)
+/// the greeting, a status report and a line's `ok`, none of them on USB.
+#[test]
+fn taut_sim_sends_on_uart1_and_reports_it() {
+    use hil_tests::board::{scratch, taut_sim};
+    let dir = scratch("uart1-cli");
+    let report = dir.join("report.json");
+    let out = std::process::Command::new(taut_sim())
+        .arg(hil_tests::firmware_elf())
+        .args(["--machine", "flatbed", "--at1", "3:?", "--at1", "3.5:G4\\x20P0\\n"])
+        .args(["--for", "4", "--report"])
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let uart1 = json["uart1"].as_str().unwrap();
+    assert!(uart1.starts_with("Grbl 1.1h"), "{uart1:?}");
+    assert!(uart1.contains("\n<Idle|"), "{uart1:?}");
+    assert!(uart1.ends_with(">\nok\n"), "{uart1:?}");
+    let usb = json["uart"].as_str().unwrap();
+    assert!(!usb.lines().any(|l| l == "ok" || l.starts_with('<')), "{usb:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
