@@ -44,7 +44,7 @@ pub fn dropped() -> u16 {
 /// A line being written: a reply, a push message or a log line, staged
 /// in the TX ring itself ([`Ring::stage`]) and queued whole at its end, so
 /// that no 100-byte copy of it sits in a frame or a static. A line begun,
-/// or bytes sent ([`Port::send`]), take the ring's free slots: a line
+/// or bytes sent ([`Port::send`]), take the ring's free slots ([`Outbox`](crate::board::usart::Outbox)): a line
 /// still open then is dropped whole (counted as refused), never mixed.
 /// Replies and log lines share this type, so each value's `ufmt` code
 /// exists once.
@@ -54,7 +54,7 @@ pub struct Line {
     /// The port whose TX ring it is staged in: a reply's is the line's it
     /// answers ([`port::answer`]), a log line's USB.
     port: Port,
-    /// Its [`Port::begin_staging`] number: another one means the slots
+    /// Its [`Outbox::begin_staging`](crate::board::usart::Outbox::begin_staging) number: another one means the slots
     /// are no longer its own.
     owner: u8,
     /// Bytes staged: a log line's note of dropped lines, then the line.
@@ -105,7 +105,10 @@ impl Line {
 
     #[inline(never)]
     fn stage(&mut self, b: u8) {
-        self.lost |= !self.port.stage(self.owner, usize::from(self.at), b);
+        self.lost |= !self
+            .port
+            .outbox()
+            .stage(self.owner, usize::from(self.at), b);
         self.at += 1;
     }
 
@@ -113,7 +116,7 @@ impl Line {
     fn new(msg: bool, port: Port) -> Line {
         Line {
             port,
-            owner: port.begin_staging(),
+            owner: port.outbox().begin_staging(),
             at: 0,
             start: 0,
             cut: false,

@@ -5,7 +5,8 @@
 
 use hil_tests::sim::Sim;
 use hil_tests::{
-    assert_ram_budget, boot_machine, is_log_line, log_tail, send_ok, steps_on_pins, Rng,
+    assert_ram_budget, boot_machine, is_log_line, log_tail, m114_counts, send_ok, steps_on_pins,
+    Rng,
 };
 use std::time::Duration;
 
@@ -59,17 +60,8 @@ fn uart1_ok(sim: &mut Sim, line: &str) {
 
 /// `M114`'s `Count X:… Y:…` steps, asked on UART1.
 fn counts_on_uart1(sim: &mut Sim) -> [i64; 2] {
-    let reply = uart1_line(sim, "M114");
-    let count = reply
-        .lines()
-        .find_map(|l| l.split_once("Count "))
-        .unwrap_or_else(|| panic!("no M114 line in {reply:?}"))
-        .1;
-    let mut out = [0; 2];
-    for (i, word) in count.split_whitespace().take(2).enumerate() {
-        out[i] = word[2..].parse().unwrap();
-    }
-    out
+    let c = m114_counts(&uart1_line(sim, "M114"));
+    [c[0], c[1]]
 }
 
 fn status_lines(text: &str) -> usize {
@@ -153,10 +145,13 @@ fn a_job_on_uart1_while_usb_polls_status() {
 }
 
 /// `?` from UART1 is answered there (its `Bf:` the 64-byte ring's room),
-/// not on USB.
+/// not on USB; `$I` there gives that ring's size for a sender to count
+/// against.
 #[test]
 fn status_asked_on_uart1_is_answered_there() {
     let mut sim = flatbed_with_uart1();
+    let info = uart1_line(&mut sim, "$I");
+    assert!(info.contains(",64]\n"), "{info:?}");
     // `Bf:` in the report.
     uart1_ok(&mut sim, "$10=3");
     let (usb, bt) = (sim.uart_bytes().len(), sim.uart1_bytes().len());
@@ -277,12 +272,23 @@ fn taut_sim_sends_on_uart1_and_reports_it() {
     let report = dir.join("report.json");
     let out = std::process::Command::new(taut_sim())
         .arg(hil_tests::firmware_elf())
-        .args(["--machine", "flatbed", "--at1", "3:?", "--at1", "3.5:G4\\x20P0\\n"])
+        .args([
+            "--machine",
+            "flatbed",
+            "--at1",
+            "3:?",
+            "--at1",
+            "3.5:G4\\x20P0\\n",
+        ])
         .args(["--for", "4", "--report"])
         .arg(&report)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     let uart1 = json["uart1"].as_str().unwrap();
@@ -290,6 +296,9 @@ fn taut_sim_sends_on_uart1_and_reports_it() {
     assert!(uart1.contains("\n<Idle|"), "{uart1:?}");
     assert!(uart1.ends_with(">\nok\n"), "{uart1:?}");
     let usb = json["uart"].as_str().unwrap();
-    assert!(!usb.lines().any(|l| l == "ok" || l.starts_with('<')), "{usb:?}");
+    assert!(
+        !usb.lines().any(|l| l == "ok" || l.starts_with('<')),
+        "{usb:?}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

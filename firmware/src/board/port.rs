@@ -2,7 +2,8 @@
 //! module). A line is answered on the port it came from; log lines go to
 //! USB only.
 
-use super::{usart, usart1};
+use super::usart::{self, Outbox};
+use super::usart1;
 use crate::queues::{RX, RX1, TX, TX1};
 use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::gcode::LINE_CUT;
@@ -76,6 +77,23 @@ impl Port {
         }
     }
 
+    /// Its receive ring's size (`$I`'s `[OPT:…]`: what a sender counts
+    /// characters against).
+    pub fn rx_capacity(self) -> usize {
+        match self {
+            Port::Usb => RX.capacity(),
+            Port::Uart1 => RX1.capacity(),
+        }
+    }
+
+    /// Bytes waiting in its receive ring.
+    pub fn rx_len(self) -> usize {
+        match self {
+            Port::Usb => RX.len(),
+            Port::Uart1 => RX1.len(),
+        }
+    }
+
     /// Free bytes of its receive ring (the status report's `Bf:`).
     pub fn rx_free(self) -> usize {
         match self {
@@ -100,18 +118,11 @@ impl Port {
         }
     }
 
-    /// Its transmit ring's free slots are now a new line's: its number.
-    pub fn begin_staging(self) -> u8 {
+    /// Its transmit ring and the line staged there (`Line`).
+    pub fn outbox(self) -> &'static Outbox {
         match self {
-            Port::Usb => usart::begin_staging(),
-            Port::Uart1 => usart1::begin_staging(),
-        }
-    }
-
-    pub fn stage(self, owner: u8, k: usize, b: u8) -> bool {
-        match self {
-            Port::Usb => usart::stage(owner, k, b),
-            Port::Uart1 => usart1::stage(owner, k, b),
+            Port::Usb => &usart::OUTBOX,
+            Port::Uart1 => &usart1::OUTBOX,
         }
     }
 

@@ -6,7 +6,7 @@
 //! a module has no use for it. Off on the string-art machine, whose
 //! `zero_drill` button is on D18.
 
-use super::usart::keep;
+use super::usart::{keep, Outbox};
 use crate::queues::{RX1, TX1};
 use avr_device::atmega2560::USART1;
 use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
@@ -66,8 +66,7 @@ pub fn configure(baud: Uart1Baud) {
 /// is off).
 #[inline(never)]
 pub fn send(bytes: &[u8]) -> bool {
-    begin_staging();
-    let ok = on() && TX1.push_all(bytes);
+    let ok = on() && OUTBOX.send(bytes);
     if ok {
         wake();
     }
@@ -83,33 +82,17 @@ fn wake() {
     avr_device::interrupt::free(|_| regs().ucsr1b().modify(|_, w| w.udrie1().set_bit()));
 }
 
-/// The number of the line staged in `TX1`'s free slots (`usart`'s
-/// `STAGING`, this port's).
-static STAGING: AtomicU8 = AtomicU8::new(0);
+/// `TX1`'s staging (`usart::Outbox`).
+pub static OUTBOX: Outbox = Outbox::new(&TX1);
 
-pub fn begin_staging() -> u8 {
-    let n = STAGING.load(Relaxed).wrapping_add(1);
-    STAGING.store(n, Relaxed);
-    n
-}
-
-pub fn stage(owner: u8, k: usize, b: u8) -> bool {
-    owner == STAGING.load(Relaxed) && TX1.stage(k, b)
-}
-
-/// Queue the `n` bytes line `owner` staged, unless it `lost` some or its
-/// slots, or the port is off (refused, then).
+/// Queue what line `owner` staged in `TX1`, unless the port is off.
 #[inline(never)]
 pub fn publish(owner: u8, n: usize, lost: bool) -> bool {
-    let current = STAGING.load(Relaxed);
-    begin_staging();
-    if lost || owner != current || !on() {
-        TX1.refuse();
-        return false;
+    let ok = OUTBOX.publish(owner, n, lost || !on());
+    if ok {
+        wake();
     }
-    TX1.publish(n);
-    wake();
-    true
+    ok
 }
 
 /// USART1 control register B and its interrupt-enable bits (`rt::nested`).

@@ -8,7 +8,6 @@
 use super::{message, Console, Listing, Owner, Sleep, Source};
 use crate::board::usart;
 use crate::motion::Motion;
-use crate::queues::RX;
 use crate::reply;
 use crate::rt::stack;
 use crate::store::{self, Store, Text};
@@ -448,7 +447,7 @@ fn build_info(cfg: &MachineConfig, store: &Store) {
         "{}{},{}]",
         flash_str!("[OPT:,"),
         taut_logic::planner::PLANNER_BLOCKS,
-        RX.capacity()
+        crate::board::port::answer().rx_capacity()
     );
     r.send();
 }
