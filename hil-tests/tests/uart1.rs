@@ -302,3 +302,36 @@ fn taut_sim_sends_on_uart1_and_reports_it() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `taut-sim --pty1` serves UART1 as a terminal of its own, as a
+/// Bluetooth module's `/dev/rfcomm0`: a line typed there is answered
+/// there, and `?` too.
+#[test]
+fn taut_sim_serves_uart1_on_a_terminal() {
+    use hil_tests::board::{scratch, taut_sim, Terminal};
+    use std::io::{BufRead, BufReader, Write};
+    let dir = scratch("uart1-pty");
+    let link = dir.join("rfcomm0");
+    let mut child = std::process::Command::new(taut_sim())
+        .arg(hil_tests::firmware_elf())
+        .args(["--machine", "flatbed", "--for", "60", "--pty1"])
+        .arg(&link)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut said = String::new();
+    while !said.contains("UART1 (second console) on") {
+        assert_ne!(err.read_line(&mut said).unwrap(), 0, "taut-sim: {said}");
+    }
+    let mut bt = Terminal::open(&link);
+    bt.wait_for("Grbl 1.1h", Duration::from_secs(10));
+    bt.send_ok("G4 P0", Duration::from_secs(20));
+    let mut file = std::fs::OpenOptions::new().write(true).open(&link).unwrap();
+    file.write_all(b"?").unwrap();
+    bt.wait_for("<Idle|", Duration::from_secs(5));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
