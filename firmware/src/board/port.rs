@@ -118,7 +118,9 @@ impl Port {
         }
     }
 
-    /// Its transmit ring and the line staged there (`Line`).
+    /// Its transmit ring and the line staged there (`Line`). Inlined: a
+    /// choice of two addresses at each byte a line stages.
+    #[inline(always)]
     pub fn outbox(self) -> &'static Outbox {
         match self {
             Port::Usb => &usart::OUTBOX,

@@ -166,6 +166,7 @@ impl Outbox {
 
     /// Stage byte `k` of line `owner` (`Ring::stage`): false if it does
     /// not fit or the slots are no longer the line's.
+    #[inline(always)]
     pub fn stage(&self, owner: u8, k: usize, b: u8) -> bool {
         owner == self.staging.load(Relaxed) && self.ring.stage(k, b)
     }
