@@ -27,13 +27,15 @@ const _: () = {
 
 impl ButtonPins {
     /// Pressed buttons as a bitmask (bit `Button as u8`); active low.
+    /// D18 is TX1 while UART1 is on (a plotter's): no switch then.
     fn raw(&mut self) -> u8 {
+        let tx1 = crate::board::usart1::on() as u8 * (1 << Button::ZeroDrill as u8);
         let bit =
             |pressed: Result<bool, _>, b: Button| (pressed == Ok(true)) as u8 * (1 << b as u8);
         bit(self.confirm.is_low(), Button::Confirm)
             | bit(self.zero_base.is_low(), Button::ZeroBase)
             | bit(self.zero_radial.is_low(), Button::ZeroRadial)
-            | bit(self.zero_drill.is_low(), Button::ZeroDrill)
+            | bit(self.zero_drill.is_low(), Button::ZeroDrill) & !tx1
     }
 }
 

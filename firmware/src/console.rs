@@ -213,7 +213,7 @@ impl Console {
         self.startup = system::STARTUP;
         self.storing = false;
         self.saving = false;
-        crate::board::usart::clear_input();
+        crate::board::port::clear_input();
     }
 
     /// The work coordinates for the status report.

@@ -11,7 +11,8 @@
 //! counted, and the count is reported on the next line that fits. Levels below `MAX_LEVEL`
 //! (cargo feature `log-debug` lowers it) compile to nothing.
 
-use crate::board::{clock, flash::FlashStr, usart};
+use crate::board::port::{self, Port};
+use crate::board::{clock, flash::FlashStr};
 use crate::rt::TaskCell;
 use avr_device::interrupt::Mutex;
 use core::cell::Cell;
@@ -43,15 +44,18 @@ pub fn dropped() -> u16 {
 /// A line being written: a reply, a push message or a log line, staged
 /// in the TX ring itself ([`Ring::stage`]) and queued whole at its end, so
 /// that no 100-byte copy of it sits in a frame or a static. A line begun,
-/// or bytes sent ([`usart::send`]), take the ring's free slots: a line
+/// or bytes sent ([`Port::send`]), take the ring's free slots ([`Outbox`](crate::board::usart::Outbox)): a line
 /// still open then is dropped whole (counted as refused), never mixed.
 /// Replies and log lines share this type, so each value's `ufmt` code
 /// exists once.
 ///
 /// [`Ring::stage`]: crate::rt::Ring::stage
 pub struct Line {
-    /// Its [`usart::staging`] number: another one means the slots are no
-    /// longer its own.
+    /// The port whose TX ring it is staged in: a reply's is the line's it
+    /// answers ([`port::answer`]), a log line's USB.
+    port: Port,
+    /// Its [`Outbox::begin_staging`](crate::board::usart::Outbox::begin_staging) number: another one means the slots
+    /// are no longer its own.
     owner: u8,
     /// Bytes staged: a log line's note of dropped lines, then the line.
     at: u8,
@@ -101,14 +105,18 @@ impl Line {
 
     #[inline(never)]
     fn stage(&mut self, b: u8) {
-        self.lost |= !usart::stage(self.owner, usize::from(self.at), b);
+        self.lost |= !self
+            .port
+            .outbox()
+            .stage(self.owner, usize::from(self.at), b);
         self.at += 1;
     }
 
     /// A new line, the ring's free slots its own.
-    fn new(msg: bool) -> Line {
+    fn new(msg: bool, port: Port) -> Line {
         Line {
-            owner: usart::begin_staging(),
+            port,
+            owner: port.outbox().begin_staging(),
             at: 0,
             start: 0,
             cut: false,
@@ -121,14 +129,19 @@ impl Line {
     /// closed by `]` even when cut.
     #[inline(never)]
     pub fn message() -> Line {
-        let mut l = Line::new(true);
+        let mut l = Line::new(true, port::answer());
         let _ = ufmt::uwrite!(l, "{}", crate::flash_str!("[MSG:"));
         l
     }
 
     /// A console reply: no level, time or module.
     pub fn bare() -> Line {
-        Line::new(false)
+        Line::to(port::answer())
+    }
+
+    /// A reply on `port` (a status report to the port that asked).
+    pub fn to(port: Port) -> Line {
+        Line::new(false, port)
     }
 
     /// Queue a reply whole; the caller made room (`reply::room`).
@@ -140,7 +153,8 @@ impl Line {
 
     /// Queue what is staged; false (counted as refused) if it was lost.
     fn queue(&self) -> bool {
-        usart::publish(self.owner, usize::from(self.at), self.lost)
+        self.port
+            .publish(self.owner, usize::from(self.at), self.lost)
     }
 
     /// The newline, always, after a log line's `]`: a line that did not
@@ -171,7 +185,7 @@ impl Line {
     /// dropped (queued only together with it).
     #[inline(never)]
     fn begin(level: Level, module: FlashStr) -> Line {
-        let mut l = Line::new(true);
+        let mut l = Line::new(true, Port::Usb);
         let dropped = dropped();
         if dropped > 0 {
             l.head(Level::Warn, crate::flash_str!("log"));

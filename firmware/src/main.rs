@@ -13,8 +13,9 @@
 //! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `SAMPLES` |
 //! | `USART0_RX` | interrupt | | a byte | `REALTIME` (`?` `!` `~` Ctrl-X, which also stops the steps), else `RX` |
 //! | `USART0_UDRE` | interrupt | | `TX` | the wire |
-//! | `Realtime` status, hold, resume, reset | software | 5 | `REALTIME` | `TX`, `JOB_CONTROL` |
-//! | `Console` one G-code line per run; a plotter's card print | software | 4 | `RX`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `CARD_IN`; signals `CardRoom` |
+//! | `USART1_RX`, `USART1_UDRE` the second console (off on the string-art machine) | interrupt | | a byte; `TX1` | as USART0's (`?` flagged apart), `RX1`; the wire |
+//! | `Realtime` status, hold, resume, reset | software | 5 | `REALTIME` | `TX`, `TX1`, `JOB_CONTROL` |
+//! | `Console` one G-code line per run; a plotter's card print | software | 4 | `RX`, `RX1`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `TX1`, `CARD_IN`; signals `CardRoom` |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
 //! | `Refill` planner → segments while the queue holds < 30 ms of motion, a part per run, yielding to a ready task between parts | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
 //! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` |
@@ -36,7 +37,8 @@ use taut_firmware::board::gpio::{Output, Pin};
 use taut_firmware::board::servo::PenServo;
 use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{
-    self, clock, step_timer::StepTimer, usart, watchdog::Watchdog, ResetCause, F_CPU,
+    self, clock, port::Port, step_timer::StepTimer, usart, usart1, watchdog::Watchdog, ResetCause,
+    F_CPU,
 };
 use taut_firmware::buttons::{self, ButtonPins, ButtonsTask};
 use taut_firmware::card::{self, CardReader};
@@ -53,6 +55,7 @@ use taut_firmware::stepper::{self, CoilPins, StepDirPins, Stepper};
 use taut_firmware::store::Store;
 use taut_firmware::{
     board::usart::{RXCIE0, UDRIE0},
+    board::usart1::{RXCIE1, UDRIE1},
     nested_vector, step_vector,
 };
 use taut_firmware::{endstop, flash_str, info, reply, warn};
@@ -386,6 +389,7 @@ fn load_store(eeprom: Eeprom) -> (bool, Found) {
         let store_now = CONFIG.with(|c| store.load(c));
         usart::set_xonxoff(store.extras().xonxoff());
         usart::release_sender();
+        CONFIG.with(|c| usart1::configure(store.extras().uart1(c.machine)));
         (store_now, store.load_checkpoint())
     })
 }
@@ -570,7 +574,12 @@ fn realtime() {
         let activity = CONSOLE.with(|c| c.activity());
         if r.reset() {
             let moving = m.stop_now();
-            STORE.with(|s| CONSOLE.with(|c| c.reset(s.as_ref().unwrap().coords())));
+            STORE.with(|s| {
+                let s = s.as_ref().unwrap();
+                CONSOLE.with(|c| c.reset(s.coords()));
+                // `$uart1_baud` and `$machine` set since, in force.
+                CONFIG.with(|c| usart1::configure(s.extras().uart1(c.machine)));
+            });
             STANDING.with(|rt| rt.reset());
             m.set_overrides(Overrides::NONE);
             control_job(Control::Abort);
@@ -609,26 +618,34 @@ fn realtime() {
                 m.set_overrides(o);
             }
         }
-        if r.status() {
-            if reply::room() {
-                let frame = CONSOLE.with(|c| c.frame());
-                KIN.with(|kin| {
-                    CONFIG.with(|cfg| {
-                        STANDING.with(|rt| {
-                            realtime::status(m, kin.as_ref().unwrap(), cfg, activity, &frame, rt)
-                        })
-                    })
-                });
-            } else {
-                realtime::status_later();
-                spawn_after(Task::Realtime, 1);
+        Port::each(|port| {
+            if r.status(port) {
+                status(m, activity, port);
             }
-        }
+        });
     });
     // A hold or a resume changes what the motion task prepares; a reset
     // frees the planner for whoever waits.
     spawn(Task::Refill);
     signal(Signal::Motion);
+}
+
+/// A status report to `port`, or again in a millisecond when its TX ring
+/// has no room. Out of line: the task's frame stays small.
+#[inline(never)]
+fn status(m: &Motion, activity: Activity, port: Port) {
+    if !reply::room_on(port) {
+        realtime::status_later(port);
+        return spawn_after(Task::Realtime, 1);
+    }
+    let frame = CONSOLE.with(|c| c.frame());
+    KIN.with(|kin| {
+        CONFIG.with(|cfg| {
+            STANDING.with(|rt| {
+                realtime::status(port, m, kin.as_ref().unwrap(), cfg, activity, &frame, rt)
+            })
+        })
+    });
 }
 
 /// A startup line is kept: the console runs it.
@@ -792,6 +809,9 @@ nested_vector!(__vector_21, timer0_compa); // TIMER0_COMPA
 nested_vector!(__vector_25, usart0_rx, reg = "0xC1", keep = "0x7F"); // USART0_RX: RXCIE0
 nested_vector!(__vector_26, usart0_udre, reg = "0xC1", keep = "0xDF"); // USART0_UDRE: UDRIE0
 const _: () = assert!(usart::UCSR0B == 0xC1 && !0x7Fu8 == 1 << RXCIE0 && !0xDFu8 == 1 << UDRIE0);
+nested_vector!(__vector_36, usart1_rx, reg = "0xC9", keep = "0x7F"); // USART1_RX: RXCIE1
+nested_vector!(__vector_37, usart1_udre, reg = "0xC9", keep = "0xDF"); // USART1_UDRE: UDRIE1
+const _: () = assert!(usart1::UCSR1B == 0xC9 && !0x7Fu8 == 1 << RXCIE1 && !0xDFu8 == 1 << UDRIE1);
 
 #[optimize(speed)]
 extern "avr-interrupt" fn timer0_compa() {
@@ -823,4 +843,18 @@ extern "avr-interrupt" fn usart0_rx() {
 #[optimize(speed)]
 extern "avr-interrupt" fn usart0_udre() {
     usart::on_data_register_empty();
+}
+
+#[optimize(speed)]
+extern "avr-interrupt" fn usart1_rx() {
+    let task = match usart1::on_receive(realtime::on_receive_uart1) {
+        true => Task::Realtime,
+        false => Task::Console,
+    };
+    spawn_from_isr(&SPAWNED, task as u8);
+}
+
+#[optimize(speed)]
+extern "avr-interrupt" fn usart1_udre() {
+    usart1::on_data_register_empty();
 }

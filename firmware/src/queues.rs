@@ -19,6 +19,13 @@ pub static RX: Ring<u8, 128, true> = Ring::new();
 /// Console, job, logger → UART transmit interrupt. Replies wait for room;
 /// a log line without room is dropped whole and counted.
 pub static TX: Ring<u8, 128> = Ring::new();
+/// USART1 (the second console, a Bluetooth module) receive interrupt →
+/// console, as `RX`: 64 bytes, the longest line a sender types by hand
+/// or a job's, its last slot kept for a line's end.
+pub static RX1: Ring<u8, 64, true> = Ring::new();
+/// Console, status reports → USART1 transmit interrupt: room for the
+/// longest reply (`reply::ROOM`).
+pub static TX1: Ring<u8, 128> = Ring::new();
 /// UART receive interrupt → `Realtime` task: `?`, `!`, `~`, Ctrl-X.
 pub static REALTIME: Flags = Flags::new();
 /// UART receive interrupt → `Realtime` task: the feed override's ±10 %

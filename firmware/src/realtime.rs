@@ -5,10 +5,12 @@
 //! highest software priority), which also writes the status report
 //! (formatted by `taut_logic::gcode::Status`).
 
+use crate::board::port::Port;
 use crate::console::{Activity, Frame};
 use crate::endstop;
+use crate::log::Line;
 use crate::motion::{self, Motion};
-use crate::queues::{FEED_PRESSES, REALTIME, RX};
+use crate::queues::{FEED_PRESSES, REALTIME};
 use crate::reply;
 use crate::rt::TaskCell;
 use crate::stepper;
@@ -28,6 +30,8 @@ const DOOR: u8 = 4;
 const JOG_CANCEL: u8 = 5;
 /// The override bytes 0x90–0x97, a bit each from here.
 const OVERRIDES: u8 = 6;
+/// `?` from UART1: its report goes there.
+const STATUS_UART1: u8 = OVERRIDES + 8;
 
 /// Grbl's safety-door and jog-cancel bytes.
 const SAFETY_DOOR_BYTE: u8 = 0x84;
@@ -72,6 +76,17 @@ pub fn on_receive(byte: u8) -> bool {
     };
     REALTIME.set(bit);
     true
+}
+
+/// The receive interrupt's part for UART1: as [`on_receive`], its `?`
+/// flagged apart (the report is written to the port that asked).
+#[inline(always)]
+pub fn on_receive_uart1(byte: u8) -> bool {
+    if Realtime::from_byte(byte) == Some(Realtime::Status) {
+        REALTIME.set(STATUS_UART1);
+        return true;
+    }
+    on_receive(byte)
 }
 
 /// The commands taken for one run of the task, in the order they act:
@@ -121,14 +136,21 @@ impl Requests {
         self.1
     }
 
-    pub fn status(self) -> bool {
-        self.has(STATUS)
+    /// `?` from `port`.
+    pub fn status(self, port: Port) -> bool {
+        self.has(match port {
+            Port::Usb => STATUS,
+            Port::Uart1 => STATUS_UART1,
+        })
     }
 }
 
-/// Ask again for a status report that found no room in the TX ring.
-pub fn status_later() {
-    REALTIME.set(STATUS);
+/// Ask again for a status report that found no room in `port`'s TX ring.
+pub fn status_later(port: Port) {
+    REALTIME.set(match port {
+        Port::Usb => STATUS,
+        Port::Uart1 => STATUS_UART1,
+    });
 }
 
 /// Ctrl-X done: in Grbl's words, alarm 6 (reset while homing) or 3 (while
@@ -146,9 +168,11 @@ pub fn after_reset(m: &mut Motion, homing: bool, moving: bool) {
     match m.position_known() {
         true => info!("reset"),
         false => {
-            let mut r = reply::line();
-            let _ = uwrite!(r, "{}", flash_str!("[MSG:'$H'|'$X' to unlock]"));
-            r.send();
+            Port::each(|port| {
+                let mut r = Line::to(port);
+                let _ = uwrite!(r, "{}", flash_str!("[MSG:'$H'|'$X' to unlock]"));
+                r.send();
+            });
             warn!("position unknown until $H, $X or zeroing");
         }
     }
@@ -196,10 +220,12 @@ impl Standing {
 /// (a plotter's pen channel as programmed: no motor counts its `Z`),
 /// the machine's or the work's as `$10` says, in `$13`'s unit, and the
 /// work offset every so often and after it changed. Out of line: the
-/// task's frame stays small when no report is asked for.
+/// task's frame stays small when no report is asked for. To `port`,
+/// `Bf:` its receive ring's room.
 #[inline(never)]
 #[optimize(speed)]
 pub fn status(
+    port: Port,
     m: &Motion,
     kin: &impl Kinematics,
     cfg: &MachineConfig,
@@ -247,14 +273,14 @@ pub fn status(
         wco: places.map(|a| frame.wco[a.index()]),
         angles: report_angles(cfg.machine),
         feed: m.feed(),
-        buffer: (m.free_blocks() as u8, RX.free() as u8),
+        buffer: (m.free_blocks() as u8, port.rx_free() as u8),
         pins,
         overrides: rt.overrides,
         extra: rt.refresh.next(busy),
         fields: cfg.status_report,
         inches: cfg.report_inches,
     };
-    let mut r = reply::line();
+    let mut r = Line::to(port);
     let _ = uwrite!(r, "{}", report);
     r.send();
 }

@@ -2,7 +2,7 @@
 //! assembled on the stack and queued whole, never cut: it runs only once
 //! the TX ring has [`ROOM`] free bytes, and no reply is longer.
 
-use crate::board::usart;
+use crate::board::port::{self, Port};
 use crate::log::Line;
 use crate::{flash_str, texts};
 use taut_logic::gcode::Error;
@@ -21,28 +21,39 @@ pub fn line() -> Reply {
     Line::bare()
 }
 
-/// There is room in the TX ring for any reply.
+/// There is room in the answered port's TX ring for any reply.
 pub fn room() -> bool {
-    crate::queues::TX.free() >= ROOM
+    room_on(port::answer())
+}
+
+/// There is room in `port`'s TX ring for any reply.
+pub fn room_on(port: Port) -> bool {
+    port.tx_free() >= ROOM
 }
 
 /// Grbl 1.1's greeting, at power-on and after Ctrl-X: what senders wait
 /// for (grbl-streamer looks for `Grbl `, UGS and CNCjs for the version).
+/// On every port: a reset concerns both senders.
 pub fn banner() {
-    let mut r = line();
-    let _ = uwrite!(r, "{}", flash_str!("Grbl 1.1h ['$' for help]"));
-    r.send();
+    Port::each(|port| {
+        let mut r = Line::to(port);
+        let _ = uwrite!(r, "{}", flash_str!("Grbl 1.1h ['$' for help]"));
+        r.send();
+    });
 }
 
-/// `ALARM:<n>`, Grbl's alarm numbers (3: reset while in motion).
+/// `ALARM:<n>`, Grbl's alarm numbers (3: reset while in motion), on
+/// every port: the machine is locked for both senders.
 pub fn alarm(n: u8) {
-    let mut r = line();
-    let _ = uwrite!(r, "{}{}", flash_str!("ALARM:"), n);
-    r.send();
+    Port::each(|port| {
+        let mut r = Line::to(port);
+        let _ = uwrite!(r, "{}{}", flash_str!("ALARM:"), n);
+        r.send();
+    });
 }
 
 pub fn ok() {
-    usart::send(b"ok\n");
+    port::answer().send(b"ok\n");
 }
 
 /// `error:<code> <text> (col <c>)`.

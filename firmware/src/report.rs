@@ -2,7 +2,9 @@
 //! a job: how full each queue got, what it refused, what the step interrupt
 //! missed.
 
-use crate::queues::{BLOCKS, BUTTONS, CARD_IN, CARD_OUT, JOB_CONTROL, RX, SAMPLES, SEGMENTS, TX};
+use crate::queues::{
+    BLOCKS, BUTTONS, CARD_IN, CARD_OUT, JOB_CONTROL, RX, RX1, SAMPLES, SEGMENTS, TX, TX1,
+};
 use crate::{flash_str, info};
 use taut_logic::sched::QueueStats;
 
@@ -38,7 +40,9 @@ pub fn queue_line(i: u8) -> bool {
             JOB_CONTROL.stats(),
             JOB_CONTROL.capacity(),
         ),
-        9 => info!("log dropped:", crate::log::dropped()),
+        9 => queue(flash_str!("rx1"), RX1.stats(), RX1.capacity()),
+        10 => queue(flash_str!("tx1"), TX1.stats(), TX1.capacity()),
+        11 => info!("log dropped:", crate::log::dropped()),
         _ => return false,
     }
     true

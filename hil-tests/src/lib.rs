@@ -267,7 +267,11 @@ pub fn steps_on_pins(sim: &sim::Sim) -> [i64; 3] {
 pub fn reported_steps(sim: &mut sim::Sim) -> [i64; 3] {
     let start = sim.uart_bytes().len();
     send_ok(sim, "M114", std::time::Duration::from_secs(1));
-    let text = sim.uart_text_from(start);
+    m114_counts(&sim.uart_text_from(start))
+}
+
+/// The steps of `M114`'s `Count X:… Y:… Z:…` in `text`.
+pub fn m114_counts(text: &str) -> [i64; 3] {
     let count = text
         .lines()
         .find_map(|l| l.split_once("Count "))

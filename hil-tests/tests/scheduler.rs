@@ -95,7 +95,7 @@ fn no_message_lost_and_pulses_on_time_under_load() {
     send(&mut sim, "$Q");
     let text = sim.uart_text();
     let queues: Vec<&str> = text.lines().filter(|l| l.contains(" sent:")).collect();
-    assert_eq!(queues.len(), 9, "every queue reported: {queues:#?}");
+    assert_eq!(queues.len(), 11, "every queue reported: {queues:#?}");
     assert!(
         queues.iter().all(|l| l.contains("refused:0 ")),
         "nothing refused: {queues:#?}"

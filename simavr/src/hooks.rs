@@ -27,6 +27,8 @@ pub(crate) struct Shared {
     pub events: u64,
     pub probes: Vec<Probe>,
     pub uart: SerialLine,
+    /// USART1's line (the firmware's second console).
+    pub uart1: SerialLine,
     /// Address of the first invalid opcode executed.
     pub bad_opcode_pc: Option<u32>,
     /// The SD card slot: what answers the SPI bytes once it is wired.
@@ -83,6 +85,7 @@ impl Shared {
             events: 0,
             probes: Vec::new(),
             uart: SerialLine::default(),
+            uart1: SerialLine::default(),
             bad_opcode_pc: None,
             sd: Slot::default(),
             spi: None,
@@ -155,29 +158,14 @@ pub(crate) unsafe extern "C" fn on_pin(_irq: *mut avr_irq_t, value: u32, param: 
 /// `param` is the `Shared` of the simulation (module invariants).
 pub(crate) unsafe extern "C" fn on_uart_tx(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
     let shared = &mut *(param as *mut Shared);
-    match value as u8 {
-        crate::serial::XOFF => shared.uart.xoff = true,
-        crate::serial::XON => shared.uart.xoff = false,
-        _ => {}
-    }
-    shared.uart.tx.push(value as u8);
-    shared.events += 1;
-    shared.end_batch();
+    transmitted(shared, |s| &mut s.uart, value);
 }
 
 /// # Safety
 /// As `on_uart_tx`.
 pub(crate) unsafe extern "C" fn on_uart_xon(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
     let shared = &mut *(param as *mut Shared);
-    if value != 0 {
-        // Raised when the FIFO was read empty.
-        shared.uart.in_fifo = 0;
-    }
-    if value != 0 && !shared.uart.rx_ready {
-        shared.uart.rx_ready = true;
-        shared.events += 1;
-        shared.end_batch();
-    }
+    fifo_ready(shared, |s| &mut s.uart, value);
 }
 
 /// # Safety
@@ -186,6 +174,61 @@ pub(crate) unsafe extern "C" fn on_uart_xoff(_irq: *mut avr_irq_t, value: u32, p
     let shared = &mut *(param as *mut Shared);
     if value != 0 {
         shared.uart.rx_ready = false;
+    }
+}
+
+/// USART1's `on_uart_tx`.
+///
+/// # Safety
+/// As `on_uart_tx`.
+pub(crate) unsafe extern "C" fn on_uart1_tx(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
+    let shared = &mut *(param as *mut Shared);
+    transmitted(shared, |s| &mut s.uart1, value);
+}
+
+/// # Safety
+/// As `on_uart_tx`.
+pub(crate) unsafe extern "C" fn on_uart1_xon(_irq: *mut avr_irq_t, value: u32, param: *mut c_void) {
+    let shared = &mut *(param as *mut Shared);
+    fifo_ready(shared, |s| &mut s.uart1, value);
+}
+
+/// # Safety
+/// As `on_uart_tx`.
+pub(crate) unsafe extern "C" fn on_uart1_xoff(
+    _irq: *mut avr_irq_t,
+    value: u32,
+    param: *mut c_void,
+) {
+    let shared = &mut *(param as *mut Shared);
+    if value != 0 {
+        shared.uart1.rx_ready = false;
+    }
+}
+
+/// A byte the firmware sent on `line`.
+fn transmitted(shared: &mut Shared, line: fn(&mut Shared) -> &mut SerialLine, value: u32) {
+    let l = line(shared);
+    match value as u8 {
+        crate::serial::XOFF => l.xoff = true,
+        crate::serial::XON => l.xoff = false,
+        _ => {}
+    }
+    l.tx.push(value as u8);
+    shared.events += 1;
+    shared.end_batch();
+}
+
+/// simavr's receive FIFO of `line` has room (raised when read empty).
+fn fifo_ready(shared: &mut Shared, line: fn(&mut Shared) -> &mut SerialLine, value: u32) {
+    let l = line(shared);
+    if value != 0 {
+        l.in_fifo = 0;
+    }
+    if value != 0 && !l.rx_ready {
+        l.rx_ready = true;
+        shared.events += 1;
+        shared.end_batch();
     }
 }
 

@@ -1,6 +1,8 @@
 //! The simulated USART0 as a pseudo-terminal: host programs that open
 //! `/dev/ttyACM0` (senders, terminals) open its path instead and talk to
-//! the firmware as to a Mega on USB, in real time.
+//! the firmware as to a Mega on USB, in real time. USART1 (the second
+//! console, a Bluetooth module's `/dev/rfcomm0`) may have one too,
+//! served with it ([`Pty::serve_uart1`]).
 //!
 //! The terminal is raw (no echo, no line-end translation), as a USB
 //! serial port is. We keep the slave end open ourselves, so a client may
@@ -59,6 +61,10 @@ pub struct Pty {
     /// inotify on the slave's device node, when an open resets the board.
     opens: Option<OwnedFd>,
     pace: Pace,
+    /// The USART this terminal is: USART1 rather than USART0.
+    uart1: bool,
+    /// USART1's terminal, served along with this one.
+    second: Option<Box<Pty>>,
 }
 
 fn check(r: libc::c_int) -> io::Result<libc::c_int> {
@@ -116,8 +122,18 @@ impl Pty {
                 received: Vec::new(),
                 opens: None,
                 pace: Pace::RealTime,
+                uart1: false,
+                second: None,
             })
         }
+    }
+
+    /// Serve `uart1` (a terminal [`Pty::open`] made) as USART1's, along
+    /// with this one: what its client writes goes to USART1, what USART1
+    /// sends to it. No reset on its open: a Bluetooth link has no DTR.
+    pub fn serve_uart1(&mut self, mut uart1: Pty) {
+        uart1.uart1 = true;
+        self.second = Some(Box::new(uart1));
     }
 
     /// The terminal device a client opens (`/dev/pts/N`).
@@ -156,6 +172,9 @@ impl Pty {
     pub fn board_replaced(&mut self) {
         self.sent = 0;
         self.start = None;
+        if let Some(second) = &mut self.second {
+            second.board_replaced();
+        }
     }
 
     pub fn set_pace(&mut self, pace: Pace) {
@@ -206,6 +225,10 @@ impl Pty {
             self.take_input(sim)?;
             let outcome = sim.run_for(span);
             self.give_output(sim)?;
+            if let Some(second) = &mut self.second {
+                second.take_input(sim)?;
+                second.give_output(sim)?;
+            }
             self.keep_pace(sim, None);
             return Ok(outcome);
         }
@@ -214,7 +237,11 @@ impl Pty {
         let end = sim.cycles() + cycles_in(span);
         let mut outcome = Outcome::Running;
         while sim.cycles() < end && !outcome.is_fatal() {
-            let busy = self.take_input(sim)? > 0 || sim.uart_pending() > 0;
+            let second_in = match &mut self.second {
+                Some(second) => second.take_input(sim)? + second.give_output(sim)?,
+                None => 0,
+            };
+            let busy = self.take_input(sim)? > 0 || sim.uart_pending() > 0 || second_in > 0;
             let step = match busy {
                 true => end - sim.cycles(),
                 false => (end - sim.cycles()).min(IDLE_STEP),
@@ -235,19 +262,25 @@ impl Pty {
     /// What the client wrote, queued for the UART: how many bytes. The
     /// line honours XON/XOFF while the client's terminal has `IXON` on.
     fn take_input(&mut self, sim: &mut Sim) -> io::Result<usize> {
+        let uart1 = self.uart1;
         // SAFETY: a termios filled by the call, on a descriptor this Pty owns.
         let ixon = unsafe {
             let mut tio: libc::termios = std::mem::zeroed();
             libc::tcgetattr(self._slave.as_raw_fd(), &mut tio) == 0 && tio.c_iflag & libc::IXON != 0
         };
-        sim.set_uart_xonxoff(ixon);
+        if !uart1 {
+            sim.set_uart_xonxoff(ixon);
+        }
         let mut buf = [0u8; 256];
         let mut got = 0;
         loop {
             match self.master.read(&mut buf) {
                 Ok(0) => return Ok(got),
                 Ok(n) => {
-                    sim.uart_send(&buf[..n]);
+                    match uart1 {
+                        false => sim.uart_send(&buf[..n]),
+                        true => sim.uart1_send(&buf[..n]),
+                    }
                     self.received.extend_from_slice(&buf[..n]);
                     got += n;
                 }
@@ -261,7 +294,10 @@ impl Pty {
 
     /// What the UART sent, to the client: how many bytes.
     fn give_output(&mut self, sim: &Sim) -> io::Result<usize> {
-        let out = &sim.uart_bytes()[self.sent..];
+        let out = match self.uart1 {
+            false => &sim.uart_bytes()[self.sent..],
+            true => &sim.uart1_bytes()[self.sent..],
+        };
         let n = match self.master.write(out) {
             Ok(n) => n,
             Err(e) if e.kind() == io::ErrorKind::WouldBlock => 0,

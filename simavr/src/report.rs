@@ -16,6 +16,8 @@ pub struct Report {
     pub peak_stack_bytes: u16,
     pub elf: Option<ElfInfo>,
     pub uart: String,
+    /// What USART1 (the second console) sent.
+    pub uart1: String,
     pub pins: Vec<PinReport>,
 }
 
@@ -68,6 +70,7 @@ impl Sim {
             peak_stack_bytes: self.peak_stack_bytes(),
             elf: self.elf().copied(),
             uart: self.uart_text(),
+            uart1: self.uart1_text(),
             pins,
         }
     }

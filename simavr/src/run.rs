@@ -17,7 +17,7 @@
 use crate::clock::cycles_in;
 use crate::elf::RAM_END;
 use crate::outcome::Outcome;
-use crate::serial::{self, CYCLES_PER_BYTE};
+use crate::serial::{self, SerialLine, CYCLES_PER_BYTE};
 use crate::sim::{Core, Executed, Sim};
 use crate::traps::ZeroOrigin;
 use std::time::{Duration, Instant};
@@ -119,11 +119,23 @@ impl Sim {
 
     /// Runs until the UART output holds `text`.
     pub fn run_until_uart_contains(&mut self, text: &str, timeout: Duration) -> Outcome {
+        self.run_until_line_contains(false, text, timeout)
+    }
+
+    /// Runs until USART1's output holds `text`.
+    pub fn run_until_uart1_contains(&mut self, text: &str, timeout: Duration) -> Outcome {
+        self.run_until_line_contains(true, text, timeout)
+    }
+
+    fn run_until_line_contains(&mut self, uart1: bool, text: &str, timeout: Duration) -> Outcome {
         let needle = text.as_bytes().to_vec();
         let mut searched = 0;
         self.run_until(
             |sim| {
-                let tx = &sim.shared().uart.tx;
+                let tx = match uart1 {
+                    false => &sim.shared().uart.tx,
+                    true => &sim.shared().uart1.tx,
+                };
                 let from = serial::resume_from(searched.min(tx.len()), needle.len());
                 searched = tx.len();
                 serial::contains(&tx[from..], &needle)
@@ -141,23 +153,31 @@ impl Sim {
         let slot = &mut self.shared_mut().sd;
         slot.apply_due(now);
         let card_due = slot.next_due().unwrap_or(u64::MAX);
-        let bytes_due = self.shared_mut().uart.release_due(now).unwrap_or(u64::MAX);
         let mut next = self.schedule.next_due().unwrap_or(u64::MAX);
-        next = next.min(card_due).min(bytes_due);
-        let uart = &self.shared().uart;
-        if uart.rx_ready && !uart.rx.is_empty() && uart.flowing() {
-            if now >= uart.next_rx_cycle {
-                let uart = &mut self.shared_mut().uart;
-                let byte = uart.rx.pop_front().unwrap_or_default();
-                uart.next_rx_cycle = now + CYCLES_PER_BYTE;
-                uart.in_fifo += 1;
-                if uart.in_fifo >= crate::serial::FIFO_BYTES {
-                    // The next waits for the firmware to read these.
-                    uart.rx_ready = false;
+        next = next.min(card_due);
+        let uart1_byte = self.uart1_cycles_per_byte();
+        for (uart1, byte_time) in [(false, CYCLES_PER_BYTE), (true, uart1_byte)] {
+            fn line(sim: &mut Sim, uart1: bool) -> &mut SerialLine {
+                match uart1 {
+                    false => &mut sim.shared_mut().uart,
+                    true => &mut sim.shared_mut().uart1,
                 }
-                self.raise_uart_rx(byte);
             }
-            next = next.min(self.shared().uart.next_rx_cycle);
+            next = next.min(line(self, uart1).release_due(now).unwrap_or(u64::MAX));
+            let l = line(self, uart1);
+            if l.rx_ready && !l.rx.is_empty() && l.flowing() {
+                if now >= l.next_rx_cycle {
+                    let byte = l.rx.pop_front().unwrap_or_default();
+                    l.next_rx_cycle = now + byte_time;
+                    l.in_fifo += 1;
+                    if l.in_fifo >= crate::serial::FIFO_BYTES {
+                        // The next waits for the firmware to read these.
+                        l.rx_ready = false;
+                    }
+                    self.raise_uart_rx(uart1, byte);
+                }
+                next = next.min(line(self, uart1).next_rx_cycle);
+            }
         }
         next
     }

@@ -57,6 +57,7 @@ pub struct Sim {
     #[allow(clippy::vec_box)]
     pin_hooks: Vec<Box<PinHook>>,
     uart_input: *mut ffi::avr_irq_t,
+    uart1_input: *mut ffi::avr_irq_t,
     pub(crate) elf: Option<ElfInfo>,
     pub(crate) ram_limit: u16,
     pub(crate) min_sp: u16,
@@ -138,6 +139,7 @@ impl Sim {
         let shared = self.shared_mut();
         shared.cycle_base += before;
         shared.uart.rx_ready = false;
+        shared.uart1.rx_ready = false;
         // The reset emptied simavr's timers.
         shared.deadline_at = None;
         self.last_avr_cycle = self.avr_cycle();
@@ -187,39 +189,46 @@ impl Sim {
         let param = shared as *mut c_void;
         // SAFETY: `a` is a live, initialised avr_t; `param` outlives it (see
         // module invariants); the callbacks match simavr's signatures.
-        let uart_input = unsafe {
+        let (uart_input, uart1_input) = unsafe {
             (*a).sleep = Some(hooks::no_sleep);
             (*a).frequency = FREQ_HZ as u32;
-            // No echo of UART output to our stdout, and no host usleep while
-            // the firmware polls an empty receiver.
-            let mut flags: u32 = 0;
-            ffi::avr_ioctl(
-                a,
-                ioctl(b'u', b'a', b'g', b'0'),
-                &mut flags as *mut u32 as *mut c_void,
-            );
-            flags &= !(ffi::AVR_UART_FLAG_STDIO | ffi::AVR_UART_FLAG_POLL_SLEEP);
-            ffi::avr_ioctl(
-                a,
-                ioctl(b'u', b'a', b's', b'0'),
-                &mut flags as *mut u32 as *mut c_void,
-            );
-            let uart = |n: u32| ffi::avr_io_getirq(a, ioctl(b'u', b'a', b'r', b'0'), n as i32);
-            ffi::avr_irq_register_notify(
-                uart(ffi::UART_IRQ_OUTPUT),
-                Some(hooks::on_uart_tx),
-                param,
-            );
-            ffi::avr_irq_register_notify(
-                uart(ffi::UART_IRQ_OUT_XON),
-                Some(hooks::on_uart_xon),
-                param,
-            );
-            ffi::avr_irq_register_notify(
-                uart(ffi::UART_IRQ_OUT_XOFF),
-                Some(hooks::on_uart_xoff),
-                param,
-            );
+            type Notify = unsafe extern "C" fn(*mut ffi::avr_irq_t, u32, *mut c_void);
+            let mut inputs = [std::ptr::null_mut(); 2];
+            let wiring: [(u8, [Notify; 3]); 2] = [
+                (
+                    b'0',
+                    [hooks::on_uart_tx, hooks::on_uart_xon, hooks::on_uart_xoff],
+                ),
+                (
+                    b'1',
+                    [
+                        hooks::on_uart1_tx,
+                        hooks::on_uart1_xon,
+                        hooks::on_uart1_xoff,
+                    ],
+                ),
+            ];
+            for (input, (n, [tx, xon, xoff])) in inputs.iter_mut().zip(wiring) {
+                // No echo of UART output to our stdout, and no host usleep
+                // while the firmware polls an empty receiver.
+                let mut flags: u32 = 0;
+                ffi::avr_ioctl(
+                    a,
+                    ioctl(b'u', b'a', b'g', n),
+                    &mut flags as *mut u32 as *mut c_void,
+                );
+                flags &= !(ffi::AVR_UART_FLAG_STDIO | ffi::AVR_UART_FLAG_POLL_SLEEP);
+                ffi::avr_ioctl(
+                    a,
+                    ioctl(b'u', b'a', b's', n),
+                    &mut flags as *mut u32 as *mut c_void,
+                );
+                let uart = |i: u32| ffi::avr_io_getirq(a, ioctl(b'u', b'a', b'r', n), i as i32);
+                ffi::avr_irq_register_notify(uart(ffi::UART_IRQ_OUTPUT), Some(tx), param);
+                ffi::avr_irq_register_notify(uart(ffi::UART_IRQ_OUT_XON), Some(xon), param);
+                ffi::avr_irq_register_notify(uart(ffi::UART_IRQ_OUT_XOFF), Some(xoff), param);
+                *input = uart(ffi::UART_IRQ_INPUT);
+            }
             let bad = ffi::avr_get_core_irq(a, ffi::AVR_CORE_BAD_OPCODE as i32);
             ffi::avr_irq_register_notify(bad, Some(hooks::on_bad_opcode), param);
             // Batched runs: simavr's run loop, and the register writes
@@ -227,10 +236,9 @@ impl Sim {
             ffi::avr_register_io_write(a, SPL as u16, Some(hooks::on_sp_write), param);
             ffi::avr_register_io_write(a, SPH as u16, Some(hooks::on_sp_write), param);
             ffi::avr_register_io_write(a, SREG, Some(hooks::on_sreg_write), param);
-            let input = uart(ffi::UART_IRQ_INPUT);
             (*a).custom.data = param;
             (*a).run = Some(hooks::run);
-            input
+            (inputs[0], inputs[1])
         };
         Sim {
             avr,
@@ -238,6 +246,7 @@ impl Sim {
             shared: unsafe { NonNull::new_unchecked(shared) },
             pin_hooks: Vec::new(),
             uart_input,
+            uart1_input,
             elf,
             ram_limit,
             min_sp: RAM_END,
@@ -650,11 +659,30 @@ impl Sim {
         }
     }
 
-    /// Puts one byte on USART0's receive line now.
-    pub(crate) fn raise_uart_rx(&mut self, byte: u8) {
-        // SAFETY: `uart_input` is UART0's input IRQ of our live avr_t; the
+    /// Puts one byte on USART0's (`uart1`: USART1's) receive line now.
+    pub(crate) fn raise_uart_rx(&mut self, uart1: bool, byte: u8) {
+        let input = if uart1 {
+            self.uart1_input
+        } else {
+            self.uart_input
+        };
+        // SAFETY: `input` is a UART's input IRQ of our live avr_t; the
         // caller holds no reference into `Shared` across the call.
-        unsafe { ffi::avr_raise_irq(self.uart_input, u32::from(byte)) };
+        unsafe { ffi::avr_raise_irq(input, u32::from(byte)) };
+    }
+
+    /// USART1's byte time on an 8N1 line, in cycles, from its UBRR1 and
+    /// U2X1 as the firmware set them (its reset values until then).
+    pub(crate) fn uart1_cycles_per_byte(&self) -> u64 {
+        // UCSR1A 0xC8 (U2X1: bit 1), UBRR1L 0xCC, UBRR1H 0xCD.
+        // SAFETY: `data` holds `ramend + 1` bytes, far above 0xCD.
+        let (a, lo, hi) = unsafe {
+            let data = (*self.avr.as_ptr()).data;
+            (*data.add(0xC8), *data.add(0xCC), *data.add(0xCD))
+        };
+        let ubrr = u64::from(u16::from_le_bytes([lo, hi]) & 0x0FFF);
+        let per_bit = if a & 2 != 0 { 8 } else { 16 };
+        10 * per_bit * (ubrr + 1)
     }
 
     /// simavr's IRQ for a board pin's level.

@@ -1,5 +1,6 @@
 //! USART0 as the host sees it: bytes the firmware sent, and bytes waiting to
-//! be received, fed at the pace of a 115200 8N1 line.
+//! be received, fed at the pace of a 115200 8N1 line; USART1 (the second
+//! console, `uart1_…`) the same at the rate its UBRR1 makes.
 
 use crate::clock::cycles_in;
 use crate::sim::Sim;
@@ -52,5 +53,43 @@ impl Sim {
     /// Bytes queued by `uart_send` (or planned and due) not yet delivered.
     pub fn uart_pending(&self) -> usize {
         self.shared().uart.rx.len()
+    }
+
+    /// Bytes USART1 transmitted since the last `take_uart1`.
+    pub fn uart1_bytes(&self) -> &[u8] {
+        &self.shared().uart1.tx
+    }
+
+    /// USART1's transmitted bytes as text.
+    pub fn uart1_text(&self) -> String {
+        String::from_utf8_lossy(self.uart1_bytes()).into_owned()
+    }
+
+    /// USART1's transmitted text, clearing the capture.
+    pub fn take_uart1(&mut self) -> String {
+        let bytes = std::mem::take(&mut self.shared_mut().uart1.tx);
+        String::from_utf8_lossy(&bytes).into_owned()
+    }
+
+    /// Queues bytes for USART1 to receive, one per byte time at the rate
+    /// the firmware set (UBRR1), as [`Sim::uart_send`].
+    pub fn uart1_send(&mut self, bytes: &[u8]) {
+        self.shared_mut().uart1.rx.extend(bytes);
+    }
+
+    /// Plans bytes for USART1 at simulated time `at`, as
+    /// [`Sim::uart_send_at`].
+    pub fn uart1_send_at(&mut self, at: Duration, bytes: &[u8]) {
+        self.shared_mut().uart1.plan(cycles_in(at), bytes);
+    }
+
+    /// Bytes queued for USART1 not yet delivered.
+    pub fn uart1_pending(&self) -> usize {
+        self.shared().uart1.rx.len()
+    }
+
+    /// USART1's byte time (8N1) at the rate the firmware set, in cycles.
+    pub fn uart1_byte_cycles(&self) -> u64 {
+        self.uart1_cycles_per_byte()
     }
 }

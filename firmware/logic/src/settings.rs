@@ -297,7 +297,8 @@ pub fn for_each(cfg: &MachineConfig, mut f: impl FnMut(Setting, Value)) {
 }
 
 /// Line `index` of `$$`: Grbl's numbered settings, then ours by name,
-/// the console's `$flow` last.
+/// the console's `$flow` and `$uart1_baud` last (0 on the string-art
+/// machine, where UART1 is off: D18 is its `zero_drill` button).
 pub fn listed(index: usize, cfg: &MachineConfig, ex: &grbl::Extras) -> Option<Listed> {
     Some(match index.checked_sub(grbl::COUNT) {
         None => {
@@ -305,6 +306,9 @@ pub fn listed(index: usize, cfg: &MachineConfig, ex: &grbl::Extras) -> Option<Li
             Listed(Key::Number(n.number()), n.get(cfg, ex))
         }
         Some(COUNT) => Listed(Key::Flow, Value::Number(ex.xonxoff() as u32)),
+        Some(i) if i == COUNT + 1 => {
+            Listed(Key::Uart1Baud, Value::Number(ex.uart1(cfg.machine).bps()))
+        }
         Some(i) => {
             let s = Setting::at(i)?;
             Listed(Key::Named(Named(s, cfg.machine)), s.get(cfg))
@@ -319,6 +323,12 @@ pub fn is_flow(key: &[u8]) -> bool {
     text!("flow").eq_ignore_ascii_case(key)
 }
 
+/// Whether `key` is `$uart1_baud`'s (any case): the second console's
+/// rate ([`grbl::Extras::set_uart1_baud`]).
+pub fn is_uart1_baud(key: &[u8]) -> bool {
+    text!("uart1_baud").eq_ignore_ascii_case(key)
+}
+
 /// A line of `$$`: `$110=3750.000`, `$radial_max_rate=2000`.
 pub struct Listed(Key, Value);
 
@@ -327,6 +337,8 @@ enum Key {
     Named(Named),
     /// `$flow=xonxoff` (value 1) or `$flow=off`.
     Flow,
+    /// `$uart1_baud=9600`, its rate (0: off).
+    Uart1Baud,
 }
 
 impl uDisplay for Listed {
@@ -338,6 +350,7 @@ impl uDisplay for Listed {
                 Value::Number(0) => text!("$flow=off").fmt(f),
                 _ => text!("$flow=xonxoff").fmt(f),
             },
+            Key::Uart1Baud => uwrite!(f, "{}{}", text!("$uart1_baud="), self.1),
         }
     }
 }

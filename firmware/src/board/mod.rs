@@ -7,10 +7,12 @@ pub mod early;
 pub mod eeprom;
 pub mod flash;
 pub mod gpio;
+pub mod port;
 pub mod servo;
 pub mod spi;
 pub mod step_timer;
 pub mod usart;
+pub mod usart1;
 pub mod watchdog;
 
 /// CPU clock of the Mega 2560.

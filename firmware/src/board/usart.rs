@@ -6,6 +6,7 @@
 //! [`XON_AT`], each ahead of the bytes waiting in `TX`.
 
 use crate::queues::{RX, TX};
+use crate::rt::Ring;
 use avr_device::atmega2560::USART0;
 use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
 use taut_logic::gcode::LINE_CUT;
@@ -33,11 +34,10 @@ fn regs() -> &'static avr_device::atmega2560::usart0::RegisterBlock {
 }
 
 /// Queue bytes for sending; all or nothing. Returns false when the ring is
-/// full. A line being staged loses its slots (`stage`).
+/// full. A line being staged loses its slots (`Outbox::stage`).
 #[inline(never)]
 pub fn send(bytes: &[u8]) -> bool {
-    begin_staging();
-    let ok = TX.push_all(bytes);
+    let ok = OUTBOX.send(bytes);
     if ok {
         wake();
     }
@@ -139,37 +139,68 @@ fn wake() {
     avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.udrie0().set_bit()));
 }
 
-/// The number of the line staged in the ring's free slots: bumped by
-/// every line begun, sent or queued. Tasks only.
-static STAGING: AtomicU8 = AtomicU8::new(0);
-
-/// The ring's free slots are now the new line's: its number.
-pub fn begin_staging() -> u8 {
-    let n = STAGING.load(Relaxed).wrapping_add(1);
-    STAGING.store(n, Relaxed);
-    n
+/// A transmit ring and the number of the line staged in its free slots:
+/// bumped by every line begun, sent or queued. Tasks only.
+pub struct Outbox {
+    ring: &'static Ring<u8, 128>,
+    staging: AtomicU8,
 }
 
-/// Stage byte `k` of line `owner` (`Ring::stage`): false if it does not
-/// fit or the slots are no longer the line's.
-pub fn stage(owner: u8, k: usize, b: u8) -> bool {
-    owner == STAGING.load(Relaxed) && TX.stage(k, b)
+/// `TX`'s.
+pub static OUTBOX: Outbox = Outbox::new(&TX);
+
+impl Outbox {
+    pub const fn new(ring: &'static Ring<u8, 128>) -> Outbox {
+        Outbox {
+            ring,
+            staging: AtomicU8::new(0),
+        }
+    }
+
+    /// The ring's free slots are now the new line's: its number.
+    pub fn begin_staging(&self) -> u8 {
+        let n = self.staging.load(Relaxed).wrapping_add(1);
+        self.staging.store(n, Relaxed);
+        n
+    }
+
+    /// Stage byte `k` of line `owner` (`Ring::stage`): false if it does
+    /// not fit or the slots are no longer the line's.
+    #[inline(always)]
+    pub fn stage(&self, owner: u8, k: usize, b: u8) -> bool {
+        owner == self.staging.load(Relaxed) && self.ring.stage(k, b)
+    }
+
+    /// Queue the `n` bytes line `owner` staged, unless it `lost` some or
+    /// its slots (refused, then): whether it did (the caller wakes its
+    /// transmitter).
+    pub fn publish(&self, owner: u8, n: usize, lost: bool) -> bool {
+        let current = self.staging.load(Relaxed);
+        // Queued, the slots are no longer the line's.
+        self.begin_staging();
+        if lost || owner != current {
+            self.ring.refuse();
+            return false;
+        }
+        self.ring.publish(n);
+        true
+    }
+
+    /// Queue bytes, all or nothing; a line being staged loses its slots.
+    pub fn send(&self, bytes: &[u8]) -> bool {
+        self.begin_staging();
+        self.ring.push_all(bytes)
+    }
 }
 
-/// Queue the `n` bytes line `owner` staged, unless it `lost` some or its
-/// slots (refused, then).
+/// Queue what line `owner` staged in `TX` (`Outbox::publish`).
 #[inline(never)]
 pub fn publish(owner: u8, n: usize, lost: bool) -> bool {
-    let current = STAGING.load(Relaxed);
-    // Queued, the slots are no longer the line's.
-    begin_staging();
-    if lost || owner != current {
-        TX.refuse();
-        return false;
+    let ok = OUTBOX.publish(owner, n, lost);
+    if ok {
+        wake();
     }
-    TX.publish(n);
-    wake();
-    true
+    ok
 }
 
 /// USART0 control register B and its interrupt-enable bits, for the
@@ -194,29 +225,30 @@ pub fn on_data_register_empty() {
 /// end goes in as [`LINE_CUT`]. Written by the receive interrupt only.
 static CUT: AtomicBool = AtomicBool::new(false);
 
-/// A received byte into `RX`. The last slot is kept for a line's end, so
-/// however long a line, however late the console reads (power-on homing),
-/// every line ends in the ring and gets its reply: a line that lost bytes
-/// (a sender ignoring the count or the flow control) ends in
-/// [`LINE_CUT`], answered `error:11`. Each lost byte is counted.
-fn keep(b: u8) {
-    let cut = CUT.load(Relaxed);
+/// A received byte into `rx`, `cut` its line's state (each port's own).
+/// The last slot is kept for a line's end, so however long a line,
+/// however late the console reads (power-on homing), every line ends in
+/// the ring and gets its reply: a line that lost bytes (a sender
+/// ignoring the count or the flow control) ends in [`LINE_CUT`],
+/// answered `error:11`. Each lost byte is counted.
+pub(super) fn keep<const N: usize>(rx: &Ring<u8, N, true>, cut: &AtomicBool, b: u8) {
+    let was_cut = cut.load(Relaxed);
     if b == b'\n' || b == b'\r' {
         // While the console is behind by a whole line the end finds no
         // room: the next line is then dropped with this one.
-        if RX.push(if cut { LINE_CUT } else { b }).is_ok() {
-            CUT.store(false, Relaxed);
+        if rx.push(if was_cut { LINE_CUT } else { b }).is_ok() {
+            cut.store(false, Relaxed);
         }
         return;
     }
     // No 0xFF from the wire is taken for the marker (Grbl drops every
     // extended byte that is no real-time command).
-    if cut || b == LINE_CUT || RX.free() <= 1 {
-        CUT.store(cut || b != LINE_CUT, Relaxed);
-        RX.refuse();
+    if was_cut || b == LINE_CUT || rx.free() <= 1 {
+        cut.store(was_cut || b != LINE_CUT, Relaxed);
+        rx.refuse();
         return;
     }
-    let _ = RX.push(b);
+    let _ = rx.push(b);
 }
 
 /// The `USART0_RX` handler, entered with its interrupt switched off: the
@@ -226,7 +258,7 @@ pub fn on_receive(take: impl FnOnce(u8) -> bool) -> bool {
     let b = regs().udr0().read().bits();
     let taken = take(b);
     if !taken {
-        keep(b);
+        keep(&RX, &CUT, b);
         if FLOW.load(Relaxed) & FLOW_ON != 0 && RX.len() >= XOFF_AT {
             flow_to(true);
         }

@@ -5,10 +5,9 @@
 #![deny(unsafe_code)]
 
 use super::{Console, Owner};
-use crate::board::usart;
+use crate::board::port;
 use crate::machine_io::Io;
 use crate::motion::Motion;
-use crate::queues::RX;
 use crate::store::Store;
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Error, ErrorKind};
@@ -65,14 +64,16 @@ impl Console {
                 }
             }
         }
-        if RX.len() >= SEED_FULL {
+        // UART1's 64-byte buffer keeps its last byte for a line's end.
+        let port = port::answer();
+        if port.rx_len() >= SEED_FULL || port.rx_free() <= 1 {
             send(b'K');
         }
     }
 }
 
-/// A one-letter answer line (`?`, `K`): the console waits for room in
-/// the TX ring before it takes a line.
+/// A one-letter answer line (`?`, `K`), on the line's port: the console
+/// waits for room in its TX ring before it takes a line.
 fn send(letter: u8) {
-    usart::send(&[letter, b'\n']);
+    port::answer().send(&[letter, b'\n']);
 }

@@ -1,15 +1,17 @@
-//! Where the console's lines come from: the serial line, or a plotter's
-//! card print (its buttons, its messages and its `M20`…`M27` lines), a
-//! serial line going by between the card's.
+//! Where the console's lines come from: the serial ports (USB, UART1),
+//! or a plotter's card print (its buttons, its messages and its
+//! `M20`…`M27` lines), a serial line going by between the card's. A
+//! serial line is read whole from the port it began on
+//! (`port::next_line`) and answered there.
 
 use super::{Console, Source};
-use crate::board::usart;
+use crate::board::port;
 use crate::motion::Motion;
-use crate::queues::{BUTTONS, RX};
+use crate::queues::BUTTONS;
 use crate::store::Store;
 use taut_logic::checkpoint::plot::ResumeAction;
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{CardLine, Error, ErrorKind, Parser, LINE_CUT};
+use taut_logic::gcode::{CardLine, Error, ErrorKind, Parser};
 use taut_logic::kinematics::Kinematics;
 use taut_logic::pinmap::Button;
 
@@ -25,15 +27,19 @@ impl Console {
             self.parser = Parser::new();
             self.source = None;
         }
+        let mut port = Some(port::answer());
         if !self.parser.mid_line() {
             self.source = Some(match self.print.running() && !serial_line_waits() {
                 true => Source::Card,
                 false => Source::Serial,
             });
+            if self.source == Some(Source::Serial) {
+                port = port::next_line();
+            }
         }
         let byte = match self.source {
             Some(Source::Card) => self.print.next_byte(),
-            _ => usart::receive(),
+            _ => port.and_then(port::Port::receive),
         };
         if byte.is_none() {
             self.print.finished();
@@ -131,7 +137,7 @@ impl Console {
     }
 }
 
-/// A whole line has arrived on the serial line.
+/// A whole line has arrived on a serial port.
 pub(super) fn serial_line_waits() -> bool {
-    RX.any(|&b| b == b'\n' || b == b'\r' || b == LINE_CUT)
+    port::any_line_waits()
 }

@@ -8,7 +8,6 @@
 use super::{message, Console, Listing, Owner, Sleep, Source};
 use crate::board::usart;
 use crate::motion::Motion;
-use crate::queues::RX;
 use crate::reply;
 use crate::rt::stack;
 use crate::store::{self, Store, Text};
@@ -188,6 +187,16 @@ impl Console {
                 at: 0,
                 why: None,
             }),
+            // In force from the next reset (Ctrl-X) or power-on: the
+            // `ok` goes out at the rate the sender speaks.
+            None if settings::is_uart1_baud(key.as_bytes()) => store
+                .extras_mut()
+                .set_uart1_baud(value.as_bytes())
+                .map_err(|e| SetError {
+                    code: ErrorKind::InvalidStatement,
+                    at: e.at,
+                    why: Some(e.kind),
+                }),
             None if settings::is_flow(key.as_bytes()) => {
                 let set = store.extras_mut().set_flow(value.as_bytes());
                 usart::set_xonxoff(store.extras().xonxoff());
@@ -438,7 +447,7 @@ fn build_info(cfg: &MachineConfig, store: &Store) {
         "{}{},{}]",
         flash_str!("[OPT:,"),
         taut_logic::planner::PLANNER_BLOCKS,
-        RX.capacity()
+        crate::board::port::answer().rx_capacity()
     );
     r.send();
 }

@@ -32,6 +32,7 @@ usage: taut-sim ELF [options]
                    [--power-cut-at SECONDS | --power-cut-on TEXT
                    [--power-cut-delay SECONDS]]
                    [--machine NAME [--endstop-mm MM]] [--pty [PATH]]
+                   [--at1 SECONDS:BYTES]... [--pty1 [PATH]]
                    [--bootloader HEX]
   ELF             the firmware, loaded into flash as a debugger would (reset
                   at address 0); with --bootloader, the application already
@@ -84,6 +85,10 @@ usage: taut-sim ELF [options]
                   until 1 s after the last planned event (--at,
                   --pull-card-at, --reinsert-at, crc-once-at). A planned
                   power cut outlasts it: the run lasts until the cut
+  --at1 SECONDS:BYTES
+                  the same for UART1, the second console (a Bluetooth
+                  module's, at the rate the firmware set: 9600 by default);
+                  the firmware turns it on on a plotter or the arm
   --vcd PATH      write a VCD trace of every probed pin, named by the
                   machine's channels (base_, radial_, drill_; x_, y_;
                   left_, right_; shoulder_, elbow_), the ULN2003 coil
@@ -101,6 +106,9 @@ usage: taut-sim ELF [options]
                   for senders and terminals, in real time; runs until
                   --for SECONDS, or SIGINT / SIGTERM, then writes the VCD,
                   the picture and the report as any run does
+  --pty1 [PATH]   serve UART1 (the second console) as a pseudo-terminal
+                  too, as a Bluetooth module's /dev/rfcomm0 is (--pty, with
+                  no link, if not given)
   --profile N     print the N functions the MCU spent the most cycles in
   --report PATH   write a JSON report (cycles, time, outcome, UART, pin figures)
   --eeprom FILE   the EEPROM's contents (settings): loaded at power-on if the
@@ -149,6 +157,8 @@ struct Args {
     faults: Vec<FaultSpec>,
     send: Option<PathBuf>,
     at: Vec<TimedBytes>,
+    /// `--at1`: the same for USART1, the second console.
+    at1: Vec<TimedBytes>,
     seconds: Option<Duration>,
     vcd: Option<PathBuf>,
     png: Option<PathBuf>,
@@ -160,6 +170,8 @@ struct Args {
     auto_confirm: bool,
     /// `--pty`, and the link to make, if any.
     pty: Option<Option<PathBuf>>,
+    /// `--pty1`: USART1's terminal, and its link.
+    pty1: Option<Option<PathBuf>>,
     /// `--profile N`: the top N functions by cycles.
     profile: Option<usize>,
     cut: Option<Cut>,
@@ -185,6 +197,7 @@ fn parse(it: impl Iterator<Item = String>) -> Result<Args, String> {
         faults: Vec::new(),
         send: None,
         at: Vec::new(),
+        at1: Vec::new(),
         seconds: None,
         vcd: None,
         png: None,
@@ -195,6 +208,7 @@ fn parse(it: impl Iterator<Item = String>) -> Result<Args, String> {
         echo: false,
         auto_confirm: false,
         pty: None,
+        pty1: None,
         profile: None,
         cut: None,
         cut_delay: Duration::ZERO,
@@ -214,6 +228,9 @@ fn parse(it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--at" => args
                 .at
                 .push(value()?.parse().map_err(|e| format!("--at {e}"))?),
+            "--at1" => args
+                .at1
+                .push(value()?.parse().map_err(|e| format!("--at1 {e}"))?),
             "--vcd" => args.vcd = Some(value()?.into()),
             "--png" => args.png = Some(value()?.into()),
             "--report" => args.report = Some(value()?.into()),
@@ -229,6 +246,10 @@ fn parse(it: impl Iterator<Item = String>) -> Result<Args, String> {
             "--pty" => {
                 let link = it.next_if(|v| !v.starts_with("--")).map(PathBuf::from);
                 args.pty = Some(link);
+            }
+            "--pty1" => {
+                let link = it.next_if(|v| !v.starts_with("--")).map(PathBuf::from);
+                args.pty1 = Some(link);
             }
             "--auto-confirm" => args.auto_confirm = true,
             "--power-cut-at" => args.cut = Some(Cut::At(time(value()?)?)),
@@ -261,6 +282,9 @@ fn parse(it: impl Iterator<Item = String>) -> Result<Args, String> {
     if args.elf.is_none() && args.bootloader.is_none() {
         return Err("missing ELF (or --bootloader HEX)".into());
     }
+    if args.pty1.is_some() {
+        args.pty.get_or_insert(None);
+    }
     if args.bootloader.is_some() && args.pty.is_none() {
         return Err("--bootloader needs --pty: the bootloader talks over the serial port".into());
     }
@@ -276,7 +300,7 @@ fn parse(it: impl Iterator<Item = String>) -> Result<Args, String> {
 impl Args {
     /// The simulated time of the last planned event.
     fn last_planned(&self) -> Option<Duration> {
-        let times = self.at.iter().map(|t| t.at);
+        let times = self.at.iter().chain(&self.at1).map(|t| t.at);
         let faults = self.faults.iter().filter_map(FaultSpec::at);
         (times.chain(self.pulls.iter().copied()))
             .chain(self.reinserts.iter().copied())
@@ -387,6 +411,9 @@ fn run(args: Args) -> Result<Ending, Box<dyn std::error::Error>> {
     for t in &args.at {
         sim.uart_send_at(t.at, &t.bytes);
     }
+    for t in &args.at1 {
+        sim.uart1_send_at(t.at, &t.bytes);
+    }
     let wall = Instant::now();
     let mut printed = 0;
     if let Some(file) = &args.send {
@@ -405,6 +432,17 @@ fn run(args: Args) -> Result<Ending, Box<dyn std::error::Error>> {
                 link.as_ref()
                     .map_or(String::new(), |l| format!(" (link {})", l.display()))
             );
+            if let Some(link1) = &args.pty1 {
+                let pty1 = Pty::open(link1.as_deref())?;
+                eprintln!(
+                    "taut-sim: UART1 (second console) on {}{}",
+                    pty1.path().display(),
+                    link1
+                        .as_ref()
+                        .map_or(String::new(), |l| format!(" (link {})", l.display()))
+                );
+                pty.serve_uart1(pty1);
+            }
             stop_on_signals();
             Some(pty)
         }
@@ -699,13 +737,14 @@ mod tests {
         let a = args(
             "fw.elf --sd card --pull-card-at 2 --reinsert-at 4.5 --pull-card-at 6 \
              --card-fault crc-once:poradi.txt --card-fault crc-once-at:3 \
-             --at 1:? --at 2.5:\\x18 --for 8",
+             --at 1:? --at 2.5:\\x18 --at1 3:G0\\x20X5\\n --for 8",
         )
         .unwrap();
         assert_eq!(a.pulls, [2.0, 6.0].map(Duration::from_secs_f64));
         assert_eq!(a.reinserts, [Duration::from_secs_f64(4.5)]);
         assert_eq!(a.faults.len(), 2);
         assert_eq!(a.at[1].bytes, [0x18]);
+        assert_eq!(a.at1[0].bytes, b"G0 X5\n");
         assert_eq!(a.seconds, Some(Duration::from_secs(8)));
         assert_eq!(a.last_planned(), Some(Duration::from_secs(6)));
     }

@@ -132,6 +132,44 @@ pub const FLAG_LASER: u8 = 16;
 /// `$flow=xonxoff`: the console sends XOFF and XON (taut's, by name: a
 /// record from before it has the bit clear, flow control off).
 pub const FLAG_XONXOFF: u8 = 32;
+/// `$uart1_baud`: the second console's rate, a [`Uart1Baud`] code in
+/// these two bits (a record from before it has them clear: 9600).
+pub const FLAGS_UART1: u8 = 0b1100_0000;
+const UART1_SHIFT: u8 = 6;
+
+/// `$uart1_baud=`: the second console's rate (an HC-05/HC-06's), or 0:
+/// off. The rates a Bluetooth module is set to most, exact enough from
+/// the Mega's 16 MHz clock.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Uart1Baud {
+    /// The modules' factory rate.
+    B9600 = 0,
+    B38400 = 1,
+    B115200 = 2,
+    Off = 3,
+}
+
+impl Uart1Baud {
+    /// Bits per second (0: off).
+    pub fn bps(self) -> u32 {
+        match self {
+            Uart1Baud::B9600 => 9600,
+            Uart1Baud::B38400 => 38400,
+            Uart1Baud::B115200 => 115_200,
+            Uart1Baud::Off => 0,
+        }
+    }
+
+    pub fn from_bps(bps: u32) -> Option<Uart1Baud> {
+        Some(match bps {
+            9600 => Uart1Baud::B9600,
+            38400 => Uart1Baud::B38400,
+            115_200 => Uart1Baud::B115200,
+            0 => Uart1Baud::Off,
+            _ => return None,
+        })
+    }
+}
 
 /// Bytes of [`Extras`] in EEPROM.
 pub const EXTRAS_BYTES: u16 = BYTES as u16 + 2 * 4 + TYPED as u16 * 4;
@@ -178,6 +216,43 @@ impl Extras {
         };
         let flags = &mut self.bytes[BYTE_FLAGS];
         *flags = *flags & !FLAG_XONXOFF | if on { FLAG_XONXOFF } else { 0 };
+        Ok(())
+    }
+
+    /// `$uart1_baud`: the second console's rate.
+    pub fn uart1_baud(&self) -> Uart1Baud {
+        match (self.flags() & FLAGS_UART1) >> UART1_SHIFT {
+            0 => Uart1Baud::B9600,
+            1 => Uart1Baud::B38400,
+            2 => Uart1Baud::B115200,
+            _ => Uart1Baud::Off,
+        }
+    }
+
+    /// UART1's rate on `machine`: off on the string-art machine, whose
+    /// `zero_drill` button is on D18 (TX1).
+    pub fn uart1(&self, machine: Machine) -> Uart1Baud {
+        match machine.is_string_art() {
+            true => Uart1Baud::Off,
+            false => self.uart1_baud(),
+        }
+    }
+
+    /// `$uart1_baud=`: 9600, 38400, 115200, or 0 (off); else the value's
+    /// error.
+    pub fn set_uart1_baud(&mut self, value: &[u8]) -> Result<(), NumError> {
+        let bad = NumError {
+            at: 0,
+            kind: ErrorKind::Invalid(text!("uart1_baud: 9600, 38400, 115200 or 0")),
+        };
+        // By hand: `str::parse` would bring a 256-byte table into SRAM.
+        let digits = !value.is_empty() && value.len() <= 6 && value.iter().all(u8::is_ascii_digit);
+        let bps = value
+            .iter()
+            .fold(0u32, |n, &d| n * 10 + u32::from(d.wrapping_sub(b'0')));
+        let baud = Uart1Baud::from_bps(bps).filter(|_| digits).ok_or(bad)?;
+        let flags = &mut self.bytes[BYTE_FLAGS];
+        *flags = *flags & !FLAGS_UART1 | (baud as u8) << UART1_SHIFT;
         Ok(())
     }
 

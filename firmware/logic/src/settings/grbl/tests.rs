@@ -26,9 +26,11 @@ fn set(cfg: &mut MachineConfig, ex: &mut Extras, key: &str, value: &str) -> Resu
 #[test]
 fn dollar_dollar_lists_grbl_s_34_numbers_then_the_named_settings() {
     let lines = listing(&MachineConfig::STRING_ART, &Extras::DEFAULT);
-    assert_eq!(lines.len(), COUNT + NAMED + 1);
+    assert_eq!(lines.len(), COUNT + NAMED + 2);
     assert_eq!(COUNT, 34);
-    assert_eq!(lines.last().unwrap(), "$flow=off");
+    assert_eq!(lines[lines.len() - 2], "$flow=off");
+    // UART1's TX is the string-art machine's zero_drill button: off.
+    assert_eq!(lines.last().unwrap(), "$uart1_baud=0");
     assert_eq!(
         lines[..COUNT],
         [
@@ -334,7 +336,7 @@ fn flow_control_is_a_flag_of_the_extras() {
     ex.set_flow(b"XonXoff").unwrap();
     assert!(ex.xonxoff());
     let cfg = MachineConfig::STRING_ART;
-    assert_eq!(listing(&cfg, &ex).last().unwrap(), "$flow=xonxoff");
+    assert!(listing(&cfg, &ex).contains(&"$flow=xonxoff".into()));
     assert_eq!(ex.flags(), FLAG_XONXOFF, "the other flags untouched");
     assert!(ex.set_flow(b"rtscts").is_err());
     assert!(ex.xonxoff(), "a refused value changes nothing");
@@ -348,4 +350,41 @@ fn flow_control_is_a_flag_of_the_extras() {
         bytes.extend_from_slice(&b[..n as usize]);
     }
     assert!(Extras::decode(|i| bytes[i as usize]).xonxoff());
+}
+
+/// `$uart1_baud` (the second console's rate) is 9600 unless set, kept in
+/// two flag bits of the extras: a record from before it reads back 9600.
+#[test]
+fn uart1_baud_is_a_code_in_the_flags() {
+    let mut ex = Extras::DEFAULT;
+    assert_eq!(ex.uart1_baud(), Uart1Baud::B9600);
+    let flatbed = MachineConfig::defaults(crate::settings::Machine::Flatbed);
+    assert_eq!(listing(&flatbed, &ex).last().unwrap(), "$uart1_baud=9600");
+    ex.set_flow(b"xonxoff").unwrap();
+    ex.set_uart1_baud(b"115200").unwrap();
+    assert_eq!(ex.uart1_baud(), Uart1Baud::B115200);
+    assert!(ex.xonxoff(), "the other flags untouched");
+    assert_eq!(listing(&flatbed, &ex).last().unwrap(), "$uart1_baud=115200");
+    for bad in [&b"4800"[..], b"", b"fast", b"-9600"] {
+        assert!(ex.set_uart1_baud(bad).is_err());
+    }
+    assert_eq!(
+        ex.uart1_baud(),
+        Uart1Baud::B115200,
+        "a refused value changes nothing"
+    );
+    ex.set_uart1_baud(b"0").unwrap();
+    assert_eq!(ex.uart1_baud(), Uart1Baud::Off);
+    let mut bytes = std::vec::Vec::new();
+    for k in 0..Extras::PARTS as u8 {
+        let (b, n) = ex.part(k).unwrap();
+        bytes.extend_from_slice(&b[..n as usize]);
+    }
+    assert_eq!(
+        Extras::decode(|i| bytes[i as usize]).uart1_baud(),
+        Uart1Baud::Off
+    );
+    ex.set_uart1_baud(b"9600").unwrap();
+    ex.set_flow(b"off").unwrap();
+    assert_eq!(ex, Extras::DEFAULT);
 }
