@@ -39,7 +39,7 @@ use junction::{Geometry, PenLimits, PenMove, PenPath, Turn};
 
 /// Number of moves the firmware's planner holds: as many as the RAM
 /// budget allows (`docs/architecture.md`).
-pub const PLANNER_BLOCKS: usize = 16;
+pub const PLANNER_BLOCKS: usize = 12;
 
 /// The firmware's planner. The host may plan with other depths
 /// ([`Lookahead`]`<N>`, say Grbl-Mega's 36) through the same code.

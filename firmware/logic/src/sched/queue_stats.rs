@@ -9,8 +9,9 @@ pub struct QueueStats {
     pub sent: u32,
     /// Sends refused because the queue was full (back-pressure events).
     pub refused: u32,
-    /// Largest length seen right after a send.
-    pub high_water: u16,
+    /// Largest length seen right after a send (a ring holds at most 255:
+    /// a byte, a byte of RAM less for each of the firmware's queues).
+    pub high_water: u8,
 }
 
 impl QueueStats {
@@ -25,7 +26,7 @@ impl QueueStats {
     /// Records an accepted message; `len_after` is the queue length with it.
     pub fn on_send(&mut self, len_after: usize) {
         self.sent = self.sent.saturating_add(1);
-        let len = u16::try_from(len_after).unwrap_or(u16::MAX);
+        let len = u8::try_from(len_after).unwrap_or(u8::MAX);
         if len > self.high_water {
             self.high_water = len;
         }
@@ -68,6 +69,6 @@ mod tests {
         s.on_refused();
         assert_eq!(s.sent, u32::MAX);
         assert_eq!(s.refused, u32::MAX);
-        assert_eq!(s.high_water, u16::MAX);
+        assert_eq!(s.high_water, u8::MAX);
     }
 }
