@@ -256,6 +256,11 @@ impl Console {
                 .resync(&kin.forward(&m.target()), motor_channels(cfg));
         }
         loop {
+            // The step queue is about to run dry inside a planned move:
+            // the refill comes first (an underrun is a fault).
+            if m.starving() {
+                return Poll::Wait(Signal::Refilled);
+            }
             // A move staged by the last run is planned a part a run, each
             // ahead of anything else: nothing may wait for it to be queued.
             if m.plan_part() {

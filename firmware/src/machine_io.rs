@@ -42,9 +42,10 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
         // A piece is not cut while the step queue runs short with pieces
         // planned ahead: planning one takes a few ms, which the
         // segments' refill needs first (with none ahead the planner
-        // would run dry instead).
+        // would run dry instead). It looks again once the refill took
+        // one of them.
         if piece && motion::urgent() && self.m.planned() >= 2 {
-            return Some(Wait::Ms(1));
+            return Some(Wait::Motion);
         }
         None
     }

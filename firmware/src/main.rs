@@ -14,9 +14,9 @@
 //! | `USART0_RX` | interrupt | | a byte | `REALTIME` (`?` `!` `~` Ctrl-X, which also stops the steps), else `RX` |
 //! | `USART0_UDRE` | interrupt | | `TX` | the wire |
 //! | `Realtime` status, hold, resume, reset | software | 5 | `REALTIME` | `TX`, `JOB_CONTROL` |
-//! | `Console` one G-code line per run; a plotter's card print | software | 4 | `RX`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `CARD_IN`; signals `CardRoom` |
+//! | `Console` one G-code line per run (waits for `Refilled` while the step queue runs short inside planned motion); a plotter's card print | software | 4 | `RX`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `CARD_IN`; signals `CardRoom` |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
-//! | `Refill` planner → segments while the queue holds < 30 ms of motion, a part per run, yielding to a ready task between parts | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
+//! | `Refill` planner → segments while the queue holds < 30 ms of motion, a part per run, yielding to a ready task between parts | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion`; `Refilled` once the queue holds 16 ms or nothing is left to cut |
 //! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` |
 //! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `JOB_CONTROL` | planner, `CARD_IN`, `TX`; signals `CardRoom` |
 //! | `Led` status LED pattern (timed edges: runs before the long tasks) | software | 2 | its timer | |
@@ -166,11 +166,16 @@ fn reschedule(task: Task, poll: Poll<Signal>) {
 
 /// `s` happened: run the tasks waiting for it.
 fn signal(s: Signal) {
-    let waiting = WAITING.with(|w| core::mem::take(&mut w[s as usize]));
-    for id in 0..Task::ALL.len() as u8 {
-        if waiting >> id & 1 != 0 {
+    let mut waiting = WAITING.with(|w| core::mem::take(&mut w[s as usize]));
+    // A bit at a time: a shift by `id` is a loop on the AVR, and the
+    // motion task signals after nearly every run, mostly to no one.
+    let mut id = 0;
+    while waiting != 0 {
+        if waiting & 1 != 0 {
             spawn(task_of(id));
         }
+        waiting >>= 1;
+        id += 1;
     }
 }
 
@@ -451,7 +456,7 @@ fn motion() {
     /// Pieces of work per run (a part of a block's profile or of a
     /// segment, ≤ ~1 ms each): one keeps the console's wait short.
     const BATCH: usize = 1;
-    let (freed, more, idle, stepping, release) = MOTION.with(|m| {
+    let (freed, more, idle, stepping, release, refilling) = MOTION.with(|m| {
         let m = m.as_mut().unwrap();
         let (freed, more) = m.refill(BATCH);
         let idle = m.is_idle();
@@ -464,7 +469,14 @@ fn motion() {
                 None
             }
         };
-        (freed, more, idle, m.stepper.is_running(), release)
+        (
+            freed,
+            more,
+            idle,
+            m.stepper.is_running(),
+            release,
+            m.refilling(),
+        )
     });
     // Drivers wait to go off after the step idle delay (`$1`).
     if let Some(ms) = release {
@@ -482,6 +494,10 @@ fn motion() {
     }
     if freed || idle {
         signal(Signal::Motion);
+    }
+    // A console waiting for the refill (`Motion::starving`) goes on.
+    if !refilling {
+        signal(Signal::Refilled);
     }
 }
 

@@ -18,6 +18,7 @@ use taut_logic::machine::Machine;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
+mod grbl;
 mod stream;
 
 /// Timer3 COMPA vector (byte address): the step interrupt.
@@ -638,7 +639,9 @@ fn main() {
     if let [flag, fw, rest @ ..] = &args[..] {
         if flag == "--stream" {
             let mut f = Map::new();
-            stream::stream_figures(Path::new(fw), &mut f, rest.first().map(String::as_str));
+            let only = rest.first().map(String::as_str);
+            stream::stream_figures(Path::new(fw), &mut f, only);
+            grbl::grbl_figures(&mut f, only);
             println!(
                 "{}",
                 serde_json::to_string_pretty(&Value::Object(f)).unwrap()
@@ -755,6 +758,7 @@ fn main() {
     f.insert("segment_prep_max_cycles".into(), json!(prep));
     feed_figures(fw, &mut f);
     stream::stream_figures(fw, &mut f, None);
+    grbl::grbl_figures(&mut f, None);
     let (mhz, wall) = demo_job(fw, &card);
     f.insert("sim_mhz".into(), json!(round(mhz, 1)));
     f.insert("demo_wall_s".into(), json!(round(wall, 2)));
