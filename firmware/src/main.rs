@@ -495,7 +495,8 @@ fn motion() {
     if freed || idle {
         signal(Signal::Motion);
     }
-    // A console waiting for the refill (`Motion::starving`) goes on.
+    // A console waiting for the refill (`Motion::starving`, a piece held
+    // back) goes on.
     if !refilling {
         signal(Signal::Refilled);
     }
