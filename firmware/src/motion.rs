@@ -169,6 +169,11 @@ impl Motion {
         PLANNER.with(|p| p.queued())
     }
 
+    /// Planner blocks free for new moves (`Bf:`).
+    pub fn free_blocks(&self) -> usize {
+        PLANNER.with(|p| p.free())
+    }
+
     /// Blocks queued whose first step has not been made: in the planner,
     /// in the preparer, or waiting for the step interrupt (which takes a
     /// block from `BLOCKS` as it begins it). The interrupt only lowers

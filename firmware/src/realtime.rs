@@ -17,7 +17,6 @@ use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{Overrides, Realtime, Refresh, State, Status, OVERRIDE_BYTES};
 use taut_logic::interp::motor_channels;
 use taut_logic::kinematics::Kinematics;
-use taut_logic::planner::PLANNER_BLOCKS;
 use taut_logic::settings::grbl::{report_angles, report_axes};
 use ufmt::uwrite;
 
@@ -248,7 +247,7 @@ pub fn status(
         wco: places.map(|a| frame.wco[a.index()]),
         angles: report_angles(cfg.machine),
         feed: m.feed(),
-        buffer: ((PLANNER_BLOCKS - m.planned()) as u8, RX.free() as u8),
+        buffer: (m.free_blocks() as u8, RX.free() as u8),
         pins,
         overrides: rt.overrides,
         extra: rt.refresh.next(busy),

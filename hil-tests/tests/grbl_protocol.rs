@@ -6,6 +6,7 @@
 use hil_tests::sim::Sim;
 use hil_tests::{boot_machine, log_tail, rising, send_ok, wait_for};
 use std::time::Duration;
+use taut_logic::planner::PLANNER_BLOCKS as BLOCKS;
 
 fn send(sim: &mut Sim, line: &str) -> String {
     let from = sim.uart_bytes().len();
@@ -43,7 +44,7 @@ fn banner_build_info_parser_state_offsets_and_status_in_grbl_formats() {
         replies(&send(&mut sim, "$I")),
         [
             format!("[VER:1.1h.taut-{version}:string_art]").as_str(),
-            "[OPT:,12,128]",
+            format!("[OPT:,{BLOCKS},128]").as_str(),
             "ok"
         ]
     );
@@ -81,7 +82,7 @@ fn banner_build_info_parser_state_offsets_and_status_in_grbl_formats() {
     let report = bytes_then(&mut sim, b"?", 20);
     assert_eq!(
         report,
-        "<Idle|MPos:0.000,0.000,0.000|Bf:12,128|FS:0,0|WCO:0.000,0.000,0.000>\n",
+        format!("<Idle|MPos:0.000,0.000,0.000|Bf:{BLOCKS},128|FS:0,0|WCO:0.000,0.000,0.000>\n"),
         "{}",
         log_tail(&sim)
     );
@@ -231,7 +232,9 @@ fn status_fields_follow_dollar_10_and_13_and_the_words_take_grbl_s_places() {
     send_ok(&mut sim, "M400", Duration::from_secs(30));
     let r = status(&mut sim);
     assert!(
-        r.starts_with("<Idle|MPos:-25.000,90.000,-1.200|Bf:12,128|FS:0,0"),
+        r.starts_with(&format!(
+            "<Idle|MPos:-25.000,90.000,-1.200|Bf:{BLOCKS},128|FS:0,0"
+        )),
         "{r}"
     );
     send(&mut sim, "$10=0");

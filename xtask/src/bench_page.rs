@@ -142,6 +142,18 @@ const SECTIONS: &[(&str, &[Figure])] = &[
         ],
     ),
     (
+        "Look-ahead",
+        &[
+            fig("planner_blocks", "blocks", "moves the planner holds (`PLANNER_BLOCKS`: what the RAM budget leaves)"),
+            fig("fine_curve_top_feed_mm_per_min", "mm/min", "the fine curve's feed: 2 000 pieces of 0.1 mm along an arc of R 150 mm on the flatbed, asked at its top feed"),
+            fig("fine_curve_host_feed_mm_per_min", "mm/min", "the curve's mean feed on the host: the same lines through the firmware's parser, executor and planner at its depth (no CPU or UART limit)"),
+            fig("fine_curve_host_36_feed_mm_per_min", "mm/min", "the same with Grbl-Mega's 36 blocks of look-ahead"),
+            fig("fine_curve_feed_mm_per_min", "mm/min", "the firmware's mean feed, first step to last, the lines streamed by character counting (Grbl's 128 bytes)"),
+            barred("fine_curve_feed_ratio", "", "the firmware's mean feed over the host's at its depth", Bar::AtLeast(0.95)),
+            barred("fine_curve_underruns", "", "step-queue underruns the firmware counted meanwhile", Bar::AtMost(0.0)),
+        ],
+    ),
+    (
         "Maths on the AVR",
         &[
             fig("polargraph_inverse_cycles", "cycles", "one whiteboard (polargraph) inverse kinematics (`fmath`)"),
@@ -242,6 +254,17 @@ and commit the page.
   lines. simavr starts no CTC timer whose TOP is 0, so the bench gives
   Grbl's Timer1 compare register its top before boot (Grbl sets it at
   its stepper interrupt's first run); the first move starts ≤ 4.1 ms late.
+- **The fine curve** (`taut-bench --curve FIRMWARE_ELF` alone, in
+  `simavr/src/bin/taut-bench/curve.rs`): 2 000 pieces of 0.1 mm along an
+  arc of R 150 mm on the flatbed (0.04° a piece; to the µm, so each
+  piece's 4 steps turn its direction by up to 14°), asked at the
+  flatbed's top feed and streamed by character counting; the mean feed is
+  the path's length over the time from its first step to its last.
+  Beside it the same lines on the host through the firmware's parser,
+  executor and planner (`GcodeTime`, the planner's depth a parameter of
+  the same code): at the firmware's depth and at Grbl-Mega's 36 blocks.
+  The two host figures agree when the speed is set by the acceleration
+  and the junctions, not by how far the planner looks ahead.
 - **Feed ratios** (`taut-bench --feed FIRMWARE_ELF` alone): fixed lines
   drawn on the whiteboard and the arm, each line's time from its first
   step to its last over its trapezoid along the pen; `F` is the pen's

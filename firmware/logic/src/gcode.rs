@@ -49,6 +49,6 @@ pub use block::{
 };
 pub use error::{Error, ErrorKind, MIN_FEED};
 pub use number::{parse_milli, NANO_LIMIT};
-pub use parser::{Message, Parser, Read, MAX_LINE, MSG_LEN};
+pub use parser::{Message, Parser, Read, LINE_CUT, MAX_LINE, MSG_LEN};
 pub use status::{coord_value, Extra, Overrides, Places, Refresh, State, Status, OVERRIDE_BYTES};
 pub use system::{Restore, SystemLine, SystemText, SystemValue, SYSTEM_TEXT, SYSTEM_VALUE};

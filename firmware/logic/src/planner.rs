@@ -37,8 +37,13 @@ use crate::units::Milli;
 use axis_jump::AxisJumps;
 use junction::{Geometry, PenLimits, PenMove, PenPath, Turn};
 
-/// Number of moves the planner holds.
-pub const PLANNER_BLOCKS: usize = 12;
+/// Number of moves the firmware's planner holds: as many as the RAM
+/// budget allows (`docs/architecture.md`).
+pub const PLANNER_BLOCKS: usize = 16;
+
+/// The firmware's planner. The host may plan with other depths
+/// ([`Lookahead`]`<N>`, say Grbl-Mega's 36) through the same code.
+pub type Planner = Lookahead<PLANNER_BLOCKS>;
 
 /// Requested speed of a move.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -211,11 +216,17 @@ struct PenLast {
     len: f32,
 }
 
-pub struct Planner {
-    blocks: [Block; PLANNER_BLOCKS],
+/// A planner of `N` blocks.
+pub struct Lookahead<const N: usize> {
+    blocks: [Block; N],
     /// Oldest block.
     head: usize,
     len: usize,
+    /// Blocks from the oldest whose entry speeds are final: the look-ahead
+    /// passes start after them (Grbl's "planned" pointer), so a push costs
+    /// the blocks whose entries may still change, not the whole queue.
+    /// 0: plan from the oldest.
+    planned: usize,
     /// Entry speed² of the oldest block, fixed: the exit speed of the block
     /// the preparer took before it.
     carry_sqr: u32,
@@ -246,13 +257,14 @@ pub struct Planner {
     stage: Stage,
 }
 
-impl Planner {
+impl<const N: usize> Lookahead<N> {
     /// A planner that moves nothing until [`Planner::configure`]: `const`, so
     /// the firmware's static holds it without building 1 KiB on the stack.
-    pub const EMPTY: Planner = Planner {
-        blocks: [Block::EMPTY; PLANNER_BLOCKS],
+    pub const EMPTY: Self = Lookahead {
+        blocks: [Block::EMPTY; N],
         head: 0,
         len: 0,
+        planned: 0,
         carry_sqr: 0,
         shift: 0,
         position: [0; AXES],
@@ -273,6 +285,7 @@ impl Planner {
     pub fn configure(&mut self, config: &MachineConfig) {
         self.head = 0;
         self.len = 0;
+        self.planned = 0;
         self.carry_sqr = 0;
         self.geometry = Geometry::new(config);
         self.pen = PenLimits::of(config);
@@ -287,7 +300,7 @@ impl Planner {
     }
 
     pub fn new(config: &MachineConfig) -> Self {
-        let mut p = Planner::EMPTY;
+        let mut p = Self::EMPTY;
         p.configure(config);
         p
     }
@@ -298,10 +311,16 @@ impl Planner {
         self.len
     }
 
+    /// Blocks a move may still be pushed into (`Bf:`): the queue's free
+    /// slots, less the one a move being planned holds.
+    pub fn free(&self) -> usize {
+        N - self.len - (self.stage != Stage::Done) as usize
+    }
+
     /// No room for a move: the queue is full, or a move is still being
     /// planned.
     pub fn is_full(&self) -> bool {
-        self.len == PLANNER_BLOCKS || self.stage != Stage::Done
+        self.len == N || self.stage != Stage::Done
     }
 
     /// Adds a move to the absolute step position `target`, planned whole.
@@ -393,7 +412,7 @@ impl Planner {
 
     /// The slot of the move being planned: the one after the queue.
     fn staged(&self) -> usize {
-        (self.head + self.len) % PLANNER_BLOCKS
+        (self.head + self.len) % N
     }
 
     /// One bounded part of planning the move [`Planner::stage`] recorded
@@ -426,7 +445,7 @@ impl Planner {
     #[inline(never)]
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_path(&mut self, feed: Feed) {
-        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        let b = &mut self.blocks[(self.head + self.len) % N];
         // Scaled to events/s by `plan_limits`: this part is the longer.
         b.feed_ev = match feed {
             Feed::Rapid => 0.0,
@@ -463,7 +482,7 @@ impl Planner {
     /// at the junction with the piece before it.
     #[inline(never)]
     fn plan_pen_path(&mut self) {
-        let slot = (self.head + self.len) % PLANNER_BLOCKS;
+        let slot = (self.head + self.len) % N;
         let path: PenPath = self
             .geometry
             .pen_path(&self.blocks[slot].step.block(), &self.pen_staged);
@@ -488,7 +507,7 @@ impl Planner {
     /// pen's speed change (0: the first piece).
     #[inline(never)]
     fn plan_pen_joints(&mut self, ev_per_milli: f32, this: &PenLast) {
-        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        let b = &mut self.blocks[(self.head + self.len) % N];
         b.junction_sqr = match (self.pen_last, &self.pen) {
             (Some(before), Some(pen)) => {
                 // The junction low enough that the speed a piece reaches
@@ -512,7 +531,7 @@ impl Planner {
     /// Built for size: it is the shortest part.
     #[inline(never)]
     fn plan_junction(&mut self, ev_per_milli: f32) {
-        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        let b = &mut self.blocks[(self.head + self.len) % N];
         // 0: the first move, or a jump that allows no speed.
         if b.junction_sqr != 0 {
             let turn = Turn::unpack((b.entry_sqr, b.delta_sqr));
@@ -527,7 +546,7 @@ impl Planner {
     #[inline(never)]
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_limits(&mut self, ev_per_milli: f32) {
-        let b = &mut self.blocks[(self.head + self.len) % PLANNER_BLOCKS];
+        let b = &mut self.blocks[(self.head + self.len) % N];
         let step = b.step.block();
         let (mut accel, mut rate) = self.geometry.limits(&step);
         if let (true, Some(pen)) = (b.step.is_pen(), &self.pen) {
@@ -584,8 +603,10 @@ impl Planner {
             return None;
         }
         let b = self.blocks[self.head];
-        self.head = (self.head + 1) % PLANNER_BLOCKS;
+        self.head = (self.head + 1) % N;
         self.len -= 1;
+        // The next block's entry is fixed now: final, as those before it.
+        self.planned = self.planned.saturating_sub(1);
         let exit_sqr = if self.len > 0 {
             self.blocks[self.head].entry_sqr
         } else {
@@ -610,6 +631,7 @@ impl Planner {
     /// the block before it was held and can no longer leave faster.
     pub fn limit_entry(&mut self, path_sqr: u64) {
         self.carry_sqr = self.carry_sqr.min(down(path_sqr, self.shift));
+        self.planned = 0;
         if self.len > 0 {
             self.recalculate();
         }
@@ -620,6 +642,7 @@ impl Planner {
     pub fn clear(&mut self, position: PerAxis<i32>) {
         self.head = 0;
         self.len = 0;
+        self.planned = 0;
         self.carry_sqr = 0;
         self.stage = Stage::Done;
         self.set_position(position);
@@ -633,7 +656,7 @@ impl Planner {
     pub fn set_overrides(&mut self, overrides: Overrides) {
         self.overrides = Some(overrides);
         for i in 0..self.len {
-            let b = &mut self.blocks[(self.head + i) % PLANNER_BLOCKS];
+            let b = &mut self.blocks[(self.head + i) % N];
             let (mut accel, mut rate) = self.geometry.limits(&b.step.block());
             let ev_per_milli = crate::fmath::sqrt(b.ev_per_milli_sqr);
             if let (true, Some(pen)) = (b.step.is_pen(), &self.pen) {
@@ -642,26 +665,30 @@ impl Planner {
             let nominal_sqr = overrides.nominal_sqr(b.feed_ev, rate, ev_per_milli);
             b.nominal_sqr = down(nominal_sqr, self.shift);
         }
+        self.planned = 0;
         if self.len > 0 {
             self.recalculate();
         }
     }
 
-    /// Grbl's passes: backwards, each entry is at most what the junction
-    /// and both cruise speeds allow and what still stops at the end of the
-    /// queue; forwards, at most what the previous block can reach from its
-    /// entry. Integer only; the ring stepped by hand (a `%` is a 16-bit
-    /// division call on the AVR).
+    /// Grbl's passes over the blocks not yet final: backwards, each entry
+    /// is at most what the junction and both cruise speeds allow and what
+    /// still stops at the end of the queue; forwards, at most what the
+    /// block before can reach from its entry. A block becomes final where
+    /// it enters at its most, or at what the block before reaches: more
+    /// blocks behind it only raise the backward pass's figures, so it
+    /// keeps that entry, and so do those before it. Integer only; the ring
+    /// stepped by hand (a `%` is a 16-bit division call on the AVR).
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn recalculate(&mut self) {
         if self.len == 0 {
             return;
         }
-        let mut i = (self.head + self.len - 1) % PLANNER_BLOCKS;
+        let mut i = (self.head + self.len - 1) % N;
         let mut nominal_sqr = self.blocks[i].nominal_sqr;
         let mut next_entry = 0u32;
-        for _ in 1..self.len {
-            let prev = i.checked_sub(1).unwrap_or(PLANNER_BLOCKS - 1);
+        for _ in self.planned + 1..self.len {
+            let prev = i.checked_sub(1).unwrap_or(N - 1);
             let prev_nominal_sqr = self.blocks[prev].nominal_sqr;
             let b = &mut self.blocks[i];
             let max_entry_sqr = b.junction_sqr.min(nominal_sqr).min(prev_nominal_sqr);
@@ -670,15 +697,25 @@ impl Planner {
             nominal_sqr = prev_nominal_sqr;
             i = prev;
         }
-        let first = &mut self.blocks[self.head];
-        first.entry_sqr = self.carry_sqr;
-        let mut reach = first.entry_sqr.saturating_add(first.delta_sqr);
-        let mut i = self.head;
-        for _ in 1..self.len {
-            i = if i + 1 == PLANNER_BLOCKS { 0 } else { i + 1 };
+        let mut i = (self.head + self.planned) % N;
+        if self.planned == 0 {
+            self.blocks[i].entry_sqr = self.carry_sqr;
+        }
+        let mut reach = self.blocks[i]
+            .entry_sqr
+            .saturating_add(self.blocks[i].delta_sqr);
+        let mut nominal_sqr = self.blocks[i].nominal_sqr;
+        for k in self.planned + 1..self.len {
+            i = if i + 1 == N { 0 } else { i + 1 };
             let b = &mut self.blocks[i];
-            b.entry_sqr = b.entry_sqr.min(reach);
+            if reach < b.entry_sqr {
+                b.entry_sqr = reach;
+                self.planned = k;
+            } else if b.entry_sqr == b.junction_sqr.min(nominal_sqr).min(b.nominal_sqr) {
+                self.planned = k;
+            }
             reach = b.entry_sqr.saturating_add(b.delta_sqr);
+            nominal_sqr = b.nominal_sqr;
         }
     }
 }

@@ -7,7 +7,8 @@
 
 use crate::queues::{RX, TX};
 use avr_device::atmega2560::USART0;
-use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
+use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
+use taut_logic::gcode::LINE_CUT;
 
 pub struct Usart0;
 
@@ -114,6 +115,7 @@ pub fn receive() -> Option<u8> {
 }
 
 /// Ctrl-X: the bytes not yet read are dropped; a paused sender goes on.
+/// A line being cut stays so: its rest never runs as a line of its own.
 pub fn clear_input() {
     RX.clear();
     flow_to(false);
@@ -188,6 +190,35 @@ pub fn on_data_register_empty() {
     }
 }
 
+/// A line lost bytes to a full `RX`: the rest of it is dropped, and its
+/// end goes in as [`LINE_CUT`]. Written by the receive interrupt only.
+static CUT: AtomicBool = AtomicBool::new(false);
+
+/// A received byte into `RX`. The last slot is kept for a line's end, so
+/// however long a line, however late the console reads (power-on homing),
+/// every line ends in the ring and gets its reply: a line that lost bytes
+/// (a sender ignoring the count or the flow control) ends in
+/// [`LINE_CUT`], answered `error:11`. Each lost byte is counted.
+fn keep(b: u8) {
+    let cut = CUT.load(Relaxed);
+    if b == b'\n' || b == b'\r' {
+        // While the console is behind by a whole line the end finds no
+        // room: the next line is then dropped with this one.
+        if RX.push(if cut { LINE_CUT } else { b }).is_ok() {
+            CUT.store(false, Relaxed);
+        }
+        return;
+    }
+    // No 0xFF from the wire is taken for the marker (Grbl drops every
+    // extended byte that is no real-time command).
+    if cut || b == LINE_CUT || RX.free() <= 1 {
+        CUT.store(cut || b != LINE_CUT, Relaxed);
+        RX.refuse();
+        return;
+    }
+    let _ = RX.push(b);
+}
+
 /// The `USART0_RX` handler, entered with its interrupt switched off: the
 /// byte goes to `take` (real-time commands), or when it declines, into
 /// `RX`. Returns what `take` said.
@@ -195,8 +226,7 @@ pub fn on_receive(take: impl FnOnce(u8) -> bool) -> bool {
     let b = regs().udr0().read().bits();
     let taken = take(b);
     if !taken {
-        // A full ring counts the lost byte (the sender ignored flow control).
-        let _ = RX.push(b);
+        keep(b);
         if FLOW.load(Relaxed) & FLOW_ON != 0 && RX.len() >= XOFF_AT {
             flow_to(true);
         }

@@ -7,7 +7,7 @@ use crate::board::usart;
 use crate::motion::Motion;
 use crate::queues::{BUTTONS, RX};
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{CardLine, Error, ErrorKind, Parser};
+use taut_logic::gcode::{CardLine, Error, ErrorKind, Parser, LINE_CUT};
 
 impl Console {
     /// The next byte of the line being read: a line from the card, or
@@ -76,5 +76,5 @@ impl Console {
 
 /// A whole line has arrived on the serial line.
 pub(super) fn serial_line_waits() -> bool {
-    RX.any(|&b| b == b'\n' || b == b'\r')
+    RX.any(|&b| b == b'\n' || b == b'\r' || b == LINE_CUT)
 }

@@ -18,6 +18,12 @@ use crate::seed::SeedBuilder;
 /// comment may be of any length.
 pub const MAX_LINE: u8 = 79;
 
+/// Put by the receive interrupt where a line's end was when bytes of that
+/// line were lost (its ring was full): the line ends there and is answered
+/// `error:11`, so a sender that waits for each line's reply gets one. Never
+/// a byte of UTF-8, and the interrupt drops it from the wire.
+pub const LINE_CUT: u8 = 0xFF;
+
 /// Most characters of a `(MSG, …)` text kept; the rest is cut.
 pub const MSG_LEN: usize = 40;
 
@@ -226,6 +232,11 @@ impl Parser {
         let after_cr = core::mem::take(&mut self.after_cr);
         match byte {
             b'\n' if after_cr => Read::More,
+            LINE_CUT => {
+                // Bytes of this line were lost: Grbl's overflow (error 11).
+                self.lexeme = Lexeme::Overflow;
+                Read::LineEnd
+            }
             b'\r' | b'\n' => {
                 // Kept across `take_line`, which starts the next line.
                 self.after_cr = byte == b'\r';

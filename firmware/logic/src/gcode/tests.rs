@@ -184,6 +184,28 @@ fn the_length_limit_counts_what_is_kept() {
     assert_eq!(out[1], Ok(Input::Block(block("G0X1"))));
 }
 
+/// A line whose bytes the receive ring lost ends at the interrupt's
+/// `LINE_CUT` with error 11, however short the part that arrived; an
+/// `\n` after it is a line of its own (the interrupt puts the marker in
+/// the place of the line's end), and the next line is read afresh.
+#[test]
+fn a_line_cut_by_a_full_ring_is_an_overflow() {
+    let mut p = Parser::new();
+    let mut bytes = b"G1 X1".to_vec();
+    bytes.push(LINE_CUT);
+    bytes.push(LINE_CUT);
+    bytes.extend_from_slice(b"G0 X2\r\n");
+    let out = push_all(&mut p, &bytes);
+    assert_eq!(out.len(), 3, "{out:?}");
+    assert_eq!(out[0].as_ref().map_err(|e| e.code()), Err(11));
+    assert_eq!(out[1].as_ref().map_err(|e| e.code()), Err(11));
+    assert_eq!(out[2], Ok(Input::Block(block("G0X2"))));
+    // After a CR the marker is still a line of its own.
+    let out = push_all(&mut p, &[b'G', b'0', b'\r', LINE_CUT]);
+    assert_eq!(out.len(), 2, "{out:?}");
+    assert_eq!(out[1].as_ref().map_err(|e| e.code()), Err(11));
+}
+
 /// A UTF-8 byte-order mark before a line's first character (a file's
 /// first line, or a stream's) is skipped; `%` is no letter (gcode.c line
 /// 118: Grbl 1.1h answers it error 1).

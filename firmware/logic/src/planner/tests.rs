@@ -105,8 +105,10 @@ fn gentle_corner_does_not_stop() {
 fn full_queue_pushes_back() {
     let mut p = Planner::new(&square());
     for k in 1..=PLANNER_BLOCKS as i32 {
+        assert_eq!(p.free(), PLANNER_BLOCKS + 1 - k as usize);
         p.push([k * 100, 0, 0], Feed::Rapid).unwrap();
     }
+    assert_eq!(p.free(), 0);
     assert_eq!(p.push([0, 0, 0], Feed::Rapid), Err(Full));
     assert!(p.take().is_some());
     assert_eq!(p.push([0, 0, 0], Feed::Rapid), Ok(()));
@@ -121,6 +123,8 @@ fn a_staged_move_is_planned_in_parts_and_queued_by_the_last() {
     whole.push([20_000, 0, 0], Feed::Rapid).unwrap();
     let second = ([20_000, 20_000, 0], Feed::PerMinute(Milli(600_000)));
     p.stage(second.0, second.1).unwrap();
+    // The move being planned holds a block.
+    assert_eq!(p.free(), PLANNER_BLOCKS - 2);
     whole.push(second.0, second.1).unwrap();
     assert_eq!(p.position(), second.0);
     let mut parts = 0;
@@ -324,4 +328,86 @@ fn overrides_scale_the_moves_not_yet_taken() {
         entries(&p)
     );
     assert!((cruise(&mut p) - 200.0).abs() < 1.0);
+}
+
+/// What a planner does to its queue, in a random stream.
+#[derive(Clone, Debug)]
+enum Op {
+    Push(PerAxis<i32>, Feed),
+    Take,
+    LimitEntry(u64),
+    Overrides(u8),
+}
+
+fn ops() -> impl Strategy<Value = Vec<Op>> {
+    let feed = prop_oneof![
+        Just(Feed::Rapid),
+        (1_000i32..200_000).prop_map(|f| Feed::PerMinute(Milli(f * 100)))
+    ];
+    // Short moves, mostly onward along a wandering heading: the queue
+    // fills with blocks whose entries are bound by the look-ahead, the
+    // junctions and the feeds in turn.
+    let op = prop_oneof![
+        8 => (proptest::array::uniform3(-400i32..400), feed).prop_map(|(d, f)| Op::Push(d, f)),
+        2 => Just(Op::Take),
+        1 => (0u64..FULL_SQR).prop_map(Op::LimitEntry),
+        1 => (10u8..=200).prop_map(Op::Overrides),
+    ];
+    proptest::collection::vec(op, 1..300)
+}
+
+/// The entries a planner planning every block from the oldest would give.
+fn replanned<const N: usize>(p: &Lookahead<N>) -> Vec<u32> {
+    let mut full = Lookahead::<N> {
+        blocks: p.blocks,
+        planned: 0,
+        ..Lookahead::EMPTY
+    };
+    (full.head, full.len, full.carry_sqr) = (p.head, p.len, p.carry_sqr);
+    full.recalculate();
+    (0..p.len)
+        .map(|i| full.blocks[(p.head + i) % N].entry_sqr)
+        .collect()
+}
+
+fn incremental_matches_full<const N: usize>(ops: &[Op]) -> Result<(), TestCaseError> {
+    let mut p = Lookahead::<N>::new(&MachineConfig::STRING_ART);
+    let mut at = [0i32; AXES];
+    for op in ops {
+        match op {
+            Op::Push(d, feed) => {
+                if p.is_full() {
+                    p.take_speeds();
+                }
+                // Onward: the move's direction mostly keeps the last one's.
+                at = core::array::from_fn(|i| at[i] + d[i] + 300);
+                p.push(at, *feed).unwrap();
+            }
+            Op::Take => {
+                p.take_speeds();
+            }
+            Op::LimitEntry(v) => p.limit_entry(*v),
+            Op::Overrides(f) => p.set_overrides(Overrides {
+                feed: *f,
+                rapid: 100,
+            }),
+        }
+        let entries: Vec<u32> = (0..p.len)
+            .map(|i| p.blocks[(p.head + i) % N].entry_sqr)
+            .collect();
+        prop_assert_eq!(entries, replanned(&p), "after {:?}", op);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+
+    /// Planning only the blocks not yet final gives what planning the
+    /// whole queue gives, at the firmware's depth and at Grbl-Mega's.
+    #[test]
+    fn planning_from_the_last_final_block_is_planning_all(ops in ops()) {
+        incremental_matches_full::<PLANNER_BLOCKS>(&ops)?;
+        incremental_matches_full::<36>(&ops)?;
+    }
 }

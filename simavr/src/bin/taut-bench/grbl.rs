@@ -8,7 +8,7 @@
 //! are reachable on a 16 MHz AVR at all is then a measured fact. Grbl
 //! reads no card and counts no underruns: serial only.
 
-use crate::stream::{chords, lines, over_serial, MACHINES, SEGMENTS};
+use crate::stream::{chords, lines, over_serial, FEED, MACHINES, SEGMENTS};
 use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -160,7 +160,7 @@ pub fn grbl_figures(f: &mut Map<String, Value>, only: Option<&str>) {
             Some(Err(e)) => panic!("grbl-Mega from {:?}: {e}", checkout.as_ref().unwrap()),
             Some(Ok(elf)) => {
                 let points = chords(centre, r, segment, crate::stream::line_count(segment));
-                let lines = lines(&points);
+                let lines = lines(&points, FEED);
                 let mut sim = ready(elf, machine, points[0]);
                 let rate = over_serial(&mut sim, &lines);
                 println!("{key:<36} {rate:>7.1} lines/s");

@@ -18,6 +18,7 @@ use taut_logic::machine::Machine;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
+mod curve;
 mod grbl;
 mod stream;
 
@@ -650,9 +651,12 @@ fn main() {
         }
     }
     if let [flag, fw] = &args[..] {
-        if flag == "--feed" {
+        if flag == "--feed" || flag == "--curve" {
             let mut f = Map::new();
-            feed_figures(Path::new(fw), &mut f);
+            match flag.as_str() {
+                "--feed" => feed_figures(Path::new(fw), &mut f),
+                _ => curve::curve_figures(Path::new(fw), &mut f),
+            }
             println!(
                 "{}",
                 serde_json::to_string_pretty(&Value::Object(f)).unwrap()
@@ -759,6 +763,7 @@ fn main() {
     feed_figures(fw, &mut f);
     stream::stream_figures(fw, &mut f, None);
     grbl::grbl_figures(&mut f, None);
+    curve::curve_figures(fw, &mut f);
     let (mhz, wall) = demo_job(fw, &card);
     f.insert("sim_mhz".into(), json!(round(mhz, 1)));
     f.insert("demo_wall_s".into(), json!(round(wall, 2)));

@@ -24,19 +24,19 @@ use taut_simavr::{Outcome, Reply, Sim};
 
 /// The machines, each with a circle's centre and radius (mm) inside its
 /// reach.
-pub const MACHINES: [(Machine, [f64; 2], f64); 3] = [
+pub(crate) const MACHINES: [(Machine, [f64; 2], f64); 3] = [
     (Machine::Flatbed, [40.0, 40.0], 20.0),
     (Machine::Whiteboard, [0.0, 0.0], 20.0),
     (Machine::Scara, [100.0, 150.0], 10.0),
 ];
 
 /// Chord lengths (mm) and their names in the figures' keys.
-pub const SEGMENTS: [(f64, &str); 2] = [(0.05, "50um"), (0.2, "200um")];
+pub(crate) const SEGMENTS: [(f64, &str); 2] = [(0.05, "50um"), (0.2, "200um")];
 
-const FEED: u32 = 1500;
+pub(crate) const FEED: u32 = 1500;
 
 /// Lines of a case: enough for a few seconds of drawing.
-pub fn line_count(segment: f64) -> usize {
+pub(crate) fn line_count(segment: f64) -> usize {
     if segment < 0.1 {
         1200
     } else {
@@ -46,7 +46,7 @@ pub fn line_count(segment: f64) -> usize {
 
 /// The chords' end points, starting at angle 0, going round (several
 /// turns if need be), rounded to µm as a sender writes them.
-pub fn chords(centre: [f64; 2], r: f64, segment: f64, n: usize) -> Vec<[f64; 2]> {
+pub(crate) fn chords(centre: [f64; 2], r: f64, segment: f64, n: usize) -> Vec<[f64; 2]> {
     let step = 2.0 * (segment / (2.0 * r)).asin();
     (0..=n)
         .map(|k| {
@@ -58,13 +58,13 @@ pub fn chords(centre: [f64; 2], r: f64, segment: f64, n: usize) -> Vec<[f64; 2]>
 }
 
 /// The G-code lines after the start: the first carries the feed.
-pub fn lines(points: &[[f64; 2]]) -> Vec<String> {
+pub(crate) fn lines(points: &[[f64; 2]], feed: u32) -> Vec<String> {
     points[1..]
         .iter()
         .enumerate()
         .map(|(k, p)| {
             let feed = if k == 0 {
-                format!(" F{FEED}")
+                format!(" F{feed}")
             } else {
                 String::new()
             };
@@ -73,7 +73,7 @@ pub fn lines(points: &[[f64; 2]]) -> Vec<String> {
         .collect()
 }
 
-fn send(sim: &mut Sim, line: &str) {
+pub(crate) fn send(sim: &mut Sim, line: &str) {
     match sim.send_line(line, Duration::from_secs(30)) {
         Ok(Reply::Ok) => {}
         other => panic!("{line}: {other:?}\n{}", sim.uart_text()),
@@ -82,7 +82,7 @@ fn send(sim: &mut Sim, line: &str) {
 
 /// The firmware's underrun count: its logger reports a change once a
 /// second (`step late:L underruns:U`).
-fn underruns(sim: &Sim) -> u64 {
+pub(crate) fn underruns(sim: &Sim) -> u64 {
     sim.uart_text()
         .lines()
         .rfind(|l| l.contains("underruns:"))
@@ -124,7 +124,7 @@ fn planner_bound(machine: Machine, start: [f64; 2], lines: &[String]) -> f64 {
 }
 
 /// A machine at the circle's start, drivers on; with `card` inserted.
-fn ready(elf: &Path, machine: Machine, start: [f64; 2], card: Option<SdImage>) -> Sim {
+pub(crate) fn ready(elf: &Path, machine: Machine, start: [f64; 2], card: Option<SdImage>) -> Sim {
     let mut sim = Sim::boot(elf);
     let has_card = card.is_some();
     if let Some(c) = card {
@@ -145,7 +145,7 @@ fn ready(elf: &Path, machine: Machine, start: [f64; 2], card: Option<SdImage>) -
 
 /// Lines per second answered `ok` from the first tenth of the stream to
 /// its last tenth, by character counting.
-pub fn over_serial(sim: &mut Sim, lines: &[String]) -> f64 {
+pub(crate) fn over_serial(sim: &mut Sim, lines: &[String]) -> f64 {
     let start = sim.uart_bytes().len();
     let n = lines.len();
     let (from, to) = (n / 10, n - n / 10);
@@ -205,7 +205,7 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
     for (machine, centre, r) in MACHINES {
         for (segment, len) in SEGMENTS {
             let points = chords(centre, r, segment, line_count(segment));
-            let lines = lines(&points);
+            let lines = lines(&points, FEED);
             let bound = planner_bound(machine, points[0], &lines);
             let key = format!("stream_{}_{len}", machine.name());
             if only.is_none_or(|o| key.contains(o)) {
