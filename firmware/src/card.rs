@@ -147,8 +147,10 @@ const ENTRIES: u8 = (BLOCK / 32) as u8;
 /// in `CARD_OUT` ([`data_waits`]). All zeros: in `.bss`.
 static BUF: TaskCell<[u8; BLOCK]> = TaskCell::new([0; BLOCK]);
 
-/// The name of the file opened last (`What::Opened`).
+/// The name of the file opened last (`What::Opened`), and its 8.3 name
+/// as the directory holds it (a print's checkpoint keeps it).
 static OPENED: TaskCell<Name> = TaskCell::new(Name::EMPTY);
+static OPENED_SHORT: TaskCell<[u8; 11]> = TaskCell::new([0; 11]);
 
 /// `f` of the file's bytes a `What::Data { at, len }` names.
 pub fn bytes<R>(at: u16, len: u8, f: impl FnOnce(&[u8]) -> R) -> R {
@@ -163,6 +165,11 @@ pub fn byte(i: u16) -> u8 {
 /// The name of the file `What::Opened` announced.
 pub fn opened_name() -> Name {
     OPENED.with(|n| *n)
+}
+
+/// Its 8.3 name as the directory holds it (`STARDR~1GCO`).
+pub fn opened_short() -> [u8; 11] {
+    OPENED_SHORT.with(|n| *n)
 }
 
 /// File bytes wait in `CARD_OUT`: the block is theirs.
@@ -388,6 +395,7 @@ impl CardReader {
             Ok((e, f)) => {
                 self.reading = Reading::File(f, ticket);
                 OPENED.with(|n| *n = e.name());
+                OPENED_SHORT.with(|n| *n = e.short);
                 Self::send(What::Opened { size: e.size }, ticket);
             }
             Err(FatError::NotFound) => Self::send(What::Missing, ticket),

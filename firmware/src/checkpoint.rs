@@ -22,7 +22,8 @@ pub enum BootNote {
 /// The checkpoint to offer, and what to say about it.
 pub fn found(found: Found, reset: ResetCause) -> (Option<Saved>, Option<BootNote>) {
     match found {
-        Found::Blank | Found::Idle { .. } => (None, None),
+        // A plotter's print: the console offers it.
+        Found::Blank | Found::Idle { .. } | Found::Plot(_) => (None, None),
         Found::Corrupt { .. } => (None, Some(BootNote::Corrupt)),
         Found::Job(s) => {
             let total = match s.phase() {

@@ -175,6 +175,18 @@ impl Console {
         self.interp.reset(&coords::stored(coords, 0));
     }
 
+    /// At power-on: a card print a power cut stopped, to go on with once
+    /// asked (`M1000`, green).
+    pub fn offer_print(&mut self) {
+        self.print.offer();
+    }
+
+    /// A print's checkpoint header, idle header or offer is still to be
+    /// written or said.
+    pub fn checkpoint_waits(&self) -> bool {
+        self.print.waits_to_keep()
+    }
+
     /// Whether a `$` setting changed since the last call (the app then has
     /// the settings stored).
     pub fn take_settings_changed(&mut self) -> bool {
@@ -255,6 +267,15 @@ impl Console {
             self.interp
                 .resync(&kin.forward(&m.target()), motor_channels(cfg));
         }
+        // Only while a print or an offer needs it: each run of a stream
+        // of tiny moves comes here.
+        if !cfg.machine.is_string_art() && self.print.keeps() {
+            self.print.keep(store, crate::board::clock::millis());
+            // Homing for a resume ended, the position read back.
+            if self.print.homing_for_resume() && self.homing.is_none() && self.epoch == m.epoch() {
+                self.print.homed(store, m.position_known());
+            }
+        }
         loop {
             // The step queue is about to run dry inside a planned move:
             // the refill comes first (an underrun is a fault).
@@ -302,7 +323,7 @@ impl Console {
                 self.ok();
             }
             // A card command waits for the reader.
-            if !cfg.machine.is_string_art() && self.card_news(m) {
+            if !cfg.machine.is_string_art() && self.card_news(m, cfg, store) {
                 return Poll::Idle;
             }
             // A serial line (`M25`, `M27`, `?`-like reads) goes by while
@@ -328,7 +349,12 @@ impl Console {
             if self.interp.busy() || self.owed {
                 return self.carry_on(m, kin, cfg, owner, store);
             }
-            if core::mem::take(&mut self.line_ready) {
+            if self.line_ready {
+                // A card's line may wait for a resume's travel back.
+                if self.source == Some(Source::Card) && !self.card_line_goes(m, kin, cfg) {
+                    continue;
+                }
+                self.line_ready = false;
                 self.take(m, kin, cfg, owner, store);
                 // One line per run: the other tasks get their turn.
                 return Poll::Again;
@@ -377,7 +403,7 @@ impl Console {
             cfg,
             allowed: Allowed {
                 motion: owner == Owner::Console,
-                checking: self.checking,
+                checking: self.checking || self.print.replaying(),
             },
         }
     }
@@ -502,7 +528,7 @@ impl Console {
             // A program's `%` delimiters in a file: passed over (Grbl
             // answers a sender error 1).
             _ if first == b'%' && self.source == Some(Source::Card) => {}
-            Ok(Input::Card(c)) => self.card_line(c, m, cfg),
+            Ok(Input::Card(c)) => self.card_line(c, m, cfg, store),
             // Grbl's G-code lock: in alarm (the position lost) or while
             // jogs run; `M114` only reads.
             _ if (!m.position_known() || jog_state) && !reads => {

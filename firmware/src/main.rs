@@ -324,6 +324,13 @@ fn init() -> Watchdog {
     reply::banner();
 
     boot_log(reset);
+    // A plotter's print a cut stopped: the console offers it.
+    if let Found::Plot(_) = found {
+        if !CONFIG.with(|c| c.machine.is_string_art()) {
+            CONSOLE.with(|c| c.offer_print());
+            spawn(Task::Console);
+        }
+    }
     let (saved, note) = checkpoint::found(found, reset);
     match store_now || STORE.with(|s| s.as_ref().unwrap().saving()) {
         true => spawn(Task::Store),
@@ -537,6 +544,12 @@ fn console() {
     }
     // New moves may be queued: the motion task feeds them to the stepper.
     spawn(Task::Motion);
+    // A print's checkpoint write (or its offer) waits for the store or for
+    // room: the console comes back for it, with no line to read too.
+    let poll = match poll {
+        Poll::Idle if CONSOLE.with(|c| c.checkpoint_waits()) => Poll::After(5),
+        p => p,
+    };
     reschedule(Task::Console, poll);
     // An operator's tool for the job.
     if !JOB_CONTROL.is_empty() {

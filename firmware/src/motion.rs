@@ -5,7 +5,7 @@
 
 use crate::board::servo::PenServo;
 use crate::drivers::Drivers;
-use crate::queues::{BLOCKS, SEGMENTS, SEGMENTS_CAPACITY};
+use crate::queues::{BEGUN, BLOCKS, SEGMENTS, SEGMENTS_CAPACITY};
 use crate::rt::TaskCell;
 use crate::stepper::{every_event, fast_segment, Stepper, FAST};
 use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
@@ -181,6 +181,17 @@ impl Motion {
     pub fn unbegun(&self) -> u8 {
         let planned = PLANNER.with(|p| p.queued()) as u8;
         planned + self.prep.holds_block() as u8 + BLOCKS.len() as u8
+    }
+
+    /// The number the next block queued will have when the step
+    /// interrupt begins it ([`BEGUN`] counts them, wrapping). Read after
+    /// [`Motion::unbegun`]: a block begun between the reads makes it one
+    /// too high, never too low.
+    pub fn next_block(&self) -> u8 {
+        let unbegun = self.unbegun();
+        BEGUN
+            .load(core::sync::atomic::Ordering::Relaxed)
+            .wrapping_add(unbegun)
     }
 
     /// Whether the planner has room for a move.

@@ -9,15 +9,25 @@
 //! the end of the last whole line: the moves already queued finish, and
 //! once the card is back, `M24` or the green button opens the file again
 //! and goes on from the next line.
+//!
+//! A print keeps a checkpoint in EEPROM (`taut_logic::checkpoint::plot`):
+//! the file, then the offset of the line whose moves the steppers are
+//! making, at most every half second; cleared when the print ends or is
+//! stopped. After a power cut the next power-on offers it (`>>> resume`):
+//! `M1000` or green goes on from that line, `M524` or green held
+//! discards it.
 
 use crate::board::flash::FlashStr;
 use crate::log::Level;
 use crate::motion::Motion;
-use crate::queues::{CardMsg, Request, What, CARD_IN, CARD_OUT};
+use crate::queues::{CardMsg, Request, What, BEGUN, CARD_IN, CARD_OUT, TX};
 use crate::reply;
+use crate::store::Store;
 use crate::{flash_str, info, warn};
+use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::buttons::ButtonEvent;
-use taut_logic::fat::Name;
+use taut_logic::checkpoint::plot::{Resume, ResumeAction, ResumeEvent, Tracker};
+use taut_logic::fat::{short_display, Name};
 use taut_logic::gcode::{CardLine, Error, ErrorKind};
 use taut_logic::pinmap::Button;
 use ufmt::uwrite;
@@ -67,6 +77,27 @@ pub struct Print {
     /// A console line waits for the reader's answer (`M20`, `M23`, `M24`
     /// opening a lost print again).
     line_waits: bool,
+    /// Where the line read last starts.
+    read_start: u32,
+    /// The print's checkpoint: which line moves (`None`: no print).
+    tracker: Option<Tracker>,
+    /// A checkpoint header to write once the store is free, or the offer
+    /// to say once there is room.
+    keep: Keep,
+    /// A power cut's print offered or being resumed (from the line at the
+    /// tracker's [`Tracker::resume_at`]).
+    resume: Option<Resume>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Keep {
+    Nothing,
+    /// A power cut's print is offered: `>>> resume …`.
+    Offer,
+    /// A print starts: its file.
+    Begin,
+    /// The print ended or was stopped: an idle header.
+    Forget,
 }
 
 /// The answer to the console line that waited: `ok`, or the error.
@@ -85,6 +116,10 @@ impl Print {
             ended: false,
             last: 0,
             line_waits: false,
+            read_start: 0,
+            tracker: None,
+            keep: Keep::Nothing,
+            resume: None,
         }
     }
 
@@ -93,9 +128,174 @@ impl Print {
         self.state == State::Running
     }
 
-    /// A print is under way (running, or lost with its card).
+    /// A print is under way (running, lost with its card, or being
+    /// resumed after a cut).
     pub fn busy(&self) -> bool {
         matches!(self.state, State::Running | State::Lost)
+            || self.resume.is_some_and(|r| r != Resume::Offered)
+    }
+
+    /// The file's lines before a cut's checkpoint are being taken again:
+    /// checked, not carried out.
+    pub fn replaying(&self) -> bool {
+        self.resume == Some(Resume::Replaying)
+    }
+
+    /// The checkpoint has work ([`Print::keep`]): a print under way, a
+    /// header to write, an offer.
+    pub fn keeps(&self) -> bool {
+        self.tracker.is_some() || self.keep != Keep::Nothing || self.resume.is_some()
+    }
+
+    /// A header, an idle header or the offer waits ([`Print::keep`]).
+    pub fn waits_to_keep(&self) -> bool {
+        self.keep != Keep::Nothing
+    }
+
+    /// A power cut's print is offered.
+    pub fn offered(&self) -> bool {
+        self.resume == Some(Resume::Offered)
+    }
+
+    /// At power-on: a print a cut stopped.
+    pub fn offer(&mut self) {
+        self.resume = Some(Resume::Offered);
+        self.keep = Keep::Offer;
+    }
+
+    /// The checkpoint's work, each console run: the offer said once there
+    /// is room, a header, or the moving line's record once it is due.
+    #[inline(never)]
+    #[optimize(size)]
+    pub fn keep(&mut self, store: &mut Store, now: u32) {
+        if self.keep == Keep::Offer {
+            if TX.free() < crate::log::LINE {
+                return;
+            }
+            self.keep = Keep::Nothing;
+            match store.plot_saved() {
+                Some(p) => info!(
+                    ">>> resume ",
+                    short_display(&p.header.short),
+                    " from byte ",
+                    p.pos(),
+                    "/",
+                    p.header.size,
+                    "? M1000 or green: resume, M524 or hold green 2 s: discard"
+                ),
+                None => self.resume = None,
+            }
+        }
+        if store.saving() {
+            return;
+        }
+        match core::mem::replace(&mut self.keep, Keep::Nothing) {
+            Keep::Begin => store.plot_begin(crate::card::opened_short(), self.size),
+            Keep::Forget => store.forget(),
+            Keep::Nothing | Keep::Offer => {
+                let begun = BEGUN.load(Relaxed);
+                if let Some(r) = self.tracker.as_mut().and_then(|t| t.due(begun, false, now)) {
+                    store.plot_record(r);
+                }
+            }
+        }
+    }
+
+    /// `M1000` or green with a print offered: what to do first (home, or
+    /// open the file); `homes`: the machine has homing switches.
+    #[inline(never)]
+    pub fn recover(&mut self, store: &Store, homes: bool) -> Result<ResumeAction, ErrorKind> {
+        let (Some(r), Some(p)) = (self.resume, store.plot_saved()) else {
+            return Err(ErrorKind::NoFileSelected);
+        };
+        let (next, action) = r.on(ResumeEvent::Take { homes }, p.pos());
+        if action == ResumeAction::None {
+            return Err(ErrorKind::Printing);
+        }
+        self.resume = next;
+        self.tracker = Some(Tracker::resuming(&p));
+        info!(
+            "resuming: ",
+            short_display(&p.header.short),
+            " from byte ",
+            p.pos()
+        );
+        Ok(action)
+    }
+
+    /// Homing for a resume ended (`homed`: the position is known): the
+    /// file opens, or the offer stands again.
+    pub fn homed(&mut self, store: &Store, homed: bool) {
+        if self.resume != Some(Resume::Homing) {
+            return;
+        }
+        if !homed {
+            self.back_to_offer();
+            return;
+        }
+        self.resume = Some(Resume::Opening);
+        self.open_saved(store);
+    }
+
+    /// Waiting for homing to end before opening the file.
+    pub fn homing_for_resume(&self) -> bool {
+        self.resume == Some(Resume::Homing)
+    }
+
+    /// Open the checkpoint's file from its start.
+    pub fn open_saved(&mut self, store: &Store) {
+        match store.plot_saved() {
+            Some(p) => {
+                self.size = p.header.size;
+                self.open(short_display(&p.header.short), true);
+            }
+            None => self.resume = None,
+        }
+    }
+
+    /// A resume stopped short (a reset, a failed homing, a missing file):
+    /// offered again, the checkpoint as it was.
+    fn back_to_offer(&mut self) {
+        if self.resume.is_some_and(|r| r != Resume::Offered) {
+            warn!("resume stopped: M1000 or green to try again");
+            self.resume = Some(Resume::Offered);
+            self.tracker = None;
+        }
+    }
+
+    /// `M524` or green held with a print offered: the checkpoint goes.
+    fn discard(&mut self) {
+        if self.resume.take().is_some() {
+            info!("checkpoint discarded");
+            self.keep = Keep::Forget;
+        }
+    }
+
+    /// A line of the file was read whole and is about to be taken: its
+    /// checkpoint candidate (its first block is `first`), or the resume's
+    /// next step for it (check it; hold it for the travel back, then the
+    /// pen; go).
+    #[inline(never)]
+    pub fn line_ready(&mut self, first: u8) -> ResumeAction {
+        let action = match self.resume {
+            None | Some(Resume::Offered) => ResumeAction::Go,
+            Some(r) => {
+                let e = match r {
+                    Resume::Travel | Resume::Pen => ResumeEvent::Done,
+                    _ => ResumeEvent::Line(self.read_start),
+                };
+                let at = self.tracker.as_ref().map_or(0, |t| t.resume_at());
+                let (next, action) = r.on(e, at);
+                self.resume = next;
+                action
+            }
+        };
+        if action == ResumeAction::Go {
+            if let Some(t) = self.tracker.as_mut() {
+                t.line(self.read_start, first);
+            }
+        }
+        action
     }
 
     /// A console line waits for the reader's answer.
@@ -135,9 +335,12 @@ impl Print {
                 Ok(())
             }
             CardLine::Abort => {
+                self.discard();
                 self.abort();
                 Ok(())
             }
+            // The console's (it may home first).
+            CardLine::Recover => Ok(()),
         }
     }
 
@@ -146,6 +349,12 @@ impl Print {
     /// card's first G-code file.
     #[inline(never)]
     pub fn button(&mut self, event: ButtonEvent, m: &mut Motion) {
+        if self.offered() {
+            if event == ButtonEvent::LongPress(Button::Confirm) {
+                self.discard();
+            }
+            return;
+        }
         if event == ButtonEvent::Pressed(Button::Confirm)
             && !m.resume()
             && self.start(false).is_err()
@@ -170,6 +379,7 @@ impl Print {
     /// `M23`: open `name`; answered when the reader has.
     pub fn select(&mut self, name: Name) -> Result<(), ErrorKind> {
         self.not_busy()?;
+        self.discard();
         self.open(name, false);
         self.line_waits = true;
         Ok(())
@@ -188,7 +398,7 @@ impl Print {
     /// go on with a lost one (the line is answered once it is open again).
     pub fn start(&mut self, line: bool) -> Result<(), ErrorKind> {
         match self.state {
-            State::Selected => self.state = State::Running,
+            State::Selected => self.begin(),
             State::Lost => {
                 self.open(crate::card::opened_name(), true);
                 self.skip = self.line_start.pos;
@@ -200,14 +410,28 @@ impl Print {
         Ok(())
     }
 
-    /// `M524`, Ctrl-X: no more lines from the file.
+    /// `M524`, Ctrl-X: no more lines from the file (a resume under way
+    /// stops: offered again).
     #[inline(never)]
     #[optimize(size)]
     pub fn abort(&mut self) {
+        if self.resume.is_some() {
+            self.back_to_offer();
+            self.close();
+            return;
+        }
         if self.busy() || self.state == State::Selected {
             info!("print aborted at line ", self.line_start.lines + 1);
         }
         self.close();
+    }
+
+    /// The print starts: its checkpoint's header, then its records.
+    fn begin(&mut self) {
+        self.state = State::Running;
+        self.resume = None;
+        self.keep = Keep::Begin;
+        self.tracker = Some(Tracker::new());
     }
 
     /// `M27`: `SD printing byte 1234/5678`, Marlin's words.
@@ -246,6 +470,7 @@ impl Print {
         if self.state != State::Idle {
             let _ = CARD_IN.push(Request::Close);
         }
+        self.forget();
         self.state = State::Idle;
         self.line_waits = false;
         self.ticket = self.ticket.wrapping_add(1).max(1);
@@ -311,6 +536,13 @@ impl Print {
         self.taken = 0;
         self.ended = false;
         self.at = Mark { pos: 0, lines: 0 };
+        self.read_start = 0;
+        if self.resume == Some(Resume::Opening) {
+            self.resume = Some(Resume::Replaying);
+            self.line_start = self.at;
+            self.state = State::Running;
+            return None;
+        }
         if self.skip > 0 {
             // Going on after a lost card: the same lines are counted again.
             self.at.lines = self.line_start.lines;
@@ -332,19 +564,24 @@ impl Print {
         );
         r.send();
         send_line(flash_str!("File selected"));
-        self.state = match start {
+        match start {
             true => {
                 info!("printing ", name);
-                State::Running
+                self.begin();
             }
-            false => State::Selected,
-        };
+            false => self.state = State::Selected,
+        }
         Some(Ok(()))
     }
 
     #[inline(never)]
     #[optimize(size)]
     fn failed(&mut self, missing: bool) -> Answer {
+        if self.resume == Some(Resume::Opening) {
+            self.state = State::Idle;
+            self.back_to_offer();
+            return None;
+        }
         match self.state {
             State::Opening { .. } | State::Listing => {
                 let green = !self.line_waits && self.skip == 0;
@@ -385,6 +622,13 @@ impl Print {
             self.line_start.lines + 1,
             ": put it back, then M24 or green"
         );
+    }
+
+    /// The print is over: its checkpoint goes.
+    fn forget(&mut self) {
+        if self.tracker.take().is_some() && self.resume.is_none() {
+            self.keep = Keep::Forget;
+        }
     }
 
     /// The file's next byte for the parser; `None` when the card has not
@@ -436,6 +680,7 @@ impl Print {
 
     /// The parser finished a line: the next one starts here.
     pub fn line_done(&mut self) {
+        self.read_start = self.line_start.pos;
         self.line_start = self.at;
     }
 
@@ -449,6 +694,7 @@ impl Print {
             && !CARD_OUT.any(|m| m.ticket == self.ticket);
         if done {
             self.state = State::Idle;
+            self.forget();
             send_line(flash_str!("Done printing file"));
         }
         done

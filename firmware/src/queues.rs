@@ -5,7 +5,7 @@
 //! (`$Q`, and the end of a job).
 
 use crate::rt::{Flags, Ring, Tally};
-use core::sync::atomic::AtomicBool;
+use core::sync::atomic::{AtomicBool, AtomicU8};
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
 use taut_logic::segment::{Segment, StepBlock};
@@ -34,6 +34,9 @@ pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
 /// 176 B more.
 pub const SEGMENTS_CAPACITY: usize = 16;
 pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
+/// Step interrupt → console: blocks begun, wrapping (a card print's
+/// checkpoint names the line whose block is moving).
+pub static BEGUN: AtomicU8 = AtomicU8::new(0);
 
 /// Tick → buttons task: one raw sample (bit `Button as u8` = pressed) per
 /// millisecond while active. Full: the sample is refused and counted (the

@@ -25,9 +25,10 @@ pub mod fast;
 
 use crate::board::gpio::{regs, Output, Pin};
 use crate::board::step_timer::StepTimer;
-use crate::queues::{BLOCKS, SEGMENTS};
+use crate::queues::{BEGUN, BLOCKS, SEGMENTS};
 use core::cell::UnsafeCell;
 use core::ptr::{read_volatile, write_volatile};
+use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::coil;
 use taut_logic::config::{Driver, MachineConfig};
@@ -528,6 +529,7 @@ fn load_segment(e: &mut Exec) -> bool {
                 return false;
             }
             let _ = BLOCKS.pop();
+            BEGUN.store(BEGUN.load(Relaxed).wrapping_add(1), Relaxed);
         }
         e.interval = seg.interval;
         e.add = seg.add;

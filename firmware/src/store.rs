@@ -19,7 +19,9 @@ use crate::queues::{Signal, TX};
 use crate::rt::Poll;
 use crate::{flash_str, info, warn};
 use taut_logic::axis::AXES;
-use taut_logic::checkpoint::{self, Found, Header, Record, HEADER_BYTES};
+use taut_logic::checkpoint::{
+    self, Found, Header, PlotHeader, PlotRecord, PlotSaved, Record, HEADER_BYTES,
+};
 use taut_logic::config::MachineConfig;
 use taut_logic::coords::{CoordData, Slot};
 use taut_logic::files::check::CardId;
@@ -411,6 +413,34 @@ impl Store {
     #[inline(never)]
     pub fn record(&mut self, r: Record) {
         self.start(Record::address(r.n), &r.encode(self.seq));
+    }
+
+    /// A plotter's print from the card starts: its header (the file).
+    #[inline(never)]
+    pub fn plot_begin(&mut self, short: [u8; 11], size: u32) {
+        self.seq = self.seq.wrapping_add(1);
+        let h = PlotHeader {
+            seq: self.seq,
+            short,
+            size,
+        };
+        self.start(Header::address(self.seq), &h.encode());
+    }
+
+    /// The line at this record's offset is moving.
+    #[inline(never)]
+    pub fn plot_record(&mut self, r: PlotRecord) {
+        self.start(PlotRecord::address(r.n), &r.encode(self.seq));
+    }
+
+    /// The print a power cut stopped, read again from EEPROM (kept there
+    /// rather than in RAM until it is resumed or discarded).
+    #[inline(never)]
+    pub fn plot_saved(&self) -> Option<PlotSaved> {
+        match checkpoint::scan(|a| self.eeprom.read(a)) {
+            Found::Plot(p) => Some(p),
+            _ => None,
+        }
     }
 
     /// No job under way any more: an idle header.

@@ -87,7 +87,7 @@ fuzz_target!(|data: &[u8]| {
                 continue;
             }
             Some(result) => {
-                assert!(b == b'\n' || b == b'\r');
+                assert!(b == b'\n' || b == b'\r' || b == taut_logic::gcode::LINE_CUT);
                 match result {
                     Err(e) => {
                         assert!(!e.message().is_empty());

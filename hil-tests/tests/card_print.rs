@@ -379,7 +379,9 @@ fn a_plotter_card_s_machine_txt_switches_the_machine_and_keeps_it() {
     let eeprom = sim.eeprom();
     let mut sim = machine();
     sim.set_eeprom(&eeprom);
-    wait_for(&mut sim, "reset:", Duration::from_millis(50));
+    // The boot's log line ends ~50 ms after power-on on a plotter's
+    // EEPROM (its last bytes wait for the UART).
+    wait_for(&mut sim, "reset:", Duration::from_millis(200));
     let from = sim.uart_bytes().len();
     send(&mut sim, "$$");
     let settings = sim.uart_text_from(from);

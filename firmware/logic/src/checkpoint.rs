@@ -30,6 +30,10 @@
 use crate::files::check::{CardId, FileSum};
 use crate::stringart::Phase;
 
+pub mod plot;
+
+pub use plot::{PlotHeader, PlotRecord, PlotSaved};
+
 /// First byte of the checkpoint area (the settings' records end below it).
 pub const START: u16 = 1536;
 /// The ATmega2560's EEPROM size.
@@ -212,6 +216,8 @@ pub enum Found {
         seq: u16,
     },
     Job(Saved),
+    /// A plotter's print from the card (`plot`).
+    Plot(PlotSaved),
     /// Bad headers or records: ignored, with a warning.
     Corrupt {
         seq: u16,
@@ -225,6 +231,7 @@ impl Found {
             Found::Blank => 1,
             Found::Idle { seq } | Found::Corrupt { seq } => seq.wrapping_add(1),
             Found::Job(s) => s.header.seq.wrapping_add(1),
+            Found::Plot(p) => p.header.seq.wrapping_add(1),
         }
     }
 }
@@ -237,6 +244,22 @@ fn read_n<const N: usize>(read: &mut impl FnMut(u16) -> u8, at: u16) -> [u8; N] 
     b
 }
 
+/// A header slot's contents: a string-art job's or a print's.
+#[derive(Clone, Copy)]
+enum Head {
+    Job(Header),
+    Plot(PlotHeader),
+}
+
+impl Head {
+    fn seq(&self) -> u16 {
+        match self {
+            Head::Job(h) => h.seq,
+            Head::Plot(h) => h.seq,
+        }
+    }
+}
+
 /// `a` is newer than `b`, sequence numbers wrapping.
 fn newer(a: u16, b: u16) -> bool {
     (a.wrapping_sub(b) as i16) > 0
@@ -246,12 +269,21 @@ fn newer(a: u16, b: u16) -> bool {
 // Out of line, as `settings::image::decode_into`.
 #[inline(never)]
 pub fn scan(mut read: impl FnMut(u16) -> u8) -> Found {
-    let slots: [Option<Header>; 2] =
-        [0, 1].map(|i| Header::decode(&read_n(&mut read, START + i * HEADER_BYTES)));
+    let slots: [Option<Head>; 2] = [0, 1].map(|i| {
+        let b = read_n(&mut read, START + i * HEADER_BYTES);
+        Header::decode(&b)
+            .map(Head::Job)
+            .or_else(|| PlotHeader::decode(&b).map(Head::Plot))
+    });
     let header = match slots {
-        [Some(a), Some(b)] => Some(if newer(b.seq, a.seq) { b } else { a }),
+        [Some(a), Some(b)] => Some(if newer(b.seq(), a.seq()) { b } else { a }),
         [Some(h), None] | [None, Some(h)] => Some(h),
         [None, None] => None,
+    };
+    let header = match header {
+        Some(Head::Job(h)) => Some(h),
+        Some(Head::Plot(h)) => return Found::Plot(plot::scan_records(&mut read, h)),
+        None => None,
     };
     let Some(header) = header else {
         let blank = (START..RING).all(|i| read(i) == 0xFF);

@@ -322,6 +322,9 @@ pub struct Interpreter {
     /// `M300 S255`: the unicorn extension's "servo off": `Z` words leave
     /// the pen alone until `M3`/`M4`/`M5` or `M300` gives it an angle.
     servo_off: bool,
+    /// The pen's angle as the last line that set it left it (also in
+    /// `$C`, where the pen does not move); 0: none set.
+    pen_deg: u8,
 }
 
 impl Default for Interpreter {
@@ -395,6 +398,7 @@ impl Interpreter {
             dwell_until: None,
             wco_changed: true,
             servo_off: false,
+            pen_deg: 0,
         }
     }
 
@@ -432,6 +436,28 @@ impl Interpreter {
         }
         self.run.clear();
         self.dwell_until = None;
+    }
+
+    /// Going on with a print a cut stopped, its lines before read again
+    /// without moving: the pen up (`up_deg`), then a rapid from where the
+    /// machine stands (`at`) to the programmed position, the start of the
+    /// line that was moving. Carried out by [`Interpreter::run`].
+    pub fn travel_back(&mut self, at: &Position, up_deg: u8) {
+        self.run.clear();
+        self.run.pen = up_deg;
+        self.run.from = coords::exact(at);
+        self.run.legs[0] = self.position;
+        self.run.todo = todo::PEN | todo::LEG_0;
+    }
+
+    /// Then the pen as the lines before left it (up if none set it).
+    pub fn pen_back(&mut self, up_deg: u8) {
+        self.run.clear();
+        self.run.pen = match self.pen_deg {
+            0 => up_deg,
+            deg => deg,
+        };
+        self.run.todo = todo::PEN;
     }
 
     /// The work coordinate offset of each channel (Grbl's `WCO`: the work
@@ -821,6 +847,7 @@ impl Interpreter {
                 self.modal.spindle = b.spindle;
                 if plotter {
                     self.run.pen = pen_deg(b.spindle != Spindle::Off);
+                    self.pen_deg = self.run.pen;
                     self.run.todo |= todo::PEN;
                     self.servo_off = false;
                 }
@@ -830,6 +857,7 @@ impl Interpreter {
                 self.servo_off = b.s.0 > 180_000;
                 if !self.servo_off {
                     self.run.pen = (b.s.0 / 1000) as u8;
+                    self.pen_deg = self.run.pen;
                     self.run.todo |= todo::PEN;
                 }
             }
@@ -910,6 +938,7 @@ impl Interpreter {
             if plotter && given >> Z & 1 != 0 && !self.servo_off {
                 let work_z = legs[count - 1][Z] - self.work_offset(Z);
                 self.run.pen_z = pen_deg(work_z <= 0);
+                self.pen_deg = self.run.pen_z;
                 self.run.todo |= todo::PEN_Z;
             }
             self.run.legs = legs;

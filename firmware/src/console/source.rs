@@ -6,8 +6,12 @@ use super::{Console, Source};
 use crate::board::usart;
 use crate::motion::Motion;
 use crate::queues::{BUTTONS, RX};
+use crate::store::Store;
+use taut_logic::checkpoint::plot::ResumeAction;
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{CardLine, Error, ErrorKind, Parser, LINE_CUT};
+use taut_logic::kinematics::Kinematics;
+use taut_logic::pinmap::Button;
 
 impl Console {
     /// The next byte of the line being read: a line from the card, or
@@ -45,8 +49,12 @@ impl Console {
     /// A plotter's buttons and card messages; `true` while a card command
     /// still waits for the reader.
     #[inline(never)]
-    pub(super) fn card_news(&mut self, m: &mut Motion) -> bool {
+    pub(super) fn card_news(&mut self, m: &mut Motion, cfg: &MachineConfig, store: &Store) -> bool {
         while let Some(event) = BUTTONS.pop() {
+            if self.print.offered() && event.is_short_press(Button::Confirm) {
+                let _ = self.recover(m, cfg, store);
+                continue;
+            }
             self.print.button(event, m);
         }
         let waited = self.print.waiting();
@@ -61,16 +69,65 @@ impl Console {
     /// `M20`, `M23`…: a plotter's card print (the string-art job owns the
     /// card on its machine; a file cannot run card commands).
     #[inline(never)]
-    pub(super) fn card_line(&mut self, c: CardLine, m: &mut Motion, cfg: &MachineConfig) {
+    pub(super) fn card_line(
+        &mut self,
+        c: CardLine,
+        m: &mut Motion,
+        cfg: &MachineConfig,
+        store: &Store,
+    ) {
         if cfg.machine.is_string_art() || self.source == Some(Source::Card) {
             return self.error(&Error::new(ErrorKind::UnsupportedCommand, 1));
         }
-        match self.print.command(c, m) {
+        let done = match c {
+            CardLine::Recover => self.recover(m, cfg, store),
+            c => self.print.command(c, m),
+        };
+        match done {
             Err(kind) => self.error(&Error::new(kind, 0)),
             // Answered when the reader has.
             Ok(()) if self.print.waiting() => {}
             Ok(()) => self.ok(),
         }
+    }
+}
+
+impl Console {
+    /// `M1000` or green with a power cut's print offered: home (a machine
+    /// with switches), then the file opens and its lines before the
+    /// checkpoint are taken without moving.
+    #[inline(never)]
+    fn recover(
+        &mut self,
+        m: &mut Motion,
+        cfg: &MachineConfig,
+        store: &Store,
+    ) -> Result<(), ErrorKind> {
+        let homes = cfg.homing.axes != 0 && store.extras().homing_enabled(cfg);
+        match self.print.recover(store, homes)? {
+            ResumeAction::Home => self.start_homing(cfg.homing.axes, m, false),
+            _ => self.print.open_saved(store),
+        }
+        Ok(())
+    }
+
+    /// A card's line read whole: taken now (`true`), or held while a
+    /// resume lifts the pen and moves back to where it starts, then puts
+    /// the pen as it was.
+    #[inline(never)]
+    pub(super) fn card_line_goes(
+        &mut self,
+        m: &Motion,
+        kin: &impl Kinematics,
+        cfg: &MachineConfig,
+    ) -> bool {
+        let up = cfg.pen.up_deg;
+        match self.print.line_ready(m.next_block()) {
+            ResumeAction::Travel => self.interp.travel_back(&kin.forward(&m.target()), up),
+            ResumeAction::Pen => self.interp.pen_back(up),
+            _ => return true,
+        }
+        false
     }
 }
 

@@ -21,14 +21,15 @@ fn header(seq: u16, phase: Phase) -> Header {
     }
 }
 
-/// The EEPROM as the firmware's writer leaves it.
-struct Eeprom(Vec<u8>);
+/// The EEPROM as the firmware's writer leaves it (also the print's
+/// checkpoint tests').
+pub(super) struct Eeprom(pub(super) Vec<u8>);
 
 impl Eeprom {
-    fn blank() -> Self {
+    pub(super) fn blank() -> Self {
         Eeprom(vec![0xFF; END as usize])
     }
-    fn write(&mut self, at: u16, bytes: &[u8]) {
+    pub(super) fn write(&mut self, at: u16, bytes: &[u8]) {
         self.0[at as usize..at as usize + bytes.len()].copy_from_slice(bytes);
     }
     fn header(&mut self, h: Header) {
@@ -37,7 +38,7 @@ impl Eeprom {
     fn record(&mut self, seq: u16, r: Record) {
         self.write(Record::address(r.n), &r.encode(seq));
     }
-    fn scan(&self) -> Found {
+    pub(super) fn scan(&self) -> Found {
         scan(|a| self.0[a as usize])
     }
 }

@@ -416,8 +416,10 @@ pub enum CardLine {
     Pause,
     /// `M27`: how far the print is.
     Progress,
-    /// `M524`: abort the print.
+    /// `M524`: abort the print (or discard a power cut's checkpoint).
     Abort,
+    /// `M1000`: go on with the print a power cut stopped (Marlin's).
+    Recover,
 }
 
 impl CardLine {
@@ -430,6 +432,7 @@ impl CardLine {
             25 => CardLine::Pause,
             27 => CardLine::Progress,
             524 => CardLine::Abort,
+            1000 => CardLine::Recover,
             _ => return None,
         })
     }

@@ -466,6 +466,7 @@ fn m114_alone_only_reads() {
 fn card_lines() {
     assert_eq!(parse("M20"), Ok(Input::Card(CardLine::List)));
     assert_eq!(parse("N5 M524"), Ok(Input::Card(CardLine::Abort)));
+    assert_eq!(parse("M1000"), Ok(Input::Card(CardLine::Recover)));
     match parse("M23 star drawing.gcode") {
         Ok(Input::Card(CardLine::Select(name))) => {
             assert_eq!(name.as_bytes(), b"star drawing.gcode")
@@ -528,7 +529,7 @@ proptest! {
             match p.push(b) {
                 Some(Ok(Input::Realtime(r))) => prop_assert_eq!(Realtime::from_byte(b), Some(r)),
                 Some(result) => {
-                    prop_assert!(b == b'\n' || b == b'\r');
+                    prop_assert!(b == b'\n' || b == b'\r' || b == LINE_CUT);
                     if let Err(e) = result {
                         prop_assert!(!e.message().is_empty());
                     }

@@ -820,3 +820,64 @@ fn a_seed_line_in_check_mode_moves_nothing() {
         Err(ErrorKind::JobOwnsMotion)
     );
 }
+
+/// A print going on after a cut: its lines before the checkpoint's taken
+/// in `$C` (nothing moves), then the pen up, a rapid from where homing
+/// left the machine to the programmed position in machine coordinates
+/// (`G92`, `G91` and inches taken into account), and the pen as the
+/// lines left it.
+#[test]
+fn a_resumed_print_replays_its_lines_without_moving_then_travels_back_and_pens() {
+    let mut b = Bench::new(Machine::Flatbed);
+    let lines = [
+        "G21 G90",
+        "M5",
+        "G0 X10 Y10",
+        "G92 X0 Y0",
+        "M3",
+        "G20 G91 G1 X1 Y0.5 F20",
+        "M0",
+        "G4 P500",
+    ];
+    let env = checking(&b.kin, &b.cfg);
+    for line in lines {
+        let mut p = Parser::new();
+        let block = match p.push_all_test(format!("{line}\n").as_bytes()) {
+            Some(Ok(Input::Block(block))) => block,
+            other => panic!("{other:?}"),
+        };
+        b.interp.accept(&block, false, &env, &mut b.io).unwrap();
+        assert_eq!(b.interp.run(&env, &mut b.io), Progress::Done);
+    }
+    assert!(b.io.did.is_empty(), "{:?}", b.io.did);
+    let (up, down) = (b.cfg.pen.up_deg, b.cfg.pen.down_deg);
+    // Homed to (0, 0): pen up, then to 10 + 25.4, 10 + 12.7 mm.
+    b.interp.travel_back(&[Milli(0); AXES], up);
+    let env = Env {
+        kin: &b.kin,
+        cfg: &b.cfg,
+        allowed: Allowed::ALL,
+    };
+    while b.interp.run(&env, &mut b.io) != Progress::Done {
+        b.io.clock += 10;
+    }
+    let to = b
+        .kin
+        .inverse(&[Milli(35_400), Milli(22_700), Milli(0)])
+        .unwrap();
+    assert_eq!(b.io.did, [Did::Pen(up), Did::Move(to, Feed::Rapid)]);
+    b.io.did.clear();
+    b.interp.pen_back(up);
+    while b.interp.run(&env, &mut b.io) != Progress::Done {
+        b.io.clock += 10;
+    }
+    assert_eq!(b.io.did, [Did::Pen(down)]);
+    // The modes are the file's: the next relative inch move goes on.
+    b.io.did.clear();
+    b.ok("X1");
+    let to = b
+        .kin
+        .inverse(&[Milli(60_800), Milli(22_700), Milli(0)])
+        .unwrap();
+    assert_eq!(b.steps(), to);
+}
