@@ -277,6 +277,11 @@ impl Console {
             }
         }
         loop {
+            // The step queue is about to run dry inside a planned move:
+            // the refill comes first (an underrun is a fault).
+            if m.starving() {
+                return Poll::Wait(Signal::Refilled);
+            }
             // A move staged by the last run is planned a part a run, each
             // ahead of anything else: nothing may wait for it to be queued.
             if m.plan_part() {
@@ -430,6 +435,7 @@ impl Console {
                 Poll::Again
             }
             Progress::Wait(Wait::Motion) => Poll::Wait(Signal::Motion),
+            Progress::Wait(Wait::Refill) => Poll::Wait(Signal::Refilled),
             Progress::Wait(Wait::Ms(ms)) => Poll::After(ms),
             Progress::Wait(Wait::Again) => Poll::Again,
         }

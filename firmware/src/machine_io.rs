@@ -3,7 +3,7 @@
 //! clock, and the work coordinate data (the store's, kept in EEPROM).
 
 use crate::board::clock;
-use crate::motion::{self, Motion};
+use crate::motion::Motion;
 use crate::store::Store;
 use crate::{flash_str, reply};
 use taut_logic::axis::AXES;
@@ -39,12 +39,12 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
         if !self.m.has_room() {
             return Some(Wait::Motion);
         }
-        // A piece is not cut while the step queue runs short with pieces
-        // planned ahead: planning one takes a few ms, which the
-        // segments' refill needs first (with none ahead the planner
-        // would run dry instead).
-        if piece && motion::urgent() && self.m.planned() >= 2 {
-            return Some(Wait::Ms(1));
+        // A piece is not cut while the refill is filling the step queue
+        // with pieces planned ahead: planning one takes a few ms, which
+        // the refill needs first (with none ahead the planner would run
+        // dry instead). It looks again once the queue is refilled.
+        if piece && self.m.planned() >= 2 && self.m.refilling() {
+            return Some(Wait::Refill);
         }
         None
     }

@@ -15,9 +15,9 @@
 //! | `USART0_UDRE` | interrupt | | `TX` | the wire |
 //! | `USART1_RX`, `USART1_UDRE` the second console (off on the string-art machine) | interrupt | | a byte; `TX1` | as USART0's (`?` flagged apart), `RX1`; the wire |
 //! | `Realtime` status, hold, resume, reset | software | 5 | `REALTIME` | `TX`, `TX1`, `JOB_CONTROL` |
-//! | `Console` one G-code line per run; a plotter's card print | software | 4 | `RX`, `RX1`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `TX1`, `CARD_IN`; signals `CardRoom` |
+//! | `Console` one G-code line per run (waits for `Refilled` while the step queue runs short inside planned motion); a plotter's card print | software | 4 | `RX`, `RX1`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `TX1`, `CARD_IN`; signals `CardRoom` |
 //! | `Timers` fires due timers | software | 3 | `TIMERS` | |
-//! | `Refill` planner → segments while the queue holds < 30 ms of motion, a part per run, yielding to a ready task between parts | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion` |
+//! | `Refill` planner → segments while the queue holds < 30 ms of motion, a part per run, yielding to a ready task between parts | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion`; `Refilled` once the queue holds 16 ms or nothing is left to cut |
 //! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` |
 //! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `JOB_CONTROL` | planner, `CARD_IN`, `TX`; signals `CardRoom` |
 //! | `Led` status LED pattern (timed edges: runs before the long tasks) | software | 2 | its timer | |
@@ -169,11 +169,16 @@ fn reschedule(task: Task, poll: Poll<Signal>) {
 
 /// `s` happened: run the tasks waiting for it.
 fn signal(s: Signal) {
-    let waiting = WAITING.with(|w| core::mem::take(&mut w[s as usize]));
-    for id in 0..Task::ALL.len() as u8 {
-        if waiting >> id & 1 != 0 {
+    let mut waiting = WAITING.with(|w| core::mem::take(&mut w[s as usize]));
+    // A bit at a time: a shift by `id` is a loop on the AVR, and the
+    // motion task signals after nearly every run, mostly to no one.
+    let mut id = 0;
+    while waiting != 0 {
+        if waiting & 1 != 0 {
             spawn(task_of(id));
         }
+        waiting >>= 1;
+        id += 1;
     }
 }
 
@@ -462,7 +467,7 @@ fn motion() {
     /// Pieces of work per run (a part of a block's profile or of a
     /// segment, ≤ ~1 ms each): one keeps the console's wait short.
     const BATCH: usize = 1;
-    let (freed, more, idle, stepping, release) = MOTION.with(|m| {
+    let (freed, more, idle, stepping, release, refilling) = MOTION.with(|m| {
         let m = m.as_mut().unwrap();
         let (freed, more) = m.refill(BATCH);
         let idle = m.is_idle();
@@ -475,7 +480,14 @@ fn motion() {
                 None
             }
         };
-        (freed, more, idle, m.stepper.is_running(), release)
+        (
+            freed,
+            more,
+            idle,
+            m.stepper.is_running(),
+            release,
+            m.refilling(),
+        )
     });
     // Drivers wait to go off after the step idle delay (`$1`).
     if let Some(ms) = release {
@@ -493,6 +505,11 @@ fn motion() {
     }
     if freed || idle {
         signal(Signal::Motion);
+    }
+    // A console waiting for the refill (`Motion::starving`, a piece held
+    // back) goes on.
+    if !refilling {
+        signal(Signal::Refilled);
     }
 }
 

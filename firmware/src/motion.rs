@@ -31,6 +31,15 @@ const URGENT_MIN: u8 = 2;
 /// stream of tiny moves (`plotter_stress`).
 const QUEUED_MAX_US: u32 = 40_000;
 
+/// Below this much queued motion, with more to cut, the step queue is
+/// about to run dry inside a planned move: the console waits for the
+/// refill ([`Motion::starving`]), and a standing stepper does not start
+/// on less (unless that is all there is to cut). Above the longest a
+/// segment's cut takes with a console run and the interrupts between
+/// (~3 ms): a stream of 0.2 mm moves on the flatbed, stopping and starting
+/// at every line, ran dry with the refill behind a console's line.
+const STARVING_US: u32 = 8_000;
+
 /// At or below this many queued segments the refill is urgent: as many of
 /// the newest as last less than the budget. Set by the refill, read by the
 /// interrupts that spawn it (one byte: atomic on the AVR).
@@ -245,7 +254,8 @@ impl Motion {
             SHORT_AT.store(short as u8, Relaxed);
         }
         self.blocks = BLOCKS.len() as u8;
-        if self.stepper.kick() {
+        // A standing stepper starts on enough motion to keep ahead of.
+        if (!self.cuts() || !self.short()) && self.stepper.kick() {
             self.drivers.moving();
         }
         if self.cancel && self.prep.hold_state() == Hold::Stopped && !self.stepper.is_running() {
@@ -255,6 +265,34 @@ impl Motion {
         let work = !self.prep.is_idle() || !PLANNER.with(|p| p.is_idle());
         let held = self.prep.hold_state() == Hold::Stopped;
         (freed, made == max && work && !held && room)
+    }
+
+    /// The step queue runs inside planned motion on less than
+    /// [`STARVING_US`] while the preparer has more to cut: cutting it
+    /// comes before anything else (an underrun is a fault).
+    pub fn starving(&self) -> bool {
+        self.stepper.is_running() && self.short() && self.cuts()
+    }
+
+    /// A console that waits for the refill while the queue starves waits
+    /// on until it holds twice [`STARVING_US`] of motion, or the preparer
+    /// has nothing more to cut now: fewer switches between the two.
+    pub fn refilling(&self) -> bool {
+        self.stepper.is_running()
+            && !self.buffered.lasts(SEGMENTS.len(), 2 * STARVING_US)
+            && self.cuts()
+    }
+
+    /// The queue holds less than [`STARVING_US`] of motion.
+    fn short(&self) -> bool {
+        !self.buffered.lasts(SEGMENTS.len(), STARVING_US)
+    }
+
+    /// The preparer can cut a segment now: a block taken or planned, no
+    /// hold's stop, room in the step queue.
+    fn cuts(&self) -> bool {
+        let work = !self.prep.is_idle() || PLANNER.with(|p| p.queued()) > 0;
+        work && self.prep.hold_state() != Hold::Stopped && SEGMENTS.free() > 0 && BLOCKS.free() > 0
     }
 
     /// Hand `cut` to the step interrupt; true if it begins a block. Out of

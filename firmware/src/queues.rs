@@ -137,8 +137,11 @@ pub enum Control {
 /// runs the waiting tasks when the condition's producer signals it.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Signal {
-    /// The motion task freed planner room or the machine came to rest.
+    /// The motion task freed planner room (took a block, or the step
+    /// interrupt began one) or the machine came to rest.
     Motion,
+    /// The step queue is refilled (`Motion::refilling` is over).
+    Refilled,
     /// The job took messages from [`CARD_OUT`].
     CardRoom,
     /// A `$` setting changed: the store writes it to EEPROM.
@@ -146,4 +149,4 @@ pub enum Signal {
 }
 
 /// Number of [`Signal`]s.
-pub const SIGNALS: usize = 3;
+pub const SIGNALS: usize = 4;

@@ -433,6 +433,21 @@ impl Sim {
         }
     }
 
+    /// Puts `bytes` into data memory at `addr` as they are, as a debugger
+    /// does: no I/O register's write callback runs (the peripheral sees
+    /// the value when it next reads the register).
+    pub fn poke_ram(&mut self, addr: u16, bytes: &[u8]) {
+        assert!(
+            addr as usize + bytes.len() <= RAM_END as usize + 1,
+            "past RAMEND"
+        );
+        // SAFETY: `data` holds `ramend + 1` bytes, checked above.
+        unsafe {
+            let data = (*self.avr.as_ptr()).data;
+            std::ptr::copy_nonoverlapping(bytes.as_ptr(), data.add(addr as usize), bytes.len());
+        }
+    }
+
     /// Record every cycle at which execution reaches byte address `pc` (an
     /// interrupt vector, a task's entry): latencies measured exactly.
     pub fn watch_pc(&mut self, pc: u32) {

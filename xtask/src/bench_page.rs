@@ -137,6 +137,8 @@ const SECTIONS: &[(&str, &[Figure])] = &[
             barred("stream_scara_200um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
             fig("stream_scara_200um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second (at most 125 at that feed)"),
             barred("stream_scara_200um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
+            fig("grbl_stream_50um_serial_lines_per_s", "lines/s", "grbl-Mega 1.1 (built from `TAUT_GRBL_MEGA`, its steps, rates, accelerations and junction deviation set to the flatbed's) in the same simulator: the flatbed's 0.05 mm stream over serial by the same character counting"),
+            fig("grbl_stream_200um_serial_lines_per_s", "lines/s", "the same with the 0.2 mm stream"),
         ],
     ),
     (
@@ -242,6 +244,16 @@ and commit the page.
   able to stop within the planned blocks), however fast the CPU.
   `TAUT_BENCH_PROFILE=N` prints where a case's cycles go: per function,
   with callees (a shadow call stack), the callers of the maths library.
+- **Grbl side by side** (`grbl_stream_*`, `simavr/src/bin/taut-bench/grbl.rs`):
+  with `TAUT_GRBL_MEGA` naming a grbl-Mega checkout (outside this
+  repository), the bench builds it with `avr-gcc` as its Makefile does
+  (its RAMPS/Mega defaults), sets its `$100`–`$121` and `$11` to the
+  flatbed's steps, rates, accelerations and junction deviation, and
+  streams the flatbed's circles by the same character counting in the
+  same simulator: what a 16 MHz AVR running Grbl carries of the same
+  lines. simavr starts no CTC timer whose TOP is 0, so the bench gives
+  Grbl's Timer1 compare register its top before boot (Grbl sets it at
+  its stepper interrupt's first run); the first move starts ≤ 4.1 ms late.
 - **The fine curve** (`taut-bench --curve FIRMWARE_ELF` alone, in
   `simavr/src/bin/taut-bench/curve.rs`): 2 000 pieces of 0.1 mm along an
   arc of R 150 mm on the flatbed (0.04° a piece; to the µm, so each

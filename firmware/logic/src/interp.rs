@@ -72,6 +72,9 @@ pub struct Env<'a, K: Kinematics> {
 pub enum Wait {
     /// Room in the planner, or the motion before to end.
     Motion,
+    /// The step queue to be refilled from the moves planned ahead:
+    /// planning another now would take the time the refill needs.
+    Refill,
     /// This many milliseconds (a dwell, the pen settling, pacing).
     Ms(u16),
     /// Nothing: a piece of a path was queued, the next comes at the

@@ -68,6 +68,25 @@ impl<const N: usize> Buffered<N> {
             * u32::from(UNIT_US)
     }
 
+    /// Whether the newest `len` segments last `us` or more: as
+    /// `queued_us(len) >= us`, counting only as far as it must (the
+    /// firmware asks at every run of its console and motion tasks).
+    /// Inlined: `us` is a constant, its division made when compiling.
+    #[inline(always)]
+    pub fn lasts(&self, len: usize, us: u32) -> bool {
+        let want = us.div_ceil(u32::from(UNIT_US));
+        let mut total = 0u32;
+        let mut at = self.next;
+        for _ in 0..len.min(N) {
+            at = if at == 0 { N - 1 } else { at - 1 };
+            total += u32::from(self.units[at]);
+            if total >= want {
+                return true;
+            }
+        }
+        want == 0
+    }
+
     /// The queue is short when it holds this many segments or fewer: the
     /// newest segments, counted back until they last `budget_us` (the
     /// oldest queued go first, so the queue then holds less than that).
@@ -122,5 +141,17 @@ mod tests {
         assert_eq!(b.short_at(20_000), 0);
         assert_eq!(b.queued_us(3), 25_000 + 2 * 2000);
         assert_eq!(b.queued_us(100), 25_000 + 7 * 2000, "at most N remembered");
+        for (len, us) in [
+            (0, 0),
+            (0, 1),
+            (1, 25_000),
+            (1, 25_001),
+            (3, 29_000),
+            (3, 29_001),
+            (100, 39_000),
+            (100, 39_001),
+        ] {
+            assert_eq!(b.lasts(len, us), b.queued_us(len) >= us, "{len} {us}");
+        }
     }
 }

@@ -19,6 +19,7 @@ use taut_simavr::sdcard::SdImage;
 use taut_simavr::{Outcome, Reply, Sim};
 
 mod curve;
+mod grbl;
 mod stream;
 
 /// Timer3 COMPA vector (byte address): the step interrupt.
@@ -639,7 +640,9 @@ fn main() {
     if let [flag, fw, rest @ ..] = &args[..] {
         if flag == "--stream" {
             let mut f = Map::new();
-            stream::stream_figures(Path::new(fw), &mut f, rest.first().map(String::as_str));
+            let only = rest.first().map(String::as_str);
+            stream::stream_figures(Path::new(fw), &mut f, only);
+            grbl::grbl_figures(&mut f, only);
             println!(
                 "{}",
                 serde_json::to_string_pretty(&Value::Object(f)).unwrap()
@@ -759,6 +762,7 @@ fn main() {
     f.insert("segment_prep_max_cycles".into(), json!(prep));
     feed_figures(fw, &mut f);
     stream::stream_figures(fw, &mut f, None);
+    grbl::grbl_figures(&mut f, None);
     curve::curve_figures(fw, &mut f);
     let (mhz, wall) = demo_job(fw, &card);
     f.insert("sim_mhz".into(), json!(round(mhz, 1)));

@@ -10,7 +10,8 @@
 //! To see why: `TAUT_BENCH_PROFILE=N` prints where each case's cycles go
 //! and the tasks' longest runs; `TAUT_BENCH_WATCH=<hex address>` the
 //! times the firmware reached that address (an underrun's count, say)
-//! with the console's and the motion task's runs just before;
+//! with the console's and the motion task's runs and the STEP pulses
+//! around;
 //! `TAUT_BENCH_UART=DIR` keeps each case's UART text.
 
 use serde_json::{json, Map, Value};
@@ -23,19 +24,19 @@ use taut_simavr::{Outcome, Reply, Sim};
 
 /// The machines, each with a circle's centre and radius (mm) inside its
 /// reach.
-const MACHINES: [(Machine, [f64; 2], f64); 3] = [
+pub(crate) const MACHINES: [(Machine, [f64; 2], f64); 3] = [
     (Machine::Flatbed, [40.0, 40.0], 20.0),
     (Machine::Whiteboard, [0.0, 0.0], 20.0),
     (Machine::Scara, [100.0, 150.0], 10.0),
 ];
 
 /// Chord lengths (mm) and their names in the figures' keys.
-const SEGMENTS: [(f64, &str); 2] = [(0.05, "50um"), (0.2, "200um")];
+pub(crate) const SEGMENTS: [(f64, &str); 2] = [(0.05, "50um"), (0.2, "200um")];
 
-const FEED: u32 = 1500;
+pub(crate) const FEED: u32 = 1500;
 
 /// Lines of a case: enough for a few seconds of drawing.
-fn line_count(segment: f64) -> usize {
+pub(crate) fn line_count(segment: f64) -> usize {
     if segment < 0.1 {
         1200
     } else {
@@ -160,7 +161,8 @@ pub(crate) fn over_serial(sim: &mut Sim, lines: &[String]) -> f64 {
         assert_eq!(sim.run_for(Duration::from_micros(250)), Outcome::Running);
         let text = sim.uart_text_from(start);
         assert!(!text.contains("error:"), "{text}");
-        let now = text.matches("ok\n").count();
+        // Grbl ends its lines with CR LF.
+        let now = text.matches("ok\n").count() + text.matches("ok\r\n").count();
         for _ in answered..now {
             in_flight.pop_front();
         }
@@ -253,6 +255,19 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
                 if let Some(w) = watch {
                     for &hit in sim.pc_hits(w) {
                         println!("hit at {:.4} s", hit as f64 / 16e6);
+                        // The pulses around it: a stop, a start, a gap.
+                        for axis in ["base", "radial"] {
+                            let e: Vec<String> = sim
+                                .probed(&format!("{axis}_step"))
+                                .edges()
+                                .iter()
+                                .filter(|e| {
+                                    e.high && e.cycle + 800_000 > hit && e.cycle < hit + 160_000
+                                })
+                                .map(|e| format!("{:.2}", (e.cycle as f64 - hit as f64) / 16e3))
+                                .collect();
+                            println!("   {axis} pulses, ms from it: {}", e.join(" "));
+                        }
                         for t in tasks {
                             let runs: Vec<String> = sim
                                 .call_runs(t)
