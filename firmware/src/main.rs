@@ -355,7 +355,11 @@ fn init() -> Watchdog {
     if homing.at_start && enabled || startup_lines() {
         spawn(Task::Console);
     }
-    // Last: the blinks are timed from here, the dispatcher's start.
+    // Last: the blinks are timed from here, the dispatcher's start. The
+    // first flash begins here too: the task first runs a millisecond or
+    // so later, behind the boot's higher-priority tasks.
+    let mut status_led = status_led;
+    let _ = status_led.set_high();
     LED.with(|l| *l = Some((status_led, clock::millis())));
     spawn(Task::Led);
 
