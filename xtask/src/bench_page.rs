@@ -107,38 +107,6 @@ const SECTIONS: &[(&str, &[Figure])] = &[
             fig("stream_planner_free_blocks_mean", "blocks", "mean free planner blocks in the stream's `?` reports (`Bf:`)"),
             fig("stream_lines_always_waiting", "", "whether a whole line always waited in the receive buffer"),
             fig("stream_limit", "", "what limits the stream: the planner, the UART or the firmware's line intake"),
-            fig("stream_flatbed_50um_planner_bound_lines_per_s", "lines/s", "0.05 mm chords of a circle at F1500 on the flatbed: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
-            barred("stream_flatbed_50um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second", Bar::AtLeast(300.0)),
-            barred("stream_flatbed_50um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            barred("stream_flatbed_50um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second", Bar::AtLeast(450.0)),
-            barred("stream_flatbed_50um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            fig("stream_flatbed_200um_planner_bound_lines_per_s", "lines/s", "0.2 mm chords of a circle at F1500 on the flatbed: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
-            fig("stream_flatbed_200um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second (at most 125 at that feed)"),
-            barred("stream_flatbed_200um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            fig("stream_flatbed_200um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second (at most 125 at that feed)"),
-            barred("stream_flatbed_200um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            fig("stream_whiteboard_50um_planner_bound_lines_per_s", "lines/s", "0.05 mm chords of a circle at F1500 on the whiteboard: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
-            barred("stream_whiteboard_50um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second", Bar::AtLeast(200.0)),
-            barred("stream_whiteboard_50um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            barred("stream_whiteboard_50um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second", Bar::AtLeast(200.0)),
-            barred("stream_whiteboard_50um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            fig("stream_whiteboard_200um_planner_bound_lines_per_s", "lines/s", "0.2 mm chords of a circle at F1500 on the whiteboard: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
-            fig("stream_whiteboard_200um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second (at most 125 at that feed)"),
-            barred("stream_whiteboard_200um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            fig("stream_whiteboard_200um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second (at most 125 at that feed)"),
-            barred("stream_whiteboard_200um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            fig("stream_scara_50um_planner_bound_lines_per_s", "lines/s", "0.05 mm chords of a circle at F1500 on the SCARA arm: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
-            barred("stream_scara_50um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second", Bar::AtLeast(200.0)),
-            barred("stream_scara_50um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            barred("stream_scara_50um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second", Bar::AtLeast(200.0)),
-            barred("stream_scara_50um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            fig("stream_scara_200um_planner_bound_lines_per_s", "lines/s", "0.2 mm chords of a circle at F1500 on the SCARA arm: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"),
-            fig("stream_scara_200um_serial_lines_per_s", "lines/s", "the same over serial by character counting (Grbl's 128 bytes), lines carried out per second (at most 125 at that feed)"),
-            barred("stream_scara_200um_serial_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            fig("stream_scara_200um_card_lines_per_s", "lines/s", "the same printed from the card, lines carried out per second (at most 125 at that feed)"),
-            barred("stream_scara_200um_card_underruns", "", "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)", Bar::AtMost(0.0)),
-            fig("grbl_stream_50um_serial_lines_per_s", "lines/s", "grbl-Mega 1.1 (built from `TAUT_GRBL_MEGA`, its steps, rates, accelerations and junction deviation set to the flatbed's) in the same simulator: the flatbed's 0.05 mm stream over serial by the same character counting"),
-            fig("grbl_stream_200um_serial_lines_per_s", "lines/s", "the same with the 0.2 mm stream"),
         ],
     ),
     (
@@ -301,22 +269,22 @@ pub fn render(figures: &Map<String, Value>) -> (String, Vec<String>) {
     let mut missed = Vec::new();
     let mut shown = std::collections::BTreeSet::new();
     for (title, figs) in SECTIONS {
-        let rows: Vec<Row> = figs
+        let mut rows: Vec<Row> = figs
             .iter()
             .filter_map(|f| {
-                let v = figures.get(f.key)?;
-                shown.insert(f.key.to_string());
-                Some(Row {
-                    key: f.key.to_string(),
-                    value: v.clone(),
-                    unit: f.unit.to_string(),
-                    what: f.what.to_string(),
-                    bar: f
-                        .bar
-                        .map(|b| (b.text(), v.as_f64().is_some_and(|x| b.met(x)))),
-                })
+                row(
+                    figures,
+                    &mut shown,
+                    f.key.into(),
+                    f.unit,
+                    f.what.into(),
+                    f.bar,
+                )
             })
             .collect();
+        if *title == "Streaming" {
+            rows.extend(stream_case_rows(figures, &mut shown));
+        }
         table(&mut out, title, &rows, &mut missed);
     }
     let stringart = stringart_rows(figures, &mut shown);
@@ -343,6 +311,71 @@ struct Row {
     what: String,
     /// The bar's text and whether it is met.
     bar: Option<(String, bool)>,
+}
+
+/// The row of figure `key`, if the bench measured it.
+fn row(
+    figures: &Map<String, Value>,
+    shown: &mut std::collections::BTreeSet<String>,
+    key: String,
+    unit: &str,
+    what: String,
+    bar: Option<Bar>,
+) -> Option<Row> {
+    let v = figures.get(&key)?;
+    shown.insert(key.clone());
+    Some(Row {
+        bar: bar.map(|b| (b.text(), v.as_f64().is_some_and(|x| b.met(x)))),
+        key,
+        value: v.clone(),
+        unit: unit.into(),
+        what,
+    })
+}
+
+/// The stream cases (`simavr/src/bin/taut-bench/stream.rs`): for each
+/// machine and chord length, what its planner allows, then serial and
+/// card, each with its underruns; then Grbl-Mega's figures beside them.
+fn stream_case_rows(
+    figures: &Map<String, Value>,
+    shown: &mut std::collections::BTreeSet<String>,
+) -> Vec<Row> {
+    const UNDERRUNS: &str =
+        "step-queue underruns the firmware counted meanwhile (the queue dry inside a planned move)";
+    let mut rows = Vec::new();
+    for (machine, name, serial_bar, card_bar) in [
+        ("flatbed", "flatbed", 300.0, 450.0),
+        ("whiteboard", "whiteboard", 200.0, 200.0),
+        ("scara", "SCARA arm", 200.0, 200.0),
+    ] {
+        for (size, mm, short) in [("50um", "0.05", true), ("200um", "0.2", false)] {
+            // Chords of 0.2 mm at F1500 come at most 125 a second.
+            let (at_most, bar): (&str, fn(f64) -> Option<Bar>) = match short {
+                true => ("", |b| Some(Bar::AtLeast(b))),
+                false => (" (at most 125 at that feed)", |_| None),
+            };
+            let key = |what: &str| format!("stream_{machine}_{size}_{what}");
+            let cases = [
+                (key("planner_bound_lines_per_s"), "lines/s", format!("{mm} mm chords of a circle at F1500 on the {name}: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"), None),
+                (key("serial_lines_per_s"), "lines/s", format!("the same over serial by character counting (Grbl's 128 bytes), lines carried out per second{at_most}"), bar(serial_bar)),
+                (key("serial_underruns"), "", UNDERRUNS.into(), Some(Bar::AtMost(0.0))),
+                (key("card_lines_per_s"), "lines/s", format!("the same printed from the card, lines carried out per second{at_most}"), bar(card_bar)),
+                (key("card_underruns"), "", UNDERRUNS.into(), Some(Bar::AtMost(0.0))),
+            ];
+            for (key, unit, what, bar) in cases {
+                rows.extend(row(figures, shown, key, unit, what, bar));
+            }
+        }
+    }
+    let grbl = [
+        ("50um", "grbl-Mega 1.1 (built from `TAUT_GRBL_MEGA`, its steps, rates, accelerations and junction deviation set to the flatbed's) in the same simulator: the flatbed's 0.05 mm stream over serial by the same character counting"),
+        ("200um", "the same with the 0.2 mm stream"),
+    ];
+    for (size, what) in grbl {
+        let key = format!("grbl_stream_{size}_serial_lines_per_s");
+        rows.extend(row(figures, shown, key, "lines/s", what.into(), None));
+    }
+    rows
 }
 
 fn table(out: &mut String, title: &str, rows: &[Row], missed: &mut Vec<String>) {
