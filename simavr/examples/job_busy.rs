@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::time::Duration;
 use taut_simavr::sdcard::SdImage;
-use taut_simavr::{Outcome, Sim};
+use taut_simavr::Sim;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let elf = Path::new(&args[1]);
@@ -43,25 +43,7 @@ fn main() {
     for pc in pcs.iter().flatten() {
         sim.watch_calls(*pc);
     }
-    let mut op = taut_simavr::operator::Operator::confirming();
-    let mark = |sim: &Sim| (sim.cycles() - sim.asleep_cycles(), sim.cycles());
-    let mut until = |sim: &mut Sim, state: &str| {
-        let from = sim.uart_text().len();
-        while !sim.uart_text()[from..].contains(state) {
-            assert_eq!(sim.run_for(Duration::from_millis(10)), Outcome::Running);
-            op.step(sim);
-            assert!(sim.time_s() < 1000.0);
-        }
-    };
-    let mut marks = Vec::new();
-    for state in [
-        "state: drilling",
-        "state: waiting for nails",
-        "state: winding",
-    ] {
-        until(&mut sim, state);
-        marks.push(mark(&sim));
-    }
+    let mut marks = taut_simavr::operator::Operator::confirming().job_phases(&mut sim);
     sim.enable_profile();
     sim.run_for(Duration::from_secs(30));
     if let Some(prof) = sim.profile() {
@@ -85,7 +67,7 @@ fn main() {
             }
         }
     }
-    marks.push(mark(&sim));
+    marks.push(taut_simavr::operator::awake_and_all(&sim));
     let busy = |a: usize| {
         let ((w0, t0), (w1, t1)) = (marks[a], marks[a + 1]);
         100.0 * (w1 - w0) as f64 / (t1 - t0) as f64

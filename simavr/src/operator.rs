@@ -65,6 +65,31 @@ impl Operator {
         }
     }
 
+    /// Runs the string-art job, this operator at the buttons, through its
+    /// drilling, the wait for nails and into the winding: the (awake, all)
+    /// cycles at each of the three, the MCU's busy share between them.
+    /// Panics past 1 000 s of simulated time or if the simulation stops.
+    pub fn job_phases(&mut self, sim: &mut Sim) -> Vec<(u64, u64)> {
+        let mut marks = Vec::new();
+        for state in [
+            "state: drilling",
+            "state: waiting for nails",
+            "state: winding",
+        ] {
+            let from = sim.uart_text().len();
+            while !sim.uart_text()[from..].contains(state) {
+                assert_eq!(
+                    sim.run_for(Duration::from_millis(10)),
+                    crate::Outcome::Running
+                );
+                self.step(sim);
+                assert!(sim.time_s() < 1000.0, "{}", sim.uart_text());
+            }
+            marks.push(awake_and_all(sim));
+        }
+        marks
+    }
+
     /// Reads the complete lines that arrived since the last call and acts
     /// on them; returns what was seen.
     pub fn step(&mut self, sim: &mut Sim) -> Vec<Seen> {
@@ -152,6 +177,11 @@ fn progress(msg: &str) -> Option<Seen> {
         done.parse().ok()?,
         total.parse().ok()?,
     ))
+}
+
+/// The cycles the MCU was awake and all cycles, so far.
+pub fn awake_and_all(sim: &Sim) -> (u64, u64) {
+    (sim.cycles() - sim.asleep_cycles(), sim.cycles())
 }
 
 #[cfg(test)]

@@ -346,28 +346,9 @@ fn job_figures(elf: &Path, card: &Path) -> (f64, f64, u64) {
     let mut sim = Sim::boot(elf);
     sim.insert_sd(SdImage::from_path(card).expect("sample card"));
     sim.watch_calls(motion);
-    let mut op = taut_simavr::operator::Operator::confirming();
-    // (awake, all) cycles so far.
-    let mark = |sim: &Sim| (sim.cycles() - sim.asleep_cycles(), sim.cycles());
-    let mut until = |sim: &mut Sim, state: &str| {
-        let from = sim.uart_text().len();
-        while !sim.uart_text()[from..].contains(state) {
-            assert_eq!(sim.run_for(Duration::from_millis(10)), Outcome::Running);
-            op.step(sim);
-            assert!(sim.time_s() < 1000.0, "{}", sim.uart_text());
-        }
-    };
-    let mut marks = Vec::new();
-    for state in [
-        "state: drilling",
-        "state: waiting for nails",
-        "state: winding",
-    ] {
-        until(&mut sim, state);
-        marks.push(mark(&sim));
-    }
+    let mut marks = taut_simavr::operator::Operator::confirming().job_phases(&mut sim);
     sim.run_for(Duration::from_secs(30));
-    marks.push(mark(&sim));
+    marks.push(taut_simavr::operator::awake_and_all(&sim));
     let busy = |a: usize| {
         let ((w0, t0), (w1, t1)) = (marks[a], marks[a + 1]);
         100.0 * (w1 - w0) as f64 / (t1 - t0) as f64
