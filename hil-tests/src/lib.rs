@@ -209,6 +209,29 @@ pub fn machine() -> sim::Sim {
     sim
 }
 
+/// The flatbed chosen on a first boot (kept in EEPROM), then the release
+/// image again with that EEPROM and the flatbed's X switch `at` steps from
+/// where X stands, not yet run: it homes X against it at power-on.
+pub fn flatbed_with_x_switch(at: i64) -> sim::Sim {
+    use taut_logic::axis::Axis;
+    use taut_logic::pinmap::{driver, Button};
+    let eeprom = {
+        let mut sim = boot_machine();
+        send_ok(
+            &mut sim,
+            "$machine=flatbed",
+            std::time::Duration::from_secs(2),
+        );
+        sim.run_for(std::time::Duration::from_secs(2));
+        sim.eeprom()
+    };
+    let mut sim = machine();
+    sim.set_eeprom(&eeprom);
+    let x = driver(Axis::Base);
+    sim.endstop(Button::ZeroBase.pin(), x.step, x.dir, true, at);
+    sim
+}
+
 /// The release image, nothing probed yet, not run; its drivers checked
 /// when it ends ([`drivers::check_at_end`]: probe STEP, DIR and ENABLE of
 /// any driver it moves).

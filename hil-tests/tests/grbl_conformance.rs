@@ -8,7 +8,7 @@
 //! line before it, left out here), `docs/console.md` says why.
 
 use hil_tests::sim::Sim;
-use hil_tests::{assert_ram_budget, boot_machine, log_tail, machine, send_ok, wait_for};
+use hil_tests::{assert_ram_budget, flatbed_with_x_switch, log_tail, send_ok, wait_for};
 use std::time::Duration;
 
 /// Grbl's reply lines to one line: `ok` / `error:N` and the feedback
@@ -146,18 +146,7 @@ fn offsets_and_modes(sim: &mut Sim) -> (Vec<String>, String) {
 /// next homes X against its simulated switch at power-on (X at 1.000, the
 /// pull-off above the switch at the travel's 0).
 pub fn homed_flatbed() -> Sim {
-    use taut_logic::axis::Axis;
-    use taut_logic::pinmap::{driver, Button};
-    let eeprom = {
-        let mut sim = boot_machine();
-        send_ok(&mut sim, "$machine=flatbed", Duration::from_secs(2));
-        sim.run_for(Duration::from_secs(2));
-        sim.eeprom()
-    };
-    let mut sim = machine();
-    sim.set_eeprom(&eeprom);
-    let x = driver(Axis::Base);
-    sim.endstop(Button::ZeroBase.pin(), x.step, x.dir, true, -120);
+    let mut sim = flatbed_with_x_switch(-120);
     wait_for(&mut sim, "homed", Duration::from_secs(20));
     send_ok(&mut sim, "M17", Duration::from_secs(2));
     sim

@@ -6,24 +6,13 @@
 //! character-counting sender's full 128 bytes fit as they always did.
 
 use hil_tests::sim::Sim;
-use hil_tests::{boot_machine, log_tail, machine, reported_steps, send_ok, wait_for, Rng};
+use hil_tests::{flatbed_with_x_switch, log_tail, reported_steps, wait_for, Rng};
 use std::time::Duration;
 
 /// The flatbed chosen (kept in EEPROM), booted again with its X switch
 /// `far` steps below where it stands: it homes at power-on meanwhile.
 fn flatbed_homing(far: i64) -> Sim {
-    use taut_logic::axis::Axis;
-    use taut_logic::pinmap::{driver, Button};
-    let eeprom = {
-        let mut sim = boot_machine();
-        send_ok(&mut sim, "$machine=flatbed", Duration::from_secs(2));
-        sim.run_for(Duration::from_secs(2));
-        sim.eeprom()
-    };
-    let mut sim = machine();
-    sim.set_eeprom(&eeprom);
-    let x = driver(Axis::Base);
-    sim.endstop(Button::ZeroBase.pin(), x.step, x.dir, true, -far);
+    let mut sim = flatbed_with_x_switch(-far);
     // Sent before the UART is set up a byte would be lost on the wire.
     wait_for(&mut sim, "reset:", Duration::from_millis(500));
     assert!(!sim.uart_text().contains("homed"), "{}", sim.uart_text());
