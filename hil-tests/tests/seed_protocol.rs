@@ -6,7 +6,7 @@
 //! same session.
 
 use hil_tests::sim::Sim;
-use hil_tests::{assert_ram_budget, boot_machine, log_tail, pen_deg_at, send_ok, settle, track};
+use hil_tests::{assert_ram_budget, boot_machine, pen_deg_at, send_ok, settle, track};
 use std::time::Duration;
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
