@@ -292,11 +292,11 @@ impl Console {
             }
             // A jog cancel or `$SLP` is braking: nothing new until it stands.
             if m.is_cancelling() {
-                return Poll::Wait(Signal::Motion);
+                return Poll::Wait(Signal::PlannerRoom);
             }
             match self.sleep {
                 Sleep::Awake => {}
-                Sleep::Falling if !m.is_idle() => return Poll::Wait(Signal::Motion),
+                Sleep::Falling if !m.is_idle() => return Poll::Wait(Signal::PlannerRoom),
                 // Only a reset wakes it: lines wait unread.
                 Sleep::Asleep => return Poll::Idle,
                 Sleep::Falling => {
@@ -434,7 +434,7 @@ impl Console {
                 }
                 Poll::Again
             }
-            Progress::Wait(Wait::Motion) => Poll::Wait(Signal::Motion),
+            Progress::Wait(Wait::Motion) => Poll::Wait(Signal::PlannerRoom),
             Progress::Wait(Wait::Refill) => Poll::Wait(Signal::Refilled),
             Progress::Wait(Wait::Ms(ms)) => Poll::After(ms),
             Progress::Wait(Wait::Again) => Poll::Again,

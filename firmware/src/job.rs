@@ -442,7 +442,7 @@ impl JobTask {
                     // The card's machine, not yet taken, before the pattern
                     // takes its place.
                     let _ = self.todo.insert(0, a);
-                    return Some(Poll::Wait(Signal::Motion));
+                    return Some(Poll::Wait(Signal::PlannerRoom));
                 }
                 Action::OpenPattern => {
                     self.configure(m, config);
@@ -460,12 +460,12 @@ impl JobTask {
                         m.cancel();
                     }
                     let _ = self.todo.insert(0, a);
-                    return Some(Poll::Wait(Signal::Motion));
+                    return Some(Poll::Wait(Signal::PlannerRoom));
                 }
                 Action::DriversOff(mask) if m.busy_axes() & mask != 0 => {
                     // Never from under an axis that a jog is moving.
                     let _ = self.todo.insert(0, a);
-                    return Some(Poll::Wait(Signal::Motion));
+                    return Some(Poll::Wait(Signal::PlannerRoom));
                 }
                 Action::StopMotion => {}
                 Action::DriversOn(mask) => m.drivers.set(mask, true),
@@ -473,7 +473,7 @@ impl JobTask {
                 Action::SetZero(_) if !m.is_idle() => {
                     // A console jog still running: zero where it ends.
                     let _ = self.todo.insert(0, a);
-                    return Some(Poll::Wait(Signal::Motion));
+                    return Some(Poll::Wait(Signal::PlannerRoom));
                 }
                 Action::Configure => self.configure(m, config),
                 Action::SetZero(axis) => {
@@ -517,7 +517,7 @@ impl JobTask {
         let mut rig = Rig { m, store };
         match self.feeder.run(&mut self.job, &mut rig, now, STEPS_PER_RUN) {
             Feeding::Again => Poll::Again,
-            Feeding::Motion => Poll::Wait(Signal::Motion),
+            Feeding::Motion => Poll::Wait(Signal::PlannerRoom),
             Feeding::After(ms) => Poll::After(ms),
             Feeding::Done => {
                 self.event(Event::MotionDone, now);

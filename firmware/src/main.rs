@@ -7,24 +7,17 @@
 //! is in `queues`; a task that must wait returns `rt::Poll`, and
 //! [`reschedule`] runs it again after a delay or on a [`Signal`].
 //!
-//! | task | kind | priority | input | output |
-//! | --- | --- | --- | --- | --- |
-//! | `TIMER3_COMPA` step events | interrupt | above all | `SEGMENTS`, `BLOCKS` | STEP/DIR pins |
-//! | `TIMER0_COMPA` 1 ms tick, button sampling | interrupt | | clock, timer alarm | `SAMPLES` |
-//! | `USART0_RX` | interrupt | | a byte | `REALTIME` (`?` `!` `~` Ctrl-X, which also stops the steps), else `RX` |
-//! | `USART0_UDRE` | interrupt | | `TX` | the wire |
-//! | `USART1_RX`, `USART1_UDRE` the second console (off on the string-art machine) | interrupt | | a byte; `TX1` | as USART0's (`?` flagged apart), `RX1`; the wire |
-//! | `Realtime` status, hold, resume, reset | software | 5 | `REALTIME` | `TX`, `TX1`, `JOB_CONTROL` |
-//! | `Console` one G-code line per run (waits for `Refilled` while the step queue runs short inside planned motion); a plotter's card print | software | 4 | `RX`, `RX1`; on a plotter `BUTTONS`, `CARD_OUT` | planner, `TX`, `TX1`, `CARD_IN`; signals `CardRoom` |
-//! | `Timers` fires due timers | software | 3 | `TIMERS` | |
-//! | `Refill` planner → segments while the queue holds < 30 ms of motion, a part per run, yielding to a ready task between parts | software | 3 | planner | `SEGMENTS`, `BLOCKS`; signals `Motion`; `Refilled` once the queue holds 16 ms or nothing is left to cut |
-//! | `Buttons` debouncing, long presses | software | 2 | `SAMPLES` | `BUTTONS` |
-//! | `Job` the string-art job's state machine | software | 2 | `BUTTONS`, `CARD_OUT`, `JOB_CONTROL` | planner, `CARD_IN`, `TX`; signals `CardRoom` |
-//! | `Led` status LED pattern (timed edges: runs before the long tasks) | software | 2 | its timer | |
-//! | `Card` SD reader: one block per run | software | 1 | `CARD_IN`, every 1 s | `CARD_OUT` |
-//! | `Motion` planner → segments, background | software | 1 | planner | as `Refill` |
-//! | `Logger` deferred reports | software | 0 | every 1 s | `TX` |
-//! | `Store` checkpoint, settings, coordinates, startup lines → EEPROM (two copies each), a changed byte per run | software | 0 | the job's checkpoint, signal `Settings` | EEPROM |
+//! The software tasks, their priorities, inputs and outputs are declared
+//! once, in the `tasks!` list below: the [`Task`] enum's doc is their
+//! table. The hardware tasks:
+//!
+//! | interrupt | priority | input | output |
+//! | --- | --- | --- | --- |
+//! | `TIMER3_COMPA` step events | above all | `SEGMENTS`, `BLOCKS` | STEP/DIR pins |
+//! | `TIMER0_COMPA` 1 ms tick, button sampling | nested | clock, timer alarm | `SAMPLES` |
+//! | `USART0_RX` | nested | a byte | `REALTIME` (`?` `!` `~` Ctrl-X, which also stops the steps), else `RX` |
+//! | `USART0_UDRE` | nested | `TX` | the wire |
+//! | `USART1_RX`, `USART1_UDRE` the second console (off on the string-art machine) | nested | a byte; `TX1` | as USART0's (`?` flagged apart), `RX1`; the wire |
 #![no_std]
 #![no_main]
 #![deny(unsafe_code)]
@@ -61,89 +54,111 @@ use taut_firmware::{
 use taut_firmware::{endstop, flash_str, info, reply, warn};
 use taut_logic::checkpoint::Found;
 use taut_logic::config::{MachineConfig, PenConfig};
-use taut_logic::kinematics::AnyKinematics;
+use taut_logic::kinematics::{AnyKinematics, Linear};
 use taut_logic::machine::Machine;
 use taut_logic::planner::Overrides;
-use taut_logic::sched::{Ready, TaskId, Timers};
+use taut_logic::sched::{Ready, Timers};
 
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Task {
-    Timers,
-    Realtime,
-    Refill,
-    Motion,
-    Console,
-    Buttons,
-    Job,
-    Card,
-    Logger,
-    Led,
-    Store,
-}
-
-const _: () = assert!(Task::ALL.len() <= 16, "interrupt spawns are a bit per task");
-
-impl Task {
-    /// Every task, in discriminant order (`Task::X as u8` indexes it).
-    const ALL: [Task; 11] = [
-        Task::Timers,
-        Task::Realtime,
-        Task::Refill,
-        Task::Motion,
-        Task::Console,
-        Task::Buttons,
-        Task::Job,
-        Task::Card,
-        Task::Logger,
-        Task::Led,
-        Task::Store,
-    ];
-}
-const _: () = {
-    let mut i = 0;
-    while i < Task::ALL.len() {
-        assert!(Task::ALL[i] as usize == i);
-        assert!(task_of(i as u8) as usize == i);
-        i += 1;
-    }
-};
-
-impl TaskId for Task {
-    const COUNT: usize = Task::ALL.len();
-    fn index(self) -> usize {
-        self as usize
-    }
-    fn priority(self) -> u8 {
-        match self {
-            Task::Realtime => 5,
-            // Above the urgent refill: a ready console waits for at most
-            // one part of a segment (the refill yields at its parts'
-            // boundaries, `Motion::yield_to`), and its own runs are short.
-            Task::Console => 4,
-            Task::Timers | Task::Refill => 3,
-            Task::Buttons | Task::Job | Task::Led => 2,
-            Task::Card | Task::Motion => 1,
-            Task::Logger | Task::Store => 0,
-        }
-    }
+taut_firmware::tasks! {
+    Timers {
+        priority: 3,
+        runs: timers,
+        does: "fires due timers",
+        input: "`TIMERS`",
+        output: "",
+    },
+    Realtime {
+        priority: 5,
+        runs: realtime,
+        does: "status, hold, resume, reset",
+        input: "`REALTIME`",
+        output: "`TX`, `TX1`, `JOB_CONTROL`",
+    },
+    Refill {
+        priority: 3,
+        runs: motion,
+        does: "planner → segments while the step queue holds < 30 ms of motion, a part per run, yielding to a ready task between parts",
+        input: "planner",
+        output: "`SEGMENTS`, `BLOCKS`; signals `PlannerRoom`; `Refilled` once the queue holds 16 ms or nothing is left to cut",
+    },
+    Prepare {
+        priority: 1,
+        runs: motion,
+        does: "planner → segments in the background: the step queue is long enough, or the machine is not stepping",
+        input: "planner",
+        output: "as `Refill`",
+    },
+    // Above the urgent refill: a ready console waits for at most one part
+    // of a segment (the refill yields at its parts' boundaries,
+    // `Motion::yield_to`), and its own runs are short.
+    Console {
+        priority: 4,
+        runs: console,
+        does: "one G-code line per run (waits for `Refilled` while the step queue runs short inside planned motion); a plotter's card print",
+        input: "`RX`, `RX1`; on a plotter `BUTTONS`, `CARD_OUT`",
+        output: "planner, `TX`, `TX1`, `CARD_IN`; signals `CardRoom`",
+    },
+    Buttons {
+        priority: 2,
+        runs: buttons,
+        does: "debouncing, long presses",
+        input: "`SAMPLES`",
+        output: "`BUTTONS`",
+    },
+    Job {
+        priority: 2,
+        runs: job,
+        does: "the string-art job's state machine",
+        input: "`BUTTONS`, `CARD_OUT`, `JOB_CONTROL`",
+        output: "planner, `CARD_IN`, `TX`; signals `CardRoom`",
+    },
+    Card {
+        priority: 1,
+        runs: card,
+        does: "SD reader: one block per run",
+        input: "`CARD_IN`, every 1 s",
+        output: "`CARD_OUT`",
+    },
+    Logger {
+        priority: 0,
+        runs: logger,
+        does: "deferred reports",
+        input: "every 1 s",
+        output: "`TX`",
+    },
+    Led {
+        priority: 2,
+        runs: led,
+        does: "status LED pattern (timed edges: runs before the long tasks)",
+        input: "its timer",
+        output: "",
+    },
+    Store {
+        priority: 0,
+        runs: store,
+        does: "checkpoint, settings, coordinates, startup lines → EEPROM (two copies each), a changed byte per run",
+        input: "the job's checkpoint, signal `Settings`",
+        output: "EEPROM",
+    },
 }
 
 /// Task ids spawned by interrupts, moved into `READY` by the dispatcher.
 static SPAWNED: Spawned = Spawned::new();
 // Software tasks only: no masking needed.
-static READY: TaskCell<Ready<Task, 11, 6>> = TaskCell::new(Ready::new());
+static READY: TaskCell<Ready<Task, { Task::ALL.len() }, { Task::LEVELS }>> =
+    TaskCell::new(Ready::new());
 static TIMERS: TaskCell<Timers<Task, 8>> = TaskCell::new(Timers::new());
 /// Tasks waiting for each [`Signal`] (bit = task).
 static WAITING: TaskCell<[u16; SIGNALS]> = TaskCell::new([0; SIGNALS]);
-static MOTION: TaskCell<Option<Motion>> = TaskCell::zeroed();
+static MOTION: TaskCell<Motion> = TaskCell::zeroed();
 static CONSOLE: TaskCell<Console> = TaskCell::zeroed();
 static CONFIG: TaskCell<MachineConfig> = TaskCell::zeroed();
 /// The kinematics of `CONFIG`, rebuilt when a setting changes.
-static KIN: TaskCell<Option<AnyKinematics>> = TaskCell::zeroed();
+static KIN: TaskCell<AnyKinematics> = TaskCell::zeroed();
 static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::new(ButtonsTask::new());
 static JOB: TaskCell<JobTask> = TaskCell::zeroed();
-static CARD: TaskCell<Option<CardReader>> = TaskCell::zeroed();
-static STORE: TaskCell<Option<Store>> = TaskCell::zeroed();
+static CARD: TaskCell<CardReader> = TaskCell::zeroed();
+static STORE: TaskCell<Store> = TaskCell::zeroed();
 
 /// Boot blink of the status LED: this many flashes, 100 ms on, 100 ms off.
 const BOOT_BLINKS: u32 = 3;
@@ -182,24 +197,6 @@ fn signal(s: Signal) {
     }
 }
 
-/// `Task::ALL[id]`, worked out: a table would sit in SRAM.
-const fn task_of(id: u8) -> Task {
-    match id {
-        0 => Task::Timers,
-        1 => Task::Realtime,
-        2 => Task::Refill,
-        3 => Task::Motion,
-        4 => Task::Console,
-        5 => Task::Buttons,
-        6 => Task::Job,
-        7 => Task::Card,
-        8 => Task::Logger,
-        9 => Task::Led,
-        10 => Task::Store,
-        _ => unreachable!(),
-    }
-}
-
 /// Spawn `task` in `ms`, replacing its earlier one-shot timer.
 fn spawn_after(task: Task, ms: u32) {
     arm(|t, now| t.spawn_after(task, now, ms).is_ok());
@@ -234,18 +231,7 @@ fn main() -> ! {
         task_of,
         clock::millis,
         || watchdog.feed(),
-        |task| match task {
-            Task::Timers => timers(),
-            Task::Realtime => realtime(),
-            Task::Refill | Task::Motion => motion(),
-            Task::Console => console(),
-            Task::Buttons => buttons(),
-            Task::Job => job(),
-            Task::Card => card(),
-            Task::Logger => logger(),
-            Task::Store => store(),
-            Task::Led => led(),
-        },
+        Task::run,
     )
 }
 
@@ -266,9 +252,8 @@ fn init() -> Watchdog {
     usart::Usart0::start(dp.USART0);
     let (store_now, found) = load_store(Eeprom::new(dp.EEPROM));
     // The stored `G54` offset in force.
-    STORE.with(|s| CONSOLE.with(|c| c.boot(s.as_ref().unwrap().coords())));
-    // Settings are only taken whole, kinematics included: never `None`.
-    KIN.with(|k| *k = CONFIG.with(|c| AnyKinematics::of(c).ok()));
+    STORE.with(|s| CONSOLE.with(|c| c.boot(s.coords())));
+    start_kinematics();
     let enable = EnablePins {
         base: pins.d38.into_output(),
         radial: pins.a2.into_output(),
@@ -335,7 +320,7 @@ fn init() -> Watchdog {
         }
     }
     let (saved, note) = checkpoint::found(found, reset);
-    match store_now || STORE.with(|s| s.as_ref().unwrap().saving()) {
+    match store_now || STORE.with(|s| s.saving()) {
         true => spawn(Task::Store),
         false => reschedule(Task::Store, Poll::Wait(Signal::Settings)),
     }
@@ -346,10 +331,10 @@ fn init() -> Watchdog {
     spawn(Task::Card);
     // A machine that homes at power-on (the flatbed's X) does so first.
     let homing = CONFIG.with(|c| c.homing);
-    let enabled = CONFIG.with(|c| STORE.with(|s| s.as_ref().unwrap().extras().homing_enabled(c)));
+    let enabled = CONFIG.with(|c| STORE.with(|s| s.extras().homing_enabled(c)));
     if homing.at_start && enabled {
         info!("homing");
-        MOTION.with(|m| CONSOLE.with(|c| c.start_homing(homing.axes, m.as_mut().unwrap(), false)));
+        MOTION.with(|m| CONSOLE.with(|c| c.start_homing(homing.axes, m, false)));
     }
     // The startup lines (after the homing, if any).
     if homing.at_start && enabled || startup_lines() {
@@ -360,7 +345,11 @@ fn init() -> Watchdog {
     // so later, behind the boot's higher-priority tasks.
     let mut status_led = status_led;
     let _ = status_led.set_high();
-    LED.with(|l| *l = Some((status_led, clock::millis())));
+    LED.init(StatusLed {
+        pin: status_led,
+        start: clock::millis(),
+        done: false,
+    });
     spawn(Task::Led);
 
     watchdog
@@ -372,12 +361,34 @@ fn init() -> Watchdog {
 #[inline(never)]
 #[optimize(size)]
 fn init_cells() {
-    MOTION.init(None);
     CONSOLE.init(Console::new());
-    KIN.init(None);
     JOB.init(JobTask::new());
-    CARD.init(None);
-    STORE.init(None);
+}
+
+/// The kinematics of the settings loaded. Settings are only taken whole,
+/// their kinematics checked (`settings::check_whole`), so `of` cannot fail
+/// here; were it to, the cylindrical kinematics (always made) keeps the
+/// machine answering rather than halting it at boot.
+#[inline(never)]
+#[optimize(size)]
+fn start_kinematics() {
+    CONFIG.with(|c| {
+        KIN.init(
+            AnyKinematics::of(c).unwrap_or_else(|_| AnyKinematics::Linear(Linear::cylindrical(c))),
+        )
+    });
+}
+
+/// `CONFIG` changed: its kinematics, the old kept if the new settings had
+/// none (they cannot: they are taken whole).
+fn kinematics_changed() {
+    CONFIG.with(|cfg| {
+        KIN.with(|kin| {
+            if let Ok(k) = AnyKinematics::of(cfg) {
+                *kin = k;
+            }
+        })
+    });
 }
 
 /// Settings and checkpoint from EEPROM into `CONFIG` and `STORE`: whether
@@ -391,10 +402,9 @@ fn load_store(eeprom: Eeprom) -> (bool, Found) {
     // as the defaults, read from flash (a starting value in `.data` would
     // be a second copy of them in flash), in place: a copy would sit on
     // init's stack.
-    STORE.with(|s| *s = Some(Store::new(eeprom)));
+    STORE.init_with(|s| s.write(Store::new(eeprom)));
     CONFIG.init_with(|c| MachineConfig::init_defaults(Machine::StringArt, c));
-    STORE.with(|s| {
-        let store = s.as_mut().unwrap();
+    STORE.with(|store| {
         let store_now = CONFIG.with(|c| store.load(c));
         usart::set_xonxoff(store.extras().xonxoff());
         usart::release_sender();
@@ -429,9 +439,10 @@ fn boot_log(reset: ResetCause) {
 #[inline(never)]
 #[optimize(size)]
 fn start_motion(stepper: Stepper, drivers: Drivers, pen: PenServo) {
-    MOTION.with(|m| {
-        let motion = m.insert(Motion::new(stepper, drivers, pen));
+    MOTION.init_with(|m| {
+        let motion = m.write(Motion::new(stepper, drivers, pen));
         motion.yield_to(others_ready);
+        motion
     });
 }
 
@@ -447,7 +458,7 @@ fn others_ready() -> bool {
 #[inline(never)]
 #[optimize(size)]
 fn start_card(spi: CardSpi) {
-    CARD.with(|c| *c = Some(CardReader::new(spi)));
+    CARD.init_with(|c| c.write(CardReader::new(spi)));
 }
 
 /// Move due timers into the ready set and re-arm the tick's alarm.
@@ -472,7 +483,6 @@ fn motion() {
     /// segment, ≤ ~1 ms each): one keeps the console's wait short.
     const BATCH: usize = 1;
     let (freed, more, idle, stepping, release, refilling) = MOTION.with(|m| {
-        let m = m.as_mut().unwrap();
         let (freed, more) = m.refill(BATCH);
         let idle = m.is_idle();
         // The clock only while standing: reading it masks interrupts,
@@ -495,7 +505,7 @@ fn motion() {
     });
     // Drivers wait to go off after the step idle delay (`$1`).
     if let Some(ms) = release {
-        spawn_after(Task::Motion, ms);
+        spawn_after(Task::Prepare, ms);
     }
     // Urgent only while steps run out of it: standing, a motion's first
     // profile and segments wait behind a console line (≤ 1 ms) rather
@@ -504,11 +514,11 @@ fn motion() {
         spawn(if stepping {
             refill_task()
         } else {
-            Task::Motion
+            Task::Prepare
         });
     }
     if freed || idle {
-        signal(Signal::Motion);
+        signal(Signal::PlannerRoom);
     }
     // A console waiting for the refill (`Motion::starving`, a piece held
     // back) goes on.
@@ -523,7 +533,7 @@ fn refill_task() -> Task {
     if motion::urgent() {
         Task::Refill
     } else {
-        Task::Motion
+        Task::Prepare
     }
 }
 
@@ -537,10 +547,8 @@ fn console() {
     let (poll, store_due) = MOTION.with(|m| {
         CONFIG.with(|cfg| {
             KIN.with(|kin| {
-                let kin = kin.as_ref().unwrap();
                 STORE.with(|s| {
-                    let s = s.as_mut().unwrap();
-                    let poll = CONSOLE.with(|c| c.poll(m.as_mut().unwrap(), kin, cfg, owner, s));
+                    let poll = CONSOLE.with(|c| c.poll(m, kin, cfg, owner, s));
                     (poll, s.wants_run())
                 })
             })
@@ -551,7 +559,7 @@ fn console() {
         signal(Signal::Settings);
     }
     // New moves may be queued: the motion task feeds them to the stepper.
-    spawn(Task::Motion);
+    spawn(Task::Prepare);
     // A print's checkpoint write (or its offer) waits for the store or for
     // room: the console comes back for it, with no line to read too.
     let poll = match poll {
@@ -579,7 +587,7 @@ fn console() {
 /// line: the kinematics it makes stay off the console's frame.
 #[inline(never)]
 fn console_settings_changed() {
-    CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
+    kinematics_changed();
     // The string-art job runs only on its machine.
     spawn(Task::Job);
 }
@@ -591,12 +599,10 @@ fn console_settings_changed() {
 fn realtime() {
     let r = Requests::take();
     MOTION.with(|m| {
-        let m = m.as_mut().unwrap();
         let activity = CONSOLE.with(|c| c.activity());
         if r.reset() {
             let moving = m.stop_now();
             STORE.with(|s| {
-                let s = s.as_ref().unwrap();
                 CONSOLE.with(|c| c.reset(s.coords()));
                 // `$uart1_baud` and `$machine` set since, in force.
                 CONFIG.with(|c| usart1::configure(s.extras().uart1(c.machine)));
@@ -648,7 +654,7 @@ fn realtime() {
     // A hold or a resume changes what the motion task prepares; a reset
     // frees the planner for whoever waits.
     spawn(Task::Refill);
-    signal(Signal::Motion);
+    signal(Signal::PlannerRoom);
 }
 
 /// A status report to `port`, or again in a millisecond when its TX ring
@@ -662,16 +668,14 @@ fn status(m: &Motion, activity: Activity, port: Port) {
     let frame = CONSOLE.with(|c| c.frame());
     KIN.with(|kin| {
         CONFIG.with(|cfg| {
-            STANDING.with(|rt| {
-                realtime::status(port, m, kin.as_ref().unwrap(), cfg, activity, &frame, rt)
-            })
+            STANDING.with(|rt| realtime::status(port, m, kin, cfg, activity, &frame, rt))
         })
     });
 }
 
 /// A startup line is kept: the console runs it.
 fn startup_lines() -> bool {
-    STORE.with(|s| s.as_ref().unwrap().has_startup_lines())
+    STORE.with(|s| s.has_startup_lines())
 }
 
 fn control_job(c: Control) {
@@ -708,8 +712,7 @@ fn job() {
     let (poll, saving) = MOTION.with(|m| {
         CONFIG.with(|cfg| {
             STORE.with(|s| {
-                let s = s.as_mut().unwrap();
-                let poll = JOB.with(|j| j.poll(m.as_mut().unwrap(), cfg, s, now));
+                let poll = JOB.with(|j| j.poll(m, cfg, s, now));
                 (poll, s.saving())
             })
         })
@@ -721,7 +724,7 @@ fn job() {
     if CONFIG.with(|cfg| cfg.machine) != machine {
         machine_switched();
     }
-    spawn(Task::Motion);
+    spawn(Task::Prepare);
     reschedule(Task::Job, poll);
     if !CARD_IN.is_empty() {
         spawn(Task::Card);
@@ -736,7 +739,7 @@ fn job() {
 /// task's frame under its deepest calls.
 #[inline(never)]
 fn machine_switched() {
-    CONFIG.with(|cfg| KIN.with(|kin| *kin = AnyKinematics::of(cfg).ok()));
+    kinematics_changed();
     settings_changed();
     spawn(Task::Console);
 }
@@ -746,8 +749,8 @@ fn card() {
     let now = clock::millis();
     // Looking for a card holds the bus at the slow init clock for ~1.5 ms:
     // not while the machine moves (the refill would wait).
-    let moving = MOTION.with(|m| !m.as_ref().unwrap().is_idle());
-    let poll = CARD.with(|c| c.as_mut().unwrap().poll(now, moving));
+    let moving = MOTION.with(|m| !m.is_idle());
+    let poll = CARD.with(|c| c.poll(now, moving));
     reschedule(Task::Card, poll);
     if !CARD_OUT.is_empty() {
         spawn(card_owner());
@@ -756,7 +759,7 @@ fn card() {
 
 /// Settings changed: their image goes to EEPROM.
 fn settings_changed() {
-    STORE.with(|s| s.as_mut().unwrap().settings_changed());
+    STORE.with(|s| s.settings_changed());
     signal(Signal::Settings);
 }
 
@@ -765,7 +768,7 @@ fn settings_changed() {
 #[inline(never)]
 #[optimize(size)]
 fn store() {
-    let poll = CONFIG.with(|cfg| STORE.with(|s| s.as_mut().unwrap().poll(cfg)));
+    let poll = CONFIG.with(|cfg| STORE.with(|s| s.poll(cfg)));
     reschedule(Task::Store, poll);
 }
 
@@ -773,7 +776,7 @@ fn store() {
 #[inline(never)]
 fn logger() {
     static LAST_FAULTS: TaskCell<(u16, u16)> = TaskCell::new((0, 0));
-    let faults = MOTION.with(|m| m.as_ref().unwrap().stepper.faults());
+    let faults = MOTION.with(|m| m.stepper.faults());
     LAST_FAULTS.with(|last| {
         if faults != *last {
             warn!("step late:", faults.0, " underruns:", faults.1);
@@ -786,8 +789,13 @@ fn logger() {
     }
 }
 
-/// The status LED and when its boot pattern started.
-static LED: TaskCell<Option<(Pin<13, Output>, u32)>> = TaskCell::new(None);
+/// The status LED, when its boot pattern started, and whether it is over.
+struct StatusLed {
+    pin: Pin<13, Output>,
+    start: u32,
+    done: bool,
+}
+static LED: TaskCell<StatusLed> = TaskCell::zeroed();
 const _: () = assert!(taut_logic::pinmap::STATUS_LED == 13);
 
 /// The status LED: `BOOT_BLINKS` flashes of 100 ms at boot, then off.
@@ -795,20 +803,20 @@ const _: () = assert!(taut_logic::pinmap::STATUS_LED == 13);
 fn led() {
     let now = clock::millis();
     LED.with(|l| {
-        let Some((led, start)) = l.as_mut() else {
+        if l.done {
             return;
-        };
-        let t = now.wrapping_sub(*start);
+        }
+        let t = now.wrapping_sub(l.start);
         let phase = t / 100;
         if phase >= BOOT_BLINKS * 2 {
-            let _ = led.set_low();
-            *l = None;
+            let _ = l.pin.set_low();
+            l.done = true;
             return;
         }
         let _ = if phase % 2 == 0 {
-            led.set_high()
+            l.pin.set_high()
         } else {
-            led.set_low()
+            l.pin.set_low()
         };
         spawn_after(Task::Led, 100 - t % 100);
     });

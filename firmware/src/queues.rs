@@ -137,9 +137,9 @@ pub enum Control {
 /// runs the waiting tasks when the condition's producer signals it.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Signal {
-    /// The motion task freed planner room (took a block, or the step
-    /// interrupt began one) or the machine came to rest.
-    Motion,
+    /// The planner has room for a block: the refill took one, the step
+    /// interrupt began one, or the machine came to rest (all of it free).
+    PlannerRoom,
     /// The step queue is refilled (`Motion::refilling` is over).
     Refilled,
     /// The job took messages from [`CARD_OUT`].

@@ -9,6 +9,7 @@ pub mod nested;
 pub mod ring;
 pub mod stack;
 pub mod task_cell;
+pub mod tasks;
 
 pub use flags::{Flags, Tally};
 
