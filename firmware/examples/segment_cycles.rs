@@ -1,4 +1,4 @@
-//! What a ramp costs the motion task on the AVR, for `cargo xtask bench`:
+//! What a ramp costs segment preparation on the AVR, for `cargo xtask bench`:
 //! the status LED (D13) is high while each batch runs, so the harness
 //! reads the cycles from its edges. In turn: 64 square roots of 64-bit
 //! speeds², 64 trapezoids made, 64 event times read off one, and every

@@ -434,7 +434,7 @@ impl Console {
                 }
                 Poll::Again
             }
-            Progress::Wait(Wait::Motion) => Poll::Wait(Signal::PlannerRoom),
+            Progress::Wait(Wait::PlannerRoom) => Poll::Wait(Signal::PlannerRoom),
             Progress::Wait(Wait::Refill) => Poll::Wait(Signal::Refilled),
             Progress::Wait(Wait::Ms(ms)) => Poll::After(ms),
             Progress::Wait(Wait::Again) => Poll::Again,

@@ -132,7 +132,7 @@ impl Drivers {
         self.since = None;
     }
 
-    /// Called with the time whenever the motion task finds the machine
+    /// Called with the time whenever segment preparation finds the machine
     /// standing (nothing queued, no step running; [`Drivers::moving`]
     /// otherwise): once it has stood for the idle delay, the drivers that
     /// do not hold go off. Returns the ms until it should be called again,

@@ -517,7 +517,7 @@ impl JobTask {
         let mut rig = Rig { m, store };
         match self.feeder.run(&mut self.job, &mut rig, now, STEPS_PER_RUN) {
             Feeding::Again => Poll::Again,
-            Feeding::Motion => Poll::Wait(Signal::PlannerRoom),
+            Feeding::PlannerRoom => Poll::Wait(Signal::PlannerRoom),
             Feeding::After(ms) => Poll::After(ms),
             Feeding::Done => {
                 self.event(Event::MotionDone, now);

@@ -1,5 +1,5 @@
 //! The executor's machine (`taut_logic::interp::MachineIo`) on the board:
-//! moves into the motion task's planner, the pen servo, the drivers, the
+//! moves into segment preparation's planner, the pen servo, the drivers, the
 //! clock, and the work coordinate data (the store's, kept in EEPROM).
 
 use crate::board::clock;
@@ -37,7 +37,7 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
 
     fn room(&mut self, piece: bool) -> Option<Wait> {
         if !self.m.has_room() {
-            return Some(Wait::Motion);
+            return Some(Wait::PlannerRoom);
         }
         // A piece is not cut while the refill is filling the step queue
         // with pieces planned ahead: planning one takes a few ms, which

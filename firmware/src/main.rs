@@ -76,14 +76,14 @@ taut_firmware::tasks! {
     },
     Refill {
         priority: 3,
-        runs: motion,
+        runs: prepare_segments,
         does: "planner → segments while the step queue holds < 30 ms of motion, a part per run, yielding to a ready task between parts",
         input: "planner",
         output: "`SEGMENTS`, `BLOCKS`; signals `PlannerRoom`; `Refilled` once the queue holds 16 ms or nothing is left to cut",
     },
     Prepare {
         priority: 1,
-        runs: motion,
+        runs: prepare_segments,
         does: "planner → segments in the background: the step queue is long enough, or the machine is not stepping",
         input: "planner",
         output: "as `Refill`",
@@ -186,7 +186,7 @@ fn reschedule(task: Task, poll: Poll<Signal>) {
 fn signal(s: Signal) {
     let mut waiting = WAITING.with(|w| core::mem::take(&mut w[s as usize]));
     // A bit at a time: a shift by `id` is a loop on the AVR, and the
-    // motion task signals after nearly every run, mostly to no one.
+    // segment preparation signals after nearly every run, mostly to no one.
     let mut id = 0;
     while waiting != 0 {
         if waiting & 1 != 0 {
@@ -369,7 +369,6 @@ fn init_cells() {
 /// their kinematics checked (`settings::check_whole`), so `of` cannot fail
 /// here; were it to, the cylindrical kinematics (always made) keeps the
 /// machine answering rather than halting it at boot.
-#[inline(never)]
 #[optimize(size)]
 fn start_kinematics() {
     CONFIG.with(|c| {
@@ -433,7 +432,7 @@ fn boot_log(reset: ResetCause) {
     }
 }
 
-/// The motion task's state. Out of `init` (also `start_card`): built on
+/// Segment preparation's state (`Motion`). Out of `init` (also `start_card`): built on
 /// the stack and copied into place, a big value would stay in `init`'s
 /// frame under everything `init` calls (the stack peak at boot).
 #[inline(never)]
@@ -447,7 +446,7 @@ fn start_motion(stepper: Stepper, drivers: Drivers, pen: PenServo) {
 }
 
 /// Another task waits to run (an interrupt spawned it, or it is ready): a
-/// motion run ends at its next part's boundary. Read without masking, as
+/// segment preparation run ends at its next part's boundary. Read without masking, as
 /// `dispatch::admit` looks first: with masked reads on every spawn and
 /// check, the `scheduler` HIL test measured a cruise pulse 2.03 µs off its
 /// grid (the bar is 2).
@@ -478,7 +477,7 @@ fn timers() {
 
 #[inline(never)]
 #[optimize(speed)]
-fn motion() {
+fn prepare_segments() {
     /// Pieces of work per run (a part of a block's profile or of a
     /// segment, ≤ ~1 ms each): one keeps the console's wait short.
     const BATCH: usize = 1;
@@ -558,7 +557,7 @@ fn console() {
     if store_due {
         signal(Signal::Settings);
     }
-    // New moves may be queued: the motion task feeds them to the stepper.
+    // New moves may be queued: segment preparation feeds them to the stepper.
     spawn(Task::Prepare);
     // A print's checkpoint write (or its offer) waits for the store or for
     // room: the console comes back for it, with no line to read too.
@@ -651,7 +650,7 @@ fn realtime() {
             }
         });
     });
-    // A hold or a resume changes what the motion task prepares; a reset
+    // A hold or a resume changes what segment preparation makes; a reset
     // frees the planner for whoever waits.
     spawn(Task::Refill);
     signal(Signal::PlannerRoom);

@@ -1,5 +1,5 @@
-//! The motion task's state: planner → segment preparer → the step
-//! interrupt's queues. Grbl's `planner` and `st_prep_buffer` in one place,
+//! Segment preparation's state (the app's `Refill` and `Prepare` tasks):
+//! planner → segment preparer → the step interrupt's queues. Grbl's `planner` and `st_prep_buffer` in one place,
 //! with its feed hold (`!`/`~`), its stop at once (Ctrl-X) and a stop that
 //! abandons the rest of the queued motion (a pulled card).
 

@@ -32,7 +32,7 @@ pub static REALTIME: Flags = Flags::new();
 /// and ±1 % presses since the last run, summed (each one counts).
 pub static FEED_PRESSES: Tally = Tally::new();
 
-/// Motion task → step interrupt: segments, and the blocks they start.
+/// Segment preparation → step interrupt: segments, and the blocks they start.
 pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
 /// Slots of the segment ring (one fewer can be queued). The shortest
 /// segments are a top-speed ramp's, 128 events (2.2 ms at 59 kHz): 15 of

@@ -378,7 +378,7 @@ impl Stepper {
     }
 
     /// The interrupt is idle and segments wait: take the first, start the
-    /// timer. Out of line: its locals stay off the motion task's frame,
+    /// timer. Out of line: its locals stay off segment preparation's frame,
     /// under the preparer's calls.
     #[inline(never)]
     #[optimize(speed)]
@@ -591,7 +591,7 @@ fn begin_block(e: &mut Exec, block: &StepBlock) {
     e.coil_due = 0;
 }
 
-/// [`Segment::flags`] bit, set by the motion task: every event of the
+/// [`Segment::flags`] bit, set by segment preparation: every event of the
 /// segment may take the assembly fast path.
 pub const FAST: u8 = 0x80;
 
@@ -603,7 +603,7 @@ pub fn every_event(block: &StepBlock) -> bool {
 
 /// Whether `seg`, of a block that steps [`every_event`], can take the
 /// fast path: no interval needs a split wait (the 24.8 fraction adds
-/// under one tick). Run by the motion task, not the interrupt.
+/// under one tick). Run by segment preparation, not the interrupt.
 pub fn fast_segment(seg: &Segment) -> bool {
     let last = seg.interval as i64 + i64::from(seg.add) * i64::from(u16::max(seg.count, 1) - 1);
     let longest = last.max(seg.interval as i64) + 255;
@@ -796,7 +796,7 @@ unsafe fn toggle_steps(m: &[u8; SLOTS]) {
 /// The `TIMER3_COMPA` interrupt's general path, entered from the assembly
 /// entry in `fast.rs`, which has raised the STEP pins unless this compare
 /// match is part of a split wait (it handles plain events itself). Returns true when the segment queue
-/// wants refilling (the app then spawns the motion task).
+/// wants refilling (the app then spawns the `Refill` or `Prepare` task).
 #[inline(always)]
 pub fn on_compare() -> bool {
     let e = exec();

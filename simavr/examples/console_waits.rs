@@ -19,7 +19,7 @@ fn main() {
     let tasks = [
         "4taut7console",
         "4taut8realtime",
-        "4taut6motion",
+        "4taut16prepare_segments",
         "4taut3job",
         "4taut4card",
         "4taut5store",

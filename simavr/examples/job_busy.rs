@@ -1,5 +1,5 @@
 //! `job_busy ELF`: the bench's busy figures of the demo job alone, with
-//! the winding window's cycles by function and the motion task's longest
+//! the winding window's cycles by function and segment preparation's longest
 //! runs (what is inside them). After `cargo xtask build`:
 //! `cargo run --release -p taut-simavr --example job_busy -- \
 //!    firmware/target/avr-none/release/taut.elf`. With `PCS=FROM-TO` (hex
@@ -12,7 +12,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let elf = Path::new(&args[1]);
     let card = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/card");
-    let motion = taut_simavr::elf::function_address(elf, "4taut6motion")
+    let motion = taut_simavr::elf::function_address(elf, "4taut16prepare_segments")
         .unwrap()
         .unwrap();
     let mut sim = Sim::boot(elf);
@@ -97,7 +97,7 @@ fn main() {
         .collect();
     let tot: u64 = w.iter().map(|x| x.1).sum();
     println!(
-        "motion task in winding: {} runs, {} cycles/s ({:.2} %), mean {}",
+        "segment preparation in winding: {} runs, {} cycles/s ({:.2} %), mean {}",
         w.len(),
         tot as f64 / t_wind,
         tot as f64 / t_wind / 16e4,

@@ -3,7 +3,7 @@
 //! random 3-axis moves, a `?` every tenth, no card in the slot; prints the
 //! three longest console runs with the calls inside them, then each
 //! watched function's run count, longest and 99th percentile (cycles),
-//! the motion task's (segment preparation) last. With `scara` or
+//! segment preparation's last. With `scara` or
 //! `whiteboard` as its argument, that machine streams 100 random lines of
 //! its work area instead (each cut into pieces, each piece converted and
 //! planned along the pen).
@@ -40,8 +40,8 @@ fn main() {
         "5ScaraNtB6_10Kinematics7inverse",
         "4taut8realtime",
         "realtime6status",
-        // The motion task: a block's profile and segments cut in parts.
-        "4taut6motion",
+        // Segment preparation: a block's profile and segments cut in parts.
+        "4taut16prepare_segments",
     ];
     let machine = std::env::args().nth(1);
     // Those the build has (inlined functions have no symbol).

@@ -15,7 +15,7 @@ pub struct Frame {
     pub depth: usize,
     /// Bytes of this frame.
     pub bytes: usize,
-    /// Function and offset, e.g. `taut::motion+0x30e`.
+    /// Function and offset, e.g. `taut::prepare_segments+0x30e`.
     pub at: String,
 }
 

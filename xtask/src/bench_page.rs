@@ -95,7 +95,7 @@ const SECTIONS: &[(&str, &[Figure])] = &[
             fig("status_report_latency_p90_us", "µs", "the same, 90th percentile"),
             fig("dispatch_latency_cycles", "cycles", "a line's byte received → the `Console` task starts, worst"),
             fig("dispatch_latency_p90_cycles", "cycles", "the same, 90th percentile"),
-            fig("segment_prep_max_cycles", "cycles", "the motion task's longest run during the demo job (segment preparation)"),
+            fig("segment_prep_max_cycles", "cycles", "segment preparation's longest run during the demo job"),
         ],
     ),
     (

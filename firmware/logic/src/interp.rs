@@ -70,8 +70,9 @@ pub struct Env<'a, K: Kinematics> {
 /// What the executor waits for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Wait {
-    /// Room in the planner, or the motion before to end.
-    Motion,
+    /// Room in the planner, or the motion before to end (the app's
+    /// `Signal::PlannerRoom`).
+    PlannerRoom,
     /// The step queue to be refilled from the moves planned ahead:
     /// planning another now would take the time the refill needs.
     Refill,

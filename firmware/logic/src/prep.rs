@@ -1,5 +1,5 @@
 //! From the planner's blocks to the step interrupt's segments, with feed
-//! hold: Grbl's `st_prep_buffer`. The firmware's motion task calls
+//! hold: Grbl's `st_prep_buffer`. The firmware's segment preparation calls
 //! [`Prep::next`] while the step queue has room and queues what it returns.
 //!
 //! A hold ([`Prep::hold`]) brakes at the block's acceleration from the speed

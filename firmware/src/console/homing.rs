@@ -1,6 +1,6 @@
 //! Homing (`$H`, and at power-on where `homing_at_start` says): the
 //! logic crate's homing legs (`taut_logic::homing`) driven against the
-//! motion task and the switches, one leg at a time.
+//! planner, segment preparation and the switches, one leg at a time.
 
 use super::Console;
 use crate::endstop;

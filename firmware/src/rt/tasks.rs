@@ -30,7 +30,7 @@ macro_rules! tasks {
             )*
         )]
         #[derive(Clone, Copy, PartialEq, Eq)]
-        #[repr(u8)]
+
         enum Task {
             $(
                 #[doc = $does]

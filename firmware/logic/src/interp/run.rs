@@ -76,7 +76,7 @@ impl Interpreter {
     fn after_motion(&self, io: &mut impl MachineIo) -> Option<Wait> {
         match io.idle() {
             true => None,
-            false => Some(Wait::Motion),
+            false => Some(Wait::PlannerRoom),
         }
     }
 
@@ -133,7 +133,7 @@ impl Interpreter {
         // Checked when the line was accepted.
         let steps = motor_steps(&to, motors, env.kin, env.cfg).unwrap_or_default();
         if !io.queue(&steps, self.run.feed) {
-            return Some(Wait::Motion);
+            return Some(Wait::PlannerRoom);
         }
         self.run.from = to;
         None
@@ -167,7 +167,7 @@ impl Interpreter {
         let before = *path;
         if let Path::Steps(steps) = before {
             if !io.queue(&steps, self.run.feed) {
-                return Some(Wait::Motion);
+                return Some(Wait::PlannerRoom);
             }
             self.run.path = None;
             return None;
@@ -201,7 +201,7 @@ impl Interpreter {
         };
         if !queued {
             self.run.path = Some(before);
-            return Some(Wait::Motion);
+            return Some(Wait::PlannerRoom);
         }
         // The next piece in a run of its own: working one out takes up
         // to ms on the arm.

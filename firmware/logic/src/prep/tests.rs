@@ -327,7 +327,7 @@ fn a_hold_while_a_profile_is_made_brakes_from_its_entry() {
     assert_eq!(travel(&events), [18_000, 0, 0]);
 }
 
-/// A block half loaded is work still to do: the motion task must run on
+/// A block half loaded is work still to do: segment preparation must run on
 /// (and `M400` wait) until its profile is made and cut.
 #[test]
 fn a_half_loaded_block_is_not_idle() {

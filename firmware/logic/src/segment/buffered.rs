@@ -70,7 +70,7 @@ impl<const N: usize> Buffered<N> {
 
     /// Whether the newest `len` segments last `us` or more: as
     /// `queued_us(len) >= us`, counting only as far as it must (the
-    /// firmware asks at every run of its console and motion tasks).
+    /// firmware asks at every run of its console and segment preparation).
     /// Inlined: `us` is a constant, its division made when compiling.
     #[inline(always)]
     pub fn lasts(&self, len: usize, us: u32) -> bool {

@@ -246,7 +246,7 @@ pub fn job_time(
         let now = m.ms();
         match feeder.run(&mut job, &mut m, now, u8::MAX) {
             Feeding::Again => {}
-            Feeding::Motion => m.run_block(),
+            Feeding::PlannerRoom => m.run_block(),
             Feeding::After(ms) => m.wait(ms),
             Feeding::Done => queue(&mut pending, job.on(Event::MotionDone, m.ms())),
             // Nothing moves and nothing is asked: the job waits for

@@ -337,12 +337,12 @@ fn sim_mhz(elf: &Path, seconds: u64) -> f64 {
 
 /// The sample job's drilling and its first 30 s of winding, the operator
 /// pressing green at once: the share of cycles the MCU is awake in each
-/// (percent), and the longest run of the motion task, which prepares the
-/// segments (cycles).
+/// (percent), and the longest run of segment preparation
+/// (`prepare_segments`, cycles).
 fn job_figures(elf: &Path, card: &Path) -> (f64, f64, u64) {
-    let motion = taut_simavr::elf::function_address(elf, "4taut6motion")
+    let motion = taut_simavr::elf::function_address(elf, "4taut16prepare_segments")
         .expect("ELF symbols")
-        .expect("the motion task");
+        .expect("prepare_segments");
     let mut sim = Sim::boot(elf);
     sim.insert_sd(SdImage::from_path(card).expect("sample card"));
     sim.watch_calls(motion);

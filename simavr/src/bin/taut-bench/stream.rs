@@ -10,7 +10,7 @@
 //! To see why: `TAUT_BENCH_PROFILE=N` prints where each case's cycles go
 //! and the tasks' longest runs; `TAUT_BENCH_WATCH=<hex address>` the
 //! times the firmware reached that address (an underrun's count, say)
-//! with the console's and the motion task's runs and the STEP pulses
+//! with the console's and segment preparation's runs and the STEP pulses
 //! around;
 //! `TAUT_BENCH_UART=DIR` keeps each case's UART text.
 
@@ -231,7 +231,7 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
                     sim.watch_pc(w);
                 }
                 let profile = std::env::var("TAUT_BENCH_PROFILE").ok();
-                let tasks = ["4taut7console", "4taut6motion"]
+                let tasks = ["4taut7console", "4taut16prepare_segments"]
                     .map(|t| taut_simavr::elf::function_address(elf, t).unwrap().unwrap());
                 if profile.is_some() {
                     sim.enable_call_profile(elf).unwrap();

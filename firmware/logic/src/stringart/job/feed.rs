@@ -53,8 +53,9 @@ pub trait Hardware {
 pub enum Feeding {
     /// Nothing: its budget of steps is used and more are waiting.
     Again,
-    /// The planner to take a block, the machine to begin one, or to stand.
-    Motion,
+    /// The planner to take a block, the machine to begin one, or to stand
+    /// (the app's `Signal::PlannerRoom`).
+    PlannerRoom,
     /// This many ms: a dwell, or a checkpoint being written.
     After(u16),
     /// The batch is done and the machine stands (or winding runs on):
@@ -176,7 +177,7 @@ impl Feeder {
                     }
                     if m.push(at).is_err() {
                         self.pending = Some(step);
-                        return Feeding::Motion;
+                        return Feeding::PlannerRoom;
                     }
                     // A move of no step is no block: it never begins.
                     if let (Wait::Marked(after), true) = (&mut self.wait, moves) {
@@ -199,7 +200,7 @@ impl Feeder {
                 }
                 _ if !m.is_idle() => {
                     self.pending = Some(step);
-                    return Feeding::Motion;
+                    return Feeding::PlannerRoom;
                 }
                 MachineStep::Dwell(ms) => {
                     self.wait = Wait::Dwell(now_ms.wrapping_add(ms as u32));
@@ -222,7 +223,7 @@ impl Feeder {
         }
         if self.stage == Stage::Settling {
             if !m.is_idle() {
-                return Feeding::Motion;
+                return Feeding::PlannerRoom;
             }
             self.stage = Stage::Idle;
             return Feeding::Done;
@@ -235,7 +236,7 @@ impl Feeder {
     /// rotation), or for the last checkpoint to be written.
     fn held(&self, m: &impl Hardware) -> Feeding {
         match self.wait {
-            Wait::Marked(after) if !passed(after, m) => Feeding::Motion,
+            Wait::Marked(after) if !passed(after, m) => Feeding::PlannerRoom,
             _ => Feeding::After(SAVE_POLL_MS),
         }
     }

@@ -121,7 +121,7 @@ fn feed_batch(job: &mut Job, m: &mut Cramped, feeder: &mut Feeder) -> usize {
         let idle = m.is_idle();
         match fed {
             Feeding::Again => {}
-            Feeding::Motion => {
+            Feeding::PlannerRoom => {
                 m.queue.pop_front().expect("a wait for motion with some");
             }
             Feeding::After(ms) => {
@@ -203,8 +203,8 @@ fn an_abort_drops_the_steps_in_hand() {
             m.saving = 0;
             feeder.run(&mut job, &mut m, 0, 1)
         })
-        .find(|&f| f == Feeding::Motion);
-    assert_eq!(fed, Some(Feeding::Motion));
+        .find(|&f| f == Feeding::PlannerRoom);
+    assert_eq!(fed, Some(Feeding::PlannerRoom));
     feeder.abort();
     m.queue.clear();
     assert_eq!(feeder.run(&mut job, &mut m, 0, 3), Feeding::Idle);

@@ -160,7 +160,7 @@ fn wind(m: &mut Timeline) {
         m.begin();
         match fed {
             Feeding::Again => {}
-            Feeding::Motion | Feeding::After(_) => {
+            Feeding::PlannerRoom | Feeding::After(_) => {
                 m.tick();
                 now += 1;
             }
