@@ -37,7 +37,7 @@ fn main() -> ! {
         }
     }
     let poradi = Name::new(b"poradi.txt").unwrap_or(Name::EMPTY);
-    let _ = CARD_IN.push(Request::Open(poradi, 1));
+    CARD_IN.put(Request::Open(poradi, 1));
     let start = clock::micros();
     let mut bytes: u32 = 0;
     loop {

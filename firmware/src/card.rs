@@ -266,11 +266,11 @@ impl CardReader {
                 if CARD_OUT.free() < ROOM {
                     return Poll::Wait(Signal::CardRoom);
                 }
-                let _ = CARD_IN.pop();
+                let _ = CARD_IN.take();
                 Self::send(What::Failed, t);
                 return Poll::Again;
             }
-            let _ = CARD_IN.pop();
+            let _ = CARD_IN.take();
             return Poll::Idle;
         };
         if let Some(request) = CARD_IN.peek() {
@@ -280,7 +280,7 @@ impl CardReader {
             if CARD_OUT.free() < ROOM || reads && data_waits() {
                 return Poll::Wait(Signal::CardRoom);
             }
-            let _ = CARD_IN.pop();
+            let _ = CARD_IN.take();
             match request {
                 Request::Open(name, ticket) => self.open(volume, ticket, Some(&name)),
                 Request::OpenFirst(ticket) => self.open(volume, ticket, None),

@@ -353,8 +353,8 @@ impl JobTask {
     /// Ask the card reader for a file; its messages carry the new ticket.
     fn open(&mut self, name: FileName) {
         self.ticket = self.ticket.wrapping_add(1).max(1);
-        // The reader takes requests before anything else: one slot will do,
-        // and a full one means the last request is being replaced anyway.
+        // The reader takes requests before anything else: a mailbox, this
+        // request replacing one still waiting.
         // Byte by byte from flash (the names fit a `Name`).
         let text = name.name();
         let mut name = Name::EMPTY;
@@ -362,9 +362,7 @@ impl JobTask {
             let _ = name.push(text.byte(i));
         }
         let request = Request::Open(name, self.ticket);
-        while CARD_IN.push(request).is_err() {
-            let _ = CARD_IN.pop();
-        }
+        CARD_IN.put(request);
     }
 
     /// End, loss or failure of `poradi.txt` while winding.

@@ -305,12 +305,10 @@ impl Print {
 
     fn ask(&mut self, request: impl FnOnce(u8) -> Request) {
         self.ticket = self.ticket.wrapping_add(1).max(1);
-        // The reader takes requests before anything else: one slot will do,
-        // and a full one means the last request is being replaced anyway.
+        // The reader takes requests before anything else: a mailbox, this
+        // request replacing one still waiting.
         let r = request(self.ticket);
-        while CARD_IN.push(r).is_err() {
-            let _ = CARD_IN.pop();
-        }
+        CARD_IN.put(r);
     }
 
     /// A card command from the console (`M20`, `M23`…); answered `ok`
@@ -468,7 +466,7 @@ impl Print {
 
     fn close(&mut self) {
         if self.state != State::Idle {
-            let _ = CARD_IN.push(Request::Close);
+            CARD_IN.put(Request::Close);
         }
         self.forget();
         self.state = State::Idle;

@@ -4,7 +4,7 @@
 //! — and every ring counts what it sent, refused, and its high-water mark
 //! (`$Q`, and the end of a job).
 
-use crate::rt::{Flags, Ring, Tally};
+use crate::rt::{Flags, Mailbox, Ring, Tally};
 use core::sync::atomic::{AtomicBool, AtomicU8};
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
@@ -53,9 +53,9 @@ pub static SAMPLES: Ring<u8, 16> = Ring::new();
 /// human's presses).
 pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
 
-/// Job → card reader: one request (the reader takes them first), its
-/// one slot usable.
-pub static CARD_IN: Ring<Request, 1, true> = Ring::new();
+/// Job or console (a plotter's card print) → card reader: the newest
+/// request (the reader takes them first; a newer one replaces it).
+pub static CARD_IN: Mailbox<Request> = Mailbox::new();
 /// Card reader → job or console, its four slots usable. Full: the reader
 /// keeps its block and waits. A file's bytes take at most two
 /// (`card::ROOM` stay free for a removal's news).

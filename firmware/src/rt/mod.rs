@@ -5,6 +5,7 @@
 pub mod dispatch;
 pub mod flags;
 pub mod isr_cell;
+pub mod mailbox;
 pub mod nested;
 pub mod ring;
 pub mod stack;
@@ -26,6 +27,7 @@ pub enum Poll<S> {
     Wait(S),
 }
 pub use isr_cell::IsrCell;
+pub use mailbox::Mailbox;
 pub use ring::Ring;
 pub use task_cell::TaskCell;
 
