@@ -5,10 +5,10 @@
 
 use crate::board::servo::PenServo;
 use crate::drivers::Drivers;
-use crate::queues::{BEGUN, BLOCKS, SEGMENTS, SEGMENTS_CAPACITY};
+use crate::queues::{BEGUN, BLOCKS, SEGMENTS, SEGMENTS_CAPACITY, SHORT_AT};
 use crate::rt::TaskCell;
 use crate::stepper::{every_event, fast_segment, Stepper, FAST};
-use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
+use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::kinematics::Piece;
@@ -39,11 +39,6 @@ const QUEUED_MAX_US: u32 = 40_000;
 /// (~3 ms): a stream of 0.2 mm moves on the flatbed, stopping and starting
 /// at every line, ran dry with the refill behind a console's line.
 const STARVING_US: u32 = 8_000;
-
-/// At or below this many queued segments the refill is urgent: as many of
-/// the newest as last less than the budget. Set by the refill, read by the
-/// interrupts that spawn it (one byte: atomic on the AVR).
-static SHORT_AT: AtomicU8 = AtomicU8::new(SEGMENTS_CAPACITY as u8);
 
 /// The step queue holds less than the urgent budget of motion.
 #[inline(always)]

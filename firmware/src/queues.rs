@@ -3,6 +3,26 @@
 //! ring is back-pressure — the producer keeps its message and tries again
 //! — and every ring counts what it sent, refused, and its high-water mark
 //! (`$Q`, and the end of a job).
+//!
+//! The shared state declared here is below, each with its writer → its
+//! reader. State that crosses contexts but is kept private beside the
+//! one module that reads and writes it (so no other module can touch it):
+//!
+//! | static | where | writer → reader |
+//! | --- | --- | --- |
+//! | `EXEC` the step interrupt's state | `stepper.rs` | `TIMER3_COMPA`; tasks only through `Stepper` with the interrupt off or masked (`kick`, `position`, `faults`) |
+//! | `WATCHED`, `HIT`, `LAST` the homing switch watched, caught, last read | `endstop.rs` | console (homing) ↔ `TIMER0_COMPA` (`endstop::on_tick` stops the steps) |
+//! | `SAMPLER` the buttons' pins and last sample | `buttons.rs` (`IsrCell`) | `TIMER0_COMPA` only (handed over at init) |
+//! | `MILLIS`, `ALARM` the clock and the timers' alarm | `board/clock.rs` (masked) | `TIMER0_COMPA` ↔ every task (`clock::millis`, `set_alarm`) |
+//! | `FLOW`, `CUT`; USART1's `ON`, `RATE`, `CUT` | `board/usart.rs`, `board/usart1.rs` | receive interrupts ↔ console, `$` settings |
+//! | `OUTBOX` a port's staged reply | `board/usart.rs`, `board/usart1.rs` | tasks → transmit interrupt (through `TX`, `TX1`) |
+//! | `ANSWER` the port a line came from | `board/port.rs` | console → replies (tasks only) |
+//! | `DROPPED` log lines lost | `log.rs` (masked) | any context → logger |
+//! | `LOG` the log line being built | `log.rs` (`TaskCell`) | tasks only |
+//! | `BUF` the card's block, `OPENED` its file's name | `card.rs` (`TaskCell`) | card → job or console, read in place while a `Data` message names it (`card::bytes`) |
+//! | `STANDING` overrides, door | `realtime.rs` (`TaskCell`) | `Realtime` task → status reports |
+//! | `PLANNER` | `motion.rs` (`TaskCell`) | console, job → segment preparation, through `Motion` |
+//! | each task's state (`MOTION`, `CONSOLE`, `JOB`, `CARD`, `STORE`, `KIN`, `LED` …), the dispatcher's `SPAWNED`, `READY`, `TIMERS`, `WAITING` | `main.rs` | the app (`SPAWNED`: interrupts → dispatcher) |
 
 use crate::rt::{Flags, Mailbox, Ring, Tally};
 use core::sync::atomic::{AtomicBool, AtomicU8};
@@ -40,6 +60,11 @@ pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
 /// segments fill the 40 ms budget with fewer (`motion.rs`). 32 slots were
 /// 176 B more.
 pub const SEGMENTS_CAPACITY: usize = 16;
+/// Segment preparation → step interrupt and tick (which spawn the urgent
+/// `Refill` at or below it): the queued segments under which the refill is
+/// urgent, as many of the newest as last less than the budget
+/// (`motion::urgent`). One byte: atomic on the AVR.
+pub static SHORT_AT: AtomicU8 = AtomicU8::new(SEGMENTS_CAPACITY as u8);
 pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
 /// Step interrupt → console: blocks begun, wrapping (a card print's
 /// checkpoint names the line whose block is moving).
