@@ -11,7 +11,7 @@ use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{clock, gpio::Pins, usart};
 use taut_firmware::card::CardReader;
 use taut_firmware::info;
-use taut_firmware::queues::{Request, Signal, What, CARD_IN, CARD_OUT};
+use taut_firmware::queues::{self, Request, Signal, What, CARD_OUT};
 use taut_firmware::rt::Poll;
 use taut_logic::fat::Name;
 
@@ -25,7 +25,8 @@ fn main() -> ! {
     clock::Clock::start(dp.TC0);
     usart::Usart0::start(dp.USART0);
     let spi = CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53);
-    let mut reader = CardReader::new(spi);
+    let (ask, _, requests) = queues::card_in_ends();
+    let mut reader = CardReader::new(spi, requests);
     // SAFETY: the two handlers below touch only the clock and the TX ring.
     unsafe { avr_device::interrupt::enable() };
     loop {
@@ -37,7 +38,7 @@ fn main() -> ! {
         }
     }
     let poradi = Name::new(b"poradi.txt").unwrap_or(Name::EMPTY);
-    CARD_IN.put(Request::Open(poradi, 1));
+    ask.put(Request::Open(poradi, 1));
     let start = clock::micros();
     let mut bytes: u32 = 0;
     loop {

@@ -15,7 +15,7 @@
 use crate::board::delay::Delay;
 use crate::board::flash::FlashStr;
 use crate::board::spi::{self, CardSpi};
-use crate::queues::{CardMsg, Request, Signal, What, CARD_IN, CARD_OUT, CHUNK, TX};
+use crate::queues::{CardMsg, CardRequests, Request, Signal, What, CARD_OUT, CHUNK, TX};
 use crate::rt::{Poll, TaskCell};
 use crate::{error, flash_str, info, warn};
 use embedded_hal::delay::DelayNs;
@@ -101,6 +101,8 @@ enum Slot {
 }
 
 pub struct CardReader {
+    /// Its end of `CARD_IN`.
+    requests: CardRequests,
     sd: Sd,
     slot: Slot,
     /// The file being streamed or the listing being written.
@@ -215,12 +217,13 @@ fn failure(e: &SdCardError) -> Failure {
 }
 
 impl CardReader {
-    pub fn new(spi: CardSpi) -> CardReader {
+    pub fn new(spi: CardSpi, requests: CardRequests) -> CardReader {
         let options = AcquireOpts {
             use_crc: true,
             acquire_retries: 4,
         };
         CardReader {
+            requests,
             sd: SdCard::new_with_options(TimedSpi(spi), TimedDelay, options),
             slot: Slot::Empty,
             reading: Reading::Nothing,
@@ -261,26 +264,26 @@ impl CardReader {
         let Slot::Mounted(volume) = self.slot else {
             // Asked of an empty or failed slot: no such file.
             if let Some(Request::Open(_, t) | Request::OpenFirst(t) | Request::List(t)) =
-                CARD_IN.peek()
+                self.requests.peek()
             {
                 if CARD_OUT.free() < ROOM {
                     return Poll::Wait(Signal::CardRoom);
                 }
-                let _ = CARD_IN.take();
+                let _ = self.requests.take();
                 Self::send(What::Failed, t);
                 return Poll::Again;
             }
-            let _ = CARD_IN.take();
+            let _ = self.requests.take();
             return Poll::Idle;
         };
-        if let Some(request) = CARD_IN.peek() {
+        if let Some(request) = self.requests.peek() {
             // Each but `Close` reads blocks: not while file bytes wait
             // (an older request's, which their owner drops).
             let reads = !matches!(request, Request::Close);
             if CARD_OUT.free() < ROOM || reads && data_waits() {
                 return Poll::Wait(Signal::CardRoom);
             }
-            let _ = CARD_IN.take();
+            let _ = self.requests.take();
             match request {
                 Request::Open(name, ticket) => self.open(volume, ticket, Some(&name)),
                 Request::OpenFirst(ticket) => self.open(volume, ticket, None),

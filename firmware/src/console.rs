@@ -25,7 +25,7 @@ use crate::flash_str;
 use crate::machine_io::Io;
 use crate::motion::Motion;
 use crate::print::Print;
-use crate::queues::{Signal, JOB_CLAIMS_TX};
+use crate::queues::{CardAsk, Signal, JOB_CLAIMS_TX};
 use crate::reply;
 use crate::rt::Poll;
 use crate::store::Store;
@@ -145,7 +145,7 @@ pub struct Frame {
 }
 
 impl Console {
-    pub const fn new() -> Console {
+    pub const fn new(card: CardAsk) -> Console {
         Console {
             parser: Parser::new(),
             line_ready: false,
@@ -157,7 +157,7 @@ impl Console {
             // the kinematics (zero steps are not (0, 0) on an arm).
             epoch: u8::MAX,
             settings_changed: false,
-            print: Print::new(),
+            print: Print::new(card),
             source: None,
             jogging: false,
             checking: false,
@@ -609,12 +609,6 @@ impl Console {
     /// next run (the machine moved, or is another one), as after a stop.
     fn resync_next_run(&mut self, m: &Motion) {
         self.epoch = m.epoch().wrapping_add(1);
-    }
-}
-
-impl Default for Console {
-    fn default() -> Self {
-        Self::new()
     }
 }
 

@@ -9,7 +9,7 @@
 use crate::checkpoint::BootNote;
 use crate::motion::Motion;
 use crate::queues::{
-    CardMsg, Control, Request, Signal, What, BUTTONS, CARD_IN, CARD_OUT, CHUNK, JOB_CLAIMS_TX,
+    CardAsk, CardMsg, Control, Request, Signal, What, BUTTONS, CARD_OUT, CHUNK, JOB_CLAIMS_TX,
     JOB_CONTROL, TX,
 };
 use crate::rt::Poll;
@@ -77,6 +77,8 @@ impl Stream {
 }
 
 pub struct JobTask {
+    /// Its end of `CARD_IN`.
+    card: CardAsk,
     job: Job,
     /// Actions not yet carried out, in order: one event's at most, as
     /// inputs are taken only when the last event's are done.
@@ -94,15 +96,10 @@ pub struct JobTask {
     boot_note: Option<BootNote>,
 }
 
-impl Default for JobTask {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
 impl JobTask {
-    pub const fn new() -> Self {
+    pub const fn new(card: CardAsk) -> Self {
         JobTask {
+            card,
             job: Job::new(),
             todo: Actions::new(),
             stream: Stream::None,
@@ -362,7 +359,7 @@ impl JobTask {
             let _ = name.push(text.byte(i));
         }
         let request = Request::Open(name, self.ticket);
-        CARD_IN.put(request);
+        self.card.put(request);
     }
 
     /// End, loss or failure of `poradi.txt` while winding.

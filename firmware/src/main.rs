@@ -40,7 +40,7 @@ use taut_firmware::console::{Activity, Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
-use taut_firmware::queues::{Control, Signal, CARD_IN, CARD_OUT, JOB_CONTROL, SIGNALS};
+use taut_firmware::queues::{self, CardRequests, Control, Signal, CARD_OUT, JOB_CONTROL, SIGNALS};
 use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{self, stack, Poll, TaskCell};
@@ -223,8 +223,8 @@ fn main() -> ! {
     stack::paint();
     // Before `init`: the cells' values are built on the stack (a console
     // is ~480 B), not above `init`'s frame.
-    init_cells();
-    let watchdog = init();
+    let card_requests = init_cells();
+    let watchdog = init(card_requests);
     dispatch::run(
         &SPAWNED,
         &READY,
@@ -239,7 +239,7 @@ fn main() -> ! {
 /// set-up's locals are gone from the stack before the dispatcher starts.
 #[inline(never)]
 #[optimize(size)]
-fn init() -> Watchdog {
+fn init(card_requests: CardRequests) -> Watchdog {
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
     let reset = ResetCause::take(&dp.CPU);
     let watchdog = Watchdog::start(dp.WDT);
@@ -299,9 +299,10 @@ fn init() -> Watchdog {
     );
     CONFIG.with(|c| motion::configure_planner(c));
     start_motion(stepper, drivers, pen);
-    start_card(CardSpi::start(
-        dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53,
-    ));
+    start_card(
+        CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53),
+        card_requests,
+    );
     buttons::start(ButtonPins {
         confirm: pins.d2.into_pull_up_input(),
         zero_base: pins.d3.into_pull_up_input(),
@@ -360,9 +361,11 @@ fn init() -> Watchdog {
 /// the stack would stay in its frame under everything it calls.
 #[inline(never)]
 #[optimize(size)]
-fn init_cells() {
-    CONSOLE.init(Console::new());
-    JOB.init(JobTask::new());
+fn init_cells() -> CardRequests {
+    let (job_asks, print_asks, requests) = queues::card_in_ends();
+    CONSOLE.init(Console::new(print_asks));
+    JOB.init(JobTask::new(job_asks));
+    requests
 }
 
 /// The kinematics of the settings loaded. Settings are only taken whole,
@@ -456,8 +459,8 @@ fn others_ready() -> bool {
 
 #[inline(never)]
 #[optimize(size)]
-fn start_card(spi: CardSpi) {
-    CARD.init_with(|c| c.write(CardReader::new(spi)));
+fn start_card(spi: CardSpi, requests: CardRequests) {
+    CARD.init_with(|c| c.write(CardReader::new(spi, requests)));
 }
 
 /// Move due timers into the ready set and re-arm the tick's alarm.
@@ -571,7 +574,7 @@ fn console() {
         spawn(Task::Job);
     }
     // A plotter's card print asks the reader and takes its messages.
-    if !CARD_IN.is_empty() {
+    if queues::card_request_waits() {
         spawn(Task::Card);
     }
     if CARD_OUT.free() > card::ROOM {
@@ -725,7 +728,7 @@ fn job() {
     }
     spawn(Task::Prepare);
     reschedule(Task::Job, poll);
-    if !CARD_IN.is_empty() {
+    if queues::card_request_waits() {
         spawn(Task::Card);
     }
     if CARD_OUT.free() > card::ROOM {

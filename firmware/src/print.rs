@@ -20,7 +20,7 @@
 use crate::board::flash::FlashStr;
 use crate::log::Level;
 use crate::motion::Motion;
-use crate::queues::{CardMsg, Request, What, BEGUN, CARD_IN, CARD_OUT, TX};
+use crate::queues::{CardAsk, CardMsg, Request, What, BEGUN, CARD_OUT, TX};
 use crate::reply;
 use crate::store::Store;
 use crate::{flash_str, info, warn};
@@ -57,6 +57,8 @@ struct Mark {
 }
 
 pub struct Print {
+    /// Its end of `CARD_IN`.
+    card: CardAsk,
     state: State,
     /// Numbers the card requests; messages of older ones are dropped.
     ticket: u8,
@@ -104,8 +106,9 @@ enum Keep {
 pub type Answer = Option<Result<(), ErrorKind>>;
 
 impl Print {
-    pub const fn new() -> Print {
+    pub const fn new(card: CardAsk) -> Print {
         Print {
+            card,
             state: State::Idle,
             ticket: 0,
             size: 0,
@@ -308,7 +311,7 @@ impl Print {
         // The reader takes requests before anything else: a mailbox, this
         // request replacing one still waiting.
         let r = request(self.ticket);
-        CARD_IN.put(r);
+        self.card.put(r);
     }
 
     /// A card command from the console (`M20`, `M23`…); answered `ok`
@@ -466,7 +469,7 @@ impl Print {
 
     fn close(&mut self) {
         if self.state != State::Idle {
-            CARD_IN.put(Request::Close);
+            self.card.put(Request::Close);
         }
         self.forget();
         self.state = State::Idle;
@@ -720,12 +723,6 @@ impl Print {
             warn!("print stopped");
             self.close();
         }
-    }
-}
-
-impl Default for Print {
-    fn default() -> Self {
-        Self::new()
     }
 }
 

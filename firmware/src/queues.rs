@@ -28,6 +28,7 @@ use crate::rt::{Flags, Mailbox, Ring, Tally};
 use core::sync::atomic::{AtomicBool, AtomicU8};
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
+use taut_logic::sched::QueueStats;
 use taut_logic::segment::{Segment, StepBlock};
 
 /// UART receive interrupt → console: line bytes (real-time commands are
@@ -80,7 +81,48 @@ pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
 
 /// Job or console (a plotter's card print) → card reader: the newest
 /// request (the reader takes them first; a newer one replaces it).
-pub static CARD_IN: Mailbox<Request> = Mailbox::new();
+/// Private: reached through its ends, [`CardAsk`] and [`CardRequests`].
+static CARD_IN: Mailbox<Request> = Mailbox::new();
+
+/// `CARD_IN`'s sending end: the job's and the console's card print's.
+/// Zero-sized: a right, not a pointer.
+pub struct CardAsk(());
+
+impl CardAsk {
+    /// Leave `request` for the reader, replacing one still waiting.
+    pub fn put(&self, request: Request) {
+        CARD_IN.put(request)
+    }
+}
+
+/// `CARD_IN`'s receiving end: the card reader's.
+pub struct CardRequests(());
+
+impl CardRequests {
+    pub fn peek(&self) -> Option<Request> {
+        CARD_IN.peek()
+    }
+
+    pub fn take(&self) -> Option<Request> {
+        CARD_IN.take()
+    }
+}
+
+/// `CARD_IN`'s ends, made once, by the app's init: the job's, the card
+/// print's, the reader's.
+pub fn card_in_ends() -> (CardAsk, CardAsk, CardRequests) {
+    (CardAsk(()), CardAsk(()), CardRequests(()))
+}
+
+/// A request waits for the reader (the app then spawns it).
+pub fn card_request_waits() -> bool {
+    !CARD_IN.is_empty()
+}
+
+/// `CARD_IN`'s counters and capacity (`$Q`).
+pub fn card_in_stats() -> (QueueStats, usize) {
+    (CARD_IN.stats(), CARD_IN.capacity())
+}
 /// Card reader → job or console, its four slots usable. Full: the reader
 /// keeps its block and waits. A file's bytes take at most two
 /// (`card::ROOM` stay free for a removal's news).

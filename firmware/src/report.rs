@@ -3,7 +3,7 @@
 //! missed.
 
 use crate::queues::{
-    BLOCKS, BUTTONS, CARD_IN, CARD_OUT, JOB_CONTROL, RX, RX1, SAMPLES, SEGMENTS, TX, TX1,
+    card_in_stats, BLOCKS, BUTTONS, CARD_OUT, JOB_CONTROL, RX, RX1, SAMPLES, SEGMENTS, TX, TX1,
 };
 use crate::{flash_str, info};
 use taut_logic::sched::QueueStats;
@@ -28,7 +28,10 @@ pub fn queue_line(i: u8) -> bool {
         ),
         3 => queue(flash_str!("blocks"), BLOCKS.stats(), BLOCKS.capacity()),
         4 => queue(flash_str!("card"), CARD_OUT.stats(), CARD_OUT.capacity()),
-        5 => queue(flash_str!("card req"), CARD_IN.stats(), CARD_IN.capacity()),
+        5 => {
+            let (stats, capacity) = card_in_stats();
+            queue(flash_str!("card req"), stats, capacity)
+        }
         6 => queue(
             flash_str!("button samples"),
             SAMPLES.stats(),
