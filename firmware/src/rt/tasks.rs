@@ -30,7 +30,6 @@ macro_rules! tasks {
             )*
         )]
         #[derive(Clone, Copy, PartialEq, Eq)]
-
         enum Task {
             $(
                 #[doc = $does]
