@@ -6,7 +6,6 @@ use std::io::{BufRead, BufReader, Read};
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use std::sync::Once;
 use std::time::{Duration, Instant};
 
 /// Debian's `arduino-core-avr`: the bootloader every Arduino Mega 2560
@@ -34,26 +33,9 @@ pub fn avrdude_args(port: &Path) -> Vec<String> {
     .collect()
 }
 
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-static BUILD_SIM: Once = Once::new();
-
-/// The `taut-sim` binary, built once per test process.
+/// The `taut-sim` binary.
 pub fn taut_sim() -> PathBuf {
-    BUILD_SIM.call_once(|| {
-        let st = Command::new("cargo")
-            .args(["build", "--quiet", "-p", "taut-simavr", "--bin", "taut-sim"])
-            .current_dir(workspace())
-            .status()
-            .expect("cannot run cargo");
-        assert!(st.success(), "taut-sim build failed");
-    });
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| workspace().join("target"));
-    target.join("debug/taut-sim")
+    crate::host_bin("taut-sim")
 }
 
 /// A folder of this test's own under the temporary directory.

@@ -16,6 +16,34 @@ pub mod feed;
 pub mod reference;
 pub mod senders;
 
+/// A host tool of this workspace (`taut`, `taut-sim`), its debug binary.
+/// Built once per test process, as `cargo test --workspace` builds it: the
+/// same packages selected, so the same features, and nothing is compiled
+/// again when that run (`cargo xtask test`) has built it already; a build
+/// of one package alone would compile its dependencies a second time with
+/// fewer features.
+pub fn host_bin(name: &str) -> PathBuf {
+    static BUILT: Once = Once::new();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    BUILT.call_once(|| {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+        let st = Command::new(cargo)
+            // The binaries of the packages with integration tests: what
+            // `cargo test --workspace` builds (with `--bins`, xtask's too,
+            // and the next `cargo xtask` would build its own again).
+            .args(["build", "--quiet", "--workspace", "--tests"])
+            .current_dir(&root)
+            .status()
+            .expect("cannot run cargo");
+        assert!(st.success(), "building the host tools failed");
+    });
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("target"))
+        .join("debug")
+        .join(name)
+}
+
 /// A tiny seeded generator (xorshift): the same draws on every run.
 pub struct Rng(u64);
 

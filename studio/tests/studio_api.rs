@@ -1,8 +1,8 @@
 //! `taut studio`'s HTTP API without a machine: every endpoint's answer,
 //! the token rule, the one-controller rule, and bad input refused with
 //! what is wrong while the server goes on. (With the machine, the
-//! simulated Mega: `hil-tests/tests/studio_app.rs`; in a browser:
-//! `hil-tests/tests/studio_browser.rs`.)
+//! simulated Mega: `hil-tests/tests/hil/studio_app.rs`; in a browser:
+//! `hil-tests/tests/hil/studio_browser.rs`.)
 
 use axum::body::Body;
 use axum::http::{Request, StatusCode};

@@ -14,7 +14,7 @@ mod run;
 mod stackargs;
 mod studio;
 
-use run::{cargo, root, Result};
+use run::{root, Result};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -26,11 +26,11 @@ usage: cargo xtask <command> [args]
   demo plotter [MACHINE]
                     a plotter (flatbed, drum, whiteboard, scara; default flatbed)
                     draws examples/plotter/star.gcode streamed over its serial port
-  test              host unit tests of every crate, the fuzz targets (40 s each),
-                    then simtest
+  test              the firmware images and lints, the fuzz targets (20 s each),
+                    then the host unit tests of every crate and the HIL tests
   fuzz [TARGET] [--seconds N] [--seed N]
                     build the libFuzzer targets and run each N seconds (default all,
-                    40 s); `cargo xtask fuzz --help` lists the targets
+                    20 s); `cargo xtask fuzz --help` lists the targets
   cycles            the import cycles between each crate's modules (test runs it)
   simtest           build the firmware images and run the HIL tests in simavr
   soak              the HIL tests at full size (5000-move streams, 100 wraps of a
@@ -111,42 +111,57 @@ fn main() -> ExitCode {
 fn test() -> Result<()> {
     let start = Instant::now();
     run::setup()?;
-    // The real senders' downloads overlap the host tests and the fuzzing.
+    // The real senders' downloads overlap the firmware build and the fuzzing.
     let clients = run::Background::start(
         "installing the HIL tests' senders (grbl-streamer, CNCjs)",
         &root().join("hil-tests/clients/install.sh"),
         &root().join("target/clients/install.log"),
     )?;
     cycles::check()?;
-    println!("== host unit tests");
-    cargo(&["test", "--workspace", "--exclude", "hil-tests"], &root())?;
-    let host = start.elapsed().as_secs();
+    let img = firmware_images()?;
+    let firmware = start.elapsed().as_secs();
     fuzz::run(&fuzz::Plan::test())?;
-    let fuzz = start.elapsed().as_secs() - host;
+    let fuzz = start.elapsed().as_secs() - firmware;
     clients.finish()?;
-    simtest()?;
+    // The host unit tests and the HIL tests in one cargo run: every crate
+    // is built once, with the features of the whole workspace (two runs
+    // selecting different packages built the shared ones twice).
+    println!("== host unit tests, then the HIL tests (release firmware in simavr)");
+    hil_tests(&["test", "--workspace"], &img)?;
     let total = start.elapsed().as_secs();
     println!(
-        "== all tests passed in {total} s (host unit tests {host} s, fuzz {fuzz} s, firmware and HIL tests {} s)",
-        total - host - fuzz
+        "== all tests passed in {total} s (firmware lints and images {firmware} s, fuzz {fuzz} s, \
+         host and HIL tests {} s)",
+        total - firmware - fuzz
     );
     Ok(())
 }
 
 fn simtest() -> Result<()> {
+    let img = firmware_images()?;
+    println!("== HIL tests (release firmware in simavr)");
+    hil_tests(&["test", "-p", "hil-tests"], &img)
+}
+
+/// The firmware's lints, its release image and the example images.
+fn firmware_images() -> Result<firmware::Image> {
     firmware::lint()?;
     let img = firmware::build_release()?;
     firmware::build_examples()?;
     img.print_size();
-    println!("== HIL tests (release firmware in simavr)");
+    Ok(img)
+}
+
+/// `cargo ARGS` running the HIL tests, then the run's RAM figure.
+fn hil_tests(args: &[&str], img: &firmware::Image) -> Result<()> {
     // Each test adds its stack peak (and, with `TAUT_STACK_CHAINS`, its
     // call chain): this run's only.
     let peaks = root().join("target/hil-stack-peaks.txt");
     let _ = std::fs::remove_file(&peaks);
     let _ = std::fs::remove_file(root().join("target/hil-stack-chains.txt"));
-    let mut test = run::cargo_cmd(&["test", "-p", "hil-tests"], &root());
+    let mut test = run::cargo_cmd(args, &root());
     run::status(test.env("TAUT_STACK_CHAINS", "1"))?;
-    print_ram(&img, &peaks)
+    print_ram(img, &peaks)
 }
 
 /// The run's RAM figure: static data plus the deepest stack any HIL test

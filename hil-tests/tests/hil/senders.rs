@@ -58,22 +58,10 @@ fn grbl_streamer_streams_2000_lines_counting_characters_and_the_pulses_follow() 
     eprintln!("{} pulses; {}", path.len(), underruns(&sim));
 }
 
-/// `taut send` (studio/), built once: the debug binary, whose dependencies
-/// the host unit tests have already built (a release build of them took
-/// minutes of the CI run).
+/// `taut send` (studio/): the debug binary, whose dependencies the host
+/// unit tests have already built (a release build of them took minutes).
 fn taut_bin() -> PathBuf {
-    static BUILT: std::sync::Once = std::sync::Once::new();
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    BUILT.call_once(|| {
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-        let status = Command::new(cargo)
-            .current_dir(&root)
-            .args(["build", "--quiet", "-p", "taut-studio", "--bin", "taut"])
-            .status()
-            .unwrap();
-        assert!(status.success(), "building taut");
-    });
-    root.join("target/debug/taut")
+    hil_tests::host_bin("taut")
 }
 
 /// Runs `taut send FILE <extra> --port <pty>` against a booted flatbed;

@@ -18,7 +18,7 @@ use taut_logic::kinematics::{AnyKinematics, Kinematics};
 use taut_logic::machine::Machine;
 use taut_logic::settings::eeprom::host;
 
-const STAR: &str = include_str!("../../examples/plotter/star.gcode");
+const STAR: &str = include_str!("../../../examples/plotter/star.gcode");
 /// A step of the flatbed's 40 steps/mm, diagonally, and a little.
 const WITHIN: f64 = 0.05;
 /// Samples along the toolpath, mm apart.

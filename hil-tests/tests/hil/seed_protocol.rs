@@ -11,7 +11,7 @@ use std::time::Duration;
 use taut_logic::config::MachineConfig;
 use taut_logic::machine::Machine;
 
-const MAGNUS: &str = include_str!("../files/seed003_magnus.txt");
+const MAGNUS: &str = include_str!("../../files/seed003_magnus.txt");
 
 fn send(sim: &mut Sim, line: &str) {
     send_ok(sim, line, Duration::from_secs(30));
