@@ -14,12 +14,16 @@
 //! does: during a job the executor refuses motion, drivers, offsets and
 //! the pen, and settings are refused here; reads are answered.
 
+mod activity;
 mod answer;
 mod homing;
 mod offsets;
 mod seed;
 mod source;
 mod system;
+
+pub use activity::{Activity, Owner};
+pub use offsets::Frame;
 
 use crate::flash_str;
 use crate::machine_io::Io;
@@ -38,7 +42,7 @@ use taut_logic::gcode::{Error, ErrorKind, Input, Parser, Read};
 use taut_logic::interp::{
     axis_letters, coords, motor_channels, Allowed, Env, Interpreter, Progress, Wait,
 };
-use taut_logic::kinematics::{Kinematics, Position};
+use taut_logic::kinematics::Kinematics;
 use taut_progmem::{text, Text};
 use ufmt::uwrite;
 
@@ -111,39 +115,6 @@ enum Listing {
     Startup(u8),
 }
 
-/// What the console is doing, for the status report.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Activity {
-    /// Reading and carrying out lines.
-    Lines,
-    Homing,
-    Jogging,
-    /// `$C`: checking lines without moving.
-    Checking,
-    /// `$SLP`: the drivers off until a reset.
-    Sleeping,
-}
-
-/// Who may move the machine now.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Owner {
-    Console,
-    /// A string-art job is drilling or winding (or paused in it).
-    Job,
-}
-
-/// What the status report takes from the console: where the work
-/// coordinates are.
-pub struct Frame {
-    /// The work coordinate offset of each channel (`WCO`).
-    pub wco: Position,
-    /// The programmed position: a plotter's pen channel reports it (no
-    /// motor counts its `Z`).
-    pub programmed: Position,
-    /// The offset changed since the last report (Grbl's WCO refresh).
-    pub changed: bool,
-}
-
 impl Console {
     pub const fn new(card: CardAsk) -> Console {
         Console {
@@ -214,15 +185,6 @@ impl Console {
         self.storing = false;
         self.saving = false;
         crate::board::port::clear_input();
-    }
-
-    /// The work coordinates for the status report.
-    pub fn frame(&mut self) -> Frame {
-        Frame {
-            wco: self.interp.wco(),
-            programmed: self.interp.target(),
-            changed: self.interp.take_wco_changed(),
-        }
     }
 
     /// A jog cancel (0x85, or `!` or the safety door while jogging): brake
@@ -591,17 +553,6 @@ impl Console {
                 self.error(&Error::new(kind, 0));
                 false
             }
-        }
-    }
-
-    /// What the console is doing.
-    pub fn activity(&self) -> Activity {
-        match self.homing {
-            _ if self.sleep != Sleep::Awake => Activity::Sleeping,
-            Some(_) => Activity::Homing,
-            _ if self.checking => Activity::Checking,
-            _ if self.jogging => Activity::Jogging,
-            _ => Activity::Lines,
         }
     }
 

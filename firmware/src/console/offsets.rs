@@ -11,7 +11,28 @@ use taut_logic::settings::grbl::{report_angles, report_axes};
 use taut_logic::units::Milli;
 use ufmt::uwrite;
 
+/// What the status report takes from the console: where the work
+/// coordinates are.
+pub struct Frame {
+    /// The work coordinate offset of each channel (`WCO`).
+    pub wco: Position,
+    /// The programmed position: a plotter's pen channel reports it (no
+    /// motor counts its `Z`).
+    pub programmed: Position,
+    /// The offset changed since the last report (Grbl's WCO refresh).
+    pub changed: bool,
+}
+
 impl Console {
+    /// The work coordinates for the status report.
+    pub fn frame(&mut self) -> Frame {
+        Frame {
+            wco: self.interp.wco(),
+            programmed: self.interp.target(),
+            changed: self.interp.take_wco_changed(),
+        }
+    }
+
     /// Line `line` of `$#` (`report_ngc_parameters`): `G54`…`G59`, `G28`,
     /// `G30` from the coordinate data, `G92` and `TLO` from the executor,
     /// `PRB` (taut has no probe: zero, not taken); `false` past the last.
