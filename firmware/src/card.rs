@@ -14,8 +14,9 @@
 
 use crate::board::delay::Delay;
 use crate::board::flash::FlashStr;
+use crate::board::port::Port;
 use crate::board::spi::{self, CardSpi};
-use crate::queues::{CardMsg, CardRequests, Request, Signal, What, CARD_OUT, CHUNK, TX};
+use crate::queues::{CardMsg, CardRequests, Request, Signal, What, CARD_OUT, CHUNK};
 use crate::rt::{Poll, TaskCell};
 use crate::{error, flash_str, info, warn};
 use embedded_hal::delay::DelayNs;
@@ -564,7 +565,7 @@ impl CardReader {
     /// that failed while mounted was never announced to the job.
     #[inline(never)]
     fn report_faulty(&mut self, lba: u32, what: FlashStr, ticket: u8) -> Poll<Signal> {
-        if TX.free() < crate::log::LINE || CARD_OUT.free() < ROOM {
+        if Port::Usb.tx_free() < crate::log::LINE || CARD_OUT.free() < ROOM {
             return Poll::After(2);
         }
         self.faulty = None;

@@ -6,11 +6,12 @@
 //! Log lines wait for room in the TX ring rather than being dropped: the
 //! prompts and the bad-file messages must reach the user.
 
+use crate::board::port::Port;
 use crate::checkpoint::BootNote;
 use crate::motion::Motion;
 use crate::queues::{
     CardAsk, CardMsg, Control, Request, Signal, What, BUTTONS, CARD_OUT, CHUNK, JOB_CLAIMS_TX,
-    JOB_CONTROL, TX,
+    JOB_CONTROL,
 };
 use crate::rt::Poll;
 use crate::store::Store;
@@ -31,7 +32,7 @@ use taut_logic::stringart::Save;
 
 /// Room for a whole log line, claimed from the console while there is none.
 fn room_for_a_line() -> bool {
-    let room = TX.free() >= LINE_ROOM;
+    let room = Port::Usb.tx_free() >= LINE_ROOM;
     JOB_CLAIMS_TX.store(!room, Relaxed);
     room
 }

@@ -18,9 +18,10 @@
 //! discards it.
 
 use crate::board::flash::FlashStr;
+use crate::board::port::Port;
 use crate::log::Level;
 use crate::motion::Motion;
-use crate::queues::{CardAsk, CardMsg, Request, What, BEGUN, CARD_OUT, TX};
+use crate::queues::{CardAsk, CardMsg, Request, What, BEGUN, CARD_OUT};
 use crate::reply;
 use crate::store::Store;
 use crate::{flash_str, info, warn};
@@ -172,7 +173,7 @@ impl Print {
     #[optimize(size)]
     pub fn keep(&mut self, store: &mut Store, now: u32) {
         if self.keep == Keep::Offer {
-            if TX.free() < crate::log::LINE {
+            if Port::Usb.tx_free() < crate::log::LINE {
                 return;
             }
             self.keep = Keep::Nothing;

@@ -15,6 +15,8 @@
 //! | `SAMPLER` the buttons' pins and last sample | `buttons.rs` (`IsrCell`) | `TIMER0_COMPA` only (handed over at init) |
 //! | `MILLIS`, `ALARM` the clock and the timers' alarm | `board/clock.rs` (masked) | `TIMER0_COMPA` ↔ every task (`clock::millis`, `set_alarm`) |
 //! | `FLOW`, `CUT`; USART1's `ON`, `RATE`, `CUT` | `board/usart.rs`, `board/usart1.rs` | receive interrupts ↔ console, `$` settings |
+//! | `RX`, `RX1` the ports' received line bytes | `board/usart.rs`, `board/usart1.rs` (the board's only) | receive interrupts → console, through `Port::receive` |
+//! | `TX`, `TX1` the ports' replies and log lines | `board/usart.rs`, `board/usart1.rs` (the board's only) | tasks, through a port's `OUTBOX` (`log::Line`, `Port::send`) → transmit interrupts |
 //! | `OUTBOX` a port's staged reply | `board/usart.rs`, `board/usart1.rs` | tasks → transmit interrupt (through `TX`, `TX1`) |
 //! | `ANSWER` the port a line came from | `board/port.rs` | console → replies (tasks only) |
 //! | `DROPPED` log lines lost | `log.rs` (masked) | any context → logger |
@@ -31,22 +33,6 @@ use taut_logic::fat::Name;
 use taut_logic::sched::QueueStats;
 use taut_logic::segment::{Segment, StepBlock};
 
-/// UART receive interrupt → console: line bytes (real-time commands are
-/// taken out before). 128 bytes, Grbl's buffer, every one usable: what
-/// senders count characters against (CNCjs 120, UGS and grbl-streamer
-/// 128, all of it unread when the console has not begun the next line).
-/// Full: the byte is lost and counted (the sender ignored flow control).
-pub static RX: Ring<u8, 128, true> = Ring::new();
-/// Console, job, logger → UART transmit interrupt. Replies wait for room;
-/// a log line without room is dropped whole and counted.
-pub static TX: Ring<u8, 128> = Ring::new();
-/// USART1 (the second console, a Bluetooth module) receive interrupt →
-/// console, as `RX`: 64 bytes, the longest line a sender types by hand
-/// or a job's, its last slot kept for a line's end.
-pub static RX1: Ring<u8, 64, true> = Ring::new();
-/// Console, status reports → USART1 transmit interrupt: room for the
-/// longest reply (`reply::ROOM`).
-pub static TX1: Ring<u8, 128> = Ring::new();
 /// UART receive interrupt → `Realtime` task: `?`, `!`, `~`, Ctrl-X.
 pub static REALTIME: Flags = Flags::new();
 /// UART receive interrupt → `Realtime` task: the feed override's ±10 %

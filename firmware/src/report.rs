@@ -2,9 +2,8 @@
 //! a job: how full each queue got, what it refused, what the step interrupt
 //! missed.
 
-use crate::queues::{
-    card_in_stats, BLOCKS, BUTTONS, CARD_OUT, JOB_CONTROL, RX, RX1, SAMPLES, SEGMENTS, TX, TX1,
-};
+use crate::board::port::Port;
+use crate::queues::{card_in_stats, BLOCKS, BUTTONS, CARD_OUT, JOB_CONTROL, SAMPLES, SEGMENTS};
 use crate::{flash_str, info};
 use taut_logic::sched::QueueStats;
 
@@ -19,8 +18,15 @@ fn queue(name: crate::board::flash::FlashStr, s: QueueStats, capacity: usize) {
 /// interrupt, then dropped log lines; line `i` of them. False past the end.
 pub fn queue_line(i: u8) -> bool {
     match i {
-        0 => queue(flash_str!("rx"), RX.stats(), RX.capacity()),
-        1 => queue(flash_str!("tx"), TX.stats(), TX.capacity()),
+        0 => queue(
+            flash_str!("rx"),
+            Port::Usb.rx_stats(),
+            Port::Usb.rx_capacity(),
+        ),
+        1 => {
+            let (stats, capacity) = Port::Usb.tx_stats();
+            queue(flash_str!("tx"), stats, capacity)
+        }
         2 => queue(
             flash_str!("segments"),
             SEGMENTS.stats(),
@@ -43,8 +49,15 @@ pub fn queue_line(i: u8) -> bool {
             JOB_CONTROL.stats(),
             JOB_CONTROL.capacity(),
         ),
-        9 => queue(flash_str!("rx1"), RX1.stats(), RX1.capacity()),
-        10 => queue(flash_str!("tx1"), TX1.stats(), TX1.capacity()),
+        9 => queue(
+            flash_str!("rx1"),
+            Port::Uart1.rx_stats(),
+            Port::Uart1.rx_capacity(),
+        ),
+        10 => {
+            let (stats, capacity) = Port::Uart1.tx_stats();
+            queue(flash_str!("tx1"), stats, capacity)
+        }
         11 => info!("log dropped:", crate::log::dropped()),
         _ => return false,
     }
