@@ -29,7 +29,7 @@ use crate::flash_str;
 use crate::machine_io::Io;
 use crate::motion::Motion;
 use crate::print::Print;
-use crate::queues::{CardAsk, Signal, JOB_CLAIMS_TX};
+use crate::queues::{CardAsk, CardNews, Signal, JOB_CLAIMS_TX};
 use crate::reply;
 use crate::rt::Poll;
 use crate::store::Store;
@@ -116,7 +116,7 @@ enum Listing {
 }
 
 impl Console {
-    pub const fn new(card: CardAsk) -> Console {
+    pub const fn new(card: CardAsk, news: CardNews) -> Console {
         Console {
             parser: Parser::new(),
             line_ready: false,
@@ -128,7 +128,7 @@ impl Console {
             // the kinematics (zero steps are not (0, 0) on an arm).
             epoch: u8::MAX,
             settings_changed: false,
-            print: Print::new(card),
+            print: Print::new(card, news),
             source: None,
             jogging: false,
             checking: false,

@@ -9,8 +9,8 @@
 use crate::checkpoint::BootNote;
 use crate::motion::Motion;
 use crate::queues::{
-    CardAsk, CardMsg, Control, Request, Signal, What, BUTTONS, CARD_OUT, CHUNK, JOB_CLAIMS_TX,
-    JOB_CONTROL, TX,
+    CardAsk, CardNews, CardMsg, Control, Request, Signal, What, BUTTONS, CHUNK,
+    JOB_CLAIMS_TX, JOB_CONTROL, TX,
 };
 use crate::rt::Poll;
 use crate::store::Store;
@@ -79,6 +79,8 @@ impl Stream {
 pub struct JobTask {
     /// Its end of `CARD_IN`.
     card: CardAsk,
+    /// Its end of `CARD_OUT`.
+    news: CardNews,
     job: Job,
     /// Actions not yet carried out, in order: one event's at most, as
     /// inputs are taken only when the last event's are done.
@@ -97,9 +99,10 @@ pub struct JobTask {
 }
 
 impl JobTask {
-    pub const fn new(card: CardAsk) -> Self {
+    pub const fn new(card: CardAsk, news: CardNews) -> Self {
         JobTask {
             card,
+            news,
             job: Job::new(),
             todo: Actions::new(),
             stream: Stream::None,
@@ -198,8 +201,10 @@ impl JobTask {
         }
         // Read in place, taken once handled: a copy would sit on the stack
         // under the file checks. The reader, a task that never runs in
-        // the middle of this one, writes only free slots.
-        let taken = CARD_OUT.peek_with(|msg| {
+        // the middle of this one, writes only free slots. Its end lent:
+        // the message is handled with all of `self`.
+        let news = self.news.clone();
+        let taken = news.peek_with(|msg| {
             // Checking the files ends in a log line (`files ok` or the error).
             if self.stream.checking() && !room_for_a_line() {
                 return false;
@@ -209,7 +214,7 @@ impl JobTask {
             // pattern is read again from its start once it is back).
             let winding = matches!(self.stream, Stream::Pattern(_));
             if matches!(msg.what, What::Data { .. }) && winding && msg.ticket == self.ticket {
-                return crate::card::removal_waits();
+                return crate::card::removal_waits(&news);
             }
             self.card(msg, m, config, now);
             true
@@ -217,7 +222,7 @@ impl JobTask {
         if taken != Some(true) {
             return false;
         }
-        let _ = CARD_OUT.pop();
+        let _ = news.pop();
         true
     }
 
@@ -381,7 +386,7 @@ impl JobTask {
             let Stream::Pattern(p) = &mut self.stream else {
                 return;
             };
-            let nail = match p.next() {
+            let nail = match p.next(&self.news) {
                 Ok(Some(nail)) => nail,
                 Ok(None) => return,
                 Err(e) => {
@@ -593,7 +598,7 @@ impl Pattern {
 
     /// The next nail index, from the chunk in hand or the card's queue;
     /// `None` until more bytes arrive.
-    fn next(&mut self) -> Result<Option<u16>, FileError> {
+    fn next(&mut self, news: &CardNews) -> Result<Option<u16>, FileError> {
         loop {
             if self.at < self.len {
                 let (used, nail) = self
@@ -611,7 +616,7 @@ impl Pattern {
             }
             // Copied in place: a copy of the message would sit in the job
             // task's frame.
-            let took = CARD_OUT.peek_with(|msg| match msg.what {
+            let took = news.peek_with(|msg| match msg.what {
                 What::Data { at, len } => {
                     crate::card::bytes(at, len, |b| self.chunk[..b.len()].copy_from_slice(b));
                     self.at = 0;
@@ -623,7 +628,7 @@ impl Pattern {
             if took != Some(true) {
                 return Ok(None);
             }
-            let _ = CARD_OUT.pop();
+            let _ = news.pop();
         }
     }
 }

@@ -40,7 +40,7 @@ use taut_firmware::console::{Activity, Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
-use taut_firmware::queues::{self, CardRequests, Control, Signal, CARD_OUT, JOB_CONTROL, SIGNALS};
+use taut_firmware::queues::{self, CardRequests, CardTell, Control, Signal, JOB_CONTROL, SIGNALS};
 use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{self, stack, Poll, TaskCell};
@@ -223,8 +223,8 @@ fn main() -> ! {
     stack::paint();
     // Before `init`: the cells' values are built on the stack (a console
     // is ~480 B), not above `init`'s frame.
-    let card_requests = init_cells();
-    let watchdog = init(card_requests);
+    let ends = init_cells();
+    let watchdog = init(ends);
     dispatch::run(
         &SPAWNED,
         &READY,
@@ -239,7 +239,7 @@ fn main() -> ! {
 /// set-up's locals are gone from the stack before the dispatcher starts.
 #[inline(never)]
 #[optimize(size)]
-fn init(card_requests: CardRequests) -> Watchdog {
+fn init(ends: Ends) -> Watchdog {
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
     let reset = ResetCause::take(&dp.CPU);
     let watchdog = Watchdog::start(dp.WDT);
@@ -301,7 +301,8 @@ fn init(card_requests: CardRequests) -> Watchdog {
     start_motion(stepper, drivers, pen);
     start_card(
         CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53),
-        card_requests,
+        ends.card_requests,
+        ends.card_tell,
     );
     buttons::start(ButtonPins {
         confirm: pins.d2.into_pull_up_input(),
@@ -361,11 +362,22 @@ fn init(card_requests: CardRequests) -> Watchdog {
 /// the stack would stay in its frame under everything it calls.
 #[inline(never)]
 #[optimize(size)]
-fn init_cells() -> CardRequests {
-    let (job_asks, print_asks, requests) = queues::card_in_ends();
-    CONSOLE.init(Console::new(print_asks));
-    JOB.init(JobTask::new(job_asks));
-    requests
+fn init_cells() -> Ends {
+    let (job_asks, print_asks, card_requests) = queues::card_in_ends();
+    let (card_tell, job_news, print_news) = queues::card_out_ends();
+    CONSOLE.init(Console::new(print_asks, print_news));
+    JOB.init(JobTask::new(job_asks, job_news));
+    Ends {
+        card_requests,
+        card_tell,
+    }
+}
+
+/// The queue ends `init_cells` leaves for `init`, which makes their
+/// holders: the card reader's.
+struct Ends {
+    card_requests: CardRequests,
+    card_tell: CardTell,
 }
 
 /// The kinematics of the settings loaded. Settings are only taken whole,
@@ -459,8 +471,8 @@ fn others_ready() -> bool {
 
 #[inline(never)]
 #[optimize(size)]
-fn start_card(spi: CardSpi, requests: CardRequests) {
-    CARD.init_with(|c| c.write(CardReader::new(spi, requests)));
+fn start_card(spi: CardSpi, requests: CardRequests, tell: CardTell) {
+    CARD.init_with(|c| c.write(CardReader::new(spi, requests, tell)));
 }
 
 /// Move due timers into the ready set and re-arm the tick's alarm.
@@ -577,7 +589,7 @@ fn console() {
     if queues::card_request_waits() {
         spawn(Task::Card);
     }
-    if CARD_OUT.free() > card::ROOM {
+    if queues::card_out_free() > card::ROOM {
         signal(Signal::CardRoom);
     }
     if CONSOLE.with(|c| c.take_settings_changed()) {
@@ -731,7 +743,7 @@ fn job() {
     if queues::card_request_waits() {
         spawn(Task::Card);
     }
-    if CARD_OUT.free() > card::ROOM {
+    if queues::card_out_free() > card::ROOM {
         signal(Signal::CardRoom);
     }
 }
@@ -754,7 +766,7 @@ fn card() {
     let moving = MOTION.with(|m| !m.is_idle());
     let poll = CARD.with(|c| c.poll(now, moving));
     reschedule(Task::Card, poll);
-    if !CARD_OUT.is_empty() {
+    if queues::card_message_waits() {
         spawn(card_owner());
     }
 }

@@ -125,8 +125,81 @@ pub fn card_in_stats() -> (QueueStats, usize) {
 }
 /// Card reader → job or console, its four slots usable. Full: the reader
 /// keeps its block and waits. A file's bytes take at most two
-/// (`card::ROOM` stay free for a removal's news).
-pub static CARD_OUT: Ring<CardMsg, 4, true> = Ring::new();
+/// (`card::ROOM` stay free for a removal's news). Private: reached
+/// through its ends, [`CardTell`] and [`CardNews`].
+static CARD_OUT: Ring<CardMsg, 4, true> = Ring::new();
+
+/// `CARD_OUT`'s sending end: the card reader's.
+pub struct CardTell(());
+
+impl CardTell {
+    #[inline(always)]
+    pub fn push(&self, msg: CardMsg) -> Result<(), CardMsg> {
+        CARD_OUT.push(msg)
+    }
+
+    #[inline(always)]
+    pub fn free(&self) -> usize {
+        CARD_OUT.free()
+    }
+
+    /// Whether a message still waiting is `f`'s: the reader's block is
+    /// lent to the file bytes waiting.
+    #[inline(always)]
+    pub fn any(&self, f: impl Fn(&CardMsg) -> bool) -> bool {
+        CARD_OUT.any(f)
+    }
+}
+
+/// `CARD_OUT`'s receiving end: the job's and the card print's (only the
+/// card's owner, the job on the string-art machine, the console on a
+/// plotter, runs to take messages). `Clone` so that its holder can lend
+/// it to itself: the job handles a message read in place with all of
+/// itself borrowed (a copy of the message would deepen the stack).
+#[derive(Clone)]
+pub struct CardNews(());
+
+impl CardNews {
+    /// `f` of the oldest message, read in place.
+    #[inline(always)]
+    pub fn peek_with<R>(&self, f: impl FnOnce(&CardMsg) -> R) -> Option<R> {
+        CARD_OUT.peek_with(f)
+    }
+
+    #[inline(always)]
+    pub fn pop(&self) -> Option<CardMsg> {
+        CARD_OUT.pop()
+    }
+
+    /// Whether any waiting message is `f`'s.
+    #[inline(always)]
+    pub fn any(&self, f: impl Fn(&CardMsg) -> bool) -> bool {
+        CARD_OUT.any(f)
+    }
+}
+
+/// `CARD_OUT`'s ends, made once, by the app's init: the reader's, the
+/// job's, the card print's.
+pub fn card_out_ends() -> (CardTell, CardNews, CardNews) {
+    (CardTell(()), CardNews(()), CardNews(()))
+}
+
+/// A message waits for the card's owner (the app then spawns it).
+#[inline(always)]
+pub fn card_message_waits() -> bool {
+    !CARD_OUT.is_empty()
+}
+
+/// `CARD_OUT`'s free slots (the app signals `CardRoom` over `card::ROOM`).
+#[inline(always)]
+pub fn card_out_free() -> usize {
+    CARD_OUT.free()
+}
+
+/// `CARD_OUT`'s counters and capacity (`$Q`).
+pub fn card_out_stats() -> (QueueStats, usize) {
+    (CARD_OUT.stats(), CARD_OUT.capacity())
+}
 /// File bytes per message at most.
 pub const CHUNK: usize = 32;
 
@@ -209,7 +282,7 @@ pub enum Signal {
     PlannerRoom,
     /// The step queue is refilled (`Motion::refilling` is over).
     Refilled,
-    /// The job took messages from [`CARD_OUT`].
+    /// The job took messages from `CARD_OUT`.
     CardRoom,
     /// A `$` setting changed: the store writes it to EEPROM.
     Settings,

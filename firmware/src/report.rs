@@ -3,7 +3,8 @@
 //! missed.
 
 use crate::queues::{
-    card_in_stats, BLOCKS, BUTTONS, CARD_OUT, JOB_CONTROL, RX, RX1, SAMPLES, SEGMENTS, TX, TX1,
+    card_in_stats, card_out_stats, BLOCKS, BUTTONS, JOB_CONTROL, RX, RX1, SAMPLES, SEGMENTS, TX,
+    TX1,
 };
 use crate::{flash_str, info};
 use taut_logic::sched::QueueStats;
@@ -27,7 +28,10 @@ pub fn queue_line(i: u8) -> bool {
             SEGMENTS.capacity(),
         ),
         3 => queue(flash_str!("blocks"), BLOCKS.stats(), BLOCKS.capacity()),
-        4 => queue(flash_str!("card"), CARD_OUT.stats(), CARD_OUT.capacity()),
+        4 => {
+            let (stats, capacity) = card_out_stats();
+            queue(flash_str!("card"), stats, capacity)
+        }
         5 => {
             let (stats, capacity) = card_in_stats();
             queue(flash_str!("card req"), stats, capacity)
