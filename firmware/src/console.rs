@@ -29,7 +29,7 @@ use crate::flash_str;
 use crate::machine_io::Io;
 use crate::motion::Motion;
 use crate::print::Print;
-use crate::queues::{CardAsk, CardNews, Signal, JOB_CLAIMS_TX};
+use crate::queues::{CardAsk, CardNews, Control, Signal, TellJob, JOB_CLAIMS_TX};
 use crate::reply;
 use crate::rt::Poll;
 use crate::store::Store;
@@ -68,6 +68,8 @@ pub struct Console {
     settings_changed: bool,
     /// A plotter's print from the card.
     print: Print,
+    /// Its end of `JOB_CONTROL`.
+    job: TellJob,
     /// Where the line being read comes from, `None` between lines: while
     /// a print runs, a serial line is read whenever one has arrived whole.
     source: Option<Source>,
@@ -116,7 +118,7 @@ enum Listing {
 }
 
 impl Console {
-    pub const fn new(card: CardAsk, news: CardNews) -> Console {
+    pub const fn new(card: CardAsk, news: CardNews, job: TellJob) -> Console {
         Console {
             parser: Parser::new(),
             line_ready: false,
@@ -129,6 +131,7 @@ impl Console {
             epoch: u8::MAX,
             settings_changed: false,
             print: Print::new(card, news),
+            job,
             source: None,
             jogging: false,
             checking: false,
@@ -162,6 +165,12 @@ impl Console {
     /// the settings stored).
     pub fn take_settings_changed(&mut self) -> bool {
         core::mem::take(&mut self.settings_changed)
+    }
+
+    /// The console's word for the job, the `Realtime` task's too (`~`,
+    /// Ctrl-X): false when the job's queue is full.
+    pub fn tell_job(&self, c: Control) -> bool {
+        self.job.push(c).is_ok()
     }
 
     /// Ctrl-X: the line in progress, the line being carried out and a

@@ -9,8 +9,8 @@
 use crate::checkpoint::BootNote;
 use crate::motion::Motion;
 use crate::queues::{
-    CardAsk, CardNews, CardMsg, Control, Request, Signal, What, BUTTONS, CHUNK,
-    JOB_CLAIMS_TX, JOB_CONTROL, TX,
+    CardAsk, CardMsg, CardNews, Control, JobControls, Request, Signal, What, BUTTONS, CHUNK,
+    JOB_CLAIMS_TX, TX,
 };
 use crate::rt::Poll;
 use crate::store::Store;
@@ -81,6 +81,8 @@ pub struct JobTask {
     card: CardAsk,
     /// Its end of `CARD_OUT`.
     news: CardNews,
+    /// Its end of `JOB_CONTROL`.
+    controls: JobControls,
     job: Job,
     /// Actions not yet carried out, in order: one event's at most, as
     /// inputs are taken only when the last event's are done.
@@ -99,10 +101,11 @@ pub struct JobTask {
 }
 
 impl JobTask {
-    pub const fn new(card: CardAsk, news: CardNews) -> Self {
+    pub const fn new(card: CardAsk, news: CardNews, controls: JobControls) -> Self {
         JobTask {
             card,
             news,
+            controls,
             job: Job::new(),
             todo: Actions::new(),
             stream: Stream::None,
@@ -184,7 +187,7 @@ impl JobTask {
             self.event(Event::Button(b), now);
             return true;
         }
-        if let Some(c) = JOB_CONTROL.pop() {
+        if let Some(c) = self.controls.pop() {
             let e = match c {
                 Control::Resume => Event::Resume,
                 Control::Abort => {

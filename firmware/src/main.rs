@@ -40,7 +40,7 @@ use taut_firmware::console::{Activity, Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
-use taut_firmware::queues::{self, CardRequests, CardTell, Control, Signal, JOB_CONTROL, SIGNALS};
+use taut_firmware::queues::{self, CardRequests, CardTell, Control, Signal, SIGNALS};
 use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{self, stack, Poll, TaskCell};
@@ -72,7 +72,7 @@ taut_firmware::tasks! {
         runs: realtime,
         does: "status, hold, resume, reset",
         input: "`REALTIME`",
-        output: "`TX`, `TX1`, `JOB_CONTROL`",
+        output: "`TX`, `TX1`, `JOB_CONTROL` (the console's end)",
     },
     Refill {
         priority: 3,
@@ -96,7 +96,7 @@ taut_firmware::tasks! {
         runs: console,
         does: "one G-code line per run (waits for `Refilled` while the step queue runs short inside planned motion); a plotter's card print",
         input: "`RX`, `RX1`; on a plotter `BUTTONS`, `CARD_OUT`",
-        output: "planner, `TX`, `TX1`, `CARD_IN`; signals `CardRoom`",
+        output: "planner, `TX`, `TX1`, `CARD_IN`, `JOB_CONTROL`; signals `CardRoom`",
     },
     Buttons {
         priority: 2,
@@ -365,8 +365,9 @@ fn init(ends: Ends) -> Watchdog {
 fn init_cells() -> Ends {
     let (job_asks, print_asks, card_requests) = queues::card_in_ends();
     let (card_tell, job_news, print_news) = queues::card_out_ends();
-    CONSOLE.init(Console::new(print_asks, print_news));
-    JOB.init(JobTask::new(job_asks, job_news));
+    let (tell_job, job_controls) = queues::job_control_ends();
+    CONSOLE.init(Console::new(print_asks, print_news, tell_job));
+    JOB.init(JobTask::new(job_asks, job_news, job_controls));
     Ends {
         card_requests,
         card_tell,
@@ -582,7 +583,7 @@ fn console() {
     };
     reschedule(Task::Console, poll);
     // An operator's tool for the job.
-    if !JOB_CONTROL.is_empty() {
+    if queues::job_control_waits() {
         spawn(Task::Job);
     }
     // A plotter's card print asks the reader and takes its messages.
@@ -692,8 +693,9 @@ fn startup_lines() -> bool {
     STORE.with(|s| s.has_startup_lines())
 }
 
+/// The console's word for the job, through its end of `JOB_CONTROL`.
 fn control_job(c: Control) {
-    if JOB_CONTROL.push(c).is_err() {
+    if !CONSOLE.with(|con| con.tell_job(c)) {
         warn!("job control queue full");
     }
     spawn(Task::Job);

@@ -203,8 +203,49 @@ pub fn card_out_stats() -> (QueueStats, usize) {
 /// File bytes per message at most.
 pub const CHUNK: usize = 32;
 
-/// `Realtime` task → job: `~` with no feed hold, Ctrl-X.
-pub static JOB_CONTROL: Ring<Control, 4> = Ring::new();
+/// Console → job: its operator's tools, and from its real-time bytes
+/// (the `Realtime` task) `~` with no feed hold and Ctrl-X. Private:
+/// reached through its ends, [`TellJob`] and [`JobControls`].
+static JOB_CONTROL: Ring<Control, 4> = Ring::new();
+
+/// `JOB_CONTROL`'s sending end: the console's, which the `Realtime` task
+/// uses too (both are software tasks, never running in each other's
+/// middle).
+pub struct TellJob(());
+
+impl TellJob {
+    #[inline(always)]
+    pub fn push(&self, c: Control) -> Result<(), Control> {
+        JOB_CONTROL.push(c)
+    }
+}
+
+/// `JOB_CONTROL`'s receiving end: the job's.
+pub struct JobControls(());
+
+impl JobControls {
+    #[inline(always)]
+    pub fn pop(&self) -> Option<Control> {
+        JOB_CONTROL.pop()
+    }
+}
+
+/// `JOB_CONTROL`'s ends, made once, by the app's init: the console's,
+/// the job's.
+pub fn job_control_ends() -> (TellJob, JobControls) {
+    (TellJob(()), JobControls(()))
+}
+
+/// A word waits for the job (the app then spawns it).
+#[inline(always)]
+pub fn job_control_waits() -> bool {
+    !JOB_CONTROL.is_empty()
+}
+
+/// `JOB_CONTROL`'s counters and capacity (`$Q`).
+pub fn job_control_stats() -> (QueueStats, usize) {
+    (JOB_CONTROL.stats(), JOB_CONTROL.capacity())
+}
 
 /// The job waits for room in the TX ring for a line it must not drop (a
 /// prompt, a bad file's message): the console holds its replies meanwhile,

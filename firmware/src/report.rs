@@ -3,8 +3,8 @@
 //! missed.
 
 use crate::queues::{
-    card_in_stats, card_out_stats, BLOCKS, BUTTONS, JOB_CONTROL, RX, RX1, SAMPLES, SEGMENTS, TX,
-    TX1,
+    card_in_stats, card_out_stats, job_control_stats, BLOCKS, BUTTONS, RX, RX1, SAMPLES,
+    SEGMENTS, TX, TX1,
 };
 use crate::{flash_str, info};
 use taut_logic::sched::QueueStats;
@@ -42,11 +42,10 @@ pub fn queue_line(i: u8) -> bool {
             SAMPLES.capacity(),
         ),
         7 => queue(flash_str!("buttons"), BUTTONS.stats(), BUTTONS.capacity()),
-        8 => queue(
-            flash_str!("job control"),
-            JOB_CONTROL.stats(),
-            JOB_CONTROL.capacity(),
-        ),
+        8 => {
+            let (stats, capacity) = job_control_stats();
+            queue(flash_str!("job control"), stats, capacity)
+        }
         9 => queue(flash_str!("rx1"), RX1.stats(), RX1.capacity()),
         10 => queue(flash_str!("tx1"), TX1.stats(), TX1.capacity()),
         11 => info!("log dropped:", crate::log::dropped()),
