@@ -5,7 +5,7 @@
 //! `BUTTONS` (`queues`).
 
 use crate::board::gpio::{Pin, PullUp};
-use crate::queues::{BUTTONS, SAMPLES};
+use crate::queues::{TellPresses, SAMPLES};
 use crate::rt::IsrCell;
 use embedded_hal::digital::InputPin;
 use taut_logic::buttons::{Debouncer, DEBOUNCE_MS};
@@ -67,26 +67,26 @@ pub fn sample() -> (bool, u8) {
         .unwrap_or((false, 0))
 }
 
-/// The buttons task's state: the debouncer.
-pub struct ButtonsTask(Debouncer);
-
-impl Default for ButtonsTask {
-    fn default() -> Self {
-        Self::new()
-    }
+/// The buttons task's state: the debouncer, its end of `BUTTONS`.
+pub struct ButtonsTask {
+    debouncer: Debouncer,
+    presses: TellPresses,
 }
 
 impl ButtonsTask {
-    pub const fn new() -> Self {
-        ButtonsTask(Debouncer::new())
+    pub const fn new(presses: TellPresses) -> Self {
+        ButtonsTask {
+            debouncer: Debouncer::new(),
+            presses,
+        }
     }
 
     /// ButtonsTask every queued sample; true when events went to the job.
     pub fn poll(&mut self) -> bool {
         let mut sent = false;
         while let Some(raw) = SAMPLES.pop() {
-            for e in self.0.tick(raw) {
-                sent |= BUTTONS.push(e).is_ok();
+            for e in self.debouncer.tick(raw) {
+                sent |= self.presses.push(e).is_ok();
             }
         }
         sent

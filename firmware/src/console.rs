@@ -29,7 +29,7 @@ use crate::flash_str;
 use crate::machine_io::Io;
 use crate::motion::Motion;
 use crate::print::Print;
-use crate::queues::{CardAsk, CardNews, Control, Signal, TellJob, JOB_CLAIMS_TX};
+use crate::queues::{CardAsk, CardNews, Control, Presses, Signal, TellJob, JOB_CLAIMS_TX};
 use crate::reply;
 use crate::rt::Poll;
 use crate::store::Store;
@@ -70,6 +70,8 @@ pub struct Console {
     print: Print,
     /// Its end of `JOB_CONTROL`.
     job: TellJob,
+    /// Its end of `BUTTONS` (a plotter's card print takes the presses).
+    presses: Presses,
     /// Where the line being read comes from, `None` between lines: while
     /// a print runs, a serial line is read whenever one has arrived whole.
     source: Option<Source>,
@@ -118,7 +120,7 @@ enum Listing {
 }
 
 impl Console {
-    pub const fn new(card: CardAsk, news: CardNews, job: TellJob) -> Console {
+    pub const fn new(card: CardAsk, news: CardNews, job: TellJob, presses: Presses) -> Console {
         Console {
             parser: Parser::new(),
             line_ready: false,
@@ -132,6 +134,7 @@ impl Console {
             settings_changed: false,
             print: Print::new(card, news),
             job,
+            presses,
             source: None,
             jogging: false,
             checking: false,

@@ -9,7 +9,7 @@
 use crate::checkpoint::BootNote;
 use crate::motion::Motion;
 use crate::queues::{
-    CardAsk, CardMsg, CardNews, Control, JobControls, Request, Signal, What, BUTTONS, CHUNK,
+    CardAsk, CardMsg, CardNews, Control, JobControls, Presses, Request, Signal, What, CHUNK,
     JOB_CLAIMS_TX, TX,
 };
 use crate::rt::Poll;
@@ -83,6 +83,8 @@ pub struct JobTask {
     news: CardNews,
     /// Its end of `JOB_CONTROL`.
     controls: JobControls,
+    /// Its end of `BUTTONS`.
+    presses: Presses,
     job: Job,
     /// Actions not yet carried out, in order: one event's at most, as
     /// inputs are taken only when the last event's are done.
@@ -101,11 +103,17 @@ pub struct JobTask {
 }
 
 impl JobTask {
-    pub const fn new(card: CardAsk, news: CardNews, controls: JobControls) -> Self {
+    pub const fn new(
+        card: CardAsk,
+        news: CardNews,
+        controls: JobControls,
+        presses: Presses,
+    ) -> Self {
         JobTask {
             card,
             news,
             controls,
+            presses,
             job: Job::new(),
             todo: Actions::new(),
             stream: Stream::None,
@@ -183,7 +191,7 @@ impl JobTask {
 
     /// The next input: a button, a card message, the console. False: none.
     fn input(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> bool {
-        if let Some(b) = BUTTONS.pop() {
+        if let Some(b) = self.presses.pop() {
             self.event(Event::Button(b), now);
             return true;
         }

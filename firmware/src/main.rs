@@ -155,7 +155,7 @@ static CONSOLE: TaskCell<Console> = TaskCell::zeroed();
 static CONFIG: TaskCell<MachineConfig> = TaskCell::zeroed();
 /// The kinematics of `CONFIG`, rebuilt when a setting changes.
 static KIN: TaskCell<AnyKinematics> = TaskCell::zeroed();
-static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::new(ButtonsTask::new());
+static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::zeroed();
 static JOB: TaskCell<JobTask> = TaskCell::zeroed();
 static CARD: TaskCell<CardReader> = TaskCell::zeroed();
 static STORE: TaskCell<Store> = TaskCell::zeroed();
@@ -366,8 +366,15 @@ fn init_cells() -> Ends {
     let (job_asks, print_asks, card_requests) = queues::card_in_ends();
     let (card_tell, job_news, print_news) = queues::card_out_ends();
     let (tell_job, job_controls) = queues::job_control_ends();
-    CONSOLE.init(Console::new(print_asks, print_news, tell_job));
-    JOB.init(JobTask::new(job_asks, job_news, job_controls));
+    let (tell_presses, job_presses, console_presses) = queues::buttons_ends();
+    CONSOLE.init(Console::new(
+        print_asks,
+        print_news,
+        tell_job,
+        console_presses,
+    ));
+    JOB.init(JobTask::new(job_asks, job_news, job_controls, job_presses));
+    BUTTONS_TASK.init(ButtonsTask::new(tell_presses));
     Ends {
         card_requests,
         card_tell,

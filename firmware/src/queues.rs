@@ -75,9 +75,43 @@ pub static BEGUN: AtomicU8 = AtomicU8::new(0);
 /// millisecond while active. Full: the sample is refused and counted (the
 /// task fell 15 ms behind; a press then counts a little late).
 pub static SAMPLES: Ring<u8, 16> = Ring::new();
-/// Buttons task → job. Full: refused and counted (the job is far behind a
-/// human's presses).
-pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
+/// Buttons task → job, or a plotter's console (its card print). Full:
+/// refused and counted (the job is far behind a human's presses).
+/// Private: reached through its ends, [`TellPresses`] and [`Presses`].
+static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
+
+/// `BUTTONS`' sending end: the buttons task's.
+pub struct TellPresses(());
+
+impl TellPresses {
+    #[inline(always)]
+    pub fn push(&self, e: ButtonEvent) -> Result<(), ButtonEvent> {
+        BUTTONS.push(e)
+    }
+}
+
+/// `BUTTONS`' receiving end: the job's and the console's (only the card's
+/// owner, the job on the string-art machine, the console on a plotter,
+/// runs to take presses).
+pub struct Presses(());
+
+impl Presses {
+    #[inline(always)]
+    pub fn pop(&self) -> Option<ButtonEvent> {
+        BUTTONS.pop()
+    }
+}
+
+/// `BUTTONS`' ends, made once, by the app's init: the buttons task's, the
+/// job's, the console's.
+pub fn buttons_ends() -> (TellPresses, Presses, Presses) {
+    (TellPresses(()), Presses(()), Presses(()))
+}
+
+/// `BUTTONS`' counters and capacity (`$Q`).
+pub fn buttons_stats() -> (QueueStats, usize) {
+    (BUTTONS.stats(), BUTTONS.capacity())
+}
 
 /// Job or console (a plotter's card print) → card reader: the newest
 /// request (the reader takes them first; a newer one replaces it).

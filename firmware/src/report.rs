@@ -3,7 +3,7 @@
 //! missed.
 
 use crate::queues::{
-    card_in_stats, card_out_stats, job_control_stats, BLOCKS, BUTTONS, RX, RX1, SAMPLES,
+    buttons_stats, card_in_stats, card_out_stats, job_control_stats, BLOCKS, RX, RX1, SAMPLES,
     SEGMENTS, TX, TX1,
 };
 use crate::{flash_str, info};
@@ -41,7 +41,10 @@ pub fn queue_line(i: u8) -> bool {
             SAMPLES.stats(),
             SAMPLES.capacity(),
         ),
-        7 => queue(flash_str!("buttons"), BUTTONS.stats(), BUTTONS.capacity()),
+        7 => {
+            let (stats, capacity) = buttons_stats();
+            queue(flash_str!("buttons"), stats, capacity)
+        }
         8 => {
             let (stats, capacity) = job_control_stats();
             queue(flash_str!("job control"), stats, capacity)
