@@ -40,7 +40,7 @@ use taut_firmware::console::{Activity, Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
-use taut_firmware::queues::{self, CardRequests, CardTell, Control, Signal, SIGNALS};
+use taut_firmware::queues::{self, CardRequests, CardTell, Control, SampleButtons, Signal, SIGNALS};
 use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{self, stack, Poll, TaskCell};
@@ -304,12 +304,15 @@ fn init(ends: Ends) -> Watchdog {
         ends.card_requests,
         ends.card_tell,
     );
-    buttons::start(ButtonPins {
+    buttons::start(
+        ButtonPins {
         confirm: pins.d2.into_pull_up_input(),
         zero_base: pins.d3.into_pull_up_input(),
         zero_radial: pins.d14.into_pull_up_input(),
         zero_drill: pins.d18.into_pull_up_input(),
-    });
+        },
+        ends.sample_buttons,
+    );
     rt::enable_interrupts();
     reply::banner();
 
@@ -374,18 +377,21 @@ fn init_cells() -> Ends {
         console_presses,
     ));
     JOB.init(JobTask::new(job_asks, job_news, job_controls, job_presses));
-    BUTTONS_TASK.init(ButtonsTask::new(tell_presses));
+    let (sample_buttons, samples) = queues::samples_ends();
+    BUTTONS_TASK.init(ButtonsTask::new(samples, tell_presses));
     Ends {
         card_requests,
         card_tell,
+        sample_buttons,
     }
 }
 
 /// The queue ends `init_cells` leaves for `init`, which makes their
-/// holders: the card reader's.
+/// holders: the card reader's, the tick's.
 struct Ends {
     card_requests: CardRequests,
     card_tell: CardTell,
+    sample_buttons: SampleButtons,
 }
 
 /// The kinematics of the settings loaded. Settings are only taken whole,

@@ -73,8 +73,41 @@ pub static BEGUN: AtomicU8 = AtomicU8::new(0);
 
 /// Tick → buttons task: one raw sample (bit `Button as u8` = pressed) per
 /// millisecond while active. Full: the sample is refused and counted (the
-/// task fell 15 ms behind; a press then counts a little late).
-pub static SAMPLES: Ring<u8, 16> = Ring::new();
+/// task fell 15 ms behind; a press then counts a little late). Private:
+/// reached through its ends, [`SampleButtons`] and [`Samples`].
+static SAMPLES: Ring<u8, 16> = Ring::new();
+
+/// `SAMPLES`' sending end: the tick's, kept with the pins it samples
+/// (`buttons::start` hands both to the interrupt).
+pub struct SampleButtons(());
+
+impl SampleButtons {
+    #[inline(always)]
+    pub fn push(&self, raw: u8) -> Result<(), u8> {
+        SAMPLES.push(raw)
+    }
+}
+
+/// `SAMPLES`' receiving end: the buttons task's.
+pub struct Samples(());
+
+impl Samples {
+    #[inline(always)]
+    pub fn pop(&self) -> Option<u8> {
+        SAMPLES.pop()
+    }
+}
+
+/// `SAMPLES`' ends, made once, by the app's init: the tick's, the buttons
+/// task's.
+pub fn samples_ends() -> (SampleButtons, Samples) {
+    (SampleButtons(()), Samples(()))
+}
+
+/// `SAMPLES`' counters and capacity (`$Q`).
+pub fn samples_stats() -> (QueueStats, usize) {
+    (SAMPLES.stats(), SAMPLES.capacity())
+}
 /// Buttons task → job, or a plotter's console (its card print). Full:
 /// refused and counted (the job is far behind a human's presses).
 /// Private: reached through its ends, [`TellPresses`] and [`Presses`].

@@ -3,8 +3,8 @@
 //! missed.
 
 use crate::queues::{
-    buttons_stats, card_in_stats, card_out_stats, job_control_stats, BLOCKS, RX, RX1, SAMPLES,
-    SEGMENTS, TX, TX1,
+    buttons_stats, card_in_stats, card_out_stats, job_control_stats, samples_stats, BLOCKS, RX,
+    RX1, SEGMENTS, TX, TX1,
 };
 use crate::{flash_str, info};
 use taut_logic::sched::QueueStats;
@@ -36,11 +36,10 @@ pub fn queue_line(i: u8) -> bool {
             let (stats, capacity) = card_in_stats();
             queue(flash_str!("card req"), stats, capacity)
         }
-        6 => queue(
-            flash_str!("button samples"),
-            SAMPLES.stats(),
-            SAMPLES.capacity(),
-        ),
+        6 => {
+            let (stats, capacity) = samples_stats();
+            queue(flash_str!("button samples"), stats, capacity)
+        }
         7 => {
             let (stats, capacity) = buttons_stats();
             queue(flash_str!("buttons"), stats, capacity)
