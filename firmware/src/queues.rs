@@ -23,6 +23,27 @@
 //! | `STANDING` overrides, door | `realtime.rs` (`TaskCell`) | `Realtime` task → status reports |
 //! | `PLANNER` | `motion.rs` (`TaskCell`) | console, job → segment preparation, through `Motion` |
 //! | each task's state (`MOTION`, `CONSOLE`, `JOB`, `CARD`, `STORE`, `KIN`, `LED` …), the dispatcher's `SPAWNED`, `READY`, `TIMERS`, `WAITING` | `main.rs` | the app (`SPAWNED`: interrupts → dispatcher) |
+//!
+//! Queues reached only through their ends: the static is private here,
+//! each end a zero-sized type (no RAM, no code) whose push or pop is the
+//! only way in, made once by the app's `init_cells` and held in its
+//! owner's state. Where two tasks take turns at one side (the card's
+//! owner is the job on the string-art machine, the console on a
+//! plotter), each holds an end of its own; software tasks never run in
+//! each other's middle. The app itself only asks whether a message waits
+//! (to spawn its reader), `$Q` reads the counters.
+//!
+//! | queue | sending end: holder | receiving end: holder |
+//! | --- | --- | --- |
+//! | `CARD_IN` | [`CardAsk`]: the job, the card print | [`CardRequests`]: the card reader |
+//! | `CARD_OUT` | [`CardTell`]: the card reader | [`CardNews`]: the job, the card print |
+//! | `JOB_CONTROL` | [`TellJob`]: the console (the `Realtime` task through `Console::tell_job`) | [`JobControls`]: the job |
+//! | `SAMPLES` | [`SampleButtons`]: the tick (`buttons::SAMPLER`, with the pins) | [`Samples`]: the buttons task |
+//! | `BUTTONS` | [`TellPresses`]: the buttons task | [`Presses`]: the job, the console |
+//!
+//! Still `pub static`, reached by name: the UART rings (`RX`, `TX`, `RX1`,
+//! `TX1`), the step rings (`SEGMENTS`, `BLOCKS`: the step interrupt's
+//! assembly addresses `SEGMENTS` by its symbol), and the flags.
 
 use crate::rt::{Flags, Mailbox, Ring, Tally};
 use core::sync::atomic::{AtomicBool, AtomicU8};
