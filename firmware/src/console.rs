@@ -29,11 +29,10 @@ use crate::flash_str;
 use crate::machine_io::Io;
 use crate::motion::Motion;
 use crate::print::Print;
-use crate::queues::{CardAsk, CardNews, Control, Presses, Signal, TellJob, JOB_CLAIMS_TX};
+use crate::queues::{CardAsk, CardNews, Control, Presses, Signal, TellJob, TxClaim};
 use crate::reply;
 use crate::rt::Poll;
 use crate::store::Store;
-use core::sync::atomic::Ordering::Relaxed;
 use homing::HomingRun;
 use source::serial_line_waits;
 use taut_logic::config::MachineConfig;
@@ -72,6 +71,8 @@ pub struct Console {
     job: TellJob,
     /// Its end of `BUTTONS` (a plotter's card print takes the presses).
     presses: Presses,
+    /// Its end of `JOB_CLAIMS_TX`.
+    job_claim: TxClaim,
     /// Where the line being read comes from, `None` between lines: while
     /// a print runs, a serial line is read whenever one has arrived whole.
     source: Option<Source>,
@@ -120,7 +121,13 @@ enum Listing {
 }
 
 impl Console {
-    pub const fn new(card: CardAsk, news: CardNews, job: TellJob, presses: Presses) -> Console {
+    pub const fn new(
+        card: CardAsk,
+        news: CardNews,
+        job: TellJob,
+        presses: Presses,
+        job_claim: TxClaim,
+    ) -> Console {
         Console {
             parser: Parser::new(),
             line_ready: false,
@@ -135,6 +142,7 @@ impl Console {
             print: Print::new(card, news),
             job,
             presses,
+            job_claim,
             source: None,
             jogging: false,
             checking: false,
@@ -261,7 +269,7 @@ impl Console {
             if m.plan_part() {
                 return Poll::Again;
             }
-            if !reply::room() || JOB_CLAIMS_TX.load(Relaxed) {
+            if !reply::room() || self.job_claim.claimed() {
                 return Poll::After(2);
             }
             // A jog cancel or `$SLP` is braking: nothing new until it stands.

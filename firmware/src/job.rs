@@ -9,13 +9,12 @@
 use crate::checkpoint::BootNote;
 use crate::motion::Motion;
 use crate::queues::{
-    CardAsk, CardMsg, CardNews, Control, JobControls, Presses, Request, Signal, What, CHUNK,
-    JOB_CLAIMS_TX, TX,
+    CardAsk, CardMsg, CardNews, ClaimTx, Control, JobControls, Presses, Request, Signal, What,
+    CHUNK, TX,
 };
 use crate::rt::Poll;
 use crate::store::Store;
 use crate::{error, info, report, texts};
-use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::checkpoint::{Record, Saved};
 use taut_logic::config::MachineConfig;
@@ -30,9 +29,9 @@ use taut_logic::stringart::job::{
 use taut_logic::stringart::Save;
 
 /// Room for a whole log line, claimed from the console while there is none.
-fn room_for_a_line() -> bool {
+fn room_for_a_line(claim: &ClaimTx) -> bool {
     let room = TX.free() >= LINE_ROOM;
-    JOB_CLAIMS_TX.store(!room, Relaxed);
+    claim.set(!room);
     room
 }
 
@@ -85,6 +84,8 @@ pub struct JobTask {
     controls: JobControls,
     /// Its end of `BUTTONS`.
     presses: Presses,
+    /// Its end of `JOB_CLAIMS_TX`.
+    claim: ClaimTx,
     job: Job,
     /// Actions not yet carried out, in order: one event's at most, as
     /// inputs are taken only when the last event's are done.
@@ -108,12 +109,14 @@ impl JobTask {
         news: CardNews,
         controls: JobControls,
         presses: Presses,
+        claim: ClaimTx,
     ) -> Self {
         JobTask {
             card,
             news,
             controls,
             presses,
+            claim,
             job: Job::new(),
             todo: Actions::new(),
             stream: Stream::None,
@@ -151,9 +154,9 @@ impl JobTask {
         now: u32,
     ) -> Poll<Signal> {
         // Claimed again below if still needed.
-        JOB_CLAIMS_TX.store(false, Relaxed);
+        self.claim.set(false);
         if let Some(note) = self.boot_note {
-            if !room_for_a_line() {
+            if !room_for_a_line(&self.claim) {
                 return Poll::After(5);
             }
             self.boot_note = None;
@@ -164,7 +167,7 @@ impl JobTask {
                 return p;
             }
             if let Some(line) = self.report_line {
-                if !room_for_a_line() {
+                if !room_for_a_line(&self.claim) {
                     return Poll::After(5);
                 }
                 self.report_line = report::queue_line(line).then_some(line + 1);
@@ -174,7 +177,7 @@ impl JobTask {
                 break;
             }
         }
-        if JOB_CLAIMS_TX.load(Relaxed) {
+        if self.claim.claimed() {
             // Card messages wait for room for the line they may end in.
             return Poll::After(5);
         }
@@ -217,7 +220,7 @@ impl JobTask {
         let news = self.news.clone();
         let taken = news.peek_with(|msg| {
             // Checking the files ends in a log line (`files ok` or the error).
-            if self.stream.checking() && !room_for_a_line() {
+            if self.stream.checking() && !room_for_a_line(&self.claim) {
                 return false;
             }
             // Pattern bytes wait in the queue until winding wants them,
@@ -430,7 +433,7 @@ impl JobTask {
                     | Action::Offer { .. }
                     | Action::Drift { .. }
             );
-            if logs && !room_for_a_line() {
+            if logs && !room_for_a_line(&self.claim) {
                 return Some(Poll::After(5));
             }
             self.todo.remove(0);

@@ -370,13 +370,21 @@ fn init_cells() -> Ends {
     let (card_tell, job_news, print_news) = queues::card_out_ends();
     let (tell_job, job_controls) = queues::job_control_ends();
     let (tell_presses, job_presses, console_presses) = queues::buttons_ends();
+    let (claim_tx, tx_claim) = queues::claims_tx_ends();
     CONSOLE.init(Console::new(
         print_asks,
         print_news,
         tell_job,
         console_presses,
+        tx_claim,
     ));
-    JOB.init(JobTask::new(job_asks, job_news, job_controls, job_presses));
+    JOB.init(JobTask::new(
+        job_asks,
+        job_news,
+        job_controls,
+        job_presses,
+        claim_tx,
+    ));
     let (sample_buttons, samples) = queues::samples_ends();
     BUTTONS_TASK.init(ButtonsTask::new(samples, tell_presses));
     Ends {

@@ -40,13 +40,14 @@
 //! | `JOB_CONTROL` | [`TellJob`]: the console (the `Realtime` task through `Console::tell_job`) | [`JobControls`]: the job |
 //! | `SAMPLES` | [`SampleButtons`]: the tick (`buttons::SAMPLER`, with the pins) | [`Samples`]: the buttons task |
 //! | `BUTTONS` | [`TellPresses`]: the buttons task | [`Presses`]: the job, the console |
+//! | `JOB_CLAIMS_TX` (a flag) | [`ClaimTx`]: the job | [`TxClaim`]: the console |
 //!
 //! Still `pub static`, reached by name: the UART rings (`RX`, `TX`, `RX1`,
 //! `TX1`), the step rings (`SEGMENTS`, `BLOCKS`: the step interrupt's
-//! assembly addresses `SEGMENTS` by its symbol), and the flags.
+//! assembly addresses `SEGMENTS` by its symbol), and the other flags.
 
 use crate::rt::{Flags, Mailbox, Ring, Tally};
-use core::sync::atomic::{AtomicBool, AtomicU8};
+use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
 use taut_logic::sched::QueueStats;
@@ -338,7 +339,39 @@ pub fn job_control_stats() -> (QueueStats, usize) {
 /// The job waits for room in the TX ring for a line it must not drop (a
 /// prompt, a bad file's message): the console holds its replies meanwhile,
 /// or a stream of replies would keep the ring full for as long as it lasts.
-pub static JOB_CLAIMS_TX: AtomicBool = AtomicBool::new(false);
+/// Private: reached through its ends, [`ClaimTx`] and [`TxClaim`].
+static JOB_CLAIMS_TX: AtomicBool = AtomicBool::new(false);
+
+/// `JOB_CLAIMS_TX`'s writing end: the job's.
+pub struct ClaimTx(());
+
+impl ClaimTx {
+    #[inline(always)]
+    pub fn set(&self, claimed: bool) {
+        JOB_CLAIMS_TX.store(claimed, Relaxed)
+    }
+
+    #[inline(always)]
+    pub fn claimed(&self) -> bool {
+        JOB_CLAIMS_TX.load(Relaxed)
+    }
+}
+
+/// `JOB_CLAIMS_TX`'s reading end: the console's.
+pub struct TxClaim(());
+
+impl TxClaim {
+    #[inline(always)]
+    pub fn claimed(&self) -> bool {
+        JOB_CLAIMS_TX.load(Relaxed)
+    }
+}
+
+/// `JOB_CLAIMS_TX`'s ends, made once, by the app's init: the job's, the
+/// console's.
+pub fn claims_tx_ends() -> (ClaimTx, TxClaim) {
+    (ClaimTx(()), TxClaim(()))
+}
 
 /// What the job (string art) or the console (a plotter's card print)
 /// asks of the card reader.
