@@ -21,6 +21,7 @@
 //! | `LOG` the log line being built | `log.rs` (`TaskCell`) | tasks only |
 //! | `BUF` the card's block, `OPENED` its file's name | `card.rs` (`TaskCell`) | card → job or console, read in place while a `Data` message names it (`card::bytes`) |
 //! | `STANDING` overrides, door | `realtime.rs` (`TaskCell`) | `Realtime` task → status reports |
+//! | `REALTIME` the real-time commands, `FEED_PRESSES` the feed override's presses | `realtime.rs` (`Flags`, `Tally`) | receive interrupts (`realtime::on_receive`) → `Realtime` task (`Requests::take`) |
 //! | `PLANNER` | `motion.rs` (`TaskCell`) | console, job → segment preparation, through `Motion` |
 //! | each task's state (`MOTION`, `CONSOLE`, `JOB`, `CARD`, `STORE`, `KIN`, `LED` …), the dispatcher's `SPAWNED`, `READY`, `TIMERS`, `WAITING` | `main.rs` | the app (`SPAWNED`: interrupts → dispatcher) |
 //!
@@ -44,9 +45,10 @@
 //!
 //! Still `pub static`, reached by name: the UART rings (`RX`, `TX`, `RX1`,
 //! `TX1`), the step rings (`SEGMENTS`, `BLOCKS`: the step interrupt's
-//! assembly addresses `SEGMENTS` by its symbol), and the other flags.
+//! assembly addresses `SEGMENTS` by its symbol), and the flags `SHORT_AT`
+//! and `BEGUN`.
 
-use crate::rt::{Flags, Mailbox, Ring, Tally};
+use crate::rt::{Mailbox, Ring};
 use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
@@ -69,11 +71,6 @@ pub static RX1: Ring<u8, 64, true> = Ring::new();
 /// Console, status reports → USART1 transmit interrupt: room for the
 /// longest reply (`reply::ROOM`).
 pub static TX1: Ring<u8, 128> = Ring::new();
-/// UART receive interrupt → `Realtime` task: `?`, `!`, `~`, Ctrl-X.
-pub static REALTIME: Flags = Flags::new();
-/// UART receive interrupt → `Realtime` task: the feed override's ±10 %
-/// and ±1 % presses since the last run, summed (each one counts).
-pub static FEED_PRESSES: Tally = Tally::new();
 
 /// Segment preparation → step interrupt: segments, and the blocks they start.
 pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
