@@ -15,7 +15,7 @@
 use crate::board::delay::Delay;
 use crate::board::flash::FlashStr;
 use crate::board::spi::{self, CardSpi};
-use crate::queues::{CardNews, CardMsg, CardRequests, CardTell, Request, Signal, What, CHUNK, TX};
+use crate::queues::{CardMsg, CardNews, CardRequests, CardTell, Request, Signal, What, CHUNK, TX};
 use crate::rt::{Poll, TaskCell};
 use crate::{error, flash_str, info, warn};
 use embedded_hal::delay::DelayNs;
@@ -304,7 +304,6 @@ impl CardReader {
             _ => Poll::Idle,
         }
     }
-
 
     #[inline(never)]
     fn look_for_card(&mut self) -> Poll<Signal> {

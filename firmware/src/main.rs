@@ -40,7 +40,9 @@ use taut_firmware::console::{Activity, Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
-use taut_firmware::queues::{self, CardRequests, CardTell, Control, SampleButtons, Signal, SIGNALS};
+use taut_firmware::queues::{
+    self, CardRequests, CardTell, Control, SampleButtons, Signal, SIGNALS,
+};
 use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{self, stack, Poll, TaskCell};
@@ -306,10 +308,10 @@ fn init(ends: Ends) -> Watchdog {
     );
     buttons::start(
         ButtonPins {
-        confirm: pins.d2.into_pull_up_input(),
-        zero_base: pins.d3.into_pull_up_input(),
-        zero_radial: pins.d14.into_pull_up_input(),
-        zero_drill: pins.d18.into_pull_up_input(),
+            confirm: pins.d2.into_pull_up_input(),
+            zero_base: pins.d3.into_pull_up_input(),
+            zero_radial: pins.d14.into_pull_up_input(),
+            zero_drill: pins.d18.into_pull_up_input(),
         },
         ends.sample_buttons,
     );

@@ -20,7 +20,7 @@
 use crate::board::flash::FlashStr;
 use crate::log::Level;
 use crate::motion::Motion;
-use crate::queues::{CardAsk, CardNews, CardMsg, Request, What, BEGUN, TX};
+use crate::queues::{CardAsk, CardMsg, CardNews, Request, What, BEGUN, TX};
 use crate::reply;
 use crate::store::Store;
 use crate::{flash_str, info, warn};
