@@ -3,7 +3,10 @@
 //! missed.
 
 use crate::board::port::Port;
-use crate::queues::{card_in_stats, BLOCKS, BUTTONS, CARD_OUT, JOB_CONTROL, SAMPLES, SEGMENTS};
+use crate::queues::{
+    buttons_stats, card_in_stats, card_out_stats, job_control_stats, samples_stats, BLOCKS,
+    SEGMENTS,
+};
 use crate::{flash_str, info};
 use taut_logic::sched::QueueStats;
 
@@ -33,22 +36,26 @@ pub fn queue_line(i: u8) -> bool {
             SEGMENTS.capacity(),
         ),
         3 => queue(flash_str!("blocks"), BLOCKS.stats(), BLOCKS.capacity()),
-        4 => queue(flash_str!("card"), CARD_OUT.stats(), CARD_OUT.capacity()),
+        4 => {
+            let (stats, capacity) = card_out_stats();
+            queue(flash_str!("card"), stats, capacity)
+        }
         5 => {
             let (stats, capacity) = card_in_stats();
             queue(flash_str!("card req"), stats, capacity)
         }
-        6 => queue(
-            flash_str!("button samples"),
-            SAMPLES.stats(),
-            SAMPLES.capacity(),
-        ),
-        7 => queue(flash_str!("buttons"), BUTTONS.stats(), BUTTONS.capacity()),
-        8 => queue(
-            flash_str!("job control"),
-            JOB_CONTROL.stats(),
-            JOB_CONTROL.capacity(),
-        ),
+        6 => {
+            let (stats, capacity) = samples_stats();
+            queue(flash_str!("button samples"), stats, capacity)
+        }
+        7 => {
+            let (stats, capacity) = buttons_stats();
+            queue(flash_str!("buttons"), stats, capacity)
+        }
+        8 => {
+            let (stats, capacity) = job_control_stats();
+            queue(flash_str!("job control"), stats, capacity)
+        }
         9 => queue(
             flash_str!("rx1"),
             Port::Uart1.rx_stats(),
