@@ -357,6 +357,7 @@ fn stream_case_rows(
             let key = |what: &str| format!("stream_{machine}_{size}_{what}");
             let cases = [
                 (key("planner_bound_lines_per_s"), "lines/s", format!("{mm} mm chords of a circle at F1500 on the {name}: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"), None),
+                (key("planner_36_bound_lines_per_s"), "lines/s", "the same with Grbl-Mega's 36 blocks of look-ahead".into(), None),
                 (key("serial_lines_per_s"), "lines/s", format!("the same over serial by character counting (Grbl's 128 bytes), lines carried out per second{at_most}"), bar(serial_bar)),
                 (key("serial_underruns"), "", UNDERRUNS.into(), Some(Bar::AtMost(0.0))),
                 (key("card_lines_per_s"), "lines/s", format!("the same printed from the card, lines carried out per second{at_most}"), bar(card_bar)),
