@@ -207,9 +207,13 @@ and commit the page.
   port by character counting (lines per second answered from the first
   tenth to the last) or printed from the card (`M24` answered → `Done
   printing file`). Underruns are the firmware's own count (its logger's
-  `underruns:N`) over the stream. Beside each, what the planner allows:
-  short moves at speed are bound by the look-ahead (the machine must be
-  able to stop within the planned blocks), however fast the CPU.
+  `underruns:N`) over the stream. Beside each, what the planner allows
+  at the firmware's depth and at Grbl-Mega's 36 blocks, however fast the
+  CPU: short moves at speed are bound by the look-ahead (the machine must
+  be able to stop within the planned blocks) and by the junctions, which
+  Grbl's rule takes between the moves as rounded to steps (a 0.05 mm
+  chord is two steps of the flatbed's 0.025 mm, so its direction turns by
+  up to 45° at each).
   `TAUT_BENCH_PROFILE=N` prints where a case's cycles go: per function,
   with callees (a shadow call stack), the callers of the maths library.
 - **Grbl side by side** (`grbl_stream_*`, `simavr/src/bin/taut-bench/grbl.rs`):
