@@ -212,8 +212,8 @@ and commit the page.
   CPU: short moves at speed are bound by the look-ahead (the machine must
   be able to stop within the planned blocks) and by the junctions, which
   Grbl's rule takes between the moves as rounded to steps (a 0.05 mm
-  chord is two steps of the flatbed's 0.025 mm, so its direction turns by
-  up to 45° at each).
+  chord is two steps of the flatbed's 0.025 mm, so the direction turns by tens of
+  degrees from one to the next).
   `TAUT_BENCH_PROFILE=N` prints where a case's cycles go: per function,
   with callees (a shadow call stack), the callers of the maths library.
 - **Grbl side by side** (`grbl_stream_*`, `simavr/src/bin/taut-bench/grbl.rs`):
