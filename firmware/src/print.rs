@@ -21,11 +21,10 @@ use crate::board::flash::FlashStr;
 use crate::board::port::Port;
 use crate::log::Level;
 use crate::motion::Motion;
-use crate::queues::{CardAsk, CardMsg, CardNews, Request, What, BEGUN};
+use crate::queues::{CardAsk, CardMsg, CardNews, Request, What};
 use crate::reply;
 use crate::store::Store;
 use crate::{flash_str, info, warn};
-use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::checkpoint::plot::{Resume, ResumeAction, ResumeEvent, Tracker};
 use taut_logic::fat::{short_display, Name};
@@ -200,7 +199,7 @@ impl Print {
             Keep::Begin => store.plot_begin(crate::card::opened_short(), self.size),
             Keep::Forget => store.forget(),
             Keep::Nothing | Keep::Offer => {
-                let begun = BEGUN.load(Relaxed);
+                let begun = crate::stepper::blocks_begun();
                 if let Some(r) = self.tracker.as_mut().and_then(|t| t.due(begun, false, now)) {
                     store.plot_record(r);
                 }

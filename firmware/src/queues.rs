@@ -25,6 +25,8 @@
 //! | `STANDING` overrides, door | `realtime.rs` (`TaskCell`) | `Realtime` task → status reports |
 //! | `REALTIME` the real-time commands, `FEED_PRESSES` the feed override's presses | `realtime.rs` (`Flags`, `Tally`) | receive interrupts (`realtime::on_receive`) → `Realtime` task (`Requests::take`) |
 //! | `PLANNER` | `motion.rs` (`TaskCell`) | console, job → segment preparation, through `Motion` |
+//! | `SHORT_AT` the queued segments under which the refill is urgent | `motion.rs` (an atomic byte) | segment preparation → step interrupt and tick (`motion::urgent`, which spawn the urgent `Refill`) |
+//! | `BEGUN` blocks begun, wrapping | `stepper.rs` (an atomic byte) | `TIMER3_COMPA` → console, job, card print (`stepper::blocks_begun`: a checkpoint names the line whose block moves) |
 //! | each task's state (`MOTION`, `CONSOLE`, `JOB`, `CARD`, `STORE`, `KIN`, `LED` …), the dispatcher's `SPAWNED`, `READY`, `TIMERS`, `WAITING` | `main.rs` | the app (`SPAWNED`: interrupts → dispatcher) |
 //!
 //! Queues reached only through their ends: the static is private here,
@@ -48,11 +50,10 @@
 //! The UART rings (`RX`, `TX`, `RX1`, `TX1`) are private to the board's
 //! serial drivers (above): tasks reach them through `Port`. Still `pub
 //! static`, reached by name: the step rings (`SEGMENTS`, `BLOCKS`: the
-//! step interrupt's assembly addresses `SEGMENTS` by its symbol), and the
-//! flags `SHORT_AT` and `BEGUN`.
+//! step interrupt's assembly addresses `SEGMENTS` by its symbol).
 
 use crate::rt::{Mailbox, Ring};
-use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
+use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
 use taut_logic::sched::QueueStats;
@@ -66,15 +67,7 @@ pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
 /// segments fill the 40 ms budget with fewer (`motion.rs`). 32 slots were
 /// 176 B more.
 pub const SEGMENTS_CAPACITY: usize = 16;
-/// Segment preparation → step interrupt and tick (which spawn the urgent
-/// `Refill` at or below it): the queued segments under which the refill is
-/// urgent, as many of the newest as last less than the budget
-/// (`motion::urgent`). One byte: atomic on the AVR.
-pub static SHORT_AT: AtomicU8 = AtomicU8::new(SEGMENTS_CAPACITY as u8);
 pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
-/// Step interrupt → console: blocks begun, wrapping (a card print's
-/// checkpoint names the line whose block is moving).
-pub static BEGUN: AtomicU8 = AtomicU8::new(0);
 
 /// Tick → buttons task: one raw sample (bit `Button as u8` = pressed) per
 /// millisecond while active. Full: the sample is refused and counted (the
