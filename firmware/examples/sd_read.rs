@@ -11,7 +11,7 @@ use taut_firmware::board::spi::CardSpi;
 use taut_firmware::board::{clock, gpio::Pins, usart};
 use taut_firmware::card::CardReader;
 use taut_firmware::info;
-use taut_firmware::queues::{self, Request, Signal, What, CARD_OUT};
+use taut_firmware::queues::{self, Request, Signal, What};
 use taut_firmware::rt::Poll;
 use taut_logic::fat::Name;
 
@@ -26,12 +26,13 @@ fn main() -> ! {
     usart::Usart0::start(dp.USART0);
     let spi = CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53);
     let (ask, _, requests) = queues::card_in_ends();
-    let mut reader = CardReader::new(spi, requests);
+    let (tell, news, _) = queues::card_out_ends();
+    let mut reader = CardReader::new(spi, requests, tell);
     // SAFETY: the two handlers below touch only the clock and the TX ring.
     unsafe { avr_device::interrupt::enable() };
     loop {
         let _ = reader.poll(clock::millis(), false);
-        if let Some(m) = CARD_OUT.pop() {
+        if let Some(m) = news.pop() {
             if matches!(m.what, What::Inserted) {
                 break;
             }
@@ -43,11 +44,11 @@ fn main() -> ! {
     let mut bytes: u32 = 0;
     loop {
         if reader.poll(clock::millis(), false) == Poll::Wait(Signal::CardRoom)
-            && CARD_OUT.is_empty()
+            && !queues::card_message_waits()
         {
             break;
         }
-        match CARD_OUT.pop().map(|m| m.what) {
+        match news.pop().map(|m| m.what) {
             Some(What::Data { len, .. }) => bytes += len as u32,
             Some(What::End) => break,
             Some(What::Opened { .. }) => {}

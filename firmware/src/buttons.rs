@@ -5,7 +5,7 @@
 //! `BUTTONS` (`queues`).
 
 use crate::board::gpio::{Pin, PullUp};
-use crate::queues::{BUTTONS, SAMPLES};
+use crate::queues::{SampleButtons, Samples, TellPresses};
 use crate::rt::IsrCell;
 use embedded_hal::digital::InputPin;
 use taut_logic::buttons::{Debouncer, DEBOUNCE_MS};
@@ -39,13 +39,15 @@ impl ButtonPins {
     }
 }
 
-/// The tick's side: the pins, the last sample, and how many quiet
-/// milliseconds (all released, unchanged) have passed since.
-static SAMPLER: IsrCell<(ButtonPins, u8, u8)> = IsrCell::new();
+/// The tick's side: the pins, the last sample, how many quiet
+/// milliseconds (all released, unchanged) have passed since, and its end
+/// of `SAMPLES`.
+static SAMPLER: IsrCell<(ButtonPins, u8, u8, SampleButtons)> = IsrCell::new();
 
-/// Hand the pins to the tick; call before interrupts are enabled.
-pub fn start(pins: ButtonPins) {
-    SAMPLER.init((pins, 0, u8::MAX));
+/// Hand the pins and the end of `SAMPLES` to the tick; call before
+/// interrupts are enabled.
+pub fn start(pins: ButtonPins, samples: SampleButtons) {
+    SAMPLER.init((pins, 0, u8::MAX, samples));
 }
 
 /// The tick's millisecond sample: queued while a button is down and until
@@ -54,7 +56,7 @@ pub fn start(pins: ButtonPins) {
 /// button), which are also the homing switches.
 pub fn sample() -> (bool, u8) {
     SAMPLER
-        .with(|(pins, last, quiet)| {
+        .with(|(pins, last, quiet, samples)| {
             let raw = pins.raw();
             *quiet = if raw == 0 && raw == *last {
                 quiet.saturating_add(1)
@@ -62,31 +64,34 @@ pub fn sample() -> (bool, u8) {
                 0
             };
             *last = raw;
-            (*quiet <= DEBOUNCE_MS && SAMPLES.push(raw).is_ok(), raw)
+            (*quiet <= DEBOUNCE_MS && samples.push(raw).is_ok(), raw)
         })
         .unwrap_or((false, 0))
 }
 
-/// The buttons task's state: the debouncer.
-pub struct ButtonsTask(Debouncer);
-
-impl Default for ButtonsTask {
-    fn default() -> Self {
-        Self::new()
-    }
+/// The buttons task's state: the debouncer, its ends of `SAMPLES` and
+/// `BUTTONS`.
+pub struct ButtonsTask {
+    debouncer: Debouncer,
+    samples: Samples,
+    presses: TellPresses,
 }
 
 impl ButtonsTask {
-    pub const fn new() -> Self {
-        ButtonsTask(Debouncer::new())
+    pub const fn new(samples: Samples, presses: TellPresses) -> Self {
+        ButtonsTask {
+            debouncer: Debouncer::new(),
+            samples,
+            presses,
+        }
     }
 
     /// ButtonsTask every queued sample; true when events went to the job.
     pub fn poll(&mut self) -> bool {
         let mut sent = false;
-        while let Some(raw) = SAMPLES.pop() {
-            for e in self.0.tick(raw) {
-                sent |= BUTTONS.push(e).is_ok();
+        while let Some(raw) = self.samples.pop() {
+            for e in self.debouncer.tick(raw) {
+                sent |= self.presses.push(e).is_ok();
             }
         }
         sent

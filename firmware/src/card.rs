@@ -14,8 +14,9 @@
 
 use crate::board::delay::Delay;
 use crate::board::flash::FlashStr;
+use crate::board::port::Port;
 use crate::board::spi::{self, CardSpi};
-use crate::queues::{CardMsg, CardRequests, Request, Signal, What, CARD_OUT, CHUNK, TX};
+use crate::queues::{CardMsg, CardNews, CardRequests, CardTell, Request, Signal, What, CHUNK};
 use crate::rt::{Poll, TaskCell};
 use crate::{error, flash_str, info, warn};
 use embedded_hal::delay::DelayNs;
@@ -103,6 +104,8 @@ enum Slot {
 pub struct CardReader {
     /// Its end of `CARD_IN`.
     requests: CardRequests,
+    /// Its end of `CARD_OUT`.
+    tell: CardTell,
     sd: Sd,
     slot: Slot,
     /// The file being streamed or the listing being written.
@@ -175,14 +178,14 @@ pub fn opened_short() -> [u8; 11] {
 }
 
 /// File bytes wait in `CARD_OUT`: the block is theirs.
-fn data_waits() -> bool {
-    CARD_OUT.any(|m| matches!(m.what, What::Data { .. }))
+fn data_waits(tell: &CardTell) -> bool {
+    tell.any(|m| matches!(m.what, What::Data { .. }))
 }
 
 /// A pull waits in `CARD_OUT`: the file bytes queued before it (which
 /// their reader leaves there until it wants them) can be dropped.
-pub fn removal_waits() -> bool {
-    CARD_OUT.any(|m| matches!(m.what, What::Removed))
+pub fn removal_waits(news: &CardNews) -> bool {
+    news.any(|m| matches!(m.what, What::Removed))
 }
 
 /// The card as the FAT reader's block device; remembers the last block
@@ -217,13 +220,14 @@ fn failure(e: &SdCardError) -> Failure {
 }
 
 impl CardReader {
-    pub fn new(spi: CardSpi, requests: CardRequests) -> CardReader {
+    pub fn new(spi: CardSpi, requests: CardRequests, tell: CardTell) -> CardReader {
         let options = AcquireOpts {
             use_crc: true,
             acquire_retries: 4,
         };
         CardReader {
             requests,
+            tell,
             sd: SdCard::new_with_options(TimedSpi(spi), TimedDelay, options),
             slot: Slot::Empty,
             reading: Reading::Nothing,
@@ -245,7 +249,7 @@ impl CardReader {
             return self.report_faulty(lba, what, ticket);
         }
         if now.wrapping_sub(self.check_at) as i32 >= 0 {
-            if CARD_OUT.free() < ROOM {
+            if self.tell.free() < ROOM {
                 return Poll::Wait(Signal::CardRoom);
             }
             // Due again at the app's next once-a-second wake-up, even if
@@ -266,11 +270,11 @@ impl CardReader {
             if let Some(Request::Open(_, t) | Request::OpenFirst(t) | Request::List(t)) =
                 self.requests.peek()
             {
-                if CARD_OUT.free() < ROOM {
+                if self.tell.free() < ROOM {
                     return Poll::Wait(Signal::CardRoom);
                 }
                 let _ = self.requests.take();
-                Self::send(What::Failed, t);
+                send(&self.tell, What::Failed, t);
                 return Poll::Again;
             }
             let _ = self.requests.take();
@@ -280,7 +284,7 @@ impl CardReader {
             // Each but `Close` reads blocks: not while file bytes wait
             // (an older request's, which their owner drops).
             let reads = !matches!(request, Request::Close);
-            if CARD_OUT.free() < ROOM || reads && data_waits() {
+            if self.tell.free() < ROOM || reads && data_waits(&self.tell) {
                 return Poll::Wait(Signal::CardRoom);
             }
             let _ = self.requests.take();
@@ -302,15 +306,10 @@ impl CardReader {
         }
     }
 
-    fn send(what: What, ticket: u8) {
-        // Callers check for room first: nothing is refused here.
-        let _ = CARD_OUT.push(CardMsg { ticket, what });
-    }
-
     #[inline(never)]
     fn look_for_card(&mut self) -> Poll<Signal> {
         // A pulled card's last bytes may still wait: the next check then.
-        if data_waits() {
+        if data_waits(&self.tell) {
             return Poll::Idle;
         }
         WAITED.with(|w| w.1 = u16::MAX);
@@ -367,7 +366,7 @@ impl CardReader {
             Some(_) => What::Inserted,
             None => What::Unusable,
         };
-        Self::send(what, 0);
+        send(&self.tell, what, 0);
         Poll::Idle
     }
 
@@ -380,7 +379,7 @@ impl CardReader {
         self.at = 0;
         self.len = 0;
         let Some(v) = volume else {
-            return Self::send(What::Failed, ticket);
+            return send(&self.tell, What::Failed, ticket);
         };
         let mut dev = Device {
             sd: &self.sd,
@@ -399,14 +398,14 @@ impl CardReader {
                 self.reading = Reading::File(f, ticket);
                 OPENED.with(|n| *n = e.name());
                 OPENED_SHORT.with(|n| *n = e.short);
-                Self::send(What::Opened { size: e.size }, ticket);
+                send(&self.tell, What::Opened { size: e.size }, ticket);
             }
-            Err(FatError::NotFound) => Self::send(What::Missing, ticket),
+            Err(FatError::NotFound) => send(&self.tell, What::Missing, ticket),
             // Reading the directory failed: the job asks again.
             Err(FatError::Device(e)) => {
                 let _ = self.read_failed(&e, dev.lba, ticket);
             }
-            Err(_) => Self::send(What::Failed, ticket),
+            Err(_) => send(&self.tell, What::Failed, ticket),
         }
     }
 
@@ -423,7 +422,7 @@ impl CardReader {
                     ticket,
                 })
             }
-            None => Self::send(What::Failed, ticket),
+            None => send(&self.tell, What::Failed, ticket),
         }
     }
 
@@ -476,7 +475,7 @@ impl CardReader {
 
     fn listed(&mut self, ticket: u8) -> Poll<Signal> {
         self.reading = Reading::Nothing;
-        Self::send(What::Listed, ticket);
+        send(&self.tell, What::Listed, ticket);
         Poll::Idle
     }
 
@@ -491,18 +490,18 @@ impl CardReader {
             // reader of the file that leaves its bytes waiting (winding
             // between nails, a print behind a long move) still hears of
             // a pull within the next check.
-            if CARD_OUT.free() <= ROOM {
+            if self.tell.free() <= ROOM {
                 return Poll::Wait(Signal::CardRoom);
             }
             let n = (self.len - self.at).min(CHUNK as u16);
             let at = self.at;
-            Self::send(What::Data { at, len: n as u8 }, ticket);
+            send(&self.tell, What::Data { at, len: n as u8 }, ticket);
             self.at += n;
         }
         // The next block is read over the bytes still waiting; at the
         // file's end nothing is read, and `End` follows them at once.
         let reads = file.pos() < file.size();
-        if CARD_OUT.free() < ROOM || reads && data_waits() {
+        if self.tell.free() < ROOM || reads && data_waits(&self.tell) {
             return Poll::Wait(Signal::CardRoom);
         }
         let mut dev = Device {
@@ -512,7 +511,7 @@ impl CardReader {
         match BUF.with(|b| file.read_next(&volume, &mut dev, b)) {
             Ok(0) => {
                 self.reading = Reading::Nothing;
-                Self::send(What::End, ticket);
+                send(&self.tell, What::End, ticket);
                 Poll::Idle
             }
             Ok(n) => {
@@ -526,7 +525,7 @@ impl CardReader {
             Err(_) => {
                 warn!("card: broken cluster chain");
                 self.reading = Reading::Nothing;
-                Self::send(What::Failed, ticket);
+                send(&self.tell, What::Failed, ticket);
                 Poll::Idle
             }
         }
@@ -564,7 +563,7 @@ impl CardReader {
     /// that failed while mounted was never announced to the job.
     #[inline(never)]
     fn report_faulty(&mut self, lba: u32, what: FlashStr, ticket: u8) -> Poll<Signal> {
-        if TX.free() < crate::log::LINE || CARD_OUT.free() < ROOM {
+        if Port::Usb.tx_free() < crate::log::LINE || self.tell.free() < ROOM {
             return Poll::After(2);
         }
         self.faulty = None;
@@ -577,7 +576,7 @@ impl CardReader {
             Reading::Nothing
         );
         if reading || ticket != 0 {
-            Self::send(What::Failed, ticket);
+            send(&self.tell, What::Failed, ticket);
         }
         Poll::Idle
     }
@@ -611,12 +610,12 @@ impl CardReader {
             core::mem::replace(&mut self.reading, Reading::Nothing),
             Reading::Nothing
         ) {
-            Self::send(What::Failed, ticket);
+            send(&self.tell, What::Failed, ticket);
         }
         self.failures = 0;
         self.sd.mark_card_uninit();
         self.slot = Slot::Empty;
-        Self::send(What::Removed, 0);
+        send(&self.tell, What::Removed, 0);
     }
 }
 
@@ -624,6 +623,11 @@ impl CardReader {
 /// the big frame of `look_for_card`, the AVR back end once stored the
 /// digits of `16` wrongly (`FAT1\xff`).
 #[inline(never)]
+/// Callers check for room first: nothing is refused here.
+fn send(tell: &CardTell, what: What, ticket: u8) {
+    let _ = tell.push(CardMsg { ticket, what });
+}
+
 fn log_mounted(blocks: u32, fat32: bool) {
     let fat = match fat32 {
         true => flash_str!("32"),

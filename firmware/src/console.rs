@@ -29,11 +29,10 @@ use crate::flash_str;
 use crate::machine_io::Io;
 use crate::motion::Motion;
 use crate::print::Print;
-use crate::queues::{CardAsk, Signal, JOB_CLAIMS_TX};
+use crate::queues::{CardAsk, CardNews, Control, Presses, Signal, TellJob, TxClaim};
 use crate::reply;
 use crate::rt::Poll;
 use crate::store::Store;
-use core::sync::atomic::Ordering::Relaxed;
 use homing::HomingRun;
 use source::serial_line_waits;
 use taut_logic::config::MachineConfig;
@@ -68,6 +67,12 @@ pub struct Console {
     settings_changed: bool,
     /// A plotter's print from the card.
     print: Print,
+    /// Its end of `JOB_CONTROL`.
+    job: TellJob,
+    /// Its end of `BUTTONS` (a plotter's card print takes the presses).
+    presses: Presses,
+    /// Its end of `JOB_CLAIMS_TX`.
+    job_claim: TxClaim,
     /// Where the line being read comes from, `None` between lines: while
     /// a print runs, a serial line is read whenever one has arrived whole.
     source: Option<Source>,
@@ -116,7 +121,13 @@ enum Listing {
 }
 
 impl Console {
-    pub const fn new(card: CardAsk) -> Console {
+    pub const fn new(
+        card: CardAsk,
+        news: CardNews,
+        job: TellJob,
+        presses: Presses,
+        job_claim: TxClaim,
+    ) -> Console {
         Console {
             parser: Parser::new(),
             line_ready: false,
@@ -128,7 +139,10 @@ impl Console {
             // the kinematics (zero steps are not (0, 0) on an arm).
             epoch: u8::MAX,
             settings_changed: false,
-            print: Print::new(card),
+            print: Print::new(card, news),
+            job,
+            presses,
+            job_claim,
             source: None,
             jogging: false,
             checking: false,
@@ -162,6 +176,12 @@ impl Console {
     /// the settings stored).
     pub fn take_settings_changed(&mut self) -> bool {
         core::mem::take(&mut self.settings_changed)
+    }
+
+    /// The console's word for the job, the `Realtime` task's too (`~`,
+    /// Ctrl-X): false when the job's queue is full.
+    pub fn tell_job(&self, c: Control) -> bool {
+        self.job.push(c).is_ok()
     }
 
     /// Ctrl-X: the line in progress, the line being carried out and a
@@ -249,7 +269,7 @@ impl Console {
             if m.plan_part() {
                 return Poll::Again;
             }
-            if !reply::room() || JOB_CLAIMS_TX.load(Relaxed) {
+            if !reply::room() || self.job_claim.claimed() {
                 return Poll::After(2);
             }
             // A jog cancel or `$SLP` is braking: nothing new until it stands.

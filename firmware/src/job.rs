@@ -6,16 +6,16 @@
 //! Log lines wait for room in the TX ring rather than being dropped: the
 //! prompts and the bad-file messages must reach the user.
 
+use crate::board::port::Port;
 use crate::checkpoint::BootNote;
 use crate::motion::Motion;
 use crate::queues::{
-    CardAsk, CardMsg, Control, Request, Signal, What, BUTTONS, CARD_OUT, CHUNK, JOB_CLAIMS_TX,
-    JOB_CONTROL, TX,
+    CardAsk, CardMsg, CardNews, ClaimTx, Control, JobControls, Presses, Request, Signal, What,
+    CHUNK,
 };
 use crate::rt::Poll;
 use crate::store::Store;
 use crate::{error, info, report, texts};
-use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::checkpoint::{Record, Saved};
 use taut_logic::config::MachineConfig;
@@ -30,9 +30,9 @@ use taut_logic::stringart::job::{
 use taut_logic::stringart::Save;
 
 /// Room for a whole log line, claimed from the console while there is none.
-fn room_for_a_line() -> bool {
-    let room = TX.free() >= LINE_ROOM;
-    JOB_CLAIMS_TX.store(!room, Relaxed);
+fn room_for_a_line(claim: &ClaimTx) -> bool {
+    let room = Port::Usb.tx_free() >= LINE_ROOM;
+    claim.set(!room);
     room
 }
 
@@ -79,6 +79,14 @@ impl Stream {
 pub struct JobTask {
     /// Its end of `CARD_IN`.
     card: CardAsk,
+    /// Its end of `CARD_OUT`.
+    news: CardNews,
+    /// Its end of `JOB_CONTROL`.
+    controls: JobControls,
+    /// Its end of `BUTTONS`.
+    presses: Presses,
+    /// Its end of `JOB_CLAIMS_TX`.
+    claim: ClaimTx,
     job: Job,
     /// Actions not yet carried out, in order: one event's at most, as
     /// inputs are taken only when the last event's are done.
@@ -97,9 +105,19 @@ pub struct JobTask {
 }
 
 impl JobTask {
-    pub const fn new(card: CardAsk) -> Self {
+    pub const fn new(
+        card: CardAsk,
+        news: CardNews,
+        controls: JobControls,
+        presses: Presses,
+        claim: ClaimTx,
+    ) -> Self {
         JobTask {
             card,
+            news,
+            controls,
+            presses,
+            claim,
             job: Job::new(),
             todo: Actions::new(),
             stream: Stream::None,
@@ -137,9 +155,9 @@ impl JobTask {
         now: u32,
     ) -> Poll<Signal> {
         // Claimed again below if still needed.
-        JOB_CLAIMS_TX.store(false, Relaxed);
+        self.claim.set(false);
         if let Some(note) = self.boot_note {
-            if !room_for_a_line() {
+            if !room_for_a_line(&self.claim) {
                 return Poll::After(5);
             }
             self.boot_note = None;
@@ -150,7 +168,7 @@ impl JobTask {
                 return p;
             }
             if let Some(line) = self.report_line {
-                if !room_for_a_line() {
+                if !room_for_a_line(&self.claim) {
                     return Poll::After(5);
                 }
                 self.report_line = report::queue_line(line).then_some(line + 1);
@@ -160,7 +178,7 @@ impl JobTask {
                 break;
             }
         }
-        if JOB_CLAIMS_TX.load(Relaxed) {
+        if self.claim.claimed() {
             // Card messages wait for room for the line they may end in.
             return Poll::After(5);
         }
@@ -177,11 +195,11 @@ impl JobTask {
 
     /// The next input: a button, a card message, the console. False: none.
     fn input(&mut self, m: &mut Motion, config: &mut MachineConfig, now: u32) -> bool {
-        if let Some(b) = BUTTONS.pop() {
+        if let Some(b) = self.presses.pop() {
             self.event(Event::Button(b), now);
             return true;
         }
-        if let Some(c) = JOB_CONTROL.pop() {
+        if let Some(c) = self.controls.pop() {
             let e = match c {
                 Control::Resume => Event::Resume,
                 Control::Abort => {
@@ -198,10 +216,12 @@ impl JobTask {
         }
         // Read in place, taken once handled: a copy would sit on the stack
         // under the file checks. The reader, a task that never runs in
-        // the middle of this one, writes only free slots.
-        let taken = CARD_OUT.peek_with(|msg| {
+        // the middle of this one, writes only free slots. Its end lent:
+        // the message is handled with all of `self`.
+        let news = self.news.clone();
+        let taken = news.peek_with(|msg| {
             // Checking the files ends in a log line (`files ok` or the error).
-            if self.stream.checking() && !room_for_a_line() {
+            if self.stream.checking() && !room_for_a_line(&self.claim) {
                 return false;
             }
             // Pattern bytes wait in the queue until winding wants them,
@@ -209,7 +229,7 @@ impl JobTask {
             // pattern is read again from its start once it is back).
             let winding = matches!(self.stream, Stream::Pattern(_));
             if matches!(msg.what, What::Data { .. }) && winding && msg.ticket == self.ticket {
-                return crate::card::removal_waits();
+                return crate::card::removal_waits(&news);
             }
             self.card(msg, m, config, now);
             true
@@ -217,7 +237,7 @@ impl JobTask {
         if taken != Some(true) {
             return false;
         }
-        let _ = CARD_OUT.pop();
+        let _ = news.pop();
         true
     }
 
@@ -381,7 +401,7 @@ impl JobTask {
             let Stream::Pattern(p) = &mut self.stream else {
                 return;
             };
-            let nail = match p.next() {
+            let nail = match p.next(&self.news) {
                 Ok(Some(nail)) => nail,
                 Ok(None) => return,
                 Err(e) => {
@@ -414,7 +434,7 @@ impl JobTask {
                     | Action::Offer { .. }
                     | Action::Drift { .. }
             );
-            if logs && !room_for_a_line() {
+            if logs && !room_for_a_line(&self.claim) {
                 return Some(Poll::After(5));
             }
             self.todo.remove(0);
@@ -593,7 +613,7 @@ impl Pattern {
 
     /// The next nail index, from the chunk in hand or the card's queue;
     /// `None` until more bytes arrive.
-    fn next(&mut self) -> Result<Option<u16>, FileError> {
+    fn next(&mut self, news: &CardNews) -> Result<Option<u16>, FileError> {
         loop {
             if self.at < self.len {
                 let (used, nail) = self
@@ -611,7 +631,7 @@ impl Pattern {
             }
             // Copied in place: a copy of the message would sit in the job
             // task's frame.
-            let took = CARD_OUT.peek_with(|msg| match msg.what {
+            let took = news.peek_with(|msg| match msg.what {
                 What::Data { at, len } => {
                     crate::card::bytes(at, len, |b| self.chunk[..b.len()].copy_from_slice(b));
                     self.at = 0;
@@ -623,7 +643,7 @@ impl Pattern {
             if took != Some(true) {
                 return Ok(None);
             }
-            let _ = CARD_OUT.pop();
+            let _ = news.pop();
         }
     }
 }

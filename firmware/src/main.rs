@@ -40,7 +40,9 @@ use taut_firmware::console::{Activity, Console, Owner};
 use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
-use taut_firmware::queues::{self, CardRequests, Control, Signal, CARD_OUT, JOB_CONTROL, SIGNALS};
+use taut_firmware::queues::{
+    self, CardRequests, CardTell, Control, SampleButtons, Signal, SIGNALS,
+};
 use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
 use taut_firmware::rt::{self, stack, Poll, TaskCell};
@@ -72,7 +74,7 @@ taut_firmware::tasks! {
         runs: realtime,
         does: "status, hold, resume, reset",
         input: "`REALTIME`",
-        output: "`TX`, `TX1`, `JOB_CONTROL`",
+        output: "`TX`, `TX1`, `JOB_CONTROL` (the console's end)",
     },
     Refill {
         priority: 3,
@@ -96,7 +98,7 @@ taut_firmware::tasks! {
         runs: console,
         does: "one G-code line per run (waits for `Refilled` while the step queue runs short inside planned motion); a plotter's card print",
         input: "`RX`, `RX1`; on a plotter `BUTTONS`, `CARD_OUT`",
-        output: "planner, `TX`, `TX1`, `CARD_IN`; signals `CardRoom`",
+        output: "planner, `TX`, `TX1`, `CARD_IN`, `JOB_CONTROL`; signals `CardRoom`",
     },
     Buttons {
         priority: 2,
@@ -155,7 +157,7 @@ static CONSOLE: TaskCell<Console> = TaskCell::zeroed();
 static CONFIG: TaskCell<MachineConfig> = TaskCell::zeroed();
 /// The kinematics of `CONFIG`, rebuilt when a setting changes.
 static KIN: TaskCell<AnyKinematics> = TaskCell::zeroed();
-static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::new(ButtonsTask::new());
+static BUTTONS_TASK: TaskCell<ButtonsTask> = TaskCell::zeroed();
 static JOB: TaskCell<JobTask> = TaskCell::zeroed();
 static CARD: TaskCell<CardReader> = TaskCell::zeroed();
 static STORE: TaskCell<Store> = TaskCell::zeroed();
@@ -223,8 +225,8 @@ fn main() -> ! {
     stack::paint();
     // Before `init`: the cells' values are built on the stack (a console
     // is ~480 B), not above `init`'s frame.
-    let card_requests = init_cells();
-    let watchdog = init(card_requests);
+    let ends = init_cells();
+    let watchdog = init(ends);
     dispatch::run(
         &SPAWNED,
         &READY,
@@ -239,7 +241,7 @@ fn main() -> ! {
 /// set-up's locals are gone from the stack before the dispatcher starts.
 #[inline(never)]
 #[optimize(size)]
-fn init(card_requests: CardRequests) -> Watchdog {
+fn init(ends: Ends) -> Watchdog {
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
     let reset = ResetCause::take(&dp.CPU);
     let watchdog = Watchdog::start(dp.WDT);
@@ -301,14 +303,18 @@ fn init(card_requests: CardRequests) -> Watchdog {
     start_motion(stepper, drivers, pen);
     start_card(
         CardSpi::start(dp.SPI, pins.d52, pins.d51, pins.d50, pins.d53),
-        card_requests,
+        ends.card_requests,
+        ends.card_tell,
     );
-    buttons::start(ButtonPins {
-        confirm: pins.d2.into_pull_up_input(),
-        zero_base: pins.d3.into_pull_up_input(),
-        zero_radial: pins.d14.into_pull_up_input(),
-        zero_drill: pins.d18.into_pull_up_input(),
-    });
+    buttons::start(
+        ButtonPins {
+            confirm: pins.d2.into_pull_up_input(),
+            zero_base: pins.d3.into_pull_up_input(),
+            zero_radial: pins.d14.into_pull_up_input(),
+            zero_drill: pins.d18.into_pull_up_input(),
+        },
+        ends.sample_buttons,
+    );
     rt::enable_interrupts();
     reply::banner();
 
@@ -361,11 +367,41 @@ fn init(card_requests: CardRequests) -> Watchdog {
 /// the stack would stay in its frame under everything it calls.
 #[inline(never)]
 #[optimize(size)]
-fn init_cells() -> CardRequests {
-    let (job_asks, print_asks, requests) = queues::card_in_ends();
-    CONSOLE.init(Console::new(print_asks));
-    JOB.init(JobTask::new(job_asks));
-    requests
+fn init_cells() -> Ends {
+    let (job_asks, print_asks, card_requests) = queues::card_in_ends();
+    let (card_tell, job_news, print_news) = queues::card_out_ends();
+    let (tell_job, job_controls) = queues::job_control_ends();
+    let (tell_presses, job_presses, console_presses) = queues::buttons_ends();
+    let (claim_tx, tx_claim) = queues::claims_tx_ends();
+    CONSOLE.init(Console::new(
+        print_asks,
+        print_news,
+        tell_job,
+        console_presses,
+        tx_claim,
+    ));
+    JOB.init(JobTask::new(
+        job_asks,
+        job_news,
+        job_controls,
+        job_presses,
+        claim_tx,
+    ));
+    let (sample_buttons, samples) = queues::samples_ends();
+    BUTTONS_TASK.init(ButtonsTask::new(samples, tell_presses));
+    Ends {
+        card_requests,
+        card_tell,
+        sample_buttons,
+    }
+}
+
+/// The queue ends `init_cells` leaves for `init`, which makes their
+/// holders: the card reader's, the tick's.
+struct Ends {
+    card_requests: CardRequests,
+    card_tell: CardTell,
+    sample_buttons: SampleButtons,
 }
 
 /// The kinematics of the settings loaded. Settings are only taken whole,
@@ -459,8 +495,8 @@ fn others_ready() -> bool {
 
 #[inline(never)]
 #[optimize(size)]
-fn start_card(spi: CardSpi, requests: CardRequests) {
-    CARD.init_with(|c| c.write(CardReader::new(spi, requests)));
+fn start_card(spi: CardSpi, requests: CardRequests, tell: CardTell) {
+    CARD.init_with(|c| c.write(CardReader::new(spi, requests, tell)));
 }
 
 /// Move due timers into the ready set and re-arm the tick's alarm.
@@ -570,14 +606,14 @@ fn console() {
     };
     reschedule(Task::Console, poll);
     // An operator's tool for the job.
-    if !JOB_CONTROL.is_empty() {
+    if queues::job_control_waits() {
         spawn(Task::Job);
     }
     // A plotter's card print asks the reader and takes its messages.
     if queues::card_request_waits() {
         spawn(Task::Card);
     }
-    if CARD_OUT.free() > card::ROOM {
+    if queues::card_out_free() > card::ROOM {
         signal(Signal::CardRoom);
     }
     if CONSOLE.with(|c| c.take_settings_changed()) {
@@ -680,8 +716,9 @@ fn startup_lines() -> bool {
     STORE.with(|s| s.has_startup_lines())
 }
 
+/// The console's word for the job, through its end of `JOB_CONTROL`.
 fn control_job(c: Control) {
-    if JOB_CONTROL.push(c).is_err() {
+    if !CONSOLE.with(|con| con.tell_job(c)) {
         warn!("job control queue full");
     }
     spawn(Task::Job);
@@ -731,7 +768,7 @@ fn job() {
     if queues::card_request_waits() {
         spawn(Task::Card);
     }
-    if CARD_OUT.free() > card::ROOM {
+    if queues::card_out_free() > card::ROOM {
         signal(Signal::CardRoom);
     }
 }
@@ -754,7 +791,7 @@ fn card() {
     let moving = MOTION.with(|m| !m.is_idle());
     let poll = CARD.with(|c| c.poll(now, moving));
     reschedule(Task::Card, poll);
-    if !CARD_OUT.is_empty() {
+    if queues::card_message_waits() {
         spawn(card_owner());
     }
 }

@@ -5,10 +5,10 @@
 
 use crate::board::servo::PenServo;
 use crate::drivers::Drivers;
-use crate::queues::{BEGUN, BLOCKS, SEGMENTS, SEGMENTS_CAPACITY, SHORT_AT};
+use crate::queues::{BLOCKS, SEGMENTS, SEGMENTS_CAPACITY};
 use crate::rt::TaskCell;
-use crate::stepper::{every_event, fast_segment, Stepper, FAST};
-use core::sync::atomic::Ordering::Relaxed;
+use crate::stepper::{blocks_begun, every_event, fast_segment, Stepper, FAST};
+use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::kinematics::Piece;
@@ -39,6 +39,12 @@ const QUEUED_MAX_US: u32 = 40_000;
 /// (~3 ms): a stream of 0.2 mm moves on the flatbed, stopping and starting
 /// at every line, ran dry with the refill behind a console's line.
 const STARVING_US: u32 = 8_000;
+
+/// The queued segments under which the refill is urgent, as many of the
+/// newest as last less than [`URGENT_BUDGET_US`]: written by segment
+/// preparation, read by the step interrupt and the tick (which spawn the
+/// urgent `Refill` at or below it). One byte: atomic on the AVR.
+static SHORT_AT: AtomicU8 = AtomicU8::new(SEGMENTS_CAPACITY as u8);
 
 /// The step queue holds less than the urgent budget of motion.
 #[inline(always)]
@@ -179,14 +185,12 @@ impl Motion {
     }
 
     /// The number the next block queued will have when the step
-    /// interrupt begins it ([`BEGUN`] counts them, wrapping). Read after
-    /// [`Motion::unbegun`]: a block begun between the reads makes it one
-    /// too high, never too low.
+    /// interrupt begins it ([`blocks_begun`] counts them, wrapping). Read
+    /// after [`Motion::unbegun`]: a block begun between the reads makes it
+    /// one too high, never too low.
     pub fn next_block(&self) -> u8 {
         let unbegun = self.unbegun();
-        BEGUN
-            .load(core::sync::atomic::Ordering::Relaxed)
-            .wrapping_add(unbegun)
+        blocks_begun().wrapping_add(unbegun)
     }
 
     /// Whether the planner has room for a move.

@@ -18,13 +18,13 @@
 //! discards it.
 
 use crate::board::flash::FlashStr;
+use crate::board::port::Port;
 use crate::log::Level;
 use crate::motion::Motion;
-use crate::queues::{CardAsk, CardMsg, Request, What, BEGUN, CARD_OUT, TX};
+use crate::queues::{CardAsk, CardMsg, CardNews, Request, What};
 use crate::reply;
 use crate::store::Store;
 use crate::{flash_str, info, warn};
-use core::sync::atomic::Ordering::Relaxed;
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::checkpoint::plot::{Resume, ResumeAction, ResumeEvent, Tracker};
 use taut_logic::fat::{short_display, Name};
@@ -59,6 +59,8 @@ struct Mark {
 pub struct Print {
     /// Its end of `CARD_IN`.
     card: CardAsk,
+    /// Its end of `CARD_OUT`.
+    news: CardNews,
     state: State,
     /// Numbers the card requests; messages of older ones are dropped.
     ticket: u8,
@@ -106,9 +108,10 @@ enum Keep {
 pub type Answer = Option<Result<(), ErrorKind>>;
 
 impl Print {
-    pub const fn new(card: CardAsk) -> Print {
+    pub const fn new(card: CardAsk, news: CardNews) -> Print {
         Print {
             card,
+            news,
             state: State::Idle,
             ticket: 0,
             size: 0,
@@ -172,7 +175,7 @@ impl Print {
     #[optimize(size)]
     pub fn keep(&mut self, store: &mut Store, now: u32) {
         if self.keep == Keep::Offer {
-            if TX.free() < crate::log::LINE {
+            if Port::Usb.tx_free() < crate::log::LINE {
                 return;
             }
             self.keep = Keep::Nothing;
@@ -196,7 +199,7 @@ impl Print {
             Keep::Begin => store.plot_begin(crate::card::opened_short(), self.size),
             Keep::Forget => store.forget(),
             Keep::Nothing | Keep::Offer => {
-                let begun = BEGUN.load(Relaxed);
+                let begun = crate::stepper::blocks_begun();
                 if let Some(r) = self.tracker.as_mut().and_then(|t| t.due(begun, false, now)) {
                     store.plot_record(r);
                 }
@@ -491,19 +494,19 @@ impl Print {
 
     fn messages(&mut self) -> Answer {
         let is_data = |m: &CardMsg| (m.ticket, matches!(m.what, What::Data { .. }));
-        while let Some((ticket, data)) = CARD_OUT.peek_with(is_data) {
+        while let Some((ticket, data)) = self.news.peek_with(is_data) {
             let ours = ticket == self.ticket;
             // Bytes wait in the queue until a line wants them, unless the
             // card went out behind them: the print stops at its last whole
             // line now (the line being carried out may wait on a long move).
             if data && ours && self.state != State::Idle {
-                if !crate::card::removal_waits() {
+                if !crate::card::removal_waits(&self.news) {
                     return None;
                 }
                 self.lost();
                 continue;
             }
-            let msg = CARD_OUT.pop()?;
+            let msg = self.news.pop()?;
             match msg.what {
                 What::Opened { size } if ours => return self.opened(size),
                 What::Listed if ours => {
@@ -641,7 +644,7 @@ impl Print {
             return None;
         }
         loop {
-            let head = CARD_OUT.peek_with(|m| match m.what {
+            let head = self.news.peek_with(|m| match m.what {
                 What::Data { at, len } if m.ticket == self.ticket => {
                     Some((len, crate::card::byte(at + u16::from(self.taken))))
                 }
@@ -661,7 +664,7 @@ impl Print {
             self.taken += 1;
             if self.taken >= len {
                 self.taken = 0;
-                let _ = CARD_OUT.pop();
+                let _ = self.news.pop();
             }
             self.at.pos += 1;
             if self.at.pos <= self.skip {
@@ -692,7 +695,7 @@ impl Print {
         let done = self.state == State::Running
             && self.ended
             && matches!(self.last, b'\n' | b'\r' | 0)
-            && !CARD_OUT.any(|m| m.ticket == self.ticket);
+            && !self.news.any(|m| m.ticket == self.ticket);
         if done {
             self.state = State::Idle;
             self.forget();

@@ -15,43 +15,49 @@
 //! | `SAMPLER` the buttons' pins and last sample | `buttons.rs` (`IsrCell`) | `TIMER0_COMPA` only (handed over at init) |
 //! | `MILLIS`, `ALARM` the clock and the timers' alarm | `board/clock.rs` (masked) | `TIMER0_COMPA` ↔ every task (`clock::millis`, `set_alarm`) |
 //! | `FLOW`, `CUT`; USART1's `ON`, `RATE`, `CUT` | `board/usart.rs`, `board/usart1.rs` | receive interrupts ↔ console, `$` settings |
+//! | `RX`, `RX1` the ports' received line bytes | `board/usart.rs`, `board/usart1.rs` (the board's only) | receive interrupts → console, through `Port::receive` |
+//! | `TX`, `TX1` the ports' replies and log lines | `board/usart.rs`, `board/usart1.rs` (the board's only) | tasks, through a port's `OUTBOX` (`log::Line`, `Port::send`) → transmit interrupts |
 //! | `OUTBOX` a port's staged reply | `board/usart.rs`, `board/usart1.rs` | tasks → transmit interrupt (through `TX`, `TX1`) |
 //! | `ANSWER` the port a line came from | `board/port.rs` | console → replies (tasks only) |
 //! | `DROPPED` log lines lost | `log.rs` (masked) | any context → logger |
 //! | `LOG` the log line being built | `log.rs` (`TaskCell`) | tasks only |
 //! | `BUF` the card's block, `OPENED` its file's name | `card.rs` (`TaskCell`) | card → job or console, read in place while a `Data` message names it (`card::bytes`) |
 //! | `STANDING` overrides, door | `realtime.rs` (`TaskCell`) | `Realtime` task → status reports |
+//! | `REALTIME` the real-time commands, `FEED_PRESSES` the feed override's presses | `realtime.rs` (`Flags`, `Tally`) | receive interrupts (`realtime::on_receive`) → `Realtime` task (`Requests::take`) |
 //! | `PLANNER` | `motion.rs` (`TaskCell`) | console, job → segment preparation, through `Motion` |
+//! | `SHORT_AT` the queued segments under which the refill is urgent | `motion.rs` (an atomic byte) | segment preparation → step interrupt and tick (`motion::urgent`, which spawn the urgent `Refill`) |
+//! | `BEGUN` blocks begun, wrapping | `stepper.rs` (an atomic byte) | `TIMER3_COMPA` → console, job, card print (`stepper::blocks_begun`: a checkpoint names the line whose block moves) |
 //! | each task's state (`MOTION`, `CONSOLE`, `JOB`, `CARD`, `STORE`, `KIN`, `LED` …), the dispatcher's `SPAWNED`, `READY`, `TIMERS`, `WAITING` | `main.rs` | the app (`SPAWNED`: interrupts → dispatcher) |
+//!
+//! Queues reached only through their ends: the static is private here,
+//! each end a zero-sized type (no RAM, no code) whose push or pop is the
+//! only way in, made once by the app's `init_cells` and held in its
+//! owner's state. Where two tasks take turns at one side (the card's
+//! owner is the job on the string-art machine, the console on a
+//! plotter), each holds an end of its own; software tasks never run in
+//! each other's middle. The app itself only asks whether a message waits
+//! (to spawn its reader), `$Q` reads the counters.
+//!
+//! | queue | sending end: holder | receiving end: holder |
+//! | --- | --- | --- |
+//! | `CARD_IN` | [`CardAsk`]: the job, the card print | [`CardRequests`]: the card reader |
+//! | `CARD_OUT` | [`CardTell`]: the card reader | [`CardNews`]: the job, the card print |
+//! | `JOB_CONTROL` | [`TellJob`]: the console (the `Realtime` task through `Console::tell_job`) | [`JobControls`]: the job |
+//! | `SAMPLES` | [`SampleButtons`]: the tick (`buttons::SAMPLER`, with the pins) | [`Samples`]: the buttons task |
+//! | `BUTTONS` | [`TellPresses`]: the buttons task | [`Presses`]: the job, the console |
+//! | `JOB_CLAIMS_TX` (a flag) | [`ClaimTx`]: the job | [`TxClaim`]: the console |
+//!
+//! The UART rings (`RX`, `TX`, `RX1`, `TX1`) are private to the board's
+//! serial drivers (above): tasks reach them through `Port`. Still `pub
+//! static`, reached by name: the step rings (`SEGMENTS`, `BLOCKS`: the
+//! step interrupt's assembly addresses `SEGMENTS` by its symbol).
 
-use crate::rt::{Flags, Mailbox, Ring, Tally};
-use core::sync::atomic::{AtomicBool, AtomicU8};
+use crate::rt::{Mailbox, Ring};
+use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
 use taut_logic::sched::QueueStats;
 use taut_logic::segment::{Segment, StepBlock};
-
-/// UART receive interrupt → console: line bytes (real-time commands are
-/// taken out before). 128 bytes, Grbl's buffer, every one usable: what
-/// senders count characters against (CNCjs 120, UGS and grbl-streamer
-/// 128, all of it unread when the console has not begun the next line).
-/// Full: the byte is lost and counted (the sender ignored flow control).
-pub static RX: Ring<u8, 128, true> = Ring::new();
-/// Console, job, logger → UART transmit interrupt. Replies wait for room;
-/// a log line without room is dropped whole and counted.
-pub static TX: Ring<u8, 128> = Ring::new();
-/// USART1 (the second console, a Bluetooth module) receive interrupt →
-/// console, as `RX`: 64 bytes, the longest line a sender types by hand
-/// or a job's, its last slot kept for a line's end.
-pub static RX1: Ring<u8, 64, true> = Ring::new();
-/// Console, status reports → USART1 transmit interrupt: room for the
-/// longest reply (`reply::ROOM`).
-pub static TX1: Ring<u8, 128> = Ring::new();
-/// UART receive interrupt → `Realtime` task: `?`, `!`, `~`, Ctrl-X.
-pub static REALTIME: Flags = Flags::new();
-/// UART receive interrupt → `Realtime` task: the feed override's ±10 %
-/// and ±1 % presses since the last run, summed (each one counts).
-pub static FEED_PRESSES: Tally = Tally::new();
 
 /// Segment preparation → step interrupt: segments, and the blocks they start.
 pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
@@ -61,23 +67,82 @@ pub static SEGMENTS: Ring<Segment, SEGMENTS_CAPACITY> = Ring::new();
 /// segments fill the 40 ms budget with fewer (`motion.rs`). 32 slots were
 /// 176 B more.
 pub const SEGMENTS_CAPACITY: usize = 16;
-/// Segment preparation → step interrupt and tick (which spawn the urgent
-/// `Refill` at or below it): the queued segments under which the refill is
-/// urgent, as many of the newest as last less than the budget
-/// (`motion::urgent`). One byte: atomic on the AVR.
-pub static SHORT_AT: AtomicU8 = AtomicU8::new(SEGMENTS_CAPACITY as u8);
 pub static BLOCKS: Ring<StepBlock, 8> = Ring::new();
-/// Step interrupt → console: blocks begun, wrapping (a card print's
-/// checkpoint names the line whose block is moving).
-pub static BEGUN: AtomicU8 = AtomicU8::new(0);
 
 /// Tick → buttons task: one raw sample (bit `Button as u8` = pressed) per
 /// millisecond while active. Full: the sample is refused and counted (the
-/// task fell 15 ms behind; a press then counts a little late).
-pub static SAMPLES: Ring<u8, 16> = Ring::new();
-/// Buttons task → job. Full: refused and counted (the job is far behind a
-/// human's presses).
-pub static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
+/// task fell 15 ms behind; a press then counts a little late). Private:
+/// reached through its ends, [`SampleButtons`] and [`Samples`].
+static SAMPLES: Ring<u8, 16> = Ring::new();
+
+/// `SAMPLES`' sending end: the tick's, kept with the pins it samples
+/// (`buttons::start` hands both to the interrupt).
+pub struct SampleButtons(());
+
+impl SampleButtons {
+    #[inline(always)]
+    pub fn push(&self, raw: u8) -> Result<(), u8> {
+        SAMPLES.push(raw)
+    }
+}
+
+/// `SAMPLES`' receiving end: the buttons task's.
+pub struct Samples(());
+
+impl Samples {
+    #[inline(always)]
+    pub fn pop(&self) -> Option<u8> {
+        SAMPLES.pop()
+    }
+}
+
+/// `SAMPLES`' ends, made once, by the app's init: the tick's, the buttons
+/// task's.
+pub fn samples_ends() -> (SampleButtons, Samples) {
+    (SampleButtons(()), Samples(()))
+}
+
+/// `SAMPLES`' counters and capacity (`$Q`).
+pub fn samples_stats() -> (QueueStats, usize) {
+    (SAMPLES.stats(), SAMPLES.capacity())
+}
+/// Buttons task → job, or a plotter's console (its card print). Full:
+/// refused and counted (the job is far behind a human's presses).
+/// Private: reached through its ends, [`TellPresses`] and [`Presses`].
+static BUTTONS: Ring<ButtonEvent, 8> = Ring::new();
+
+/// `BUTTONS`' sending end: the buttons task's.
+pub struct TellPresses(());
+
+impl TellPresses {
+    #[inline(always)]
+    pub fn push(&self, e: ButtonEvent) -> Result<(), ButtonEvent> {
+        BUTTONS.push(e)
+    }
+}
+
+/// `BUTTONS`' receiving end: the job's and the console's (only the card's
+/// owner, the job on the string-art machine, the console on a plotter,
+/// runs to take presses).
+pub struct Presses(());
+
+impl Presses {
+    #[inline(always)]
+    pub fn pop(&self) -> Option<ButtonEvent> {
+        BUTTONS.pop()
+    }
+}
+
+/// `BUTTONS`' ends, made once, by the app's init: the buttons task's, the
+/// job's, the console's.
+pub fn buttons_ends() -> (TellPresses, Presses, Presses) {
+    (TellPresses(()), Presses(()), Presses(()))
+}
+
+/// `BUTTONS`' counters and capacity (`$Q`).
+pub fn buttons_stats() -> (QueueStats, usize) {
+    (BUTTONS.stats(), BUTTONS.capacity())
+}
 
 /// Job or console (a plotter's card print) → card reader: the newest
 /// request (the reader takes them first; a newer one replaces it).
@@ -125,18 +190,164 @@ pub fn card_in_stats() -> (QueueStats, usize) {
 }
 /// Card reader → job or console, its four slots usable. Full: the reader
 /// keeps its block and waits. A file's bytes take at most two
-/// (`card::ROOM` stay free for a removal's news).
-pub static CARD_OUT: Ring<CardMsg, 4, true> = Ring::new();
+/// (`card::ROOM` stay free for a removal's news). Private: reached
+/// through its ends, [`CardTell`] and [`CardNews`].
+static CARD_OUT: Ring<CardMsg, 4, true> = Ring::new();
+
+/// `CARD_OUT`'s sending end: the card reader's.
+pub struct CardTell(());
+
+impl CardTell {
+    #[inline(always)]
+    pub fn push(&self, msg: CardMsg) -> Result<(), CardMsg> {
+        CARD_OUT.push(msg)
+    }
+
+    #[inline(always)]
+    pub fn free(&self) -> usize {
+        CARD_OUT.free()
+    }
+
+    /// Whether a message still waiting is `f`'s: the reader's block is
+    /// lent to the file bytes waiting.
+    #[inline(always)]
+    pub fn any(&self, f: impl Fn(&CardMsg) -> bool) -> bool {
+        CARD_OUT.any(f)
+    }
+}
+
+/// `CARD_OUT`'s receiving end: the job's and the card print's (only the
+/// card's owner, the job on the string-art machine, the console on a
+/// plotter, runs to take messages). `Clone` so that its holder can lend
+/// it to itself: the job handles a message read in place with all of
+/// itself borrowed (a copy of the message would deepen the stack).
+#[derive(Clone)]
+pub struct CardNews(());
+
+impl CardNews {
+    /// `f` of the oldest message, read in place.
+    #[inline(always)]
+    pub fn peek_with<R>(&self, f: impl FnOnce(&CardMsg) -> R) -> Option<R> {
+        CARD_OUT.peek_with(f)
+    }
+
+    #[inline(always)]
+    pub fn pop(&self) -> Option<CardMsg> {
+        CARD_OUT.pop()
+    }
+
+    /// Whether any waiting message is `f`'s.
+    #[inline(always)]
+    pub fn any(&self, f: impl Fn(&CardMsg) -> bool) -> bool {
+        CARD_OUT.any(f)
+    }
+}
+
+/// `CARD_OUT`'s ends, made once, by the app's init: the reader's, the
+/// job's, the card print's.
+pub fn card_out_ends() -> (CardTell, CardNews, CardNews) {
+    (CardTell(()), CardNews(()), CardNews(()))
+}
+
+/// A message waits for the card's owner (the app then spawns it).
+#[inline(always)]
+pub fn card_message_waits() -> bool {
+    !CARD_OUT.is_empty()
+}
+
+/// `CARD_OUT`'s free slots (the app signals `CardRoom` over `card::ROOM`).
+#[inline(always)]
+pub fn card_out_free() -> usize {
+    CARD_OUT.free()
+}
+
+/// `CARD_OUT`'s counters and capacity (`$Q`).
+pub fn card_out_stats() -> (QueueStats, usize) {
+    (CARD_OUT.stats(), CARD_OUT.capacity())
+}
 /// File bytes per message at most.
 pub const CHUNK: usize = 32;
 
-/// `Realtime` task → job: `~` with no feed hold, Ctrl-X.
-pub static JOB_CONTROL: Ring<Control, 4> = Ring::new();
+/// Console → job: its operator's tools, and from its real-time bytes
+/// (the `Realtime` task) `~` with no feed hold and Ctrl-X. Private:
+/// reached through its ends, [`TellJob`] and [`JobControls`].
+static JOB_CONTROL: Ring<Control, 4> = Ring::new();
+
+/// `JOB_CONTROL`'s sending end: the console's, which the `Realtime` task
+/// uses too (both are software tasks, never running in each other's
+/// middle).
+pub struct TellJob(());
+
+impl TellJob {
+    #[inline(always)]
+    pub fn push(&self, c: Control) -> Result<(), Control> {
+        JOB_CONTROL.push(c)
+    }
+}
+
+/// `JOB_CONTROL`'s receiving end: the job's.
+pub struct JobControls(());
+
+impl JobControls {
+    #[inline(always)]
+    pub fn pop(&self) -> Option<Control> {
+        JOB_CONTROL.pop()
+    }
+}
+
+/// `JOB_CONTROL`'s ends, made once, by the app's init: the console's,
+/// the job's.
+pub fn job_control_ends() -> (TellJob, JobControls) {
+    (TellJob(()), JobControls(()))
+}
+
+/// A word waits for the job (the app then spawns it).
+#[inline(always)]
+pub fn job_control_waits() -> bool {
+    !JOB_CONTROL.is_empty()
+}
+
+/// `JOB_CONTROL`'s counters and capacity (`$Q`).
+pub fn job_control_stats() -> (QueueStats, usize) {
+    (JOB_CONTROL.stats(), JOB_CONTROL.capacity())
+}
 
 /// The job waits for room in the TX ring for a line it must not drop (a
 /// prompt, a bad file's message): the console holds its replies meanwhile,
 /// or a stream of replies would keep the ring full for as long as it lasts.
-pub static JOB_CLAIMS_TX: AtomicBool = AtomicBool::new(false);
+/// Private: reached through its ends, [`ClaimTx`] and [`TxClaim`].
+static JOB_CLAIMS_TX: AtomicBool = AtomicBool::new(false);
+
+/// `JOB_CLAIMS_TX`'s writing end: the job's.
+pub struct ClaimTx(());
+
+impl ClaimTx {
+    #[inline(always)]
+    pub fn set(&self, claimed: bool) {
+        JOB_CLAIMS_TX.store(claimed, Relaxed)
+    }
+
+    #[inline(always)]
+    pub fn claimed(&self) -> bool {
+        JOB_CLAIMS_TX.load(Relaxed)
+    }
+}
+
+/// `JOB_CLAIMS_TX`'s reading end: the console's.
+pub struct TxClaim(());
+
+impl TxClaim {
+    #[inline(always)]
+    pub fn claimed(&self) -> bool {
+        JOB_CLAIMS_TX.load(Relaxed)
+    }
+}
+
+/// `JOB_CLAIMS_TX`'s ends, made once, by the app's init: the job's, the
+/// console's.
+pub fn claims_tx_ends() -> (ClaimTx, TxClaim) {
+    (ClaimTx(()), TxClaim(()))
+}
 
 /// What the job (string art) or the console (a plotter's card print)
 /// asks of the card reader.
@@ -209,7 +420,7 @@ pub enum Signal {
     PlannerRoom,
     /// The step queue is refilled (`Motion::refilling` is over).
     Refilled,
-    /// The job took messages from [`CARD_OUT`].
+    /// The job took messages from `CARD_OUT`.
     CardRoom,
     /// A `$` setting changed: the store writes it to EEPROM.
     Settings,

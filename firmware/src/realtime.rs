@@ -10,9 +10,8 @@ use crate::console::{Activity, Frame};
 use crate::endstop;
 use crate::log::Line;
 use crate::motion::{self, Motion};
-use crate::queues::{FEED_PRESSES, REALTIME};
 use crate::reply;
-use crate::rt::TaskCell;
+use crate::rt::{Flags, Tally, TaskCell};
 use crate::stepper;
 use crate::{flash_str, info, warn};
 use taut_logic::config::MachineConfig;
@@ -32,6 +31,14 @@ const JOG_CANCEL: u8 = 5;
 const OVERRIDES: u8 = 6;
 /// `?` from UART1: its report goes there.
 const STATUS_UART1: u8 = OVERRIDES + 8;
+
+/// Receive interrupts → `Realtime` task: `?`, `!`, `~`, Ctrl-X, the
+/// override bytes. Private: set only by [`on_receive`] (and
+/// [`status_later`]), taken only by [`Requests::take`].
+static REALTIME: Flags = Flags::new();
+/// Receive interrupts → `Realtime` task: the feed override's ±10 % and
+/// ±1 % presses since the last run, summed (each one counts).
+static FEED_PRESSES: Tally = Tally::new();
 
 /// Grbl's safety-door and jog-cancel bytes.
 const SAFETY_DOOR_BYTE: u8 = 0x84;

@@ -25,10 +25,10 @@ pub mod fast;
 
 use crate::board::gpio::{regs, Output, Pin};
 use crate::board::step_timer::StepTimer;
-use crate::queues::{BEGUN, BLOCKS, SEGMENTS};
+use crate::queues::{BLOCKS, SEGMENTS};
 use core::cell::UnsafeCell;
 use core::ptr::{read_volatile, write_volatile};
-use core::sync::atomic::Ordering::Relaxed;
+use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::coil;
 use taut_logic::config::{Driver, MachineConfig};
@@ -208,6 +208,16 @@ pub struct ExecCell(UnsafeCell<Exec>);
 // SAFETY: `Exec` is touched by TIMER3_COMPA, or by task code while that
 // interrupt is off (`kick`) or inside a critical section (the readers).
 unsafe impl Sync for ExecCell {}
+
+/// Blocks the step interrupt has begun, wrapping: written by it, read by
+/// tasks through [`blocks_begun`] (a card print's checkpoint names the line
+/// whose block moves). One byte: atomic on the AVR.
+static BEGUN: AtomicU8 = AtomicU8::new(0);
+
+/// Blocks the step interrupt has begun, wrapping.
+pub fn blocks_begun() -> u8 {
+    BEGUN.load(Relaxed)
+}
 
 #[doc(hidden)]
 pub static EXEC: ExecCell = ExecCell(UnsafeCell::new(Exec {

@@ -15,7 +15,8 @@
 //! `G30.1`): written in the background, in force at once.
 
 use crate::board::eeprom::Eeprom;
-use crate::queues::{Signal, TX};
+use crate::board::port::Port;
+use crate::queues::Signal;
 use crate::rt::Poll;
 use crate::{flash_str, info, warn};
 use taut_logic::axis::AXES;
@@ -496,7 +497,7 @@ impl Store {
     /// once all agree.
     pub fn poll(&mut self, cfg: &MachineConfig) -> Poll<Signal> {
         if let Some(note) = self.notes[0] {
-            if TX.free() < crate::log::LINE {
+            if Port::Usb.tx_free() < crate::log::LINE {
                 return Poll::After(5);
             }
             self.notes = [self.notes[1], None];

@@ -3,7 +3,7 @@
 //! `taut_logic::stringart::job::tools`): the console passes them to the
 //! job, which refuses them while it moves and logs what they did.
 
-use crate::queues::{Control, JOB_CONTROL};
+use crate::queues::{Control, TellJob};
 use taut_logic::stringart::job::tools;
 
 /// `$key=…` names a tool, not a setting.
@@ -11,12 +11,13 @@ pub fn is_tool(key: &str) -> bool {
     tools::parse(key, "0").is_some()
 }
 
-/// Hands the tool to the job; `Err(column)` for a bad value, or when the
-/// job's queue is full (the job is far behind: try again).
-pub fn send(key: &str, value: &str) -> Result<(), u8> {
+/// Hands the tool to the job through the console's end of its queue;
+/// `Err(column)` for a bad value, or when the job's queue is full (the
+/// job is far behind: try again).
+pub fn send(job: &TellJob, key: &str, value: &str) -> Result<(), u8> {
     let at = (key.len() + 3).min(u8::MAX as usize) as u8;
     match tools::parse(key, value) {
-        Some(Ok(t)) => JOB_CONTROL.push(Control::Tool(t)).map_err(|_| 0),
+        Some(Ok(t)) => job.push(Control::Tool(t)).map_err(|_| 0),
         _ => Err(at),
     }
 }

@@ -12,6 +12,7 @@
 //!   into that same `avr_t` and are private here: other modules reach
 //!   `Shared`'s plain data only.
 
+use crate::compare_fix::Timers;
 use crate::probe::Probe;
 use crate::sdcard::slot::Slot;
 use crate::serial::SerialLine;
@@ -66,6 +67,8 @@ pub(crate) struct Shared {
     /// The I flag before the last SREG write (simavr has unpacked the new
     /// value by the time the write hook runs).
     i_on: bool,
+    /// The compares simavr would skip after a late overflow.
+    timers: Timers,
 }
 
 /// simavr's IRQs the SD card slot reads and writes.
@@ -102,6 +105,8 @@ impl Shared {
             spm_refused: 0,
             hard_deadline: false,
             i_on: false,
+            // SAFETY: `avr` is live and initialised (module invariants).
+            timers: unsafe { Timers::of(avr) },
         }
     }
 
@@ -403,6 +408,7 @@ pub(crate) unsafe extern "C" fn run(avr: *mut avr_t) {
     }
     let before = (*avr).cycle;
     let sleep = simavr_ffi::avr_cycle_timer_process(avr);
+    (*shared).timers.catch_up(avr);
     if (*avr).cycle < before {
         (*shared).reset_at = Some(before);
     }

@@ -9,6 +9,7 @@ pub mod boot;
 mod calls;
 mod card_slot;
 pub mod clock;
+mod compare_fix;
 pub mod console;
 pub mod elf;
 mod endstop;

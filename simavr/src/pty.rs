@@ -80,7 +80,13 @@ impl Pty {
     pub fn open(link: Option<&Path>) -> io::Result<Pty> {
         // SAFETY: plain libc calls on descriptors this function owns.
         unsafe {
-            let master = check(libc::posix_openpt(libc::O_RDWR | libc::O_NOCTTY))?;
+            // Close-on-exec, both ends: a process another thread spawns
+            // meanwhile (a test binary runs tests side by side) would keep
+            // a copy, and the terminal would not hang up when the
+            // simulator ends (the client would never see its link lost).
+            let master = check(libc::posix_openpt(
+                libc::O_RDWR | libc::O_NOCTTY | libc::O_CLOEXEC,
+            ))?;
             let master = File::from_raw_fd(master);
             check(libc::grantpt(master.as_raw_fd()))?;
             check(libc::unlockpt(master.as_raw_fd()))?;
@@ -95,7 +101,10 @@ impl Pty {
                     .to_str()
                     .map_err(io::Error::other)?,
             );
-            let slave = check(libc::open(name.as_ptr(), libc::O_RDWR | libc::O_NOCTTY))?;
+            let slave = check(libc::open(
+                name.as_ptr(),
+                libc::O_RDWR | libc::O_NOCTTY | libc::O_CLOEXEC,
+            ))?;
             let slave = OwnedFd::from_raw_fd(slave);
             let mut tio: libc::termios = std::mem::zeroed();
             check(libc::tcgetattr(slave.as_raw_fd(), &mut tio))?;

@@ -207,9 +207,13 @@ and commit the page.
   port by character counting (lines per second answered from the first
   tenth to the last) or printed from the card (`M24` answered → `Done
   printing file`). Underruns are the firmware's own count (its logger's
-  `underruns:N`) over the stream. Beside each, what the planner allows:
-  short moves at speed are bound by the look-ahead (the machine must be
-  able to stop within the planned blocks), however fast the CPU.
+  `underruns:N`) over the stream. Beside each, what the planner allows
+  at the firmware's depth and at Grbl-Mega's 36 blocks, however fast the
+  CPU: short moves at speed are bound by the look-ahead (the machine must
+  be able to stop within the planned blocks) and by the junctions, which
+  Grbl's rule takes between the moves as rounded to steps (a 0.05 mm
+  chord is two steps of the flatbed's 0.025 mm, so the direction turns by tens of
+  degrees from one to the next).
   `TAUT_BENCH_PROFILE=N` prints where a case's cycles go: per function,
   with callees (a shadow call stack), the callers of the maths library.
 - **Grbl side by side** (`grbl_stream_*`, `simavr/src/bin/taut-bench/grbl.rs`):
@@ -357,6 +361,7 @@ fn stream_case_rows(
             let key = |what: &str| format!("stream_{machine}_{size}_{what}");
             let cases = [
                 (key("planner_bound_lines_per_s"), "lines/s", format!("{mm} mm chords of a circle at F1500 on the {name}: what its planner allows (the same lines through the firmware's parser, executor and planner on the host, no CPU or UART limit)"), None),
+                (key("planner_36_bound_lines_per_s"), "lines/s", "the same with Grbl-Mega's 36 blocks of look-ahead".into(), None),
                 (key("serial_lines_per_s"), "lines/s", format!("the same over serial by character counting (Grbl's 128 bytes), lines carried out per second{at_most}"), bar(serial_bar)),
                 (key("serial_underruns"), "", UNDERRUNS.into(), Some(Bar::AtMost(0.0))),
                 (key("card_lines_per_s"), "lines/s", format!("the same printed from the card, lines carried out per second{at_most}"), bar(card_bar)),

@@ -2,11 +2,11 @@
 //! module). A line is answered on the port it came from; log lines go to
 //! USB only.
 
-use super::usart::{self, Outbox};
-use super::usart1;
-use crate::queues::{RX, RX1, TX, TX1};
+use super::usart::{self, Outbox, RX, TX};
+use super::usart1::{self, RX1, TX1};
 use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
 use taut_logic::gcode::LINE_CUT;
+use taut_logic::sched::QueueStats;
 
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Port {
@@ -99,6 +99,22 @@ impl Port {
         match self {
             Port::Usb => RX.free(),
             Port::Uart1 => RX1.free(),
+        }
+    }
+
+    /// Its receive ring's counts (`$Q`).
+    pub fn rx_stats(self) -> QueueStats {
+        match self {
+            Port::Usb => RX.stats(),
+            Port::Uart1 => RX1.stats(),
+        }
+    }
+
+    /// Its transmit ring's counts and size (`$Q`).
+    pub fn tx_stats(self) -> (QueueStats, usize) {
+        match self {
+            Port::Usb => (TX.stats(), TX.capacity()),
+            Port::Uart1 => (TX1.stats(), TX1.capacity()),
         }
     }
 

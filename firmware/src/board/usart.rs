@@ -5,11 +5,21 @@
 //! when `RX` holds [`XOFF_AT`] bytes and XON once it is down to
 //! [`XON_AT`], each ahead of the bytes waiting in `TX`.
 
-use crate::queues::{RX, TX};
 use crate::rt::Ring;
 use avr_device::atmega2560::USART0;
 use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
 use taut_logic::gcode::LINE_CUT;
+
+/// Receive interrupt → console: line bytes (real-time commands are taken
+/// out before). 128 bytes, Grbl's buffer, every one usable: what senders
+/// count characters against (CNCjs 120, UGS and grbl-streamer 128, all of
+/// it unread when the console has not begun the next line). Full: the
+/// byte is lost and counted (the sender ignored flow control). The board's
+/// only: the console reads it through `Port`.
+pub(super) static RX: Ring<u8, 128, true> = Ring::new();
+/// Tasks (through [`OUTBOX`]) → transmit interrupt. Replies wait for room;
+/// a log line without room is dropped whole and counted.
+pub(super) static TX: Ring<u8, 128> = Ring::new();
 
 pub struct Usart0;
 

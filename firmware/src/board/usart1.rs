@@ -7,10 +7,18 @@
 //! `zero_drill` button is on D18.
 
 use super::usart::{keep, Outbox};
-use crate::queues::{RX1, TX1};
+use crate::rt::Ring;
 use avr_device::atmega2560::USART1;
 use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
 use taut_logic::settings::grbl::Uart1Baud;
+
+/// Receive interrupt → console, as `usart::RX`: 64 bytes, the longest
+/// line a sender types by hand or a job's, its last slot kept for a
+/// line's end.
+pub(super) static RX1: Ring<u8, 64, true> = Ring::new();
+/// Tasks (through [`OUTBOX`]) → transmit interrupt: room for the longest
+/// reply (`reply::ROOM`).
+pub(super) static TX1: Ring<u8, 128> = Ring::new();
 
 fn regs() -> &'static avr_device::atmega2560::usart1::RegisterBlock {
     // SAFETY: USART1 is configured by `configure` only, from a task;

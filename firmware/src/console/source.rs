@@ -7,7 +7,6 @@
 use super::{Console, Source};
 use crate::board::port;
 use crate::motion::Motion;
-use crate::queues::BUTTONS;
 use crate::store::Store;
 use taut_logic::checkpoint::plot::ResumeAction;
 use taut_logic::config::MachineConfig;
@@ -56,7 +55,7 @@ impl Console {
     /// still waits for the reader.
     #[inline(never)]
     pub(super) fn card_news(&mut self, m: &mut Motion, cfg: &MachineConfig, store: &Store) -> bool {
-        while let Some(event) = BUTTONS.pop() {
+        while let Some(event) = self.presses.pop() {
             if self.print.offered() && event.is_short_press(Button::Confirm) {
                 let _ = self.recover(m, cfg, store);
                 continue;

@@ -71,7 +71,7 @@ impl Console {
             // The job's tools: it answers them itself, in its log (and
             // refuses them while it moves).
             SystemLine::Set { key, value } if tools::is_tool(key) => {
-                if let Err(col) = tools::send(key, value) {
+                if let Err(col) = tools::send(&self.job, key, value) {
                     return self.error(&Error::new(ErrorKind::InvalidStatement, col));
                 }
             }

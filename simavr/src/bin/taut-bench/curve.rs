@@ -23,7 +23,7 @@ const RADIUS_MM: f64 = 150.0;
 /// Inside the flatbed's 140 mm of X: x from 135 mm down to 21 mm.
 const CENTRE: [f64; 2] = [-15.0, 0.0];
 /// Grbl-Mega's planner depth (`BLOCK_BUFFER_SIZE` for the 2560).
-const GRBL_MEGA_BLOCKS: usize = 36;
+pub(crate) const GRBL_MEGA_BLOCKS: usize = 36;
 
 /// The flatbed's top feed, mm/min: its axes' `max_rate` (the same on
 /// both) over their steps per mm.

@@ -14,10 +14,12 @@
 //! around;
 //! `TAUT_BENCH_UART=DIR` keeps each case's UART text.
 
+use crate::curve::GRBL_MEGA_BLOCKS;
 use serde_json::{json, Map, Value};
 use std::path::Path;
 use std::time::Duration;
 use taut_logic::machine::Machine;
+use taut_logic::planner::PLANNER_BLOCKS;
 use taut_simavr::sdcard::SdImage;
 use taut_simavr::sdimage::FatChoice;
 use taut_simavr::{Outcome, Reply, Sim};
@@ -102,10 +104,12 @@ pub(crate) fn underruns(sim: &Sim) -> u64 {
 /// firmware's parser, executor and planner, a block timed when the full
 /// planner hands it on), with no limit from the CPU or the UART. Short
 /// moves at speed are bound by the look-ahead: the machine must be able
-/// to stop within the planned blocks.
-fn planner_bound(machine: Machine, start: [f64; 2], lines: &[String]) -> f64 {
+/// to stop within the planned blocks. `N`: the planner's depth (the
+/// firmware's, or Grbl-Mega's 36 to show what a deeper one allows).
+fn planner_bound<const N: usize>(machine: Machine, start: [f64; 2], lines: &[String]) -> f64 {
     let cfg = taut_logic::config::MachineConfig::defaults(machine);
-    let mut timing = taut_logic::interp::estimate::GcodeTime::new(&cfg).expect("kinematics");
+    let mut timing =
+        taut_logic::interp::estimate::GcodeTime::<N>::with_depth(&cfg).expect("kinematics");
     timing.push(format!("G90 G21\nG0 X{} Y{}\n", start[0], start[1]).as_bytes());
     let n = lines.len();
     let (from, to) = (n / 10, n - n / 10);
@@ -206,13 +210,20 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
         for (segment, len) in SEGMENTS {
             let points = chords(centre, r, segment, line_count(segment));
             let lines = lines(&points, FEED);
-            let bound = planner_bound(machine, points[0], &lines);
             let key = format!("stream_{}_{len}", machine.name());
             if only.is_none_or(|o| key.contains(o)) {
-                println!("{key:<36} {bound:>7.1} lines/s the planner allows");
+                let bound = planner_bound::<PLANNER_BLOCKS>(machine, points[0], &lines);
+                let deep = planner_bound::<GRBL_MEGA_BLOCKS>(machine, points[0], &lines);
+                println!(
+                    "{key:<36} {bound:>7.1} lines/s the planner allows ({deep:.1} at 36 blocks)"
+                );
                 f.insert(
                     format!("{key}_planner_bound_lines_per_s"),
                     json!((bound * 10.0).round() / 10.0),
+                );
+                f.insert(
+                    format!("{key}_planner_36_bound_lines_per_s"),
+                    json!((deep * 10.0).round() / 10.0),
                 );
             }
             for source in ["serial", "card"] {
