@@ -43,7 +43,10 @@ fn main() {
         .lines()
         .find(|l| l.starts_with("[MSG:W"))
         .map(String::from);
-    println!("the warning's store run: {cycles} cycles at {:.3} ms", at as f64 / 16e3);
+    println!(
+        "the warning's store run: {cycles} cycles at {:.3} ms",
+        at as f64 / 16e3
+    );
     println!("longest store run: {longest} cycles");
     println!("its line: {}", line.as_deref().unwrap_or("(none)"));
     // The same boot again, the profile taken over that run only.
