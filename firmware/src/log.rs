@@ -41,6 +41,27 @@ pub fn dropped() -> u16 {
     avr_device::interrupt::free(|cs| DROPPED.borrow(cs).get())
 }
 
+/// A piece's bytes, from SRAM or flash: one staging loop for both.
+enum Bytes<'a> {
+    Ram(core::slice::Iter<'a, u8>),
+    /// The text and the next byte's index.
+    Flash(FlashStr, usize),
+}
+
+impl Iterator for Bytes<'_> {
+    type Item = u8;
+    fn next(&mut self) -> Option<u8> {
+        match self {
+            Bytes::Ram(bytes) => bytes.next().copied(),
+            Bytes::Flash(s, i) if *i < s.len() => {
+                *i += 1;
+                Some(s.byte(*i - 1))
+            }
+            Bytes::Flash(..) => None,
+        }
+    }
+}
+
 /// A line being written: a reply, a push message or a log line, staged
 /// in the TX ring itself ([`Ring::stage`]) and queued whole at its end, so
 /// that no 100-byte copy of it sits in a frame or a static. A line begun,
@@ -87,29 +108,40 @@ impl ufmt::uWrite for Line {
 }
 
 impl Line {
-    /// Staged if it fits the line (else the line is cut).
+    /// A byte, staged if it fits the line (else the line is cut).
+    #[inline(never)]
     fn push(&mut self, b: u8) {
-        if usize::from(self.at - self.start) >= LINE {
-            self.cut = true;
-        } else {
-            self.stage(b);
-        }
+        self.push_all(core::slice::from_ref(&b));
     }
 
+    /// Bytes, staged as far as the line goes (the rest cut).
     #[inline(never)]
     pub fn push_all(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.push(b);
-        }
+        self.stage(bytes.len(), Bytes::Ram(bytes.iter()));
     }
 
+    /// A text from flash, read straight into the ring (no copy on the
+    /// stack, as its `uDisplay` makes).
     #[inline(never)]
-    fn stage(&mut self, b: u8) {
-        self.lost |= !self
-            .port
-            .outbox()
-            .stage(self.owner, usize::from(self.at), b);
-        self.at += 1;
+    fn push_text(&mut self, s: FlashStr) {
+        self.stage(s.len(), Bytes::Flash(s, 0));
+    }
+
+    /// Stage the `n` bytes of `bytes` as far as the line goes (the rest
+    /// cut): the port, the slots' owner and the room are looked up once
+    /// for them all, not per byte.
+    #[inline(never)]
+    fn stage(&mut self, n: usize, bytes: Bytes) {
+        let left = LINE as u8 - (self.at - self.start);
+        let n = match u8::try_from(n) {
+            Ok(n) if n <= left => n,
+            _ => {
+                self.cut = true;
+                left
+            }
+        };
+        self.lost |= !self.port.outbox().stage(self.owner, self.at, n, bytes);
+        self.at += n;
     }
 
     /// A new line, the ring's free slots its own.
@@ -130,7 +162,7 @@ impl Line {
     #[inline(never)]
     pub fn message() -> Line {
         let mut l = Line::new(true, port::answer());
-        let _ = ufmt::uwrite!(l, "{}", crate::flash_str!("[MSG:"));
+        l.push_text(crate::flash_str!("[MSG:"));
         l
     }
 
@@ -163,22 +195,31 @@ impl Line {
         let close = usize::from(self.msg);
         if self.cut || usize::from(self.at - self.start) + close + 1 > LINE {
             self.at = self.start + (LINE - 2 - close) as u8;
-            self.stage(b'~');
+            self.push(b'~');
         }
+        // Never cut: with them the line is `LINE` bytes at most.
         if self.msg {
-            self.stage(b']');
+            self.push(b']');
         }
-        self.stage(b'\n');
+        self.push(b'\n');
     }
 
     /// A log line's start: `[MSG:` from flash (a format string's pieces
     /// would sit in SRAM, pushed bytes cost code), level, time, module.
     fn head(&mut self, level: Level, module: FlashStr) {
-        let _ = ufmt::uwrite!(self, "{}", crate::flash_str!("[MSG:"));
+        self.push_text(crate::flash_str!("[MSG:"));
         // Immediates, not a byte string: that would be a copy in SRAM.
         #[allow(clippy::byte_char_slices)]
         self.push([b'E', b'W', b'I', b'D'][level as usize]);
-        let _ = ufmt::uwrite!(self, " {} {}: ", clock::millis(), module);
+        // The first 65 s in 16 bits: a digit of a 32-bit number costs a
+        // 32-bit division, some 700 cycles.
+        let ms = clock::millis();
+        let _ = match u16::try_from(ms) {
+            Ok(short) => ufmt::uwrite!(self, " {} ", short),
+            Err(_) => ufmt::uwrite!(self, " {} ", ms),
+        };
+        self.push_text(module);
+        let _ = ufmt::uwrite!(self, ": ");
     }
 
     /// A new log line; `n lines dropped` before it while lines were
@@ -189,7 +230,8 @@ impl Line {
         let dropped = dropped();
         if dropped > 0 {
             l.head(Level::Warn, crate::flash_str!("log"));
-            let _ = ufmt::uwrite!(l, "{}{}", dropped, crate::flash_str!(" lines dropped"));
+            let _ = ufmt::uwrite!(l, "{}", dropped);
+            l.push_text(crate::flash_str!(" lines dropped"));
             l.end();
             l.start = l.at;
             l.cut = false;
@@ -229,9 +271,7 @@ pub fn start(level: Level, module: FlashStr) {
 #[doc(hidden)]
 #[inline(never)]
 pub fn text(s: FlashStr) {
-    LOG.with(|l| {
-        let _ = ufmt::uwrite!(l, "{}", s);
-    });
+    LOG.with(|l| l.push_text(s));
 }
 
 /// A log line of one text from flash (`log!` of a lone literal): one
@@ -251,6 +291,34 @@ pub fn part<T: ufmt::uDisplay + ?Sized>(value: &T) {
     with_line(|l| {
         let _ = ufmt::uwrite!(l, "{}", value);
     });
+}
+
+/// `log!`'s parts by type, at the call site: a text from flash goes
+/// straight into the ring ([`text`]), any other value through its
+/// `uDisplay` ([`part`]). A method of `&FlashStr` is found before one of
+/// `&&T`, so `(&value).log_part()` picks the first for a text.
+#[doc(hidden)]
+pub trait TextPart {
+    fn log_part(&self);
+}
+
+impl TextPart for FlashStr {
+    #[inline(always)]
+    fn log_part(&self) {
+        text(*self);
+    }
+}
+
+#[doc(hidden)]
+pub trait ValuePart {
+    fn log_part(&self);
+}
+
+impl<T: ufmt::uDisplay + ?Sized> ValuePart for &T {
+    #[inline(always)]
+    fn log_part(&self) {
+        part(*self);
+    }
 }
 
 /// Append to the log line what `f` writes (a line put together by hand,
@@ -282,7 +350,12 @@ macro_rules! __log_parts {
         $crate::__log_parts!($($($rest)*)?);
     };
     ($e:expr $(, $($rest:tt)*)?) => {
-        $crate::log::part(&$e);
+        {
+            #[allow(unused_imports)]
+            use $crate::log::{TextPart as _, ValuePart as _};
+            let part = &$e;
+            part.log_part();
+        }
         $crate::__log_parts!($($($rest)*)?);
     };
 }

@@ -174,11 +174,12 @@ impl Outbox {
         n
     }
 
-    /// Stage byte `k` of line `owner` (`Ring::stage`): false if it does
-    /// not fit or the slots are no longer the line's.
+    /// Stage the `n` bytes of `bytes` as bytes `k`… of line `owner`
+    /// (`Ring::stage`): false if not all fit (those that do are written)
+    /// or the slots are no longer the line's (none is).
     #[inline(always)]
-    pub fn stage(&self, owner: u8, k: usize, b: u8) -> bool {
-        owner == self.staging.load(Relaxed) && self.ring.stage(k, b)
+    pub fn stage(&self, owner: u8, k: u8, n: u8, bytes: impl Iterator<Item = u8>) -> bool {
+        owner == self.staging.load(Relaxed) && self.ring.stage(k, n, bytes)
     }
 
     /// Queue the `n` bytes line `owner` staged, unless it `lost` some or

@@ -104,18 +104,23 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
         true
     }
 
-    /// Producer: write `item` `k` slots past the last one queued, if that
-    /// slot is free; the consumer sees it once [`Ring::publish`] counts it
-    /// in. A message built in the ring itself (a log line): no copy of it
-    /// elsewhere. Nothing else may be pushed meanwhile.
-    pub fn stage(&self, k: usize, item: T) -> bool {
-        if k >= self.free() {
-            return false;
+    /// Producer: write the `n` items of `items` from `k` slots past the
+    /// last one queued, as many as there are free slots for; the consumer
+    /// sees them once [`Ring::publish`] counts them in. A message built in
+    /// the ring itself (a log line): no copy of it elsewhere. Nothing else
+    /// may be pushed meanwhile. The free slots are counted once, before
+    /// the first: the consumer only frees more. Whether all fit.
+    #[inline(always)]
+    pub fn stage(&self, k: u8, n: u8, items: impl Iterator<Item = T>) -> bool {
+        // At most 255 free: `N` ≤ 256 and one stays empty, or `N` ≤ 128.
+        let fit = (self.free() as u8).saturating_sub(k).min(n);
+        let mut h = self.head.load(Relaxed).wrapping_add(k);
+        for item in items.take(usize::from(fit)) {
+            // SAFETY: slot `h` is free (counted above) and the producer's.
+            unsafe { (*self.buf.get())[(h & Self::MASK) as usize] = MaybeUninit::new(item) };
+            h = h.wrapping_add(1);
         }
-        let h = self.head.load(Relaxed).wrapping_add(k as u8);
-        // SAFETY: slot `h` is free (checked above) and the producer's.
-        unsafe { (*self.buf.get())[(h & Self::MASK) as usize] = MaybeUninit::new(item) };
-        true
+        fit == n
     }
 
     /// Producer: queue the first `n` items staged (all written).

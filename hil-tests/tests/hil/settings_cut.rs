@@ -26,10 +26,9 @@ use taut_logic::units::Milli;
 
 /// The store task's longest run (0.5 ms at 16 MHz): it compares a few
 /// parts of a record a run and starts at most one byte's write. One run
-/// may print the boot's warning line instead (a log line, staged in the
-/// USB port's outbox: 0.82 ms).
+/// may print the boot's warning line instead (a log line: 0.72 ms).
 const STORE_RUN_CYCLES: u64 = 8_000;
-const LOG_LINE_CYCLES: u64 = 14_000;
+const LOG_LINE_CYCLES: u64 = 12_000;
 
 /// What a cut at one millisecond leaves.
 struct Cut {
