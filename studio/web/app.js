@@ -64,7 +64,9 @@ function clock(s) {
 
 function debounce(f, ms) {
   let t;
-  return (...a) => { clearTimeout(t); t = setTimeout(() => f(...a), ms); };
+  const later = (...a) => { clearTimeout(t); t = setTimeout(() => f(...a), ms); };
+  later.cancel = () => clearTimeout(t);
+  return later;
 }
 
 function download(name, data, type) {
@@ -138,6 +140,10 @@ let vectorizing = 0;
 async function vectorize() {
   if (!S.file || S.file.kind === 'gcode') { notice('open a picture (PNG, JPEG or SVG) first'); return; }
   const n = ++vectorizing;
+  // This run takes the fields as they are now: a live run still waiting
+  // on an edit (a width typed just before a file was opened) would only
+  // do it again.
+  liveVectorize.cancel();
   $('v-figures').textContent = 'vectorising…';
   const mode = $('v-mode').value;
   const query = {
