@@ -56,12 +56,6 @@ impl Scara {
     }
 }
 
-/// acos of a cosine that float rounding may push just past ±1.
-fn acos_clamped(c: f32) -> f32 {
-    let c = c.clamp(-1.0, 1.0);
-    fmath::atan2(fmath::sqrt(1.0 - c * c), c)
-}
-
 impl Kinematics for Scara {
     fn inverse(&self, pos: &Position) -> Result<Steps, KinError> {
         self.inverse_fine(pos).map(|(steps, _)| steps)
@@ -81,16 +75,21 @@ impl Kinematics for Scara {
         let x = -(mm(pos[0]) - self.offset[0]);
         let y = mm(pos[1]) - self.offset[1];
         let h2 = x * x + y * y;
-        let h = fmath::sqrt(h2);
-        // Reach, with 1 µm of slack for the decimal input.
-        if h == 0.0 || h > l1 + l2 + 0.001 || h < (l1 - l2).abs() - 0.001 {
+        // Reach, with 1 µm of slack for the decimal input: on squares,
+        // no root.
+        let (outer, inner) = (l1 + l2 + 0.001, (l1 - l2).abs() - 0.001);
+        if h2 == 0.0 || h2 > outer * outer || (inner > 0.0 && h2 < inner * inner) {
             return Err(KinError::Unreachable);
         }
-        let shoulder = fmath::atan2(x, y) - acos_clamped((h2 + l1 * l1 - l2 * l2) / (2.0 * l1 * h));
-        // The original arm's notes print "+ L1² + L2²" here; the law of
-        // cosines has minus.
-        let elbow =
-            shoulder * self.crosstalk + acos_clamped((h2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2));
+        // The elbow's bend from the law of cosines (the original arm's
+        // notes print "+ L1² + L2²"; it has minus), and the shoulder's
+        // angle off the pen's bearing from the same sine and cosine: one
+        // root, where two arc cosines took three and a division.
+        let c = ((h2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)).clamp(-1.0, 1.0);
+        let s = fmath::sqrt(1.0 - c * c);
+        let bend = fmath::atan2(s, c);
+        let shoulder = fmath::atan2(x, y) - fmath::atan2(l2 * s, l1 + l2 * c);
+        let elbow = shoulder * self.crosstalk + bend;
         let mut steps = self.scale.all_steps(pos)?;
         let mut frac = [0; AXES];
         (steps[0], frac[0]) = self.scale.steps_fine(0, shoulder * DEG)?;
