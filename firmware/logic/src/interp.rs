@@ -1213,9 +1213,13 @@ fn check_travel(cfg: &MachineConfig, lo: &Exact, hi: &Exact, motors: u8) -> Resu
     }
 }
 
-/// `pos` in thousandths, the channels without a motor at 0.
+/// `pos` in thousandths, the channels without a motor at 0 (and not
+/// converted: a plotter's spare channel costs nothing).
 fn motor_milli(pos: &Exact, motors: u8) -> Position {
-    motor_only(&coords::milli(pos), motors)
+    core::array::from_fn(|i| match motors >> i & 1 {
+        0 => Milli::ZERO,
+        _ => Milli(coords::to_milli(pos[i])),
+    })
 }
 
 /// `pos` with the channels without a motor at 0 (a path's piece: no

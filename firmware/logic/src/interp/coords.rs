@@ -30,7 +30,7 @@ pub fn milli(exact: &Exact) -> Position {
 /// Millionths to thousandths, rounded half away from zero, saturated.
 /// Within ±4.29 m a product, not a 64-bit division (~700 cycles on the
 /// AVR, a dozen a line of the arm's path).
-fn to_milli(v: i64) -> i32 {
+pub fn to_milli(v: i64) -> i32 {
     const HALF: u64 = PER_MILLI as u64 / 2;
     let a = v.unsigned_abs();
     if a <= u32::MAX as u64 - HALF {
