@@ -137,6 +137,17 @@ impl ChannelScale {
         Ok(out)
     }
 
+    /// The steps of the channels from `first` on (below it: 0), for a
+    /// kinematics that works out the others in floats: no 64-bit division
+    /// for a count it would overwrite.
+    fn steps_from(&self, first: usize, pos: &Position) -> Result<Steps, KinError> {
+        let mut out = [0; AXES];
+        for i in first..AXES {
+            out[i] = self.steps(i, pos[i])?;
+        }
+        Ok(out)
+    }
+
     fn all_milli(&self, steps: &Steps) -> Position {
         core::array::from_fn(|i| self.milli(i, steps[i]))
     }

@@ -58,7 +58,7 @@ impl Kinematics for Polargraph {
     fn inverse_fine(&self, pos: &Position) -> Result<(Steps, Frac), KinError> {
         let p = [self.origin[0] + mm(pos[0]), self.origin[1] + mm(pos[1])];
         let len = self.lengths(p)?;
-        let mut steps = self.scale.all_steps(pos)?;
+        let mut steps = self.scale.steps_from(2, pos)?;
         let mut frac = [0; AXES];
         for i in 0..2 {
             (steps[i], frac[i]) = self.scale.steps_fine(i, len[i] - self.home[i])?;

@@ -90,7 +90,7 @@ impl Kinematics for Scara {
         let bend = fmath::atan2(s, c);
         let shoulder = fmath::atan2(x, y) - fmath::atan2(l2 * s, l1 + l2 * c);
         let elbow = shoulder * self.crosstalk + bend;
-        let mut steps = self.scale.all_steps(pos)?;
+        let mut steps = self.scale.steps_from(2, pos)?;
         let mut frac = [0; AXES];
         (steps[0], frac[0]) = self.scale.steps_fine(0, shoulder * DEG)?;
         (steps[1], frac[1]) = self.scale.steps_fine(1, elbow * DEG)?;
