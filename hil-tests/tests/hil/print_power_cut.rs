@@ -1,10 +1,14 @@
 //! Power cuts during a plotter's print from the card, on the release
-//! image: the flatbed (its X homed against a switch at each power-on)
-//! prints `examples/plotter/star.gcode`, the power goes at a seeded moment
-//! (on some seeds in the middle of a checkpoint's EEPROM write), and the
-//! next power-on, with only the EEPROM kept, offers the print (`>>>
-//! resume`); `M1000` goes on. The drawing is rebuilt from the STEP, DIR
-//! and pen pulses of both runs: every piece of the toolpath is drawn with
+//! image: each plotter prints `examples/plotter/star.gcode` (moved onto
+//! its drawing area), the power goes at a seeded moment (on some seeds in
+//! the middle of a checkpoint's EEPROM write), and the next power-on, with
+//! only the EEPROM kept, offers the print (`>>> resume`); `M1000` goes on.
+//! The flatbed homes its X against a switch at each power-on; the
+//! whiteboard and the arm have no switches and take where they stand at
+//! power-on as their zero, so the maker puts them back there before
+//! powering on again (a fresh simulator stands at zero steps). The drawing
+//! is rebuilt from the STEP, DIR and pen pulses of both runs through the
+//! machine's forward kinematics: every piece of the toolpath is drawn with
 //! the pen down, nothing off it, and only the lines from the checkpoint's
 //! to the one cut short are drawn twice.
 
@@ -19,8 +23,6 @@ use taut_logic::machine::Machine;
 use taut_logic::settings::eeprom::host;
 
 const STAR: &str = include_str!("../../../examples/plotter/star.gcode");
-/// A step of the flatbed's 40 steps/mm, diagonally, and a little.
-const WITHIN: f64 = 0.05;
 /// Samples along the toolpath, mm apart.
 const SAMPLE_MM: f64 = 0.2;
 
@@ -75,43 +77,103 @@ fn drawing_lines(text: &str) -> Vec<Line> {
     lines
 }
 
-/// The flatbed as it powers on with `eeprom`, the star on its card, a
-/// switch 3 mm below its X; run until it has homed and mounted the card.
-fn power_on(eeprom: &[u8]) -> (Sim, [i32; 2]) {
-    let cfg = MachineConfig::defaults(Machine::Flatbed);
-    // Probed under the string-art names `track` reads (X, Y are its
-    // base and radial channels).
-    let mut sim = hil_tests::machine();
-    sim.set_eeprom(eeprom);
-    let endstops = sim.fit_machine_endstops(&cfg, 3.0);
-    sim.watch_eeprom();
-    sim.insert_sd(card(&[("STAR.GCO", STAR.as_bytes())]));
-    wait_for(&mut sim, "homed", Duration::from_secs(20));
-    wait_for(&mut sim, "MiB FAT", Duration::from_secs(3));
-    let origin = endstops.power_on_origin(&sim, &cfg);
-    (sim, origin)
+/// The star moved by `by` mm: every `X` and `Y` word (the arcs' `I`,
+/// `J` are relative and stay).
+fn star_at(by: [f64; 2]) -> String {
+    let shift = |t: &str, axis: char, d: f64| match t.strip_prefix(axis) {
+        Some(v) => format!("{axis}{:.3}", v.parse::<f64>().unwrap() + d),
+        None => t.to_string(),
+    };
+    STAR.lines()
+        .map(|l| match l.starts_with(';') {
+            true => l.to_string(),
+            false => l
+                .split(' ')
+                .map(|t| shift(&shift(t, 'X', by[0]), 'Y', by[1]))
+                .collect::<Vec<_>>()
+                .join(" "),
+        })
+        .map(|l| l + "\n")
+        .collect()
+}
+
+/// A plotter under the test: where its star goes, how near the pulses
+/// must come to the toolpath (about a step of its coarsest motor), and
+/// between which seconds of the print it is cut (once the pen has gone
+/// down, before the star is done).
+struct Plotter {
+    machine: Machine,
+    by: [f64; 2],
+    within: f64,
+    cut_s: (f64, f64),
+}
+
+const FLATBED: Plotter = Plotter {
+    machine: Machine::Flatbed,
+    by: [0.0, 0.0],
+    within: 0.05,
+    cut_s: (1.0, 22.0),
+};
+
+impl Plotter {
+    fn cfg(&self) -> MachineConfig {
+        MachineConfig::defaults(self.machine)
+    }
+
+    fn file(&self) -> String {
+        star_at(self.by)
+    }
+
+    /// The machine as it powers on with `eeprom`, its star on the card
+    /// (the flatbed with a switch 3 mm below its X); run until it has
+    /// homed and mounted the card. Where it stood at power-on, in steps.
+    fn power_on(&self, eeprom: &[u8]) -> (Sim, [i32; 2]) {
+        let cfg = self.cfg();
+        // Probed under the string-art names `track` reads (X, Y are its
+        // base and radial channels).
+        let mut sim = hil_tests::machine();
+        sim.set_eeprom(eeprom);
+        let endstops = (cfg.homing.axes != 0).then(|| sim.fit_machine_endstops(&cfg, 3.0));
+        sim.watch_eeprom();
+        sim.insert_sd(card(&[("STAR.GCO", self.file().as_bytes())]));
+        if endstops.is_some() {
+            wait_for(&mut sim, "homed", Duration::from_secs(20));
+        }
+        wait_for(&mut sim, "MiB FAT", Duration::from_secs(3));
+        let origin = endstops.map_or([0, 0], |e| e.power_on_origin(&sim, &cfg));
+        (sim, origin)
+    }
+
+    /// Where the pen stood at each step with it down, mm in the drawing's
+    /// frame (the steps counted from power-on, `origin` where the machine
+    /// stood then).
+    fn pen_down_points(&self, sim: &Sim, origin: [i32; 2]) -> Vec<[f64; 2]> {
+        let cfg = self.cfg();
+        let kin = AnyKinematics::of(&cfg).unwrap();
+        track(sim)
+            .into_iter()
+            .filter(|(cycle, _)| {
+                let deg = pen_deg_at(sim, *cycle).expect("no pen pulses");
+                (deg - f64::from(cfg.pen.down_deg)).abs() < 1.0
+            })
+            .map(|(_, s)| {
+                let p = kin.forward(&[s[0] as i32 + origin[0], s[1] as i32 + origin[1], 0]);
+                [p[0].0 as f64 / 1000.0, p[1].0 as f64 / 1000.0]
+            })
+            .collect()
+    }
+
+    /// Whether any of `points` is within `within` of `p`.
+    fn covered(&self, points: &[[f64; 2]], p: [f64; 2]) -> bool {
+        let w = self.within;
+        points
+            .iter()
+            .any(|q| (q[0] - p[0]).abs() <= w && (q[1] - p[1]).hypot(q[0] - p[0]) <= w)
+    }
 }
 
 fn send(sim: &mut Sim, line: &str) {
     hil_tests::send_ok(sim, line, Duration::from_secs(10));
-}
-
-/// Where the pen stood at each step with it down, machine mm (the steps
-/// counted from power-on, `origin` where the machine stood then).
-fn pen_down_points(sim: &Sim, origin: [i32; 2]) -> Vec<[f64; 2]> {
-    let cfg = MachineConfig::defaults(Machine::Flatbed);
-    let kin = AnyKinematics::of(&cfg).unwrap();
-    track(sim)
-        .into_iter()
-        .filter(|(cycle, _)| {
-            let deg = pen_deg_at(sim, *cycle).expect("no pen pulses");
-            (deg - f64::from(cfg.pen.down_deg)).abs() < 1.0
-        })
-        .map(|(_, s)| {
-            let p = kin.forward(&[s[0] as i32 + origin[0], s[1] as i32 + origin[1], 0]);
-            [p[0].0 as f64 / 1000.0, p[1].0 as f64 / 1000.0]
-        })
-        .collect()
 }
 
 /// Points along each line's path, `SAMPLE_MM` of its length apart, and
@@ -136,18 +198,41 @@ fn samples(lines: &[Line]) -> Vec<(usize, [f64; 2])> {
     out
 }
 
-/// Whether any of `points` is within `WITHIN` of `p`.
-fn covered(points: &[[f64; 2]], p: [f64; 2]) -> bool {
-    points
-        .iter()
-        .any(|q| (q[0] - p[0]).abs() <= WITHIN && (q[1] - p[1]).hypot(q[0] - p[0]) <= WITHIN)
+#[test]
+fn a_flatbed_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_lines() {
+    cut_and_resume(
+        &FLATBED,
+        soak_or(vec![1u64, 2, 3, 4, 5, 6, 7, 8], vec![11, 12, 13]),
+    );
 }
 
 #[test]
-fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_lines() {
-    let cfg = MachineConfig::defaults(Machine::Flatbed);
-    let fresh = host::eeprom(&cfg, &Default::default(), &Default::default());
-    let lines = drawing_lines(STAR);
+fn a_whiteboard_print_cut_at_seeded_moments_resumes_with_no_gap() {
+    let whiteboard = Plotter {
+        machine: Machine::Whiteboard,
+        by: [-40.0, -40.0],
+        within: 0.1,
+        cut_s: (3.0, 30.0),
+    };
+    cut_and_resume(&whiteboard, soak_or(vec![31u64, 32, 33], vec![34, 35, 36]));
+}
+
+#[test]
+fn an_arm_print_cut_at_seeded_moments_resumes_with_no_gap() {
+    let arm = Plotter {
+        machine: Machine::Scara,
+        by: [60.0, 110.0],
+        within: 0.3,
+        cut_s: (3.0, 30.0),
+    };
+    cut_and_resume(&arm, soak_or(vec![41u64, 42, 43], vec![44, 45, 46]));
+}
+
+fn cut_and_resume(plotter: &Plotter, seeds: Vec<u64>) {
+    let name = plotter.machine.name();
+    let fresh = host::eeprom(&plotter.cfg(), &Default::default(), &Default::default());
+    let file = plotter.file();
+    let lines = drawing_lines(&file);
     let all = samples(&lines);
     // Samples where another line of the drawing passes (the star's
     // crossings, the centre's rays): drawn there twice by the file itself.
@@ -157,27 +242,30 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
             lines
                 .iter()
                 .enumerate()
-                .any(|(j, l)| j != i && l.path.distance(p) < 0.3)
+                .any(|(j, l)| j != i && l.path.distance(p) < plotter.within + 0.25)
         })
         .collect();
-    for seed in soak_or(vec![1u64, 2, 3, 4, 5, 6, 7, 8], vec![11, 12, 13]) {
+    for seed in seeds {
         let mut rng = Rng::new(seed);
-        let (mut sim, origin) = power_on(&fresh);
+        let (mut sim, origin) = plotter.power_on(&fresh);
         send(&mut sim, "M17");
         send(&mut sim, "M23 star.gco");
         send(&mut sim, "M24");
-        // The print takes ~30 s: cut within it, on some seeds once a
-        // checkpoint byte is being written (a record torn).
-        sim.run_for(Duration::from_secs_f64(rng.between(1.0, 22.0)));
+        // Cut within the print, on some seeds once a checkpoint byte is
+        // being written (a record torn).
+        let (from_s, to_s) = plotter.cut_s;
+        sim.run_for(Duration::from_secs_f64(rng.between(from_s, to_s)));
         let torn_record = rng.below(2) == 0;
         if torn_record {
+            // A record is written when the line drawing changes: the
+            // star's circle is one line of some 10 s.
             let armed = sim.eeprom_writes();
             let started = sim.run_until(
                 |s| {
                     s.eeprom_writes() > armed
                         && s.eeprom_writing().is_some_and(|a| a >= checkpoint::START)
                 },
-                Duration::from_secs(5),
+                Duration::from_secs(15),
             );
             assert_eq!(started, hil_tests::sim::Outcome::Done, "{}", log_tail(&sim));
             sim.run_for(Duration::from_secs_f64(rng.between(0.0, 0.03)));
@@ -185,25 +273,26 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
         let uart = sim.uart_text();
         assert!(
             uart.contains("File selected") && !uart.contains("Done printing file"),
-            "seed {seed}: the cut must fall mid-print\n{}",
+            "{name} seed {seed}: the cut must fall mid-print\n{}",
             log_tail(&sim)
         );
         let (eeprom, torn) = sim.eeprom_after_cut(0xFF);
-        let first = pen_down_points(&sim, origin);
+        let first = plotter.pen_down_points(&sim, origin);
         assert!(
             !first.is_empty(),
-            "seed {seed}: nothing drawn before the cut"
+            "{name} seed {seed}: nothing drawn before the cut\n{}",
+            log_tail(&sim)
         );
         assert!(
-            all.iter().any(|&(_, p)| !covered(&first, p)),
-            "seed {seed}: all drawn before the cut"
+            all.iter().any(|&(_, p)| !plotter.covered(&first, p)),
+            "{name} seed {seed}: all drawn before the cut"
         );
         let Found::Plot(saved) = checkpoint::scan(|a| eeprom[a as usize]) else {
-            panic!("seed {seed}: no print checkpoint after the cut")
+            panic!("{name} seed {seed}: no print checkpoint after the cut")
         };
         drop(sim);
 
-        let (mut sim, origin) = power_on(&eeprom);
+        let (mut sim, origin) = plotter.power_on(&eeprom);
         wait_for(
             &mut sim,
             ">>> resume STAR.GCO from byte ",
@@ -212,9 +301,9 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
         send(&mut sim, "M1000");
         wait_for(&mut sim, "Done printing file", Duration::from_secs(120));
         send(&mut sim, "M400");
-        let second = pen_down_points(&sim, origin);
+        let second = plotter.pen_down_points(&sim, origin);
         eprintln!(
-            "seed {seed}: resumed run's stack peak {} B at {:#x}",
+            "{name} seed {seed}: resumed run's stack peak {} B at {:#x}",
             sim.peak_stack_bytes(),
             sim.peak_stack_pc()
         );
@@ -222,7 +311,10 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
         // The checkpoint is cleared once the print is done.
         sim.run_for(Duration::from_millis(300));
         let left = checkpoint::scan(|a| sim.eeprom()[a as usize]);
-        assert!(matches!(left, Found::Idle { .. }), "seed {seed}: {left:?}");
+        assert!(
+            matches!(left, Found::Idle { .. }),
+            "{name} seed {seed}: {left:?}"
+        );
 
         // Nothing off the toolpath with the pen down, in either run.
         for p in first.iter().chain(&second) {
@@ -230,7 +322,10 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
                 .iter()
                 .map(|l| l.path.distance(*p))
                 .fold(f64::MAX, f64::min);
-            assert!(d <= WITHIN, "seed {seed}: pen down at {p:?}, {d:.3} mm off");
+            assert!(
+                d <= plotter.within,
+                "{name} seed {seed}: pen down at {p:?}, {d:.3} mm off"
+            );
         }
         // The checkpoint's line: the first drawing line at or after it;
         // the line cut short: the last one run 1 drew on.
@@ -241,8 +336,8 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
         let mut cut_line = 0;
         let mut doubled = Vec::new();
         for (k, &(i, p)) in all.iter().enumerate() {
-            let (a, b) = (covered(&first, p), covered(&second, p));
-            assert!(a || b, "seed {seed}: a gap at {p:?} (line {i})");
+            let (a, b) = (plotter.covered(&first, p), plotter.covered(&second, p));
+            assert!(a || b, "{name} seed {seed}: a gap at {p:?} (line {i})");
             if a && !crossing[k] {
                 cut_line = cut_line.max(i);
             }
@@ -255,21 +350,21 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
         if let Some(s) = start {
             let d = (second[0][0] - s[0]).hypot(second[0][1] - s[1]);
             assert!(
-                d <= WITHIN,
-                "seed {seed}: resumed at {:?}, not {s:?}",
+                d <= plotter.within,
+                "{name} seed {seed}: resumed at {:?}, not {s:?}",
                 second[0]
             );
         }
         for &i in &doubled {
             assert!(
                 (from..=cut_line).contains(&i),
-                "seed {seed}: line {i} drawn twice, outside lines {from}..={cut_line}"
+                "{name} seed {seed}: line {i} drawn twice, outside lines {from}..={cut_line}"
             );
         }
         let twice_mm = doubled.len() as f64 * SAMPLE_MM;
         doubled.dedup();
         eprintln!(
-            "seed {seed}: cut {} (byte {torn:?} torn), checkpoint byte {} (drawing line \
+            "{name} seed {seed}: cut {} (byte {torn:?} torn), checkpoint byte {} (drawing line \
              {from}), cut in drawing line {cut_line}; drawn twice: lines {doubled:?}, \
              {twice_mm:.1} mm",
             if torn_record {
@@ -281,7 +376,10 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
         );
         // At most the line cut short and the lines since the last record
         // (one record every 0.5 s, or the one before a torn record).
-        assert!(cut_line <= from + 3, "seed {seed}: {from}..={cut_line}");
+        assert!(
+            cut_line <= from + 3,
+            "{name} seed {seed}: {from}..={cut_line}"
+        );
     }
 }
 
@@ -293,9 +391,8 @@ fn a_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_the_cut_li
 fn green_resumes_and_held_green_or_m524_discards_the_offer() {
     use hil_tests::press;
     use taut_logic::pinmap::Button;
-    let cfg = MachineConfig::defaults(Machine::Flatbed);
-    let fresh = host::eeprom(&cfg, &Default::default(), &Default::default());
-    let (mut sim, _) = power_on(&fresh);
+    let fresh = host::eeprom(&FLATBED.cfg(), &Default::default(), &Default::default());
+    let (mut sim, _) = FLATBED.power_on(&fresh);
     send(&mut sim, "M17");
     send(&mut sim, "M23 star.gco");
     send(&mut sim, "M24");
@@ -308,7 +405,7 @@ fn green_resumes_and_held_green_or_m524_discards_the_offer() {
     assert!(saved.pos() > 0, "six seconds in, a line is recorded");
     drop(sim);
     let offered = |eeprom: &[u8]| {
-        let (mut sim, _) = power_on(eeprom);
+        let (mut sim, _) = FLATBED.power_on(eeprom);
         wait_for(
             &mut sim,
             ">>> resume STAR.GCO from byte ",
@@ -326,10 +423,10 @@ fn green_resumes_and_held_green_or_m524_discards_the_offer() {
     press(&mut sim, Button::Confirm, 2500);
     wait_for(&mut sim, "checkpoint discarded", Duration::from_secs(1));
     assert!(matches!(idle_after(&mut sim), Found::Idle { .. }));
-    assert!(pen_down_points(&sim, [0, 0]).is_empty());
+    assert!(FLATBED.pen_down_points(&sim, [0, 0]).is_empty());
     let after = sim.eeprom();
     drop(sim);
-    let (mut sim, _) = power_on(&after);
+    let (mut sim, _) = FLATBED.power_on(&after);
     sim.run_for(Duration::from_secs(1));
     assert!(
         !sim.uart_text().contains(">>> resume"),
@@ -353,7 +450,7 @@ fn green_resumes_and_held_green_or_m524_discards_the_offer() {
     );
     sim.run_for(Duration::from_secs(6));
     assert!(
-        !pen_down_points(&sim, [0, 0]).is_empty(),
+        !FLATBED.pen_down_points(&sim, [0, 0]).is_empty(),
         "{}",
         log_tail(&sim)
     );
