@@ -317,6 +317,9 @@ impl Preparer {
             Some((Slope::Accel | Slope::Decel, _)) if self.shorter.0 == k0 => {
                 self.fit(k0, self.shorter.1)?
             }
+            // One event left on the ramp (a tiny block's): a segment of
+            // it, as the sizing below would make, without its cost.
+            Some((Slope::Accel | Slope::Decel, end)) if end - k0 == 1 => self.fit(k0, 1)?,
             Some((Slope::Accel, end)) => {
                 self.spend(SIZE_COST)?;
                 let n = self.ramp_run(k0).min(end - k0);
