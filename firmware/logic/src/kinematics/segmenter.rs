@@ -55,18 +55,9 @@ impl Segmenter {
     /// gets a single piece. The length counts every coordinate.
     pub fn new(kin: &impl Kinematics, from: Position, to: &Position, segment_len: u32) -> Self {
         let delta: [i64; AXES] = core::array::from_fn(|i| to[i].0 as i64 - from[i].0 as i64);
-        let pieces: u32 = if kin.is_linear() {
-            1
-        } else {
-            // Rounded up, so no piece is longer than asked.
-            let len2 = delta
-                .iter()
-                .map(|d| d.unsigned_abs().saturating_mul(d.unsigned_abs()))
-                .fold(0u64, u64::saturating_add);
-            let root = isqrt(len2);
-            let len = if root * root < len2 { root + 1 } else { root };
-            let seg = segment_len.max(1) as u64;
-            len.div_ceil(seg).clamp(1, u32::MAX as u64) as u32
+        let pieces: u32 = match kin.is_linear() {
+            true => 1,
+            false => pieces(&delta, segment_len),
         };
         let mut down = 0;
         let share = core::array::from_fn(|i| {
@@ -135,6 +126,27 @@ impl Iterator for Segmenter {
     }
 }
 
+/// Pieces of at most `segment_len` (µm) along `delta`: its length
+/// rounded up over `segment_len`, rounded up. A move shorter than a piece
+/// (a stream of tiny lines: every one of them) is one piece without the
+/// root and the 64-bit division: no coordinate over half a piece less a
+/// µm keeps the length under √3/2 of one. Two i32s differ by less than
+/// 2³²: a coordinate's change fits a `u32`.
+fn pieces(delta: &[i64; AXES], segment_len: u32) -> u32 {
+    let most = delta.iter().map(|d| d.unsigned_abs() as u32).max();
+    if most.unwrap_or(0) < segment_len / 2 {
+        return 1;
+    }
+    let seg = segment_len.max(1) as u64;
+    let len2 = delta
+        .iter()
+        .map(|d| d.unsigned_abs().saturating_mul(d.unsigned_abs()))
+        .fold(0u64, u64::saturating_add);
+    let root = isqrt(len2);
+    let len = if root * root < len2 { root + 1 } else { root };
+    len.div_ceil(seg).clamp(1, u32::MAX as u64) as u32
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::{ChannelScale, Linear, Polargraph};
@@ -151,6 +163,28 @@ mod tests {
 
     fn pos(x: i32, y: i32) -> Position {
         [Milli(x), Milli(y), Milli(0)]
+    }
+
+    /// The pieces by the length's root alone, as before the short cut.
+    fn pieces_by_root(delta: &[i64; AXES], segment_len: u32) -> u32 {
+        let len2 = delta
+            .iter()
+            .map(|d| d.unsigned_abs().saturating_mul(d.unsigned_abs()))
+            .fold(0u64, u64::saturating_add);
+        let root = isqrt(len2);
+        let len = if root * root < len2 { root + 1 } else { root };
+        len.div_ceil(segment_len.max(1) as u64)
+            .clamp(1, u32::MAX as u64) as u32
+    }
+
+    proptest! {
+        #[test]
+        fn a_move_under_a_piece_is_one_piece_as_its_length_says(
+            d in prop::array::uniform3(prop_oneof![-3000i64..3000, -(1i64 << 32) + 1..(1i64 << 32)]),
+            seg in prop_oneof![1u32..6000, 1000u32..=5000],
+        ) {
+            prop_assert_eq!(pieces(&d, seg), pieces_by_root(&d, seg));
+        }
     }
 
     #[test]
