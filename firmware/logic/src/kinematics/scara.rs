@@ -88,7 +88,7 @@ impl Kinematics for Scara {
         let c = ((h2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)).clamp(-1.0, 1.0);
         let s = fmath::sqrt(1.0 - c * c);
         let bend = fmath::atan2(s, c);
-        let shoulder = fmath::atan2(x, y) - fmath::atan2(l2 * s, l1 + l2 * c);
+        let shoulder = shoulder(x, y, l2 * s, l1 + l2 * c);
         let elbow = shoulder * self.crosstalk + bend;
         let mut steps = self.scale.steps_from(2, pos)?;
         let mut frac = [0; AXES];
@@ -151,6 +151,20 @@ impl Kinematics for Scara {
 
     fn words(&self) -> [u8; AXES] {
         *b"XYZ"
+    }
+}
+
+/// The shoulder's angle: the pen's bearing `atan2(x, y)` (in (−π, π],
+/// −π on the ray behind the shoulder) less the elbow's offset
+/// `atan2(ox, oy)` (in [0, π]), as one arc tangent of the difference's
+/// sine and cosine: that lies in (−π, π], a whole turn above the
+/// difference where the bearing is on the left (x ≤ 0, −0 included) and
+/// the difference is below −π.
+fn shoulder(x: f32, y: f32, ox: f32, oy: f32) -> f32 {
+    let a = fmath::atan2(x * oy - y * ox, y * oy + x * ox);
+    match x.is_sign_negative() && a > 0.0 {
+        true => a - 2.0 * PI,
+        false => a,
     }
 }
 
@@ -290,6 +304,24 @@ mod tests {
                 last = steps;
             }
             prop_assert_eq!(k.reaches_line(&a, &b), !jumped);
+        }
+
+        /// The one arc tangent is the bearing less the offset, as two
+        /// were, on either side of the ray behind the shoulder and on it.
+        #[test]
+        fn the_shoulder_is_the_bearing_less_the_elbows_offset(
+            (x, y) in prop_oneof![
+                (-300.0f32..300.0, -300.0f32..300.0),
+                (prop_oneof![Just(0.0f32), Just(-0.0f32), -1e-3f32..1e-3], -300.0f32..-1.0),
+            ],
+            bend in 0.05f32..3.09,
+        ) {
+            let (l1, l2) = (150.0f32, 120.0f32);
+            let (s, c) = (libm::sinf(bend), libm::cosf(bend));
+            let (ox, oy) = (l2 * s, l1 + l2 * c);
+            let two = fmath::atan2(x, y) - fmath::atan2(ox, oy);
+            let one = shoulder(x, y, ox, oy);
+            prop_assert!((one - two).abs() < 2e-5, "{x} {y} {bend}: {one} {two}");
         }
 
         /// One step moves the tip at most (L1 + L2)·0.028° ≈ 132 µm; the
