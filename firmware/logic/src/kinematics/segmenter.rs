@@ -137,6 +137,11 @@ fn pieces(delta: &[i64; AXES], segment_len: u32) -> u32 {
     if most.unwrap_or(0) < segment_len / 2 {
         return 1;
     }
+    pieces_by_root(delta, segment_len)
+}
+
+/// [`pieces`] from the length's root.
+fn pieces_by_root(delta: &[i64; AXES], segment_len: u32) -> u32 {
     let seg = segment_len.max(1) as u64;
     let len2 = delta
         .iter()
@@ -163,18 +168,6 @@ mod tests {
 
     fn pos(x: i32, y: i32) -> Position {
         [Milli(x), Milli(y), Milli(0)]
-    }
-
-    /// The pieces by the length's root alone, as before the short cut.
-    fn pieces_by_root(delta: &[i64; AXES], segment_len: u32) -> u32 {
-        let len2 = delta
-            .iter()
-            .map(|d| d.unsigned_abs().saturating_mul(d.unsigned_abs()))
-            .fold(0u64, u64::saturating_add);
-        let root = isqrt(len2);
-        let len = if root * root < len2 { root + 1 } else { root };
-        len.div_ceil(segment_len.max(1) as u64)
-            .clamp(1, u32::MAX as u64) as u32
     }
 
     proptest! {
