@@ -283,8 +283,9 @@ impl Parser {
         let column = self.column;
         // Marlin's checksum covers every byte before the `*` (not the one
         // of `$RST=*`).
-        let restore_all = matches!(&self.statement, Statement::System(s) if s.restores());
-        let star = self.lexeme == Lexeme::Code && c == b'*' && !restore_all;
+        let star = self.lexeme == Lexeme::Code
+            && c == b'*'
+            && !matches!(&self.statement, Statement::System(s) if s.restores());
         if self.checksum.is_none() && !star {
             self.xor ^= c;
         }
