@@ -6,13 +6,15 @@
 # application through `eicall` with EIND = 1: word 0x10000, byte 0x20000,
 # not 0. An image over 128 KiB has code of its own there. So:
 #   1. link as usual, with a map;
-#   2. read from the map the function sections of `.text` in order, up to
-#      the first one that does not end below 0x20000;
+#   2. read from the map the function sections of `.text` in order and
+#      keep below 0x20000 each that still fits there (first fit, a few
+#      trampolines' room kept spare), skipping those that do not;
 #   3. link again with the default script changed so that those sections
 #      stay where they were, `.text` goes on at 0x20000 with the watchdog
 #      entry, then every other function.
 # The image stays one run of bytes from 0: the gap before 0x20000 (less
-# than one function; all of the rest up to it in a small image) is filled
+# than the smallest function left above it, and the spare room; all of
+# the rest up to it in a small image) is filled
 # (zeros: `nop`s). That bootloader erases pages in the order it writes
 # them, counting from 0 whatever address it is told: a hole in the hex
 # would make it erase each page after the hole just after writing it.
@@ -36,18 +38,22 @@ avr-gcc "$@" -Wl,-Map="$map"
 default=$(avr-ld --verbose -mavr6 | awk '/^====/ { inside = !inside; next } inside')
 [ -n "$default" ] || { echo "avr-link.sh: cannot read the linker's default script" >&2; exit 1; }
 
-# The `.text.*` input sections below 0x20000, in the order the first link
-# placed them (names may stand on a line of their own, before their
-# address and size).
+# The `.text.*` input sections kept below 0x20000: in the order the first
+# link placed them, from where it placed the first, each that still fits
+# (sizes rounded to a word); the others go above. 64 bytes stay spare:
+# a function moved above may need a trampoline (4 bytes) below (names
+# may stand on a line of their own, before their address and size).
 low=$(awk '
     function hex(s,   i, v) {
         s = tolower(s); sub(/^0x/, "", s); v = 0
         for (i = 1; i <= length(s); i++) v = v * 16 + index("0123456789abcdef", substr(s, i, 1)) - 1
         return v
     }
-    function place(name, addr, size) {
-        if (crossed) return
-        if (hex(addr) + hex(size) > 131072) { crossed = 1; return }
+    function place(name, addr, size,   end) {
+        if (n == 0 && !crossed) at = hex(addr)
+        end = at + hex(size) + hex(size) % 2
+        if (end > 131072 - 64) { crossed = 1; return }
+        at = end
         low[n++] = "    *(" name ")"
     }
     /^\.text[ \t]/ || $0 == ".text" { in_text = 1; next }
