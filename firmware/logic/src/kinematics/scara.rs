@@ -158,8 +158,8 @@ impl Kinematics for Scara {
 /// −π on the ray behind the shoulder) less the elbow's offset
 /// `atan2(ox, oy)` (in [0, π]), as one arc tangent of the difference's
 /// sine and cosine: that lies in (−π, π], a whole turn above the
-/// difference where the bearing is on the left (x ≤ 0, −0 included) and
-/// the difference is below −π.
+/// difference where the bearing is on the left (x below 0, or −0: its
+/// bearing there is −π) and the difference is below −π.
 fn shoulder(x: f32, y: f32, ox: f32, oy: f32) -> f32 {
     let a = fmath::atan2(x * oy - y * ox, y * oy + x * ox);
     match x.is_sign_negative() && a > 0.0 {
