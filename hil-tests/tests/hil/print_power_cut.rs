@@ -78,8 +78,11 @@ fn drawing_lines(text: &str) -> Vec<Line> {
 }
 
 /// The star moved by `by` mm: every `X` and `Y` word (the arcs' `I`,
-/// `J` are relative and stay).
+/// `J` are relative and stay); unmoved, the example's bytes as they are.
 fn star_at(by: [f64; 2]) -> String {
+    if by == [0.0, 0.0] {
+        return STAR.to_string();
+    }
     let shift = |t: &str, axis: char, d: f64| match t.strip_prefix(axis) {
         Some(v) => format!("{axis}{:.3}", v.parse::<f64>().unwrap() + d),
         None => t.to_string(),
