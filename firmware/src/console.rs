@@ -26,7 +26,7 @@ pub use activity::{Activity, Owner};
 pub use offsets::Frame;
 
 use crate::flash_str;
-use crate::machine_io::Io;
+use crate::machine_io::{Io, Trace};
 use crate::motion::Motion;
 use crate::print::Print;
 use crate::queues::{CardAsk, CardNews, Control, Presses, Signal, TellJob, TxClaim};
@@ -403,11 +403,17 @@ impl Console {
         store: &mut Store,
     ) -> Poll<Signal> {
         let env = self.env(kin, cfg, owner);
+        let pen_deg = self.interp.pen_now(cfg.pen.up_deg);
         let mut io = Io {
             m,
             kin,
             store,
             replies: self.owed,
+            trace: self.print.trace().map(|left| Trace {
+                left,
+                pen_deg,
+                settle_ms: cfg.pen.settle_ms,
+            }),
         };
         match self.interp.run(&env, &mut io) {
             Progress::Done => {
@@ -563,6 +569,7 @@ impl Console {
             kin,
             store,
             replies: owed,
+            trace: None,
         };
         match self.interp.accept(b, jog, &env, &mut io) {
             Ok(()) => {

@@ -1,6 +1,11 @@
 //! The executor's machine (`taut_logic::interp::MachineIo`) on the board:
 //! moves into segment preparation's planner, the pen servo, the drivers, the
 //! clock, and the work coordinate data (the store's, kept in EEPROM).
+//!
+//! A print resumed after a power cut goes over the blocks its checkpoint
+//! says were drawn with the pen up, as rapids along the same path
+//! ([`Trace`]), and puts the pen down where the block moving at the cut
+//! began.
 
 use crate::board::clock;
 use crate::motion::Motion;
@@ -21,6 +26,70 @@ pub struct Io<'a, K: Kinematics> {
     pub store: &'a mut Store,
     /// `M114` is answered (not from the card).
     pub replies: bool,
+    /// A resumed print going over what it drew before the cut.
+    pub trace: Option<Trace<'a>>,
+}
+
+/// Going over drawn blocks: `left - 1` more to queue (the pen stays up;
+/// pen words and `M0` among them are passed over, the executor keeps
+/// the pen's state), then, at 1, the pen to `pen_deg` once the machine
+/// stands at the end of the last, and 0: drawing again.
+pub struct Trace<'a> {
+    pub left: &'a mut u16,
+    pub pen_deg: u8,
+    pub settle_ms: u16,
+}
+
+impl Trace<'_> {
+    /// Blocks still to go over with the pen up.
+    fn going_over(&self) -> bool {
+        *self.left > 1
+    }
+}
+
+/// Blocks still to go over with the pen up.
+fn tracing(trace: &Option<Trace>) -> bool {
+    trace.as_ref().is_some_and(Trace::going_over)
+}
+
+/// The move queued with the pen up (a rapid along the same path: the
+/// planner makes the same blocks, a move of no step none), or drawn.
+/// Out of line and not generic: one copy for every machine.
+#[inline(never)]
+fn stage(
+    m: &mut Motion,
+    trace: &mut Option<Trace>,
+    steps: &Steps,
+    feed: Feed,
+    piece: Option<&Piece>,
+) -> bool {
+    if let Some(t) = trace.as_mut().filter(|t| t.going_over()) {
+        let before = m.target();
+        let queued = m.stage(*steps, Feed::Rapid).is_ok();
+        *t.left -= (m.target() != before) as u16;
+        return queued;
+    }
+    match piece {
+        Some(p) => m.stage_piece(p, feed).is_ok(),
+        None => m.stage(*steps, feed).is_ok(),
+    }
+}
+
+/// The drawn blocks are gone over: the pen as the lines left it once the
+/// machine stands, then its settle time.
+#[inline(never)]
+fn pen_after_trace(m: &mut Motion, trace: &mut Option<Trace>) -> Option<Wait> {
+    let t = trace.as_mut().filter(|t| *t.left == 1)?;
+    if !m.is_idle() {
+        return Some(Wait::PlannerRoom);
+    }
+    let us = PenConfig::pulse_us(t.pen_deg);
+    if m.pen.pulse_us() != us {
+        m.pen.set_pulse_us(us);
+        return Some(Wait::Ms(t.settle_ms));
+    }
+    *t.left = 0;
+    None
 }
 
 impl<K: Kinematics> MachineIo for Io<'_, K> {
@@ -36,6 +105,9 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
     }
 
     fn room(&mut self, piece: bool) -> Option<Wait> {
+        if let Some(wait) = pen_after_trace(self.m, &mut self.trace) {
+            return Some(wait);
+        }
         if !self.m.has_room() {
             return Some(Wait::PlannerRoom);
         }
@@ -54,11 +126,11 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
     }
 
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
-        self.m.stage(*steps, feed).is_ok()
+        stage(self.m, &mut self.trace, steps, feed, None)
     }
 
     fn queue_piece(&mut self, piece: &Piece, feed: Feed) -> bool {
-        self.m.stage_piece(piece, feed).is_ok()
+        stage(self.m, &mut self.trace, &piece.steps, feed, Some(piece))
     }
 
     fn idle(&mut self) -> bool {
@@ -66,6 +138,13 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
     }
 
     fn pen(&mut self, deg: u8) -> bool {
+        if tracing(&self.trace) {
+            return false;
+        }
+        // A line's own pen word right after the drawn blocks: its own.
+        if let Some(t) = self.trace.as_mut() {
+            *t.left = 0;
+        }
         let us = PenConfig::pulse_us(deg);
         let moves = self.m.pen.pulse_us() != us;
         self.m.pen.set_pulse_us(us);
@@ -81,6 +160,9 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
     }
 
     fn pause(&mut self) {
+        if tracing(&self.trace) {
+            return;
+        }
         self.m.hold();
     }
 

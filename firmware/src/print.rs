@@ -12,10 +12,11 @@
 //!
 //! A print keeps a checkpoint in EEPROM (`taut_logic::checkpoint::plot`):
 //! the file, then the offset of the line whose moves the steppers are
-//! making, at most every half second; cleared when the print ends or is
-//! stopped. After a power cut the next power-on offers it (`>>> resume`):
-//! `M1000` or green goes on from that line, `M524` or green held
-//! discards it.
+//! making and its blocks drawn, at most every half second; cleared when
+//! the print ends or is stopped. After a power cut the next power-on
+//! offers it (`>>> resume`): `M1000` or green goes on from that line,
+//! over its drawn blocks with the pen up, `M524` or green held discards
+//! it.
 
 use crate::board::flash::FlashStr;
 use crate::board::port::Port;
@@ -91,6 +92,9 @@ pub struct Print {
     /// A power cut's print offered or being resumed (from the line at the
     /// tracker's [`Tracker::resume_at`]).
     resume: Option<Resume>,
+    /// Blocks of that line drawn before the cut, plus one (0: none): gone
+    /// over with the pen up once the print goes on (`machine_io::Trace`).
+    trace: u16,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -126,6 +130,7 @@ impl Print {
             tracker: None,
             keep: Keep::Nothing,
             resume: None,
+            trace: 0,
         }
     }
 
@@ -220,6 +225,10 @@ impl Print {
         }
         self.resume = next;
         self.tracker = Some(Tracker::resuming(&p));
+        self.trace = match p.done() {
+            0 => 0,
+            done => done + 1,
+        };
         info!(
             "resuming: ",
             short_display(&p.header.short),
@@ -302,6 +311,20 @@ impl Print {
             }
         }
         action
+    }
+
+    /// The resumed line's first blocks are to be gone over with the pen
+    /// up: it stays up after the travel back.
+    pub fn traces(&self) -> bool {
+        self.trace > 0
+    }
+
+    /// Once the print goes on: the blocks to go over.
+    pub fn trace(&mut self) -> Option<&mut u16> {
+        match self.resume {
+            None if self.trace > 0 => Some(&mut self.trace),
+            _ => None,
+        }
     }
 
     /// A console line waits for the reader's answer.
@@ -474,6 +497,7 @@ impl Print {
         if self.state != State::Idle {
             self.card.put(Request::Close);
         }
+        self.trace = 0;
         self.forget();
         self.state = State::Idle;
         self.line_waits = false;

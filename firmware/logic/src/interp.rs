@@ -454,11 +454,16 @@ impl Interpreter {
     /// Then the pen as the lines before left it (up if none set it).
     pub fn pen_back(&mut self, up_deg: u8) {
         self.run.clear();
-        self.run.pen = match self.pen_deg {
+        self.run.pen = self.pen_now(up_deg);
+        self.run.todo = todo::PEN;
+    }
+
+    /// The pen as the lines taken so far left it (up if none set it).
+    pub fn pen_now(&self, up_deg: u8) -> u8 {
+        match self.pen_deg {
             0 => up_deg,
             deg => deg,
-        };
-        self.run.todo = todo::PEN;
+        }
     }
 
     /// The work coordinate offset of each channel (Grbl's `WCO`: the work

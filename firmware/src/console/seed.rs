@@ -57,6 +57,7 @@ impl Console {
                     kin,
                     store,
                     replies: owed,
+                    trace: None,
                 };
                 match self.interp.accept_steps(&mv, &env, &mut io) {
                     Ok(()) => self.owed = owed,

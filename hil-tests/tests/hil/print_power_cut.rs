@@ -9,8 +9,9 @@
 //! powering on again (a fresh simulator stands at zero steps). The drawing
 //! is rebuilt from the STEP, DIR and pen pulses of both runs through the
 //! machine's forward kinematics: every piece of the toolpath is drawn with
-//! the pen down, nothing off it, and only the lines from the checkpoint's
-//! to the one cut short are drawn twice.
+//! the pen down, nothing off it, and drawn twice only what was drawn
+//! after the checkpoint's block began: the blocks of its line drawn before
+//! it are gone over with the pen up.
 
 use hil_tests::drawing::Toolpath;
 use hil_tests::sim::Sim;
@@ -101,14 +102,16 @@ fn star_at(by: [f64; 2]) -> String {
 }
 
 /// A plotter under the test: where its star goes, how near the pulses
-/// must come to the toolpath (about a step of its coarsest motor), and
+/// must come to the toolpath (about a step of its coarsest motor),
 /// between which seconds of the print it is cut (once the pen has gone
-/// down, before the star is done).
+/// down, before the star is done), and its longest block (a straight
+/// line is one on the flatbed; the others cut lines into pieces).
 struct Plotter {
     machine: Machine,
     by: [f64; 2],
     within: f64,
     cut_s: (f64, f64),
+    block_mm: f64,
 }
 
 const FLATBED: Plotter = Plotter {
@@ -116,7 +119,11 @@ const FLATBED: Plotter = Plotter {
     by: [0.0, 0.0],
     within: 0.05,
     cut_s: (1.0, 22.0),
+    block_mm: 53.3,
 };
+
+/// The star's feed, mm/s (`F1500`).
+const FEED_MM_S: f64 = 25.0;
 
 impl Plotter {
     fn cfg(&self) -> MachineConfig {
@@ -216,6 +223,7 @@ fn a_whiteboard_print_cut_at_seeded_moments_resumes_with_no_gap() {
         by: [-40.0, -40.0],
         within: 0.1,
         cut_s: (3.0, 30.0),
+        block_mm: 5.0,
     };
     cut_and_resume(&whiteboard, soak_or(vec![31u64, 32, 33], vec![34, 35, 36]));
 }
@@ -227,6 +235,7 @@ fn an_arm_print_cut_at_seeded_moments_resumes_with_no_gap() {
         by: [60.0, 110.0],
         within: 0.3,
         cut_s: (3.0, 30.0),
+        block_mm: 2.0,
     };
     cut_and_resume(&arm, soak_or(vec![41u64, 42, 43], vec![44, 45, 46]));
 }
@@ -348,14 +357,27 @@ fn cut_and_resume(plotter: &Plotter, seeds: Vec<u64>) {
                 doubled.push(i);
             }
         }
-        // Run 2 starts drawing where the checkpoint's line starts.
-        let start = lines.get(from).map(|l| l.path.0[0]);
-        if let Some(s) = start {
-            let d = (second[0][0] - s[0]).hypot(second[0][1] - s[1]);
+        // Run 2 starts drawing on the checkpoint's line, or one after it
+        // (blocks counted past a line that draws nothing), and past its
+        // start when blocks of it were drawn.
+        let on = |i: usize| lines[i].path.distance(second[0]) <= plotter.within;
+        assert!(
+            (from..=cut_line.max(from)).any(on),
+            "{name} seed {seed}: resumed at {:?}, not on lines {from}..={cut_line}",
+            second[0]
+        );
+        let start = lines[from].path.0[0];
+        let past_start = (second[0][0] - start[0]).hypot(second[0][1] - start[1]);
+        if saved.done() > 0 && lines[from].start == saved.pos() as usize {
             assert!(
-                d <= plotter.within,
-                "{name} seed {seed}: resumed at {:?}, not {s:?}",
-                second[0]
+                past_start > 0.5,
+                "{name} seed {seed}: {} blocks drawn, resumed at the line's start",
+                saved.done()
+            );
+        } else {
+            assert!(
+                past_start <= plotter.within,
+                "{name} seed {seed}: {past_start:.3} mm"
             );
         }
         for &i in &doubled {
@@ -367,21 +389,24 @@ fn cut_and_resume(plotter: &Plotter, seeds: Vec<u64>) {
         let twice_mm = doubled.len() as f64 * SAMPLE_MM;
         doubled.dedup();
         eprintln!(
-            "{name} seed {seed}: cut {} (byte {torn:?} torn), checkpoint byte {} (drawing line \
-             {from}), cut in drawing line {cut_line}; drawn twice: lines {doubled:?}, \
-             {twice_mm:.1} mm",
+            "{name} seed {seed}: cut {} (byte {torn:?} torn), checkpoint byte {} block {} \
+             (drawing line {from}), cut in drawing line {cut_line}; drawn twice: lines \
+             {doubled:?}, {twice_mm:.1} mm",
             if torn_record {
                 "mid-record"
             } else {
                 "between writes"
             },
             saved.pos(),
+            saved.done(),
         );
-        // At most the line cut short and the lines since the last record
-        // (one record every 0.5 s, or the one before a torn record).
+        // At most what was drawn since the block moving at the last record
+        // began: a record every 0.5 s (the one before a torn one: 0.5 s
+        // more), 34 ms to write, and that block.
+        let bound = FEED_MM_S * 1.1 + plotter.block_mm;
         assert!(
-            cut_line <= from + 3,
-            "{name} seed {seed}: {from}..={cut_line}"
+            twice_mm <= bound,
+            "{name} seed {seed}: {twice_mm:.1} mm drawn twice, over {bound:.1}"
         );
     }
 }

@@ -4,34 +4,44 @@
 //! power-loss recovery, without its extra hardware).
 //!
 //! The header slot holds the file (its 8.3 name and size) under kind
-//! [`KIND`]; the ring's 8-byte records hold `n` (u16, its slot `n %
-//! SLOTS`), the line's offset (u32) and a CRC-16 over both and the
-//! header's sequence number. The newest record whose CRC holds is the
-//! checkpoint: a record torn by a cut fails its CRC and the one before
-//! it stands (an earlier line: more is drawn again, nothing is skipped).
+//! [`KIND`]; the ring's [`PLOT_RECORD_BYTES`]-byte records hold `n` (u16,
+//! its slot `n % PLOT_SLOTS`), the line's offset (u32), how many of its
+//! blocks were drawn (u16) and a CRC-16 over them and the header's
+//! sequence number. The newest record whose CRC holds is the checkpoint:
+//! a record torn by a cut fails its CRC and the one before it stands
+//! (earlier: more is drawn again, nothing is skipped).
 //!
 //! The modal state the line needs (units, distance mode, feed, offsets,
 //! the pen) is not stored: the file's lines before it are read again on
 //! resume, checked and taken without moving (as `$C` does), which leaves
 //! the executor exactly as they left it when the line was first read.
 //!
-//! [`Tracker`] says which line is moving: each planned block is counted
-//! by the step interrupt as it begins, and a line's first block has
-//! number `begun + unbegun` when the line is read (`Motion::unbegun`).
+//! [`Tracker`] says which line is moving, and how far: each planned block
+//! is counted by the step interrupt as it begins, and a line's first block
+//! has number `begun + unbegun` when the line is read (`Motion::unbegun`).
 //! Once the steppers have begun that block, every line before it is
-//! drawn, and that line's offset is safe to record.
+//! drawn; once they have begun its `k + 1`-th, its first `k` blocks are
+//! (an arc's chords, a path's pieces): a resumed print goes over those
+//! with the pen up and puts it down where the block moving at the cut
+//! began.
 
-use super::{crc16, newer, CRC_START, END, HEADER_BYTES, MAGIC, RECORD_BYTES, RING, SLOTS, START};
+use super::{crc16, newer, CRC_START, END, HEADER_BYTES, MAGIC, RING, START};
 
 /// Header byte 4 of a print's checkpoint (the string-art phases are 1
 /// and 2, none 0).
 pub const KIND: u8 = 3;
-const VERSION: u8 = 1;
+const VERSION: u8 = 2;
 
-/// Records at most this often: after a cut, the line that was moving is
-/// drawn again from its start, and before it at most this much of the
-/// drawing (and a few blocks, [`Tracker`]); the ring's cells last
-/// [`hours_before_wear_out`] of printing.
+/// A record's bytes: `n`, the offset, the blocks drawn, the CRC.
+pub const PLOT_RECORD_BYTES: u16 = 10;
+/// Record slots in the ring.
+pub const PLOT_SLOTS: u16 = (END - RING) / PLOT_RECORD_BYTES;
+
+/// Records at most this often: after a cut, the drawing goes on from
+/// the start of the block that was moving when the last record was
+/// written, at most this long before the cut (and the few blocks the
+/// [`Tracker`] lags by); the ring's cells last [`hours_before_wear_out`]
+/// of printing.
 pub const RECORD_EVERY_MS: u32 = 500;
 
 /// The print: its file, and the sequence number records are written
@@ -74,32 +84,38 @@ impl PlotHeader {
     }
 }
 
-/// Record `n`: the line starting at byte `pos` was moving.
+/// Record `n`: the line starting at byte `pos` was moving, its first
+/// `done` blocks drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PlotRecord {
     pub n: u16,
     pub pos: u32,
+    pub done: u16,
 }
+
+type RecordBytes = [u8; PLOT_RECORD_BYTES as usize];
 
 impl PlotRecord {
     pub fn address(n: u16) -> u16 {
-        RING + (n % SLOTS) * RECORD_BYTES
+        RING + (n % PLOT_SLOTS) * PLOT_RECORD_BYTES
     }
 
-    pub fn encode(&self, seq: u16) -> [u8; RECORD_BYTES as usize] {
-        let mut b = [0u8; RECORD_BYTES as usize];
+    pub fn encode(&self, seq: u16) -> RecordBytes {
+        let mut b = [0u8; PLOT_RECORD_BYTES as usize];
         b[..2].copy_from_slice(&self.n.to_le_bytes());
         b[2..6].copy_from_slice(&self.pos.to_le_bytes());
-        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..6]);
-        b[6..].copy_from_slice(&crc.to_le_bytes());
+        b[6..8].copy_from_slice(&self.done.to_le_bytes());
+        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..8]);
+        b[8..].copy_from_slice(&crc.to_le_bytes());
         b
     }
 
-    pub fn decode(b: &[u8; RECORD_BYTES as usize], seq: u16) -> Option<PlotRecord> {
-        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..6]);
-        (crc == u16::from_le_bytes([b[6], b[7]])).then(|| PlotRecord {
+    pub fn decode(b: &RecordBytes, seq: u16) -> Option<PlotRecord> {
+        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..8]);
+        (crc == u16::from_le_bytes([b[8], b[9]])).then(|| PlotRecord {
             n: u16::from_le_bytes([b[0], b[1]]),
             pos: u32::from_le_bytes([b[2], b[3], b[4], b[5]]),
+            done: u16::from_le_bytes([b[6], b[7]]),
         })
     }
 }
@@ -118,6 +134,11 @@ impl PlotSaved {
         self.last.map_or(0, |r| r.pos)
     }
 
+    /// That line's blocks already drawn.
+    pub fn done(&self) -> u16 {
+        self.last.map_or(0, |r| r.done)
+    }
+
     /// The next record's number.
     pub fn next_n(&self) -> u16 {
         self.last.map_or(1, |r| r.n.wrapping_add(1))
@@ -128,16 +149,16 @@ impl PlotSaved {
 /// is stale or foreign: passed over).
 pub(super) fn scan_records(read: &mut impl FnMut(u16) -> u8, header: PlotHeader) -> PlotSaved {
     let mut last: Option<PlotRecord> = None;
-    for slot in 0..SLOTS {
-        let at = RING + slot * RECORD_BYTES;
-        let mut b = [0u8; RECORD_BYTES as usize];
+    for slot in 0..PLOT_SLOTS {
+        let at = RING + slot * PLOT_RECORD_BYTES;
+        let mut b = [0u8; PLOT_RECORD_BYTES as usize];
         for (i, x) in b.iter_mut().enumerate() {
             *x = read(at + i as u16);
         }
         let Some(r) = PlotRecord::decode(&b, header.seq) else {
             continue;
         };
-        if r.n % SLOTS != slot {
+        if r.n % PLOT_SLOTS != slot {
             continue;
         }
         // Numbers wrap; all those under one header lie within a ring.
@@ -152,13 +173,15 @@ pub(super) fn scan_records(read: &mut impl FnMut(u16) -> u8, header: PlotHeader)
 /// begun of them is a block or two behind the one moving.
 pub const FOLLOWED: usize = 7;
 
-/// Which line of a print is moving, and when its record is due.
+/// Which line of a print is moving, how far, and when its record is due.
 ///
 /// The planner and the step queue hold a score of blocks, and the file's
 /// lines are read as far ahead: the line read is not the one moving. A
 /// few lines read are kept with the number of their first block, spread
 /// over the blocks in flight; once blocks up to one of them have begun,
-/// that line is moving (or done), and every line before it is drawn.
+/// that line is moving (or done), and every line before it is drawn. The
+/// oldest one's blocks begun are then counted on (past the block
+/// numbers' wrap): a record names the line and its blocks drawn.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Tracker {
     /// The oldest followed line's offset, the others' as bytes after it;
@@ -168,6 +191,13 @@ pub struct Tracker {
     /// first block.
     lines: [(u16, u8); FOLLOWED],
     len: u8,
+    /// The oldest line's blocks begun (0: none yet), up to when `begun`
+    /// was `counted`.
+    into: u16,
+    counted: u8,
+    /// Something began since the last record (none is written while the
+    /// machine stands).
+    moved: bool,
     /// When the last record was asked for (ms, wrapping: a record at most
     /// [`RECORD_EVERY_MS`] late after a minute without one).
     last_ms: u16,
@@ -182,6 +212,9 @@ impl Tracker {
             base: 0,
             lines: [(0, 0); FOLLOWED],
             len: 0,
+            into: 0,
+            counted: 0,
+            moved: false,
             last_ms: 0,
             next: 1,
         }
@@ -205,10 +238,12 @@ impl Tracker {
     /// `pos`, and its first block (if it has any) will be block number
     /// `first` (blocks begun + blocks queued and not begun, read in that
     /// order: a block begun between the reads makes `first` one too
-    /// high, which only waits a block longer). Not followed: a line whose
-    /// first block is the last followed line's (that earlier one stands
-    /// for it), or one 64 KiB past the oldest. With all places taken, the
-    /// line closest after another gives its place up.
+    /// high, which only waits a block longer). A line whose first block
+    /// is the last followed line's, not begun, takes its place: the
+    /// earlier one queued no block (`M3`, `G4`), and the pen and modes it
+    /// set are taken again on resume. Not followed: a line 64 KiB past
+    /// the oldest. With all places taken, the line closest after another
+    /// gives its place up.
     pub fn line(&mut self, pos: u32, first: u8) {
         let len = self.len as usize;
         if len == 0 {
@@ -217,7 +252,11 @@ impl Tracker {
         let Ok(after) = u16::try_from(pos.wrapping_sub(self.base)) else {
             return;
         };
-        if len > 0 && self.lines[len - 1].1 == first {
+        if len > 0 && self.lines[len - 1].1 == first && (len > 1 || self.into == 0) {
+            match len {
+                1 => self.base = pos,
+                _ => self.lines[len - 1].0 = after,
+            }
             return;
         }
         if len == FOLLOWED {
@@ -240,9 +279,6 @@ impl Tracker {
 
     /// The `k` oldest followed lines are done with.
     fn drop_oldest(&mut self, k: usize) {
-        if k == 0 {
-            return;
-        }
         let len = self.len as usize;
         let shift = self.lines.get(k).map_or(0, |l| l.0);
         self.base = self.base.wrapping_add(u32::from(shift));
@@ -254,24 +290,45 @@ impl Tracker {
     }
 
     /// The record to write now: the newest followed line whose first
-    /// block has begun (`begun` blocks so far), once the last record is
-    /// [`RECORD_EVERY_MS`] old. `writing`: the last record is not yet
+    /// block has begun (`begun` blocks so far) and its blocks before the
+    /// one moving, once the last record is [`RECORD_EVERY_MS`] old and
+    /// something moved since. `writing`: the last record is not yet
     /// durable (the next waits).
     pub fn due(&mut self, begun: u8, writing: bool, now_ms: u32) -> Option<PlotRecord> {
         let len = self.len as usize;
-        let moving = self.lines[..len]
+        let has_begun = |first: u8| (begun.wrapping_sub(first) as i8) >= 1;
+        let newer = self.lines[..len]
             .iter()
-            .rposition(|&(_, first)| (begun.wrapping_sub(first) as i8) >= 1)?;
-        // The older ones are drawn: the newest begun stands for them.
-        self.drop_oldest(moving);
-        let rested = (now_ms as u16).wrapping_sub(self.last_ms) >= RECORD_EVERY_MS as u16;
-        if writing || !rested {
+            .skip(1)
+            .rposition(|l| has_begun(l.1));
+        if let Some(k) = newer {
+            // The older ones are drawn: the newest begun stands for them.
+            self.drop_oldest(k + 1);
+            self.into = 0;
+        }
+        let more = begun.wrapping_sub(self.counted);
+        if self.into > 0 {
+            self.into = self.into.saturating_add(u16::from(more));
+        } else if len > 0 && has_begun(self.lines[0].1) {
+            self.into = u16::from(begun.wrapping_sub(self.lines[0].1));
+            self.moved = true;
+        } else {
             return None;
         }
-        let pos = self.base;
-        self.drop_oldest(1);
+        self.counted = begun;
+        self.moved |= more > 0;
+        let rested = (now_ms as u16).wrapping_sub(self.last_ms) >= RECORD_EVERY_MS as u16;
+        if writing || !rested || !self.moved {
+            return None;
+        }
+        self.moved = false;
         self.last_ms = now_ms as u16;
-        let r = PlotRecord { n: self.next, pos };
+        let r = PlotRecord {
+            n: self.next,
+            pos: self.base,
+            // The block moving may be cut short: drawn again.
+            done: self.into - 1,
+        };
         self.next = self.next.wrapping_add(1);
         Some(r)
     }
@@ -360,11 +417,11 @@ impl Resume {
 /// Wear: hours of printing before the most-written cell of the ring
 /// reaches `endurance` writes, a record every [`RECORD_EVERY_MS`].
 pub fn hours_before_wear_out(endurance: u32) -> u32 {
-    let lap_ms = u64::from(SLOTS) * u64::from(RECORD_EVERY_MS);
+    let lap_ms = u64::from(PLOT_SLOTS) * u64::from(RECORD_EVERY_MS);
     (u64::from(endurance) * lap_ms / 3_600_000) as u32
 }
 
-const _: () = assert!(RING + SLOTS * RECORD_BYTES <= END && START < RING);
+const _: () = assert!(RING + PLOT_SLOTS * PLOT_RECORD_BYTES <= END && START < RING);
 
 #[cfg(test)]
 mod tests;

@@ -40,11 +40,12 @@ fn header_and_record_round_trip_and_a_flipped_bit_fails() {
     let r = PlotRecord {
         n: 513,
         pos: 98_765,
+        done: 4321,
     };
     assert_eq!(PlotRecord::decode(&r.encode(7), 7), Some(r));
     // Under another header's number it is stale.
     assert_eq!(PlotRecord::decode(&r.encode(7), 8), None);
-    for bit in 0..64 {
+    for bit in 0..80 {
         let mut b = r.encode(7);
         b[bit / 8] ^= 1 << (bit % 8);
         assert_eq!(PlotRecord::decode(&b, 7), None, "bit {bit}");
@@ -73,12 +74,18 @@ fn the_newest_record_wins_across_laps_of_the_ring_and_number_wraps() {
     let mut e = Eeprom::blank();
     e.header(header(9));
     // Three laps and a bit, numbers wrapping past u16::MAX.
-    let start = u16::MAX - 2 * SLOTS;
+    let start = u16::MAX - 2 * PLOT_SLOTS;
     let mut n = start;
-    for k in 0..(3 * SLOTS as u32 + 17) {
-        e.record(9, PlotRecord { n, pos: 1000 + k });
+    for k in 0..(3 * PLOT_SLOTS as u32 + 17) {
+        let r = PlotRecord {
+            n,
+            pos: 1000 + k,
+            done: k as u16,
+        };
+        e.record(9, r);
         let Found::Plot(p) = e.scan() else { panic!() };
-        assert_eq!(p.last, Some(PlotRecord { n, pos: 1000 + k }));
+        assert_eq!(p.last, Some(r));
+        assert_eq!((p.pos(), p.done()), (1000 + k, k as u16));
         assert_eq!(p.next_n(), n.wrapping_add(1));
         n = n.wrapping_add(1);
     }
@@ -86,32 +93,44 @@ fn the_newest_record_wins_across_laps_of_the_ring_and_number_wraps() {
 
 #[test]
 fn a_record_torn_at_any_byte_leaves_the_one_before() {
-    for torn in 0..RECORD_BYTES as usize {
+    for torn in 0..PLOT_RECORD_BYTES as usize {
         for erased in [0xFF, 0x00] {
             let mut e = Eeprom::blank();
             e.header(header(1));
-            for n in 1..=(SLOTS + 4) {
+            for n in 1..=(PLOT_SLOTS + 4) {
                 e.record(
                     1,
                     PlotRecord {
                         n,
                         pos: 10 * n as u32,
+                        done: n,
                     },
                 );
             }
             let next = PlotRecord {
-                n: SLOTS + 5,
+                n: PLOT_SLOTS + 5,
                 pos: 99_999,
+                done: 7,
             };
             let mut b = next.encode(1);
             // The bytes from `torn` on were not written (the slot held
             // record 5's); the torn one holds `erased`.
-            let old = PlotRecord { n: 5, pos: 50 }.encode(1);
+            let old = PlotRecord {
+                n: 5,
+                pos: 50,
+                done: 5,
+            }
+            .encode(1);
             b[torn] = erased;
             b[torn + 1..].copy_from_slice(&old[torn + 1..]);
             e.write(PlotRecord::address(next.n), &b);
             let Found::Plot(p) = e.scan() else { panic!() };
-            assert_eq!(p.pos(), 10 * (SLOTS as u32 + 4), "torn at {torn}");
+            let before = PLOT_SLOTS + 4;
+            assert_eq!(
+                (p.pos(), p.done()),
+                (10 * before as u32, before),
+                "torn at {torn}"
+            );
         }
     }
 }
@@ -120,7 +139,14 @@ fn a_record_torn_at_any_byte_leaves_the_one_before() {
 fn a_new_header_hides_the_last_print_s_records_and_an_idle_one_ends_it() {
     let mut e = Eeprom::blank();
     e.header(header(1));
-    e.record(1, PlotRecord { n: 1, pos: 400 });
+    e.record(
+        1,
+        PlotRecord {
+            n: 1,
+            pos: 400,
+            done: 0,
+        },
+    );
     e.header(header(2));
     let Found::Plot(p) = e.scan() else { panic!() };
     assert_eq!(p.last, None);
@@ -175,7 +201,11 @@ fn the_record_names_a_line_only_once_its_first_block_has_begun() {
     assert_eq!(t.due(begun, true, 700), None, "the last write first");
     assert_eq!(
         t.due(begun, false, 700),
-        Some(PlotRecord { n: 1, pos: 100 })
+        Some(PlotRecord {
+            n: 1,
+            pos: 100,
+            done: 0
+        })
     );
     assert_eq!(t.due(begun, false, 700), None);
 }
@@ -186,7 +216,11 @@ fn the_record_names_a_line_only_once_its_first_block_has_begun() {
 fn run(depth: u8, ms: u32, lines: u32) -> Vec<(u32, PlotRecord)> {
     let mut t = Tracker::resuming(&PlotSaved {
         header: header(1),
-        last: Some(PlotRecord { n: 40, pos: 0 }),
+        last: Some(PlotRecord {
+            n: 40,
+            pos: 0,
+            done: 0,
+        }),
     });
     assert_eq!(t.resume_at(), 0);
     let mut out = Vec::new();
@@ -214,14 +248,23 @@ fn records_come_no_oftener_than_the_wear_limit_and_name_a_line_just_begun() {
         assert!(20 * (w[1].0 - w[0].0) >= RECORD_EVERY_MS, "{out:?}");
         assert_eq!(w[1].1.n, w[0].1.n + 1);
     }
-    assert_eq!(out[0].1, PlotRecord { n: 41, pos: 0 });
+    assert_eq!(
+        out[0].1,
+        PlotRecord {
+            n: 41,
+            pos: 0,
+            done: 0
+        }
+    );
+    // One block a line: the block named is the line's number and the
+    // blocks drawn after its start (lines not followed among them).
     for (moving, r) in &out {
-        let line = r.pos / 30;
-        assert!(line <= *moving && moving - line <= 4, "{out:?}");
+        let block = r.pos / 30 + u32::from(r.done);
+        assert!(block <= *moving && moving - block <= 1, "{out:?}");
     }
     // A cell is written once a lap of the ring.
     assert!(
-        hours_before_wear_out(100_000) >= 4000,
+        hours_before_wear_out(100_000) >= 3000,
         "{}",
         hours_before_wear_out(100_000)
     );
@@ -235,22 +278,68 @@ fn long_lines_are_recorded_as_each_begins() {
     assert!(out.len() >= 30, "{out:?}");
     let exact = out.iter().filter(|(m, r)| r.pos == m * 30).count();
     for (moving, r) in &out {
-        assert!(r.pos <= moving * 30 && moving * 30 - r.pos <= 30, "{out:?}");
+        let block = r.pos / 30 + u32::from(r.done);
+        assert!(block <= *moving && moving - block <= 1, "{out:?}");
     }
     eprintln!("{exact} of {} records name the line moving", out.len());
 }
 
 #[test]
-fn a_line_that_queues_nothing_is_recorded_once_the_next_move_begins() {
+fn a_line_that_queues_nothing_gives_its_place_to_the_next_one() {
     let mut t = Tracker::new();
     // `M3` at byte 50, nothing queued ahead: its "first block" is the
-    // next line's, which the next line (byte 53) does not take over.
+    // next line's (byte 53), which stands for it.
     t.line(50, 7);
     t.line(53, 7);
     // Too far after the oldest: not followed.
-    t.line(50 + 70_000, 9);
+    t.line(53 + 70_000, 9);
     assert_eq!(t.due(7, false, 600), None);
-    assert_eq!(t.due(8, false, 600), Some(PlotRecord { n: 1, pos: 50 }));
+    assert_eq!(
+        t.due(8, false, 600),
+        Some(PlotRecord {
+            n: 1,
+            pos: 53,
+            done: 0
+        })
+    );
+    // A line read once every block is begun and none is queued has the
+    // same number the moving line's count stands at: followed on its own.
+    t.line(60, 8);
+    assert_eq!(t.due(9, false, 1200).map(|r| r.pos), Some(60));
+}
+
+#[test]
+fn a_long_line_s_blocks_drawn_are_counted_past_the_numbers_wrap() {
+    // An arc of 700 chords at byte 200 (blocks 5…704), then a line at
+    // byte 260; the planner 16 blocks ahead.
+    let mut t = Tracker::new();
+    t.line(120, 3);
+    t.line(200, 5);
+    let mut out = Vec::new();
+    let mut begun = 0u8;
+    for b in 1..=704u32 {
+        begun = begun.wrapping_add(1);
+        if b + 16 == 705 {
+            t.line(260, 705u32 as u8);
+        }
+        if let Some(r) = t.due(begun, false, b * 10) {
+            out.push((b, r));
+        }
+    }
+    assert!(out.len() >= 12, "{out:?}");
+    for (b, r) in &out {
+        // Block `b` begun (numbered b - 1): blocks 5…b - 2 are drawn.
+        assert_eq!((r.pos, u32::from(r.done)), (200, b - 6), "{out:?}");
+    }
+    // The last chord begins; then, standing, no record however long.
+    begun = begun.wrapping_add(1);
+    let r = t.due(begun, false, 9_000).unwrap();
+    assert_eq!((r.pos, r.done), (200, 699));
+    assert_eq!(t.due(begun, false, 60_000), None);
+    // The next line begins.
+    begun = begun.wrapping_add(1);
+    let r = t.due(begun, false, 61_000).unwrap();
+    assert_eq!((r.pos, r.done), (260, 0));
 }
 
 #[test]
