@@ -172,6 +172,11 @@ impl Console {
         self.print.waits_to_keep()
     }
 
+    /// A print under way keeps records of where it is.
+    pub fn print_records(&self) -> bool {
+        self.print.tracking()
+    }
+
     /// Whether a `$` setting changed since the last call (the app then has
     /// the settings stored).
     pub fn take_settings_changed(&mut self) -> bool {
@@ -252,7 +257,7 @@ impl Console {
         // Only while a print or an offer needs it: each run of a stream
         // of tiny moves comes here.
         if !cfg.machine.is_string_art() && self.print.keeps() {
-            self.print.keep(store, crate::board::clock::millis());
+            self.print.keep(store, m, crate::board::clock::millis());
             // Homing for a resume ended, the position read back.
             if self.print.homing_for_resume() && self.homing.is_none() && self.epoch == m.epoch() {
                 self.print.homed(store, m.position_known());

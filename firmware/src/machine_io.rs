@@ -4,8 +4,8 @@
 //!
 //! A print resumed after a power cut goes over the blocks its checkpoint
 //! says were drawn with the pen up, as rapids along the same path
-//! ([`Trace`]), and puts the pen down where the block moving at the cut
-//! began.
+//! ([`Trace`]), on along the block that was moving to where the motors
+//! stood, and puts the pen down there.
 
 use crate::board::clock;
 use crate::motion::Motion;
@@ -30,10 +30,12 @@ pub struct Io<'a, K: Kinematics> {
     pub trace: Option<Trace<'a>>,
 }
 
-/// Going over drawn blocks: `left - 1` more to queue (the pen stays up;
-/// pen words and `M0` among them are passed over, the executor keeps
-/// the pen's state), then, at 1, the pen to `pen_deg` once the machine
-/// stands at the end of the last, and 0: drawing again.
+/// Going over drawn blocks: `left - 2` more to queue (the pen stays up;
+/// pen words and `M0` until drawing again are passed over, the executor
+/// keeps the pen's state); at 2, once the machine stands at the end of the
+/// last, a rapid to where the checkpoint's motors stood (on the next
+/// block's way); at 1, there, the pen to `pen_deg`; 0: drawing again,
+/// the next block from that point.
 pub struct Trace<'a> {
     pub left: &'a mut u16,
     pub pen_deg: u8,
@@ -43,13 +45,13 @@ pub struct Trace<'a> {
 impl Trace<'_> {
     /// Blocks still to go over with the pen up.
     fn going_over(&self) -> bool {
-        *self.left > 1
+        *self.left > 2
     }
 }
 
-/// Blocks still to go over with the pen up.
+/// Not drawing again yet: the pen is the trace's.
 fn tracing(trace: &Option<Trace>) -> bool {
-    trace.as_ref().is_some_and(Trace::going_over)
+    trace.as_ref().is_some_and(|t| *t.left > 0)
 }
 
 /// The move queued with the pen up (a rapid along the same path: the
@@ -64,9 +66,8 @@ fn stage(
     piece: Option<&Piece>,
 ) -> bool {
     if let Some(t) = trace.as_mut().filter(|t| t.going_over()) {
-        let before = m.target();
         let queued = m.stage(*steps, Feed::Rapid).is_ok();
-        *t.left -= (m.target() != before) as u16;
+        *t.left -= (queued && m.staging()) as u16;
         return queued;
     }
     match piece {
@@ -75,13 +76,25 @@ fn stage(
     }
 }
 
-/// The drawn blocks are gone over: the pen as the lines left it once the
-/// machine stands, then its settle time.
+/// The drawn blocks are gone over: once the machine stands, a rapid to
+/// where the checkpoint's motors stood, then the pen as the lines left
+/// it, and its settle time. The checkpoint is the one resumed from: no
+/// record is written meanwhile (`Print::keep`).
 #[inline(never)]
-fn pen_after_trace(m: &mut Motion, trace: &mut Option<Trace>) -> Option<Wait> {
-    let t = trace.as_mut().filter(|t| *t.left == 1)?;
+fn pen_after_trace(m: &mut Motion, store: &Store, trace: &mut Option<Trace>) -> Option<Wait> {
+    let t = trace.as_mut().filter(|t| *t.left <= 2)?;
     if !m.is_idle() {
         return Some(Wait::PlannerRoom);
+    }
+    if *t.left == 2 {
+        *t.left = 1;
+        if let Some(r) = store.plot_saved().and_then(|s| s.last) {
+            let mut to = m.target();
+            to[0] = r.at[0];
+            to[1] = r.at[1];
+            let _ = m.stage(to, Feed::Rapid);
+            return Some(Wait::Again);
+        }
     }
     let us = PenConfig::pulse_us(t.pen_deg);
     if m.pen.pulse_us() != us {
@@ -105,7 +118,7 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
     }
 
     fn room(&mut self, piece: bool) -> Option<Wait> {
-        if let Some(wait) = pen_after_trace(self.m, &mut self.trace) {
+        if let Some(wait) = pen_after_trace(self.m, self.store, &mut self.trace) {
             return Some(wait);
         }
         if !self.m.has_room() {
@@ -140,10 +153,6 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
     fn pen(&mut self, deg: u8) -> bool {
         if tracing(&self.trace) {
             return false;
-        }
-        // A line's own pen word right after the drawn blocks: its own.
-        if let Some(t) = self.trace.as_mut() {
-            *t.left = 0;
         }
         let us = PenConfig::pulse_us(deg);
         let moves = self.m.pen.pulse_us() != us;

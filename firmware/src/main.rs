@@ -165,6 +165,9 @@ static STORE: TaskCell<Store> = TaskCell::zeroed();
 /// Boot blink of the status LED: this many flashes, 100 ms on, 100 ms off.
 const BOOT_BLINKS: u32 = 3;
 const LOGGER_PERIOD_MS: u32 = 1000;
+/// A console waiting while a print moves looks at its checkpoint this
+/// often (a record is due every `plot::RECORD_EVERY_MS`).
+const RECORD_CHECK_MS: u32 = taut_logic::checkpoint::plot::RECORD_EVERY_MS / 4;
 
 /// Make `task` ready, after what the interrupts spawned meanwhile.
 fn spawn(task: Task) {
@@ -604,6 +607,10 @@ fn console() {
         Poll::Idle if CONSOLE.with(|c| c.checkpoint_waits()) => Poll::After(5),
         p => p,
     };
+    // A print's records come while the console waits on a long move too.
+    if matches!(poll, Poll::Wait(_)) && CONSOLE.with(|c| c.print_records()) {
+        spawn_after(Task::Console, RECORD_CHECK_MS);
+    }
     reschedule(Task::Console, poll);
     // An operator's tool for the job.
     if queues::job_control_waits() {

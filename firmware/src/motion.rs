@@ -165,6 +165,11 @@ impl Motion {
         PLANNER.with(|p| p.plan_part())
     }
 
+    /// A move staged is being planned (a move of no step is not).
+    pub fn staging(&self) -> bool {
+        PLANNER.with(|p| p.is_planning())
+    }
+
     /// Moves queued in the planner, not yet taken to be cut.
     pub fn planned(&self) -> usize {
         PLANNER.with(|p| p.queued())

@@ -92,8 +92,9 @@ pub struct Print {
     /// A power cut's print offered or being resumed (from the line at the
     /// tracker's [`Tracker::resume_at`]).
     resume: Option<Resume>,
-    /// Blocks of that line drawn before the cut, plus one (0: none): gone
-    /// over with the pen up once the print goes on (`machine_io::Trace`).
+    /// Blocks of that line drawn before the cut, plus two (0: none):
+    /// gone over with the pen up once the print goes on, then the move on
+    /// to where the motors stood, then the pen (`machine_io::Trace`).
     trace: u16,
 }
 
@@ -158,6 +159,11 @@ impl Print {
         self.tracker.is_some() || self.keep != Keep::Nothing || self.resume.is_some()
     }
 
+    /// A print under way: records follow it ([`Print::keep`]).
+    pub fn tracking(&self) -> bool {
+        self.tracker.is_some()
+    }
+
     /// A header, an idle header or the offer waits ([`Print::keep`]).
     pub fn waits_to_keep(&self) -> bool {
         self.keep != Keep::Nothing
@@ -178,7 +184,7 @@ impl Print {
     /// is room, a header, or the moving line's record once it is due.
     #[inline(never)]
     #[optimize(size)]
-    pub fn keep(&mut self, store: &mut Store, now: u32) {
+    pub fn keep(&mut self, store: &mut Store, m: &Motion, now: u32) {
         if self.keep == Keep::Offer {
             if Port::Usb.tx_free() < crate::log::LINE {
                 return;
@@ -205,7 +211,20 @@ impl Print {
             Keep::Forget => store.forget(),
             Keep::Nothing | Keep::Offer => {
                 let begun = crate::stepper::blocks_begun();
-                if let Some(r) = self.tracker.as_mut().and_then(|t| t.due(begun, false, now)) {
+                let running = m.stepper.is_running();
+                let Some(mut r) = self
+                    .tracker
+                    .as_mut()
+                    .and_then(|t| t.due(begun, running, false, now))
+                else {
+                    return;
+                };
+                let at = m.stepper.position();
+                // Not while the drawn blocks are gone over (the record
+                // resumed from stands), nor with a block begun since
+                // `begun` was read: the motors are past the one named.
+                if self.trace == 0 && crate::stepper::blocks_begun() == begun {
+                    r.at = [at[0], at[1]];
                     store.plot_record(r);
                 }
             }
@@ -225,10 +244,7 @@ impl Print {
         }
         self.resume = next;
         self.tracker = Some(Tracker::resuming(&p));
-        self.trace = match p.done() {
-            0 => 0,
-            done => done + 1,
-        };
+        self.trace = p.done() + 2;
         info!(
             "resuming: ",
             short_display(&p.header.short),
@@ -311,12 +327,6 @@ impl Print {
             }
         }
         action
-    }
-
-    /// The resumed line's first blocks are to be gone over with the pen
-    /// up: it stays up after the travel back.
-    pub fn traces(&self) -> bool {
-        self.trace > 0
     }
 
     /// Once the print goes on: the blocks to go over.
@@ -497,7 +507,6 @@ impl Print {
         if self.state != State::Idle {
             self.card.put(Request::Close);
         }
-        self.trace = 0;
         self.forget();
         self.state = State::Idle;
         self.line_waits = false;
@@ -654,6 +663,7 @@ impl Print {
 
     /// The print is over: its checkpoint goes.
     fn forget(&mut self) {
+        self.trace = 0;
         if self.tracker.take().is_some() && self.resume.is_none() {
             self.keep = Keep::Forget;
         }

@@ -227,7 +227,7 @@ impl Store {
     /// On a chip of another layout whatever stands there is stale: retired
     /// without a word.
     pub fn load_checkpoint(&mut self) -> Found {
-        let found = checkpoint::scan(|a| self.eeprom.read(a));
+        let found = self.scan();
         self.seq = found.next_seq().wrapping_sub(1);
         if let Found::Corrupt { .. } = found {
             self.forget();
@@ -438,10 +438,16 @@ impl Store {
     /// rather than in RAM until it is resumed or discarded).
     #[inline(never)]
     pub fn plot_saved(&self) -> Option<PlotSaved> {
-        match checkpoint::scan(|a| self.eeprom.read(a)) {
+        match self.scan() {
             Found::Plot(p) => Some(p),
             _ => None,
         }
+    }
+
+    /// The checkpoint area read (one copy of the scan for every caller).
+    #[inline(never)]
+    fn scan(&self) -> Found {
+        checkpoint::scan(|a| self.eeprom.read(a))
     }
 
     /// No job under way any more: an idle header.

@@ -129,9 +129,8 @@ impl Console {
         let up = cfg.pen.up_deg;
         match self.print.line_ready(m.next_block()) {
             ResumeAction::Travel => self.interp.travel_back(&kin.forward(&m.target()), up),
-            // Pen up over the blocks drawn before the cut: down after them.
-            ResumeAction::Pen if self.print.traces() => {}
-            ResumeAction::Pen => self.interp.pen_back(up),
+            // Up over the blocks drawn before the cut: down after them.
+            ResumeAction::Pen => {}
             _ => return true,
         }
         false

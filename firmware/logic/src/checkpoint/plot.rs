@@ -6,8 +6,8 @@
 //! The header slot holds the file (its 8.3 name and size) under kind
 //! [`KIND`]; the ring's [`PLOT_RECORD_BYTES`]-byte records hold `n` (u16,
 //! its slot `n % PLOT_SLOTS`), the line's offset (u32), how many of its
-//! blocks were drawn (u16) and a CRC-16 over them and the header's
-//! sequence number. The newest record whose CRC holds is the checkpoint:
+//! blocks were drawn (u16), where the motors stood (two i32 steps) and a
+//! CRC-16 over them and the header's sequence number. The newest record whose CRC holds is the checkpoint:
 //! a record torn by a cut fails its CRC and the one before it stands
 //! (earlier: more is drawn again, nothing is skipped).
 //!
@@ -22,8 +22,8 @@
 //! Once the steppers have begun that block, every line before it is
 //! drawn; once they have begun its `k + 1`-th, its first `k` blocks are
 //! (an arc's chords, a path's pieces): a resumed print goes over those
-//! with the pen up and puts it down where the block moving at the cut
-//! began.
+//! with the pen up, moves on along the block that was moving to where the
+//! motors stood, and puts the pen down there.
 
 use super::{crc16, newer, CRC_START, END, HEADER_BYTES, MAGIC, RING, START};
 
@@ -32,15 +32,15 @@ use super::{crc16, newer, CRC_START, END, HEADER_BYTES, MAGIC, RING, START};
 pub const KIND: u8 = 3;
 const VERSION: u8 = 2;
 
-/// A record's bytes: `n`, the offset, the blocks drawn, the CRC.
-pub const PLOT_RECORD_BYTES: u16 = 10;
+/// A record's bytes: `n`, the offset, the blocks drawn, the motors'
+/// steps, the CRC.
+pub const PLOT_RECORD_BYTES: u16 = 18;
 /// Record slots in the ring.
 pub const PLOT_SLOTS: u16 = (END - RING) / PLOT_RECORD_BYTES;
 
-/// Records at most this often: after a cut, the drawing goes on from
-/// the start of the block that was moving when the last record was
-/// written, at most this long before the cut (and the few blocks the
-/// [`Tracker`] lags by); the ring's cells last [`hours_before_wear_out`]
+/// Records at most this often while the machine moves: after a cut, the
+/// drawing goes on from where it stood at the last record, at most this
+/// long before the cut; the ring's cells last [`hours_before_wear_out`]
 /// of printing.
 pub const RECORD_EVERY_MS: u32 = 500;
 
@@ -85,12 +85,13 @@ impl PlotHeader {
 }
 
 /// Record `n`: the line starting at byte `pos` was moving, its first
-/// `done` blocks drawn.
+/// `done` blocks drawn, the next one's up to the motors' steps `at`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PlotRecord {
     pub n: u16,
     pub pos: u32,
     pub done: u16,
+    pub at: [i32; 2],
 }
 
 type RecordBytes = [u8; PLOT_RECORD_BYTES as usize];
@@ -105,17 +106,21 @@ impl PlotRecord {
         b[..2].copy_from_slice(&self.n.to_le_bytes());
         b[2..6].copy_from_slice(&self.pos.to_le_bytes());
         b[6..8].copy_from_slice(&self.done.to_le_bytes());
-        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..8]);
-        b[8..].copy_from_slice(&crc.to_le_bytes());
+        b[8..12].copy_from_slice(&self.at[0].to_le_bytes());
+        b[12..16].copy_from_slice(&self.at[1].to_le_bytes());
+        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..16]);
+        b[16..].copy_from_slice(&crc.to_le_bytes());
         b
     }
 
     pub fn decode(b: &RecordBytes, seq: u16) -> Option<PlotRecord> {
-        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..8]);
-        (crc == u16::from_le_bytes([b[8], b[9]])).then(|| PlotRecord {
+        let crc = crc16(crc16(CRC_START, &seq.to_le_bytes()), &b[..16]);
+        let i32_at = |i: usize| i32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+        (crc == u16::from_le_bytes([b[16], b[17]])).then(|| PlotRecord {
             n: u16::from_le_bytes([b[0], b[1]]),
             pos: u32::from_le_bytes([b[2], b[3], b[4], b[5]]),
             done: u16::from_le_bytes([b[6], b[7]]),
+            at: [i32_at(8), i32_at(12)],
         })
     }
 }
@@ -195,8 +200,8 @@ pub struct Tracker {
     /// was `counted`.
     into: u16,
     counted: u8,
-    /// Something began since the last record (none is written while the
-    /// machine stands).
+    /// The machine moved since the last record (none is written while
+    /// it stands).
     moved: bool,
     /// When the last record was asked for (ms, wrapping: a record at most
     /// [`RECORD_EVERY_MS`] late after a minute without one).
@@ -277,33 +282,45 @@ impl Tracker {
         self.len += 1;
     }
 
-    /// The `k` oldest followed lines are done with.
+    /// The lines before the `k`-th followed one (`0 < k < len`) are
+    /// drawn: it is the oldest now.
     fn drop_oldest(&mut self, k: usize) {
-        let len = self.len as usize;
-        let shift = self.lines.get(k).map_or(0, |l| l.0);
+        let len = (self.len as usize).min(FOLLOWED);
+        let shift = self.lines[k].0;
         self.base = self.base.wrapping_add(u32::from(shift));
-        self.lines.copy_within(k..len, 0);
-        self.len -= k as u8;
-        for l in &mut self.lines[..self.len as usize] {
-            l.0 -= shift;
+        for i in k..len {
+            self.lines[i - k] = (self.lines[i].0 - shift, self.lines[i].1);
         }
+        self.len -= k as u8;
     }
 
     /// The record to write now: the newest followed line whose first
     /// block has begun (`begun` blocks so far) and its blocks before the
     /// one moving, once the last record is [`RECORD_EVERY_MS`] old and
-    /// something moved since. `writing`: the last record is not yet
-    /// durable (the next waits).
-    pub fn due(&mut self, begun: u8, writing: bool, now_ms: u32) -> Option<PlotRecord> {
-        let len = self.len as usize;
+    /// the machine moved since (`running`: it moves now). `writing`: the
+    /// last record is not yet durable (the next waits). Its `at` is the
+    /// caller's: where the motors stand, read while block `begun - 1` is
+    /// still the one moving.
+    #[inline(never)]
+    pub fn due(
+        &mut self,
+        begun: u8,
+        running: bool,
+        writing: bool,
+        now_ms: u32,
+    ) -> Option<PlotRecord> {
+        let len = (self.len as usize).min(FOLLOWED);
         let has_begun = |first: u8| (begun.wrapping_sub(first) as i8) >= 1;
-        let newer = self.lines[..len]
-            .iter()
-            .skip(1)
-            .rposition(|l| has_begun(l.1));
-        if let Some(k) = newer {
-            // The older ones are drawn: the newest begun stands for them.
-            self.drop_oldest(k + 1);
+        // The newest followed line begun after the oldest: the older ones
+        // are drawn, it stands for them.
+        let mut newest = 0;
+        for i in 1..len {
+            if has_begun(self.lines[i].1) {
+                newest = i;
+            }
+        }
+        if newest > 0 {
+            self.drop_oldest(newest);
             self.into = 0;
         }
         let more = begun.wrapping_sub(self.counted);
@@ -316,7 +333,7 @@ impl Tracker {
             return None;
         }
         self.counted = begun;
-        self.moved |= more > 0;
+        self.moved |= more > 0 || running;
         let rested = (now_ms as u16).wrapping_sub(self.last_ms) >= RECORD_EVERY_MS as u16;
         if writing || !rested || !self.moved {
             return None;
@@ -326,8 +343,9 @@ impl Tracker {
         let r = PlotRecord {
             n: self.next,
             pos: self.base,
-            // The block moving may be cut short: drawn again.
+            // The block moving: drawn up to `at`.
             done: self.into - 1,
+            at: [0; 2],
         };
         self.next = self.next.wrapping_add(1);
         Some(r)
