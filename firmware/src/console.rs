@@ -338,7 +338,7 @@ impl Console {
             }
             if self.line_ready {
                 // A card's line may wait for a resume's travel back.
-                if self.source == Some(Source::Card) && !self.card_line_goes(m, kin, cfg) {
+                if self.source == Some(Source::Card) && !self.card_line_goes(m, kin, cfg, store) {
                     continue;
                 }
                 self.line_ready = false;

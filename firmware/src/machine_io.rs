@@ -31,8 +31,8 @@ pub struct Io<'a, K: Kinematics> {
 }
 
 /// Going over drawn blocks: `left - 2` more to queue (the pen stays up;
-/// pen words and `M0` until drawing again are passed over, the executor
-/// keeps the pen's state); at 2, once the machine stands at the end of the
+/// pen words until drawing again are passed over, the executor keeps the
+/// pen's state); at 2, once the machine stands at the end of the
 /// last, a rapid to where the checkpoint's motors stood (on the next
 /// block's way); at 1, there, the pen to `pen_deg`; 0: drawing again,
 /// the next block from that point.
@@ -82,27 +82,21 @@ fn stage(
 /// record is written meanwhile (`Print::keep`).
 #[inline(never)]
 fn pen_after_trace(m: &mut Motion, store: &Store, trace: &mut Option<Trace>) -> Option<Wait> {
-    let t = trace.as_mut().filter(|t| *t.left <= 2)?;
+    let t = trace.as_mut().filter(|t| *t.left <= 2 && *t.left > 0)?;
     if !m.is_idle() {
         return Some(Wait::PlannerRoom);
     }
-    if *t.left == 2 {
-        *t.left = 1;
+    *t.left -= 1;
+    if *t.left == 1 {
         if let Some(r) = store.plot_saved().and_then(|s| s.last) {
             let mut to = m.target();
-            to[0] = r.at[0];
-            to[1] = r.at[1];
+            (to[0], to[1]) = (r.at[0], r.at[1]);
             let _ = m.stage(to, Feed::Rapid);
-            return Some(Wait::Again);
         }
+        return Some(Wait::Again);
     }
-    let us = PenConfig::pulse_us(t.pen_deg);
-    if m.pen.pulse_us() != us {
-        m.pen.set_pulse_us(us);
-        return Some(Wait::Ms(t.settle_ms));
-    }
-    *t.left = 0;
-    None
+    m.pen.set_pulse_us(PenConfig::pulse_us(t.pen_deg));
+    Some(Wait::Ms(t.settle_ms))
 }
 
 impl<K: Kinematics> MachineIo for Io<'_, K> {
@@ -169,9 +163,6 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
     }
 
     fn pause(&mut self) {
-        if tracing(&self.trace) {
-            return;
-        }
         self.m.hold();
     }
 

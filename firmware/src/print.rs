@@ -207,7 +207,12 @@ impl Print {
             return;
         }
         match core::mem::replace(&mut self.keep, Keep::Nothing) {
-            Keep::Begin => store.plot_begin(crate::card::opened_short(), self.size),
+            Keep::Begin => {
+                // No line of the file is taken before (`next_byte`): the
+                // motors' target is where it begins.
+                let at = m.target();
+                store.plot_begin(crate::card::opened_short(), self.size, [at[0], at[1]]);
+            }
             Keep::Forget => store.forget(),
             Keep::Nothing | Keep::Offer => {
                 let begun = crate::stepper::blocks_begun();
@@ -575,7 +580,7 @@ impl Print {
         self.at = Mark { pos: 0, lines: 0 };
         self.read_start = 0;
         if self.resume == Some(Resume::Opening) {
-            self.resume = Some(Resume::Replaying);
+            self.resume = Some(Resume::Placing);
             self.line_start = self.at;
             self.state = State::Running;
             return None;
@@ -674,7 +679,8 @@ impl Print {
     /// line without its newline gets one.
     #[inline(never)]
     pub fn next_byte(&mut self) -> Option<u8> {
-        if self.state != State::Running {
+        // A print's first line waits for its header (where it begins).
+        if self.state != State::Running || self.keep == Keep::Begin {
             return None;
         }
         loop {

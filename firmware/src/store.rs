@@ -418,12 +418,13 @@ impl Store {
 
     /// A plotter's print from the card starts: its header (the file).
     #[inline(never)]
-    pub fn plot_begin(&mut self, short: [u8; 11], size: u32) {
+    pub fn plot_begin(&mut self, short: [u8; 11], size: u32, at: [i32; 2]) {
         self.seq = self.seq.wrapping_add(1);
         let h = PlotHeader {
             seq: self.seq,
             short,
             size,
+            at,
         };
         self.start(Header::address(self.seq), &h.encode());
     }

@@ -11,6 +11,7 @@ use crate::store::Store;
 use taut_logic::checkpoint::plot::ResumeAction;
 use taut_logic::config::MachineConfig;
 use taut_logic::gcode::{CardLine, Error, ErrorKind, Parser};
+use taut_logic::interp::motor_channels;
 use taut_logic::kinematics::Kinematics;
 use taut_logic::pinmap::Button;
 
@@ -117,17 +118,25 @@ impl Console {
     }
 
     /// A card's line read whole: taken now (`true`), or held while a
-    /// resume lifts the pen and moves back to where it starts, then puts
-    /// the pen as it was.
+    /// resume places the executor where the print began, lifts the pen
+    /// and moves back to where the line starts.
     #[inline(never)]
     pub(super) fn card_line_goes(
         &mut self,
         m: &Motion,
         kin: &impl Kinematics,
         cfg: &MachineConfig,
+        store: &Store,
     ) -> bool {
         let up = cfg.pen.up_deg;
         match self.print.line_ready(m.next_block()) {
+            ResumeAction::Place => {
+                if let Some(p) = store.plot_saved() {
+                    let mut at = m.target();
+                    (at[0], at[1]) = (p.header.at[0], p.header.at[1]);
+                    self.interp.resync(&kin.forward(&at), motor_channels(cfg));
+                }
+            }
             ResumeAction::Travel => self.interp.travel_back(&kin.forward(&m.target()), up),
             // Up over the blocks drawn before the cut: down after them.
             ResumeAction::Pen => {}

@@ -135,6 +135,11 @@ impl Plotter {
     /// (the flatbed with a switch 3 mm below its X); run until it has
     /// homed and mounted the card. Where it stood at power-on, in steps.
     fn power_on(&self, eeprom: &[u8]) -> (Sim, [i32; 2]) {
+        self.power_on_with(eeprom, ("STAR.GCO", &self.file()))
+    }
+
+    /// [`Plotter::power_on`] with `file` (name, text) on the card.
+    fn power_on_with(&self, eeprom: &[u8], file: (&str, &str)) -> (Sim, [i32; 2]) {
         let cfg = self.cfg();
         // Probed under the string-art names `track` reads (X, Y are its
         // base and radial channels).
@@ -142,7 +147,7 @@ impl Plotter {
         sim.set_eeprom(eeprom);
         let endstops = (cfg.homing.axes != 0).then(|| sim.fit_machine_endstops(&cfg, 3.0));
         sim.watch_eeprom();
-        sim.insert_sd(card(&[("STAR.GCO", self.file().as_bytes())]));
+        sim.insert_sd(card(&[(file.0, file.1.as_bytes())]));
         if endstops.is_some() {
             wait_for(&mut sim, "homed", Duration::from_secs(20));
         }
@@ -393,6 +398,92 @@ fn cut_and_resume(plotter: &Plotter, seeds: Vec<u64>) {
         assert!(
             twice_mm <= bound,
             "{name} seed {seed}: {twice_mm:.1} mm drawn twice, over {bound:.1}"
+        );
+    }
+}
+
+/// gcodetools' file as it comes (`G92 X40 Y-5` "the pen stands here",
+/// arcs, the pen from `Z` on each move), printed from the card where the
+/// maker put the pen, the middle of the bed, and cut at seeded moments.
+/// The flatbed homes at the next power-on; the resume reads the file's
+/// `G92` again from where the print began (the checkpoint's header keeps
+/// it), so the rest lands on the first part: no gap, nothing off the
+/// strokes, at most 1.1 s of drawing twice.
+#[test]
+fn a_gcodetools_file_begun_mid_bed_resumes_where_its_g92_put_it() {
+    const FILE: &str = include_str!("../../files/gcodetools_arcs.ngc");
+    const BEGIN: [f64; 2] = [70.0, 100.0];
+    let cfg = FLATBED.cfg();
+    let strokes = hil_tests::reference::read(FILE, BEGIN, &cfg);
+    let lines: Vec<Line> = strokes
+        .drawn
+        .iter()
+        .map(|path| Line {
+            start: 0,
+            path: Toolpath(path.0.clone()),
+        })
+        .collect();
+    let all = samples(&lines);
+    let fresh = host::eeprom(&cfg, &Default::default(), &Default::default());
+    let file = ("ARCS.NGC", FILE);
+    for seed in soak_or(vec![21u64, 22, 23, 24], vec![25, 26]) {
+        let mut rng = Rng::new(seed);
+        let (mut sim, origin) = FLATBED.power_on_with(&fresh, file);
+        for line in ["M17", &format!("G0 X{} Y{}", BEGIN[0], BEGIN[1]), "M400"] {
+            send(&mut sim, line);
+        }
+        send(&mut sim, "M23 arcs.ngc");
+        send(&mut sim, "M24");
+        sim.run_for(Duration::from_secs_f64(rng.between(4.0, 60.0)));
+        assert!(
+            !sim.uart_text().contains("Done printing file"),
+            "seed {seed}: the cut must fall mid-print"
+        );
+        let (eeprom, _) = sim.eeprom_after_cut(0xFF);
+        let first = FLATBED.pen_down_points(&sim, origin);
+        let Found::Plot(saved) = checkpoint::scan(|a| eeprom[a as usize]) else {
+            panic!("seed {seed}: no print checkpoint after the cut")
+        };
+        drop(sim);
+
+        let (mut sim, origin) = FLATBED.power_on_with(&eeprom, file);
+        wait_for(&mut sim, ">>> resume ARCS.NGC", Duration::from_secs(2));
+        send(&mut sim, "M1000");
+        wait_for(&mut sim, "Done printing file", Duration::from_secs(240));
+        send(&mut sim, "M400");
+        let second = FLATBED.pen_down_points(&sim, origin);
+        hil_tests::assert_ram_budget(&sim);
+
+        for p in first.iter().chain(&second) {
+            let d = strokes.distance(*p, true);
+            assert!(
+                d <= FLATBED.within,
+                "seed {seed}: pen down at {p:?}, {d:.3} mm off"
+            );
+        }
+        let mut twice = 0;
+        for &(i, p) in &all {
+            let (a, b) = (FLATBED.covered(&first, p), FLATBED.covered(&second, p));
+            assert!(
+                a || b,
+                "seed {seed}: a gap at {p:?} (stroke {i})\n{}",
+                log_tail(&sim)
+            );
+            twice += (a && b) as usize;
+        }
+        let twice_mm = twice as f64 * SAMPLE_MM;
+        eprintln!(
+            "gcodetools seed {seed}: checkpoint byte {} block {}, {} points drawn before the \
+             cut, {} after; drawn twice {twice_mm:.1} mm",
+            saved.pos(),
+            saved.done(),
+            first.len(),
+            second.len()
+        );
+        // F400: 6.7 mm/s for 1.1 s.
+        assert!(
+            twice_mm <= 400.0 / 60.0 * 1.1,
+            "seed {seed}: {twice_mm:.1} mm twice"
         );
     }
 }

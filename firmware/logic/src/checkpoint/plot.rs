@@ -13,8 +13,11 @@
 //!
 //! The modal state the line needs (units, distance mode, feed, offsets,
 //! the pen) is not stored: the file's lines before it are read again on
-//! resume, checked and taken without moving (as `$C` does), which leaves
-//! the executor exactly as they left it when the line was first read.
+//! resume, checked and taken without moving (as `$C` does), from where
+//! the motors stood when the print began (the header keeps it: a file's
+//! `G92` "here is X40 Y-5" and its relative moves count from there),
+//! which leaves the executor exactly as they left it when the line was
+//! first read.
 //!
 //! [`Tracker`] says which line is moving, and how far: each planned block
 //! is counted by the step interrupt as it begins, and a line's first block
@@ -52,6 +55,8 @@ pub struct PlotHeader {
     /// The 8.3 name as the directory holds it (`STARDR~1GCO`).
     pub short: [u8; 11],
     pub size: u32,
+    /// Where the motors stood when it began, steps.
+    pub at: [i32; 2],
 }
 
 impl PlotHeader {
@@ -63,6 +68,8 @@ impl PlotHeader {
         b[4] = KIND;
         b[5..16].copy_from_slice(&self.short);
         b[16..20].copy_from_slice(&self.size.to_le_bytes());
+        b[20..24].copy_from_slice(&self.at[0].to_le_bytes());
+        b[24..28].copy_from_slice(&self.at[1].to_le_bytes());
         let crc = crc16(CRC_START, &b[..30]);
         b[30..].copy_from_slice(&crc.to_le_bytes());
         b
@@ -76,10 +83,12 @@ impl PlotHeader {
         }
         let mut short = [0u8; 11];
         short.copy_from_slice(&b[5..16]);
+        let word = |i: usize| [b[i], b[i + 1], b[i + 2], b[i + 3]];
         Some(PlotHeader {
             seq: u16::from_le_bytes([b[2], b[3]]),
             short,
-            size: u32::from_le_bytes([b[16], b[17], b[18], b[19]]),
+            size: u32::from_le_bytes(word(16)),
+            at: [i32::from_le_bytes(word(20)), i32::from_le_bytes(word(24))],
         })
     }
 }
@@ -301,7 +310,6 @@ impl Tracker {
     /// last record is not yet durable (the next waits). Its `at` is the
     /// caller's: where the motors stand, read while block `begun - 1` is
     /// still the one moving.
-    #[inline(never)]
     pub fn due(
         &mut self,
         begun: u8,
@@ -354,8 +362,9 @@ impl Tracker {
 
 /// Going on with a print a cut stopped, step by step: offered at
 /// power-on; taken (`M1000`, green), the machine homes if it has
-/// switches, the file opens from its start, its lines before the
-/// checkpoint's are read and taken without moving, then the pen goes up,
+/// switches, the file opens from its start, the executor is placed where
+/// the print began, the lines before the checkpoint's are read and taken
+/// without moving, then the pen goes up,
 /// the machine moves to where the checkpoint's line starts, the pen goes
 /// as it was there, and the print goes on with that line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -364,6 +373,8 @@ pub enum Resume {
     Offered,
     Homing,
     Opening,
+    /// The file is open: the executor goes where the print began.
+    Placing,
     /// Lines before the checkpoint's offset: checked and taken, no motion.
     Replaying,
     /// The pen up and the move back to the line's start.
@@ -397,6 +408,8 @@ pub enum ResumeAction {
     Home,
     /// Open the file from its start, as a print.
     Open,
+    /// Program the executor where the motors stood when the print began.
+    Place,
     /// Take the line without moving (as `$C`).
     Check,
     /// Hold the line: pen up, then a rapid to the executor's position.
@@ -422,7 +435,8 @@ impl Resume {
                 (Some(S::Opening), A::Open)
             }
             (S::Offered, E::Discard) => (None, A::Forget),
-            (S::Opening, E::Opened) => (Some(S::Replaying), A::None),
+            (S::Opening, E::Opened) => (Some(S::Placing), A::None),
+            (S::Placing, E::Line(_)) => (Some(S::Replaying), A::Place),
             (S::Replaying, E::Line(pos)) if pos < at => (Some(S::Replaying), A::Check),
             (S::Replaying, E::Line(_)) => (Some(S::Travel), A::Travel),
             (S::Travel, E::Done) => (Some(S::Pen), A::Pen),

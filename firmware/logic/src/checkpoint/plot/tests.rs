@@ -12,6 +12,7 @@ fn header(seq: u16) -> PlotHeader {
         seq,
         short: SHORT,
         size: 2316,
+        at: [-4_000, 123_456],
     }
 }
 
@@ -370,6 +371,7 @@ fn resume_homes_opens_replays_the_lines_before_then_travels_and_pens() {
         E::Take { homes: true },
         E::Homed,
         E::Opened,
+        E::Line(0), // placed
         E::Line(0),
         E::Line(40),
         E::Line(119),
@@ -390,6 +392,7 @@ fn resume_homes_opens_replays_the_lines_before_then_travels_and_pens() {
             A::Home,
             A::Open,
             A::None,
+            A::Place,
             A::Check,
             A::Check,
             A::Check,
