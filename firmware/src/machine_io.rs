@@ -79,7 +79,7 @@ fn stage(
 /// The drawn blocks are gone over: once the machine stands, a rapid to
 /// where the checkpoint's motors stood, then the pen as the lines left
 /// it, and its settle time. The checkpoint is the one resumed from: no
-/// record is written meanwhile (`Print::keep`).
+/// line read meanwhile is followed for records (`Print::line_ready`).
 #[inline(never)]
 fn pen_after_trace(m: &mut Motion, store: &Store, trace: &mut Option<Trace>) -> Option<Wait> {
     let t = trace.as_mut().filter(|t| *t.left <= 2 && *t.left > 0)?;

@@ -225,10 +225,9 @@ impl Print {
                     return;
                 };
                 let at = m.stepper.position();
-                // Not while the drawn blocks are gone over (the record
-                // resumed from stands), nor with a block begun since
-                // `begun` was read: the motors are past the one named.
-                if self.trace == 0 && crate::stepper::blocks_begun() == begun {
+                // Not with a block begun since `begun` was read: the
+                // motors are past the one named.
+                if crate::stepper::blocks_begun() == begun {
                     r.at = [at[0], at[1]];
                     store.plot_record(r);
                 }
@@ -326,7 +325,11 @@ impl Print {
                 action
             }
         };
-        if action == ResumeAction::Go {
+        // Not while a resume goes over the blocks drawn before the cut: its
+        // rapid on to where the pen stood is a block the file does not
+        // have. Records follow from the line after (a cut before goes on
+        // from the record resumed from).
+        if action == ResumeAction::Go && self.trace == 0 {
             if let Some(t) = self.tracker.as_mut() {
                 t.line(self.read_start, first);
             }

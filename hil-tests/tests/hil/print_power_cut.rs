@@ -402,6 +402,88 @@ fn cut_and_resume(plotter: &Plotter, seeds: Vec<u64>) {
     }
 }
 
+/// A second cut while the resumed print draws the rest of the line it
+/// went on in (the whiteboard's star circle is one `G3` line of some
+/// 8 s): the rapid on to where the pen stood is a block the file does not
+/// have, so the resumed run writes no record until a later line moves,
+/// and the third run goes on from the first record again: no gap, nothing
+/// off the toolpath.
+#[test]
+fn a_second_cut_in_the_line_a_resume_went_on_in_leaves_no_gap() {
+    let wb = Plotter {
+        machine: Machine::Whiteboard,
+        by: [-40.0, -40.0],
+        within: 0.1,
+        cut_s: (0.0, 0.0),
+    };
+    let fresh = host::eeprom(&wb.cfg(), &Default::default(), &Default::default());
+    let lines = drawing_lines(&wb.file());
+    let (mut sim, origin) = wb.power_on(&fresh);
+    send(&mut sim, "M17");
+    send(&mut sim, "M23 star.gco");
+    send(&mut sim, "M24");
+    sim.run_for(Duration::from_secs(4));
+    let (eeprom, _) = sim.eeprom_after_cut(0xFF);
+    let mut drawn = wb.pen_down_points(&sim, origin);
+    let Found::Plot(cut1) = checkpoint::scan(|a| eeprom[a as usize]) else {
+        panic!("no print checkpoint after the first cut")
+    };
+    assert!(
+        cut1.done() > 0,
+        "the first cut must fall inside the circle: {cut1:?}"
+    );
+    drop(sim);
+
+    // Run 2: cut 1.5 s after the pen is down again.
+    let (mut sim, origin) = wb.power_on(&eeprom);
+    wait_for(&mut sim, ">>> resume STAR.GCO", Duration::from_secs(2));
+    send(&mut sim, "M1000");
+    let down = sim.run_until(
+        |s| {
+            pen_deg_at(s, s.cycles())
+                .is_some_and(|d| (d - f64::from(wb.cfg().pen.down_deg)).abs() < 1.0)
+        },
+        Duration::from_secs(30),
+    );
+    assert_eq!(down, hil_tests::sim::Outcome::Done, "{}", log_tail(&sim));
+    sim.run_for(Duration::from_millis(1500));
+    let (eeprom, _) = sim.eeprom_after_cut(0xFF);
+    let second = wb.pen_down_points(&sim, origin);
+    assert!(!second.is_empty(), "run 2 drew nothing before its cut");
+    drawn.extend(second);
+    let Found::Plot(cut2) = checkpoint::scan(|a| eeprom[a as usize]) else {
+        panic!("no print checkpoint after the second cut")
+    };
+    // Still in the circle: no record since the resume (one counting the
+    // rapid as a chord would name the block after the one moving).
+    assert_eq!(cut2.last, cut1.last);
+    drop(sim);
+
+    let (mut sim, origin) = wb.power_on(&eeprom);
+    wait_for(&mut sim, ">>> resume STAR.GCO", Duration::from_secs(2));
+    send(&mut sim, "M1000");
+    wait_for(&mut sim, "Done printing file", Duration::from_secs(120));
+    send(&mut sim, "M400");
+    drawn.extend(wb.pen_down_points(&sim, origin));
+    for p in &drawn {
+        let d = lines
+            .iter()
+            .map(|l| l.path.distance(*p))
+            .fold(f64::MAX, f64::min);
+        assert!(d <= wb.within, "pen down at {p:?}, {d:.3} mm off");
+    }
+    for (i, p) in samples(&lines) {
+        assert!(wb.covered(&drawn, p), "a gap at {p:?} (line {i})");
+    }
+    eprintln!(
+        "first cut: byte {} block {}; second: byte {} block {}",
+        cut1.pos(),
+        cut1.done(),
+        cut2.pos(),
+        cut2.done()
+    );
+}
+
 /// gcodetools' file as it comes (`G92 X40 Y-5` "the pen stands here",
 /// arcs, the pen from `Z` on each move), printed from the card where the
 /// maker put the pen, the middle of the bed, and cut at seeded moments.
