@@ -408,7 +408,6 @@ impl Console {
         store: &mut Store,
     ) -> Poll<Signal> {
         let env = self.env(kin, cfg, owner);
-        let pen_deg = self.interp.pen_now(cfg.pen.up_deg);
         let mut io = Io {
             m,
             kin,
@@ -416,7 +415,7 @@ impl Console {
             replies: self.owed,
             trace: self.print.trace().map(|left| Trace {
                 left,
-                pen_deg,
+                pen_deg: self.interp.pen_now(cfg.pen.up_deg),
                 settle_ms: cfg.pen.settle_ms,
             }),
         };

@@ -54,26 +54,14 @@ fn tracing(trace: &Option<Trace>) -> bool {
     trace.as_ref().is_some_and(|t| *t.left > 0)
 }
 
-/// The move queued with the pen up (a rapid along the same path: the
-/// planner makes the same blocks, a move of no step none), or drawn.
-/// Out of line and not generic: one copy for every machine.
+/// A drawn block queued again with the pen up: a rapid along the same
+/// path (the planner makes the same blocks, a move of no step none). Out
+/// of line: off the path of a print that is not resuming.
 #[inline(never)]
-fn stage(
-    m: &mut Motion,
-    trace: &mut Option<Trace>,
-    steps: &Steps,
-    feed: Feed,
-    piece: Option<&Piece>,
-) -> bool {
-    if let Some(t) = trace.as_mut().filter(|t| t.going_over()) {
-        let queued = m.stage(*steps, Feed::Rapid).is_ok();
-        *t.left -= (queued && m.staging()) as u16;
-        return queued;
-    }
-    match piece {
-        Some(p) => m.stage_piece(p, feed).is_ok(),
-        None => m.stage(*steps, feed).is_ok(),
-    }
+fn stage_over(m: &mut Motion, t: &mut Trace, steps: &Steps) -> bool {
+    let queued = m.stage(*steps, Feed::Rapid).is_ok();
+    *t.left -= (queued && m.staging()) as u16;
+    queued
 }
 
 /// The drawn blocks are gone over: once the machine stands, a rapid to
@@ -133,11 +121,17 @@ impl<K: Kinematics> MachineIo for Io<'_, K> {
     }
 
     fn queue(&mut self, steps: &Steps, feed: Feed) -> bool {
-        stage(self.m, &mut self.trace, steps, feed, None)
+        match self.trace.as_mut().filter(|t| t.going_over()) {
+            Some(t) => stage_over(self.m, t, steps),
+            None => self.m.stage(*steps, feed).is_ok(),
+        }
     }
 
     fn queue_piece(&mut self, piece: &Piece, feed: Feed) -> bool {
-        stage(self.m, &mut self.trace, &piece.steps, feed, Some(piece))
+        match self.trace.as_mut().filter(|t| t.going_over()) {
+            Some(t) => stage_over(self.m, t, &piece.steps),
+            None => self.m.stage_piece(piece, feed).is_ok(),
+        }
     }
 
     fn idle(&mut self) -> bool {

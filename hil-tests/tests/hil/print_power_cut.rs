@@ -119,6 +119,13 @@ const FLATBED: Plotter = Plotter {
     cut_s: (1.0, 22.0),
 };
 
+const WHITEBOARD: Plotter = Plotter {
+    machine: Machine::Whiteboard,
+    by: [-40.0, -40.0],
+    within: 0.1,
+    cut_s: (3.0, 30.0),
+};
+
 /// The star's feed, mm/s (`F1500`).
 const FEED_MM_S: f64 = 25.0;
 
@@ -220,13 +227,7 @@ fn a_flatbed_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_th
 
 #[test]
 fn a_whiteboard_print_cut_at_seeded_moments_resumes_with_no_gap() {
-    let whiteboard = Plotter {
-        machine: Machine::Whiteboard,
-        by: [-40.0, -40.0],
-        within: 0.1,
-        cut_s: (3.0, 30.0),
-    };
-    cut_and_resume(&whiteboard, soak_or(vec![31u64, 32, 33], vec![34, 35, 36]));
+    cut_and_resume(&WHITEBOARD, soak_or(vec![31u64, 32, 33], vec![34, 35, 36]));
 }
 
 #[test]
@@ -410,12 +411,7 @@ fn cut_and_resume(plotter: &Plotter, seeds: Vec<u64>) {
 /// off the toolpath.
 #[test]
 fn a_second_cut_in_the_line_a_resume_went_on_in_leaves_no_gap() {
-    let wb = Plotter {
-        machine: Machine::Whiteboard,
-        by: [-40.0, -40.0],
-        within: 0.1,
-        cut_s: (0.0, 0.0),
-    };
+    let wb = &WHITEBOARD;
     let fresh = host::eeprom(&wb.cfg(), &Default::default(), &Default::default());
     let lines = drawing_lines(&wb.file());
     let (mut sim, origin) = wb.power_on(&fresh);
