@@ -30,7 +30,8 @@ const LIBM: &[&str] = &[
     "floatundisf.o",
 ];
 
-/// Members of avr-gcc's `libgcc.a`: integer division and 64-bit multiply.
+/// Members of avr-gcc's `libgcc.a`: integer division. (The 64-bit
+/// multiply is the image's own, `src/rt/mul64.rs`.)
 const LIBGCC: &[&str] = &[
     "_udivmodhi4.o",
     "_divmodhi4.o",
@@ -38,7 +39,6 @@ const LIBGCC: &[&str] = &[
     "_divmodsi4.o",
     "_udivdi3.o",
     "_divdi3.o",
-    "_muldi3.o",
 ];
 
 /// Members of avr-libc's `libc.a`: the memory routines LLVM calls for
@@ -104,6 +104,15 @@ fn main() {
             println!("cargo:rustc-link-arg={}", out.join(m).display());
         }
     }
+    // The image's own 64-bit product (src/rt/mul64.rs says why).
+    let mul = out.join("mul64.o");
+    let st = Command::new("avr-gcc")
+        .args(["-mmcu=atmega2560", "-c", "src/rt/mul64.S", "-o"])
+        .arg(&mul)
+        .status()
+        .expect("avr-gcc (Debian gcc-avr) is needed to link the firmware");
+    assert!(st.success(), "avr-gcc -c src/rt/mul64.S");
+    println!("cargo:rustc-link-arg={}", mul.display());
     // After the objects: the archives are searched in order.
     println!("cargo:rustc-link-arg=-lm");
     println!("cargo:rustc-link-arg=-lgcc");

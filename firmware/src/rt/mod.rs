@@ -6,6 +6,7 @@ pub mod dispatch;
 pub mod flags;
 pub mod isr_cell;
 pub mod mailbox;
+pub mod mul64;
 pub mod nested;
 pub mod ring;
 pub mod stack;

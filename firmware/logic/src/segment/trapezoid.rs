@@ -175,7 +175,7 @@ impl Trapezoid {
 
     /// The next part of the profile begun by [`Trapezoid::begin`]; true
     /// once it is whole (and for every profile after).
-    #[inline(always)]
+    #[inline(never)]
     pub fn advance(&mut self) -> bool {
         let two_ae = self.two_a * self.events as u64;
         match self.part {
@@ -498,7 +498,12 @@ pub fn div_to_u32(n: u64, d: u32) -> u32 {
 /// The same on the AVR, in assembly (the compiled loop spilled to the
 /// stack: 2 300 cycles): the dividend's low half shifts into the
 /// remainder while the quotient's bits fill it from the right, ~20 cycles
-/// a bit. Checked against the division above by `segment_cycles.elf`.
+/// a bit. Leading zero bytes of the quotient go first, a byte at a time
+/// (~19 cycles each, where eight bits take ~160): while the remainder
+/// with the next dividend byte is below the divisor, that byte moves in
+/// whole and the quotient gets eight zeros (a pace, a segment's `add`
+/// and `interval`, a ramp's run: quotients of 8 to 24 bits). Checked
+/// against the division above by `arith_check.elf` (HIL test).
 #[cfg(target_arch = "avr")]
 #[allow(unsafe_code)]
 pub fn div_to_u32(n: u64, d: u32) -> u32 {
@@ -508,6 +513,17 @@ pub fn div_to_u32(n: u64, d: u32) -> u32 {
     unsafe {
         core::arch::asm!(
             "ldi {count}, 32",
+            // r3 zero and r2:r1:r0:l3 below d: eight zero bits.
+            "0:",
+            "tst {r3}",
+            "brne 1f",
+            "cp {l3}, {d0}", "cpc {r0}, {d1}", "cpc {r1}, {d2}", "cpc {r2}, {d3}",
+            "brcc 1f",
+            "mov {r3}, {r2}", "mov {r2}, {r1}", "mov {r1}, {r0}", "mov {r0}, {l3}",
+            "mov {l3}, {l2}", "mov {l2}, {l1}", "mov {l1}, {l0}", "clr {l0}",
+            "subi {count}, 8",
+            "brne 0b",
+            "rjmp 4f",
             "1:",
             "lsl {l0}", "rol {l1}", "rol {l2}", "rol {l3}",
             "rol {r0}", "rol {r1}", "rol {r2}", "rol {r3}",
@@ -522,6 +538,7 @@ pub fn div_to_u32(n: u64, d: u32) -> u32 {
             "3:",
             "dec {count}",
             "brne 1b",
+            "4:",
             count = out(reg_upper) _,
             l0 = inout(reg) l0, l1 = inout(reg) l1, l2 = inout(reg) l2, l3 = inout(reg) l3,
             r0 = inout(reg) r0, r1 = inout(reg) r1, r2 = inout(reg) r2, r3 = inout(reg) r3,

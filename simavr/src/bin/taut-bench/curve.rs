@@ -6,7 +6,7 @@
 //! firmware's depth and at Grbl-Mega's 36 blocks: how fast the look-ahead
 //! lets the machine go, and how close the firmware comes to it.
 
-use crate::stream::{chords, lines, over_serial, ready, send, underruns};
+use crate::stream::{chords, lines, over_serial, print_profile, ready, send, underruns};
 use crate::{rises, round};
 use serde_json::{json, Map, Value};
 use std::path::Path;
@@ -61,10 +61,17 @@ fn firmware_seconds(elf: &Path, start: [f64; 2], lines: &[String]) -> (f64, u64)
     let axes = [Axis::Base, Axis::Radial];
     let before = axes.map(|a| rises(&sim, a).len());
     let under = underruns(&sim);
+    let profile = std::env::var("TAUT_BENCH_PROFILE").ok();
+    if profile.is_some() {
+        sim.enable_call_profile(elf).unwrap();
+    }
     over_serial(&mut sim, lines);
     send(&mut sim, "M400");
     // The logger's next report.
     sim.run_for(Duration::from_millis(1100));
+    if let (Some(n), Some(p)) = (profile, sim.profile()) {
+        print_profile(elf, p, n.parse().unwrap_or(30));
+    }
     let (mut first, mut last) = (u64::MAX, 0);
     for (a, n) in axes.iter().zip(before) {
         let r = rises(&sim, *a);

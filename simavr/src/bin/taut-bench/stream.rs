@@ -317,7 +317,7 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
 
 /// `TAUT_BENCH_PROFILE=N`: the N functions the case spent the most
 /// cycles in (their own instructions, callees apart), with their share.
-fn print_profile(elf: &Path, p: &taut_simavr::profile::Profile, n: usize) {
+pub(crate) fn print_profile(elf: &Path, p: &taut_simavr::profile::Profile, n: usize) {
     let total = p.total() as f64;
     println!("  own cycles:");
     for (cycles, name) in p.by_function(elf).unwrap().iter().take(n) {
@@ -348,9 +348,11 @@ fn print_profile(elf: &Path, p: &taut_simavr::profile::Profile, n: usize) {
         "__divdi3",
         "__mulsf3",
         "__divsf3",
+        "__mulsf3x",
+        "__udivmodsi4",
     ] {
         println!("  callers of {callee}:");
-        for (cycles, name) in p.callers_of(callee).iter().take(8) {
+        for (cycles, name) in p.callers_of(callee).iter().take(12) {
             println!(
                 "  {:>5.1} % {cycles:>11} {name}",
                 *cycles as f64 * 100.0 / total
