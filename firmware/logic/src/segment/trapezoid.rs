@@ -160,6 +160,13 @@ impl Trapezoid {
         } else {
             self.per_speed = 0;
         }
+        // Entering at the speed the profile before (whole, same scale)
+        // left at: its exit root is this entry's (a root less a block in
+        // a stream of short ramps). Part 5 is part 1 with `s0` known.
+        let entry_known = self.part == 0 && v0_sqr == self.v1_sqr && shift == self.shift;
+        if entry_known {
+            self.s0 = self.s1;
+        }
         self.events = events;
         self.accel = a;
         self.two_a = two_a;
@@ -170,7 +177,7 @@ impl Trapezoid {
         self.acc2 = peak - v0_sqr;
         self.dec2 = peak - v1_sqr;
         // The rest is made by `advance`, in order.
-        self.part = 1;
+        self.part = if entry_known { 5 } else { 1 };
     }
 
     /// The next part of the profile begun by [`Trapezoid::begin`]; true
@@ -185,12 +192,14 @@ impl Trapezoid {
             // peak's scaled speed waits in `cruise_iv`.
             // A block that cruises through (a stream of short moves at
             // speed) has one root, not three.
-            1 => {
+            part @ (1 | 5) => {
                 self.cruise_iv = self.scaled_speed(self.v0_sqr + self.acc2);
-                self.s0 = match self.acc2 {
-                    0 => self.cruise_iv,
-                    _ => self.scaled_speed(self.v0_sqr),
-                };
+                if self.acc2 == 0 {
+                    self.s0 = self.cruise_iv;
+                } else if part == 1 {
+                    self.s0 = self.scaled_speed(self.v0_sqr);
+                }
+                self.part = 1;
             }
             2 => {
                 self.s1 = if self.dec2 == 0 {
@@ -211,7 +220,9 @@ impl Trapezoid {
                 // Q / a = per_speed / 2^(per_speed_shift - shift), below 2^33.
                 self.stop_per_speed =
                     (per_speed >> (per_speed_shift - self.shift)).min(u32::MAX as u64) as u32;
-                self.cruise_iv = (Q << 31) / sp;
+                // sp in [2^31, 2^32) (the scale fills 64 bits with the
+                // peak²) and Q < 2^33: a 32-bit quotient, nearly always.
+                self.cruise_iv = div_rem_u32(Q << 31, sp as u32).0;
                 self.t_acc = self.ramp_time(sp, self.s0);
                 // The peak's scaled speed until the last part.
                 self.t_end = sp;
@@ -396,9 +407,10 @@ impl Trapezoid {
         }
     }
 
-    /// Time to cruise `w / (2a)` events.
+    /// Time to cruise `w / (2a)` events (`2a` below 2^26).
     fn cruise_time(&self, w: u64) -> u64 {
-        self.cruise_span(w / self.two_a, w % self.two_a)
+        let (q, r) = div_rem_u32(w, self.two_a as u32);
+        self.cruise_span(q, r)
     }
 
     /// Time to cruise `q + r / (2a)` events (`r` below `2a`): the
@@ -460,6 +472,17 @@ pub fn isqrt(x: u64) -> u64 {
         r -= 1;
     }
     r
+}
+
+/// `n / d` and `n % d`, 32 bits wide ([`div_to_u32`], a fifth of a `u64`
+/// division's cycles on the AVR) when the quotient fits.
+fn div_rem_u32(n: u64, d: u32) -> (u64, u64) {
+    if n >> 32 < d as u64 {
+        let q = div_to_u32(n, d) as u64;
+        (q, n - q * d as u64)
+    } else {
+        (n / d as u64, n % d as u64)
+    }
 }
 
 /// `x << n` for `n < 64`: whole bytes, then bits. On the AVR a variable
@@ -665,4 +688,28 @@ const fn cbrt_mantissas() -> [u16; 24] {
         i += 1;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Speeds, Trapezoid};
+
+    /// A block entering at the speed the one before left at takes that
+    /// exit's root (no root worked out for it) and is the same profile as
+    /// one made afresh; one entering at another speed works its root out.
+    #[test]
+    fn an_entry_at_the_last_exit_takes_its_root() {
+        let speeds = |entry: u64, exit: u64| Speeds {
+            entry_sqr: entry * entry,
+            cruise_sqr: 900 * 900,
+            exit_sqr: exit * exit,
+        };
+        for (entry, known) in [(400, true), (401, false)] {
+            let mut t = Trapezoid::new(40, 5000, &speeds(300, 400));
+            t.begin_in_place(37, 5000, &speeds(entry, 350));
+            assert_eq!(t.part == 5, known, "entry {entry}");
+            while !t.advance() {}
+            assert_eq!(t, Trapezoid::new(37, 5000, &speeds(entry, 350)));
+        }
+    }
 }
