@@ -3,7 +3,8 @@
 //! pieces with 32-bit multiplications only (factors of every size, signs
 //! and edges), and the segment maths' `div_to_u32` against the compiler's
 //! `u64` division (quotients of every length, remainders up to the
-//! divisor). D11 goes high if every result agrees, then D12 when the
+//! divisor), and the square root built on both: floor roots at every
+//! length. D11 goes high if every result agrees, then D12 when the
 //! check is over. The status LED (D13) is high while 256
 //! products of two 32-bit factors run, so the harness reads their cycles.
 #![no_std]
@@ -12,7 +13,7 @@
 use core::hint::black_box;
 use panic_halt as _;
 use taut_firmware::rt::mul64::mul as __muldi3;
-use taut_logic::segment::div_to_u32;
+use taut_logic::segment::{div_to_u32, isqrt};
 
 /// `a · b` modulo 2^64 from 16-bit pieces: no 64-bit multiplication.
 fn reference(a: u64, b: u64) -> u64 {
@@ -68,6 +69,15 @@ fn main() -> ! {
         let n = q as u64 * d as u64 + (y.rotate_left(3) % d) as u64;
         agree &= div_to_u32(black_box(n), black_box(d)) == q;
         agree &= q as u64 == black_box(n) / black_box(d as u64);
+    }
+    // Square roots of every length: floor roots.
+    for k in 0..640u32 {
+        y ^= y << 13;
+        y ^= y >> 17;
+        y ^= y << 5;
+        let v = ((y as u64) << 32 | y.rotate_left(11) as u64) >> (k % 64);
+        let r = isqrt(black_box(v));
+        agree &= r * r <= v && (r + 1).checked_mul(r + 1).is_none_or(|s| s > v);
     }
     // The largest dividend whose quotient fits, and the smallest.
     let n = (u32::MAX as u64) * (u32::MAX as u64) + (u32::MAX - 1) as u64;

@@ -87,6 +87,20 @@ impl Profile {
         out
     }
 
+    /// What `name` called, with the cycles each took from its calls
+    /// (callees included), most first.
+    pub fn callees_of(&self, name: &str) -> Vec<(u64, String)> {
+        let Some(c) = &self.calls else {
+            return Vec::new();
+        };
+        let mut out: Vec<(u64, String)> = (c.edges.iter())
+            .filter(|((caller, _), _)| c.names[*caller].contains(name))
+            .map(|((_, callee), cycles)| (*cycles, c.names[*callee].clone()))
+            .collect();
+        out.sort_by(|a, b| b.cmp(a));
+        out
+    }
+
     /// Each function's cycles with its callees, most first: (cycles,
     /// entries, name). A recursive function counts its depth over.
     pub fn inclusive(&self) -> Vec<(u64, u64, String)> {

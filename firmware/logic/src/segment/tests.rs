@@ -162,6 +162,21 @@ proptest::proptest! {
     }
 
     #[test]
+    fn isqrt_is_the_floor_root_at_every_length(x in proptest::prelude::any::<u64>(), k in 0u32..64) {
+        // Every scale the root's top-bits path takes (random u64s are
+        // nearly all 63–64 bits long), and squares' neighbours.
+        let x = x >> k;
+        let r = isqrt(x);
+        proptest::prop_assert!(r * r <= x);
+        proptest::prop_assert!((r + 1).checked_mul(r + 1).is_none_or(|s| s > x));
+        let s = (x >> 32).max(1) * (x >> 32).max(1);
+        for y in [s - 1, s, s + 1] {
+            let r = isqrt(y);
+            proptest::prop_assert!(r * r <= y && (r + 1) * (r + 1) > y);
+        }
+    }
+
+    #[test]
     fn isqrt_is_the_floor_root(x in proptest::prelude::any::<u64>()) {
         let r = isqrt(x);
         proptest::prop_assert!(r * r <= x);

@@ -219,7 +219,7 @@ impl Trapezoid {
                 let (per_speed, per_speed_shift) = (self.per_speed, self.per_speed_shift);
                 // Q / a = per_speed / 2^(per_speed_shift - shift), below 2^33.
                 self.stop_per_speed =
-                    (per_speed >> (per_speed_shift - self.shift)).min(u32::MAX as u64) as u32;
+                    shr(per_speed, per_speed_shift - self.shift).min(u32::MAX as u64) as u32;
                 // sp in [2^31, 2^32) (the scale fills 64 bits with the
                 // peak²) and Q < 2^33: a 32-bit quotient, nearly always.
                 self.cruise_iv = div_rem_u32(Q << 31, sp as u32).0;
@@ -273,7 +273,7 @@ impl Trapezoid {
     /// cycles on the AVR, once a cruise segment kept a ready console
     /// waiting).
     pub fn cruise_events_in(&self, subticks: u32) -> u32 {
-        let pace = (self.cruise_iv >> (31 - self.shift)).min(u32::MAX as u64 - 1) as u32 + 1;
+        let pace = shr(self.cruise_iv, 31 - self.shift).min(u32::MAX as u64 - 1) as u32 + 1;
         div_to_u32(subticks as u64, pace).max(1)
     }
 
@@ -322,7 +322,7 @@ impl Trapezoid {
             (self.t_end.saturating_sub(back), s)
         } else {
             let t = self.t_acc + self.cruise_time_to(k);
-            let iv = self.cruise_iv >> (31 - self.shift);
+            let iv = shr(self.cruise_iv, 31 - self.shift);
             return (t, iv.min(u32::MAX as u64) as u32);
         };
         (t, if pace { self.pace(s) } else { 0 })
@@ -393,7 +393,7 @@ impl Trapezoid {
         let ds = s_hi - s_lo;
         let low = ds * (self.per_speed & 0xFFFF_FFFF);
         let high = ds * (self.per_speed >> 32);
-        (high + (low >> 32)) >> (self.per_speed_shift - 32)
+        shr(high + (low >> 32), self.per_speed_shift - 32)
     }
 
     /// [`Trapezoid::cruise_time`] from the end of the acceleration to
@@ -427,7 +427,7 @@ impl Trapezoid {
             d if part >> 32 < d as u64 => div_to_u32(part, d) as u64,
             _ => part / self.two_a,
         };
-        (q * self.cruise_iv + frac) >> (31 - self.shift)
+        shr(q * self.cruise_iv + frac, 31 - self.shift)
     }
 }
 
@@ -461,11 +461,18 @@ pub fn isqrt(x: u64) -> u64 {
     if x >= TOP * TOP {
         return TOP;
     }
-    // x ≥ 2^32: shift right by the even amount that leaves 31–32 bits.
-    let shift = (33 - x.leading_zeros()) & !1;
+    // x ≥ 2^32: its top 31–32 bits, `x >> shift` for the even shift
+    // that leaves them, from the 32-bit halves (a `u64` shift by a
+    // variable is a loop of ~12 cycles a bit on the AVR, a `u32` one ~6).
+    let hi = (x >> 32) as u32;
+    let shift = (33 - hi.leading_zeros()) & !1;
+    let top = match shift {
+        32 => hi,
+        s => hi << (32 - s) | (x as u32) >> s,
+    };
     // r0 ≤ √x < r0 + 2^(shift/2): start from the upper end, below 2^32
     // (a root of 2^32 would need x ≥ TOP²).
-    let r0 = shl(isqrt32((x >> shift) as u32) as u64 + 1, shift / 2).min(TOP) as u32;
+    let r0 = shl(isqrt32(top) as u64 + 1, shift / 2).min(TOP) as u32;
     // x / r0 ≤ √x < 2^32: the quotient fits.
     let mut r = (r0 as u64 + div_to_u32(x, r0) as u64) / 2;
     while r * r > x {
@@ -487,14 +494,36 @@ fn div_rem_u32(n: u64, d: u32) -> (u64, u64) {
 
 /// `x << n` for `n < 64`: whole bytes, then bits. On the AVR a variable
 /// `u64` shift is a loop of one-bit shifts over eight bytes (~12 cycles a
-/// bit); whole bytes are register moves.
+/// bit); a constant shift by whole bytes is register moves, so the bytes
+/// go by a `match` (~70 cycles in all, where copying through a byte
+/// array took ~250).
 fn shl(x: u64, n: u32) -> u64 {
-    let bytes = (n / 8) as usize;
-    let mut b = [0u8; 16];
-    b[8..].copy_from_slice(&x.to_le_bytes());
-    let mut out = [0u8; 8];
-    out.copy_from_slice(&b[8 - bytes..16 - bytes]);
-    u64::from_le_bytes(out) << (n % 8)
+    let x = match n / 8 {
+        0 => x,
+        1 => x << 8,
+        2 => x << 16,
+        3 => x << 24,
+        4 => x << 32,
+        5 => x << 40,
+        6 => x << 48,
+        _ => x << 56,
+    };
+    x << (n % 8)
+}
+
+/// `x >> n` for `n < 64`, as [`shl`]: whole bytes by a `match`, then bits.
+fn shr(x: u64, n: u32) -> u64 {
+    let x = match n / 8 {
+        0 => x,
+        1 => x >> 8,
+        2 => x >> 16,
+        3 => x >> 24,
+        4 => x >> 32,
+        5 => x >> 40,
+        6 => x >> 48,
+        _ => x >> 56,
+    };
+    x >> (n % 8)
 }
 
 /// `n / d`, for a quotient known to fit 32 bits (`n >> 32 < d`): restoring

@@ -631,6 +631,14 @@ fn main() {
             return;
         }
     }
+    if let [flag, elf] = &args[..] {
+        if flag == "--segment" {
+            // `segment_cycles.elf` alone: root, profile, event time, segment.
+            let (c, n) = segment_cycles(Path::new(elf));
+            println!("cycles: root {}, profile {}, event time {}, segment {} ({n} segments)", c[0], c[1], c[2], c[3]);
+            return;
+        }
+    }
     if let [flag, fw] = &args[..] {
         if flag == "--feed" || flag == "--curve" {
             let mut f = Map::new();

@@ -340,6 +340,20 @@ pub(crate) fn print_profile(elf: &Path, p: &taut_simavr::profile::Profile, n: us
             *cycles as f64 * 100.0 / total
         );
     }
+    // `TAUT_BENCH_CALLEES=a,b`: what functions whose names hold a or b
+    // called.
+    for caller in std::env::var("TAUT_BENCH_CALLEES").unwrap_or_default().split(',') {
+        if caller.is_empty() {
+            continue;
+        }
+        println!("  callees of {caller}:");
+        for (cycles, name) in p.callees_of(caller).iter().take(12) {
+            println!(
+                "  {:>5.1} % {cycles:>11} {name}",
+                *cycles as f64 * 100.0 / total
+            );
+        }
+    }
     for callee in [
         "memcpy",
         "__muldi3",
