@@ -212,18 +212,21 @@ impl Motion {
         self.busy
     }
 
-    /// Move planned blocks into the interrupt's queues, at most `max`
-    /// pieces of work (taking a block, a part of its profile or of a
-    /// segment: ≤ ~1 ms each, so other tasks interleave), and start the
-    /// interrupt.
+    /// Move planned blocks into the interrupt's queues, `max` pieces of
+    /// work (taking a block, a part of its profile or of a segment: ≤ ~1
+    /// ms each, so other tasks interleave), up to `most` while `others`
+    /// says no other task waits, and start the interrupt.
     /// Returns (a planner slot was freed or a block begun, more can be
     /// prepared).
-    pub fn refill(&mut self, max: usize) -> (bool, bool) {
+    pub fn refill(&mut self, max: usize, most: usize, others: fn() -> bool) -> (bool, bool) {
         let mut freed = BLOCKS.len() < self.blocks as usize;
         let mut made = 0;
         let mut pushed = false;
         let mut room = SEGMENTS.free() > 0 && BLOCKS.free() > 0;
-        while room && made < max && self.buffered.queued_us(SEGMENTS.len()) < QUEUED_MAX_US {
+        while room
+            && (made < max || made < most && !others())
+            && self.buffered.queued_us(SEGMENTS.len()) < QUEUED_MAX_US
+        {
             // Taking a block, a part of its profile and a part of a
             // segment each count as one piece of work (each ≤ ~1 ms).
             let (loaded, took) = PLANNER.with(|p| {
@@ -268,7 +271,7 @@ impl Motion {
         }
         let work = !self.prep.is_idle() || !PLANNER.with(|p| p.is_idle());
         let held = self.prep.hold_state() == Hold::Stopped;
-        (freed, made == max && work && !held && room)
+        (freed, made >= max && work && !held && room)
     }
 
     /// The step queue runs inside planned motion on less than

@@ -39,6 +39,12 @@ impl Flags {
         unsafe { core::ptr::read_volatile(self.0.get()) == 0 }
     }
 
+    /// [`Flags::seems_empty`] for the bits of `mask` alone.
+    pub fn seems_any(&self, mask: u16) -> bool {
+        // SAFETY: as `seems_empty`'s.
+        unsafe { core::ptr::read_volatile(self.0.get()) & mask != 0 }
+    }
+
     /// With interrupts masked (the dispatcher's idle path): the two bytes
     /// agree.
     pub fn is_empty_masked(&self) -> bool {

@@ -635,7 +635,10 @@ fn main() {
         if flag == "--segment" {
             // `segment_cycles.elf` alone: root, profile, event time, segment.
             let (c, n) = segment_cycles(Path::new(elf));
-            println!("cycles: root {}, profile {}, event time {}, segment {} ({n} segments)", c[0], c[1], c[2], c[3]);
+            println!(
+                "cycles: root {}, profile {}, event time {}, segment {} ({n} segments)",
+                c[0], c[1], c[2], c[3]
+            );
             return;
         }
     }

@@ -342,7 +342,10 @@ pub(crate) fn print_profile(elf: &Path, p: &taut_simavr::profile::Profile, n: us
     }
     // `TAUT_BENCH_CALLEES=a,b`: what functions whose names hold a or b
     // called.
-    for caller in std::env::var("TAUT_BENCH_CALLEES").unwrap_or_default().split(',') {
+    for caller in std::env::var("TAUT_BENCH_CALLEES")
+        .unwrap_or_default()
+        .split(',')
+    {
         if caller.is_empty() {
             continue;
         }
