@@ -119,10 +119,10 @@ impl Reader {
         for g in codes('G') {
             match g {
                 g if g == 0.0 || g == 1.0 || g == 2.0 || g == 3.0 => self.motion = g as u8,
-                g if g == 90.0 => self.absolute = true,
-                g if g == 91.0 => self.absolute = false,
-                g if g == 20.0 => self.inch = true,
-                g if g == 21.0 => self.inch = false,
+                90.0 => self.absolute = true,
+                91.0 => self.absolute = false,
+                20.0 => self.inch = true,
+                21.0 => self.inch = false,
                 g if g == 92.0 || g == 10.0 => offset_line = Some(g),
                 _ => {}
             }

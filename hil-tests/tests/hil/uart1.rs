@@ -226,7 +226,7 @@ fn a_half_typed_usb_line_never_mixes_with_uart1_lines() {
         // Absolute moves: X from USB, Y from UART1.
         let head = "G90 G1 X2";
         let cut = 1 + rng.below(head.len() as u64 - 1) as usize;
-        sim.uart_send(head[..cut].as_bytes());
+        sim.uart_send(&head.as_bytes()[..cut]);
         sim.run_for(Duration::from_millis(rng.below(50)));
         let mut y = 0;
         for _ in 0..5 {
