@@ -41,10 +41,16 @@ const LIBGCC: &[&str] = &[
     "_divdi3.o",
 ];
 
-/// Members of avr-libc's `libc.a`: the memory routines LLVM calls for
-/// struct copies and clears (the Rust ones copy a byte per loop turn;
-/// these are assembly, about three times faster).
-const LIBC: &[&str] = &["memcpy.o", "memmove.o", "memset.o", "memcmp.o"];
+/// Members of avr-libc's `libc.a`: memory routines LLVM calls (the Rust
+/// ones copy a byte per loop turn; these are assembly, about three times
+/// faster). `memcpy` and `memset`, called for every struct move and
+/// clear, are the image's own (`src/rt/mem.S`).
+const LIBC: &[&str] = &["memmove.o", "memcmp.o"];
+
+/// The image's own assembly routines in `src/rt/`, each an object of
+/// every image: the linker takes them before the builtins' weak portable
+/// ones and instead of the archives' (the files say why each is there).
+const OWN: &[&str] = &["mul64", "mem"];
 
 fn main() {
     let hash = Command::new("git")
@@ -104,15 +110,16 @@ fn main() {
             println!("cargo:rustc-link-arg={}", out.join(m).display());
         }
     }
-    // The image's own 64-bit product (src/rt/mul64.rs says why).
-    let mul = out.join("mul64.o");
-    let st = Command::new("avr-gcc")
-        .args(["-mmcu=atmega2560", "-c", "src/rt/mul64.S", "-o"])
-        .arg(&mul)
-        .status()
-        .expect("avr-gcc (Debian gcc-avr) is needed to link the firmware");
-    assert!(st.success(), "avr-gcc -c src/rt/mul64.S");
-    println!("cargo:rustc-link-arg={}", mul.display());
+    for name in OWN {
+        let (src, obj) = (format!("src/rt/{name}.S"), out.join(format!("{name}.o")));
+        let st = Command::new("avr-gcc")
+            .args(["-mmcu=atmega2560", "-c", &src, "-o"])
+            .arg(&obj)
+            .status()
+            .expect("avr-gcc (Debian gcc-avr) is needed to link the firmware");
+        assert!(st.success(), "avr-gcc -c {src}");
+        println!("cargo:rustc-link-arg={}", obj.display());
+    }
     // After the objects: the archives are searched in order.
     println!("cargo:rustc-link-arg=-lm");
     println!("cargo:rustc-link-arg=-lgcc");

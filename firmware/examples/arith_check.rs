@@ -4,9 +4,12 @@
 //! and edges), and the segment maths' `div_to_u32` against the compiler's
 //! `u64` division (quotients of every length, remainders up to the
 //! divisor), and the square root built on both: floor roots at every
-//! length. D11 goes high if every result agrees, then D12 when the
-//! check is over. The status LED (D13) is high while 256
-//! products of two 32-bit factors run, so the harness reads their cycles.
+//! length; its `memcpy` and `memset` (`src/rt/mem.S`) against byte-by-
+//! byte volatile copies and clears, every length to 70 at every offset
+//! mod 4, the bytes around untouched. D11 goes high if every result
+//! agrees, then D12 when the check is over. The status LED (D13) is high
+//! while 256 products of two 32-bit factors run, D10 while 64 copies of
+//! 64 bytes run, so the harness reads their cycles.
 #![no_std]
 #![no_main]
 
@@ -28,12 +31,70 @@ fn reference(a: u64, b: u64) -> u64 {
     r
 }
 
+/// `memcpy` and `memset` (the compiler's calls for a length known only
+/// at run time) against volatile byte loops, which it cannot make calls
+/// of: every length to 70 from and to every offset mod 4, with guard
+/// bytes on both sides.
+fn copies_and_clears_agree() -> bool {
+    let mut agree = true;
+    let mut src = [0u8; 80];
+    for (i, b) in src.iter_mut().enumerate() {
+        *b = (i as u8).wrapping_mul(37) ^ 0xA5;
+    }
+    let (mut got, mut want) = ([0u8; 80], [0u8; 80]);
+    for len in 0..=70usize {
+        for (from, to) in [(0, 0), (1, 3), (2, 1), (3, 2), (5, 4)] {
+            for buf in [&mut got, &mut want] {
+                for (i, b) in buf.iter_mut().enumerate() {
+                    // SAFETY: a byte of a local array.
+                    unsafe { core::ptr::write_volatile(b, i as u8) };
+                }
+            }
+            // SAFETY: `from + len` and `to + len` are within the 80-byte
+            // arrays, which are distinct.
+            unsafe {
+                core::ptr::copy_nonoverlapping(
+                    black_box(src.as_ptr().add(from)),
+                    got.as_mut_ptr().add(to),
+                    black_box(len),
+                );
+            }
+            for k in 0..len {
+                // SAFETY: bytes of local arrays, within their lengths.
+                unsafe {
+                    core::ptr::write_volatile(
+                        &mut want[to + k],
+                        core::ptr::read_volatile(&src[from + k]),
+                    )
+                };
+            }
+            agree &= got == want;
+            let value = black_box(len as u8 ^ 0x3C);
+            // SAFETY: `to + len` is within the 80-byte array.
+            unsafe { core::ptr::write_bytes(got.as_mut_ptr().add(to), value, black_box(len)) };
+            for k in 0..len {
+                // SAFETY: a byte of a local array, within its length.
+                unsafe { core::ptr::write_volatile(&mut want[to + k], value) };
+            }
+            agree &= got == want;
+        }
+    }
+    agree
+}
+
 #[avr_device::entry]
 fn main() -> ! {
     let dp = avr_device::atmega2560::Peripherals::take().unwrap();
-    dp.PORTB
-        .ddrb()
-        .write(|w| w.pb7().set_bit().pb6().set_bit().pb5().set_bit());
+    dp.PORTB.ddrb().write(|w| {
+        w.pb7()
+            .set_bit()
+            .pb6()
+            .set_bit()
+            .pb5()
+            .set_bit()
+            .pb4()
+            .set_bit()
+    });
     let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
     let mut agree = true;
     let edges = [0, 1, 0xFF, 0xFFFF_FFFF, 1 << 32, u64::MAX, 1 << 63];
@@ -83,6 +144,7 @@ fn main() -> ! {
     let n = (u32::MAX as u64) * (u32::MAX as u64) + (u32::MAX - 1) as u64;
     agree &= div_to_u32(black_box(n), black_box(u32::MAX)) == u32::MAX;
     agree &= div_to_u32(black_box(0), black_box(7)) == 0;
+    agree &= copies_and_clears_agree();
     dp.PORTB.portb().write(|w| w.pb5().bit(agree));
     dp.PORTB.portb().modify(|_, w| w.pb7().set_bit());
     for i in 0..256u32 {
@@ -93,7 +155,23 @@ fn main() -> ! {
     }
     dp.PORTB
         .portb()
-        .modify(|_, w| w.pb7().clear_bit().pb6().set_bit());
+        .modify(|_, w| w.pb7().clear_bit().pb4().set_bit());
+    let (mut from, mut to) = ([0x5Au8; 64], [0u8; 64]);
+    for _ in 0..64 {
+        // SAFETY: two distinct 64-byte arrays.
+        unsafe {
+            core::ptr::copy_nonoverlapping(
+                black_box(&from).as_ptr(),
+                to.as_mut_ptr(),
+                black_box(64),
+            )
+        };
+        black_box(&mut to);
+        from[0] = to[1];
+    }
+    dp.PORTB
+        .portb()
+        .modify(|_, w| w.pb4().clear_bit().pb6().set_bit());
     loop {
         avr_device::asm::sleep();
     }
