@@ -96,7 +96,10 @@ fn the_images_wide_arithmetic_is_exact() {
     sim.probe(10, "copies");
     let end = sim.run_until(|s| s.pin_level(12), Duration::from_secs(2));
     assert_eq!(end, Outcome::Done, "the check ran to its end");
-    assert!(sim.pin_level(11), "every product and quotient agrees");
+    assert!(
+        sim.pin_level(11),
+        "every product, quotient, root, copy and clear agrees"
+    );
     let e = sim.probed("led").edges();
     assert_eq!(e.len(), 2, "one timed batch");
     let per = (e[1].cycle - e[0].cycle) as f64 / 256.0;
