@@ -18,6 +18,7 @@ use super::{milli, mm, ChannelScale, Frac, KinError, Kinematics, Position, Steps
 use crate::axis::AXES;
 use crate::config::Geometry;
 use crate::fmath;
+use crate::units::Milli;
 use core::f32::consts::PI;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,8 +27,9 @@ pub struct Scara {
     /// Arm lengths, mm.
     l1: f32,
     l2: f32,
-    /// Position of the shoulder joint, mm.
-    offset: [f32; 2],
+    /// Position of the shoulder joint: the pen's place less this is exact
+    /// in integers, and one conversion to mm.
+    offset: [Milli; 2],
     /// 1/ECR; 0 when the elbow motor sits on the elbow (no crosstalk).
     crosstalk: f32,
 }
@@ -47,12 +49,20 @@ impl Scara {
             scale: *scale,
             l1: mm(l1),
             l2: mm(l2),
-            offset: [mm(g.origin[0]), mm(g.origin[1])],
+            offset: g.origin,
             crosstalk: match ecr.num {
                 0 => 0.0,
                 n => ecr.den as f32 / n as f32,
             },
         })
+    }
+
+    /// `pos` from the shoulder, mm.
+    fn shoulder_to(&self, pos: &Position) -> [f32; 2] {
+        // Saturated: a place that far is out of reach either way.
+        let x = pos[0].0.saturating_sub(self.offset[0].0);
+        let y = pos[1].0.saturating_sub(self.offset[1].0);
+        [mm(Milli(x)), mm(Milli(y))]
     }
 }
 
@@ -72,8 +82,8 @@ impl Kinematics for Scara {
     #[inline(never)]
     fn inverse_fine(&self, pos: &Position) -> Result<(Steps, Frac), KinError> {
         let (l1, l2) = (self.l1, self.l2);
-        let x = -(mm(pos[0]) - self.offset[0]);
-        let y = mm(pos[1]) - self.offset[1];
+        let [x, y] = self.shoulder_to(pos);
+        let x = -x;
         let h2 = x * x + y * y;
         // Reach, with 1 µm of slack for the decimal input: on squares,
         // no root.
@@ -105,8 +115,8 @@ impl Kinematics for Scara {
         let e = b - a * self.crosstalk;
         let (sin_s, cos_s) = fmath::sin_cos(s);
         let (sin_se, cos_se) = fmath::sin_cos(s + e);
-        let x = -sin_s * self.l1 - sin_se * self.l2 + self.offset[0];
-        let y = cos_s * self.l1 + cos_se * self.l2 + self.offset[1];
+        let x = -sin_s * self.l1 - sin_se * self.l2 + mm(self.offset[0]);
+        let y = cos_s * self.l1 + cos_se * self.l2 + mm(self.offset[1]);
         let mut pos = self.scale.all_milli(steps);
         pos[0] = milli(x);
         pos[1] = milli(y);
@@ -122,9 +132,10 @@ impl Kinematics for Scara {
     /// ray behind it (see the module's notes).
     fn reaches_line(&self, a: &Position, b: &Position) -> bool {
         let outer = self.l1 + self.l2 + 0.001;
-        let (ax, ay) = (mm(a[0]) - self.offset[0], mm(a[1]) - self.offset[1]);
-        let (bx, by) = (mm(b[0]) - self.offset[0], mm(b[1]) - self.offset[1]);
-        if ax * ax + ay * ay > outer * outer || bx * bx + by * by > outer * outer {
+        let [ax, ay] = self.shoulder_to(a);
+        let [bx, by] = self.shoulder_to(b);
+        let (a2, b2) = (ax * ax + ay * ay, bx * bx + by * by);
+        if a2 > outer * outer || b2 > outer * outer {
             return false;
         }
         // The inverse's bearing is atan2(−x, y): on the ray (x = 0, y < 0)
@@ -138,14 +149,25 @@ impl Kinematics for Scara {
             }
         }
         let (dx, dy) = (bx - ax, by - ay);
+        // The shoulder itself is out of reach even with equal arms.
+        // (A comparison: `max` is a call on the AVR.)
+        let inner = match (self.l1 - self.l2).abs() - 0.001 {
+            d if d > 0.001 => d,
+            _ => 0.001,
+        };
+        // Every point of the line is within its length (at most
+        // |dx| + |dy|) of `a`: a short line well clear of the hole needs
+        // no closest point (a division and a dozen products).
+        let clear = inner + dx.abs() + dy.abs();
+        if a2 >= clear * clear {
+            return true;
+        }
         let len2 = dx * dx + dy * dy;
         let t = match len2 > 0.0 {
             true => (-(ax * dx + ay * dy) / len2).clamp(0.0, 1.0),
             false => 0.0,
         };
         let (cx, cy) = (ax + t * dx, ay + t * dy);
-        // The shoulder itself is out of reach even with equal arms.
-        let inner = ((self.l1 - self.l2).abs() - 0.001).max(0.001);
         cx * cx + cy * cy >= inner * inner
     }
 
