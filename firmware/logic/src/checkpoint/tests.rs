@@ -51,7 +51,7 @@ fn crc16_is_ccitt_false() {
 
 #[test]
 fn layout_fits_above_the_settings_and_in_the_eeprom() {
-    assert!(crate::settings::eeprom::END <= START);
+    const { assert!(crate::settings::eeprom::END <= START) };
     assert_eq!(SLOTS, 312);
     const { assert!(RING + SLOTS * RECORD_BYTES <= END) };
 }
