@@ -247,7 +247,7 @@ pub(super) fn keep<const N: usize>(rx: &Ring<u8, N, true>, cut: &AtomicBool, b: 
     if b == b'\n' || b == b'\r' {
         // While the console is behind by a whole line the end finds no
         // room: the next line is then dropped with this one.
-        if rx.push(if was_cut { LINE_CUT } else { b }).is_ok() {
+        if rx.push_inlined(if was_cut { LINE_CUT } else { b }).is_ok() {
             cut.store(false, Relaxed);
         }
         return;
@@ -259,7 +259,7 @@ pub(super) fn keep<const N: usize>(rx: &Ring<u8, N, true>, cut: &AtomicBool, b: 
         rx.refuse();
         return;
     }
-    let _ = rx.push(b);
+    let _ = rx.push_inlined(b);
 }
 
 /// The `USART0_RX` handler, entered with its interrupt switched off: the

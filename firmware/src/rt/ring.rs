@@ -140,6 +140,26 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
         unsafe { (*self.stats.get()).on_refused() };
     }
 
+    /// [`Ring::push`] inlined, for an interrupt handler: a call there
+    /// costs the saving of every register a callee may clobber (the UART's
+    /// byte went from ~350 cycles to ~200).
+    #[inline(always)]
+    pub fn push_inlined(&self, item: T) -> Result<(), T> {
+        // SAFETY: only the producer touches `stats` mutably.
+        let stats = unsafe { &mut *self.stats.get() };
+        if self.free() == 0 {
+            stats.on_refused();
+            return Err(item);
+        }
+        let h = self.head.load(Relaxed);
+        // SAFETY: slot `h` is free (checked above) and the producer's.
+        unsafe { (*self.buf.get())[(h & Self::MASK) as usize] = MaybeUninit::new(item) };
+        compiler_fence(Release);
+        self.head.store(Self::next(h), Relaxed);
+        stats.on_send(self.len());
+        Ok(())
+    }
+
     pub fn push(&self, item: T) -> Result<(), T> {
         if self.push_all(&[item]) {
             Ok(())

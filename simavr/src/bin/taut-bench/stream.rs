@@ -367,6 +367,10 @@ pub(crate) fn print_profile(elf: &Path, p: &taut_simavr::profile::Profile, n: us
         "__divsf3",
         "__mulsf3x",
         "__udivmodsi4",
+        "__gesf2",
+        "__cmpsf2",
+        "__addsf3",
+        "__subsf3",
     ] {
         println!("  callers of {callee}:");
         for (cycles, name) in p.callers_of(callee).iter().take(12) {
