@@ -390,6 +390,7 @@ pub enum Realtime {
 }
 
 impl Realtime {
+    #[inline]
     pub const fn from_byte(byte: u8) -> Option<Realtime> {
         match byte {
             b'?' => Some(Realtime::Status),
