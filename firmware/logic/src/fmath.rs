@@ -40,6 +40,14 @@ const PIO4_LO: f32 = 1.569_582_4e-7;
 /// tan(π/8) = √2 − 1.
 const TAN_PI_8: f32 = 0.414_213_57;
 
+/// +∞'s bits; a magnitude's above them are NaN's.
+const INF_BITS: u32 = 0x7f80_0000;
+
+/// |x|'s bits: for any two that are not NaN, in the order of the values.
+fn magnitude(x: f32) -> u32 {
+    x.to_bits() & 0x7fff_ffff
+}
+
 /// 2⁴⁰, exactly.
 const TWO_POW_40: f32 = (1u64 << 40) as f32;
 
@@ -102,20 +110,23 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
 /// The angle of the point (x, y) from the positive x axis, in [−π, π]:
 /// `libm::atan2f`'s conventions for zeros, infinities and NaN.
 pub fn atan2(y: f32, x: f32) -> f32 {
-    if x.is_nan() || y.is_nan() {
+    // Magnitudes compared as their bits (in the order of their values, for
+    // any that is not NaN): on the AVR a float comparison is a call.
+    let (bx, by) = (magnitude(x), magnitude(y));
+    if bx > INF_BITS || by > INF_BITS {
         return x + y;
     }
-    let (ax, ay) = (x.abs(), y.abs());
     // Fold the octant: t = num/den ∈ [0, 1].
-    let swapped = ay > ax;
-    let (mut num, mut den) = if swapped { (ax, ay) } else { (ay, ax) };
-    if num == f32::INFINITY {
+    let swapped = by > bx;
+    let (nb, db) = if swapped { (bx, by) } else { (by, bx) };
+    let (mut num, mut den) = (f32::from_bits(nb), f32::from_bits(db));
+    if nb == INF_BITS {
         // Both infinite: ±π/4, ±3π/4.
         (num, den) = (1.0, 1.0);
-    } else if den > 1e38 {
+    } else if db > 1e38f32.to_bits() {
         // Keep num + den finite.
         (num, den) = (num * 0.5, den * 0.5);
-    } else if den < 1e-30 {
+    } else if db < 1e-30f32.to_bits() {
         // Keep tan(π/8)·den normal, so that the test below is sharp
         // (exact: a power of two, no overflow).
         (num, den) = (num * TWO_POW_40, den * TWO_POW_40);
@@ -123,9 +134,9 @@ pub fn atan2(y: f32, x: f32) -> f32 {
     // The angle is n·π/4 + p, n ∈ 0..=4, p = ±atan(u), |u| ≤ tan(π/8);
     // for t > tan(π/8), atan t = π/4 + atan((t − 1)/(t + 1)). One division
     // either way.
-    let (mut n, mut p) = if den == 0.0 {
+    let (mut n, mut p) = if db == 0 {
         (0u8, 0.0) // both zero: the sign bits decide below
-    } else if num > TAN_PI_8 * den {
+    } else if magnitude(num) > magnitude(TAN_PI_8 * den) {
         (1u8, atan_poly((num - den) / (num + den)))
     } else {
         (0u8, atan_poly(num / den))
@@ -157,10 +168,12 @@ pub fn atan2(y: f32, x: f32) -> f32 {
 /// √x, correctly rounded (round to nearest even). √±0 = ±0, √+∞ = +∞;
 /// negative x or NaN gives NaN.
 pub fn sqrt(x: f32) -> f32 {
-    if x.is_nan() || x == 0.0 || x == f32::INFINITY {
+    // As bits: see `atan2`.
+    let m = magnitude(x);
+    if m > INF_BITS || m == 0 || x.to_bits() == INF_BITS {
         return x;
     }
-    if x < 0.0 {
+    if x.is_sign_negative() {
         return f32::NAN;
     }
     // fdlibm's e_sqrtf.c: x = m·2^e with m the 24-bit integer mantissa,
