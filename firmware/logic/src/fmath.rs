@@ -43,8 +43,9 @@ const TAN_PI_8: f32 = 0.414_213_57;
 /// +∞'s bits; a magnitude's above them are NaN's.
 const INF_BITS: u32 = 0x7f80_0000;
 
-/// |x|'s bits: for any two that are not NaN, in the order of the values.
-fn magnitude(x: f32) -> u32 {
+/// |x|'s bits: for any two that are not NaN, in the order of the values
+/// (a comparison of integers: of floats, it is a call on the AVR).
+pub fn magnitude(x: f32) -> u32 {
     x.to_bits() & 0x7fff_ffff
 }
 

@@ -27,6 +27,7 @@ pub use segmenter::{Piece, Segmenter};
 
 use crate::axis::{PerAxis, AXES};
 use crate::config::MachineConfig;
+use crate::fmath::magnitude;
 use crate::machine::Machine;
 use crate::units::{div_round, Milli, StepsPerUnit};
 
@@ -114,8 +115,10 @@ impl ChannelScale {
     fn steps_fine(&self, axis: usize, value: f32) -> Result<(i32, i8), KinError> {
         let exact = value * self.0[axis].as_f32();
         let s = libm::roundf(exact);
-        // 2^31 is exact in f32; NaN fails both comparisons.
-        if (-2_147_483_648.0..2_147_483_648.0).contains(&s) {
+        // 2^31 is exact in f32; NaN's magnitude is above it. (Compared as
+        // bits: `fmath::magnitude`.)
+        const I32_END: f32 = 2_147_483_648.0;
+        if magnitude(s) < I32_END.to_bits() || s.to_bits() == (-I32_END).to_bits() {
             // Saturating: ±½ step is ±128.
             Ok((s as i32, ((exact - s) * 256.0) as i8))
         } else {

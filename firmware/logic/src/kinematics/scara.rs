@@ -17,7 +17,7 @@
 use super::{milli, mm, ChannelScale, Frac, KinError, Kinematics, Position, Steps};
 use crate::axis::AXES;
 use crate::config::Geometry;
-use crate::fmath;
+use crate::fmath::{self, magnitude};
 use crate::units::Milli;
 use core::f32::consts::PI;
 
@@ -35,6 +35,9 @@ pub struct Scara {
 }
 
 const DEG: f32 = 180.0 / PI;
+
+/// 1.0's bits.
+const ONE: u32 = 0x3f80_0000;
 
 impl Scara {
     /// `lengths` are L1 and L2, `origin` the shoulder's place, `crosstalk`
@@ -87,15 +90,23 @@ impl Kinematics for Scara {
         let h2 = x * x + y * y;
         // Reach, with 1 µm of slack for the decimal input: on squares,
         // no root.
+        // (Compared as magnitudes' bits: `fmath::magnitude`.)
         let (outer, inner) = (l1 + l2 + 0.001, (l1 - l2).abs() - 0.001);
-        if h2 == 0.0 || h2 > outer * outer || (inner > 0.0 && h2 < inner * inner) {
+        let h = magnitude(h2);
+        let hole = inner.to_bits() as i32 > 0 && h < magnitude(inner * inner);
+        if h == 0 || h > magnitude(outer * outer) || hole {
             return Err(KinError::Unreachable);
         }
         // The elbow's bend from the law of cosines (the original arm's
         // notes print "+ L1² + L2²"; it has minus), and the shoulder's
         // angle off the pen's bearing from the same sine and cosine: one
         // root, where two arc cosines took three and a division.
-        let c = ((h2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)).clamp(-1.0, 1.0);
+        let c = (h2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2);
+        // Within ±1 (by a rounding, or the slack), sign kept.
+        let c = match magnitude(c) > ONE {
+            true => f32::from_bits(ONE | c.to_bits() & 0x8000_0000),
+            false => c,
+        };
         let s = fmath::sqrt(1.0 - c * c);
         let bend = fmath::atan2(s, c);
         let shoulder = shoulder(x, y, l2 * s, l1 + l2 * c);
@@ -184,7 +195,8 @@ impl Kinematics for Scara {
 /// bearing there is −π) and the difference is below −π.
 fn shoulder(x: f32, y: f32, ox: f32, oy: f32) -> f32 {
     let a = fmath::atan2(x * oy - y * ox, y * oy + x * ox);
-    match x.is_sign_negative() && a > 0.0 {
+    // a > 0 as bits (not NaN: its arguments are finite).
+    match x.is_sign_negative() && a.to_bits() as i32 > 0 {
         true => a - 2.0 * PI,
         false => a,
     }
