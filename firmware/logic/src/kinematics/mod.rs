@@ -100,20 +100,48 @@ impl ChannelScale {
 
     /// Steps of one coordinate, rounded once from the absolute target.
     pub fn steps(&self, axis: usize, target: Milli) -> Result<i32, KinError> {
-        let spu = self.0[axis];
-        let n = target.0 as i64 * spu.num as i64;
-        let steps = div_round(n, spu.den as i64 * Milli::SCALE as i64);
-        i32::try_from(steps).map_err(|_| KinError::Overflow)
+        steps_of(self.0[axis], target)
     }
 
     pub fn milli(&self, axis: usize, steps: i32) -> Milli {
         self.0[axis].milli(steps)
     }
 
+    fn all_steps(&self, pos: &Position) -> Result<Steps, KinError> {
+        let mut out = [0; AXES];
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.steps(i, pos[i])?;
+        }
+        Ok(out)
+    }
+
+    fn all_milli(&self, steps: &Steps) -> Position {
+        core::array::from_fn(|i| self.milli(i, steps[i]))
+    }
+}
+
+/// The scale of a kinematics that works its two joints (channels 0 and 1)
+/// out in floats: their steps per unit as floats, made once (a float
+/// division each, ~600 cycles on the AVR, was part of every piece), and
+/// the pen's channel (2) exactly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct JointScale {
+    per_unit: [f32; 2],
+    pen: StepsPerUnit,
+}
+
+impl JointScale {
+    fn new(scale: &ChannelScale) -> Self {
+        JointScale {
+            per_unit: [scale.0[0].as_f32(), scale.0[1].as_f32()],
+            pen: scale.0[2],
+        }
+    }
+
     /// Steps of a joint value computed in floating point (mm or degrees),
     /// and what the rounding took off, in 1/256 step.
-    fn steps_fine(&self, axis: usize, value: f32) -> Result<(i32, i8), KinError> {
-        let exact = value * self.0[axis].as_f32();
+    fn steps_fine(&self, joint: usize, value: f32) -> Result<(i32, i8), KinError> {
+        let exact = value * self.per_unit[joint];
         let s = libm::roundf(exact);
         // 2^31 is exact in f32; NaN's magnitude is above it. (Compared as
         // bits: `fmath::magnitude`.)
@@ -127,33 +155,28 @@ impl ChannelScale {
     }
 
     /// The joint value (mm or degrees) of a step count.
-    fn value_f32(&self, axis: usize, steps: i32) -> f32 {
-        let spu = self.0[axis];
-        steps as f32 * spu.den as f32 / spu.num as f32
+    fn value_f32(&self, joint: usize, steps: i32) -> f32 {
+        steps as f32 / self.per_unit[joint]
     }
 
-    fn all_steps(&self, pos: &Position) -> Result<Steps, KinError> {
-        let mut out = [0; AXES];
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = self.steps(i, pos[i])?;
-        }
-        Ok(out)
+    /// The pen channel's steps of `pos`; the joints' 0, for the caller to
+    /// work out.
+    fn pen_steps(&self, pos: &Position) -> Result<Steps, KinError> {
+        Ok([0, 0, steps_of(self.pen, pos[2])?])
     }
 
-    /// The steps of the channels from `first` on (below it: 0), for a
-    /// kinematics that works out the others in floats: no 64-bit division
-    /// for a count it would overwrite.
-    fn steps_from(&self, first: usize, pos: &Position) -> Result<Steps, KinError> {
-        let mut out = [0; AXES];
-        for i in first..AXES {
-            out[i] = self.steps(i, pos[i])?;
-        }
-        Ok(out)
+    /// The pen channel's place at `steps`; the joints' 0, for the caller
+    /// to work out.
+    fn pen_milli(&self, steps: &Steps) -> Position {
+        [Milli::ZERO, Milli::ZERO, self.pen.milli(steps[2])]
     }
+}
 
-    fn all_milli(&self, steps: &Steps) -> Position {
-        core::array::from_fn(|i| self.milli(i, steps[i]))
-    }
+/// Steps of one coordinate, rounded once from the absolute target.
+fn steps_of(spu: StepsPerUnit, target: Milli) -> Result<i32, KinError> {
+    let n = target.0 as i64 * spu.num as i64;
+    let steps = div_round(n, spu.den as i64 * Milli::SCALE as i64);
+    i32::try_from(steps).map_err(|_| KinError::Overflow)
 }
 
 /// µm → mm for the float kinematics: a product, within an ulp of the

@@ -5,14 +5,14 @@
 //! lifts the pen. The user's (0, 0) is `origin` in that frame, and the step
 //! counts are zero there (the pen is parked at the origin when zeroed).
 
-use super::{milli, mm, ChannelScale, Frac, KinError, Kinematics, Position, Steps};
+use super::{milli, mm, ChannelScale, Frac, JointScale, KinError, Kinematics, Position, Steps};
 use crate::axis::AXES;
 use crate::config::Geometry;
 use crate::fmath;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Polargraph {
-    scale: ChannelScale,
+    scale: JointScale,
     /// Distance between the string exits, mm.
     distance: f32,
     /// The user's origin in the motors' frame, mm.
@@ -26,7 +26,7 @@ impl Polargraph {
     /// `lengths[0]` is the distance between the strings' exits.
     pub fn new(scale: &ChannelScale, g: &Geometry) -> Result<Self, KinError> {
         let mut k = Polargraph {
-            scale: *scale,
+            scale: JointScale::new(scale),
             distance: mm(g.lengths[0]),
             origin: [mm(g.origin[0]), mm(g.origin[1])],
             home: [0.0; 2],
@@ -58,7 +58,7 @@ impl Kinematics for Polargraph {
     fn inverse_fine(&self, pos: &Position) -> Result<(Steps, Frac), KinError> {
         let p = [self.origin[0] + mm(pos[0]), self.origin[1] + mm(pos[1])];
         let len = self.lengths(p)?;
-        let mut steps = self.scale.steps_from(2, pos)?;
+        let mut steps = self.scale.pen_steps(pos)?;
         let mut frac = [0; AXES];
         for i in 0..2 {
             (steps[i], frac[i]) = self.scale.steps_fine(i, len[i] - self.home[i])?;
@@ -86,7 +86,7 @@ impl Kinematics for Polargraph {
         // Intersection of the two circles, the lower one.
         let x = (l * l - r * r + d * d) / (2.0 * d);
         let y = -fmath::sqrt((l * l - x * x).max(0.0));
-        let mut pos = self.scale.all_milli(steps);
+        let mut pos = self.scale.pen_milli(steps);
         pos[0] = milli(x - self.origin[0]);
         pos[1] = milli(y - self.origin[1]);
         pos

@@ -14,7 +14,7 @@
 //! reach ([`Kinematics::reaches_line`]): refused before anything moves,
 //! never drawn the long way round.
 
-use super::{milli, mm, ChannelScale, Frac, KinError, Kinematics, Position, Steps};
+use super::{milli, mm, ChannelScale, Frac, JointScale, KinError, Kinematics, Position, Steps};
 use crate::axis::AXES;
 use crate::config::Geometry;
 use crate::fmath::{self, magnitude};
@@ -23,7 +23,7 @@ use core::f32::consts::PI;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Scara {
-    scale: ChannelScale,
+    scale: JointScale,
     /// Arm lengths, mm.
     l1: f32,
     l2: f32,
@@ -49,7 +49,7 @@ impl Scara {
             return Err(KinError::Unreachable);
         }
         Ok(Scara {
-            scale: *scale,
+            scale: JointScale::new(scale),
             l1: mm(l1),
             l2: mm(l2),
             offset: g.origin,
@@ -111,7 +111,7 @@ impl Kinematics for Scara {
         let bend = fmath::atan2(s, c);
         let shoulder = shoulder(x, y, l2 * s, l1 + l2 * c);
         let elbow = shoulder * self.crosstalk + bend;
-        let mut steps = self.scale.steps_from(2, pos)?;
+        let mut steps = self.scale.pen_steps(pos)?;
         let mut frac = [0; AXES];
         (steps[0], frac[0]) = self.scale.steps_fine(0, shoulder * DEG)?;
         (steps[1], frac[1]) = self.scale.steps_fine(1, elbow * DEG)?;
@@ -128,7 +128,7 @@ impl Kinematics for Scara {
         let (sin_se, cos_se) = fmath::sin_cos(s + e);
         let x = -sin_s * self.l1 - sin_se * self.l2 + mm(self.offset[0]);
         let y = cos_s * self.l1 + cos_se * self.l2 + mm(self.offset[1]);
-        let mut pos = self.scale.all_milli(steps);
+        let mut pos = self.scale.pen_milli(steps);
         pos[0] = milli(x);
         pos[1] = milli(y);
         pos
