@@ -6,7 +6,8 @@ use super::{
     motor_channels, motor_milli, motor_only, motor_steps, todo, Env, Interpreter, MachineIo, Path,
     Progress, Wait,
 };
-use crate::kinematics::{Kinematics, Segmenter};
+use crate::axis::AXES;
+use crate::kinematics::{Kinematics, Piece, Segmenter};
 
 impl Interpreter {
     /// Carry out what is left of the accepted line, as far as the
@@ -121,6 +122,9 @@ impl Interpreter {
         io: &mut impl MachineIo,
     ) -> Option<Wait> {
         if !env.kin.is_linear() {
+            if let Some(waits) = self.one_piece(second, env, io) {
+                return waits;
+            }
             self.line_path(second, env);
             // Its pieces next, from this same call.
             return self.piece(env, io);
@@ -137,6 +141,39 @@ impl Interpreter {
         }
         self.run.from = to;
         None
+    }
+
+    /// A straight leg no longer than half a piece (each line of a stream
+    /// of tiny ones) queued as its one piece, with no path kept: the piece
+    /// [`Interpreter::piece`] would queue. `None` for a longer leg. Out of
+    /// line: the piece is built in its frame.
+    #[inline(never)]
+    fn one_piece<K: Kinematics>(
+        &mut self,
+        second: bool,
+        env: &Env<K>,
+        io: &mut impl MachineIo,
+    ) -> Option<Option<Wait>> {
+        let motors = motor_channels(env.cfg);
+        let mut piece = Piece {
+            start: motor_milli(&self.run.from, motors),
+            to: motor_milli(&self.run.legs[second as usize], motors),
+            steps: [0; AXES],
+            frac: [0; AXES],
+        };
+        if !Segmenter::is_one_piece(&piece.start, &piece.to, env.kin.piece_um()) {
+            return None;
+        }
+        if let Some(wait) = io.room(true) {
+            return Some(Some(wait));
+        }
+        // Checked when the line was accepted.
+        (piece.steps, piece.frac) = env.kin.inverse_fine(&piece.to).ok()?;
+        if !io.queue_piece(&piece, self.run.feed) {
+            return Some(Some(Wait::PlannerRoom));
+        }
+        self.run.from = self.run.legs[second as usize];
+        Some(None)
     }
 
     /// A straight leg as a path of pieces: the leg's bit off, the path's

@@ -31,6 +31,8 @@ struct Recorder {
     coords: CoordData,
     clock: u32,
     pen: Option<u8>,
+    /// Pieces to refuse before the next is taken (a full planner).
+    refuse: u32,
 }
 
 impl MachineIo for Recorder {
@@ -56,6 +58,10 @@ impl MachineIo for Recorder {
         true
     }
     fn queue_piece(&mut self, piece: &Piece, feed: Feed) -> bool {
+        if self.refuse > 0 {
+            self.refuse -= 1;
+            return false;
+        }
         self.did.push(Did::Piece(*piece, feed));
         true
     }
@@ -114,6 +120,7 @@ impl Bench {
             coords: CoordData::ZERO,
             clock: 0,
             pen: None,
+            refuse: 0,
         };
         let mut interp = Interpreter::new();
         interp.reset(&io.coord(0));
@@ -702,6 +709,54 @@ fn the_arms_straight_moves_are_the_pens_pieces() {
     // A rapid too, at the pen's top speed.
     b.ok("G0 X100 Y150");
     assert_eq!(b.pieces().last().unwrap().1, Feed::Rapid);
+}
+
+/// A line shorter than half a piece (each of a stream of tiny ones)
+/// goes to the planner as its one piece at once, no path kept: the piece
+/// a path of it gives, from the last line's end, as are lines at and past
+/// that edge; a full planner makes it wait and it is queued once.
+#[test]
+fn a_tiny_line_is_its_one_piece() {
+    for (machine, at, half) in [
+        (Machine::Scara, (100_000, 150_000), 1000),
+        (Machine::Whiteboard, (0, 0), 2500),
+    ] {
+        let mut b = Bench::new(machine);
+        b.ok(&format!("G0 X{} Y{}", at.0 / 1000, at.1 / 1000));
+        b.io.did.clear();
+        let (mut x, mut y) = at;
+        let steps = [
+            (50, 0),
+            (35, 35),
+            (0, -50),
+            (half - 1, 0),
+            (1 - half, half - 1),
+            (half, 0),
+            (-half, -half),
+        ];
+        for (k, (dx, dy)) in steps.into_iter().enumerate() {
+            b.io.refuse = (k % 2) as u32;
+            let from = [Milli(x), Milli(y), Milli(0)];
+            (x, y) = (x + dx, y + dy);
+            b.ok(&format!(
+                "G1 X{:.3} Y{:.3} F1500",
+                x as f64 / 1000.0,
+                y as f64 / 1000.0
+            ));
+            let pieces = b.pieces();
+            assert_eq!(pieces.len(), k + 1, "{machine:?} {k}");
+            let (p, feed) = pieces[k];
+            let to = [Milli(x), Milli(y), Milli(0)];
+            let path: Vec<Position> = Segmenter::new(&b.kin, from, &to, b.kin.piece_um()).collect();
+            assert_eq!(
+                (p.start, p.to, path),
+                (from, to, std::vec![to]),
+                "{machine:?} {k}"
+            );
+            assert_eq!(Ok((p.steps, p.frac)), b.kin.inverse_fine(&p.to));
+            assert_eq!(feed, Feed::PerMinute(Milli(1_500_000)));
+        }
+    }
 }
 
 /// The arm's shoulder cannot follow round behind its base (x = 100,

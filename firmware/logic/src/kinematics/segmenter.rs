@@ -91,6 +91,13 @@ impl Segmenter {
         self.pieces
     }
 
+    /// Whether the move from `from` to `to` is plainly one piece of at
+    /// most `segment_len` µm (as [`pieces`] finds without its root): a
+    /// line of a stream of tiny ones, which then needs no segmenter.
+    pub fn is_one_piece(from: &Position, to: &Position, segment_len: u32) -> bool {
+        (0..AXES).all(|i| to[i].0.abs_diff(from[i].0) < segment_len / 2)
+    }
+
     pub fn start(&self) -> Position {
         self.from
     }
