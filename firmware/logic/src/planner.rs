@@ -412,7 +412,7 @@ impl<const N: usize> Lookahead<N> {
 
     /// The slot of the move being planned: the one after the queue.
     fn staged(&self) -> usize {
-        (self.head + self.len) % N
+        wrap::<N>(self.head + self.len)
     }
 
     /// One bounded part of planning the move [`Planner::stage`] recorded
@@ -445,7 +445,7 @@ impl<const N: usize> Lookahead<N> {
     #[inline(never)]
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_path(&mut self, feed: Feed) {
-        let b = &mut self.blocks[(self.head + self.len) % N];
+        let b = &mut self.blocks[self.staged()];
         // Scaled to events/s by `plan_limits`: this part is the longer.
         b.feed_ev = match feed {
             Feed::Rapid => 0.0,
@@ -482,7 +482,7 @@ impl<const N: usize> Lookahead<N> {
     /// at the junction with the piece before it.
     #[inline(never)]
     fn plan_pen_path(&mut self) {
-        let slot = (self.head + self.len) % N;
+        let slot = self.staged();
         let path: PenPath = self
             .geometry
             .pen_path(&self.blocks[slot].step.block(), &self.pen_staged);
@@ -507,7 +507,7 @@ impl<const N: usize> Lookahead<N> {
     /// pen's speed change (0: the first piece).
     #[inline(never)]
     fn plan_pen_joints(&mut self, ev_per_milli: f32, this: &PenLast) {
-        let b = &mut self.blocks[(self.head + self.len) % N];
+        let b = &mut self.blocks[self.staged()];
         b.junction_sqr = match (self.pen_last, &self.pen) {
             (Some(before), Some(pen)) => {
                 // The junction low enough that the speed a piece reaches
@@ -531,7 +531,7 @@ impl<const N: usize> Lookahead<N> {
     /// Built for size: it is the shortest part.
     #[inline(never)]
     fn plan_junction(&mut self, ev_per_milli: f32) {
-        let b = &mut self.blocks[(self.head + self.len) % N];
+        let b = &mut self.blocks[self.staged()];
         // 0: the first move, or a jump that allows no speed.
         if b.junction_sqr != 0 {
             let turn = Turn::unpack((b.entry_sqr, b.delta_sqr));
@@ -546,7 +546,7 @@ impl<const N: usize> Lookahead<N> {
     #[inline(never)]
     #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_limits(&mut self, ev_per_milli: f32) {
-        let b = &mut self.blocks[(self.head + self.len) % N];
+        let b = &mut self.blocks[self.staged()];
         let step = b.step.block();
         let (mut accel, mut rate) = self.geometry.limits(&step);
         if let (true, Some(pen)) = (b.step.is_pen(), &self.pen) {
@@ -603,7 +603,7 @@ impl<const N: usize> Lookahead<N> {
             return None;
         }
         let b = self.blocks[self.head];
-        self.head = (self.head + 1) % N;
+        self.head = wrap::<N>(self.head + 1);
         self.len -= 1;
         // The next block's entry is fixed now: final, as those before it.
         self.planned = self.planned.saturating_sub(1);
@@ -656,7 +656,7 @@ impl<const N: usize> Lookahead<N> {
     pub fn set_overrides(&mut self, overrides: Overrides) {
         self.overrides = Some(overrides);
         for i in 0..self.len {
-            let b = &mut self.blocks[(self.head + i) % N];
+            let b = &mut self.blocks[wrap::<N>(self.head + i)];
             let (mut accel, mut rate) = self.geometry.limits(&b.step.block());
             let ev_per_milli = crate::fmath::sqrt(b.ev_per_milli_sqr);
             if let (true, Some(pen)) = (b.step.is_pen(), &self.pen) {
@@ -684,7 +684,7 @@ impl<const N: usize> Lookahead<N> {
         if self.len == 0 {
             return;
         }
-        let mut i = (self.head + self.len - 1) % N;
+        let mut i = wrap::<N>(self.head + self.len - 1);
         let mut nominal_sqr = self.blocks[i].nominal_sqr;
         let mut next_entry = 0u32;
         for _ in self.planned + 1..self.len {
@@ -697,7 +697,7 @@ impl<const N: usize> Lookahead<N> {
             nominal_sqr = prev_nominal_sqr;
             i = prev;
         }
-        let mut i = (self.head + self.planned) % N;
+        let mut i = wrap::<N>(self.head + self.planned);
         if self.planned == 0 {
             self.blocks[i].entry_sqr = self.carry_sqr;
         }
@@ -730,6 +730,17 @@ fn shift_for(max_sqr: f32) -> u8 {
         shift += 1;
     }
     shift
+}
+
+/// `i` back in the ring of `N` slots, for `i` < 2·`N` (a slot plus a
+/// count): a subtraction, where a `%` is a 16-bit division call on the
+/// AVR (~200 cycles, several a move).
+fn wrap<const N: usize>(i: usize) -> usize {
+    if i >= N {
+        i - N
+    } else {
+        i
+    }
 }
 
 /// A speed² for the planner's fields: shifted, at most `u32::MAX` (a
