@@ -194,7 +194,7 @@ impl Console {
     /// Grbl's power-on ones, `G92` cleared, `G54` (from `coords`) in force
     /// (Grbl's `gc_init`); the startup lines run again.
     pub fn reset(&mut self, coords: &CoordData) {
-        self.parser = Parser::new();
+        self.parser.clear();
         self.line_ready = false;
         self.owed = false;
         self.pattern = None;

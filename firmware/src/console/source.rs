@@ -10,7 +10,7 @@ use crate::motion::Motion;
 use crate::store::Store;
 use taut_logic::checkpoint::plot::ResumeAction;
 use taut_logic::config::MachineConfig;
-use taut_logic::gcode::{CardLine, Error, ErrorKind, Parser};
+use taut_logic::gcode::{CardLine, Error, ErrorKind};
 use taut_logic::interp::motor_channels;
 use taut_logic::kinematics::Kinematics;
 use taut_logic::pinmap::Button;
@@ -18,13 +18,27 @@ use taut_logic::pinmap::Button;
 impl Console {
     /// The next byte of the line being read: a line from the card, or
     /// from the serial line once it has arrived whole while a print runs
-    /// (its lines are not cut into by the card's).
-    #[inline(never)]
+    /// (its lines are not cut into by the card's). Most bytes are the
+    /// rest of a port's line: taken here, the rest out of line.
+    #[inline]
     pub(super) fn next_byte(&mut self) -> Option<u8> {
+        if !self.parser.mid_line() || self.source == Some(Source::Card) {
+            return self.next_byte_other();
+        }
+        let byte = port::answer().receive();
+        if byte.is_none() {
+            self.print.finished();
+        }
+        byte
+    }
+
+    /// [`Console::next_byte`] between lines or from the card.
+    #[inline(never)]
+    fn next_byte_other(&mut self) -> Option<u8> {
         if self.source == Some(Source::Card) && !self.print.running() {
             // The print stopped mid-line: the part read is dropped (a lost
             // print reads the line again).
-            self.parser = Parser::new();
+            self.parser.clear();
             self.source = None;
         }
         let mut port = Some(port::answer());

@@ -39,7 +39,13 @@ impl AxisWord {
     }
 
     pub fn from_letter(upper: u8) -> Option<AxisWord> {
-        AxisWord::ALL.into_iter().find(|w| w.letter() == upper)
+        match upper {
+            b'C' => Some(AxisWord::C),
+            b'X' => Some(AxisWord::X),
+            b'Y' => Some(AxisWord::Y),
+            b'Z' => Some(AxisWord::Z),
+            _ => None,
+        }
     }
 
     /// The word's bit in [`Block::words`].

@@ -69,6 +69,7 @@ impl Number {
 
     /// One character of the number; per byte, so no division and no
     /// 64-bit arithmetic.
+    #[inline]
     pub(super) fn push(&mut self, c: u8) -> Result<(), ()> {
         match c {
             b'+' | b'-' if !self.has(SIGNED | DIGITS | POINT) => {
@@ -87,12 +88,17 @@ impl Number {
         }
     }
 
+    #[inline]
     fn digit(&mut self, d: u8) {
         self.flags |= DIGITS;
         let point = self.has(POINT);
         if self.sig < DIGITS_KEPT {
-            // Leading zeros cost nothing: `sig` stays 0.
-            self.sig = self.sig * 10 + d as u32;
+            // Leading zeros cost nothing: `sig` stays 0. The first four
+            // digits in 16 bits: the AVR's `u32` product is a library call.
+            self.sig = match u16::try_from(self.sig) {
+                Ok(small) if small < u16::MAX / 10 => u32::from(small * 10 + u16::from(d)),
+                _ => self.sig * 10 + u32::from(d),
+            };
             if point && self.exp > -EXP_LIMIT {
                 self.exp -= 1;
             }
@@ -144,10 +150,33 @@ impl Number {
         v.min(limit)
     }
 
+    /// `value × 10^shift` if it is whole and fits 32 bits (the common
+    /// case of every conversion: no 64-bit arithmetic), by tenfolds.
+    #[inline]
+    fn narrow(&self, shift: i8) -> Option<u32> {
+        // `exp` is within ±[`EXP_LIMIT`]: no overflow.
+        let mut k = self.exp + shift;
+        if k < 0 {
+            return None;
+        }
+        let mut v = self.sig;
+        while k > 0 {
+            if v > u32::MAX / 10 {
+                return None;
+            }
+            v *= 10;
+            k -= 1;
+        }
+        Some(v)
+    }
+
     /// The value in millionths (nanometres of a mm), saturated at
     /// ±[`NANO_LIMIT`]; `None` without a digit.
     pub(super) fn nano(&self) -> Option<i64> {
-        let v = self.scaled(6, NANO_LIMIT as u64) as i64;
+        let v = match self.narrow(6) {
+            Some(v) => i64::from(v),
+            None => self.scaled(6, NANO_LIMIT as u64) as i64,
+        };
         self.has_digits()
             .then_some(if self.has(NEGATIVE) { -v } else { v })
     }
@@ -155,7 +184,10 @@ impl Number {
     /// The value in thousandths, rounded once and saturated at
     /// ±`i32::MAX`; `None` without a digit.
     pub(super) fn milli(&self) -> Option<Milli> {
-        let v = self.scaled(3, i32::MAX as u64) as i32;
+        let v = match self.narrow(3) {
+            Some(v) => v.min(i32::MAX as u32) as i32,
+            None => self.scaled(3, i32::MAX as u64) as i32,
+        };
         self.has_digits()
             .then_some(Milli(if self.has(NEGATIVE) { -v } else { v }))
     }
@@ -163,6 +195,13 @@ impl Number {
     /// The whole part (truncated, saturated) and the hundredths (rounded)
     /// of a non-negative number, as Grbl's `int_value` and `mantissa`.
     pub(super) fn code(&self) -> Code {
+        // A whole number as written (`G1`, `M3`): no conversion.
+        if self.exp == 0 {
+            return Code {
+                int: self.sig,
+                hundredths: 0,
+            };
+        }
         let int = self.whole();
         let all = self.scaled(2, u32::MAX as u64);
         Code {
@@ -175,6 +214,9 @@ impl Number {
     /// `N`, `T`, `L`).
     pub(super) fn whole(&self) -> u32 {
         let exp = self.exp as i16;
+        if exp == 0 {
+            return self.sig;
+        }
         if exp >= 0 {
             return self.scaled(0, u32::MAX as u64) as u32;
         }
@@ -313,10 +355,22 @@ mod tests {
 
     proptest::proptest! {
         #[test]
+        fn digits_are_kept_exactly_s(digits in "[0-9]{1,9}") {
+            let n = read(&digits);
+            proptest::prop_assert_eq!(n.sig, digits.parse::<u32>().unwrap());
+            proptest::prop_assert_eq!(n.exp, 0);
+        }
+
+        #[test]
         fn scaled_is_the_wide_product_s(sig in 0u32..=1_000_000_000, exp in -60i8..=60, shift in 0i8..=6, wide in proptest::bool::ANY) {
             let n = Number { sig, exp, flags: DIGITS };
             let limit = if wide { NANO_LIMIT as u64 } else { u32::MAX as u64 };
             proptest::prop_assert_eq!(n.scaled(shift, limit), scaled_wide(&n, shift, limit));
+            if let Some(v) = n.narrow(shift) {
+                proptest::prop_assert_eq!(u64::from(v), scaled_wide(&n, shift, u64::MAX));
+            } else {
+                proptest::prop_assert!(exp + shift < 0 || scaled_wide(&n, shift, u64::MAX) > u64::from(u32::MAX));
+            }
             let trunc = if exp >= 0 { scaled_wide(&n, 0, u32::MAX as u64) } else if exp < -10 { 0 } else { (sig as u64 / 10u64.pow((-exp) as u32)).min(u32::MAX as u64) };
             proptest::prop_assert_eq!(n.whole() as u64, trunc);
         }

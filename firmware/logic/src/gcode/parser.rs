@@ -30,7 +30,7 @@ pub const MSG_LEN: usize = 40;
 /// The text of a line's `(MSG, text)` comment: LinuxCNC's operator message,
 /// which grblHAL and senders show as `[MSG:text]` (a plotter file's pen
 /// change names the next pen so). Printable ASCII; another byte reads `?`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Eq)]
 pub struct Message {
     len: u8,
     text: [u8; MSG_LEN],
@@ -44,6 +44,11 @@ impl Message {
 
     pub fn is_empty(&self) -> bool {
         self.len == 0
+    }
+
+    /// Emptied: the bytes past `len` mean nothing.
+    fn clear(&mut self) {
+        self.len = 0;
     }
 
     /// The text, printable ASCII, its trailing spaces cut (by hand: on
@@ -72,12 +77,23 @@ impl Message {
     }
 }
 
+/// Messages of the same text are equal, whatever bytes lie past it.
+impl PartialEq for Message {
+    fn eq(&self, other: &Message) -> bool {
+        let len = usize::from(self.len);
+        self.len == other.len && self.text[..len] == other.text[..len]
+    }
+}
+
 /// How far a `( … )` comment matched `MSG,`.
 const MSG_WORD: &[u8; 3] = b"MSG";
 /// The comment is not a message.
 const NOT_MSG: u8 = u8::MAX;
 /// After `MSG,`: the text follows.
 const MSG_TEXT: u8 = 4;
+
+/// Every axis letter: a parser's before it is told the machine's.
+const EVERY_AXIS: u8 = 0b1111;
 
 /// The UTF-8 byte-order mark an editor may put before a file's first line.
 const BOM: [u8; 3] = [0xEF, 0xBB, 0xBF];
@@ -172,7 +188,7 @@ impl Parser {
             column: 0,
             kept: 0,
             bom: 0,
-            letters: 0b1111,
+            letters: EVERY_AXIS,
             first: 0,
             xor: 0,
             lexeme: Lexeme::Code,
@@ -220,8 +236,46 @@ impl Parser {
     /// [`Parser::push`] in two steps, for a small stack: the byte, then
     /// at [`Read::LineEnd`] the line's result ([`Parser::take_line`]).
     /// Every byte goes through here, so its frame stays a few bytes; the
-    /// line's result (~100 B) is made only where it is used.
+    /// line's result (~100 B) is made only where it is used. Most bytes
+    /// are digits of a word's number: they go straight to it.
+    #[inline]
     pub fn read(&mut self, byte: u8) -> Read {
+        if self.number_byte(byte) {
+            return Read::More;
+        }
+        self.read_other(byte)
+    }
+
+    /// A digit or point of the number being read mid-line, as
+    /// [`Parser::read`] and [`Parser::take`] would take it: kept (within
+    /// [`MAX_LINE`]), in the checksum (code before a `*` has none yet),
+    /// and to the word; false, touching nothing, for any other byte or
+    /// state. After a line's first byte no `\r` is pending.
+    #[inline]
+    fn number_byte(&mut self, byte: u8) -> bool {
+        if !(byte.is_ascii_digit() || byte == b'.')
+            || self.column == 0
+            || self.lexeme != Lexeme::Code
+            || self.kept >= MAX_LINE
+        {
+            return false;
+        }
+        let Statement::GCode(words) = &mut self.statement else {
+            return false;
+        };
+        if !words.number_byte(byte) {
+            return false;
+        }
+        self.column = self.column.saturating_add(1);
+        self.kept += 1;
+        self.xor ^= byte;
+        true
+    }
+
+    /// [`Parser::read`] of any byte. Out of line: the frame of the calls
+    /// below stays off the caller's.
+    #[inline(never)]
+    fn read_other(&mut self, byte: u8) -> Read {
         if let Some(realtime) = Realtime::from_byte(byte) {
             if realtime == Realtime::Reset {
                 // The line so far is dropped; where lines end is not.
@@ -248,7 +302,7 @@ impl Parser {
             }
             _ => {
                 if self.column == 0 {
-                    self.message = Message::NONE;
+                    self.message.clear();
                 }
                 self.column = self.column.saturating_add(1);
                 if self.lexeme != Lexeme::Overflow {
@@ -268,15 +322,43 @@ impl Parser {
         line
     }
 
+    /// [`Parser::new`] but for `after_cr`, the axis letters and the
+    /// message (it outlives the line's end: the console says it once the
+    /// line is accepted; the next line's first byte clears it). Field by
+    /// field: a whole new value is built on the stack and copied.
     fn restart(&mut self, after_cr: bool) {
-        *self = Parser {
-            after_cr,
-            letters: self.letters,
-            // The line's message outlives its end: the console says it
-            // once the line is accepted. The next line's first byte clears it.
-            message: self.message,
-            ..Parser::new()
-        };
+        // Every field named: a new one must be thought of here.
+        let Parser {
+            after_cr: cr,
+            column,
+            kept,
+            bom,
+            letters: _,
+            first,
+            xor,
+            lexeme,
+            checksum,
+            statement,
+            msg_at,
+            message: _,
+        } = self;
+        *cr = after_cr;
+        *column = 0;
+        *kept = 0;
+        *bom = 0;
+        *first = 0;
+        *xor = 0;
+        *lexeme = Lexeme::Code;
+        *checksum = None;
+        *statement = Statement::Start;
+        *msg_at = NOT_MSG;
+    }
+
+    /// As [`Parser::new`], in place (no copy of a new one on the stack).
+    pub fn clear(&mut self) {
+        self.restart(false);
+        self.letters = EVERY_AXIS;
+        self.message = Message::NONE;
     }
 
     fn take(&mut self, c: u8) {
@@ -404,7 +486,12 @@ impl Parser {
             Statement::GCode(words) => words.line_number(),
             _ => None,
         };
-        self.result().map_err(|e| e.with_line_number(line_number))
+        // The error is changed in place: no move of a line's block.
+        let mut line = self.result();
+        if let Err(e) = &mut line {
+            *e = e.with_line_number(line_number);
+        }
+        line
     }
 
     fn result(&mut self) -> Result<Input, Error> {
@@ -434,18 +521,7 @@ impl Parser {
             self.start_words(false);
         }
         match &mut self.statement {
-            Statement::GCode(words) => {
-                let jog = words.is_jog();
-                match words.finish(end)? {
-                    Input::Block(block) if jog => Ok(Input::Jog(block)),
-                    _ if jog => Err(Error::new(ErrorKind::InvalidJogCommand, end)),
-                    Input::Block(mut block) => {
-                        block.checksum = checksum;
-                        Ok(Input::Block(block))
-                    }
-                    other => Ok(other),
-                }
-            }
+            Statement::GCode(words) => words.finish(end, checksum),
             Statement::System(system) => system.finish(end).map(Input::System),
             Statement::Seed(seed) => Ok(Input::Seed(seed.finish())),
             // Made G-code above.
