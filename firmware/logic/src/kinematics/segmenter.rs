@@ -95,7 +95,8 @@ impl Segmenter {
     /// most `segment_len` µm (as [`pieces`] finds without its root): a
     /// line of a stream of tiny ones, which then needs no segmenter.
     pub fn is_one_piece(from: &Position, to: &Position, segment_len: u32) -> bool {
-        (0..AXES).all(|i| to[i].0.abs_diff(from[i].0) < segment_len / 2)
+        // In 32 bits: two i32s differ by less than 2³².
+        (0..AXES).all(|i| under_half(to[i].0.abs_diff(from[i].0), segment_len))
     }
 
     pub fn start(&self) -> Position {
@@ -146,11 +147,19 @@ impl Iterator for Segmenter {
 /// µm keeps the length under √3/2 of one. Two i32s differ by less than
 /// 2³²: a coordinate's change fits a `u32`.
 fn pieces(delta: &[i64; AXES], segment_len: u32) -> u32 {
-    let most = delta.iter().map(|d| d.unsigned_abs() as u32).max();
-    if most.unwrap_or(0) < segment_len / 2 {
+    if delta
+        .iter()
+        .all(|d| under_half(d.unsigned_abs() as u32, segment_len))
+    {
         return 1;
     }
     pieces_by_root(delta, segment_len)
+}
+
+/// A coordinate's `change` is under half a piece: with every coordinate
+/// so, the length is under √3/2 of one, a piece found without the root.
+fn under_half(change: u32, segment_len: u32) -> bool {
+    change < segment_len / 2
 }
 
 /// [`pieces`] from the length's root.
