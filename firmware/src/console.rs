@@ -343,6 +343,9 @@ impl Console {
                 }
                 self.line_ready = false;
                 self.take(m, kin, cfg, owner, store);
+                if self.source == Some(Source::Card) {
+                    self.card_line_taken(m);
+                }
                 // One line per run: the other tasks get their turn.
                 return Poll::Again;
             }
@@ -355,6 +358,15 @@ impl Console {
                 Ok(false) => {}
             }
             match self.read() {
+                Err(Poll::Idle) if self.interp.joining() && !self.print.running() => {
+                    // The input paused with tiny moves joined: they are
+                    // queued once the planner runs low (a card's print
+                    // joins as its lines say, whenever they come).
+                    if m.planned() >= 2 {
+                        return Poll::Wait(Signal::PlannerRoom);
+                    }
+                    self.interp.flush_soon();
+                }
                 Err(wait) => return wait,
                 // A line read whole is taken in a run of its own.
                 Ok(true) => {

@@ -41,7 +41,8 @@ use taut_firmware::drivers::{Drivers, EnablePins};
 use taut_firmware::job::JobTask;
 use taut_firmware::motion::{self, Motion};
 use taut_firmware::queues::{
-    self, CardRequests, CardTell, Control, SampleButtons, Signal, SIGNALS,
+    self, CardAsk, CardNews, CardRequests, CardTell, ClaimTx, Control, JobControls, Presses,
+    SampleButtons, Signal, TellJob, TxClaim, SIGNALS,
 };
 use taut_firmware::realtime::{self, Requests, STANDING};
 use taut_firmware::rt::dispatch::{self, spawn_from_isr, Spawned};
@@ -376,20 +377,8 @@ fn init_cells() -> Ends {
     let (tell_job, job_controls) = queues::job_control_ends();
     let (tell_presses, job_presses, console_presses) = queues::buttons_ends();
     let (claim_tx, tx_claim) = queues::claims_tx_ends();
-    CONSOLE.init(Console::new(
-        print_asks,
-        print_news,
-        tell_job,
-        console_presses,
-        tx_claim,
-    ));
-    JOB.init(JobTask::new(
-        job_asks,
-        job_news,
-        job_controls,
-        job_presses,
-        claim_tx,
-    ));
+    init_console(print_asks, print_news, tell_job, console_presses, tx_claim);
+    init_job(job_asks, job_news, job_controls, job_presses, claim_tx);
     let (sample_buttons, samples) = queues::samples_ends();
     BUTTONS_TASK.init(ButtonsTask::new(samples, tell_presses));
     Ends {
@@ -397,6 +386,25 @@ fn init_cells() -> Ends {
         card_tell,
         sample_buttons,
     }
+}
+
+/// The console, built in a frame of its own: not on top of the job's
+/// (the deepest stack of a run is the boot's, these two).
+#[inline(never)]
+fn init_console(card: CardAsk, news: CardNews, job: TellJob, presses: Presses, claim: TxClaim) {
+    CONSOLE.init(Console::new(card, news, job, presses, claim));
+}
+
+/// The job task, in a frame of its own.
+#[inline(never)]
+fn init_job(
+    asks: CardAsk,
+    news: CardNews,
+    controls: JobControls,
+    presses: Presses,
+    claim: ClaimTx,
+) {
+    JOB.init(JobTask::new(asks, news, controls, presses, claim));
 }
 
 /// The queue ends `init_cells` leaves for `init`, which makes their

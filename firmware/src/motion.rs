@@ -305,7 +305,6 @@ impl Motion {
     /// Hand `cut` to the step interrupt; true if it begins a block. Out of
     /// line: its copies stay off the frame under the preparer's calls.
     #[inline(never)]
-    #[optimize(speed)]
     fn queue(&mut self, cut: &Cut) -> bool {
         let mut seg = cut.segment;
         if let Some(block) = &cut.block {

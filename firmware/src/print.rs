@@ -306,13 +306,12 @@ impl Print {
         }
     }
 
-    /// A line of the file was read whole and is about to be taken: its
-    /// checkpoint candidate (its first block is `first`), or the resume's
-    /// next step for it (check it; hold it for the travel back, then the
-    /// pen; go).
+    /// A line of the file was read whole and is about to be taken: the
+    /// resume's next step for it (check it; hold it for the travel back,
+    /// then the pen; go).
     #[inline(never)]
-    pub fn line_ready(&mut self, first: u8) -> ResumeAction {
-        let action = match self.resume {
+    pub fn line_ready(&mut self) -> ResumeAction {
+        match self.resume {
             None | Some(Resume::Offered) => ResumeAction::Go,
             Some(r) => {
                 let e = match r {
@@ -324,17 +323,20 @@ impl Print {
                 self.resume = next;
                 action
             }
-        };
-        // Not while a resume goes over the blocks drawn before the cut: its
-        // rapid on to where the pen stood is a block the file does not
-        // have. Records follow from the line after (a cut before goes on
-        // from the record resumed from).
-        if action == ResumeAction::Go && self.trace == 0 {
-            if let Some(t) = self.tracker.as_mut() {
-                t.line(self.read_start, first);
-            }
         }
-        action
+    }
+
+    /// The line was taken and goes: its checkpoint candidate, its first
+    /// block numbered `first` (`None`: it starts no block, its motion
+    /// joined the tiny moves before, which are not queued yet). Not while
+    /// a resume goes over the blocks drawn before the cut: its rapid on
+    /// to where the pen stood is a block the file does not have. Records
+    /// follow from the line after (a cut before goes on from the record
+    /// resumed from).
+    pub fn line_taken(&mut self, first: Option<u8>) {
+        if let (0, Some(first), Some(t)) = (self.trace, first, self.tracker.as_mut()) {
+            t.line(self.read_start, first);
+        }
     }
 
     /// Once the print goes on: the blocks to go over.

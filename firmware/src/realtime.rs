@@ -230,7 +230,6 @@ impl Standing {
 /// task's frame stays small when no report is asked for. To `port`,
 /// `Bf:` its receive ring's room.
 #[inline(never)]
-#[optimize(speed)]
 pub fn status(
     port: Port,
     m: &Motion,

@@ -20,6 +20,7 @@
 
 pub mod coords;
 pub mod estimate;
+mod join;
 mod raw;
 mod run;
 mod state;
@@ -172,32 +173,35 @@ impl Modal {
 /// The actions of an accepted line still to do, in Grbl's order (bits
 /// of [`Run::todo`]).
 mod todo {
+    /// The joined move before the line (`join`) queued first: the line
+    /// does not join it, and waits for it or moves.
+    pub const FLUSH: u16 = 1 << 0;
     /// The pen from `M3`/`M4`/`M5` or `M300` (Grbl's spindle, `[7]`).
-    pub const PEN: u16 = 1 << 0;
+    pub const PEN: u16 = 1 << 1;
     /// `M17`.
-    pub const DRIVERS_ON: u16 = 1 << 1;
+    pub const DRIVERS_ON: u16 = 1 << 2;
     /// `G4` (`[10]`).
-    pub const DWELL: u16 = 1 << 2;
+    pub const DWELL: u16 = 1 << 3;
     /// A plotter's pen from a `Z` word, before the line's moves.
-    pub const PEN_Z: u16 = 1 << 3;
+    pub const PEN_Z: u16 = 1 << 4;
     /// Straight moves to `legs[0]`, `legs[1]` (`[19]` `G28`/`G30`, `[20]`).
-    pub const LEG_0: u16 = 1 << 4;
-    pub const LEG_1: u16 = 1 << 5;
+    pub const LEG_0: u16 = 1 << 5;
+    pub const LEG_1: u16 = 1 << 6;
     /// The pieces of `path` (an arc, or a leg on a machine that is not
     /// linear).
-    pub const PATH: u16 = 1 << 6;
+    pub const PATH: u16 = 1 << 7;
     /// `M0` (`[21]`).
-    pub const PAUSE: u16 = 1 << 7;
+    pub const PAUSE: u16 = 1 << 8;
     /// `M2`, `M30` (`[21]`).
-    pub const END: u16 = 1 << 8;
+    pub const END: u16 = 1 << 9;
     /// `M18`, `M84`.
-    pub const DRIVERS_OFF: u16 = 1 << 9;
+    pub const DRIVERS_OFF: u16 = 1 << 10;
     /// `M400`.
-    pub const WAIT: u16 = 1 << 10;
+    pub const WAIT: u16 = 1 << 11;
     /// `M114`.
-    pub const REPORT: u16 = 1 << 11;
+    pub const REPORT: u16 = 1 << 12;
     /// `M18 S`, `M84 S`.
-    pub const IDLE_DELAY: u16 = 1 << 12;
+    pub const IDLE_DELAY: u16 = 1 << 13;
 }
 
 /// An accepted line's actions.
@@ -218,6 +222,8 @@ struct Run {
     /// The line's path piece by piece: an arc (its last piece on the
     /// exact target of the last leg), or a straight leg's pieces.
     path: Option<Path>,
+    /// Its one leg may join the tiny moves around it ([`join`]).
+    joins: bool,
 }
 
 impl Run {
@@ -232,6 +238,7 @@ impl Run {
             from: [0; AXES],
             feed: Feed::Rapid,
             path: None,
+            joins: false,
         }
     }
 
@@ -248,6 +255,7 @@ impl Run {
         self.from = [0; AXES];
         self.feed = Feed::Rapid;
         self.path = None;
+        self.joins = false;
     }
 }
 
@@ -316,6 +324,8 @@ pub struct Interpreter {
     /// `G43.1`'s offset of the `Z` channel.
     tlo: i64,
     run: Run,
+    /// Tiny moves joined into one, not yet queued: it ends at `run.from`.
+    join: Option<join::Join>,
     /// The end of a dwell or of the pen's settling.
     dwell_until: Option<u32>,
     /// The work offset changed since the status report last asked.
@@ -385,6 +395,7 @@ fn mm_milli(v: Milli, units: Units) -> Milli {
 impl Interpreter {
     /// Grbl's power-on state: `G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0`,
     /// at zero, no offsets; [`Interpreter::reset`] then loads `G54`.
+    #[inline(always)]
     pub const fn new() -> Self {
         Interpreter {
             modal: Modal::new(),
@@ -396,6 +407,7 @@ impl Interpreter {
             coord_offset: [0; AXES],
             tlo: 0,
             run: Run::new(),
+            join: None,
             dwell_until: None,
             wco_changed: true,
             servo_off: false,
@@ -436,6 +448,7 @@ impl Interpreter {
             }
         }
         self.run.clear();
+        self.join = None;
         self.dwell_until = None;
     }
 
@@ -445,6 +458,7 @@ impl Interpreter {
     /// line that was moving. Carried out by [`Interpreter::run`].
     pub fn travel_back(&mut self, at: &Position, up_deg: u8) {
         self.run.clear();
+        self.join = None;
         self.run.pen = up_deg;
         self.run.from = coords::exact(at);
         self.run.legs[0] = self.position;
@@ -497,7 +511,33 @@ impl Interpreter {
     /// card): its other actions too.
     pub fn drop_line(&mut self) {
         self.run.clear();
+        self.join = None;
         self.dwell_until = None;
+    }
+
+    /// Tiny moves are joined, not yet queued ([`join`]).
+    pub fn joining(&self) -> bool {
+        self.join.is_some()
+    }
+
+    /// The joined moves are queued at the next [`Interpreter::run`] (no
+    /// line is carried out now): the input paused.
+    pub fn flush_soon(&mut self) {
+        if self.join.is_some() && self.run.todo == 0 {
+            self.run.todo = todo::FLUSH;
+        }
+    }
+
+    /// For a print's checkpoint, once a line is accepted: the blocks
+    /// queued before its own (1: the joined moves before it), or `None`
+    /// when it starts none (it joined the moves before, or it has no
+    /// motion and they are not queued yet).
+    pub fn blocks_before(&self) -> Option<u8> {
+        match (self.join.is_some(), self.run.todo & todo::FLUSH != 0) {
+            (false, _) => Some(0),
+            (true, true) => Some(1),
+            (true, false) => None,
+        }
     }
 
     /// Checks `block` (a jog's if `jog`) against the modal state in
@@ -835,6 +875,7 @@ impl Interpreter {
 
         // Step 4: the line is good. Its state, then its actions.
         self.run.clear();
+        self.run.from = self.position;
         let pen_deg = |down: bool| {
             if down {
                 cfg.pen.down_deg
@@ -923,6 +964,9 @@ impl Interpreter {
             // [20]
             self.modal.motion = m.motion;
         }
+        // A plain `G1` may join the tiny moves around it (a line of one
+        // leg, nothing else to do, at a feed per minute: `join_or_flush`).
+        let joins = plotter && !jog;
         if count > 0 {
             if !jog {
                 self.run.feed = match (
@@ -948,7 +992,6 @@ impl Interpreter {
                 self.run.todo |= todo::PEN_Z;
             }
             self.run.legs = legs;
-            self.run.from = self.position;
             self.run.todo |= match count {
                 1 => todo::LEG_0,
                 _ => todo::LEG_0 | todo::LEG_1,
@@ -992,6 +1035,7 @@ impl Interpreter {
         if env.allowed.checking {
             self.run.todo &= todo::REPORT;
         }
+        self.join_or_flush(joins, env);
         self.dwell_until = None;
         Ok(())
     }
@@ -1219,7 +1263,9 @@ fn check_travel(cfg: &MachineConfig, lo: &Exact, hi: &Exact, motors: u8) -> Resu
 }
 
 /// `pos` in thousandths, the channels without a motor at 0 (and not
-/// converted: a plotter's spare channel costs nothing).
+/// converted: a plotter's spare channel costs nothing). Out of line:
+/// one copy of its three conversions for its half-dozen callers.
+#[inline(never)]
 fn motor_milli(pos: &Exact, motors: u8) -> Position {
     core::array::from_fn(|i| match motors >> i & 1 {
         0 => Milli::ZERO,

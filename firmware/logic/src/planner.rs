@@ -39,7 +39,7 @@ use junction::{Geometry, PenLimits, PenMove, PenPath, Turn};
 
 /// Number of moves the firmware's planner holds: as many as the RAM
 /// budget allows (`docs/architecture.md`).
-pub const PLANNER_BLOCKS: usize = 12;
+pub const PLANNER_BLOCKS: usize = 11;
 
 /// The firmware's planner. The host may plan with other depths
 /// ([`Lookahead`]`<N>`, say Grbl-Mega's 36) through the same code.
@@ -443,7 +443,6 @@ impl<const N: usize> Lookahead<N> {
     /// `plan_limits`). Out of line, as each part: the parts are measured
     /// apart (`simavr/examples/task_runs.rs`).
     #[inline(never)]
-    #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_path(&mut self, feed: Feed) {
         let b = &mut self.blocks[self.staged()];
         // Scaled to events/s by `plan_limits`: this part is the longer.
@@ -544,7 +543,6 @@ impl<const N: usize> Lookahead<N> {
     /// The staged move's acceleration and cruise speed within the axes'
     /// limits, and how much its speed² can change over it.
     #[inline(never)]
-    #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn plan_limits(&mut self, ev_per_milli: f32) {
         let b = &mut self.blocks[self.staged()];
         let step = b.step.block();
@@ -679,7 +677,6 @@ impl<const N: usize> Lookahead<N> {
     /// blocks behind it only raise the backward pass's figures, so it
     /// keeps that entry, and so do those before it. Integer only; the ring
     /// stepped by hand (a `%` is a 16-bit division call on the AVR).
-    #[cfg_attr(target_arch = "avr", optimize(speed))]
     fn recalculate(&mut self) {
         if self.len == 0 {
             return;

@@ -32,7 +32,7 @@ mod tests;
 pub use buffered::Buffered;
 pub use expand::{expand, Event, Expand};
 pub use prepare::{Later, Preparer};
-pub use trapezoid::{cbrt_floor_approx, div_to_u32, isqrt, Speeds, Trapezoid, MAX_ACCEL};
+pub use trapezoid::{cbrt_floor_approx, div_to_u32, isqrt, isqrt32, Speeds, Trapezoid, MAX_ACCEL};
 
 use crate::axis::PerAxis;
 

@@ -143,7 +143,7 @@ impl Console {
         store: &Store,
     ) -> bool {
         let up = cfg.pen.up_deg;
-        match self.print.line_ready(m.next_block()) {
+        match self.print.line_ready() {
             ResumeAction::Place => {
                 if let Some(p) = store.plot_saved() {
                     let mut at = m.target();
@@ -157,6 +157,17 @@ impl Console {
             _ => return true,
         }
         false
+    }
+}
+
+impl Console {
+    /// A card's line was taken: its checkpoint candidate, with the
+    /// number of its first block, if it starts one.
+    #[inline(never)]
+    pub(super) fn card_line_taken(&mut self, m: &Motion) {
+        let first = self.interp.blocks_before();
+        self.print
+            .line_taken(first.map(|b| m.next_block().wrapping_add(b)));
     }
 }
 

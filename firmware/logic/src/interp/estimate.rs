@@ -183,6 +183,14 @@ impl<const N: usize> GcodeTime<N> {
 
     /// The whole stream's time: every block still planned run out.
     pub fn finish(mut self) -> f64 {
+        // The tiny moves joined last.
+        self.interp.flush_soon();
+        let env = Env {
+            kin: &self.kin,
+            cfg: &self.config,
+            allowed: Allowed::ALL,
+        };
+        while self.interp.run(&env, &mut self.machine) != Progress::Done {}
         self.machine.settle();
         self.seconds()
     }
@@ -241,6 +249,7 @@ mod tests {
     /// handed on must leave at a speed that stops within the others
     /// planned, so the cruise speed² grows with the depth: v² = 2·a·(N −
     /// 1)·length, far below F3000's 50 mm/s for 0.1 mm on the flatbed.
+    /// (Each line's feed differs from the last's: none are joined.)
     #[test]
     fn a_deeper_planner_runs_tiny_moves_faster() {
         fn seconds<const N: usize>() -> f64 {
@@ -249,7 +258,8 @@ mod tests {
             t.push(b"G21 G90\nG1 X0 Y10 F3000\nG4 P0\n");
             let before = t.seconds();
             for k in 1..=1000 {
-                t.push(std::format!("G1 Y{}\n", 10.0 + k as f64 * 0.1).as_bytes());
+                let feed = 3000 - k % 2;
+                t.push(std::format!("G1 Y{} F{feed}\n", 10.0 + k as f64 * 0.1).as_bytes());
             }
             assert_eq!(t.refused, 0);
             t.finish() - before
@@ -266,6 +276,25 @@ mod tests {
         ] {
             assert!((s / ideal(n) - 1.0).abs() < 0.02, "{n} blocks: {s} s");
         }
+    }
+
+    /// The same tiny moves at one feed are joined (under 2 mm each): the
+    /// look-ahead reaches 20 mm, and they run at the feed but for the
+    /// ramps (100 mm at 50 mm/s, and v/a lost at the ends).
+    #[test]
+    fn joined_tiny_moves_run_at_the_feed() {
+        let cfg = MachineConfig::defaults(Machine::Flatbed);
+        let mut t = GcodeTime::new(&cfg).unwrap();
+        t.push(b"G21 G90\nG1 X0 Y10 F3000\nG4 P0\n");
+        let before = t.seconds();
+        for k in 1..=1000 {
+            t.push(std::format!("G1 Y{}\n", 10.0 + k as f64 * 0.1).as_bytes());
+        }
+        let s = t.finish() - before;
+        assert!(
+            (s / (100.0 / 50.0 + 50.0 / 100.0) - 1.0).abs() < 0.02,
+            "{s} s"
+        );
     }
 
     /// On the arm and the whiteboard `F` is the pen's speed: a line takes

@@ -3,11 +3,13 @@
 //! planner would, and goes on at the next call.
 
 use super::{
-    motor_channels, motor_milli, motor_only, motor_steps, todo, Env, Interpreter, MachineIo, Path,
-    Progress, Wait,
+    motor_channels, motor_milli, motor_only, motor_steps, todo, Env, Exact, Interpreter, MachineIo,
+    Path, Progress, Wait,
 };
 use crate::axis::AXES;
-use crate::kinematics::{Kinematics, Piece, Segmenter};
+use crate::kinematics::{Kinematics, Piece, Position, Segmenter};
+use crate::planner::Feed;
+use crate::units::Milli;
 
 impl Interpreter {
     /// Carry out what is left of the accepted line, as far as the
@@ -23,6 +25,7 @@ impl Interpreter {
                 return Progress::Done;
             }
             let waits = match next {
+                todo::FLUSH => self.flush(env, io),
                 todo::PEN => self.pen(self.run.pen, env, io),
                 todo::PEN_Z => self.pen(self.run.pen_z, env, io),
                 todo::DRIVERS_ON => {
@@ -114,66 +117,72 @@ impl Interpreter {
 
     /// A straight leg: one move on a linear machine, from the exact
     /// target; on the others, pieces no longer than the kinematics'
-    /// `piece_um` (then the leg's bit is off and the path's on).
+    /// `piece_um` (then the leg's bit is off and the path's on). A tiny
+    /// one may join the moves around it instead ([`super::join`]).
     fn leg<K: Kinematics>(
         &mut self,
         second: bool,
         env: &Env<K>,
         io: &mut impl MachineIo,
     ) -> Option<Wait> {
+        // A line that did not join the moves before: they are queued, it
+        // may start a join of its own.
+        if self.run.joins && self.open_join(env) {
+            return None;
+        }
+        let to = self.run.legs[second as usize];
         if !env.kin.is_linear() {
-            if let Some(waits) = self.one_piece(second, env, io) {
-                return waits;
-            }
             self.line_path(second, env);
             // Its pieces next, from this same call.
             return self.piece(env, io);
         }
-        let to = self.run.legs[second as usize];
-        let motors = motor_channels(env.cfg);
-        if let Some(wait) = io.room(false) {
-            return Some(wait);
+        let waits = self.queue_move(&[Milli::ZERO; AXES], &to, self.run.feed, env, io);
+        if waits.is_none() {
+            self.run.from = to;
         }
-        // Checked when the line was accepted.
-        let steps = motor_steps(&to, motors, env.kin, env.cfg).unwrap_or_default();
-        if !io.queue(&steps, self.run.feed) {
-            return Some(Wait::PlannerRoom);
-        }
-        self.run.from = to;
-        None
+        waits
     }
 
-    /// A straight leg no longer than half a piece (each line of a stream
-    /// of tiny ones) queued as its one piece, with no path kept: the piece
-    /// [`Interpreter::piece`] would queue. `None` for a longer leg. Out of
-    /// line: the piece is built in its frame.
+    /// One straight move to `to`: on a linear machine its steps, rounded
+    /// once from the exact target; on the others one piece from `start`
+    /// (µm), the pen's. Out of line: the piece is built in its frame.
     #[inline(never)]
-    fn one_piece<K: Kinematics>(
-        &mut self,
-        second: bool,
+    pub(super) fn queue_move<K: Kinematics>(
+        &self,
+        start: &Position,
+        to: &Exact,
+        feed: Feed,
         env: &Env<K>,
         io: &mut impl MachineIo,
-    ) -> Option<Option<Wait>> {
+    ) -> Option<Wait> {
         let motors = motor_channels(env.cfg);
-        let mut piece = Piece {
-            start: motor_milli(&self.run.from, motors),
-            to: motor_milli(&self.run.legs[second as usize], motors),
-            steps: [0; AXES],
-            frac: [0; AXES],
+        let linear = env.kin.is_linear();
+        if let Some(wait) = io.room(!linear) {
+            return Some(wait);
+        }
+        // Every target was checked when its line was accepted.
+        let queued = match linear {
+            true => {
+                let steps = motor_steps(to, motors, env.kin, env.cfg).unwrap_or_default();
+                io.queue(&steps, feed)
+            }
+            false => {
+                let to = motor_milli(to, motors);
+                match env.kin.inverse_fine(&to) {
+                    Ok((steps, frac)) => io.queue_piece(
+                        &Piece {
+                            start: *start,
+                            to,
+                            steps,
+                            frac,
+                        },
+                        feed,
+                    ),
+                    Err(_) => true,
+                }
+            }
         };
-        if !Segmenter::is_one_piece(&piece.start, &piece.to, env.kin.piece_um()) {
-            return None;
-        }
-        if let Some(wait) = io.room(true) {
-            return Some(Some(wait));
-        }
-        // Checked when the line was accepted.
-        (piece.steps, piece.frac) = env.kin.inverse_fine(&piece.to).ok()?;
-        if !io.queue_piece(&piece, self.run.feed) {
-            return Some(Some(Wait::PlannerRoom));
-        }
-        self.run.from = self.run.legs[second as usize];
-        Some(None)
+        (!queued).then_some(Wait::PlannerRoom)
     }
 
     /// A straight leg as a path of pieces: the leg's bit off, the path's

@@ -140,9 +140,17 @@ impl Bench {
         b
     }
 
-    /// Sends `text` (one line) and carries it out whole; Grbl's error
-    /// code if refused.
+    /// Sends `text` (one line) and carries it out whole, then the input
+    /// pauses (tiny moves joined are queued); Grbl's error code if refused.
     fn send(&mut self, text: &str) -> Result<(), u8> {
+        self.stream(text)?;
+        self.interp.flush_soon();
+        self.run_out();
+        Ok(())
+    }
+
+    /// [`Bench::send`] with more lines coming: tiny moves stay joined.
+    fn stream(&mut self, text: &str) -> Result<(), u8> {
         let mut p = Parser::new();
         let mut out: Vec<_> = text
             .bytes()
@@ -164,9 +172,20 @@ impl Bench {
             Err(e) => return Err(e.code()),
         }
         .map_err(|e| e as u8)?;
+        self.run_out();
+        Ok(())
+    }
+
+    /// The accepted line carried out.
+    fn run_out(&mut self) {
+        let env = Env {
+            kin: &self.kin,
+            cfg: &self.cfg,
+            allowed: Allowed::ALL,
+        };
         loop {
             match self.interp.run(&env, &mut self.io) {
-                Progress::Done => return Ok(()),
+                Progress::Done => return,
                 Progress::Wait(Wait::Ms(ms)) => self.io.clock += ms as u32,
                 Progress::Wait(_) => {}
             }
@@ -935,4 +954,81 @@ fn a_resumed_print_replays_its_lines_without_moving_then_travels_back_and_pens()
         .inverse(&[Milli(60_800), Milli(22_700), Milli(0)])
         .unwrap();
     assert_eq!(b.steps(), to);
+}
+
+/// A stream of 0.05 mm chords of a circle (the bench's) is joined into
+/// moves whose every vertex lies within the arc tolerance: on the
+/// flatbed ~25 lines a move at 20 mm (sagitta L²/8R = 10 µm at 1.26 mm),
+/// fewer on the arm's 10 mm; each move ends on a line's exact target,
+/// the last on the last line's once the input pauses.
+#[test]
+fn a_circles_tiny_chords_are_joined_within_the_tolerance() {
+    for (m, c, r, per) in [
+        (Machine::Flatbed, (40.0, 40.0), 20.0, 22..=26),
+        (Machine::Whiteboard, (0.0, 0.0), 20.0, 22..=26),
+        (Machine::Scara, (100.0, 150.0), 10.0, 15..=18),
+    ] {
+        let mut b = Bench::new(m);
+        b.ok(&format!("G0 X{} Y{}", c.0 + r, c.1));
+        b.io.did.clear();
+        let step = 2.0f64 * (0.05f64 / (2.0 * r)).asin();
+        let at = |k: usize| {
+            let a = step * k as f64;
+            let p = [c.0 + r * a.cos(), c.1 + r * a.sin()];
+            p.map(|v| (v * 1000.0).round() as i32)
+        };
+        let n = 1200;
+        for k in 1..=n {
+            let p = at(k);
+            b.stream(&format!(
+                "G1 X{} Y{} F1500",
+                p[0] as f64 / 1000.0,
+                p[1] as f64 / 1000.0
+            ))
+            .unwrap();
+        }
+        b.interp.flush_soon();
+        b.run_out();
+        let ends: Vec<[i32; 2]> = match m {
+            Machine::Flatbed => {
+                b.io.did
+                    .iter()
+                    .filter_map(|d| match d {
+                        Did::Move(s, _) => Some([s[0] * 25, s[1] * 25]),
+                        _ => None,
+                    })
+                    .collect()
+            }
+            _ => b
+                .pieces()
+                .iter()
+                .map(|(p, _)| [p.to[0].0, p.to[1].0])
+                .collect(),
+        };
+        let moves = ends.len();
+        assert!(per.contains(&(n / moves)), "{m:?}: {moves} moves");
+        // Every vertex within 10 µm of its move (the flatbed's ends are
+        // its steps: 25 µm each, rounded from the exact target).
+        let mut k = 0;
+        let mut from = at(0);
+        for end in &ends {
+            let first = k;
+            while at(k) != *end && k < n && m != Machine::Flatbed
+                || m == Machine::Flatbed
+                    && (at(k)[0] - end[0]).abs().max((at(k)[1] - end[1]).abs()) > 12
+            {
+                k += 1;
+            }
+            for v in first..k {
+                let (p, a, e) = (at(v), from, at(k));
+                let (dx, dy) = ((e[0] - a[0]) as f64, (e[1] - a[1]) as f64);
+                let off = ((p[0] - a[0]) as f64 * dy - (p[1] - a[1]) as f64 * dx).abs()
+                    / (dx * dx + dy * dy).sqrt();
+                assert!(off <= 10.0, "{m:?}: vertex {v} {off} µm off");
+            }
+            from = at(k);
+            k += 1;
+        }
+        assert_eq!(k, n + 1, "{m:?}");
+    }
 }

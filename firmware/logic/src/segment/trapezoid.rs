@@ -605,7 +605,7 @@ pub fn div_to_u32(n: u64, d: u32) -> u32 {
 /// 32-bit integer square root, rounded down (digit by digit: two bits of
 /// `x` in, one bit of the root out, sixteen times).
 #[cfg(not(target_arch = "avr"))]
-fn isqrt32(mut x: u32) -> u32 {
+pub fn isqrt32(mut x: u32) -> u32 {
     let (mut rem, mut root) = (0u32, 0u32);
     for _ in 0..16 {
         rem = rem << 2 | x >> 30;
@@ -627,7 +627,7 @@ fn isqrt32(mut x: u32) -> u32 {
 /// root by `segment_cycles.elf`.
 #[cfg(target_arch = "avr")]
 #[allow(unsafe_code)]
-fn isqrt32(x: u32) -> u32 {
+pub fn isqrt32(x: u32) -> u32 {
     let [mut x0, mut x1, mut x2, mut x3] = x.to_le_bytes();
     let (mut y0, mut y1) = (0u8, 0u8);
     // SAFETY: registers only; no memory, no stack.
