@@ -613,7 +613,8 @@ fn message(text: Text) {
     r.send();
 }
 
-/// Bytes parsed in one run at most: ~0.06 ms a byte on average (0.1 ms
-/// at most), the line end that completes a line up to ~0.5 ms; a 40-byte
-/// line read whole took ~2.4 ms, which a `?` or any task waited behind.
-const READ_PER_RUN: u8 = 6;
+/// Bytes parsed in one run at most: ~0.04 ms a byte (the fetch and the
+/// parser's ~350 cycles), so a run stays near 0.5 ms, which a `?` or any
+/// task waits behind; a line of a stream of tiny moves (~20 bytes) in two
+/// runs, each run's own cost (~2 000 cycles) paid twice, not four times.
+const READ_PER_RUN: u8 = 12;

@@ -137,7 +137,7 @@ impl Print {
 
     /// Lines come from the card now.
     pub fn running(&self) -> bool {
-        self.state == State::Running
+        matches!(self.state, State::Running)
     }
 
     /// A print is under way (running, lost with its card, or being
@@ -434,7 +434,7 @@ impl Print {
 
     /// The green button with no print: the card's first G-code file.
     pub fn start_first(&mut self) {
-        if self.state == State::Idle {
+        if matches!(self.state, State::Idle) {
             self.ask(Request::OpenFirst);
             self.state = State::Opening { start: true };
             self.skip = 0;
@@ -467,7 +467,7 @@ impl Print {
             self.close();
             return;
         }
-        if self.busy() || self.state == State::Selected {
+        if self.busy() || matches!(self.state, State::Selected) {
             info!("print aborted at line ", self.line_start.lines + 1);
         }
         self.close();
@@ -514,7 +514,7 @@ impl Print {
     }
 
     fn close(&mut self) {
-        if self.state != State::Idle {
+        if !matches!(self.state, State::Idle) {
             self.card.put(Request::Close);
         }
         self.forget();
@@ -542,7 +542,7 @@ impl Print {
             // Bytes wait in the queue until a line wants them, unless the
             // card went out behind them: the print stops at its last whole
             // line now (the line being carried out may wait on a long move).
-            if data && ours && self.state != State::Idle {
+            if data && ours && !matches!(self.state, State::Idle) {
                 if !crate::card::removal_waits(&self.news) {
                     return None;
                 }
@@ -564,7 +564,7 @@ impl Print {
                 What::Missing if ours => return self.failed(true),
                 What::Failed if ours => return self.failed(false),
                 What::Removed => self.lost(),
-                What::Inserted if self.state == State::Lost => {
+                What::Inserted if matches!(self.state, State::Lost) => {
                     info!("card back: M24 or the green button goes on");
                 }
                 // Older requests', and the slot's news when they change nothing.
@@ -656,8 +656,8 @@ impl Print {
     #[inline(never)]
     #[optimize(size)]
     fn lost(&mut self) {
-        if self.state != State::Running {
-            if self.state == State::Selected {
+        if !matches!(self.state, State::Running) {
+            if matches!(self.state, State::Selected) {
                 self.state = State::Idle;
             }
             return;
@@ -685,7 +685,7 @@ impl Print {
     #[inline(never)]
     pub fn next_byte(&mut self) -> Option<u8> {
         // A print's first line waits for its header (where it begins).
-        if self.state != State::Running || self.keep == Keep::Begin {
+        if !matches!(self.state, State::Running) || self.keep == Keep::Begin {
             return None;
         }
         loop {
@@ -698,7 +698,7 @@ impl Print {
             let Some(Some((len, byte))) = head else {
                 // Nothing waits while the print runs.
                 let _ = self.messages();
-                if !self.ended || self.state != State::Running {
+                if !self.ended || !matches!(self.state, State::Running) {
                     return None;
                 }
                 return match self.last {
@@ -737,7 +737,7 @@ impl Print {
     #[inline(never)]
     #[optimize(size)]
     pub fn finished(&mut self) -> bool {
-        let done = self.state == State::Running
+        let done = matches!(self.state, State::Running)
             && self.ended
             && matches!(self.last, b'\n' | b'\r' | 0)
             && !self.news.any(|m| m.ticket == self.ticket);

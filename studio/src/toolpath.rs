@@ -174,6 +174,10 @@ pub fn from_gcode(text: &str, machine: Machine) -> Result<Toolpath, String> {
             .map_err(|e| fail(e as u8, e.message()))?;
         while interp.run(&env, &mut io) != Progress::Done {}
     }
+    // The tiny moves joined last, as the firmware queues them when the
+    // input ends.
+    interp.flush_soon();
+    while interp.run(&env, &mut io) != Progress::Done {}
     Ok(io.path)
 }
 

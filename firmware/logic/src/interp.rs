@@ -222,8 +222,9 @@ struct Run {
     /// The line's path piece by piece: an arc (its last piece on the
     /// exact target of the last leg), or a straight leg's pieces.
     path: Option<Path>,
-    /// Its one leg may join the tiny moves around it ([`join`]).
-    joins: bool,
+    /// Its one leg starts a joined move ([`join`]): it did when the line
+    /// was accepted, or it may once the move joined before is queued.
+    opens: bool,
 }
 
 impl Run {
@@ -238,7 +239,7 @@ impl Run {
             from: [0; AXES],
             feed: Feed::Rapid,
             path: None,
-            joins: false,
+            opens: false,
         }
     }
 
@@ -255,7 +256,7 @@ impl Run {
         self.from = [0; AXES];
         self.feed = Feed::Rapid;
         self.path = None;
-        self.joins = false;
+        self.opens = false;
     }
 }
 
@@ -533,10 +534,12 @@ impl Interpreter {
     /// when it starts none (it joined the moves before, or it has no
     /// motion and they are not queued yet).
     pub fn blocks_before(&self) -> Option<u8> {
-        match (self.join.is_some(), self.run.todo & todo::FLUSH != 0) {
-            (false, _) => Some(0),
-            (true, true) => Some(1),
-            (true, false) => None,
+        let flush = self.run.todo & todo::FLUSH != 0;
+        match (self.join.is_some(), flush, self.run.opens) {
+            (false, _, _) => Some(0),
+            (true, true, _) => Some(1),
+            (true, false, true) => Some(0),
+            (true, false, false) => None,
         }
     }
 
@@ -1186,6 +1189,12 @@ fn check_leg(
 ) -> Result<(), ErrorKind> {
     check_travel(cfg, to, to, motors)?;
     if kin.is_linear() {
+        // The steps queued later fit (`motor_steps`), mostly seen at once.
+        let fits = (0..AXES)
+            .all(|i| motors >> i & 1 == 0 || cfg.axes[i].steps_per_unit.surely_fits(to[i]));
+        if fits {
+            return Ok(());
+        }
         return motor_steps(to, motors, kin, cfg).map(drop);
     }
     let (a, b) = (motor_milli(from, motors), motor_milli(to, motors));

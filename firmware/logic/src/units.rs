@@ -104,6 +104,14 @@ impl StepsPerUnit {
         self.steps_exact_wide(target)
     }
 
+    /// [`StepsPerUnit::steps_exact`] of `target` surely fits an `i32`:
+    /// within ±2.1 m at under 1 000 steps a unit, some 2 million steps at
+    /// most (each line's check on a linear machine, without the division;
+    /// false: ask `steps_exact`).
+    pub fn surely_fits(self, target: i64) -> bool {
+        self.num < 1000 && (-(1 << 31)..1 << 31).contains(&target)
+    }
+
     /// [`StepsPerUnit::steps_exact`] for any target, in 64 bits.
     fn steps_exact_wide(self, target: i64) -> Option<i32> {
         let n = target.checked_mul(self.num as i64)?;
@@ -277,6 +285,7 @@ mod tests {
         ) {
             let s = StepsPerUnit::new(num.max(1), den.max(1));
             prop_assert_eq!(s.steps_exact(target), s.steps_exact_wide(target));
+            prop_assert!(!s.surely_fits(target) || s.steps_exact_wide(target).is_some());
         }
     }
 
@@ -319,6 +328,10 @@ mod tests {
                 i64::MIN,
             ] {
                 assert_eq!(s.steps_exact(t), s.steps_exact_wide(t), "{num}/{den} {t}");
+                assert!(
+                    !s.surely_fits(t) || s.steps_exact(t).is_some(),
+                    "{num}/{den} {t}"
+                );
             }
         }
     }

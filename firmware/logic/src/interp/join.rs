@@ -110,11 +110,15 @@ impl Interpreter {
     #[inline(never)]
     pub(super) fn join_or_flush<K: Kinematics>(&mut self, joins: bool, env: &Env<K>) {
         if joins && self.run.todo == todo::LEG_0 {
+            let fresh = self.join.is_none();
             if self.open_join(env) {
                 self.run.todo = 0;
+                self.run.opens = fresh;
                 return;
             }
-            self.run.joins = true;
+            // One that did not join the move before may start its own
+            // once that is queued.
+            self.run.opens = !fresh;
         }
         // `M114`, `M17`, `M18 S` neither move nor wait.
         let moves = todo::REPORT | todo::DRIVERS_ON | todo::IDLE_DELAY;

@@ -5,8 +5,8 @@
 //! setting the pace: both finish together).
 
 use super::{
-    check_travel, coords, motor_channels, motor_only, pick, todo, Env, Interpreter, MachineIo,
-    Path, Run,
+    check_travel, coords, motor_channels, motor_only, motor_steps, pick, todo, Env, Interpreter,
+    MachineIo, Path, Run,
 };
 use crate::gcode::ErrorKind;
 use crate::kinematics::Kinematics;
@@ -37,11 +37,16 @@ impl Interpreter {
         if !env.allowed.motion {
             return Err(ErrorKind::JobOwnsMotion);
         }
-        let mut steps = io.steps();
+        let motors = motor_channels(cfg);
+        // From where the moves end: the tiny ones joined (queued first,
+        // `todo::FLUSH`) end at `run.from`.
+        let mut steps = match self.join.is_some() {
+            true => motor_steps(&self.run.from, motors, kin, cfg).unwrap_or_else(|_| io.steps()),
+            false => io.steps(),
+        };
         for (s, d) in steps.iter_mut().zip(mv.steps) {
             *s = s.saturating_add(i32::from(d));
         }
-        let motors = motor_channels(cfg);
         let at = motor_only(&kin.forward(&steps), motors);
         let reached = kin.inverse(&at).is_ok_and(|back| {
             back.iter()
@@ -56,13 +61,16 @@ impl Interpreter {
         self.position = end;
         let plotter = !cfg.machine.is_string_art();
         self.run = Run {
-            todo: if plotter { todo::PEN } else { 0 } | todo::PATH,
+            todo: if plotter { todo::PEN } else { 0 }
+                | todo::PATH
+                | if self.join.is_some() { todo::FLUSH } else { 0 },
             pen: match mv.pen_up {
                 true => cfg.pen.up_deg,
                 false => cfg.pen.down_deg,
             },
             feed: Feed::Rapid,
             path: Some(Path::Steps(steps)),
+            from: self.run.from,
             ..Run::new()
         };
         if env.allowed.checking {

@@ -127,7 +127,7 @@ impl Interpreter {
     ) -> Option<Wait> {
         // A line that did not join the moves before: they are queued, it
         // may start a join of its own.
-        if self.run.joins && self.open_join(env) {
+        if self.run.opens && self.open_join(env) {
             return None;
         }
         let to = self.run.legs[second as usize];

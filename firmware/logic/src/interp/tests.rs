@@ -151,6 +151,13 @@ impl Bench {
 
     /// [`Bench::send`] with more lines coming: tiny moves stay joined.
     fn stream(&mut self, text: &str) -> Result<(), u8> {
+        self.take(text)?;
+        self.run_out();
+        Ok(())
+    }
+
+    /// `text` accepted, not yet carried out.
+    fn take(&mut self, text: &str) -> Result<(), u8> {
         let mut p = Parser::new();
         let mut out: Vec<_> = text
             .bytes()
@@ -172,7 +179,6 @@ impl Bench {
             Err(e) => return Err(e.code()),
         }
         .map_err(|e| e as u8)?;
-        self.run_out();
         Ok(())
     }
 
@@ -1031,4 +1037,82 @@ fn a_circles_tiny_chords_are_joined_within_the_tolerance() {
         }
         assert_eq!(k, n + 1, "{m:?}");
     }
+}
+
+/// Tiny lines at one feed make one move, queued before whatever does not
+/// join it: a line at another feed, `M3`, a dwell, a seed line (its raw
+/// steps from the joined move's end); `M114` and an `F` alone leave it
+/// open. A card print's checkpoint follows only the lines that start a
+/// move (`blocks_before`).
+#[test]
+fn joined_moves_are_queued_before_what_does_not_join() {
+    let mut b = Bench::flatbed_at(10, 10);
+    b.io.did.clear();
+    let x = |k: i32| format!("{:.3}", 10.0 + 0.1 * k as f64);
+    b.take(&format!("G1 X{} Y10 F600", x(1))).unwrap();
+    assert_eq!(
+        b.interp.blocks_before(),
+        Some(0),
+        "the first starts the move"
+    );
+    b.run_out();
+    for k in 2..=4 {
+        b.take(&format!("G1 X{}", x(k))).unwrap();
+        assert_eq!(b.interp.blocks_before(), None, "joined");
+        b.run_out();
+    }
+    b.stream("M114").unwrap();
+    b.take("F600").unwrap();
+    assert_eq!(b.interp.blocks_before(), None);
+    b.run_out();
+    assert_eq!(b.io.did, [Did::Report]);
+    // Another feed: the joined move first (to X10.4: 416 steps), then
+    // the line starts a join of its own.
+    b.take(&format!("G1 X{} F900", x(5))).unwrap();
+    assert_eq!(b.interp.blocks_before(), Some(1));
+    b.run_out();
+    assert_eq!(b.interp.blocks_before(), Some(0));
+    assert_eq!(
+        b.io.did[1..],
+        [Did::Move([416, 400, 0], Feed::PerMinute(Milli(600_000)))]
+    );
+    // The pen waits for it.
+    b.stream("M3").unwrap();
+    let down = b.cfg.pen.down_deg;
+    assert_eq!(
+        b.io.did[2..],
+        [
+            Did::Move([420, 400, 0], Feed::PerMinute(Milli(900_000))),
+            Did::Pen(down)
+        ]
+    );
+    // A seed line counts its steps from the joined move's end.
+    b.stream("G1 X10.6 F900").unwrap();
+    b.stream("G1 X10.7").unwrap();
+    assert_eq!(b.io.did.len(), 4);
+    b.stream("+0010+0000n").unwrap();
+    assert_eq!(
+        b.io.did[4..],
+        [
+            Did::Move([428, 400, 0], Feed::PerMinute(Milli(900_000))),
+            Did::Pen(down),
+            Did::Move([438, 400, 0], Feed::Rapid)
+        ]
+    );
+    // A dwell waits for the move; so does the end of the input.
+    b.stream("G1 X11 F900").unwrap();
+    b.stream("G1 X11.1").unwrap();
+    b.stream("G4 P0").unwrap();
+    assert_eq!(
+        b.io.did[7],
+        Did::Move([444, 400, 0], Feed::PerMinute(Milli(900_000)))
+    );
+    b.stream("G1 X11.2").unwrap();
+    assert_eq!(b.io.did.len(), 8);
+    b.interp.flush_soon();
+    b.run_out();
+    assert_eq!(
+        b.io.did[8],
+        Did::Move([448, 400, 0], Feed::PerMinute(Milli(900_000)))
+    );
 }

@@ -18,6 +18,7 @@ use crate::curve::GRBL_MEGA_BLOCKS;
 use serde_json::{json, Map, Value};
 use std::path::Path;
 use std::time::Duration;
+use taut_logic::interp::estimate::GcodeTime;
 use taut_logic::machine::Machine;
 use taut_logic::planner::PLANNER_BLOCKS;
 use taut_simavr::sdcard::SdImage;
@@ -101,30 +102,27 @@ pub(crate) fn underruns(sim: &Sim) -> u64 {
 
 /// What the planner allows: the lines per second of the same stream
 /// from the first tenth to the last on the host (`GcodeTime`: the
-/// firmware's parser, executor and planner, a block timed when the full
-/// planner hands it on), with no limit from the CPU or the UART. Short
-/// moves at speed are bound by the look-ahead: the machine must be able
-/// to stop within the planned blocks. `N`: the planner's depth (the
-/// firmware's, or Grbl-Mega's 36 to show what a deeper one allows).
+/// firmware's parser, executor and planner), with no limit from the CPU
+/// or the UART: the time of the stream cut after its last tenth less
+/// that of the stream cut after its first (each run out to a stop: the
+/// two stops' ramps cancel). Short moves at speed are bound by the
+/// look-ahead: the machine must be able to stop within the planned
+/// blocks. `N`: the planner's depth (the firmware's, or Grbl-Mega's 36
+/// to show what a deeper one allows).
 fn planner_bound<const N: usize>(machine: Machine, start: [f64; 2], lines: &[String]) -> f64 {
-    let cfg = taut_logic::config::MachineConfig::defaults(machine);
-    let mut timing =
-        taut_logic::interp::estimate::GcodeTime::<N>::with_depth(&cfg).expect("kinematics");
-    timing.push(format!("G90 G21\nG0 X{} Y{}\n", start[0], start[1]).as_bytes());
+    let seconds = |k: usize| {
+        let cfg = taut_logic::config::MachineConfig::defaults(machine);
+        let mut t = GcodeTime::<N>::with_depth(&cfg).expect("kinematics");
+        t.push(format!("G90 G21\nG0 X{} Y{}\n", start[0], start[1]).as_bytes());
+        for l in &lines[..k] {
+            t.push(format!("{l}\n").as_bytes());
+        }
+        assert_eq!(t.refused, 0);
+        t.finish()
+    };
     let n = lines.len();
     let (from, to) = (n / 10, n - n / 10);
-    let mut at = [0.0; 2];
-    for (k, l) in lines.iter().enumerate() {
-        if k == from {
-            at[0] = timing.seconds();
-        }
-        if k == to {
-            at[1] = timing.seconds();
-        }
-        timing.push(format!("{l}\n").as_bytes());
-    }
-    assert_eq!(timing.refused, 0);
-    (to - from) as f64 / (at[1] - at[0])
+    (to - from) as f64 / (seconds(to) - seconds(from))
 }
 
 /// A machine at the circle's start, drivers on; with `card` inserted.
