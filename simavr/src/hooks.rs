@@ -64,6 +64,9 @@ pub(crate) struct Shared {
     pub spm_refused: u32,
     /// A sleep keeps the run loop's deadline (`Sim::run_to`).
     pub hard_deadline: bool,
+    /// The deadline fired in the timers just processed: a sleep ends
+    /// there, not at the timer after it.
+    deadline_fired: bool,
     /// The I flag before the last SREG write (simavr has unpacked the new
     /// value by the time the write hook runs).
     i_on: bool,
@@ -104,6 +107,7 @@ impl Shared {
             unseen_mask: false,
             spm_refused: 0,
             hard_deadline: false,
+            deadline_fired: false,
             i_on: false,
             // SAFETY: `avr` is live and initialised (module invariants).
             timers: unsafe { Timers::of(avr) },
@@ -358,6 +362,7 @@ unsafe extern "C" fn deadline(
     param: *mut c_void,
 ) -> simavr_ffi::avr_cycle_count_t {
     (*(param as *mut Shared)).deadline_at = None;
+    (*(param as *mut Shared)).deadline_fired = true;
     0
 }
 
@@ -407,7 +412,13 @@ pub(crate) unsafe extern "C" fn run(avr: *mut avr_t) {
         (*shared).deadline_at = None;
     }
     let before = (*avr).cycle;
-    let sleep = simavr_ffi::avr_cycle_timer_process(avr);
+    (*shared).deadline_fired = false;
+    let mut sleep = simavr_ffi::avr_cycle_timer_process(avr);
+    // A kept deadline due now ends the stretch here: the next timer may
+    // lie a byte's time later (a cut asked at this cycle would come late).
+    if (*shared).deadline_fired && (*shared).hard_deadline {
+        sleep = 0;
+    }
     (*shared).timers.catch_up(avr);
     if (*avr).cycle < before {
         (*shared).reset_at = Some(before);

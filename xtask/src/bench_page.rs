@@ -209,11 +209,23 @@ and commit the page.
   printing file`). Underruns are the firmware's own count (its logger's
   `underruns:N`) over the stream. Beside each, what the planner allows
   at the firmware's depth and at Grbl-Mega's 36 blocks, however fast the
-  CPU: short moves at speed are bound by the look-ahead (the machine must
-  be able to stop within the planned blocks) and by the junctions, which
-  Grbl's rule takes between the moves as rounded to steps (a 0.05 mm
-  chord is two steps of the flatbed's 0.025 mm, so the direction turns by tens of
-  degrees from one to the next).
+  CPU and the line (the host's time of the stream cut after its last
+  tenth less that of the stream cut after its first, each run out to a
+  stop): short moves at speed are bound by the look-ahead (the machine
+  must be able to stop within the planned blocks) and by the junctions,
+  which Grbl's rule takes between the moves as rounded to steps. taut
+  joins a circle's tiny chords into moves of about a millimetre within
+  the arc tolerance (`docs/console.md`), so its planner allows the feed
+  itself (F1500: 500 chords of 0.05 mm a second); Grbl-Mega plans each
+  chord (a 0.05 mm chord is two steps of the flatbed's 0.025 mm, so the
+  direction turns by tens of degrees from one to the next).
+  The simulated serial line carries some 5.5 kB/s into the firmware here,
+  half of 115 200 baud's 11.5 kB/s (the simulator's receive path; why it
+  is half is not found yet). Lines that move nothing show it: 21 bytes
+  of `G90 G21 G17 G94 (xx)` are answered 252 a second (5.5 kB/s), 4
+  bytes of `G90` 1 070 a second (4.3 kB/s) with the CPU idle half the
+  time. The flatbed's 0.05 mm chords (19 bytes a line) then come at
+  most some 280 a second over serial.
   `TAUT_BENCH_PROFILE=N` prints where a case's cycles go: per function,
   with callees (a shadow call stack), the callers of the maths library.
 - **Grbl side by side** (`grbl_stream_*`, `simavr/src/bin/taut-bench/grbl.rs`):

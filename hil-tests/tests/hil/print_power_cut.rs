@@ -101,6 +101,40 @@ fn star_at(by: [f64; 2]) -> String {
         .collect()
 }
 
+/// `text` with each `G1 X Y` line cut into chords of `mm` from where the
+/// line before ended, to the µm, the last on the line's target.
+fn in_chords(text: &str, mm: f64) -> String {
+    let mut at = [0.0f64; 2];
+    let mut out = String::new();
+    for raw in text.lines() {
+        let code = raw.split(';').next().unwrap().trim();
+        let word = |w: char| {
+            code.split_whitespace()
+                .find(|t| t.starts_with(w))
+                .map(|t| t[1..].parse::<f64>().unwrap())
+        };
+        let (Some(x), Some(y)) = (word('X'), word('Y')) else {
+            out += raw;
+            out += "\n";
+            continue;
+        };
+        if code.starts_with("G1 ") {
+            let len = (x - at[0]).hypot(y - at[1]);
+            let n = (len / mm).ceil().max(1.0) as usize;
+            let feed = word('F').map(|f| format!(" F{f}")).unwrap_or_default();
+            for k in 1..n {
+                let t = k as f64 / n as f64;
+                let p = [at[0] + t * (x - at[0]), at[1] + t * (y - at[1])];
+                out += &format!("G1 X{:.3} Y{:.3}{feed}\n", p[0], p[1]);
+            }
+        }
+        out += raw;
+        out += "\n";
+        at = [x, y];
+    }
+    out
+}
+
 /// A plotter under the test: where its star goes, how near the pulses
 /// must come to the toolpath (about a step of its coarsest motor), and
 /// between which seconds of the print it is cut (once the pen has gone
@@ -110,6 +144,10 @@ struct Plotter {
     by: [f64; 2],
     within: f64,
     cut_s: (f64, f64),
+    /// The star's straight lines cut into chords this long (mm; 0: as
+    /// the example has them): a stream of tiny lines, which the firmware
+    /// joins into moves.
+    chord_mm: f64,
 }
 
 const FLATBED: Plotter = Plotter {
@@ -117,6 +155,7 @@ const FLATBED: Plotter = Plotter {
     by: [0.0, 0.0],
     within: 0.05,
     cut_s: (1.0, 22.0),
+    chord_mm: 0.0,
 };
 
 const WHITEBOARD: Plotter = Plotter {
@@ -124,6 +163,7 @@ const WHITEBOARD: Plotter = Plotter {
     by: [-40.0, -40.0],
     within: 0.1,
     cut_s: (3.0, 30.0),
+    chord_mm: 0.0,
 };
 
 /// The star's feed, mm/s (`F1500`).
@@ -135,7 +175,10 @@ impl Plotter {
     }
 
     fn file(&self) -> String {
-        star_at(self.by)
+        match self.chord_mm > 0.0 {
+            true => in_chords(&star_at(self.by), self.chord_mm),
+            false => star_at(self.by),
+        }
     }
 
     /// The machine as it powers on with `eeprom`, its star on the card
@@ -225,6 +268,19 @@ fn a_flatbed_print_cut_at_seeded_moments_resumes_with_no_gap_and_redraws_only_th
     );
 }
 
+/// The star's lines as chords of 0.1 mm (thousands of lines, joined
+/// into moves of about a millimetre): a cut anywhere resumes from the
+/// line that starts the move it fell in, the same lines joined the same
+/// way, with no gap.
+#[test]
+fn a_flatbed_print_of_tiny_chords_cut_at_seeded_moments_resumes_with_no_gap() {
+    let chords = Plotter {
+        chord_mm: 0.1,
+        ..FLATBED
+    };
+    cut_and_resume(&chords, soak_or(vec![51u64, 52, 53, 54, 56], vec![55]));
+}
+
 #[test]
 fn a_whiteboard_print_cut_at_seeded_moments_resumes_with_no_gap() {
     cut_and_resume(&WHITEBOARD, soak_or(vec![31u64, 32, 33], vec![34, 35, 36]));
@@ -237,6 +293,7 @@ fn an_arm_print_cut_at_seeded_moments_resumes_with_no_gap() {
         by: [60.0, 110.0],
         within: 0.3,
         cut_s: (3.0, 30.0),
+        chord_mm: 0.0,
     };
     cut_and_resume(&arm, soak_or(vec![41u64, 42, 43], vec![44, 45, 46]));
 }
@@ -252,10 +309,14 @@ fn cut_and_resume(plotter: &Plotter, seeds: Vec<u64>) {
     let crossing: Vec<bool> = all
         .iter()
         .map(|&(i, p)| {
-            lines
-                .iter()
-                .enumerate()
-                .any(|(j, l)| j != i && l.path.distance(p) < plotter.within + 0.25)
+            lines.iter().enumerate().any(|(j, l)| {
+                // A chord's neighbours are the same line of the star.
+                let near = match plotter.chord_mm > 0.0 {
+                    true => ((0.5 / plotter.chord_mm) as usize).max(1),
+                    false => 0,
+                };
+                j.abs_diff(i) > near && l.path.distance(p) < plotter.within + 0.25
+            })
         })
         .collect();
     for seed in seeds {

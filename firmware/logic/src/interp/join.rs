@@ -302,4 +302,46 @@ mod tests {
         // Longer than half the span.
         assert!(Join::start(&at(0, 0), &at(2000, 0), Milli(900), 10, JOIN_SPAN_UM).is_none());
     }
+
+    proptest::proptest! {
+        /// Any stream of short moves, joined as the executor joins them:
+        /// every vertex of a joined move lies within the tolerance of the
+        /// straight move from its start to its end, and the move goes on
+        /// along the way (no vertex past its end).
+        #[test]
+        fn every_joined_vertex_lies_within_the_tolerance(
+            steps in proptest::collection::vec((1i32..400, -300i32..300), 2..200),
+            tol in 1u32..60,
+        ) {
+            let mut at = at(0, 0);
+            let mut heading = 0.0f64;
+            let mut points = std::vec![at];
+            for (len, turn) in &steps {
+                heading += *turn as f64 / 1000.0;
+                at = [
+                    Milli(at[0].0 + (*len as f64 * heading.cos()).round() as i32),
+                    Milli(at[1].0 + (*len as f64 * heading.sin()).round() as i32),
+                    Milli(0),
+                ];
+                points.push(at);
+            }
+            let mut start = 0;
+            while start + 1 < points.len() {
+                let mut j = Join::new(&points[start], Milli(1000), tol);
+                let mut end = start;
+                while end + 1 < points.len() && j.extend(&points[end + 1], tol, JOIN_SPAN_UM) {
+                    end += 1;
+                }
+                if end == start {
+                    start += 1;
+                    continue;
+                }
+                for v in start + 1..end {
+                    let d = off(&points[start], &points[end], &points[v]);
+                    proptest::prop_assert!(d <= tol as f64, "vertex {} is {} µm off", v, d);
+                }
+                start = end;
+            }
+        }
+    }
 }
