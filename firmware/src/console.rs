@@ -337,6 +337,12 @@ impl Console {
                 return self.carry_on(m, kin, cfg, owner, store);
             }
             if self.line_ready {
+                // A `$` line (`$C`, `$H`, `$J=`, `$SLP`…) sees the tiny
+                // moves joined before it queued, as a sender expects.
+                if self.interp.joining() && self.parser.first_char() == b'$' {
+                    self.interp.flush_soon();
+                    continue;
+                }
                 // A card's line may wait for a resume's travel back.
                 if self.source == Some(Source::Card) && !self.card_line_goes(m, kin, cfg, store) {
                     continue;
