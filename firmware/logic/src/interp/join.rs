@@ -72,7 +72,7 @@ impl Join {
     }
 
     /// `to` as the joined move's new end, if every vertex so far lies
-    /// within `tol` (µm, at most [`MAX_TOL_UM`]) of the move from `from`
+    /// within `tol` (µm, 1 to [`MAX_TOL_UM`]) of the move from `from`
     /// to it, and it is no nearer than the last; then its own cone is
     /// taken in. (A zero bound is no bound.)
     #[inline(never)]
@@ -135,8 +135,12 @@ impl Interpreter {
         let Feed::PerMinute(feed) = self.run.feed else {
             return false;
         };
-        let motors = motor_channels(env.cfg);
         let tol = tolerance(env);
+        // `$12=0`: no vertex may stray, so nothing is joined.
+        if tol == 0 {
+            return false;
+        }
+        let motors = motor_channels(env.cfg);
         let fresh = self.join.is_none();
         let from = &self.run.from;
         let j = self

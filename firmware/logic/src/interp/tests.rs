@@ -1116,3 +1116,19 @@ fn joined_moves_are_queued_before_what_does_not_join() {
         Did::Move([448, 400, 0], Feed::PerMinute(Milli(900_000)))
     );
 }
+
+/// `$12=0`: no vertex may stray from a joined move, so nothing is joined:
+/// each tiny line is its own move at once (the cone's sine would have no
+/// tolerance to take its half µm from).
+#[test]
+fn an_arc_tolerance_of_zero_joins_nothing() {
+    let mut b = Bench::flatbed_at(10, 10);
+    b.cfg.arc_tolerance_um = 0;
+    b.io.did.clear();
+    for k in 1..=3 {
+        b.stream(&format!("G1 X{:.3} Y10 F600", 10.0 + 0.1 * k as f64))
+            .unwrap();
+        assert!(!b.interp.joining());
+        assert_eq!(b.moves(), k);
+    }
+}
