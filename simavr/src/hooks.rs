@@ -618,3 +618,30 @@ mod tests {
         assert_eq!(super::plain("\x1b[31mCORE: bad\x1b[0m!"), "CORE: bad!");
     }
 }
+
+/// USART0's and USART1's control register A (U2X is its bit 1); each one's
+/// UBRRnL lies four bytes above it.
+pub(crate) const UCSR_A: [u16; 2] = [0xC0, 0xC8];
+
+/// A write of UCSRnA: simavr works out the USART's byte time only when
+/// UBRRnL is written, with the U2X bit it holds then, so a firmware that
+/// sets U2X after the rate (the silicon does not mind the order) would
+/// get a line of half its rate. Here the rate is worked out again, by
+/// simavr's own UBRRnL handler with the value UBRRnL holds.
+///
+/// # Safety
+/// `avr` is the live avr_t and `addr` one of [`UCSR_A`] (simavr's own
+/// handler of the register ran before: it was registered first).
+pub(crate) unsafe extern "C" fn on_ucsra_write(
+    avr: *mut avr_t,
+    addr: simavr_ffi::avr_io_addr_t,
+    _v: u8,
+    _param: *mut c_void,
+) {
+    let ubrrl = addr + 4;
+    // simavr's I/O table starts at data address 0x20 (AVR_DATA_TO_IO).
+    let io = &(*avr).io[usize::from(ubrrl) - 0x20].w;
+    if let Some(write) = io.c {
+        write(avr, ubrrl, *(*avr).data.add(usize::from(ubrrl)), io.param);
+    }
+}

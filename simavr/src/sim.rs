@@ -236,6 +236,9 @@ impl Sim {
             ffi::avr_register_io_write(a, SPL as u16, Some(hooks::on_sp_write), param);
             ffi::avr_register_io_write(a, SPH as u16, Some(hooks::on_sp_write), param);
             ffi::avr_register_io_write(a, SREG, Some(hooks::on_sreg_write), param);
+            for ucsra in hooks::UCSR_A {
+                ffi::avr_register_io_write(a, ucsra, Some(hooks::on_ucsra_write), param);
+            }
             (*a).custom.data = param;
             (*a).run = Some(hooks::run);
             (inputs[0], inputs[1])

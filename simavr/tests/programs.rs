@@ -220,6 +220,47 @@ fn uart_echoes_bytes_sent_before_the_receiver_is_on() {
     assert_eq!(sim.uart_text(), "");
 }
 
+#[test]
+fn uart_runs_at_its_rate_whichever_register_was_set_last() {
+    // UBRR0 = 16 and then U2X0 (117 647 baud, the order the firmware
+    // uses; the silicon does not mind it), RX with its interrupt and TX
+    // on; the USART0_RX handler echoes each byte plus one.
+    const RX_VECTOR: usize = 25 * 2; // in words: two per vector
+    let rjmp = |from: usize, to: usize| 0xC000 | ((to as i32 - from as i32 - 1) as u16 & 0x0FFF);
+    let main = RX_VECTOR + 2;
+    let mut program = vec![rjmp(0, main)];
+    program.resize(RX_VECTOR, NOP);
+    program.extend([rjmp(RX_VECTOR, main + 11), NOP]);
+    program.extend([
+        0xE100, // main: ldi r16, 16
+        0x9300, 0x00C4, // sts UBRR0L, r16
+        0xE002, // ldi r16, U2X0
+        0x9300, 0x00C0, // sts UCSR0A, r16
+        0xE908, // ldi r16, RXCIE0|RXEN0|TXEN0
+        0x9300, 0x00C1, // sts UCSR0B, r16
+        0x9478, // sei
+        0xCFFF, // rjmp .
+        0x9120, 0x00C6, // isr: lds r18, UDR0
+        0x9523, // inc r18
+        0x9320, 0x00C6, // sts UDR0, r18
+        0x9518, // reti
+    ]);
+    let mut sim = Sim::from_program(&program).unwrap();
+    let n = 40;
+    sim.uart_send(&vec![b'A'; n]);
+    let echoed = "B".repeat(n);
+    assert_eq!(sim.run_until_uart_contains(&echoed, ms(20)), Outcome::Done);
+    // simavr's receiver raises a byte every 11 bits of 136 cycles (1 496
+    // cycles) at this rate; at U2X0's half rate (worked out before U2X0
+    // was set) the 40 bytes would take twice as long.
+    let byte = 11 * 136;
+    let cycles = sim.cycles();
+    assert!(
+        cycles >= (n as u64 - 1) * byte && cycles < (n as u64 + 2) * byte,
+        "{n} bytes in {cycles} cycles"
+    );
+}
+
 /// Calls a function three times; it counts r16 down from 10 and returns.
 const CALL_3: [u16; 10] = [
     0xE013, // ldi r17, 3
