@@ -619,8 +619,9 @@ fn message(text: Text) {
     r.send();
 }
 
-/// Bytes parsed in one run at most: ~0.04 ms a byte (the fetch and the
-/// parser's ~350 cycles), so a run stays near 0.5 ms, which a `?` or any
-/// task waits behind; a line of a stream of tiny moves (~20 bytes) in two
-/// runs, each run's own cost (~2 000 cycles) paid twice, not four times.
-const READ_PER_RUN: u8 = 12;
+/// Bytes parsed in one run at most: ~0.03 ms a byte (the fetch and the
+/// parser's ~450 cycles), so a run stays under 1 ms, which a `?` or any
+/// task waits behind (carrying a line out takes as long); a line of a
+/// stream of tiny moves (~20 bytes) in one run, its own cost (~2 000
+/// cycles) paid once.
+const READ_PER_RUN: u8 = 24;

@@ -219,13 +219,12 @@ and commit the page.
   itself (F1500: 500 chords of 0.05 mm a second); Grbl-Mega plans each
   chord (a 0.05 mm chord is two steps of the flatbed's 0.025 mm, so the
   direction turns by tens of degrees from one to the next).
-  The simulated serial line carries some 5.5 kB/s into the firmware here,
-  half of 115 200 baud's 11.5 kB/s (the simulator's receive path; why it
-  is half is not found yet). Lines that move nothing show it: 21 bytes
-  of `G90 G21 G17 G94 (xx)` are answered 252 a second (5.5 kB/s), 4
-  bytes of `G90` 1 070 a second (4.3 kB/s) with the CPU idle half the
-  time. The flatbed's 0.05 mm chords (19 bytes a line) then come at
-  most some 280 a second over serial.
+  The simulated line carries a byte every 11 bits of the rate the
+  firmware set (UBRR0 16 with U2X0: 117 647 baud, 10.7 kB/s), simavr's
+  receiver; the flatbed's 0.05 mm chords (19 bytes a line) come at most
+  some 560 a second over serial. (simavr works out a USART's byte time
+  only when UBRRnL is written; the simulator works it out again when U2X
+  is set after, as the firmware does, and the silicon does not mind.)
   `TAUT_BENCH_PROFILE=N` prints where a case's cycles go: per function,
   with callees (a shadow call stack), the callers of the maths library.
 - **Grbl side by side** (`grbl_stream_*`, `simavr/src/bin/taut-bench/grbl.rs`):

@@ -84,8 +84,10 @@ fn no_message_lost_and_pulses_on_time_under_load() {
         );
     }
     assert_eq!(oks(&sim) - base_oks, lines, "every line answered once");
+    let stream_end = sim.cycles();
     sim.release(taut_logic::pinmap::Button::ZeroDrill.pin());
-    send(&mut sim, "M400");
+    // The stream ends mid-move (the move takes 6 s): M400 waits for the rest.
+    hil_tests::send_ok(&mut sim, "M400", Duration::from_secs(8));
     let text = sim.uart_text();
     assert!(
         text.contains("files ok: shape 6 nails 24 radius 200000um connections 3000")
@@ -122,6 +124,10 @@ fn no_message_lost_and_pulses_on_time_under_load() {
         .map(|e| e.cycle)
         .collect();
     assert_eq!(r.len(), steps);
+    assert!(
+        r[r.len() - 1] > stream_end,
+        "the whole stream was answered while the base moved"
+    );
     let ramp = (1.05 * rate * rate / (2.0 * accel)).ceil() as usize + 16;
     let cruise = &r[ramp..r.len() - ramp];
     let n = cruise.len() as f64;
