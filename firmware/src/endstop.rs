@@ -4,8 +4,9 @@
 //! the steps at once when it closes, as Ctrl-X does: a homing leg is then
 //! over wherever the switch caught it.
 
+use crate::rt::byte;
 use crate::stepper;
-use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
+use core::sync::atomic::{AtomicBool, AtomicU8};
 use taut_logic::axis::AXES;
 use taut_logic::pinmap::Button;
 
@@ -25,41 +26,41 @@ static LAST: AtomicU8 = AtomicU8::new(0);
 
 /// Stop the steps when channel `axis`'s switch closes.
 pub fn watch(axis: usize) {
-    HIT.store(false, Relaxed);
-    WATCHED.store(MIN_INPUT[axis], Relaxed);
+    byte::store_bool(&HIT, false);
+    byte::store(&WATCHED, MIN_INPUT[axis]);
 }
 
 /// Whether the watched switch has stopped the steps.
 pub fn hit() -> bool {
-    HIT.load(Relaxed)
+    byte::load_bool(&HIT)
 }
 
 /// Stop watching: whether the switch had stopped the steps.
 pub fn disarm() -> bool {
     // No swap on the AVR: masked, so a tick cannot set it in between.
     avr_device::interrupt::free(|_| {
-        WATCHED.store(0, Relaxed);
-        let hit = HIT.load(Relaxed);
-        HIT.store(false, Relaxed);
+        byte::store(&WATCHED, 0);
+        let hit = byte::load_bool(&HIT);
+        byte::store_bool(&HIT, false);
         hit
     })
 }
 
 /// Channel `axis`'s switch is closed, as the last tick read it.
 pub fn closed(axis: usize) -> bool {
-    LAST.load(Relaxed) & MIN_INPUT[axis] != 0
+    byte::load(&LAST) & MIN_INPUT[axis] != 0
 }
 
 /// The tick, with the inputs it read (bit = button): true when the
 /// watched switch just closed (the steps are stopped; the console goes on).
 pub fn on_tick(raw: u8) -> bool {
-    LAST.store(raw, Relaxed);
-    let watched = WATCHED.load(Relaxed);
+    byte::store(&LAST, raw);
+    let watched = byte::load(&WATCHED);
     if watched == 0 || raw & watched == 0 {
         return false;
     }
     stepper::halt();
-    WATCHED.store(0, Relaxed);
-    HIT.store(true, Relaxed);
+    byte::store(&WATCHED, 0);
+    byte::store_bool(&HIT, true);
     true
 }

@@ -6,9 +6,10 @@
 use crate::board::servo::PenServo;
 use crate::drivers::Drivers;
 use crate::queues::{BLOCKS, SEGMENTS, SEGMENTS_CAPACITY};
+use crate::rt::byte;
 use crate::rt::TaskCell;
 use crate::stepper::{blocks_begun, every_event, fast_segment, Stepper, FAST};
-use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
+use core::sync::atomic::AtomicU8;
 use taut_logic::axis::PerAxis;
 use taut_logic::config::MachineConfig;
 use taut_logic::kinematics::Piece;
@@ -49,7 +50,7 @@ static SHORT_AT: AtomicU8 = AtomicU8::new(SEGMENTS_CAPACITY as u8);
 /// The step queue holds less than the urgent budget of motion.
 #[inline(always)]
 pub fn urgent() -> bool {
-    SEGMENTS.len() <= SHORT_AT.load(Relaxed) as usize
+    SEGMENTS.len() <= byte::load(&SHORT_AT) as usize
 }
 
 /// The look-ahead ring (1 KiB): its own static, built in place.
@@ -258,7 +259,7 @@ impl Motion {
                 .buffered
                 .short_at(URGENT_BUDGET_US)
                 .max(URGENT_MIN as usize);
-            SHORT_AT.store(short as u8, Relaxed);
+            byte::store(&SHORT_AT, short as u8);
         }
         self.blocks = BLOCKS.len() as u8;
         // A standing stepper starts on enough motion to keep ahead of.

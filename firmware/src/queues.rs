@@ -52,8 +52,9 @@
 //! static`, reached by name: the step rings (`SEGMENTS`, `BLOCKS`: the
 //! step interrupt's assembly addresses `SEGMENTS` by its symbol).
 
+use crate::rt::byte;
 use crate::rt::{Mailbox, Ring};
-use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
+use core::sync::atomic::AtomicBool;
 use taut_logic::buttons::ButtonEvent;
 use taut_logic::fat::Name;
 use taut_logic::sched::QueueStats;
@@ -324,12 +325,12 @@ pub struct ClaimTx(());
 impl ClaimTx {
     #[inline(always)]
     pub fn set(&self, claimed: bool) {
-        JOB_CLAIMS_TX.store(claimed, Relaxed)
+        byte::store_bool(&JOB_CLAIMS_TX, claimed)
     }
 
     #[inline(always)]
     pub fn claimed(&self) -> bool {
-        JOB_CLAIMS_TX.load(Relaxed)
+        byte::load_bool(&JOB_CLAIMS_TX)
     }
 }
 
@@ -339,7 +340,7 @@ pub struct TxClaim(());
 impl TxClaim {
     #[inline(always)]
     pub fn claimed(&self) -> bool {
-        JOB_CLAIMS_TX.load(Relaxed)
+        byte::load_bool(&JOB_CLAIMS_TX)
     }
 }
 

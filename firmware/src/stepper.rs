@@ -26,9 +26,10 @@ pub mod fast;
 use crate::board::gpio::{regs, Output, Pin};
 use crate::board::step_timer::StepTimer;
 use crate::queues::{BLOCKS, SEGMENTS};
+use crate::rt::byte;
 use core::cell::UnsafeCell;
 use core::ptr::{read_volatile, write_volatile};
-use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
+use core::sync::atomic::AtomicU8;
 use taut_logic::axis::{PerAxis, AXES};
 use taut_logic::coil;
 use taut_logic::config::{Driver, MachineConfig};
@@ -216,7 +217,7 @@ static BEGUN: AtomicU8 = AtomicU8::new(0);
 
 /// Blocks the step interrupt has begun, wrapping.
 pub fn blocks_begun() -> u8 {
-    BEGUN.load(Relaxed)
+    byte::load(&BEGUN)
 }
 
 #[doc(hidden)]
@@ -539,7 +540,7 @@ fn load_segment(e: &mut Exec) -> bool {
                 return false;
             }
             let _ = BLOCKS.pop();
-            BEGUN.store(BEGUN.load(Relaxed).wrapping_add(1), Relaxed);
+            byte::store(&BEGUN, byte::load(&BEGUN).wrapping_add(1));
         }
         e.interval = seg.interval;
         e.add = seg.add;

@@ -4,7 +4,8 @@
 
 use super::usart::{self, Outbox, RX, TX};
 use super::usart1::{self, RX1, TX1};
-use core::sync::atomic::{AtomicU8, Ordering::Relaxed};
+use crate::rt::byte;
+use core::sync::atomic::AtomicU8;
 use taut_logic::gcode::LINE_CUT;
 use taut_logic::sched::QueueStats;
 
@@ -20,7 +21,7 @@ static ANSWER: AtomicU8 = AtomicU8::new(Port::Usb as u8);
 
 /// The port of the line being read or answered.
 pub fn answer() -> Port {
-    match ANSWER.load(Relaxed) {
+    match byte::load(&ANSWER) {
         0 => Port::Usb,
         _ => Port::Uart1,
     }
@@ -47,7 +48,7 @@ pub fn next_line() -> Option<Port> {
         (false, true) => Port::Uart1,
         (false, false) => return None,
     };
-    ANSWER.store(port as u8, Relaxed);
+    byte::store(&ANSWER, port as u8);
     Some(port)
 }
 

@@ -5,9 +5,10 @@
 //! when `RX` holds [`XOFF_AT`] bytes and XON once it is down to
 //! [`XON_AT`], each ahead of the bytes waiting in `TX`.
 
+use crate::rt::byte;
 use crate::rt::Ring;
 use avr_device::atmega2560::USART0;
-use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
+use core::sync::atomic::{AtomicBool, AtomicU8};
 use taut_logic::gcode::LINE_CUT;
 
 /// Receive interrupt → console: line bytes (real-time commands are taken
@@ -78,13 +79,13 @@ pub const XON_AT: usize = 64;
 /// paused, XON releases it.
 pub fn set_xonxoff(on: bool) {
     avr_device::interrupt::free(|_| {
-        let f = FLOW.load(Relaxed);
+        let f = byte::load(&FLOW);
         let f = match on {
             true => f | FLOW_ON,
             false if f & FLOW_STOPPED != 0 => FLOW_DUE,
             false => f & FLOW_DUE,
         };
-        FLOW.store(f, Relaxed);
+        byte::store(&FLOW, f);
     });
     wake();
 }
@@ -92,8 +93,8 @@ pub fn set_xonxoff(on: bool) {
 /// At power-on with flow control on: XON, which lets a sender go on
 /// that the board paused before it was reset.
 pub fn release_sender() {
-    if FLOW.load(Relaxed) & FLOW_ON != 0 {
-        FLOW.store(FLOW_ON | FLOW_DUE, Relaxed);
+    if byte::load(&FLOW) & FLOW_ON != 0 {
+        byte::store(&FLOW, FLOW_ON | FLOW_DUE);
         wake();
     }
 }
@@ -102,12 +103,12 @@ pub fn release_sender() {
 /// it is not so already.
 fn flow_to(stop: bool) {
     let changed = avr_device::interrupt::free(|_| {
-        let f = FLOW.load(Relaxed);
+        let f = byte::load(&FLOW);
         if f & FLOW_ON == 0 || (f & FLOW_STOPPED != 0) == stop {
             return false;
         }
         let stopped = if stop { FLOW_STOPPED } else { 0 };
-        FLOW.store(f & !FLOW_STOPPED | stopped | FLOW_DUE, Relaxed);
+        byte::store(&FLOW, f & !FLOW_STOPPED | stopped | FLOW_DUE);
         true
     });
     if changed {
@@ -118,7 +119,7 @@ fn flow_to(stop: bool) {
 /// The next received byte for the console; XON once `RX` has room again.
 pub fn receive() -> Option<u8> {
     let b = RX.pop();
-    if FLOW.load(Relaxed) & FLOW_STOPPED != 0 && RX.len() <= XON_AT {
+    if byte::load(&FLOW) & FLOW_STOPPED != 0 && RX.len() <= XON_AT {
         flow_to(false);
     }
     b
@@ -134,11 +135,11 @@ pub fn clear_input() {
 /// The flow byte due, taken.
 fn flow_byte() -> Option<u8> {
     avr_device::interrupt::free(|_| {
-        let f = FLOW.load(Relaxed);
+        let f = byte::load(&FLOW);
         if f & FLOW_DUE == 0 {
             return None;
         }
-        FLOW.store(f & !FLOW_DUE, Relaxed);
+        byte::store(&FLOW, f & !FLOW_DUE);
         Some(if f & FLOW_STOPPED != 0 { XOFF } else { XON })
     })
 }
@@ -169,8 +170,8 @@ impl Outbox {
 
     /// The ring's free slots are now the new line's: its number.
     pub fn begin_staging(&self) -> u8 {
-        let n = self.staging.load(Relaxed).wrapping_add(1);
-        self.staging.store(n, Relaxed);
+        let n = byte::load(&self.staging).wrapping_add(1);
+        byte::store(&self.staging, n);
         n
     }
 
@@ -179,14 +180,14 @@ impl Outbox {
     /// or the slots are no longer the line's (none is).
     #[inline(always)]
     pub fn stage(&self, owner: u8, k: u8, n: u8, bytes: impl Iterator<Item = u8>) -> bool {
-        owner == self.staging.load(Relaxed) && self.ring.stage(k, n, bytes)
+        owner == byte::load(&self.staging) && self.ring.stage(k, n, bytes)
     }
 
     /// Queue the `n` bytes line `owner` staged, unless it `lost` some or
     /// its slots (refused, then): whether it did (the caller wakes its
     /// transmitter).
     pub fn publish(&self, owner: u8, n: usize, lost: bool) -> bool {
-        let current = self.staging.load(Relaxed);
+        let current = byte::load(&self.staging);
         // Queued, the slots are no longer the line's.
         self.begin_staging();
         if lost || owner != current {
@@ -226,7 +227,7 @@ pub fn on_data_register_empty() {
     if let Some(b) = flow_byte().or_else(|| TX.pop()) {
         // SAFETY: UDR0 takes any byte.
         regs().udr0().write(|w| unsafe { w.bits(b) });
-        if !TX.is_empty() || FLOW.load(Relaxed) & FLOW_DUE != 0 {
+        if !TX.is_empty() || byte::load(&FLOW) & FLOW_DUE != 0 {
             avr_device::interrupt::free(|_| regs().ucsr0b().modify(|_, w| w.udrie0().set_bit()));
         }
     }
@@ -243,19 +244,19 @@ static CUT: AtomicBool = AtomicBool::new(false);
 /// ignoring the count or the flow control) ends in [`LINE_CUT`],
 /// answered `error:11`. Each lost byte is counted.
 pub(super) fn keep<const N: usize>(rx: &Ring<u8, N, true>, cut: &AtomicBool, b: u8) {
-    let was_cut = cut.load(Relaxed);
+    let was_cut = byte::load_bool(&cut);
     if b == b'\n' || b == b'\r' {
         // While the console is behind by a whole line the end finds no
         // room: the next line is then dropped with this one.
         if rx.push_inlined(if was_cut { LINE_CUT } else { b }).is_ok() {
-            cut.store(false, Relaxed);
+            byte::store_bool(&cut, false);
         }
         return;
     }
     // No 0xFF from the wire is taken for the marker (Grbl drops every
     // extended byte that is no real-time command).
     if was_cut || b == LINE_CUT || rx.free() <= 1 {
-        cut.store(was_cut || b != LINE_CUT, Relaxed);
+        byte::store_bool(&cut, was_cut || b != LINE_CUT);
         rx.refuse();
         return;
     }
@@ -270,7 +271,7 @@ pub fn on_receive(take: impl FnOnce(u8) -> bool) -> bool {
     let taken = take(b);
     if !taken {
         keep(&RX, &CUT, b);
-        if FLOW.load(Relaxed) & FLOW_ON != 0 && RX.len() >= XOFF_AT {
+        if byte::load(&FLOW) & FLOW_ON != 0 && RX.len() >= XOFF_AT {
             flow_to(true);
         }
     }

@@ -7,9 +7,10 @@
 //! `zero_drill` button is on D18.
 
 use super::usart::{keep, Outbox};
+use crate::rt::byte;
 use crate::rt::Ring;
 use avr_device::atmega2560::USART1;
-use core::sync::atomic::{AtomicBool, AtomicU8, Ordering::Relaxed};
+use core::sync::atomic::{AtomicBool, AtomicU8};
 use taut_logic::settings::grbl::Uart1Baud;
 
 /// Receive interrupt → console, as `usart::RX`: 64 bytes, the longest
@@ -31,7 +32,7 @@ fn regs() -> &'static avr_device::atmega2560::usart1::RegisterBlock {
 static ON: AtomicBool = AtomicBool::new(false);
 
 pub fn on() -> bool {
-    ON.load(Relaxed)
+    byte::load_bool(&ON)
 }
 
 /// The rate set (a [`Uart1Baud`] code).
@@ -43,10 +44,10 @@ static RATE: AtomicU8 = AtomicU8::new(Uart1Baud::Off as u8);
 /// Ctrl-X. A new rate drops the bytes not yet read or sent.
 pub fn configure(baud: Uart1Baud) {
     // Tasks only (no swap on the AVR).
-    if RATE.load(Relaxed) == baud as u8 {
+    if byte::load(&RATE) == baud as u8 {
         return;
     }
-    RATE.store(baud as u8, Relaxed);
+    byte::store(&RATE, baud as u8);
     let ubrr = match baud {
         Uart1Baud::Off => None,
         Uart1Baud::B9600 => Some(207),
@@ -58,8 +59,8 @@ pub fn configure(baud: Uart1Baud) {
         r.ucsr1b().write(|w| w);
         RX1.clear();
         TX1.clear();
-        CUT.store(false, Relaxed);
-        ON.store(ubrr.is_some(), Relaxed);
+        byte::store_bool(&CUT, false);
+        byte::store_bool(&ON, ubrr.is_some());
         if let Some(ubrr) = ubrr {
             r.ubrr1().write(|w| w.set(ubrr));
             r.ucsr1a().write(|w| w.u2x1().set_bit());

@@ -2,6 +2,7 @@
 //! queues, stack measurement. The dispatcher's ordering logic is
 //! `taut_logic::sched` (host-tested); the app holds it in `TaskCell` statics.
 
+pub mod byte;
 pub mod dispatch;
 pub mod flags;
 pub mod isr_cell;

@@ -1,10 +1,11 @@
 //! A lock-free single-producer single-consumer ring for queues that cross
 //! an interrupt boundary (UART bytes, step segments). Indices are single
-//! bytes, which the AVR loads and stores atomically, so neither side ever
-//! masks interrupts. Each ring counts what it accepted and refused and how
+//! bytes, which the AVR loads and stores atomically (`byte`), so neither
+//! side ever masks interrupts. Each ring counts what it accepted and refused and how
 //! full it got: a full ring is back-pressure to the producer, never a
 //! silent loss.
 
+use super::byte;
 use core::cell::UnsafeCell;
 use core::mem::MaybeUninit;
 use core::ptr::read_volatile;
@@ -59,10 +60,7 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
 
     /// Messages waiting.
     pub fn len(&self) -> usize {
-        let n = self
-            .head
-            .load(Relaxed)
-            .wrapping_sub(self.tail.load(Relaxed));
+        let n = byte::load(&self.head).wrapping_sub(byte::load(&self.tail));
         match WHOLE {
             true => n as usize,
             false => (n & Self::MASK) as usize,
@@ -76,7 +74,7 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
     /// Consumer: drop everything queued (its producer must be quiet, or
     /// its new items may go too).
     pub fn clear(&self) {
-        self.tail.store(self.head.load(Relaxed), Relaxed);
+        byte::store(&self.tail, byte::load(&self.head));
     }
 
     /// Free slots (unless `WHOLE`, one stays empty to tell full from empty).
@@ -92,14 +90,14 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
             stats.on_refused();
             return false;
         }
-        let mut h = self.head.load(Relaxed);
+        let mut h = byte::load(&self.head);
         for &item in items {
             // SAFETY: slot `h` is free (checked above) and the producer's.
             unsafe { (*self.buf.get())[(h & Self::MASK) as usize] = MaybeUninit::new(item) };
             h = Self::next(h);
         }
         compiler_fence(Release);
-        self.head.store(h, Relaxed);
+        byte::store(&self.head, h);
         stats.on_send(self.len());
         true
     }
@@ -114,7 +112,7 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
     pub fn stage(&self, k: u8, n: u8, items: impl Iterator<Item = T>) -> bool {
         // At most 255 free: `N` ≤ 256 and one stays empty, or `N` ≤ 128.
         let fit = (self.free() as u8).saturating_sub(k).min(n);
-        let mut h = self.head.load(Relaxed).wrapping_add(k);
+        let mut h = byte::load(&self.head).wrapping_add(k);
         for item in items.take(usize::from(fit)) {
             // SAFETY: slot `h` is free (counted above) and the producer's.
             unsafe { (*self.buf.get())[(h & Self::MASK) as usize] = MaybeUninit::new(item) };
@@ -127,10 +125,9 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
     pub fn publish(&self, n: usize) {
         // SAFETY: only the producer touches `stats` mutably.
         let stats = unsafe { &mut *self.stats.get() };
-        let h = self.head.load(Relaxed).wrapping_add(n as u8);
+        let h = byte::load(&self.head).wrapping_add(n as u8);
         compiler_fence(Release);
-        self.head
-            .store(if WHOLE { h } else { h & Self::MASK }, Relaxed);
+        byte::store(&self.head, if WHOLE { h } else { h & Self::MASK });
         stats.on_send(self.len());
     }
 
@@ -151,11 +148,11 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
             stats.on_refused();
             return Err(item);
         }
-        let h = self.head.load(Relaxed);
+        let h = byte::load(&self.head);
         // SAFETY: slot `h` is free (checked above) and the producer's.
         unsafe { (*self.buf.get())[(h & Self::MASK) as usize] = MaybeUninit::new(item) };
         compiler_fence(Release);
-        self.head.store(Self::next(h), Relaxed);
+        byte::store(&self.head, Self::next(h));
         stats.on_send(self.len());
         Ok(())
     }
@@ -169,22 +166,22 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
     /// takes its blocks with it, and a call there deepens the stack peak.
     #[inline(always)]
     pub fn pop(&self) -> Option<T> {
-        let t = self.tail.load(Relaxed);
-        if t == self.head.load(Relaxed) {
+        let t = byte::load(&self.tail);
+        if t == byte::load(&self.head) {
             return None;
         }
         compiler_fence(Acquire);
         // SAFETY: slot `t` was published by the producer and not yet consumed.
         let item = unsafe { (*self.buf.get())[(t & Self::MASK) as usize].assume_init() };
         compiler_fence(Release);
-        self.tail.store(Self::next(t), Relaxed);
+        byte::store(&self.tail, Self::next(t));
         Some(item)
     }
 
     /// Consumer: the oldest message without taking it.
     pub fn peek(&self) -> Option<T> {
-        let t = self.tail.load(Relaxed);
-        if t == self.head.load(Relaxed) {
+        let t = byte::load(&self.tail);
+        if t == byte::load(&self.head) {
             return None;
         }
         compiler_fence(Acquire);
@@ -196,8 +193,8 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
     /// [`Ring::pop`].
     #[inline(always)]
     pub fn peek_with<R>(&self, f: impl FnOnce(&T) -> R) -> Option<R> {
-        let t = self.tail.load(Relaxed);
-        if t == self.head.load(Relaxed) {
+        let t = byte::load(&self.tail);
+        if t == byte::load(&self.head) {
             return None;
         }
         compiler_fence(Acquire);
@@ -209,7 +206,7 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
 
     /// Consumer: whether any waiting message is `f`'s.
     pub fn any(&self, f: impl Fn(&T) -> bool) -> bool {
-        let (mut t, h) = (self.tail.load(Relaxed), self.head.load(Relaxed));
+        let (mut t, h) = (byte::load(&self.tail), byte::load(&self.head));
         compiler_fence(Acquire);
         while t != h {
             // SAFETY: slots from tail to head are published and not consumed.
