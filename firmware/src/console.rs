@@ -457,7 +457,37 @@ impl Console {
     #[inline(never)]
     #[optimize(speed)]
     fn read(&mut self) -> Result<bool, Poll<Signal>> {
-        for _ in 0..READ_PER_RUN {
+        let mut budget = READ_PER_RUN;
+        while budget > 0 {
+            // Mid-line from the card: the bytes in place, a run at a time
+            // (one parser step a byte, without a byte's own fetch).
+            if self.source == Some(Source::Card) && self.parser.mid_line() && self.pattern.is_none()
+            {
+                if let Some((at, of)) = self.print.run() {
+                    let parser = &mut self.parser;
+                    let (n, lines, last, end) = crate::card::bytes(at, of.min(budget), |s| {
+                        let mut lines = 0;
+                        for (i, &b) in s.iter().enumerate() {
+                            lines += (b == b'\n') as u8;
+                            let end = parser.read(b) == Read::LineEnd;
+                            // A line end, or a Ctrl-X that began the line
+                            // again (the next line's source is chosen anew).
+                            if end || !parser.mid_line() {
+                                return (i as u8 + 1, lines, b, end);
+                            }
+                        }
+                        (s.len() as u8, lines, s[s.len() - 1], false)
+                    });
+                    self.print.took_run(n, of, lines, last);
+                    if end {
+                        self.print.line_done();
+                        return Ok(true);
+                    }
+                    budget -= n;
+                    continue;
+                }
+            }
+            budget -= 1;
             let byte = match self.pattern.as_mut() {
                 Some((text, at)) if usize::from(*at) < text.len() => {
                     *at += 1;

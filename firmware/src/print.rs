@@ -719,6 +719,43 @@ impl Print {
         }
     }
 
+    /// The file's bytes a line may take now in place, as `next_byte` would
+    /// give them one by one: where they start in the block and how many.
+    /// `None` when `next_byte` must go on (nothing sent, the print not
+    /// running, bytes still to pass over).
+    #[inline(always)]
+    pub fn run(&self) -> Option<(u16, u8)> {
+        if !matches!(self.state, State::Running)
+            || self.keep == Keep::Begin
+            || self.at.pos < self.skip
+        {
+            return None;
+        }
+        let taken = self.taken;
+        self.news
+            .peek_with(|m| match m.what {
+                What::Data { at, len } if m.ticket == self.ticket && len > taken => {
+                    Some((at + u16::from(taken), len - taken))
+                }
+                _ => None,
+            })
+            .flatten()
+    }
+
+    /// `n` bytes of a [`Print::run`] of `of` were taken, `lines` line
+    /// ends among them, the last `last`.
+    #[inline(never)]
+    pub fn took_run(&mut self, n: u8, of: u8, lines: u8, last: u8) {
+        self.taken += n;
+        if n >= of {
+            self.taken = 0;
+            let _ = self.news.pop();
+        }
+        self.at.pos += u32::from(n);
+        self.at.lines += u32::from(lines);
+        self.last = last;
+    }
+
     fn took(&mut self, byte: u8) -> u8 {
         if byte == b'\n' {
             self.at.lines += 1;
