@@ -374,11 +374,9 @@ impl Console {
                     self.interp.flush_soon();
                 }
                 Err(wait) => return wait,
-                // A line read whole is taken in a run of its own.
-                Ok(true) => {
-                    self.line_ready = true;
-                    return Poll::Again;
-                }
+                // A line read whole is taken in this run, after the
+                // checks above (a starving step queue first).
+                Ok(true) => self.line_ready = true,
                 Ok(false) => {}
             }
         }

@@ -244,19 +244,19 @@ static CUT: AtomicBool = AtomicBool::new(false);
 /// ignoring the count or the flow control) ends in [`LINE_CUT`],
 /// answered `error:11`. Each lost byte is counted.
 pub(super) fn keep<const N: usize>(rx: &Ring<u8, N, true>, cut: &AtomicBool, b: u8) {
-    let was_cut = byte::load_bool(&cut);
+    let was_cut = byte::load_bool(cut);
     if b == b'\n' || b == b'\r' {
         // While the console is behind by a whole line the end finds no
         // room: the next line is then dropped with this one.
         if rx.push_inlined(if was_cut { LINE_CUT } else { b }).is_ok() {
-            byte::store_bool(&cut, false);
+            byte::store_bool(cut, false);
         }
         return;
     }
     // No 0xFF from the wire is taken for the marker (Grbl drops every
     // extended byte that is no real-time command).
     if was_cut || b == LINE_CUT || rx.free() <= 1 {
-        byte::store_bool(&cut, was_cut || b != LINE_CUT);
+        byte::store_bool(cut, was_cut || b != LINE_CUT);
         rx.refuse();
         return;
     }

@@ -91,18 +91,27 @@ impl Number {
     #[inline]
     fn digit(&mut self, d: u8) {
         self.flags |= DIGITS;
-        let point = self.has(POINT);
         if self.sig < DIGITS_KEPT {
-            // Leading zeros cost nothing: `sig` stays 0. The first four
-            // digits in 16 bits: the AVR's `u32` product is a library call.
-            self.sig = match u16::try_from(self.sig) {
-                Ok(small) if small < u16::MAX / 10 => u32::from(small * 10 + u16::from(d)),
-                _ => self.sig * 10 + u32::from(d),
-            };
-            if point && self.exp > -EXP_LIMIT {
+            // Leading zeros cost nothing: `sig` stays 0. Tenfold as
+            // shifts and an add: the AVR's `u32` product is a library call
+            // (~70 cycles, and the registers it takes are saved at every
+            // digit), which LLVM would fold the shifts back into, were
+            // one of them not hidden from it.
+            let twice = self.sig << 1;
+            self.sig = (core::hint::black_box(twice) << 2) + twice + u32::from(d);
+            if self.has(POINT) && self.exp > -EXP_LIMIT {
                 self.exp -= 1;
             }
-        } else if !point {
+        } else {
+            self.digit_past_kept(d);
+        }
+    }
+
+    /// A digit past the kept ones (a tenth and later significant digit).
+    #[cold]
+    #[inline(never)]
+    fn digit_past_kept(&mut self, d: u8) {
+        if !self.has(POINT) {
             // An integer digit past the kept ones: the value grows tenfold.
             self.exp = (self.exp + 1).min(EXP_LIMIT);
         } else if !self.has(ROUNDED) {

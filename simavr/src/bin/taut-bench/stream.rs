@@ -298,6 +298,8 @@ pub fn stream_figures(elf: &Path, f: &mut Map<String, Value>, only: Option<&str>
                             .map(|(at, n)| format!("{n} at {:.3} s", *at as f64 / 16e6))
                             .collect();
                         println!("  longest runs of {t:#x}: {}", longest.join(", "));
+                        let total: u64 = runs.iter().map(|r| r.1).sum();
+                        println!("  all runs of {t:#x}: {} runs, {total} cycles", runs.len());
                     }
                 }
                 if let (Some(n), Some(p)) = (profile, sim.profile()) {
