@@ -730,14 +730,23 @@ impl Interpreter {
             }
             _ => {
                 if axis_command != AxisCommand::ToolLength {
-                    let from = match (b.non_modal, m.distance) {
-                        (NonModal::AbsoluteOverride, _) => [0; AXES],
-                        (_, Distance::Absolute) => {
-                            sum(&block_coord, &self.plus_tlo(&self.coord_offset), 1)
+                    // The named channels from where their words count
+                    // from, the others where they are: one pass, no
+                    // intermediate arrays (every line of a stream of
+                    // moves comes here).
+                    for i in 0..AXES {
+                        if given >> i & 1 != 0 {
+                            let from = match (b.non_modal, m.distance) {
+                                (NonModal::AbsoluteOverride, _) => 0,
+                                (_, Distance::Absolute) => {
+                                    let tlo = if i == Z { self.tlo } else { 0 };
+                                    block_coord[i] + self.coord_offset[i] + tlo
+                                }
+                                (_, Distance::Relative) => self.position[i],
+                            };
+                            target[i] = from + axes[i];
                         }
-                        (_, Distance::Relative) => self.position,
-                    };
-                    target = pick(&self.position, &sum(&from, &axes, 1), given);
+                    }
                 }
                 match b.non_modal {
                     NonModal::GoHome0 | NonModal::GoHome1 => {
