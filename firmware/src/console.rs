@@ -245,7 +245,13 @@ impl Console {
         owner: Owner,
         store: &mut Store,
     ) -> Poll<Signal> {
-        if self.epoch != m.epoch() && reply::room() {
+        if self.epoch != m.epoch() {
+            // The line being carried out ends first, its answer owed: no
+            // line is taken or carried on before (one taken meanwhile
+            // would be dropped too, answered and never carried out).
+            if !reply::room() {
+                return Poll::After(2);
+            }
             self.epoch = m.epoch();
             // Queued moves were dropped with the motion (homing goes on:
             // its own stops take the epoch; Ctrl-X resets): the line they

@@ -58,7 +58,10 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
         }
     }
 
-    /// Messages waiting.
+    /// Messages waiting. Two loads and a subtraction: inlined (a call
+    /// from an interrupt handler costs the saving of every register a
+    /// callee may clobber).
+    #[inline(always)]
     pub fn len(&self) -> usize {
         let n = byte::load(&self.head).wrapping_sub(byte::load(&self.tail));
         match WHOLE {
@@ -78,6 +81,7 @@ impl<T: Copy, const N: usize, const WHOLE: bool> Ring<T, N, WHOLE> {
     }
 
     /// Free slots (unless `WHOLE`, one stays empty to tell full from empty).
+    #[inline(always)]
     pub fn free(&self) -> usize {
         self.capacity() - self.len()
     }
