@@ -393,3 +393,83 @@ fn a_plotter_card_s_machine_txt_switches_the_machine_and_keeps_it() {
         assert!(settings.contains(s), "{s} in\n{settings}");
     }
 }
+
+/// A card file of seeded lines in the shapes PCs' tools write (LF, CRLF
+/// or CR line ends, capitals or not, leading spaces, comments in brackets
+/// and after `;`, blank and comment-only lines, lines of 4 to over 100
+/// bytes, running across the card's 512-byte blocks) prints as its lines
+/// say: no error, every line's end reached in order, the last exactly.
+/// The reader hands a line's bytes on from the block in place, a run at a
+/// time; this is its stress.
+#[test]
+fn a_card_file_of_seeded_line_shapes_prints_as_its_lines_say() {
+    use hil_tests::senders::assert_path_through;
+    use hil_tests::{soak_or, Rng};
+    for seed in soak_or(vec![61u64, 62, 63, 64, 65, 66], vec![61]) {
+        let mut rng = Rng::new(seed);
+        let mut text = b"G21 G90\n".to_vec();
+        let mut ends = Vec::new();
+        for k in 0..400 {
+            let eol: &[u8] = match rng.below(3) {
+                0 => b"\n",
+                1 => b"\r\n",
+                _ => b"\r",
+            };
+            match rng.below(12) {
+                0 => {
+                    text.extend(format!("; {}", "-".repeat(rng.below(90) as usize)).bytes());
+                    text.extend(eol);
+                    continue;
+                }
+                1 => {
+                    text.extend(eol);
+                    continue;
+                }
+                _ => {}
+            }
+            // To the µm, inside a 10 mm square; 40 steps a mm.
+            let at = [rng.between(5.0, 15.0), rng.between(5.0, 15.0)]
+                .map(|v| (v * 1000.0).round() / 1000.0);
+            let mut line = " ".repeat(rng.below(3) as usize);
+            line.push_str(&format!("G1 X{} Y{}", at[0], at[1]));
+            if k == 0 || rng.below(8) == 0 {
+                line.push_str(&format!(" F{}", 2000 + 500 * rng.below(3)));
+            }
+            if rng.below(3) == 0 {
+                line.push_str(&format!(" ({})", "c".repeat(rng.below(60) as usize)));
+            }
+            if rng.below(3) == 0 {
+                line.push_str(&format!(" ; {}", "=".repeat(rng.below(40) as usize)));
+            }
+            if rng.below(2) == 0 {
+                line = line.to_lowercase();
+            }
+            text.extend(line.bytes());
+            text.extend(eol);
+            ends.push(at.map(|v| (v * 40.0).round() as i64));
+        }
+        assert!(text.len() > 8 * 512, "{} bytes: several blocks", text.len());
+        let mut sim = flatbed_with(&[("SHAPES.GCO", &text)]);
+        send(&mut sim, "M23 shapes.gco");
+        send(&mut sim, "M24");
+        let ended = sim.run_until(
+            |s| s.uart_text().contains("Done printing file"),
+            Duration::from_secs(200),
+        );
+        assert_eq!(
+            ended,
+            hil_tests::sim::Outcome::Done,
+            "seed {seed}: {}",
+            log_tail(&sim)
+        );
+        send(&mut sim, "M400");
+        assert!(
+            !sim.uart_text().contains("error:"),
+            "seed {seed}: {}",
+            log_tail(&sim)
+        );
+        assert_path_through(&mut sim, &ends);
+        let last = ends[ends.len() - 1];
+        assert_eq!(steps_on_pins(&sim)[..2], last, "seed {seed}");
+    }
+}
