@@ -611,14 +611,6 @@ impl SpmGuard {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn colour_codes_are_dropped() {
-        assert_eq!(super::plain("\x1b[31mCORE: bad\x1b[0m!"), "CORE: bad!");
-    }
-}
-
 /// USART0's and USART1's control register A (U2X is its bit 1); each one's
 /// UBRRnL lies four bytes above it.
 pub(crate) const UCSR_A: [u16; 2] = [0xC0, 0xC8];
@@ -643,5 +635,13 @@ pub(crate) unsafe extern "C" fn on_ucsra_write(
     let io = &(*avr).io[usize::from(ubrrl) - 0x20].w;
     if let Some(write) = io.c {
         write(avr, ubrrl, *(*avr).data.add(usize::from(ubrrl)), io.param);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn colour_codes_are_dropped() {
+        assert_eq!(super::plain("\x1b[31mCORE: bad\x1b[0m!"), "CORE: bad!");
     }
 }

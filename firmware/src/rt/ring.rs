@@ -1,9 +1,9 @@
 //! A lock-free single-producer single-consumer ring for queues that cross
 //! an interrupt boundary (UART bytes, step segments). Indices are single
 //! bytes, which the AVR loads and stores atomically (`byte`), so neither
-//! side ever masks interrupts. Each ring counts what it accepted and refused and how
-//! full it got: a full ring is back-pressure to the producer, never a
-//! silent loss.
+//! side ever masks interrupts. Each ring counts what it accepted and
+//! refused and how full it got: a full ring is back-pressure to the
+//! producer, never a silent loss.
 
 use super::byte;
 use core::cell::UnsafeCell;

@@ -240,7 +240,7 @@ impl Parser {
     /// are digits of a word's number: they go straight to it.
     #[inline]
     pub fn read(&mut self, byte: u8) -> Read {
-        if matches!(byte, b'0'..=b'9' | b'.') && self.number_byte(byte) {
+        if self.number_byte(byte) {
             return Read::More;
         }
         self.read_other(byte)
