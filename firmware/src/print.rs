@@ -689,13 +689,7 @@ impl Print {
             return None;
         }
         loop {
-            let head = self.news.peek_with(|m| match m.what {
-                What::Data { at, len } if m.ticket == self.ticket => {
-                    Some((len, crate::card::byte(at + u16::from(self.taken))))
-                }
-                _ => None,
-            });
-            let Some(Some((len, byte))) = head else {
+            let Some((at, of)) = self.head() else {
                 // Nothing waits while the print runs.
                 let _ = self.messages();
                 if !self.ended || !matches!(self.state, State::Running) {
@@ -703,19 +697,21 @@ impl Print {
                 }
                 return match self.last {
                     b'\n' | b'\r' | 0 => None,
-                    _ => Some(self.took(b'\n')),
+                    _ => {
+                        self.at.lines += 1;
+                        self.last = b'\n';
+                        Some(b'\n')
+                    }
                 };
             };
-            self.taken += 1;
-            if self.taken >= len {
-                self.taken = 0;
-                let _ = self.news.pop();
-            }
-            self.at.pos += 1;
-            if self.at.pos <= self.skip {
+            let byte = crate::card::byte(at);
+            // Bytes before where a lost print goes on are passed over.
+            if self.at.pos < self.skip {
+                self.took_run(1, of, 0, self.last);
                 continue;
             }
-            return Some(self.took(byte));
+            self.took_run(1, of, (byte == b'\n') as u8, byte);
+            return Some(byte);
         }
     }
 
@@ -731,10 +727,17 @@ impl Print {
         {
             return None;
         }
+        self.head().filter(|&(_, of)| of > 0)
+    }
+
+    /// The bytes of the oldest `Data` message of this print not yet
+    /// taken: where they start in the block and how many.
+    #[inline(always)]
+    fn head(&self) -> Option<(u16, u8)> {
         let taken = self.taken;
         self.news
             .peek_with(|m| match m.what {
-                What::Data { at, len } if m.ticket == self.ticket && len > taken => {
+                What::Data { at, len } if m.ticket == self.ticket => {
                     Some((at + u16::from(taken), len - taken))
                 }
                 _ => None,
@@ -742,8 +745,8 @@ impl Print {
             .flatten()
     }
 
-    /// `n` bytes of a [`Print::run`] of `of` were taken, `lines` line
-    /// ends among them, the last `last`.
+    /// `n` of the `of` bytes of [`Print::head`] were taken (a run, or
+    /// `next_byte`'s one), `lines` line ends among them, the last `last`.
     #[inline(never)]
     pub fn took_run(&mut self, n: u8, of: u8, lines: u8, last: u8) {
         self.taken += n;
@@ -754,14 +757,6 @@ impl Print {
         self.at.pos += u32::from(n);
         self.at.lines += u32::from(lines);
         self.last = last;
-    }
-
-    fn took(&mut self, byte: u8) -> u8 {
-        if byte == b'\n' {
-            self.at.lines += 1;
-        }
-        self.last = byte;
-        byte
     }
 
     /// The parser finished a line: the next one starts here.
